@@ -1,0 +1,30 @@
+//! Machines, tool-axis kinematics and the Equation-6 feed bound.
+//!
+//! # Units (one rule for the whole crate)
+//! - Angles are **degrees** in every public value (as in NC files); functions convert to
+//!   radians internally only.
+//! - Lengths are millimetres, time is seconds. Internal limits are stored as
+//!   mm/s, mm/s², mm/s³ for linear axes and °/s, °/s², °/s³ for rotary axes; the TOML
+//!   machine files use the units of the machine tables (m/min, m/s², m/s³ for linear axes;
+//!   rpm, rev/s², rev/s³ for rotary axes), converted once on load.
+//! - Geometric derivatives along the tool-tip path length s are per mm: mm/mm for a
+//!   linear axis, °/mm, °/mm², °/mm³ for a rotary axis.
+//!
+//! # Frames and senses
+//! The tool axis `o_wp = (i, j, k)` is expressed in the workpiece frame. A machine's
+//! primary rotary axis tilts about X (A) or Y (B); the secondary C turns the table about
+//! Z and rides on the primary. With senses `sp`, `sc` = ±1 from the machine definition:
+//! `o_wp = Rz(sc·C) · Rp(sp·P) · ẑ`, where `Rp` is `Rx` for A and `Ry` for B.
+//! G16 eq. 1 is `sp = sc = +1` with A (`i = sin C sin A, j = −cos C sin A, k = cos A`);
+//! C17 eq. 2 is `sp = sc = −1` (`i = sin C sin A, j = cos C sin A, k = cos A`).
+
+pub mod feed;
+pub mod forward;
+pub mod inverse;
+pub mod machine;
+pub mod tolerances;
+
+pub use feed::{AxisBound, FeedBound, LimitKind, axis_feed_bound, feed_bound};
+pub use forward::forward;
+pub use inverse::{BranchRule, IkSolution, inverse, inverse_path};
+pub use machine::{Axis, AxisLimits, Machine, MachineError, PrimaryAxis};

@@ -1,0 +1,1 @@
+//! Byte-level lexing of one line into words and pass-through tokens.

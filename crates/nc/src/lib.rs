@@ -1,0 +1,25 @@
+//! Byte-faithful reading and rewriting of NC programs.
+//!
+//! [`parse`] reads a program as bytes (any encoding; only ASCII is interpreted) into
+//! blocks and words, each word keeping its byte span, with the modal state after every
+//! block. [`runs`] groups G1 motion into runs with the cumulative tool-tip path length s.
+//! [`write`] renders the program with chosen words changed or inserted in the file's own
+//! number style; every other byte is copied unchanged, so `write(&parse(b)?, &[]) == b`.
+//!
+//! Units: linear values and s in mm (inch programs, G20/G70, are converted on read),
+//! feed in mm/min, rotary values in degrees as written.
+
+pub mod error;
+pub mod lexer;
+pub mod modal;
+pub mod program;
+pub mod run;
+pub mod style;
+pub mod writer;
+
+pub use error::ParseError;
+pub use modal::{Modal, Motion};
+pub use program::{Block, Dialect, Program, Word, parse};
+pub use run::{Run, RunBreak, runs};
+pub use style::NumberStyle;
+pub use writer::{Edit, write};
