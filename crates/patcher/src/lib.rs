@@ -5,5 +5,5 @@
 pub mod analysis;
 pub mod path;
 
-pub use analysis::{RunAnalysis, analyze_path};
+pub use analysis::{AnalysisOptions, RunAnalysis, Sample, Zone, ZoneKind, analyze_path};
 pub use path::{Path, PathError};
