@@ -1,9 +1,20 @@
 //! Analysis and patching of 5-axis paths near the pole.
 //!
-//! Works on in-memory paths (no file I/O): see [`Path`].
+//! Works on in-memory paths (no file I/O): see [`Path`]. The NC crate and the CLI do the
+//! file side.
 
 pub mod analysis;
+pub mod direct;
+pub mod g16;
+pub mod limits;
+pub mod options;
+pub mod patch;
 pub mod path;
+pub mod report;
 
 pub use analysis::{AnalysisOptions, RunAnalysis, Sample, Zone, ZoneKind, analyze_path};
+pub use limits::CLimits;
+pub use options::PatchOptions;
+pub use patch::{PatchResult, patch_path};
 pub use path::{Path, PathError};
+pub use report::{Method, Outcome, QpStats, ZoneFigures, ZoneReport};

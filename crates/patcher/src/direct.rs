@@ -1,0 +1,1 @@
+//! The direct formulation: a QP on the CL C values through the analysis spline.
