@@ -4,6 +4,7 @@
 //! file side.
 
 pub mod analysis;
+pub mod candidate;
 pub mod direct;
 pub mod g16;
 pub mod limits;
@@ -12,6 +13,7 @@ pub mod patch;
 pub mod path;
 pub mod report;
 
+pub use candidate::{Candidate, PatchFailure};
 pub use analysis::{AnalysisOptions, RunAnalysis, Sample, Zone, ZoneKind, analyze_path};
 pub use limits::CLimits;
 pub use options::PatchOptions;
