@@ -49,6 +49,9 @@ pub enum PathError {
         /// The value.
         value: f64,
     },
+    /// The analysis spline could not be built (should not happen for a validated path).
+    #[error("analysis spline: {0}")]
+    Spline(String),
     /// Feed not positive and finite.
     #[error("programmed feed must be positive, got {0} mm/min")]
     BadFeed(f64),
