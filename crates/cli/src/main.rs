@@ -1,1 +1,191 @@
-fn main() {}
+//! The `polepatch` command line.
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand};
+use polepatch::kinematics::{Axis, Machine};
+use polepatch::patcher::AnalysisOptions;
+use polepatch::program::{load, read_program};
+use polepatch::report::{AnalyzeReport, analyze_program, axis_letter};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "polepatch",
+    version,
+    about = "Find and patch the places where the C axis slows a table-table 5-axis machine near the pole"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Report where and why the machine slows down (Equation 6 along every G1 run).
+    Analyze(AnalyzeArgs),
+}
+
+#[derive(clap::Args)]
+struct AnalyzeArgs {
+    /// NC program (Heidenhain ISO, Sinumerik or Fanuc G-code).
+    file: PathBuf,
+    /// Machine: a built-in name (mikron-ucp710, mikron-hsm600) or a TOML file.
+    #[arg(long, short)]
+    machine: String,
+    /// Feed in mm/min for runs with no F in force.
+    #[arg(long)]
+    feed: Option<f64>,
+    /// Singular cone, degrees.
+    #[arg(long, default_value_t = 5.0)]
+    cone: f64,
+    /// Interpolation cycle time override, ms (default: the machine's).
+    #[arg(long)]
+    tcy_ms: Option<f64>,
+    /// Print one JSON document instead of the table.
+    #[arg(long)]
+    json: bool,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Analyze(args) => analyze(args),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("polepatch: error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn machine(name: &str) -> Result<Machine> {
+    Ok(Machine::load(name)?)
+}
+
+fn check_positive(name: &str, v: Option<f64>) -> Result<()> {
+    if let Some(v) = v
+        && !(v.is_finite() && v > 0.0)
+    {
+        bail!("{name} must be a positive number, got {v}");
+    }
+    Ok(())
+}
+
+fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
+    check_positive("--feed", args.feed)?;
+    check_positive("--tcy-ms", args.tcy_ms)?;
+    check_positive("--cone", Some(args.cone))?;
+    let machine = machine(&args.machine)?;
+    let program = read_program(&args.file)?;
+    let name = args.file.display().to_string();
+    let lp = load(program, &name, &machine, args.feed)?;
+    let opts = AnalysisOptions {
+        cone_deg: args.cone,
+        tcy_s: args.tcy_ms.map(|ms| ms / 1000.0),
+        keep_samples: false,
+    };
+    let report = analyze_program(&lp, &machine, &opts);
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).context("writing JSON")?
+        );
+    } else {
+        print_analysis(&report, lp.primary_letter);
+    }
+    for w in &report.warnings {
+        eprintln!("polepatch: warning: {w}");
+    }
+    let failed: Vec<_> = report.runs.iter().filter(|r| r.error.is_some()).collect();
+    for r in &failed {
+        eprintln!(
+            "polepatch: error: {}: run {} (lines {}–{}): {}",
+            report.file,
+            r.run,
+            r.lines[0],
+            r.lines[1],
+            r.error.as_deref().unwrap_or("")
+        );
+    }
+    Ok(if failed.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+fn print_analysis(report: &AnalyzeReport, primary_letter: u8) {
+    println!(
+        "{} on {} (singular cone {}°)",
+        report.file, report.machine, report.cone_deg
+    );
+    for r in &report.runs {
+        let feed = r
+            .feed_mm_min
+            .map_or("no F".to_string(), |f| format!("F{f}"));
+        println!(
+            "\nrun {}: lines {}–{}, {} points, {:.3} mm at {}",
+            r.run, r.lines[0], r.lines[1], r.points, r.length_mm, feed
+        );
+        let Some(f) = &r.figures else {
+            println!("  not analysed: {}", r.error.as_deref().unwrap_or(""));
+            continue;
+        };
+        match &f.limiting_axis {
+            Some(axis) => println!(
+                "  min feed ratio {:.3}: {} {} limit at line {} (s = {:.3} mm)",
+                f.min_ratio,
+                axis,
+                match f.limiting_limit {
+                    "V" => "velocity",
+                    "A" => "acceleration",
+                    _ => "jerk",
+                },
+                f.min_at_line,
+                f.min_at_s_mm
+            ),
+            None => println!("  reaches the programmed feed everywhere"),
+        }
+        println!(
+            "  estimated time {:.3} s against L/F {:.3} s ({:+.1} %)",
+            f.time_s,
+            f.ideal_time_s,
+            100.0 * (f.time_s / f.ideal_time_s - 1.0)
+        );
+        let peaks: Vec<String> = Axis::ALL
+            .iter()
+            .map(|&a| {
+                let l = axis_letter(a, primary_letter);
+                let unit = if a.is_rotary() { "rpm" } else { "m/min" };
+                format!("{l} {:.3} {unit}", f.peak_speed[&l])
+            })
+            .collect();
+        println!("  peak speed at F: {}", peaks.join(", "));
+        let ratios: Vec<String> = Axis::ALL
+            .iter()
+            .map(|&a| {
+                let l = axis_letter(a, primary_letter);
+                format!("{l} {:.3} ({})", f.axis_min_ratio[&l], f.axis_limit[&l])
+            })
+            .collect();
+        println!("  min ratio per axis: {}", ratios.join(", "));
+        if f.zones.is_empty() {
+            println!("  no singular zone");
+        }
+        for z in &f.zones {
+            println!(
+                "  singular zone lines {}–{} ({}), min |{}| {:.3}° at line {}, C ratio {:.3}",
+                z.lines[0],
+                z.lines[1],
+                z.kind,
+                primary_letter as char,
+                z.min_abs_primary_deg,
+                z.singular_line,
+                z.c_ratio_min
+            );
+        }
+    }
+}

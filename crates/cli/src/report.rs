@@ -1,0 +1,205 @@
+//! Report documents (serde): what `analyze` prints, as data.
+
+use crate::program::LoadedProgram;
+use polepatch_kinematics::{Axis, LimitKind, Machine};
+use polepatch_patcher::{AnalysisOptions, RunAnalysis, ZoneKind, analyze_path};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// Axis letter as written in the program (primary: the letter in use).
+pub fn axis_letter(axis: Axis, primary_letter: u8) -> String {
+    match axis {
+        Axis::X => "X".into(),
+        Axis::Y => "Y".into(),
+        Axis::Z => "Z".into(),
+        Axis::Primary => (primary_letter as char).to_string(),
+        Axis::C => "C".into(),
+    }
+}
+
+/// Short name of a limit: `V`, `A`, `J`, or `F` (the programmed feed).
+pub fn limit_name(kind: LimitKind) -> &'static str {
+    match kind {
+        LimitKind::Feed => "F",
+        LimitKind::Velocity => "V",
+        LimitKind::Acceleration => "A",
+        LimitKind::Jerk => "J",
+    }
+}
+
+/// Speed in the machine tables' units: m/min for a linear axis (from mm/s), rpm for a
+/// rotary axis (from °/s).
+pub fn machine_units(axis: Axis, internal: f64) -> f64 {
+    if axis.is_rotary() {
+        internal / 6.0
+    } else {
+        internal * 0.06
+    }
+}
+
+/// A singular zone in a run.
+#[derive(Debug, Clone, Serialize)]
+pub struct ZoneSummary {
+    /// File lines of the first and last point of the zone.
+    pub lines: [usize; 2],
+    /// `A-flip` or `C-swing`.
+    pub kind: &'static str,
+    /// File line of the singular point.
+    pub singular_line: usize,
+    /// Smallest |primary| in the zone, degrees.
+    pub min_abs_primary_deg: f64,
+    /// Lowest C-limited Equation-6 ratio in the zone.
+    pub c_ratio_min: f64,
+}
+
+/// Name of a zone kind in reports.
+pub fn zone_kind_name(kind: ZoneKind) -> &'static str {
+    match kind {
+        ZoneKind::AFlip => "A-flip",
+        ZoneKind::CSwing => "C-swing",
+    }
+}
+
+/// Equation-6 figures of an analysed run.
+#[derive(Debug, Clone, Serialize)]
+pub struct RunFigures {
+    /// Lowest feed ratio over the run (bound / F).
+    pub min_ratio: f64,
+    /// Axis limiting there (`null`: the feed itself).
+    pub limiting_axis: Option<String>,
+    /// Limit binding there: `V`, `A`, `J` or `F`.
+    pub limiting_limit: &'static str,
+    /// Where, mm along the run.
+    pub min_at_s_mm: f64,
+    /// File line of the point at or just after that place.
+    pub min_at_line: usize,
+    /// Lowest ratio per axis letter.
+    pub axis_min_ratio: BTreeMap<String, f64>,
+    /// Binding limit per axis letter at its lowest ratio.
+    pub axis_limit: BTreeMap<String, &'static str>,
+    /// Estimated time ∫ds/ṡ, s.
+    pub time_s: f64,
+    /// L/F, s.
+    pub ideal_time_s: f64,
+    /// Peak speed of each axis at the programmed feed: rpm (rotary), m/min (linear).
+    pub peak_speed: BTreeMap<String, f64>,
+    /// Singular zones.
+    pub zones: Vec<ZoneSummary>,
+}
+
+/// One run in the analysis report.
+#[derive(Debug, Clone, Serialize)]
+pub struct RunReport {
+    /// Run number, from 1.
+    pub run: usize,
+    /// File lines of the first point (start position) and of the last block.
+    pub lines: [usize; 2],
+    /// CL points (blocks + 1).
+    pub points: usize,
+    /// Path length, mm.
+    pub length_mm: f64,
+    /// Feed used, mm/min (`null` if none).
+    pub feed_mm_min: Option<f64>,
+    /// Why this run was not analysed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+    /// The figures (absent when `error` is set).
+    #[serde(flatten)]
+    pub figures: Option<RunFigures>,
+}
+
+/// The whole analysis document.
+#[derive(Debug, Clone, Serialize)]
+pub struct AnalyzeReport {
+    /// File name.
+    pub file: String,
+    /// Machine name.
+    pub machine: String,
+    /// Singular cone used, degrees.
+    pub cone_deg: f64,
+    /// Notes for the user.
+    pub warnings: Vec<String>,
+    /// Runs in file order.
+    pub runs: Vec<RunReport>,
+}
+
+/// Summarise one analysed run.
+pub fn run_figures(lp: &LoadedProgram, r: usize, a: &RunAnalysis) -> RunFigures {
+    let pl = lp.primary_letter;
+    let s = &lp.runs[r].run.s_mm;
+    let k = s
+        .partition_point(|&v| v < a.min_s_mm - 1e-9)
+        .min(s.len() - 1);
+    let mut axis_min_ratio = BTreeMap::new();
+    let mut axis_limit = BTreeMap::new();
+    let mut peak_speed = BTreeMap::new();
+    for axis in Axis::ALL {
+        let l = axis_letter(axis, pl);
+        axis_min_ratio.insert(l.clone(), a.axis_min[axis.index()].0);
+        axis_limit.insert(l.clone(), limit_name(a.axis_min[axis.index()].1));
+        peak_speed.insert(l, machine_units(axis, a.peak_speed[axis.index()]));
+    }
+    RunFigures {
+        min_ratio: a.min.ratio,
+        limiting_axis: a.min.axis.map(|x| axis_letter(x, pl)),
+        limiting_limit: limit_name(a.min.kind),
+        min_at_s_mm: a.min_s_mm,
+        min_at_line: lp.line_of(r, k),
+        axis_min_ratio,
+        axis_limit,
+        time_s: a.time_s,
+        ideal_time_s: a.ideal_time_s,
+        peak_speed,
+        zones: a
+            .zones
+            .iter()
+            .map(|z| ZoneSummary {
+                lines: [lp.line_of(r, z.first), lp.line_of(r, z.last)],
+                kind: zone_kind_name(z.kind),
+                singular_line: lp.line_of(r, z.singular),
+                min_abs_primary_deg: z.min_abs_primary_deg,
+                c_ratio_min: z.c_ratio_min,
+            })
+            .collect(),
+    }
+}
+
+/// Analyse every run of a loaded program.
+pub fn analyze_program(
+    lp: &LoadedProgram,
+    machine: &Machine,
+    opts: &AnalysisOptions,
+) -> AnalyzeReport {
+    let runs = lp
+        .runs
+        .iter()
+        .enumerate()
+        .map(|(r, rp)| {
+            let n = rp.run.len();
+            let mut rep = RunReport {
+                run: r + 1,
+                lines: [lp.line_of(r, 0), lp.line_of(r, n - 1)],
+                points: n,
+                length_mm: rp.run.length_mm(),
+                feed_mm_min: rp.path.as_ref().ok().map(|p| p.feed_mm_min),
+                error: None,
+                figures: None,
+            };
+            match &rp.path {
+                Err(problem) => rep.error = Some(problem.to_string()),
+                Ok(path) => match analyze_path(path, machine, opts) {
+                    Ok(a) => rep.figures = Some(run_figures(lp, r, &a)),
+                    Err(e) => rep.error = Some(e.to_string()),
+                },
+            }
+            rep
+        })
+        .collect();
+    AnalyzeReport {
+        file: lp.name.clone(),
+        machine: machine.name.clone(),
+        cone_deg: opts.cone_deg,
+        warnings: lp.warnings.clone(),
+        runs,
+    }
+}
