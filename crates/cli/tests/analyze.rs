@@ -1,0 +1,227 @@
+//! `polepatch analyze` on the C17 programs and on bad input.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn polepatch(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_polepatch"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("run polepatch");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn analyze_json(file: &str, machine: &str) -> serde_json::Value {
+    let (code, out, err) = polepatch(&["analyze", file, "--machine", machine, "--json"]);
+    assert_eq!(code, 0, "stderr: {err}");
+    serde_json::from_str(&out).expect("one JSON document")
+}
+
+/// The run that carries the cutting pass (the longest one).
+fn main_run(doc: &serde_json::Value) -> &serde_json::Value {
+    doc["runs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .max_by(|a, b| {
+            a["length_mm"]
+                .as_f64()
+                .unwrap()
+                .total_cmp(&b["length_mm"].as_f64().unwrap())
+        })
+        .unwrap()
+}
+
+fn peak(run: &serde_json::Value, axis: &str) -> f64 {
+    run["peak_speed"][axis].as_f64().unwrap()
+}
+
+#[test]
+fn sing_peak_c_speed_is_about_200_rpm_with_a_zone_around_x25() {
+    let doc = analyze_json("fixtures/c17/SING.I", "mikron-ucp710");
+    let run = main_run(&doc);
+    let c = peak(run, "C");
+    assert!(
+        (180.0..=220.0).contains(&c),
+        "peak C speed {c} rpm, C17 §4 says ~200"
+    );
+    let zones: Vec<_> = doc["runs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|r| r["zones"].as_array().unwrap().clone())
+        .collect();
+    assert_eq!(zones.len(), 1, "{zones:?}");
+    let z = &zones[0];
+    assert_eq!(z["kind"], "C-swing");
+    assert!((z["min_abs_primary_deg"].as_f64().unwrap() - 1.0).abs() < 1e-9);
+    // The zone spans the X=25 block (file line 41: `N360 X+25 Y+0 Z-8 A+1 C+180 *`).
+    let lines = z["lines"].as_array().unwrap();
+    let (a, b) = (lines[0].as_u64().unwrap(), lines[1].as_u64().unwrap());
+    assert!(a < 41 && 41 < b, "zone lines {a}–{b}");
+    assert_eq!(z["singular_line"], 41);
+    assert!(z["c_ratio_min"].as_f64().unwrap() < 0.2);
+}
+
+#[test]
+fn non_sing_peak_c_speed_is_about_18_rpm_and_no_zone() {
+    let doc = analyze_json("fixtures/c17/NON_SING.I", "mikron-ucp710");
+    let run = main_run(&doc);
+    let c = peak(run, "C");
+    assert!(
+        (16.2..=19.8).contains(&c),
+        "peak C speed {c} rpm, C17 §4 says ~18"
+    );
+    for r in doc["runs"].as_array().unwrap() {
+        assert!(r["zones"].as_array().unwrap().is_empty());
+    }
+}
+
+#[test]
+fn json_peak_speed_is_keyed_by_axis_letter() {
+    let doc = analyze_json("fixtures/c17/SING.I", "mikron-ucp710");
+    for r in doc["runs"].as_array().unwrap() {
+        let keys: Vec<&String> = r["peak_speed"].as_object().unwrap().keys().collect();
+        assert_eq!(keys, ["A", "C", "X", "Y", "Z"]);
+    }
+    // On the B-C machine the program's A words are read as its primary axis, with a warning.
+    let (code, _, err) = polepatch(&[
+        "analyze",
+        "fixtures/c17/SING.I",
+        "--machine",
+        "mikron-hsm600",
+    ]);
+    assert_eq!(code, 0);
+    assert!(
+        err.contains("uses A but machine mikron-hsm600 has B"),
+        "{err}"
+    );
+}
+
+fn temp_file(name: &str, bytes: &[u8]) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("polepatch-cli-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+fn fails_with(args: &[&str], needle: &str) {
+    let (code, _, err) = polepatch(args);
+    assert_ne!(code, 0, "expected failure for {args:?}");
+    assert!(!err.contains("panicked"), "panic for {args:?}: {err}");
+    assert!(
+        err.contains(needle),
+        "for {args:?} expected '{needle}' in: {err}"
+    );
+}
+
+#[test]
+fn bad_input_gets_a_clear_message_and_nonzero_exit() {
+    fails_with(
+        &[
+            "analyze",
+            "fixtures/c17/SING.I",
+            "--machine",
+            "mikron-ucp999",
+        ],
+        "built-ins: mikron-ucp710, mikron-hsm600",
+    );
+    fails_with(
+        &[
+            "analyze",
+            "fixtures/does-not-exist.I",
+            "--machine",
+            "mikron-ucp710",
+        ],
+        "cannot read fixtures/does-not-exist.I",
+    );
+    let empty = temp_file("empty.nc", b"  \n\n");
+    fails_with(
+        &[
+            "analyze",
+            empty.to_str().unwrap(),
+            "--machine",
+            "mikron-ucp710",
+        ],
+        "empty program",
+    );
+    let three_axis = temp_file("xyz.nc", b"G1 X0 Y0 Z0 F1000\nX10\nX20 Y5\n");
+    fails_with(
+        &[
+            "analyze",
+            three_axis.to_str().unwrap(),
+            "--machine",
+            "mikron-ucp710",
+        ],
+        "no rotary axis words",
+    );
+    let bad = temp_file("bad.nc", b"G1 X0 Y0 Z0 A1 C0 F1000\nX1 C12..5\n");
+    fails_with(
+        &[
+            "analyze",
+            bad.to_str().unwrap(),
+            "--machine",
+            "mikron-ucp710",
+        ],
+        ":2:",
+    );
+    fails_with(
+        &[
+            "analyze",
+            bad.to_str().unwrap(),
+            "--machine",
+            "mikron-ucp710",
+        ],
+        "12..5",
+    );
+    let nan = temp_file("nan.nc", b"G1 X0 Y0 Z0 A1 C0 F1000\nX1 CNaN\n");
+    fails_with(
+        &[
+            "analyze",
+            nan.to_str().unwrap(),
+            "--machine",
+            "mikron-ucp710",
+        ],
+        ":2:",
+    );
+    let no_f = temp_file("nof.nc", b"G1 X0 Y0 Z0 A1 C0\nX1 C1\nX2 C2\nX3 C3\n");
+    fails_with(
+        &[
+            "analyze",
+            no_f.to_str().unwrap(),
+            "--machine",
+            "mikron-ucp710",
+        ],
+        "no feed (F)",
+    );
+    let (code, _, err) = polepatch(&[
+        "analyze",
+        no_f.to_str().unwrap(),
+        "--machine",
+        "mikron-ucp710",
+        "--feed",
+        "1000",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    fails_with(
+        &[
+            "analyze",
+            no_f.to_str().unwrap(),
+            "--machine",
+            "mikron-ucp710",
+            "--feed",
+            "-5",
+        ],
+        "--feed must be a positive number",
+    );
+}
