@@ -1,0 +1,297 @@
+//! Synthetic near-pole programs.
+//!
+//! The tool tip runs along a straight line in X; the tool axis follows a small circle on
+//! the unit sphere (angular radius `circle_radius_deg`) whose closest approach to the pole
+//! is `pole_distance_deg` (0 = exactly through the pole), reached halfway along the line.
+//! Joint values come from inverse kinematics with either the G16 Table 1 domain rule (the
+//! primary axis flips sign, C jumps up to 180°) or a continuous branch (C swings, the
+//! primary keeps its sign, as in C17's `%SING`). The program is written in Heidenhain ISO,
+//! Sinumerik or Fanuc style for an A-C or a B-C machine (G16 senses: sp = sc = +1).
+
+use polepatch_kinematics::{BranchRule, Machine, inverse_path};
+use std::fmt::Write as _;
+
+/// Dialect of the written program.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dialect {
+    /// Heidenhain ISO: `%NAME G71 *`, `N10 G01 X+1 … *`, M128.
+    Heidenhain,
+    /// Sinumerik: `;` comments, TRAORI, CRLF line ends.
+    Sinumerik,
+    /// Fanuc: `%`, `O1000`, `( )` comments, G43.4, modal omission of unchanged words.
+    Fanuc,
+}
+
+impl Dialect {
+    /// All dialects.
+    pub const ALL: [Dialect; 3] = [Dialect::Heidenhain, Dialect::Sinumerik, Dialect::Fanuc];
+    /// Short name used in file names.
+    pub fn name(self) -> &'static str {
+        match self {
+            Dialect::Heidenhain => "heidenhain",
+            Dialect::Sinumerik => "sinumerik",
+            Dialect::Fanuc => "fanuc",
+        }
+    }
+    /// File extension.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Dialect::Heidenhain => "I",
+            Dialect::Sinumerik => "mpf",
+            Dialect::Fanuc => "nc",
+        }
+    }
+}
+
+/// One synthetic pass.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pass {
+    /// Closest angular distance of the tool axis to the pole, degrees (≥ 0).
+    pub pole_distance_deg: f64,
+    /// Angular radius of the tool-axis circle, degrees.
+    pub circle_radius_deg: f64,
+    /// Half the arc of the circle swept, degrees (the pass goes from −this to +this).
+    pub half_sweep_deg: f64,
+    /// Azimuth of the closest approach about Z, degrees (rotates the whole pass).
+    pub azimuth_deg: f64,
+    /// Length of the tool-tip line, mm.
+    pub length_mm: f64,
+    /// Spacing of the CL points, mm.
+    pub spacing_mm: f64,
+    /// Programmed feed, mm/min.
+    pub feed_mm_min: f64,
+    /// Primary axis letter: A-C (`false`) or B-C (`true`) machine.
+    pub b_axis: bool,
+    /// Domain rule (primary flips) instead of a continuous branch.
+    pub domain_rule: bool,
+    /// Decimal places of the written rotary values.
+    pub rotary_decimals: usize,
+}
+
+impl Default for Pass {
+    fn default() -> Self {
+        Pass {
+            pole_distance_deg: 0.5,
+            circle_radius_deg: 15.0,
+            half_sweep_deg: 60.0,
+            azimuth_deg: 0.0,
+            length_mm: 50.0,
+            spacing_mm: 1.0,
+            feed_mm_min: 2000.0,
+            b_axis: false,
+            domain_rule: false,
+            rotary_decimals: 3,
+        }
+    }
+}
+
+fn rot_z(v: [f64; 3], a: f64) -> [f64; 3] {
+    let (s, c) = a.sin_cos();
+    [c * v[0] - s * v[1], s * v[0] + c * v[1], v[2]]
+}
+
+/// The kinematic model used to write joint values: G16 senses, A or B primary.
+pub fn machine(b_axis: bool) -> Machine {
+    let name = if b_axis {
+        "mikron-hsm600"
+    } else {
+        "mikron-ucp710"
+    };
+    let mut m = Machine::builtin(name).expect("built-in machine");
+    m.primary_sense = 1.0;
+    m.c_sense = 1.0;
+    m.primary_range_deg = (-120.0, 120.0);
+    m
+}
+
+/// CL points of a pass: tool tip (X, Y, Z) in mm and tool axis (i, j, k).
+pub fn cl_points(p: &Pass) -> Vec<([f64; 3], [f64; 3])> {
+    let n = (p.length_mm / p.spacing_mm).round().max(2.0) as usize;
+    let rho = p.circle_radius_deg.to_radians();
+    let tc = (p.pole_distance_deg + p.circle_radius_deg).to_radians();
+    let c = [tc.sin(), 0.0, tc.cos()];
+    let u = [-tc.cos(), 0.0, tc.sin()];
+    let v = [0.0, 1.0, 0.0];
+    let az = p.azimuth_deg.to_radians();
+    (0..=n)
+        .map(|k| {
+            let t = k as f64 / n as f64;
+            let phi = (2.0 * t - 1.0) * p.half_sweep_deg.to_radians();
+            let mut o = [0.0; 3];
+            for d in 0..3 {
+                o[d] = rho.cos() * c[d] + rho.sin() * (phi.cos() * u[d] + phi.sin() * v[d]);
+            }
+            let norm = (o[0] * o[0] + o[1] * o[1] + o[2] * o[2]).sqrt();
+            let o = rot_z([o[0] / norm, o[1] / norm, o[2] / norm], az);
+            ([t * p.length_mm, 0.0, -5.0], o)
+        })
+        .collect()
+}
+
+/// Joint values (X, Y, Z, P, C) of a pass, rounded as they will be written.
+pub fn joints(p: &Pass) -> Vec<[f64; 5]> {
+    let pts = cl_points(p);
+    let o: Vec<[f64; 3]> = pts.iter().map(|q| q.1).collect();
+    let rule = if p.domain_rule {
+        BranchRule::DomainRule
+    } else {
+        BranchRule::Nearest
+    };
+    let sol = inverse_path(&machine(p.b_axis), &o, rule);
+    let scale = 10f64.powi(p.rotary_decimals as i32);
+    pts.iter()
+        .zip(sol)
+        .map(|(q, s)| {
+            let r = |v: f64| (v * scale).round() / scale;
+            [q.0[0], q.0[1], q.0[2], r(s.p_deg), r(s.c_deg)]
+        })
+        .collect()
+}
+
+fn num(v: f64, decimals: usize, plus: bool) -> String {
+    let mut s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        while s.ends_with('0') {
+            s.pop();
+        }
+        if s.ends_with('.') {
+            s.pop();
+        }
+    }
+    if s == "-0" {
+        s = "0".into();
+    }
+    if plus && !s.starts_with('-') {
+        s.insert(0, '+');
+    }
+    s
+}
+
+/// The program text of a pass in `dialect`, named `name`.
+pub fn program(p: &Pass, dialect: Dialect, name: &str) -> String {
+    let j = joints(p);
+    let pl = if p.b_axis { 'B' } else { 'A' };
+    let d = p.rotary_decimals;
+    let f = num(p.feed_mm_min, 0, false);
+    let mut out = String::new();
+    let nl = if dialect == Dialect::Sinumerik {
+        "\r\n"
+    } else {
+        "\n"
+    };
+    let mut line = |s: String| {
+        out.push_str(&s);
+        out.push_str(nl);
+    };
+    let describe = format!(
+        "pole distance {} deg, circle {} deg, {}, {}-C",
+        p.pole_distance_deg,
+        p.circle_radius_deg,
+        if p.domain_rule {
+            "domain rule"
+        } else {
+            "continuous branch"
+        },
+        pl
+    );
+    match dialect {
+        Dialect::Heidenhain => {
+            line(format!("%{name} G71 *"));
+            line(format!("; {describe} *"));
+            line("N10 G90 *".into());
+            line("N20 T1 M6 *".into());
+            line("N30 S12000 M3 *".into());
+            line("N40 M128 *".into());
+            let mut n = 50;
+            for (k, q) in j.iter().enumerate() {
+                let head = if k == 0 { "G01 " } else { "" };
+                let feed = if k == 0 {
+                    format!(" F{f}")
+                } else {
+                    String::new()
+                };
+                line(format!(
+                    "N{n} {head}X{} Y{} Z{} {pl}{} C{}{feed} *",
+                    num(q[0], 3, true),
+                    num(q[1], 3, true),
+                    num(q[2], 3, true),
+                    num(q[3], d, true),
+                    num(q[4], d, true)
+                ));
+                n += 10;
+            }
+            line(format!("N{n} M129 *"));
+            line(format!("N{} M30 *", n + 10));
+            line(format!("N999999 %{name} G71 *"));
+        }
+        Dialect::Sinumerik => {
+            line(format!("; {name}: {describe}"));
+            line("G90 G17 G71".into());
+            line("T1 D1".into());
+            line("M6".into());
+            line("S12000 M3".into());
+            line("TRAORI".into());
+            for (k, q) in j.iter().enumerate() {
+                let feed = if k == 0 {
+                    format!(" F{f}")
+                } else {
+                    String::new()
+                };
+                let head = if k == 0 { "G1 " } else { "" };
+                line(format!(
+                    "{head}X{} Y{} Z{} {pl}={} C={}{feed}",
+                    num(q[0], 3, false),
+                    num(q[1], 3, false),
+                    num(q[2], 3, false),
+                    num(q[3], d, false),
+                    num(q[4], d, false)
+                ));
+            }
+            line("TRAFOOF".into());
+            line("M30".into());
+        }
+        Dialect::Fanuc => {
+            line("%".into());
+            line("O1000".into());
+            line(format!("({describe})"));
+            line("G90 G21 G94".into());
+            line("T1 M6".into());
+            line("S12000 M3".into());
+            line("G43.4 H1".into());
+            let mut prev: Option<[String; 5]> = None;
+            for (k, q) in j.iter().enumerate() {
+                let w = [
+                    num(q[0], 3, false),
+                    num(q[1], 3, false),
+                    num(q[2], 3, false),
+                    num(q[3], d, false),
+                    num(q[4], d, false),
+                ];
+                let letters = ['X', 'Y', 'Z', pl, 'C'];
+                let mut s = String::new();
+                if k == 0 {
+                    s.push_str("G1");
+                }
+                for i in 0..5 {
+                    if prev.as_ref().is_none_or(|p| p[i] != w[i]) {
+                        if !s.is_empty() {
+                            s.push(' ');
+                        }
+                        let _ = write!(s, "{}{}", letters[i], w[i]);
+                    }
+                }
+                if k == 0 {
+                    let _ = write!(s, " F{f}");
+                }
+                if !s.is_empty() {
+                    line(s);
+                }
+                prev = Some(w);
+            }
+            line("G49".into());
+            line("M30".into());
+            line("%".into());
+        }
+    }
+    out
+}
