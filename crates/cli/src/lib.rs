@@ -9,5 +9,6 @@ pub use polepatch_kinematics as kinematics;
 pub use polepatch_nc as nc;
 pub use polepatch_patcher as patcher;
 
+pub mod job;
 pub mod program;
 pub mod report;

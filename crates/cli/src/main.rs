@@ -24,6 +24,63 @@ struct Cli {
 enum Command {
     /// Report where and why the machine slows down (Equation 6 along every G1 run).
     Analyze(AnalyzeArgs),
+    /// Rewrite the C words near the pole so that C reaches the programmed feed.
+    Patch(PatchArgs),
+}
+
+#[derive(clap::Args)]
+pub(crate) struct PatchArgs {
+    /// NC programs, or folders of them (with --out-dir).
+    #[arg(required = true)]
+    pub(crate) inputs: Vec<PathBuf>,
+    /// Output file (one input).
+    #[arg(long, short, conflicts_with = "out_dir")]
+    pub(crate) output: Option<PathBuf>,
+    /// Output folder (any number of inputs; each output keeps its file name).
+    #[arg(long)]
+    pub(crate) out_dir: Option<PathBuf>,
+    /// Machine: a built-in name (mikron-ucp710, mikron-hsm600) or a TOML file.
+    #[arg(long, short)]
+    pub(crate) machine: String,
+    /// Write the per-zone report as JSON to this file.
+    #[arg(long)]
+    pub(crate) report: Option<PathBuf>,
+    /// Write the per-zone rows of every file as CSV to this file.
+    #[arg(long)]
+    pub(crate) csv: Option<PathBuf>,
+    /// Exit with status 2 if any zone stays below feed.
+    #[arg(long)]
+    pub(crate) strict: bool,
+    /// Feed in mm/min for runs with no F in force.
+    #[arg(long)]
+    pub(crate) feed: Option<f64>,
+    /// Singular cone, degrees.
+    #[arg(long, default_value_t = 5.0)]
+    pub(crate) cone: f64,
+    /// Largest orientation deviation allowed, degrees (default: no limit, still minimised).
+    #[arg(long)]
+    pub(crate) max_deviation: Option<f64>,
+    /// Interpolation cycle time override, ms (default: the machine's).
+    #[arg(long)]
+    pub(crate) tcy_ms: Option<f64>,
+    /// Safety margin on the C limits, as a fraction.
+    #[arg(long, default_value_t = 0.02)]
+    pub(crate) margin: f64,
+    /// Most decimal places to write for C when the file's precision cannot hold Equation 6.
+    #[arg(long, default_value_t = 4)]
+    pub(crate) max_decimals: usize,
+    /// Longest patch, mm (default: up to the whole run).
+    #[arg(long)]
+    pub(crate) max_patch_length: Option<f64>,
+    /// Do not ask for third-derivative continuity at the joins.
+    #[arg(long)]
+    pub(crate) no_jerk_continuity: bool,
+    /// Never add a 360° multiple to C after a zone.
+    #[arg(long)]
+    pub(crate) no_c_offset: bool,
+    /// Worker threads for batches (default: all cores).
+    #[arg(long)]
+    pub(crate) jobs: Option<usize>,
 }
 
 #[derive(clap::Args)]
@@ -51,6 +108,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Analyze(args) => analyze(args),
+        Command::Patch(args) => patch::run(args),
     };
     match result {
         Ok(code) => code,
@@ -61,11 +119,13 @@ fn main() -> ExitCode {
     }
 }
 
-fn machine(name: &str) -> Result<Machine> {
+mod patch;
+
+pub(crate) fn machine(name: &str) -> Result<Machine> {
     Ok(Machine::load(name)?)
 }
 
-fn check_positive(name: &str, v: Option<f64>) -> Result<()> {
+pub(crate) fn check_positive(name: &str, v: Option<f64>) -> Result<()> {
     if let Some(v) = v
         && !(v.is_finite() && v > 0.0)
     {

@@ -1,0 +1,321 @@
+//! Patching a whole program: runs → patcher → edits → bytes, and writing them safely.
+
+use crate::program::{InputError, LoadedProgram, load, read_program};
+use crate::report::{axis_letter, limit_name, zone_kind_name};
+use polepatch_kinematics::Machine;
+use polepatch_nc::{Edit, NumberStyle, Program, modal};
+use polepatch_patcher::{Method, Outcome, PatchOptions, ZoneFigures, ZoneReport, patch_path};
+use serde::Serialize;
+use std::io::Write;
+use std::path::Path as FsPath;
+
+/// Equation-6 figures of a zone, with axis letters (report form of [`ZoneFigures`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct FiguresRow {
+    /// Lowest C-limited ratio.
+    pub c_ratio: f64,
+    /// Lowest primary-limited ratio.
+    pub primary_ratio: f64,
+    /// Lowest overall ratio.
+    pub overall_ratio: f64,
+    /// Limiting axis letter (`null`: the feed).
+    pub limiting_axis: Option<String>,
+    /// `V`, `A`, `J` or `F`.
+    pub limiting_limit: &'static str,
+    /// Estimated time over the zone, s.
+    pub time_s: f64,
+}
+
+impl FiguresRow {
+    fn new(f: &ZoneFigures, primary_letter: u8) -> Self {
+        FiguresRow {
+            c_ratio: f.c_ratio,
+            primary_ratio: f.primary_ratio,
+            overall_ratio: f.overall_ratio,
+            limiting_axis: f.limiting_axis.map(|a| axis_letter(a, primary_letter)),
+            limiting_limit: limit_name(f.limiting_kind),
+            time_s: f.time_s,
+        }
+    }
+}
+
+/// One zone of one file (a report row; also the CSV row, flattened).
+#[derive(Debug, Clone, Serialize)]
+pub struct ZoneRow {
+    /// Input file.
+    pub file: String,
+    /// Run number, from 1.
+    pub run: usize,
+    /// File lines of the first and last point of the zone/patch.
+    pub lines: [usize; 2],
+    /// `A-flip` or `C-swing`.
+    pub kind: &'static str,
+    /// Smallest |primary|, degrees.
+    pub min_abs_primary_deg: f64,
+    /// Before patching.
+    pub before: FiguresRow,
+    /// After patching, on the values as written.
+    pub after: FiguresRow,
+    /// L/F over the zone, s.
+    pub ideal_time_s: f64,
+    /// Largest orientation deviation, degrees.
+    pub max_deviation_deg: f64,
+    /// Points whose C changed.
+    pub points_modified: usize,
+    /// Patched length, mm.
+    pub patch_length_mm: f64,
+    /// `reached`, `improved` or `unchanged`.
+    pub outcome: &'static str,
+    /// `g16-patch`, `direct` or `none`.
+    pub method: &'static str,
+    /// Last solver status.
+    pub qp_status: String,
+    /// Interior-point iterations, summed.
+    pub qp_iterations: u32,
+    /// QP solves.
+    pub qp_solves: u32,
+    /// Solve time, ms, summed.
+    pub solve_time_ms: f64,
+    /// Decimal places written for the changed C words.
+    pub decimals: usize,
+    /// 360° multiple added to C after the zone.
+    pub c_offset_deg: f64,
+}
+
+/// Report name of an outcome.
+pub fn outcome_name(o: Outcome) -> &'static str {
+    match o {
+        Outcome::Reached => "reached",
+        Outcome::Improved => "improved",
+        Outcome::Unchanged => "unchanged",
+    }
+}
+
+fn method_name(m: Method) -> &'static str {
+    match m {
+        Method::G16Patch => "g16-patch",
+        Method::Direct => "direct",
+        Method::None => "none",
+    }
+}
+
+impl ZoneRow {
+    fn new(lp: &LoadedProgram, run: usize, z: &ZoneReport) -> Self {
+        let pl = lp.primary_letter;
+        ZoneRow {
+            file: lp.name.clone(),
+            run: run + 1,
+            lines: [lp.line_of(run, z.first), lp.line_of(run, z.last)],
+            kind: zone_kind_name(z.kind),
+            min_abs_primary_deg: z.min_abs_primary_deg,
+            before: FiguresRow::new(&z.before, pl),
+            after: FiguresRow::new(&z.after, pl),
+            ideal_time_s: z.ideal_time_s,
+            max_deviation_deg: z.max_deviation_deg,
+            points_modified: z.points_modified,
+            patch_length_mm: z.patch_length_mm,
+            outcome: outcome_name(z.outcome),
+            method: method_name(z.method),
+            qp_status: z.qp.status.clone(),
+            qp_iterations: z.qp.iterations,
+            qp_solves: z.qp.solves,
+            solve_time_ms: z.qp.solve_time_s * 1e3,
+            decimals: z.decimals,
+            c_offset_deg: z.c_offset_deg,
+        }
+    }
+}
+
+/// What patching one program did.
+#[derive(Debug, Clone, Serialize)]
+pub struct FileReport {
+    /// Input file.
+    pub file: String,
+    /// Output file (when written).
+    pub output: Option<String>,
+    /// Machine name.
+    pub machine: String,
+    /// C words changed or inserted.
+    pub words_changed: usize,
+    /// Decimal places of the file's C words.
+    pub file_c_decimals: usize,
+    /// Decimal places written for changed C words (more than the file's when its
+    /// precision could not hold Equation 6).
+    pub written_c_decimals: usize,
+    /// Runs not analysed, and why.
+    pub skipped_runs: Vec<String>,
+    /// Notes for the user.
+    pub warnings: Vec<String>,
+    /// One row per zone.
+    pub zones: Vec<ZoneRow>,
+}
+
+impl FileReport {
+    /// Zones whose C stays below feed.
+    pub fn zones_below_feed(&self) -> usize {
+        self.zones.iter().filter(|z| z.outcome != "reached").count()
+    }
+}
+
+/// Patch a loaded program: the edits to write and the report.
+pub fn patch_program(
+    lp: &LoadedProgram,
+    machine: &Machine,
+    opts: &PatchOptions,
+) -> (Vec<Edit>, FileReport) {
+    let program = &lp.program;
+    let style = NumberStyle::of(program, b'C');
+    let opts = PatchOptions {
+        c_decimals: style.decimals,
+        max_decimals: opts.max_decimals.max(style.decimals),
+        ..opts.clone()
+    };
+    let mut edits: Vec<Edit> = Vec::new();
+    let mut rows = Vec::new();
+    let mut skipped = Vec::new();
+    let mut written_decimals = style.decimals;
+    for (r, rp) in lp.runs.iter().enumerate() {
+        let path = match &rp.path {
+            Ok(p) => p,
+            Err(problem) => {
+                skipped.push(format!(
+                    "run {} (lines {}–{}): {problem}",
+                    r + 1,
+                    lp.line_of(r, 0),
+                    lp.line_of(r, rp.run.len() - 1)
+                ));
+                continue;
+            }
+        };
+        let result = match patch_path(path, machine, &opts) {
+            Ok(res) => res,
+            Err(e) => {
+                skipped.push(format!("run {}: {e}", r + 1));
+                continue;
+            }
+        };
+        rows.extend(result.zones.iter().map(|z| ZoneRow::new(lp, r, z)));
+        for k in 0..rp.run.len() {
+            if !result.changed[k] {
+                continue;
+            }
+            if k == 0 {
+                // Point 0 belongs to the block before the run; the patcher never moves it.
+                debug_assert!(false, "patcher changed the start point of a run");
+                continue;
+            }
+            written_decimals = written_decimals.max(result.decimals);
+            edits.push(Edit {
+                block: rp.run.blocks[k],
+                letter: b'C',
+                value: result.c_deg[k],
+                decimals: result.decimals,
+            });
+        }
+    }
+    restore_modal_c(program, &mut edits, style.decimals);
+    edits.sort_by_key(|e| e.block);
+    let report = FileReport {
+        file: lp.name.clone(),
+        output: None,
+        machine: machine.name.clone(),
+        words_changed: edits.len(),
+        file_c_decimals: style.decimals,
+        written_c_decimals: written_decimals,
+        skipped_runs: skipped,
+        warnings: lp.warnings.clone(),
+        zones: rows,
+    };
+    (edits, report)
+}
+
+/// A block after an edited one that relied on modal C (no C word) would now inherit the new
+/// value: give the next such move its original C explicitly.
+fn restore_modal_c(program: &Program, edits: &mut Vec<Edit>, decimals: usize) {
+    let edited: std::collections::HashSet<usize> = edits.iter().map(|e| e.block).collect();
+    let mut extra = Vec::new();
+    for e in edits.iter() {
+        let next = (e.block + 1..program.blocks.len())
+            .find(|&b| program.blocks[b].is_move || program.word(b, b'C').is_some());
+        let Some(b) = next else { continue };
+        if edited.contains(&b) || program.word(b, b'C').is_some() {
+            continue;
+        }
+        if let Some(c) = program.blocks[b].state.pos[modal::C] {
+            extra.push(Edit {
+                block: b,
+                letter: b'C',
+                value: c,
+                decimals,
+            });
+        }
+    }
+    edits.extend(extra);
+}
+
+/// Read, patch and write one file. The output is written to a temporary file beside it and
+/// renamed on success: nothing half-written, the input never touched.
+pub fn patch_file(
+    input: &FsPath,
+    output: &FsPath,
+    machine: &Machine,
+    opts: &PatchOptions,
+    feed_fallback_mm_min: Option<f64>,
+) -> Result<FileReport, JobError> {
+    let name = input.display().to_string();
+    if same_file(input, output) {
+        return Err(JobError::Overwrite { path: name });
+    }
+    let program = read_program(input)?;
+    let lp = load(program, &name, machine, feed_fallback_mm_min)?;
+    let (edits, mut report) = patch_program(&lp, machine, opts);
+    let bytes = polepatch_nc::write(&lp.program, &edits);
+    write_atomic(output, &bytes).map_err(|source| JobError::Write {
+        path: output.display().to_string(),
+        source,
+    })?;
+    report.output = Some(output.display().to_string());
+    Ok(report)
+}
+
+fn same_file(a: &FsPath, b: &FsPath) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
+}
+
+/// Write `bytes` to `path` through a temporary file in the same folder and a rename.
+pub fn write_atomic(path: &FsPath, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => FsPath::new("."),
+    };
+    let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
+    tmp.write_all(bytes)?;
+    tmp.as_file().sync_all()?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
+
+/// Errors of a patch job.
+#[derive(Debug, thiserror::Error)]
+pub enum JobError {
+    /// Bad input file.
+    #[error(transparent)]
+    Input(#[from] InputError),
+    /// The output could not be written.
+    #[error("cannot write {path}: {source}")]
+    Write {
+        /// Output path.
+        path: String,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// Output and input are the same file.
+    #[error("{path}: the output would overwrite the input; polepatch never modifies its input")]
+    Overwrite {
+        /// Path.
+        path: String,
+    },
+}

@@ -1,0 +1,309 @@
+//! `polepatch patch`: one file or a batch.
+
+use crate::{PatchArgs, check_positive, machine};
+use anyhow::{Context, Result, bail};
+use indicatif::{ProgressBar, ProgressStyle};
+use polepatch::job::{FileReport, JobError, patch_file, write_atomic};
+use polepatch::patcher::PatchOptions;
+use rayon::prelude::*;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+fn options(args: &PatchArgs) -> Result<PatchOptions> {
+    check_positive("--cone", Some(args.cone))?;
+    check_positive("--max-deviation", args.max_deviation)?;
+    check_positive("--tcy-ms", args.tcy_ms)?;
+    check_positive("--feed", args.feed)?;
+    check_positive("--max-patch-length", args.max_patch_length)?;
+    if !(0.0..0.5).contains(&args.margin) {
+        bail!("--margin must be in [0, 0.5), got {}", args.margin);
+    }
+    if args.max_decimals > 9 {
+        bail!(
+            "--max-decimals must be at most 9, got {}",
+            args.max_decimals
+        );
+    }
+    Ok(PatchOptions {
+        cone_deg: args.cone,
+        max_deviation_deg: args.max_deviation,
+        tcy_s: args.tcy_ms.map(|ms| ms / 1000.0),
+        margin: args.margin,
+        third_derivative_continuity: !args.no_jerk_continuity,
+        max_decimals: args.max_decimals,
+        max_patch_length_mm: args.max_patch_length,
+        allow_c_offset: !args.no_c_offset,
+        ..PatchOptions::default()
+    })
+}
+
+/// Files named on the command line; folders expand to the files in them (recursively,
+/// skipping hidden entries), each with its path relative to the folder's parent.
+fn expand(inputs: &[PathBuf]) -> Result<Vec<(PathBuf, PathBuf)>> {
+    let mut out = Vec::new();
+    for input in inputs {
+        if input.is_dir() {
+            let base = input.parent().unwrap_or(Path::new(""));
+            let mut stack = vec![input.clone()];
+            while let Some(dir) = stack.pop() {
+                let mut entries: Vec<_> = std::fs::read_dir(&dir)
+                    .with_context(|| format!("cannot read folder {}", dir.display()))?
+                    .filter_map(|e| e.ok().map(|e| e.path()))
+                    .filter(|p| {
+                        !p.file_name()
+                            .is_some_and(|n| n.to_string_lossy().starts_with('.'))
+                    })
+                    .collect();
+                entries.sort();
+                for p in entries {
+                    if p.is_dir() {
+                        stack.push(p);
+                    } else {
+                        let rel = p.strip_prefix(base).unwrap_or(&p).to_path_buf();
+                        out.push((p, rel));
+                    }
+                }
+            }
+        } else {
+            let rel = PathBuf::from(input.file_name().unwrap_or(input.as_os_str()));
+            out.push((input.clone(), rel));
+        }
+    }
+    Ok(out)
+}
+
+pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
+    let opts = options(&args)?;
+    let machine = machine(&args.machine)?;
+    let reports: Vec<Result<FileReport, JobError>> = match (&args.output, &args.out_dir) {
+        (Some(output), None) => {
+            if args.inputs.len() != 1 || args.inputs[0].is_dir() {
+                bail!("-o/--output takes one input file; use --out-dir for several or a folder");
+            }
+            vec![patch_file(
+                &args.inputs[0],
+                output,
+                &machine,
+                &opts,
+                args.feed,
+            )]
+        }
+        (None, Some(dir)) => {
+            let files = expand(&args.inputs)?;
+            if files.is_empty() {
+                bail!("no input files");
+            }
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(args.jobs.unwrap_or(0))
+                .build()
+                .context("starting worker threads")?;
+            let bar = if std::io::stderr().is_terminal() && files.len() > 1 {
+                let b = ProgressBar::new(files.len() as u64);
+                b.set_style(
+                    ProgressStyle::with_template(
+                        "{bar:40} {pos}/{len} files {elapsed_precise} {msg}",
+                    )
+                    .expect("valid template"),
+                );
+                b
+            } else {
+                ProgressBar::hidden()
+            };
+            let out = pool.install(|| {
+                files
+                    .par_iter()
+                    .map(|(input, rel)| {
+                        let output = dir.join(rel);
+                        if let Some(parent) = output.parent() {
+                            std::fs::create_dir_all(parent).map_err(|source| JobError::Write {
+                                path: parent.display().to_string(),
+                                source,
+                            })?;
+                        }
+                        let r = patch_file(input, &output, &machine, &opts, args.feed);
+                        bar.inc(1);
+                        r
+                    })
+                    .collect()
+            });
+            bar.finish_and_clear();
+            out
+        }
+        _ => bail!("give either -o OUTPUT (one input) or --out-dir DIR"),
+    };
+
+    let mut ok: Vec<&FileReport> = Vec::new();
+    let mut failed = 0;
+    for r in &reports {
+        match r {
+            Ok(rep) => ok.push(rep),
+            Err(e) => {
+                failed += 1;
+                eprintln!("polepatch: error: {e}");
+            }
+        }
+    }
+    print_summary(&ok);
+    for rep in &ok {
+        for w in rep.warnings.iter().chain(&rep.skipped_runs) {
+            eprintln!("polepatch: warning: {}: {w}", rep.file);
+        }
+    }
+    if let Some(path) = &args.report {
+        let doc = if ok.len() == 1 && args.output.is_some() {
+            serde_json::to_string_pretty(ok[0])?
+        } else {
+            serde_json::to_string_pretty(&ok)?
+        };
+        write_atomic(path, doc.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if let Some(path) = &args.csv {
+        write_atomic(path, &csv_rows(&ok)?)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    let below: usize = ok.iter().map(|r| r.zones_below_feed()).sum();
+    if failed > 0 {
+        return Ok(ExitCode::from(1));
+    }
+    if args.strict && below > 0 {
+        eprintln!("polepatch: {below} zone(s) stay below feed (--strict)");
+        return Ok(ExitCode::from(2));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn csv_rows(reports: &[&FileReport]) -> Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record([
+        "file",
+        "run",
+        "first_line",
+        "last_line",
+        "kind",
+        "min_abs_primary_deg",
+        "c_ratio_before",
+        "c_ratio_after",
+        "primary_ratio_before",
+        "primary_ratio_after",
+        "overall_ratio_before",
+        "overall_ratio_after",
+        "limiting_before",
+        "limiting_after",
+        "time_before_s",
+        "time_after_s",
+        "ideal_time_s",
+        "max_deviation_deg",
+        "points_modified",
+        "patch_length_mm",
+        "outcome",
+        "method",
+        "qp_status",
+        "qp_iterations",
+        "qp_solves",
+        "solve_time_ms",
+        "decimals",
+        "c_offset_deg",
+    ])?;
+    for rep in reports {
+        for z in &rep.zones {
+            let lim = |f: &polepatch::job::FiguresRow| {
+                format!(
+                    "{}:{}",
+                    f.limiting_axis.clone().unwrap_or_else(|| "-".into()),
+                    f.limiting_limit
+                )
+            };
+            w.write_record([
+                z.file.clone(),
+                z.run.to_string(),
+                z.lines[0].to_string(),
+                z.lines[1].to_string(),
+                z.kind.to_string(),
+                format!("{:.6}", z.min_abs_primary_deg),
+                format!("{:.6}", z.before.c_ratio),
+                format!("{:.6}", z.after.c_ratio),
+                format!("{:.6}", z.before.primary_ratio),
+                format!("{:.6}", z.after.primary_ratio),
+                format!("{:.6}", z.before.overall_ratio),
+                format!("{:.6}", z.after.overall_ratio),
+                lim(&z.before),
+                lim(&z.after),
+                format!("{:.6}", z.before.time_s),
+                format!("{:.6}", z.after.time_s),
+                format!("{:.6}", z.ideal_time_s),
+                format!("{:.6}", z.max_deviation_deg),
+                z.points_modified.to_string(),
+                format!("{:.3}", z.patch_length_mm),
+                z.outcome.to_string(),
+                z.method.to_string(),
+                z.qp_status.clone(),
+                z.qp_iterations.to_string(),
+                z.qp_solves.to_string(),
+                format!("{:.3}", z.solve_time_ms),
+                z.decimals.to_string(),
+                format!("{}", z.c_offset_deg),
+            ])?;
+        }
+    }
+    Ok(w.into_inner()?)
+}
+
+fn print_summary(reports: &[&FileReport]) {
+    println!(
+        "{:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8} {:>6} {:>8}",
+        "file", "zones", "reached", "C ratio", "overall", "time s", "dev °", "points", "words"
+    );
+    for rep in reports {
+        let reached = rep.zones.iter().filter(|z| z.outcome == "reached").count();
+        let min = |f: &dyn Fn(&polepatch::job::ZoneRow) -> f64| {
+            rep.zones.iter().map(f).fold(f64::INFINITY, f64::min)
+        };
+        let sum =
+            |f: &dyn Fn(&polepatch::job::ZoneRow) -> f64| rep.zones.iter().map(f).sum::<f64>();
+        let name = Path::new(&rep.file)
+            .file_name()
+            .map_or(rep.file.clone(), |n| n.to_string_lossy().into_owned());
+        if rep.zones.is_empty() {
+            println!(
+                "{name:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8} {:>6} {:>8}",
+                0, "-", "-", "-", "-", "-", 0, rep.words_changed
+            );
+            continue;
+        }
+        println!(
+            "{:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8.3} {:>6} {:>8}",
+            name,
+            rep.zones.len(),
+            reached,
+            format!(
+                "{:.3} → {:.3}",
+                min(&|z| z.before.c_ratio),
+                min(&|z| z.after.c_ratio)
+            ),
+            format!(
+                "{:.3} → {:.3}",
+                min(&|z| z.before.overall_ratio),
+                min(&|z| z.after.overall_ratio)
+            ),
+            format!(
+                "{:.3} → {:.3}",
+                sum(&|z| z.before.time_s),
+                sum(&|z| z.after.time_s)
+            ),
+            rep.zones
+                .iter()
+                .map(|z| z.max_deviation_deg)
+                .fold(0.0, f64::max),
+            rep.zones.iter().map(|z| z.points_modified).sum::<usize>(),
+            rep.words_changed,
+        );
+        if rep.written_c_decimals > rep.file_c_decimals {
+            println!(
+                "  note: C written with {} decimals (the file uses {}) so that Equation 6 holds on the written values",
+                rep.written_c_decimals, rep.file_c_decimals
+            );
+        }
+    }
+}
