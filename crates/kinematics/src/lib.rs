@@ -24,6 +24,9 @@ pub mod inverse;
 pub mod machine;
 pub mod tolerances;
 
+#[cfg(test)]
+mod testutil;
+
 pub use feed::{AxisBound, FeedBound, LimitKind, axis_feed_bound, feed_bound};
 pub use forward::forward;
 pub use inverse::{BranchRule, IkSolution, inverse, inverse_path};

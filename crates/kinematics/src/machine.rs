@@ -109,18 +109,66 @@ impl Machine {
     }
     /// A built-in machine by name.
     pub fn builtin(name: &str) -> Option<Machine> {
-        let _ = name;
-        todo!()
+        let text = builtin_toml(name)?;
+        // The built-in files are checked by the tests; a failure here is a build defect.
+        Some(Machine::from_toml_str(text, name).expect("built-in machine file is valid"))
     }
     /// Parse a machine from TOML text; `origin` names the source in errors.
+    ///
+    /// The format (every field required unless marked optional; unknown fields are errors):
+    ///
+    /// ```toml
+    /// name = "mikron-ucp710"
+    /// description = "free text"        # optional, not kept
+    /// tcy_ms = 1.0                     # optional, interpolation cycle time, default 1 ms
+    /// [x]                              # also [y] and [z]
+    /// v_m_min = 30.0                   # max velocity, m/min
+    /// a_m_s2 = 2.5                     # max acceleration, m/s²
+    /// j_m_s3 = 5.0                     # max jerk, m/s³
+    /// [primary]
+    /// letter = "A"                     # "A" tilts about X, "B" about Y
+    /// sense = 1                        # +1 or -1, sp in o = Rz(sc·C)·Rp(sp·P)·ẑ
+    /// range_deg = [-100.0, 120.0]      # travel, degrees
+    /// v_rpm = 15.0                     # max velocity, rpm
+    /// a_rev_s2 = 0.83                  # max acceleration, rev/s²
+    /// j_rev_s3 = 5.0                   # max jerk, rev/s³
+    /// [c]
+    /// sense = 1                        # +1 or -1, sc
+    /// range_deg = [-360.0, 360.0]      # optional; omitted = endless
+    /// v_rpm = 20.0
+    /// a_rev_s2 = 0.83
+    /// j_rev_s3 = 50.0
+    /// ```
+    ///
+    /// Limits are converted once to internal units: m/min → mm/s ×1000/60, m/s² → mm/s²
+    /// ×1000, m/s³ → mm/s³ ×1000, rpm → °/s ×6, rev/s² → °/s² ×360, rev/s³ → °/s³ ×360.
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Machine, MachineError> {
-        let _ = (text, origin);
-        todo!()
+        let invalid = |message: String| MachineError::Invalid {
+            path: origin.to_string(),
+            message,
+        };
+        let file: MachineFile = toml::from_str(text).map_err(|e| invalid(e.to_string()))?;
+        file.into_machine().map_err(invalid)
     }
     /// A built-in name or a path to a TOML file.
+    ///
+    /// Built-in names win over files of the same name in the working directory.
     pub fn load(name_or_path: &str) -> Result<Machine, MachineError> {
-        let _ = name_or_path;
-        todo!()
+        if let Some(m) = Machine::builtin(name_or_path) {
+            return Ok(m);
+        }
+        let path = std::path::Path::new(name_or_path);
+        if !path.exists() {
+            return Err(MachineError::Unknown {
+                name: name_or_path.to_string(),
+                builtins: Machine::builtin_names().join(", "),
+            });
+        }
+        let text = std::fs::read_to_string(path).map_err(|source| MachineError::Io {
+            path: name_or_path.to_string(),
+            source,
+        })?;
+        Machine::from_toml_str(&text, name_or_path)
     }
     /// Letter of the primary axis in NC words (`'A'` or `'B'`).
     pub fn primary_letter(&self) -> char {
@@ -132,5 +180,409 @@ impl Machine {
     /// Limits of one axis.
     pub fn limit(&self, axis: Axis) -> &AxisLimits {
         &self.limits[axis.index()]
+    }
+}
+
+/// TOML text of a built-in machine.
+fn builtin_toml(name: &str) -> Option<&'static str> {
+    match name {
+        "mikron-ucp710" => Some(include_str!("../machines/mikron-ucp710.toml")),
+        "mikron-hsm600" => Some(include_str!("../machines/mikron-hsm600.toml")),
+        _ => None,
+    }
+}
+
+/// mm/s per m/min.
+const MM_S_PER_M_MIN: f64 = 1000.0 / 60.0;
+/// mm per m (for m/s² and m/s³).
+const MM_PER_M: f64 = 1000.0;
+/// °/s per rpm.
+const DEG_S_PER_RPM: f64 = 6.0;
+/// Degrees per revolution (for rev/s² and rev/s³).
+const DEG_PER_REV: f64 = 360.0;
+
+/// The TOML file as written (units of the machine tables).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MachineFile {
+    name: String,
+    #[allow(dead_code)]
+    description: Option<String>,
+    tcy_ms: Option<f64>,
+    x: LinearFile,
+    y: LinearFile,
+    z: LinearFile,
+    primary: PrimaryFile,
+    c: CFile,
+}
+
+/// `[x]`, `[y]`, `[z]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LinearFile {
+    v_m_min: f64,
+    a_m_s2: f64,
+    j_m_s3: f64,
+}
+
+/// `[primary]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PrimaryFile {
+    letter: PrimaryAxis,
+    sense: f64,
+    range_deg: [f64; 2],
+    v_rpm: f64,
+    a_rev_s2: f64,
+    j_rev_s3: f64,
+}
+
+/// `[c]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CFile {
+    sense: f64,
+    range_deg: Option<[f64; 2]>,
+    v_rpm: f64,
+    a_rev_s2: f64,
+    j_rev_s3: f64,
+}
+
+/// A limit must be positive and finite; `field` is its dotted TOML name.
+fn positive(field: &str, value: f64) -> Result<f64, String> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(format!("{field} must be positive and finite, got {value}"))
+    }
+}
+
+/// A sense must be exactly +1 or −1.
+fn sense(field: &str, value: f64) -> Result<f64, String> {
+    if value == 1.0 || value == -1.0 {
+        Ok(value)
+    } else {
+        Err(format!("{field} must be +1 or -1, got {value}"))
+    }
+}
+
+/// A range must be finite with min < max.
+fn range(field: &str, r: [f64; 2]) -> Result<(f64, f64), String> {
+    let [lo, hi] = r;
+    if !(lo.is_finite() && hi.is_finite()) {
+        return Err(format!("{field} must be finite, got [{lo}, {hi}]"));
+    }
+    if lo >= hi {
+        return Err(format!("{field}: min must be below max, got [{lo}, {hi}]"));
+    }
+    Ok((lo, hi))
+}
+
+impl LinearFile {
+    fn limits(&self, axis: &str) -> Result<AxisLimits, String> {
+        Ok(AxisLimits {
+            v: positive(&format!("{axis}.v_m_min"), self.v_m_min)? * MM_S_PER_M_MIN,
+            a: positive(&format!("{axis}.a_m_s2"), self.a_m_s2)? * MM_PER_M,
+            j: positive(&format!("{axis}.j_m_s3"), self.j_m_s3)? * MM_PER_M,
+        })
+    }
+}
+
+/// Rotary limits from rpm, rev/s², rev/s³.
+fn rotary_limits(
+    axis: &str,
+    v_rpm: f64,
+    a_rev_s2: f64,
+    j_rev_s3: f64,
+) -> Result<AxisLimits, String> {
+    Ok(AxisLimits {
+        v: positive(&format!("{axis}.v_rpm"), v_rpm)? * DEG_S_PER_RPM,
+        a: positive(&format!("{axis}.a_rev_s2"), a_rev_s2)? * DEG_PER_REV,
+        j: positive(&format!("{axis}.j_rev_s3"), j_rev_s3)? * DEG_PER_REV,
+    })
+}
+
+impl MachineFile {
+    /// Validate and convert to internal units; the error names the field.
+    fn into_machine(self) -> Result<Machine, String> {
+        let tcy_ms = self.tcy_ms.unwrap_or(1.0);
+        if !(tcy_ms.is_finite() && tcy_ms > 0.0) {
+            return Err(format!("tcy_ms must be positive and finite, got {tcy_ms}"));
+        }
+        let p = &self.primary;
+        let c = &self.c;
+        Ok(Machine {
+            name: self.name,
+            primary: p.letter,
+            primary_sense: sense("primary.sense", p.sense)?,
+            c_sense: sense("c.sense", c.sense)?,
+            primary_range_deg: range("primary.range_deg", p.range_deg)?,
+            c_range_deg: c.range_deg.map(|r| range("c.range_deg", r)).transpose()?,
+            tcy_s: tcy_ms / 1000.0,
+            limits: [
+                self.x.limits("x")?,
+                self.y.limits("y")?,
+                self.z.limits("z")?,
+                rotary_limits("primary", p.v_rpm, p.a_rev_s2, p.j_rev_s3)?,
+                rotary_limits("c", c.v_rpm, c.a_rev_s2, c.j_rev_s3)?,
+            ],
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Relative closeness for converted figures (the conversions multiply by inexact
+    /// constants such as 1000/60).
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() <= 1e-12 * b.abs().max(1.0)
+    }
+
+    fn assert_limits(m: &Machine, axis: Axis, v: f64, a: f64, j: f64) {
+        let l = m.limit(axis);
+        assert!(close(l.v, v), "{} {axis:?} v = {}, want {v}", m.name, l.v);
+        assert!(close(l.a, a), "{} {axis:?} a = {}, want {a}", m.name, l.a);
+        assert!(close(l.j, j), "{} {axis:?} j = {}, want {j}", m.name, l.j);
+    }
+
+    #[test]
+    fn ucp710_has_the_figures_of_g16_table_2_in_internal_units() {
+        let m = Machine::builtin("mikron-ucp710").unwrap();
+        assert_eq!(m.name, "mikron-ucp710");
+        assert_eq!(m.primary, PrimaryAxis::A);
+        assert_eq!(m.primary_letter(), 'A');
+        assert_eq!((m.primary_sense, m.c_sense), (1.0, 1.0));
+        assert_eq!(m.primary_range_deg, (-100.0, 120.0));
+        assert_eq!(m.c_range_deg, None);
+        assert_eq!(m.tcy_s, 0.001);
+        // 30 m/min = 500 mm/s.
+        assert_limits(&m, Axis::X, 500.0, 2500.0, 5000.0);
+        assert_limits(&m, Axis::Y, 500.0, 3000.0, 5000.0);
+        assert_limits(&m, Axis::Z, 500.0, 2100.0, 50000.0);
+        // A: 15 rpm = 90 °/s, 0.83 rev/s² = 298.8 °/s², 5 rev/s³ = 1800 °/s³.
+        assert_limits(&m, Axis::Primary, 90.0, 298.8, 1800.0);
+        // C: 20 rpm = 120 °/s, 0.83 rev/s² = 298.8 °/s², 50 rev/s³ = 18000 °/s³.
+        assert_limits(&m, Axis::C, 120.0, 298.8, 18000.0);
+    }
+
+    #[test]
+    fn hsm600_has_the_figures_of_g16_table_3_in_internal_units() {
+        let m = Machine::builtin("mikron-hsm600").unwrap();
+        assert_eq!(m.name, "mikron-hsm600");
+        assert_eq!(m.primary, PrimaryAxis::B);
+        assert_eq!(m.primary_letter(), 'B');
+        assert_eq!((m.primary_sense, m.c_sense), (1.0, 1.0));
+        assert_eq!(m.primary_range_deg, (-120.0, 120.0));
+        assert_eq!(m.c_range_deg, None);
+        assert_eq!(m.tcy_s, 0.001);
+        // 100 m/min = 1666.67 mm/s.
+        let v = 100_000.0 / 60.0;
+        assert_limits(&m, Axis::X, v, 10_000.0, 100_000.0);
+        assert_limits(&m, Axis::Y, v, 9_000.0, 100_000.0);
+        assert_limits(&m, Axis::Z, v, 10_000.0, 100_000.0);
+        // B: 200 rpm = 1200 °/s, 1.7 rev/s² = 612 °/s², 50 rev/s³ = 18000 °/s³.
+        assert_limits(&m, Axis::Primary, 1200.0, 612.0, 18_000.0);
+        // C: 360 rpm = 2160 °/s, 7 rev/s² = 2520 °/s², 100 rev/s³ = 36000 °/s³.
+        assert_limits(&m, Axis::C, 2160.0, 2520.0, 36_000.0);
+    }
+
+    #[test]
+    fn every_builtin_name_loads_and_names_itself() {
+        for name in Machine::builtin_names() {
+            let m = Machine::load(name).unwrap();
+            assert_eq!(&m.name, name);
+        }
+        assert!(Machine::builtin("mikron-ucp711").is_none());
+    }
+
+    #[test]
+    fn axis_order_and_kinds() {
+        for (k, axis) in Axis::ALL.iter().enumerate() {
+            assert_eq!(axis.index(), k);
+        }
+        assert!(!Axis::Z.is_rotary());
+        assert!(Axis::Primary.is_rotary() && Axis::C.is_rotary());
+    }
+
+    /// A small valid machine; tests edit one line of it.
+    const GOOD: &str = r#"
+name = "test-bc"
+tcy_ms = 2.0
+[x]
+v_m_min = 60
+a_m_s2 = 1
+j_m_s3 = 10
+[y]
+v_m_min = 60
+a_m_s2 = 1
+j_m_s3 = 10
+[z]
+v_m_min = 60
+a_m_s2 = 1
+j_m_s3 = 10
+[primary]
+letter = "B"
+sense = -1
+range_deg = [-30, 110]
+v_rpm = 10
+a_rev_s2 = 1
+j_rev_s3 = 1
+[c]
+sense = -1
+range_deg = [-360.0, 360.0]
+v_rpm = 10
+a_rev_s2 = 1
+j_rev_s3 = 1
+"#;
+
+    fn invalid_message(text: &str) -> String {
+        match Machine::from_toml_str(text, "bad.toml") {
+            Err(MachineError::Invalid { path, message }) => {
+                assert_eq!(path, "bad.toml");
+                message
+            }
+            other => panic!("expected Invalid, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn user_machine_with_integers_negative_senses_and_c_range() {
+        let m = Machine::from_toml_str(GOOD, "good.toml").unwrap();
+        assert_eq!(m.name, "test-bc");
+        assert_eq!(m.primary, PrimaryAxis::B);
+        assert_eq!((m.primary_sense, m.c_sense), (-1.0, -1.0));
+        assert_eq!(m.primary_range_deg, (-30.0, 110.0));
+        assert_eq!(m.c_range_deg, Some((-360.0, 360.0)));
+        assert_eq!(m.tcy_s, 0.002);
+        assert_limits(&m, Axis::X, 1000.0, 1000.0, 10_000.0);
+        assert_limits(&m, Axis::C, 60.0, 360.0, 360.0);
+    }
+
+    #[test]
+    fn omitted_tcy_is_one_millisecond() {
+        let text = GOOD.replace("tcy_ms = 2.0\n", "");
+        assert_eq!(Machine::from_toml_str(&text, "t").unwrap().tcy_s, 0.001);
+    }
+
+    #[test]
+    fn invalid_fields_are_named_in_the_message() {
+        // (text of GOOD, its replacement, what the message must contain); first match only.
+        let edits: &[(&str, &str, &str)] = &[
+            (
+                "v_rpm = 10",
+                "v_rpm = -10",
+                "primary.v_rpm must be positive and finite, got -10",
+            ),
+            (
+                "360.0]\nv_rpm = 10",
+                "360.0]\nv_rpm = 0",
+                "c.v_rpm must be positive and finite, got 0",
+            ),
+            (
+                "[x]\nv_m_min = 60",
+                "[x]\nv_m_min = 0",
+                "x.v_m_min must be positive and finite, got 0",
+            ),
+            (
+                "[y]\nv_m_min = 60\na_m_s2 = 1",
+                "[y]\nv_m_min = 60\na_m_s2 = nan",
+                "y.a_m_s2 must be positive and finite, got NaN",
+            ),
+            (
+                "[z]\nv_m_min = 60\na_m_s2 = 1\nj_m_s3 = 10",
+                "[z]\nv_m_min = 60\na_m_s2 = 1\nj_m_s3 = inf",
+                "z.j_m_s3 must be positive and finite, got inf",
+            ),
+            (
+                "sense = -1\nrange_deg = [-30",
+                "sense = 2\nrange_deg = [-30",
+                "primary.sense must be +1 or -1, got 2",
+            ),
+            (
+                "sense = -1\nrange_deg = [-360.0",
+                "sense = 0\nrange_deg = [-360.0",
+                "c.sense must be +1 or -1, got 0",
+            ),
+            (
+                "range_deg = [-30, 110]",
+                "range_deg = [110, -30]",
+                "primary.range_deg: min must be below max, got [110, -30]",
+            ),
+            (
+                "range_deg = [-360.0, 360.0]",
+                "range_deg = [5.0, 5.0]",
+                "c.range_deg: min must be below max, got [5, 5]",
+            ),
+            (
+                "tcy_ms = 2.0",
+                "tcy_ms = 0.0",
+                "tcy_ms must be positive and finite, got 0",
+            ),
+            (
+                "tcy_ms = 2.0",
+                "tcy_ms = -1.0",
+                "tcy_ms must be positive and finite, got -1",
+            ),
+            (
+                "j_rev_s3 = 1\n[c]",
+                "j_rev_s3 = 1\nc_rpm = 3\n[c]",
+                "unknown field `c_rpm`",
+            ),
+            ("tcy_ms = 2.0", "tcy = 2.0", "unknown field `tcy`"),
+            ("letter = \"B\"", "letter = \"D\"", "unknown variant `D`"),
+            ("name = \"test-bc\"\n", "", "missing field `name`"),
+            ("[x]\nv_m_min = 60", "[x]\nv_m_min = \"fast\"", "v_m_min"),
+        ];
+        for (from, to, want) in edits {
+            assert!(GOOD.contains(from), "test edit {from:?} does not apply");
+            let msg = invalid_message(&GOOD.replacen(from, to, 1));
+            assert!(
+                msg.contains(want),
+                "edit {to:?}: message {msg:?} lacks {want:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn unknown_machine_lists_the_builtins() {
+        let err = Machine::load("no-such-machine-xyz").unwrap_err();
+        assert!(matches!(err, MachineError::Unknown { .. }), "{err:?}");
+        let msg = err.to_string();
+        assert!(msg.contains("'no-such-machine-xyz'"), "{msg}");
+        assert!(msg.contains("mikron-ucp710, mikron-hsm600"), "{msg}");
+    }
+
+    #[test]
+    fn load_reads_a_file_path_and_reports_it_in_errors() {
+        let dir = std::env::temp_dir().join(format!("polepatch-kin-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let good = dir.join("good.toml");
+        std::fs::write(&good, GOOD).unwrap();
+        let m = Machine::load(good.to_str().unwrap()).unwrap();
+        assert_eq!(m.name, "test-bc");
+
+        let bad = dir.join("bad.toml");
+        std::fs::write(
+            &bad,
+            GOOD.replace(
+                "sense = -1\nrange_deg = [-30",
+                "sense = 3\nrange_deg = [-30",
+            ),
+        )
+        .unwrap();
+        let msg = Machine::load(bad.to_str().unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.contains("bad.toml") && msg.contains("primary.sense"),
+            "{msg}"
+        );
+
+        // A directory exists but cannot be read as a file.
+        let err = Machine::load(dir.to_str().unwrap()).unwrap_err();
+        assert!(matches!(err, MachineError::Io { .. }), "{err:?}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
