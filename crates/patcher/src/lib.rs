@@ -11,10 +11,12 @@ pub mod limits;
 pub mod options;
 pub mod patch;
 pub mod path;
+mod qp;
 pub mod report;
+pub mod verify;
 
-pub use candidate::{Candidate, PatchFailure};
 pub use analysis::{AnalysisOptions, RunAnalysis, Sample, Zone, ZoneKind, analyze_path};
+pub use candidate::{Candidate, PatchFailure};
 pub use limits::CLimits;
 pub use options::PatchOptions;
 pub use patch::{PatchResult, patch_path};
