@@ -79,8 +79,17 @@ pub fn inverse(machine: &Machine, o_wp: [f64; 3]) -> Option<[IkSolution; 2]> {
 
 /// An angle in degrees wrapped to (−180, 180].
 pub fn wrap_deg(angle_deg: f64) -> f64 {
-    let w = angle_deg.rem_euclid(360.0); // [0, 360], 360 only by rounding
-    if w > 180.0 { w - 360.0 } else { w }
+    if angle_deg > -180.0 && angle_deg <= 180.0 {
+        return angle_deg;
+    }
+    let w = angle_deg % 360.0; // exact, in (−360, 360)
+    if w > 180.0 {
+        w - 360.0
+    } else if w <= -180.0 {
+        w + 360.0
+    } else {
+        w
+    }
 }
 
 /// `angle_deg + n·360` for the integer n that puts it within (ref − 180, ref + 180], degrees.
@@ -185,4 +194,404 @@ pub fn inverse_path(machine: &Machine, o_wp: &[[f64; 3]], rule: BranchRule) -> V
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::forward::forward;
+    use crate::testutil::{SplitMix64, all_kinds, machine};
+
+    fn ucp710() -> Machine {
+        Machine::builtin("mikron-ucp710").unwrap()
+    }
+
+    fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+    }
+
+    /// The special angles a sweep must hit on purpose, besides random ones.
+    fn p_choices(m: &Machine) -> Vec<f64> {
+        let (lo, hi) = m.primary_range_deg;
+        vec![
+            0.0, -0.0, 1e-14, 1e-9, -1e-9, 0.5, -0.5, lo, hi, 90.0, -90.0, 180.0,
+        ]
+    }
+    const C_CHOICES_DEG: [f64; 9] = [
+        180.0, -180.0, 0.0, 90.0, -90.0, 179.999, -179.999, 360.0, 540.0,
+    ];
+
+    #[test]
+    fn fk_of_ik_is_the_identity_on_a_seeded_sweep() {
+        let mut rng = SplitMix64(0x5eed);
+        let mut poles = 0;
+        for m in all_kinds() {
+            let ps = p_choices(&m);
+            for n in 0..4000 {
+                let p = if n % 2 == 0 {
+                    rng.pick(&ps)
+                } else {
+                    rng.uniform(-180.0, 180.0)
+                };
+                let c = if n % 3 == 0 {
+                    rng.pick(&C_CHOICES_DEG)
+                } else {
+                    rng.uniform(-400.0, 400.0)
+                };
+                let o = forward(&m, p, c);
+                let Some(sols) = inverse(&m, o) else {
+                    // Only on the pole: the tilt is below the tolerance.
+                    assert!(p.to_radians().sin().abs() < POLE_SIN_TOL, "{p} {c}");
+                    poles += 1;
+                    continue;
+                };
+                assert!(sols[0].p_deg >= 0.0 && sols[1].p_deg <= 0.0, "{sols:?}");
+                for s in sols {
+                    assert!(-180.0 < s.c_deg && s.c_deg <= 180.0, "{s:?}");
+                    assert!(-180.0 < s.p_deg && s.p_deg <= 180.0, "{s:?}");
+                    let back = forward(&m, s.p_deg, s.c_deg);
+                    assert!(
+                        dist(back, o) < 4e-16 * 8.0,
+                        "{:?} P={p} C={c}: {s:?}",
+                        m.primary
+                    );
+                }
+                // One of the two is (p, c) itself, up to a turn of C; C is only as
+                // accurate as the tilt allows (error ~ ε / sin P).
+                let s = if p >= 0.0 { sols[0] } else { sols[1] };
+                let c_tol = 1e-13 / p.to_radians().sin().abs();
+                assert!((s.p_deg - p).abs() < 1e-12, "P={p}: {s:?}");
+                assert!(
+                    wrap_deg(s.c_deg - c).abs() < c_tol.max(1e-12),
+                    "P={p} C={c}: {s:?}"
+                );
+            }
+        }
+        assert!(poles > 100, "the sweep must hit the pole ({poles})");
+    }
+
+    #[test]
+    fn inverse_is_none_exactly_on_the_pole_and_the_opposite_pole() {
+        let m = ucp710();
+        assert!(inverse(&m, [0.0, 0.0, 1.0]).is_none());
+        assert!(inverse(&m, [0.0, 0.0, -1.0]).is_none());
+        assert!(inverse(&m, [1e-13, -1e-13, 1.0]).is_none());
+        // A tilt of 1e-11 rad is not the pole; an unnormalised vector is fine.
+        let s = inverse(&m, [0.0, -1e-11 * 5.0, 5.0]).unwrap();
+        assert!((s[0].p_deg - 1e-11f64.to_degrees()).abs() < 1e-20);
+        assert_eq!(s[0].c_deg, 0.0);
+    }
+
+    #[test]
+    fn bad_tool_axes_give_nan_not_the_pole() {
+        let m = ucp710();
+        for o in [[0.0; 3], [f64::NAN, 0.0, 1.0], [0.0, f64::INFINITY, 1.0]] {
+            let s = inverse(&m, o).expect("not the pole");
+            assert!(s[0].p_deg.is_nan() && s[1].c_deg.is_nan(), "{o:?}: {s:?}");
+        }
+        let path = inverse_path(
+            &m,
+            &[[0.0, -0.5, 0.866], [f64::NAN; 3], [0.0, -0.5, 0.866]],
+            BranchRule::Nearest,
+        );
+        assert!(path[1].p_deg.is_nan());
+        assert_eq!(
+            path[2], path[0],
+            "the path continues from the last finite point"
+        );
+    }
+
+    /// G16 Table 1, both solutions, every cell, for the UCP710 (k = cos 30°).
+    #[test]
+    fn g16_table_1_case_by_case() {
+        let m = ucp710();
+        let k = 30f64.to_radians().cos();
+        let acos_k = k.acos().to_degrees();
+        let deg = |r: f64| r.to_degrees();
+        // (i, j) on the circle of radius sin 30° = 0.5.
+        let cells = [
+            (-0.3, -0.4),
+            (0.0, -0.5),
+            (0.3, -0.4),
+            (-0.5, 0.0),
+            (0.5, 0.0),
+            (-0.3, 0.4),
+            (0.0, 0.5),
+            (0.3, 0.4),
+        ];
+        for (i, j) in cells {
+            let o = [i, j, k];
+            // Table 1, literally (C wrapped to (−180, 180] where it says "+ π").
+            let ((a1, c1), (a2, c2)) = if j < 0.0 {
+                (
+                    (acos_k, -deg((i / j).atan())),
+                    (-acos_k, wrap_deg(-deg((i / j).atan()) + 180.0)),
+                )
+            } else if j > 0.0 {
+                (
+                    (acos_k, wrap_deg(-deg((i / j).atan()) + 180.0)),
+                    (-acos_k, -deg((i / j).atan())),
+                )
+            } else if i < 0.0 {
+                ((acos_k, -90.0), (-acos_k, 90.0))
+            } else {
+                ((acos_k, 90.0), (-acos_k, -90.0))
+            };
+            let [s1, s2] = inverse(&m, o).unwrap();
+            let close = |s: IkSolution, a: f64, c: f64| {
+                (s.p_deg - a).abs() < 1e-12 && wrap_deg(s.c_deg - c).abs() < 1e-12
+            };
+            assert!(close(s1, a1, c1), "i={i} j={j}: {s1:?} vs A1={a1} C1={c1}");
+            assert!(close(s2, a2, c2), "i={i} j={j}: {s2:?} vs A2={a2} C2={c2}");
+            // The domain rule (the controller's choice): j ≤ 0 → (A1, C1), j > 0 → (A2, C2).
+            let d = inverse_path(&m, &[o], BranchRule::DomainRule)[0];
+            let want = if j > 0.0 { s2 } else { s1 };
+            assert_eq!(d, want, "i={i} j={j}");
+            assert!((-90.0..=90.0).contains(&d.c_deg), "{d:?}");
+        }
+        // j = 0: C is exactly ±90 and A is positive.
+        assert_eq!(
+            inverse_path(&m, &[[-0.5, 0.0, k]], BranchRule::DomainRule)[0].c_deg,
+            -90.0
+        );
+        assert_eq!(
+            inverse_path(&m, &[[0.5, -0.0, k]], BranchRule::DomainRule)[0].c_deg,
+            90.0
+        );
+        // i = j = 0: A = 0, C undefined (held, 0 for a first point).
+        let pole = inverse_path(&m, &[[0.0, 0.0, 1.0]], BranchRule::DomainRule)[0];
+        assert_eq!(
+            pole,
+            IkSolution {
+                p_deg: 0.0,
+                c_deg: 0.0
+            }
+        );
+    }
+
+    #[test]
+    fn domain_rule_keeps_c_within_90_degrees_for_every_kind_of_machine() {
+        let mut rng = SplitMix64(90);
+        for m in all_kinds() {
+            for _ in 0..2000 {
+                let o = forward(&m, rng.uniform(1.0, 100.0), rng.uniform(-180.0, 180.0));
+                let s = inverse_path(&m, &[o], BranchRule::DomainRule)[0];
+                assert!(
+                    (-90.0..=90.0).contains(&s.c_deg),
+                    "{:?} {o:?}: {s:?}",
+                    m.primary
+                );
+                assert!(dist(forward(&m, s.p_deg, s.c_deg), o) < 1e-14);
+            }
+        }
+    }
+
+    /// A planted pole crossing: the tool axis passes 0.02 rad (≈ 1.15°) beside the pole
+    /// while j runs from −0.1 to 0.1 through exactly 0.
+    fn crossing() -> Vec<[f64; 3]> {
+        (-10..=10)
+            .map(|n| {
+                let (i, j) = (0.02, f64::from(n) * 0.01);
+                [i, j, (1.0 - i * i - j * j).sqrt()]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn domain_rule_flips_p_and_jumps_c_where_j_crosses_zero() {
+        let m = ucp710();
+        let path = inverse_path(&m, &crossing(), BranchRule::DomainRule);
+        for (n, s) in path.iter().enumerate() {
+            // j ≤ 0 up to n = 10 (j = 0 exactly), then j > 0.
+            assert_eq!(s.p_deg > 0.0, n <= 10, "point {n}: {s:?}");
+            assert!((-90.0..=90.0).contains(&s.c_deg), "point {n}: {s:?}");
+        }
+        assert_eq!(path[10].c_deg, 90.0);
+        // The jump: C1 = 90° at j = 0, C2 = −atan(0.02/0.01) = −63.4° just after.
+        let jump = path[11].c_deg - path[10].c_deg;
+        assert!(
+            (jump + 90.0 + 2f64.atan().to_degrees()).abs() < 1e-9,
+            "jump {jump}"
+        );
+        let steps = path
+            .windows(2)
+            .filter(|w| (w[1].c_deg - w[0].c_deg).abs() > 90.0)
+            .count();
+        assert_eq!(steps, 1, "exactly one jump of C");
+        // P flips sign: the tilt after the crossing mirrors the one before it.
+        assert_eq!(path[11].p_deg, -path[9].p_deg);
+    }
+
+    #[test]
+    fn nearest_and_constant_sign_rules_stay_continuous_through_the_crossing() {
+        let m = ucp710();
+        let o = crossing();
+        for (rule, sign) in [
+            (BranchRule::Nearest, 1.0),
+            (BranchRule::PreferPositive, 1.0),
+            (BranchRule::PreferNegative, -1.0),
+        ] {
+            let path = inverse_path(&m, &o, rule);
+            for (s, o) in path.iter().zip(&o) {
+                assert!(s.p_deg * sign > 0.0, "{rule:?}: {s:?}");
+                assert!(dist(forward(&m, s.p_deg, s.c_deg), *o) < 1e-15);
+            }
+            // C sweeps 180° − 2·atan(0.02/0.1) monotonically; the largest step,
+            // 90° − atan 2 ≈ 26.6°, is next to the pole.
+            let max_step = path
+                .windows(2)
+                .map(|w| (w[1].c_deg - w[0].c_deg).abs())
+                .fold(0.0, f64::max);
+            assert!(max_step < 27.0, "{rule:?}: max step {max_step}");
+            let sweep = path[20].c_deg - path[0].c_deg;
+            let want = 180.0 - 2.0 * 0.2f64.atan().to_degrees();
+            assert!(
+                (sweep - want).abs() < 1e-9,
+                "{rule:?}: sweep {sweep} vs {want}"
+            );
+        }
+    }
+
+    #[test]
+    fn c_is_unwrapped_past_180_degrees_except_under_the_domain_rule() {
+        // Two full turns of C at a 20° tilt, 7.5° apart, for every kind of machine.
+        for m in all_kinds() {
+            let o: Vec<_> = (0..=96)
+                .map(|n| forward(&m, 20.0, f64::from(n) * 7.5 - 180.0))
+                .collect();
+            for rule in [BranchRule::Nearest, BranchRule::PreferPositive] {
+                let path = inverse_path(&m, &o, rule);
+                assert_eq!(path[0].c_deg, 180.0, "first C in (−180, 180]");
+                for (n, s) in path.iter().enumerate() {
+                    let want = f64::from(n as u32) * 7.5 + 180.0;
+                    assert!(
+                        (s.c_deg - want).abs() < 1e-9 && (s.p_deg - 20.0).abs() < 1e-9,
+                        "{rule:?} {n}: {s:?}"
+                    );
+                }
+            }
+            let neg = inverse_path(&m, &o, BranchRule::PreferNegative);
+            assert!((neg[96].c_deg - neg[0].c_deg - 720.0).abs() < 1e-9);
+            let dom = inverse_path(&m, &o, BranchRule::DomainRule);
+            assert!(dom.iter().all(|s| (-90.0..=90.0).contains(&s.c_deg)));
+        }
+    }
+
+    #[test]
+    fn on_the_pole_p_is_zero_and_c_is_held() {
+        let m = ucp710();
+        let o = [
+            [0.0, 0.0, 1.0],
+            forward(&m, 10.0, 250.0),
+            [0.0, 0.0, 1.0],
+            forward(&m, 10.0, 255.0),
+        ];
+        for rule in [
+            BranchRule::Nearest,
+            BranchRule::DomainRule,
+            BranchRule::PreferPositive,
+            BranchRule::PreferNegative,
+        ] {
+            let path = inverse_path(&m, &o, rule);
+            assert_eq!(
+                path[0],
+                IkSolution {
+                    p_deg: 0.0,
+                    c_deg: 0.0
+                },
+                "{rule:?}"
+            );
+            assert!(
+                path[2].p_deg == 0.0 && path[2].p_deg.is_sign_positive(),
+                "{rule:?}"
+            );
+            assert_eq!(path[2].c_deg, path[1].c_deg, "{rule:?}");
+        }
+        // Nearest from (0, 0): (10, −110) is 110 away, (−10, 70) only 70 (max of |ΔP|, |ΔC|).
+        let path = inverse_path(&m, &o, BranchRule::Nearest);
+        assert!((path[1].p_deg + 10.0).abs() < 1e-12 && (path[1].c_deg - 70.0).abs() < 1e-9);
+        assert!((path[3].p_deg + 10.0).abs() < 1e-12, "{path:?}");
+        assert!((path[3].c_deg - 75.0).abs() < 1e-9, "{path:?}");
+    }
+
+    #[test]
+    fn opposite_pole_is_180_degrees_with_c_held() {
+        let m = machine(crate::machine::PrimaryAxis::A, 1.0, 1.0, (-190.0, 190.0));
+        let o = [forward(&m, -170.0, 30.0), [0.0, 0.0, -1.0]];
+        let near = inverse_path(&m, &o, BranchRule::Nearest);
+        assert_eq!(near[1].c_deg, near[0].c_deg);
+        assert_eq!(near[1].p_deg, 180.0, "P ≥ 0 first, 170 is nearest");
+        let neg = inverse_path(&m, &o, BranchRule::PreferNegative);
+        assert!((neg[0].p_deg + 170.0).abs() < 1e-9);
+        assert_eq!(neg[1].p_deg, -180.0);
+        assert_eq!(inverse_path(&m, &o, BranchRule::DomainRule)[1].p_deg, 180.0);
+        // Out of range on the UCP710 either way: the rule's choice stands.
+        assert_eq!(
+            inverse_path(&ucp710(), &o[1..], BranchRule::PreferNegative)[0].p_deg,
+            -180.0
+        );
+    }
+
+    #[test]
+    fn a_solution_outside_the_primary_range_gives_way_to_the_other() {
+        let m = ucp710(); // A in [−100, 120]
+        let o = forward(&m, 110.0, 30.0);
+        for rule in [
+            BranchRule::Nearest,
+            BranchRule::DomainRule,
+            BranchRule::PreferPositive,
+            BranchRule::PreferNegative,
+        ] {
+            let s = inverse_path(&m, &[o], rule)[0];
+            assert!((s.p_deg - 110.0).abs() < 1e-9, "{rule:?}: {s:?}");
+        }
+        // Domain rule would choose A = −50 (C = −150 is outside ±90 for A = +50)...
+        let m = machine(crate::machine::PrimaryAxis::A, 1.0, 1.0, (-30.0, 110.0));
+        let o = forward(&m, 50.0, -150.0);
+        assert_eq!(domain_rule_index(&m, o), 1);
+        // ... but −50 is out of range, so the path keeps A = +50, C = −150.
+        let s = inverse_path(&m, &[o], BranchRule::DomainRule)[0];
+        assert!(
+            (s.p_deg - 50.0).abs() < 1e-9 && (s.c_deg + 150.0).abs() < 1e-9,
+            "{s:?}"
+        );
+        // When neither is in range, the rule's choice stands.
+        let o = forward(&m, 150.0, 0.0);
+        assert!(inverse_path(&m, &[o], BranchRule::PreferPositive)[0].p_deg > 0.0);
+        assert!(inverse_path(&m, &[o], BranchRule::PreferNegative)[0].p_deg < 0.0);
+    }
+
+    #[test]
+    fn wrap_and_unwrap() {
+        assert_eq!(wrap_deg(180.0), 180.0);
+        assert_eq!(wrap_deg(-180.0), 180.0);
+        assert_eq!(wrap_deg(540.0), 180.0);
+        assert_eq!(wrap_deg(-190.0), 170.0);
+        assert_eq!(wrap_deg(0.0), 0.0);
+        assert_eq!(unwrap_near_deg(-170.0, 170.0), 190.0);
+        assert_eq!(unwrap_near_deg(10.0, 725.0), 730.0);
+        assert_eq!(unwrap_near_deg(-1e-20, 0.0), -1e-20);
+    }
+
+    mod prop {
+        use super::*;
+        use proptest::prelude::*;
+
+        proptest! {
+            /// fk(ik(o)) = o for any tool axis off the pole, any kind of machine.
+            #[test]
+            fn fk_of_ik_round_trip(kind in 0usize..8, x in -1.0f64..1.0, y in -1.0f64..1.0, z in -1.0f64..1.0) {
+                let m = &all_kinds()[kind];
+                let n = (x * x + y * y + z * z).sqrt();
+                prop_assume!(n > 1e-3);
+                let o = [x / n, y / n, z / n];
+                match inverse(m, o) {
+                    None => prop_assert!(x.hypot(y) < POLE_SIN_TOL * n),
+                    Some(sols) => for s in sols {
+                        prop_assert!(dist(forward(m, s.p_deg, s.c_deg), o) < 1e-15);
+                    },
+                }
+            }
+        }
+    }
 }
