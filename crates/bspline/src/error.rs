@@ -31,6 +31,14 @@ pub enum SplineError {
         /// The value.
         value: f64,
     },
+    /// A least-squares weight is negative.
+    #[error("weight w[{index}] = {value} is negative")]
+    NegativeWeight {
+        /// Index of the weight.
+        index: usize,
+        /// Its value.
+        value: f64,
+    },
     /// Lengths of inputs disagree.
     #[error("length mismatch: {what}")]
     LengthMismatch {
