@@ -1,7 +1,7 @@
 //! Inverse kinematics: tool axis → (primary, C) in degrees, both solutions, branch choice.
 //!
 //! Off the pole every unit tool axis `o_wp = (i, j, k)` has exactly two joint solutions
-//! (see [`crate::forward`] for the model):
+//! (see [`crate::forward::forward`] for the model):
 //!
 //! ```text
 //! P1 = atan2(√(i² + j²), k) ∈ [0°, 180°]          (= acos k, but accurate near the pole)

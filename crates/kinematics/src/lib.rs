@@ -29,5 +29,7 @@ mod testutil;
 
 pub use feed::{AxisBound, FeedBound, LimitKind, axis_feed_bound, feed_bound};
 pub use forward::forward;
-pub use inverse::{BranchRule, IkSolution, inverse, inverse_path};
+pub use inverse::{
+    BranchRule, IkSolution, domain_rule_index, inverse, inverse_path, unwrap_near_deg, wrap_deg,
+};
 pub use machine::{Axis, AxisLimits, Machine, MachineError, PrimaryAxis};
