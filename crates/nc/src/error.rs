@@ -16,6 +16,15 @@ pub struct ParseError {
 }
 
 impl ParseError {
+    /// An error at 1-based `line` and byte `column`, without a file name.
+    pub fn at(line: usize, column: usize, message: impl Into<String>) -> Self {
+        ParseError {
+            path: None,
+            line,
+            column,
+            message: message.into(),
+        }
+    }
     /// Attach a file name for display.
     pub fn with_path(mut self, path: impl Into<String>) -> Self {
         self.path = Some(path.into());
@@ -27,7 +36,11 @@ impl fmt::Display for ParseError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match &self.path {
             Some(p) => write!(f, "{p}:{}:{}: {}", self.line, self.column, self.message),
-            None => write!(f, "line {}, col {}: {}", self.line, self.column, self.message),
+            None => write!(
+                f,
+                "line {}, col {}: {}",
+                self.line, self.column, self.message
+            ),
         }
     }
 }

@@ -1,1 +1,581 @@
 //! Byte-level lexing of one line into words and pass-through tokens.
+//!
+//! The rules are shared by all dialects and only ASCII is interpreted; any other byte
+//! is kept inside the token it falls in (comments, strings, unknown tokens):
+//!
+//! - blanks (space, tab, CR, VT, FF) separate tokens and are skipped;
+//! - `;` starts a comment to the end of the line, `(` a comment to the next `)`;
+//! - `*` ends the block (Heidenhain); it and the rest of the line pass through;
+//! - `%` starts a pass-through rest of line (`%NAME G71 *`, `N999999 %SING G71 *`);
+//! - a letter followed by a sign, digit or `.` is an address word (`C+148.494`, `X-.5`,
+//!   `G01`, `X10.`); followed by `=` it is a Sinumerik word (`X=12.5`);
+//! - a letter followed by a letter or `_` starts an identifier (`TRAORI`, `CYCLE800(…)`,
+//!   `MSG("…")`), which takes a following `(…)`/`[…]` and `=expression` along;
+//! - `/` with optional level digits is the block-delete marker;
+//! - anything else up to the next blank, letter, `;` or `(` is an unknown token.
+//!
+//! Errors: a malformed or non-finite number on an address word, a value that is an
+//! expression on an axis word (X Y Z A B C F), and a letter that needs a number but has
+//! none (`X`, `X+`).
+
+use std::ops::Range;
+
+/// One token of a line. Spans are absolute byte offsets into the file.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Token {
+    /// An address word with a plain number: `C+148.494`, `X=12.5`, `G43.4`.
+    Word {
+        /// Upper-case letter.
+        letter: u8,
+        /// Letter to last digit.
+        span: Range<usize>,
+        /// The number, sign included.
+        value_span: Range<usize>,
+        /// The number as written.
+        value: f64,
+    },
+    /// An identifier with its arguments or assignment: `TRAORI`, `CYCLE800(0,1)`,
+    /// `MSG("…")`.
+    Ident {
+        /// The whole token.
+        span: Range<usize>,
+        /// The identifier alone (letters, digits and `_`).
+        name: Range<usize>,
+    },
+    /// A letter with a value that is not a plain number, on a letter where that is
+    /// allowed (`T="MILL"`, `R1=R2*3`, `S=R5`).
+    Assign {
+        /// Upper-case letter.
+        letter: u8,
+        /// The whole token.
+        span: Range<usize>,
+    },
+    /// `;` comment to the end of the line, or `( … )` comment.
+    Comment {
+        /// The comment, delimiters included.
+        span: Range<usize>,
+    },
+    /// `*` block end and the rest of the line.
+    BlockEnd {
+        /// From `*` to the end of the line.
+        span: Range<usize>,
+    },
+    /// `%` and the rest of the line.
+    Percent {
+        /// From `%` to the end of the line.
+        span: Range<usize>,
+    },
+    /// `/` block-delete marker with optional level digits.
+    Slash {
+        /// The marker.
+        span: Range<usize>,
+    },
+    /// Anything else, kept as it is.
+    Other {
+        /// The token.
+        span: Range<usize>,
+    },
+}
+
+/// A lexing error at an absolute byte offset.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LexError {
+    /// Absolute byte offset of the offending word.
+    pub at: usize,
+    /// What is wrong, naming the value.
+    pub message: String,
+}
+
+/// Letters whose values polepatch reads as numbers and needs plain (axis words and F).
+pub const AXIS_LETTERS: &[u8] = b"XYZABCF";
+/// Letters that always need a number after them.
+pub const NUMBER_LETTERS: &[u8] = b"XYZABCFGMNTS";
+
+fn is_blank(b: u8) -> bool {
+    matches!(b, b' ' | b'\t' | b'\r' | 0x0b | 0x0c)
+}
+
+fn is_axis(letter: u8) -> bool {
+    AXIS_LETTERS.contains(&letter)
+}
+
+fn is_non_finite_name(text: &[u8]) -> bool {
+    let t = match text.first() {
+        Some(b'+' | b'-') => &text[1..],
+        _ => text,
+    };
+    t.eq_ignore_ascii_case(b"nan")
+        || t.eq_ignore_ascii_case(b"inf")
+        || t.eq_ignore_ascii_case(b"infinity")
+}
+
+/// Exact powers of ten representable in f64.
+const POW10: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+/// Parse a plain decimal number: optional sign, digits with at most one `.`, at least one
+/// digit (`12`, `-.5`, `+180.`, `0.25`). No exponent. The result is correctly rounded
+/// (same as `str::parse::<f64>`). `None` if malformed.
+pub fn parse_number(text: &[u8]) -> Option<f64> {
+    let (neg, body) = match text.first()? {
+        b'-' => (true, &text[1..]),
+        b'+' => (false, &text[1..]),
+        _ => (false, text),
+    };
+    let mut mantissa: u64 = 0;
+    let mut digits = 0usize;
+    let mut frac = 0usize;
+    let mut point = false;
+    let mut exact = true;
+    for &b in body {
+        match b {
+            b'0'..=b'9' => {
+                digits += 1;
+                if point {
+                    frac += 1;
+                }
+                if exact {
+                    mantissa = mantissa * 10 + u64::from(b - b'0');
+                    if mantissa >= (1u64 << 53) {
+                        exact = false;
+                    }
+                }
+            }
+            b'.' if !point => point = true,
+            _ => return None,
+        }
+    }
+    if digits == 0 {
+        return None;
+    }
+    let magnitude = if exact && frac < POW10.len() {
+        // Both operands exact: one correctly rounded division (Clinger's fast path).
+        mantissa as f64 / POW10[frac]
+    } else {
+        std::str::from_utf8(body).ok()?.parse::<f64>().ok()?
+    };
+    Some(if neg { -magnitude } else { magnitude })
+}
+
+/// Tokens of one line.
+pub struct Lexer<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+    end: usize,
+}
+
+impl<'a> Lexer<'a> {
+    /// Lex `line` (a byte range of `bytes`, without its line ending).
+    pub fn new(bytes: &'a [u8], line: Range<usize>) -> Self {
+        let end = line.end.min(bytes.len());
+        Lexer {
+            bytes,
+            pos: line.start.min(end),
+            end,
+        }
+    }
+
+    fn err(&self, at: usize, message: String) -> Option<Result<Token, LexError>> {
+        Some(Err(LexError { at, message }))
+    }
+
+    fn text(&self, r: Range<usize>) -> String {
+        String::from_utf8_lossy(&self.bytes[r]).into_owned()
+    }
+
+    /// End of a bracketed group starting at `i` (`(` or `[`), quotes respected; the
+    /// line end if unclosed.
+    fn skip_group(&self, mut i: usize) -> usize {
+        let b = self.bytes;
+        let mut depth = 0usize;
+        let mut in_str = false;
+        while i < self.end {
+            let c = b[i];
+            i += 1;
+            if in_str {
+                in_str = c != b'"';
+                continue;
+            }
+            match c {
+                b'"' => in_str = true,
+                b'(' | b'[' => depth += 1,
+                b')' | b']' => {
+                    depth = depth.saturating_sub(1);
+                    if depth == 0 {
+                        return i;
+                    }
+                }
+                _ => {}
+            }
+        }
+        self.end
+    }
+
+    /// End of an expression starting at `i`: up to a blank or `;` outside brackets and
+    /// quotes, or the line end.
+    fn skip_expr(&self, mut i: usize) -> usize {
+        let b = self.bytes;
+        while i < self.end {
+            match b[i] {
+                b'(' | b'[' => i = self.skip_group(i),
+                b'"' => {
+                    i += 1;
+                    while i < self.end && b[i] != b'"' {
+                        i += 1;
+                    }
+                    i = (i + 1).min(self.end);
+                }
+                c if is_blank(c) || c == b';' => return i,
+                _ => i += 1,
+            }
+        }
+        self.end
+    }
+
+    /// Scan `[sign] [0-9.]*` from `i`: (end of sign, end of number).
+    fn scan_number(&self, i: usize) -> (usize, usize) {
+        let b = self.bytes;
+        let mut e = i;
+        if e < self.end && matches!(b[e], b'+' | b'-') {
+            e += 1;
+        }
+        let digits_start = e;
+        while e < self.end && (b[e].is_ascii_digit() || b[e] == b'.') {
+            e += 1;
+        }
+        (digits_start, e)
+    }
+
+    fn word(&mut self, p: usize, letter: u8) -> Option<Result<Token, LexError>> {
+        let b = self.bytes;
+        let l = letter as char;
+        let q = p + 1;
+        let eq = q < self.end && b[q] == b'=';
+        let ns = if eq { q + 1 } else { q };
+        let (ds, e) = self.scan_number(ns);
+        let followed_by_expr = e < self.end
+            && matches!(
+                b[e],
+                b'+' | b'-' | b'*' | b'/' | b'[' | b'(' | b'<' | b'>' | b'^' | b'#'
+            );
+        if e == ds
+            || (eq && followed_by_expr)
+            || (!eq && e < self.end && matches!(b[e], b'#' | b'['))
+        {
+            // Not a plain number.
+            let x = self.skip_expr(ns);
+            if is_axis(letter) {
+                let text = &b[ns..x];
+                return if text.is_empty() {
+                    self.err(p, format!("{l} word has no number"))
+                } else if matches!(text, b"+" | b"-") {
+                    self.err(
+                        p,
+                        format!("{l} value '{}' is not a number", self.text(ns..x)),
+                    )
+                } else if is_non_finite_name(text) {
+                    self.err(
+                        p,
+                        format!("{l} value '{}' is not a finite number", self.text(ns..x)),
+                    )
+                } else {
+                    self.err(
+                        p,
+                        format!(
+                            "{l} value '{}' is an expression; polepatch needs a plain number on axis words",
+                            self.text(ns..x)
+                        ),
+                    )
+                };
+            }
+            if NUMBER_LETTERS.contains(&letter) && !eq && e == ds {
+                let next = b.get(e).copied().filter(|_| e < self.end);
+                if !matches!(next, Some(b'#' | b'[')) {
+                    return if e > ns {
+                        self.err(
+                            p,
+                            format!("{l} value '{}' is not a number", self.text(ns..e)),
+                        )
+                    } else {
+                        self.err(p, format!("{l} word has no number"))
+                    };
+                }
+            }
+            self.pos = x.max(q);
+            return Some(Ok(if x > q {
+                Token::Assign {
+                    letter,
+                    span: p..self.pos,
+                }
+            } else {
+                Token::Other { span: p..q }
+            }));
+        }
+        let value = match parse_number(&b[ns..e]) {
+            Some(v) => v,
+            None => {
+                return self.err(
+                    p,
+                    format!("{l} value '{}' is not a number", self.text(ns..e)),
+                );
+            }
+        };
+        if !value.is_finite() {
+            return self.err(
+                p,
+                format!("{l} value '{}' is not a finite number", self.text(ns..e)),
+            );
+        }
+        if !eq && e < self.end && b[e] == b'=' {
+            // Parameter assignment such as `R1=5`.
+            let x = self.skip_expr(e + 1);
+            self.pos = x;
+            return Some(Ok(Token::Assign { letter, span: p..x }));
+        }
+        self.pos = e;
+        Some(Ok(Token::Word {
+            letter,
+            span: p..e,
+            value_span: ns..e,
+            value,
+        }))
+    }
+
+    fn ident(&mut self, p: usize) -> Option<Result<Token, LexError>> {
+        let b = self.bytes;
+        let mut i = p + 1;
+        while i < self.end && (b[i].is_ascii_alphanumeric() || b[i] == b'_') {
+            i += 1;
+        }
+        let name = p..i;
+        let letter = b[p].to_ascii_uppercase();
+        if is_axis(letter) && is_non_finite_name(&b[p + 1..i]) {
+            return self.err(
+                p,
+                format!(
+                    "{} value '{}' is not a finite number",
+                    letter as char,
+                    self.text(p + 1..i)
+                ),
+            );
+        }
+        while i < self.end && matches!(b[i], b'(' | b'[') {
+            i = self.skip_group(i);
+        }
+        if i < self.end && b[i] == b'=' {
+            i = self.skip_expr(i + 1);
+        }
+        self.pos = i;
+        Some(Ok(Token::Ident { span: p..i, name }))
+    }
+}
+
+impl Iterator for Lexer<'_> {
+    type Item = Result<Token, LexError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        let b = self.bytes;
+        while self.pos < self.end && is_blank(b[self.pos]) {
+            self.pos += 1;
+        }
+        if self.pos >= self.end {
+            return None;
+        }
+        let p = self.pos;
+        let c = b[p];
+        match c {
+            b'A'..=b'Z' | b'a'..=b'z' => {
+                let next = if p + 1 < self.end { b[p + 1] } else { b' ' };
+                if next.is_ascii_alphabetic() || next == b'_' {
+                    self.ident(p)
+                } else {
+                    self.word(p, c.to_ascii_uppercase())
+                }
+            }
+            b';' => {
+                self.pos = self.end;
+                Some(Ok(Token::Comment { span: p..self.end }))
+            }
+            b'(' => {
+                let mut i = p + 1;
+                while i < self.end && b[i] != b')' {
+                    i += 1;
+                }
+                self.pos = (i + 1).min(self.end);
+                Some(Ok(Token::Comment { span: p..self.pos }))
+            }
+            b'*' => {
+                self.pos = self.end;
+                Some(Ok(Token::BlockEnd { span: p..self.end }))
+            }
+            b'%' => {
+                self.pos = self.end;
+                Some(Ok(Token::Percent { span: p..self.end }))
+            }
+            b'/' => {
+                let mut i = p + 1;
+                while i < self.end && b[i].is_ascii_digit() {
+                    i += 1;
+                }
+                self.pos = i;
+                Some(Ok(Token::Slash { span: p..i }))
+            }
+            b'"' => {
+                let mut i = p + 1;
+                while i < self.end && b[i] != b'"' {
+                    i += 1;
+                }
+                self.pos = (i + 1).min(self.end);
+                Some(Ok(Token::Other { span: p..self.pos }))
+            }
+            _ => {
+                let mut i = p + 1;
+                while i < self.end
+                    && !(is_blank(b[i])
+                        || b[i].is_ascii_alphabetic()
+                        || matches!(b[i], b';' | b'('))
+                {
+                    i += 1;
+                }
+                self.pos = i;
+                Some(Ok(Token::Other { span: p..i }))
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lex(s: &str) -> Vec<Token> {
+        Lexer::new(s.as_bytes(), 0..s.len())
+            .collect::<Result<_, _>>()
+            .unwrap()
+    }
+
+    fn lex_err(s: &str) -> LexError {
+        Lexer::new(s.as_bytes(), 0..s.len())
+            .find_map(|t| t.err())
+            .expect("an error")
+    }
+
+    #[test]
+    fn numbers_parse_like_std() {
+        for s in [
+            "0",
+            "-0",
+            "+0",
+            "12",
+            "12.",
+            ".5",
+            "-.5",
+            "+148.494",
+            "0.1",
+            "123456789012345678901234.5",
+            "0.30000000000000004",
+            "1.0000000000000000000000001",
+            "9007199254740993",
+        ] {
+            let std: f64 = s.parse().unwrap();
+            assert_eq!(
+                parse_number(s.as_bytes()).unwrap().to_bits(),
+                std.to_bits(),
+                "{s}"
+            );
+        }
+        for s in ["", ".", "+", "-", "1..2", "1.2.", "+-1", "1e5", "--1", " 1"] {
+            assert_eq!(parse_number(s.as_bytes()), None, "{s}");
+        }
+    }
+
+    #[test]
+    fn heidenhain_block() {
+        let t = lex("N120 X+1 Y+0 Z-8 A+14.351 C+135.638 *");
+        assert_eq!(t.len(), 7);
+        assert_eq!(
+            t[5],
+            Token::Word {
+                letter: b'C',
+                span: 26..35,
+                value_span: 27..35,
+                value: 135.638
+            }
+        );
+        assert_eq!(t[6], Token::BlockEnd { span: 36..37 });
+    }
+
+    #[test]
+    fn fanuc_without_spaces_and_comment() {
+        let t = lex("G1X10.Y-.5(CUT)");
+        assert!(matches!(
+            t[0],
+            Token::Word {
+                letter: b'G',
+                value: 1.0,
+                ..
+            }
+        ));
+        assert!(matches!(
+            t[1],
+            Token::Word {
+                letter: b'X',
+                value: 10.0,
+                ..
+            }
+        ));
+        assert!(matches!(
+            t[2],
+            Token::Word {
+                letter: b'Y',
+                value: -0.5,
+                ..
+            }
+        ));
+        assert_eq!(t[3], Token::Comment { span: 10..15 });
+    }
+
+    #[test]
+    fn sinumerik_tokens() {
+        let t =
+            lex(r#"N10 G1 X=12.5 TRAORI CYCLE800(0,"TC1",1) MSG("a;b") R1=R2*3 T="MILL" ; done"#);
+        assert!(
+            matches!(t[2], Token::Word { letter: b'X', value: 12.5, ref value_span, .. } if *value_span == (9..13))
+        );
+        assert!(matches!(t[3], Token::Ident { .. }));
+        assert!(matches!(&t[4], Token::Ident { span, .. } if span.end == 40));
+        assert!(matches!(&t[5], Token::Ident { span, .. } if span.len() == 10));
+        assert!(matches!(t[6], Token::Assign { letter: b'R', .. }));
+        assert!(matches!(t[7], Token::Assign { letter: b'T', .. }));
+        assert!(matches!(t[8], Token::Comment { .. }));
+    }
+
+    #[test]
+    fn errors_name_the_value() {
+        assert_eq!(
+            lex_err("N1 C12..5").message,
+            "C value '12..5' is not a number"
+        );
+        assert_eq!(lex_err("N1 C12..5").at, 3);
+        assert_eq!(
+            lex_err("CNaN").message,
+            "C value 'NaN' is not a finite number"
+        );
+        assert_eq!(
+            lex_err("C=inf").message,
+            "C value 'inf' is not a finite number"
+        );
+        assert!(
+            lex_err("X=IC(5)")
+                .message
+                .contains("'IC(5)' is an expression")
+        );
+        assert!(lex_err("X[#1+2]").message.contains("is an expression"));
+        assert_eq!(lex_err("G1 X").message, "X word has no number");
+        assert_eq!(lex_err("G1 X+ Y1").message, "X value '+' is not a number");
+        let huge = format!("X{}", "9".repeat(400));
+        assert!(lex_err(&huge).message.ends_with("is not a finite number"));
+    }
+}

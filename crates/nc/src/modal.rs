@@ -28,6 +28,9 @@ pub const B: usize = 4;
 /// C index.
 pub const C: usize = 5;
 
+/// The axis letters in [`Modal::pos`] order.
+pub const AXES: &[u8; 6] = b"XYZABC";
+
 /// Modal state after a block.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Modal {

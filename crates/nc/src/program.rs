@@ -1,6 +1,10 @@
 //! Parsed program: blocks, words with byte spans, modal state.
 
-use crate::{error::ParseError, modal::Modal};
+use crate::{
+    error::ParseError,
+    lexer::{Lexer, Token},
+    modal::{A, B, C, Modal, Motion, X, Y, Z},
+};
 use std::ops::Range;
 
 /// Dialect of the file (detected, or forced by the caller).
@@ -68,14 +72,517 @@ impl Program {
     }
     /// The word with `letter` in a block, if any (the last one if repeated).
     pub fn word(&self, block: usize, letter: u8) -> Option<&Word> {
-        self.block_words(block).iter().rev().find(|w| w.letter == letter)
+        self.block_words(block)
+            .iter()
+            .rev()
+            .find(|w| w.letter == letter)
     }
 }
 
 /// Parse `bytes`. Errors name line and column: malformed or non-finite numbers on address
 /// words, an axis word whose value is an expression, and the like. Unknown words and
 /// tokens are kept, not rejected.
+///
+/// Every line (split at `\n`; a `\r` before it belongs to the line ending) is one
+/// [`Block`]; a final line without a newline is a block too, a final empty segment after
+/// the last newline is not. See [`crate::lexer`] for the token rules and
+/// [`crate::modal`] for how the modal state follows the blocks.
 pub fn parse(bytes: Vec<u8>, dialect: Dialect) -> Result<Program, ParseError> {
-    let _ = (bytes, dialect);
-    todo!()
+    let dialect = match dialect {
+        Dialect::Auto => detect(&bytes),
+        d => d,
+    };
+    let mut blocks = Vec::with_capacity(bytes.len() / 32 + 1);
+    let mut words = Vec::with_capacity(bytes.len() / 8 + 1);
+    let mut interp = Interpreter::new(dialect);
+    let n = bytes.len();
+    let mut start = 0;
+    let mut line = 1;
+    while start < n {
+        let (end, next) = match bytes[start..].iter().position(|&b| b == b'\n') {
+            Some(k) => {
+                let nl = start + k;
+                (
+                    if nl > start && bytes[nl - 1] == b'\r' {
+                        nl - 1
+                    } else {
+                        nl
+                    },
+                    nl + 1,
+                )
+            }
+            None => (n, n),
+        };
+        let block = interp.block(&bytes, start..end, line, &mut words)?;
+        blocks.push(block);
+        start = next;
+        line += 1;
+    }
+    Ok(Program {
+        bytes,
+        blocks,
+        words,
+        dialect,
+    })
+}
+
+/// Guess the dialect from the first 64 KiB: a `*` block end or a `%NAME G71` header →
+/// Heidenhain; `TRAORI`/`TRAFOOF` → Sinumerik; `( )` comments or `G43.4` → Fanuc; `;`
+/// comments → Sinumerik; else Fanuc.
+pub fn detect(bytes: &[u8]) -> Dialect {
+    let head = &bytes[..bytes.len().min(64 * 1024)];
+    let contains = |needle: &[u8]| {
+        head.windows(needle.len())
+            .any(|w| w.eq_ignore_ascii_case(needle))
+    };
+    for line in head.split(|&b| b == b'\n') {
+        let code = match line.iter().position(|&b| b == b';') {
+            Some(k) => &line[..k],
+            None => line,
+        };
+        let trimmed = code.trim_ascii_end();
+        if trimmed.ends_with(b"*") && !trimmed.starts_with(b"(") {
+            return Dialect::Heidenhain;
+        }
+        if line.first() == Some(&b'%')
+            && line
+                .split(|b| b.is_ascii_whitespace())
+                .any(|w| w.eq_ignore_ascii_case(b"G71") || w.eq_ignore_ascii_case(b"G70"))
+        {
+            return Dialect::Heidenhain;
+        }
+    }
+    if contains(b"TRAORI") || contains(b"TRAFOOF") {
+        Dialect::Sinumerik
+    } else if head.contains(&b'(') || contains(b"G43.4") {
+        Dialect::Fanuc
+    } else if head.contains(&b';') {
+        Dialect::Sinumerik
+    } else {
+        Dialect::Fanuc
+    }
+}
+
+/// Feed interpretation (modal G group 5).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum FeedMode {
+    /// G94: F is a feed per minute.
+    PerMinute,
+    /// G93 inverse time or G95 feed per revolution: F is not a feed in mm/min.
+    Other,
+}
+
+/// `G`/`M` code number times ten (`G43.4` → 434, `M128` → 1280), if it is one.
+fn code10(v: f64) -> Option<i64> {
+    let t = v * 10.0;
+    let r = t.round();
+    ((t - r).abs() < 1e-6 && (0.0..1e9).contains(&r)).then_some(r as i64)
+}
+
+/// What one block says, collected before the modal state is updated.
+#[derive(Default)]
+struct Scan {
+    axes: [Option<f64>; 6],
+    feed: Option<f64>,
+    motion: Option<Motion>,
+    incremental: Option<bool>,
+    inch: Option<bool>,
+    tcpm: Option<bool>,
+    feed_mode: Option<FeedMode>,
+    /// Axis words define a datum/frame (Heidenhain G54, G92, G10, G52, TRANS…): not a move.
+    datum_shift: bool,
+    /// Work offset selection (Fanuc/Sinumerik G54…G59, G500): positions re-based.
+    work_offset: bool,
+    /// Reference / machine-coordinate move (G28, G30, G53, SUPA).
+    reference: bool,
+    /// Axis words are arguments, not a move (G4 dwell, G65 macro call).
+    no_move: bool,
+    /// Positions are unknown afterwards (macro call).
+    unknown_after: bool,
+    breaks: bool,
+}
+
+struct Interpreter {
+    dialect: Dialect,
+    modal: Modal,
+    feed_mode: FeedMode,
+}
+
+impl Interpreter {
+    fn new(dialect: Dialect) -> Self {
+        Interpreter {
+            dialect,
+            modal: Modal::default(),
+            feed_mode: FeedMode::PerMinute,
+        }
+    }
+
+    fn g(&self, code: Option<i64>, s: &mut Scan) {
+        let heidenhain = self.dialect == Dialect::Heidenhain;
+        match code {
+            Some(0) => s.motion = Some(Motion::Rapid),
+            Some(10) => s.motion = Some(Motion::Linear),
+            Some(20) => s.motion = Some(Motion::ArcCw),
+            Some(30) => s.motion = Some(Motion::ArcCcw),
+            // Plane, cutter compensation off, canned cycle off, path control modes.
+            Some(170 | 180 | 190 | 400 | 800 | 600 | 610 | 640 | 6410..=6450) => {}
+            Some(900) => s.incremental = Some(false),
+            Some(910) => s.incremental = Some(true),
+            Some(200 | 700 | 7000) => s.inch = Some(true),
+            Some(210 | 710 | 7100) => s.inch = Some(false),
+            Some(434 | 435) => s.tcpm = Some(true),
+            Some(490) => s.tcpm = Some(false),
+            Some(940) => s.feed_mode = Some(FeedMode::PerMinute),
+            Some(930 | 950) => {
+                s.feed_mode = Some(FeedMode::Other);
+                s.breaks = true;
+            }
+            Some(530 | 540) if heidenhain => s.datum_shift = true,
+            Some(540..=590 | 5000 | 5050..=5990) => s.work_offset = true,
+            Some(920 | 100 | 520 | 500 | 510 | 680 | 681 | 690) => s.datum_shift = true,
+            Some(530 | 280 | 300) => s.reference = true,
+            Some(40) => {
+                s.no_move = true;
+                s.breaks = true;
+            }
+            Some(650 | 660) => {
+                s.no_move = true;
+                s.unknown_after = true;
+                s.breaks = true;
+            }
+            _ => s.breaks = true,
+        }
+    }
+
+    fn m(code: Option<i64>, s: &mut Scan) {
+        match code {
+            // Spindle and coolant.
+            Some(30 | 40 | 50 | 70 | 80 | 90 | 130 | 140) => {}
+            Some(1280) => s.tcpm = Some(true),
+            Some(1290) => s.tcpm = Some(false),
+            // Stops, end of program, tool change, anything unknown.
+            _ => s.breaks = true,
+        }
+    }
+
+    fn ident(name: &[u8], s: &mut Scan) {
+        let is = |n: &[u8]| name.eq_ignore_ascii_case(n);
+        if is(b"TRAORI") {
+            s.tcpm = Some(true);
+        } else if is(b"TRAFOOF") {
+            s.tcpm = Some(false);
+        } else if is(b"MSG") {
+        } else if [
+            &b"TRANS"[..],
+            b"ATRANS",
+            b"CTRANS",
+            b"ROT",
+            b"AROT",
+            b"CROT",
+            b"SCALE",
+            b"ASCALE",
+            b"MIRROR",
+            b"AMIRROR",
+        ]
+        .iter()
+        .any(|n| is(n))
+        {
+            s.datum_shift = true;
+        } else if is(b"SUPA") {
+            s.reference = true;
+        } else {
+            s.breaks = true;
+        }
+    }
+
+    fn block(
+        &mut self,
+        bytes: &[u8],
+        span: Range<usize>,
+        line: usize,
+        words: &mut Vec<Word>,
+    ) -> Result<Block, ParseError> {
+        let first_word = words.len();
+        let mut s = Scan::default();
+        for token in Lexer::new(bytes, span.clone()) {
+            let token =
+                token.map_err(|e| ParseError::at(line, e.at - span.start + 1, e.message))?;
+            match token {
+                Token::Word {
+                    letter,
+                    span,
+                    value_span,
+                    value,
+                } => {
+                    match letter {
+                        b'X' => s.axes[X] = Some(value),
+                        b'Y' => s.axes[Y] = Some(value),
+                        b'Z' => s.axes[Z] = Some(value),
+                        b'A' => s.axes[A] = Some(value),
+                        b'B' => s.axes[B] = Some(value),
+                        b'C' => s.axes[C] = Some(value),
+                        b'F' => s.feed = Some(value),
+                        b'G' => self.g(code10(value), &mut s),
+                        b'M' => Self::m(code10(value), &mut s),
+                        b'N' | b'S' | b'I' | b'J' | b'K' | b'R' | b'O' => {}
+                        // T tool, D/H offsets, U V W axes, P Q L E parameters.
+                        _ => s.breaks = true,
+                    }
+                    words.push(Word {
+                        letter,
+                        span,
+                        value_span,
+                        value,
+                    });
+                }
+                Token::Ident { name, .. } => Self::ident(&bytes[name], &mut s),
+                Token::Assign { letter, .. } => {
+                    if !matches!(letter, b'R' | b'S') {
+                        s.breaks = true;
+                    }
+                }
+                Token::Percent { span } => {
+                    for w in bytes[span].split(|b| b.is_ascii_whitespace()) {
+                        if w.eq_ignore_ascii_case(b"G70") {
+                            s.inch = Some(true);
+                        } else if w.eq_ignore_ascii_case(b"G71") {
+                            s.inch = Some(false);
+                        }
+                    }
+                }
+                Token::Slash { .. } => s.breaks = true,
+                Token::Comment { .. } | Token::BlockEnd { .. } | Token::Other { .. } => {}
+            }
+        }
+        Ok(self.apply(s, line, span, first_word..words.len()))
+    }
+
+    fn apply(&mut self, s: Scan, line: usize, span: Range<usize>, words: Range<usize>) -> Block {
+        let m = &mut self.modal;
+        let mut breaks = s.breaks;
+        if let Some(mo) = s.motion {
+            m.motion = mo;
+        }
+        if let Some(inc) = s.incremental {
+            m.incremental = inc;
+        }
+        if let Some(inch) = s.inch {
+            m.inch = inch;
+        }
+        if let Some(t) = s.tcpm {
+            m.tcpm = t;
+            breaks = true;
+        }
+        if let Some(fm) = s.feed_mode {
+            if fm != self.feed_mode {
+                self.feed_mode = fm;
+                m.feed_mm_min = None;
+                breaks = true;
+            }
+        }
+        let scale = if m.inch { 25.4 } else { 1.0 };
+        if let Some(f) = s.feed {
+            m.feed_mm_min = (self.feed_mode == FeedMode::PerMinute).then_some(f * scale);
+        }
+        let has_axes = s.axes.iter().any(Option::is_some);
+        let mut is_move = false;
+        if s.datum_shift || s.reference || s.unknown_after {
+            // Linear positions unknown afterwards; so are rotary axes named in the block.
+            for (i, p) in m.pos.iter_mut().enumerate() {
+                if i < A || s.axes[i].is_some() || s.unknown_after {
+                    *p = None;
+                }
+            }
+            is_move = s.reference && has_axes;
+            breaks = true;
+        } else if s.no_move {
+            breaks = true;
+        } else {
+            if s.work_offset {
+                m.pos[X] = None;
+                m.pos[Y] = None;
+                m.pos[Z] = None;
+                breaks = true;
+            }
+            for (i, v) in s.axes.iter().enumerate() {
+                if let Some(v) = *v {
+                    let v = if i < A { v * scale } else { v };
+                    m.pos[i] = if m.incremental {
+                        m.pos[i].map(|p| p + v)
+                    } else {
+                        Some(v)
+                    };
+                }
+            }
+            if has_axes {
+                is_move = m.motion != Motion::None;
+                if m.motion != Motion::Linear {
+                    breaks = true;
+                }
+            }
+        }
+        Block {
+            line,
+            span,
+            words,
+            state: *m,
+            is_move,
+            breaks_run: breaks,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn p(s: &str) -> Program {
+        parse(s.as_bytes().to_vec(), Dialect::Auto).unwrap()
+    }
+
+    #[test]
+    fn lines_and_endings() {
+        let prog = p("G1 X1\r\nY2\n\nZ3");
+        assert_eq!(prog.blocks.len(), 4);
+        assert_eq!(prog.blocks[0].span, 0..5);
+        assert_eq!(prog.blocks[1].span, 7..9);
+        assert_eq!(prog.blocks[2].span, 10..10);
+        assert_eq!(prog.blocks[3].span, 11..13);
+        assert_eq!(
+            prog.blocks[3].state.pos[..3],
+            [Some(1.0), Some(2.0), Some(3.0)]
+        );
+        assert_eq!(p("X1\n").blocks.len(), 1);
+        assert!(p("").blocks.is_empty());
+    }
+
+    #[test]
+    fn dialects_are_detected() {
+        assert_eq!(detect(b"%P G71 *\nN10 G90 *\n"), Dialect::Heidenhain);
+        assert_eq!(detect(b"N10 TRAORI\nN20 G1 X1 ; cut\n"), Dialect::Sinumerik);
+        assert_eq!(detect(b"%\nO1234 (PART)\nG43.4 H1\n%\n"), Dialect::Fanuc);
+    }
+
+    #[test]
+    fn modal_state() {
+        let prog = p("G21 G90 G1 X1 Y2 Z3 F100\nG91 X1 C10\nG90 G20 X1 F10\nG0 Z1\nM128\nG49\n");
+        let st: Vec<Modal> = prog.blocks.iter().map(|b| b.state).collect();
+        assert_eq!(st[0].feed_mm_min, Some(100.0));
+        assert_eq!(st[1].pos[X], Some(2.0));
+        assert_eq!(
+            st[1].pos[C], None,
+            "incremental from an unknown position stays unknown"
+        );
+        assert!(st[1].incremental);
+        assert_eq!(st[2].pos[X], Some(25.4));
+        assert!((st[2].feed_mm_min.unwrap() - 254.0).abs() < 1e-12);
+        assert_eq!(st[3].motion, Motion::Rapid);
+        assert!(prog.blocks[3].breaks_run && prog.blocks[3].is_move);
+        assert!(st[4].tcpm && prog.blocks[4].breaks_run);
+        assert!(!st[5].tcpm && prog.blocks[5].breaks_run);
+        assert!(!prog.blocks[1].breaks_run && prog.blocks[1].is_move);
+    }
+
+    #[test]
+    fn heidenhain_datum_shift_is_not_a_move() {
+        let prog =
+            p("%P G71 *\nN10 G01 X+1 Y+2 Z+3 A+5 F100 *\nN20 G54 X+1 Y+2 Z+3 *\nN30 X+4 *\n");
+        let b = &prog.blocks[2];
+        assert!(!b.is_move && b.breaks_run);
+        assert_eq!(b.state.pos, [None, None, None, Some(5.0), None, None]);
+        assert_eq!(prog.blocks[3].state.pos[X], Some(4.0));
+        assert!(prog.blocks[3].is_move && !prog.blocks[3].breaks_run);
+    }
+
+    #[test]
+    fn fanuc_work_offset_select_moves_in_the_new_frame() {
+        let prog = p("G1 X1 Y2 Z3\nG54 G0 X5 Y6 (SELECT)\n");
+        let b = &prog.blocks[1];
+        assert!(b.is_move && b.breaks_run);
+        assert_eq!(b.state.pos[..3], [Some(5.0), Some(6.0), None]);
+    }
+
+    #[test]
+    fn run_breakers() {
+        let breaks = |s: &str| p(&format!("G1 X0 Y0 Z0 F100\n{s}\n")).blocks[1].breaks_run;
+        for s in [
+            "T5",
+            "M6",
+            "M06",
+            "M0",
+            "M00",
+            "M1",
+            "M30",
+            "M2",
+            "M128",
+            "M129",
+            "TRAORI",
+            "TRAFOOF",
+            "G43.4 H1",
+            "G49",
+            "G92 X0",
+            "G10 L2 P1 X0",
+            "G53 Z0",
+            "G28 Z0",
+            "G93",
+            "G0 X1",
+            "G2 X1 I1",
+            "G3 X1 I1",
+            "CYCLE800(1)",
+            "/N10 X1",
+            "G4 X1",
+            "T=\"MILL\"",
+        ] {
+            assert!(breaks(s), "{s} should break a run");
+        }
+        for s in [
+            "",
+            "; comment",
+            "(comment)",
+            "S12000 M13",
+            "M8",
+            "M9",
+            "M3 S100",
+            "M05 M09",
+            "X1 Y2",
+            "F200",
+            "MSG(\"hello\")",
+            "R1=5",
+            "G90",
+            "G17",
+        ] {
+            assert!(!breaks(s), "{s} should not break a run");
+        }
+    }
+
+    #[test]
+    fn errors_have_line_and_column() {
+        let e = parse(b"N10 G1 X1\nN20 C12..5\n".to_vec(), Dialect::Auto).unwrap_err();
+        assert_eq!((e.line, e.column), (2, 5));
+        assert_eq!(
+            e.to_string(),
+            "line 2, col 5: C value '12..5' is not a number"
+        );
+        let e = parse(b"N10 G1\r\nN20 X=IC(5) Y1\r\n".to_vec(), Dialect::Sinumerik).unwrap_err();
+        assert_eq!((e.line, e.column), (2, 5));
+        assert!(e.message.contains("needs a plain number"), "{}", e.message);
+    }
+
+    #[test]
+    fn non_utf8_passes() {
+        let prog = parse(
+            b"N10 G1 X1 ; \xe9\xff\nN20 Y\xfc\xfc\n".to_vec(),
+            Dialect::Auto,
+        );
+        assert!(
+            prog.is_err(),
+            "Y followed by a non-number byte needs a number"
+        );
+        let prog = parse(
+            b"N10 G1 X1 ; \xe9\xff\nN20 \xfc\xfc Y2\n".to_vec(),
+            Dialect::Auto,
+        )
+        .unwrap();
+        assert_eq!(prog.blocks[1].state.pos[Y], Some(2.0));
+    }
 }

@@ -1,5 +1,6 @@
 //! Runs of G1 motion with cumulative tool-tip path length s.
 
+use crate::modal::{Modal, X, Y, Z};
 use crate::program::Program;
 
 /// Why a run ended (for reports).
@@ -50,8 +51,150 @@ impl Run {
     }
 }
 
+/// A G1 block whose tool tip moves less than this (mm) has zero tool-tip length: it ends
+/// the current run and is not part of any run. Exact repeats give 0; the tolerance only
+/// absorbs rounding from inch conversion and incremental sums.
+pub const ZERO_LENGTH_MM: f64 = 1e-9;
+
 /// The runs of a program (each with at least 2 points), in file order.
+///
+/// Walking the blocks: a block that breaks runs ([`crate::Block::breaks_run`], which
+/// includes every G0/G2/G3 move) ends the current run. A G1 move with tool-tip motion
+/// extends the current run, or starts one from the block that established its start
+/// position (ending the current run first if F or the TCPM state differs). A G1 move
+/// whose start or end X Y Z is unknown, or whose tool-tip length is zero (only rotary
+/// motion, or nothing moving), ends the current run and becomes point 0 of the next one.
+/// Other blocks (comments, S, coolant, an F alone) are skipped.
 pub fn runs(program: &Program) -> Vec<Run> {
-    let _ = program;
-    todo!()
+    let mut out = Vec::new();
+    let mut cur: Option<Run> = None;
+    let mut prev = Modal::default();
+    let mut last_pos: Option<usize> = None;
+    let finish = |cur: &mut Option<Run>, why: RunBreak, out: &mut Vec<Run>| {
+        if let Some(mut r) = cur.take() {
+            if r.len() >= 2 {
+                r.ended_by = why;
+                out.push(r);
+            }
+        }
+    };
+    let start = |block: usize, st: &Modal| Run {
+        blocks: vec![block],
+        s_mm: vec![0.0],
+        pos: vec![st.pos],
+        feed_mm_min: st.feed_mm_min,
+        tcpm: st.tcpm,
+        ended_by: RunBreak::End,
+    };
+    for (i, b) in program.blocks.iter().enumerate() {
+        let st = &b.state;
+        if b.breaks_run {
+            finish(&mut cur, RunBreak::Block, &mut out);
+        } else if b.is_move {
+            match (xyz(&prev.pos), xyz(&st.pos)) {
+                (Some(p0), Some(p1)) => {
+                    let d = ((p1[0] - p0[0]).powi(2)
+                        + (p1[1] - p0[1]).powi(2)
+                        + (p1[2] - p0[2]).powi(2))
+                    .sqrt();
+                    if d <= ZERO_LENGTH_MM {
+                        finish(&mut cur, RunBreak::ZeroLength, &mut out);
+                        cur = Some(start(i, st));
+                    } else {
+                        if let Some(r) = &mut cur {
+                            if r.feed_mm_min != st.feed_mm_min || r.tcpm != st.tcpm {
+                                if r.len() == 1 {
+                                    r.feed_mm_min = st.feed_mm_min;
+                                    r.tcpm = st.tcpm;
+                                } else {
+                                    finish(&mut cur, RunBreak::FeedChange, &mut out);
+                                }
+                            }
+                        }
+                        let r = cur.get_or_insert_with(|| {
+                            let mut r = start(last_pos.unwrap_or(i), &prev);
+                            r.feed_mm_min = st.feed_mm_min;
+                            r.tcpm = st.tcpm;
+                            r
+                        });
+                        let s = r.length_mm() + d;
+                        r.blocks.push(i);
+                        r.s_mm.push(s);
+                        r.pos.push(st.pos);
+                    }
+                }
+                _ => {
+                    finish(&mut cur, RunBreak::Block, &mut out);
+                    cur = Some(start(i, st));
+                }
+            }
+        }
+        if b.is_move || st.pos != prev.pos {
+            last_pos = Some(i);
+        }
+        prev = *st;
+    }
+    finish(&mut cur, RunBreak::End, &mut out);
+    out
+}
+
+fn xyz(pos: &[Option<f64>; 6]) -> Option<[f64; 3]> {
+    Some([pos[X]?, pos[Y]?, pos[Z]?])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::modal::{A, C};
+    use crate::{Dialect, parse};
+
+    fn runs_of(s: &str) -> (Program, Vec<Run>) {
+        let p = parse(s.as_bytes().to_vec(), Dialect::Auto).unwrap();
+        let r = runs(&p);
+        (p, r)
+    }
+
+    #[test]
+    fn planted_run() {
+        let (_, r) =
+            runs_of("G0 X0 Y0 Z0\nG1 X3 Y4 F100 C10\n; note\nX6 Y8 C20\nM8\nX6 Y8 Z10\nG0 Z50\n");
+        assert_eq!(r.len(), 1);
+        assert_eq!(r[0].blocks, vec![0, 1, 3, 5]);
+        assert_eq!(r[0].s_mm, vec![0.0, 5.0, 10.0, 20.0]);
+        assert_eq!(r[0].pos[2][C], Some(20.0));
+        assert_eq!(r[0].pos[0][C], None);
+        assert_eq!(r[0].feed_mm_min, Some(100.0));
+        assert_eq!(r[0].ended_by, RunBreak::Block);
+    }
+
+    #[test]
+    fn zero_length_block_splits_and_is_not_moved() {
+        let (_, r) = runs_of("G1 X0 Y0 Z0 F100\nX1\nX2\nA10 C5\nX3\nX4\n");
+        assert_eq!(r.len(), 2);
+        assert_eq!(r[0].blocks, vec![0, 1, 2]);
+        assert_eq!(r[0].ended_by, RunBreak::ZeroLength);
+        assert_eq!(r[1].blocks, vec![3, 4, 5]);
+        assert_eq!(r[1].pos[0][A], Some(10.0));
+        assert_eq!(r[1].ended_by, RunBreak::End);
+    }
+
+    #[test]
+    fn feed_change_shares_the_boundary_point() {
+        let (_, r) = runs_of("G1 X0 Y0 Z0 F100\nX1\nX2\nF200\nX3\nX4 F300\n");
+        assert_eq!(r.len(), 3);
+        assert_eq!(r[0].blocks, vec![0, 1, 2]);
+        assert_eq!(r[0].ended_by, RunBreak::FeedChange);
+        assert_eq!(r[1].blocks, vec![2, 4]);
+        assert_eq!(r[1].feed_mm_min, Some(200.0));
+        assert_eq!(r[2].blocks, vec![4, 5]);
+        assert_eq!(r[2].feed_mm_min, Some(300.0));
+    }
+
+    #[test]
+    fn unknown_start_starts_at_the_end_point() {
+        let (_, r) = runs_of("G1 Z5 F100\nX0 Y0\nX1\nG92 X0 Y0 Z0\nG1 X1 Y1 Z1\nX2\n");
+        assert_eq!(r.len(), 2);
+        assert_eq!(r[0].blocks, vec![1, 2]);
+        assert_eq!(r[1].blocks, vec![4, 5]);
+    }
 }

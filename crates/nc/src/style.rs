@@ -1,5 +1,7 @@
 //! The file's number style, so that rewritten words look like their neighbours.
 
+use crate::lexer::parse_number;
+use crate::modal::AXES;
 use crate::program::Program;
 
 /// How numbers of one address letter are written in a file.
@@ -20,21 +22,261 @@ pub struct NumberStyle {
     pub equals: bool,
 }
 
+/// What the words of one letter show about their style.
+#[derive(Default)]
+struct Evidence {
+    words: usize,
+    max_decimals: usize,
+    min_decimals: usize,
+    /// Non-negative values with / without `+`.
+    plus: usize,
+    unsigned: usize,
+    /// Whole numbers with / without a trailing point.
+    point: usize,
+    no_point: usize,
+    /// Values below 1 written `0.5` / `.5`.
+    zero: usize,
+    no_zero: usize,
+    equals: usize,
+    /// Values whose last decimal is a `0` (`12.500`): evidence against stripping.
+    trailing_zero: usize,
+}
+
+impl Evidence {
+    fn collect(program: &Program, pick: impl Fn(u8) -> bool) -> Evidence {
+        let mut e = Evidence {
+            min_decimals: usize::MAX,
+            ..Evidence::default()
+        };
+        let bytes = &program.bytes[..];
+        for w in program.words.iter().filter(|w| pick(w.letter)) {
+            let text = &bytes[w.value_span.clone()];
+            e.words += 1;
+            if w.value_span.start > w.span.start + 1 {
+                e.equals += 1;
+            }
+            let (sign, body) = match text.first() {
+                Some(b'+') => (Some(b'+'), &text[1..]),
+                Some(b'-') => (Some(b'-'), &text[1..]),
+                _ => (None, text),
+            };
+            match sign {
+                Some(b'+') => e.plus += 1,
+                None => e.unsigned += 1,
+                _ => {}
+            }
+            let (decimals, has_point) = match body.iter().position(|&b| b == b'.') {
+                Some(k) => (body.len() - k - 1, true),
+                None => (0, false),
+            };
+            e.max_decimals = e.max_decimals.max(decimals);
+            e.min_decimals = e.min_decimals.min(decimals);
+            if decimals > 0 && body.last() == Some(&b'0') {
+                e.trailing_zero += 1;
+            }
+            if decimals == 0 {
+                if has_point {
+                    e.point += 1;
+                } else {
+                    e.no_point += 1;
+                }
+            } else if body.first() == Some(&b'.') {
+                e.no_zero += 1;
+            } else if body.first() == Some(&b'0') && body.get(1) == Some(&b'.') {
+                e.zero += 1;
+            }
+        }
+        e
+    }
+}
+
+impl Evidence {
+    /// Whether these words strip trailing zeros: `Some(true)` if some are written with
+    /// fewer decimals than others, `Some(false)` if one ends in a decimal `0`, `None`
+    /// when they cannot tell (no words, or all with the same decimals).
+    fn strips(&self) -> Option<bool> {
+        if self.trailing_zero > 0 {
+            Some(false)
+        } else if self.words > 0 && self.min_decimals < self.max_decimals {
+            Some(true)
+        } else {
+            None
+        }
+    }
+}
+
 impl NumberStyle {
     /// The style of `letter` words in `program`, falling back to the style of the other
     /// axis words when the letter never occurs.
+    ///
+    /// - `plus_sign`: a non-negative value of the letter is written with `+` (if the
+    ///   letter has no non-negative value: one of the axis words X Y Z A B C is);
+    /// - `decimals`: the most decimals written;
+    /// - `strip_trailing_zeros`: some value is written with fewer decimals than that and
+    ///   none ends in a decimal `0` (letter; if its words all have the same decimals,
+    ///   the axis words decide; else false);
+    /// - `trailing_point`: a whole number is written `180.` (letter, else axis words);
+    /// - `leading_zero`: false only if values below 1 are written `.5` and never `0.5`
+    ///   (letter, else axis words);
+    /// - `equals`: a word is written `C=…`.
     pub fn of(program: &Program, letter: u8) -> NumberStyle {
-        let _ = (program, letter);
-        todo!()
+        let letter = letter.to_ascii_uppercase();
+        let own = Evidence::collect(program, |l| l == letter);
+        let axes = Evidence::collect(program, |l| AXES.contains(&l));
+        let main = if own.words > 0 { &own } else { &axes };
+        let plus = if main.plus + main.unsigned > 0 {
+            main
+        } else {
+            &axes
+        };
+        let point = if main.point + main.no_point > 0 {
+            main
+        } else {
+            &axes
+        };
+        let zero = if main.zero + main.no_zero > 0 {
+            main
+        } else {
+            &axes
+        };
+        NumberStyle {
+            plus_sign: plus.plus > 0,
+            decimals: main.max_decimals,
+            strip_trailing_zeros: main
+                .strips()
+                .unwrap_or_else(|| axes.strips().unwrap_or(false)),
+            trailing_point: point.point > 0,
+            leading_zero: !(zero.no_zero > 0 && zero.zero == 0),
+            equals: main.equals > 0,
+        }
     }
+
     /// The number as this style writes it with `decimals` places (not the letter).
+    ///
+    /// Starts from `format!("{:.*}", decimals, value)` (round half to even on the binary
+    /// value, as the patcher verifies), then: a negative zero loses its `-`; trailing
+    /// zeros are stripped (and the point unless `trailing_point`) if
+    /// `strip_trailing_zeros`, else a whole number gets a point if `trailing_point`; a
+    /// leading `0` before the point is dropped unless `leading_zero`; `+` is put before a
+    /// non-negative value if `plus_sign`.
     pub fn render(&self, value: f64, decimals: usize) -> String {
-        let _ = (value, decimals);
-        todo!()
+        let mut s = format!("{:.*}", decimals, value);
+        if s.starts_with('-') && s[1..].bytes().all(|b| b == b'0' || b == b'.') {
+            s.remove(0);
+        }
+        if s.contains('.') {
+            if self.strip_trailing_zeros {
+                let keep = s.trim_end_matches('0').len();
+                s.truncate(keep);
+                if s.ends_with('.') && !self.trailing_point {
+                    s.pop();
+                }
+            }
+        } else if self.trailing_point && s.bytes().all(|b| b.is_ascii_digit() || b == b'-') {
+            s.push('.');
+        }
+        if !self.leading_zero {
+            let digits = if s.starts_with('-') { 1 } else { 0 };
+            if s[digits..].starts_with("0.") && s.len() > digits + 2 {
+                s.remove(digits);
+            }
+        }
+        if self.plus_sign && !s.starts_with('-') {
+            s.insert(0, '+');
+        }
+        s
     }
-    /// The value the controller receives: `render` parsed back.
+
+    /// The value the controller receives: `render` parsed back (NaN if `value` is not
+    /// finite).
     pub fn rounded(&self, value: f64, decimals: usize) -> f64 {
-        let _ = (value, decimals);
-        todo!()
+        parse_number(self.render(value, decimals).as_bytes()).unwrap_or(f64::NAN)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Dialect, parse};
+
+    fn style(s: &str, letter: u8) -> NumberStyle {
+        NumberStyle::of(
+            &parse(s.as_bytes().to_vec(), Dialect::Auto).unwrap(),
+            letter,
+        )
+    }
+
+    const HEID: NumberStyle = NumberStyle {
+        plus_sign: true,
+        decimals: 3,
+        strip_trailing_zeros: true,
+        trailing_point: false,
+        leading_zero: true,
+        equals: false,
+    };
+
+    #[test]
+    fn heidenhain_style() {
+        let st = style("N1 G01 X+0 C+126.28 *\nN2 C+148.494 *\nN3 C+180 *\n", b'C');
+        assert_eq!(st, HEID);
+        assert_eq!(st.render(180.0, 3), "+180");
+        assert_eq!(st.render(126.2800001, 3), "+126.28");
+        assert_eq!(st.render(-0.0001, 3), "+0");
+        assert_eq!(st.render(-12.5, 3), "-12.5");
+        assert_eq!(st.render(0.25, 3), "+0.25");
+        assert_eq!(st.rounded(148.4944, 3), 148.494);
+        assert_eq!(st.rounded(148.4946, 4), 148.4946);
+    }
+
+    #[test]
+    fn fanuc_style() {
+        let st = style("G1 X10. Y-.5 C12.5\nC180.\nC-.25\n", b'C');
+        assert!(!st.plus_sign && st.trailing_point && st.strip_trailing_zeros && !st.leading_zero);
+        assert_eq!(st.decimals, 2);
+        assert_eq!(st.render(180.0, 3), "180.");
+        assert_eq!(st.render(0.5, 3), ".5");
+        assert_eq!(st.render(-0.5, 3), "-.5");
+        assert_eq!(st.render(0.0, 3), "0.");
+        assert_eq!(st.render(-0.0, 3), "0.");
+        assert_eq!(st.rounded(-0.4999, 3), -0.5);
+    }
+
+    #[test]
+    fn fixed_decimals_and_equals() {
+        let st = style("N10 G1 X=10.000 A=2.500 C=30.000\n", b'C');
+        assert!(st.equals && !st.plus_sign && !st.strip_trailing_zeros);
+        assert_eq!(st.decimals, 3);
+        assert_eq!(st.render(30.0, 3), "30.000");
+        assert_eq!(st.render(-0.0, 3), "0.000");
+    }
+
+    #[test]
+    fn missing_letter_falls_back_to_axis_words() {
+        let st = style("N1 G01 X+1.5 Y+0 A+2.25 *\n", b'C');
+        assert!(st.plus_sign && st.strip_trailing_zeros);
+        assert_eq!(st.decimals, 2);
+        // Only negative C values: the sign style comes from the axis words.
+        assert!(style("N1 G01 X+1.5 C-2.5 *\n", b'C').plus_sign);
+    }
+
+    #[test]
+    fn render_is_based_on_std_format() {
+        let st = NumberStyle {
+            plus_sign: false,
+            decimals: 3,
+            strip_trailing_zeros: false,
+            trailing_point: false,
+            leading_zero: true,
+            equals: false,
+        };
+        for v in [0.0005, 0.0015, 2.675, -1.0005, 123456.789, 1e-9, -1e-9] {
+            let f = format!("{:.3}", v);
+            let expected = if f == "-0.000" {
+                "0.000".to_string()
+            } else {
+                f
+            };
+            assert_eq!(st.render(v, 3), expected, "{v}");
+        }
     }
 }

@@ -1,6 +1,8 @@
 //! Rewriting: changed or inserted words, every other byte copied.
 
+use crate::modal::AXES;
 use crate::program::Program;
+use crate::style::NumberStyle;
 
 /// Set word `letter` of block `block` to `value`, written with `decimals` places in the
 /// file's style for that letter ([`crate::NumberStyle::of`]). A block without the word gets
@@ -19,8 +21,206 @@ pub struct Edit {
 }
 
 /// The program's bytes with `edits` applied (any order; at most one edit per block and
-/// letter). Nothing else changes.
+/// letter — if a pair repeats, the last edit wins). Nothing else changes.
+///
+/// An existing word has only its number (`value_span`) replaced: letter, `=`, sign
+/// position and everything around stay. An inserted word is `sep letter [=] number`
+/// placed right after its anchor word, where `sep` is the gap the block leaves before its
+/// anchor word (or after it), else the file's usual gap between words (a space or
+/// nothing). With no edits this is a plain copy.
+///
+/// # Panics
+/// If an edit names a block that does not exist.
 pub fn write(program: &Program, edits: &[Edit]) -> Vec<u8> {
-    let _ = (program, edits);
-    todo!()
+    let bytes = &program.bytes;
+    if edits.is_empty() {
+        return bytes.clone();
+    }
+    let mut order: Vec<usize> = (0..edits.len()).collect();
+    order.sort_by_key(|&i| (edits[i].block, edits[i].letter.to_ascii_uppercase()));
+    let mut styles: [Option<NumberStyle>; 26] = [None; 26];
+    let mut default_gap: Option<&'static [u8]> = None;
+    // (start, end, rank, replacement)
+    let mut splices: Vec<(usize, usize, usize, Vec<u8>)> = Vec::with_capacity(edits.len());
+    for (k, &i) in order.iter().enumerate() {
+        let e = &edits[i];
+        let letter = e.letter.to_ascii_uppercase();
+        if order.get(k + 1).is_some_and(|&j| {
+            (edits[j].block, edits[j].letter.to_ascii_uppercase()) == (e.block, letter)
+        }) {
+            continue;
+        }
+        assert!(
+            e.block < program.blocks.len(),
+            "edit of block {} but the program has {}",
+            e.block,
+            program.blocks.len()
+        );
+        let style = *styles[usize::from(letter.wrapping_sub(b'A')).min(25)]
+            .get_or_insert_with(|| NumberStyle::of(program, letter));
+        let number = style.render(e.value, e.decimals);
+        let own_rank = rank(letter);
+        if let Some(w) = program.word(e.block, letter) {
+            splices.push((
+                w.value_span.start,
+                w.value_span.end,
+                own_rank,
+                number.into_bytes(),
+            ));
+            continue;
+        }
+        let words = program.block_words(e.block);
+        let anchor = words
+            .iter()
+            .rposition(|w| rank(w.letter) < own_rank && own_rank < AXES.len())
+            .or_else(|| words.len().checked_sub(1));
+        let mut text = Vec::with_capacity(number.len() + 3);
+        let at = match anchor {
+            Some(a) => {
+                let gap_before = a
+                    .checked_sub(1)
+                    .map(|p| &bytes[words[p].span.end..words[a].span.start]);
+                let gap_after = words
+                    .get(a + 1)
+                    .map(|n| &bytes[words[a].span.end..n.span.start]);
+                let blank = |g: &&[u8]| g.iter().all(|&b| b == b' ' || b == b'\t');
+                match gap_before.filter(blank).or(gap_after.filter(blank)) {
+                    Some(g) => text.extend_from_slice(g),
+                    None => {
+                        text.extend_from_slice(default_gap.get_or_insert_with(|| file_gap(program)))
+                    }
+                }
+                words[a].span.end
+            }
+            None => program.blocks[e.block].span.start,
+        };
+        text.push(letter);
+        if style.equals {
+            text.push(b'=');
+        }
+        text.extend_from_slice(number.as_bytes());
+        if anchor.is_none() && !program.blocks[e.block].span.is_empty() {
+            text.push(b' ');
+        }
+        splices.push((at, at, own_rank, text));
+    }
+    splices.sort_by_key(|s| (s.0, s.2));
+    let extra: usize = splices.iter().map(|s| s.3.len()).sum();
+    let mut out = Vec::with_capacity(bytes.len() + extra);
+    let mut pos = 0;
+    for (start, end, _, text) in &splices {
+        out.extend_from_slice(&bytes[pos..*start]);
+        out.extend_from_slice(text);
+        pos = *end;
+    }
+    out.extend_from_slice(&bytes[pos..]);
+    out
+}
+
+/// Position of `letter` in X Y Z A B C order; other letters come after.
+fn rank(letter: u8) -> usize {
+    AXES.iter().position(|&l| l == letter).unwrap_or(AXES.len())
+}
+
+/// The usual gap between two words of a block in this file: a space, unless most words
+/// follow each other directly (`G1X10.Y5.`).
+fn file_gap(program: &Program) -> &'static [u8] {
+    let (mut spaced, mut tight) = (0usize, 0usize);
+    for b in &program.blocks {
+        let ws = &program.words[b.words.clone()];
+        for pair in ws.windows(2) {
+            if pair[0].span.end == pair[1].span.start {
+                tight += 1;
+            } else {
+                spaced += 1;
+            }
+        }
+    }
+    if tight > spaced { b"" } else { b" " }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Dialect, parse};
+
+    fn edit(src: &str, edits: &[Edit]) -> String {
+        let p = parse(src.as_bytes().to_vec(), Dialect::Auto).unwrap();
+        String::from_utf8(write(&p, edits)).unwrap()
+    }
+
+    fn c(block: usize, value: f64) -> Edit {
+        Edit {
+            block,
+            letter: b'C',
+            value,
+            decimals: 3,
+        }
+    }
+
+    #[test]
+    fn no_edits_is_a_copy() {
+        let src = "N1 G01 X+1 C+12.5 *\r\nN2 C+13 *";
+        assert_eq!(edit(src, &[]), src);
+    }
+
+    #[test]
+    fn replaces_only_the_number() {
+        let src = "N1 G01 X+1 C+12.5 *\nN2 X+2 C+13.125 *\n";
+        assert_eq!(
+            edit(src, &[c(0, 12.25)]),
+            "N1 G01 X+1 C+12.25 *\nN2 X+2 C+13.125 *\n"
+        );
+        assert_eq!(
+            edit(src, &[c(1, -0.0001), c(0, 180.0)]),
+            "N1 G01 X+1 C+180 *\nN2 X+2 C+0 *\n"
+        );
+        assert_eq!(
+            edit("N10 G1 X=1.25 C=30\n", &[c(0, 31.5)]),
+            "N10 G1 X=1.25 C=31.5\n"
+        );
+    }
+
+    #[test]
+    fn inserts_in_the_file_way() {
+        let src = "N1 G01 X+1 Y+2 Z+3 A+4 C+12.5 F100 *\nN2 X+2 A+5 F200 *\nN3 F300 *\n";
+        assert_eq!(
+            edit(src, &[c(1, 13.0), c(2, 14.0)]),
+            "N1 G01 X+1 Y+2 Z+3 A+4 C+12.5 F100 *\nN2 X+2 A+5 C+13 F200 *\nN3 F300 C+14 *\n"
+        );
+        // Without spaces, and with a comment at the end.
+        let src = "G1 X1. Y2. C3.5\nG1X10.Y5.(CUT)\nX11.\tY5.\n";
+        assert_eq!(
+            edit(src, &[c(1, 4.0), c(2, 4.5)]),
+            "G1 X1. Y2. C3.5\nG1X10.Y5.C4.(CUT)\nX11.\tY5.\tC4.5\n"
+        );
+        // Two insertions at one place keep X Y Z A B C order.
+        let ab = [
+            Edit {
+                block: 0,
+                letter: b'C',
+                value: 1.0,
+                decimals: 1,
+            },
+            Edit {
+                block: 0,
+                letter: b'A',
+                value: 2.0,
+                decimals: 1,
+            },
+        ];
+        assert_eq!(
+            edit("G1 X1.5 Y2.5 F100\n", &ab),
+            "G1 X1.5 Y2.5 A2.0 C1.0 F100\n",
+            "fixed one decimal"
+        );
+    }
+
+    #[test]
+    fn last_edit_of_a_pair_wins() {
+        assert_eq!(
+            edit("G1 X1.5 Y2 C1.5\n", &[c(0, 2.0), c(0, 3.0)]),
+            "G1 X1.5 Y2 C3\n"
+        );
+    }
 }
