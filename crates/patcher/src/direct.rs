@@ -274,7 +274,7 @@ pub fn direct_patch(
             if k >= mon_lo && k < mon_hi {
                 push_sign(&mut rows, &b1, sigma);
             }
-            if k + 1 == spans.end && k + 1 <= mon_hi && k + 1 >= mon_lo {
+            if k + 1 == spans.end && k < mon_hi && k + 1 >= mon_lo {
                 push_sign(&mut rows, &sp.m1, sigma);
             }
         }
@@ -347,7 +347,7 @@ pub fn deviation_bound_sampled(
     step_mm: f64,
 ) -> Result<(f64, QpStats), PatchFailure> {
     check_range(s_mm.len(), first, last)?;
-    if !(step_mm > 0.0) {
+    if step_mm.is_nan() || step_mm <= 0.0 {
         return Err(PatchFailure::TooShort);
     }
     let r = Responses::new(s_mm, c_deg, first, last);
@@ -374,7 +374,7 @@ pub fn deviation_bound_sampled(
         .map(|i| p_deg[i].to_radians().sin().abs())
         .collect();
     let mut stats = QpStats::default();
-    let mut feasible = |tdeg: f64, stats: &mut QpStats| -> bool {
+    let feasible = |tdeg: f64, stats: &mut QpStats| -> bool {
         let mut rows = spline_rows.clone();
         let st = (tdeg.to_radians() / 2.0).sin();
         for (i, wi) in w.iter().enumerate() {
