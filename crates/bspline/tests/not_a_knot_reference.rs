@@ -5,6 +5,8 @@
 //! magnitude over length^k if larger (a derivative passing through zero has no relative
 //! error of its own).
 
+#![allow(clippy::needless_range_loop)]
+
 use polepatch_bspline::{NotAKnotSystem, interpolate_not_a_knot};
 
 const CSV: &str = include_str!("data/not_a_knot_reference.csv");

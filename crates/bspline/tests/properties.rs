@@ -1,6 +1,8 @@
 //! Property tests: cubic reproduction on random parameters, and degenerate input that is
 //! always a clear error (never a panic, never a silent NaN).
 
+#![allow(clippy::needless_range_loop)]
+
 use polepatch_bspline::{
     NotAKnotSystem, SplineError, fit_least_squares, interpolate_clamped, interpolate_not_a_knot,
     knots::clamped_cubic, sample_params,
