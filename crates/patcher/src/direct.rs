@@ -465,11 +465,10 @@ mod tests {
 
     #[test]
     fn direct_reaches_feed_on_a_swing() {
-        let (s, p, c) = swing(161, 1.0, 0.5);
-        let lim = ucp_limits(2000.0, 0.02);
-        let lim0 = ucp_limits(2000.0, 0.0);
-        let (first, last) = (10, 150);
-        eprintln!("C {} .. {} .. {}", c[first], c[80], c[last]);
+        let (s, p, c) = swing(101, 1.0, 0.5);
+        let lim = ucp_limits(1000.0, 0.02);
+        let lim0 = ucp_limits(1000.0, 0.0);
+        let (first, last) = (20, 80);
         let cand = direct_patch(
             &s,
             &p,
@@ -483,7 +482,7 @@ mod tests {
         .expect("solvable");
         let mut c2 = c.clone();
         c2[first..=last].copy_from_slice(&cand.c_deg);
-        let v = verify_c_change(&s, &c, &c2, first, last, &lim0, 2000.0 / 60.0 * 1e-3);
+        let v = verify_c_change(&s, &c, &c2, first, last, &lim0, 1000.0 / 60.0 * 1e-3);
         assert!(
             v.core_min_before < 0.5,
             "planted case must be below feed: {v:?}"
@@ -493,7 +492,7 @@ mod tests {
             .map(|i| orientation_deviation_deg(p[i], c2[i] - c[i]))
             .fold(0.0, f64::max);
         let (bound, _) =
-            deviation_bound_sampled(&s, &p, &c, first, last, &lim0, 2000.0 / 60.0 * 1e-3).unwrap();
+            deviation_bound_sampled(&s, &p, &c, first, last, &lim0, 1000.0 / 60.0 * 1e-3).unwrap();
         assert!(bound <= dev + 1e-6, "bound {bound} vs achieved {dev}");
         assert!(
             dev <= 1.25 * bound + 1e-3,

@@ -572,6 +572,29 @@ mod tests {
         }
     }
 
+    /// The same planted passes through [`patch_path`] (G16 first, direct as fallback).
+    #[test]
+    fn planted_passes_reach_feed_with_g16() {
+        let opts = PatchOptions::default();
+        for (mname, feed) in [("mikron-hsm600", 2000.0), ("mikron-ucp710", 2000.0)] {
+            let m = machine(mname);
+            for flip in [false, true] {
+                for d in [0.01, 0.5, 2.0, 4.0] {
+                    let path = planted(121, 1.0, d, flip, feed);
+                    let res = patch_path(&path, &m, &opts).unwrap();
+                    for z in &res.zones {
+                        eprintln!(
+                            "g16+direct {mname} F{feed} flip={flip} d={d}: {:?} {:?} {:?} \
+                             len {:.1} dev {:.3}",
+                            z.kind, z.outcome, z.method, z.patch_length_mm, z.max_deviation_deg
+                        );
+                    }
+                    check_invariants(&path, &m, &res, &opts);
+                }
+            }
+        }
+    }
+
     #[test]
     fn no_point_in_cone_is_unchanged() {
         let m = machine("mikron-hsm600");
