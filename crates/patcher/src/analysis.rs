@@ -181,7 +181,7 @@ pub fn analyze_path(
     let mut acc = Accumulator::new(n, feed_mm_s, opts.keep_samples);
     let mut params: Vec<(f64, usize)> = Vec::with_capacity(CHUNK + 64);
     let mut ts: Vec<f64> = Vec::with_capacity(CHUNK + 64);
-    let mut derivs: Vec<Vec<[f64; 4]>> = vec![Vec::with_capacity(CHUNK + 64); 5];
+    let mut derivs: Vec<Vec<[f64; 4]>> = (0..5).map(|_| Vec::with_capacity(CHUNK + 64)).collect();
     for i in 0..n - 1 {
         span_samples(s, i, step_mm, &mut params);
         if params.len() >= CHUNK || i + 2 == n {
@@ -305,10 +305,7 @@ impl Accumulator {
         }
         let length_mm = path.s_mm[path.s_mm.len() - 1] - path.s_mm[0];
         let min = self.min.expect("a validated path has at least one sample");
-        let mut peak_speed = [0.0; 5];
-        for k in 0..5 {
-            peak_speed[k] = self.peak_slope[k] * self.feed_mm_s;
-        }
+        let peak_speed = self.peak_slope.map(|d| d * self.feed_mm_s);
         (
             RunAnalysis {
                 length_mm,
