@@ -15,18 +15,20 @@
 //!    side: the far parts of the path do not matter to the patch.
 //! 3. **Offset and direction.** C_a may be shifted by k·360°, k ∈ {−1, 0, 1} (only with
 //!    `allow_c_offset`), and the patch moves C in the direction σ = ±1.
-//! 4. **Join search** (stages 4–6): from the split, step outward with
+//! 4. **Join search** (stages 4–6): for each (k, σ), step from the split outward with
 //!    h = [`JOIN_STEP_FRACTION`] · (median CL spacing), backwards on C_b and forwards on
-//!    C_a independently, until σ·C'(s) ≥ 0, |C'(s)| ≤ v and |C''(s)| ≤ a, never closer
-//!    than one CL point to the zone's first/last points. This gives the *core*
-//!    [s_b*, s_a*] for each (k, σ). A choice is consistent when the change it asks,
-//!    gap = C_a(s_a*) + k·360 − C_b(s_b*), has the sign σ (a monotone patch can make it);
-//!    among consistent choices the shortest join |gap| wins. (The plain rule "k from the
-//!    jump at the split, σ from the net change over the window" picks, for a domain-rule
-//!    flip whose jump is close to 180°, a direction against the motion on both sides,
-//!    for which no join exists.)
-//!    The patch [s_b, s_a] is the core widened by `extra` (+ the internal growth, below)
-//!    CL points on each side, clipped to the fit window; the first and last points of the
+//!    C_a independently, until σ·C'(s) ≥ 0: the *core* [s_b*, s_a*], where the patch
+//!    must be monotone. A choice is consistent when the change it asks,
+//!    gap = C_a(s_a*) + k·360 − C_b(s_b*), has the sign σ; among consistent choices the
+//!    shortest join |gap| wins. (The plain rule "k from the jump at the split, σ from the
+//!    net change over the window" picks, for a domain-rule flip whose jump is close to
+//!    180°, a direction against the motion on both sides, for which no join exists; and
+//!    for a C swing like C17 `%SING` it may pick the long way round.)
+//!    The patch ends s_b ≤ min(s_b*, s(zone.first − 1)) and
+//!    s_a ≥ max(s_a*, s(zone.last + 1)) are the first samples further out where
+//!    |C'| ≤ v and |C''| ≤ a (the joins are at least one CL point outside the zone). The
+//!    patch [s_b, s_a] is then widened by `extra` (+ the internal growth, below) CL
+//!    points on each side, clipped to the fit window; the first and last points of the
 //!    path are never modified.
 //! 5. **Patch QP** (stages 8–9), below.
 //! 6. **Projection** (stage 10): every CL point strictly inside (s_b, s_a) gets
@@ -71,16 +73,18 @@
 //! degrees); the form is exact to first order and over-estimates the true deviation
 //! (asin x ≥ x, |sin y| ≤ |y|), so `t ≤ max_deviation_deg` is conservative.
 //!
-//! **Monotonicity.** Inside the core, ℓ_k = 0 (G16 stage 9: P never reverses). In the
-//! extensions [s_b, s_b*] and [s_a*, s_a] the original curve itself may move against σ
-//! (that is why the join search stopped where it did), and P' equals C' at the joins, so
-//! ℓ_k = min(0, min σ·C'(s) over the part of the support of d_k in the extension): P
+//! **Monotonicity.** Inside the core, ℓ_k = 0 (G16 stage 9: P never reverses). Between
+//! the core and the patch ends (the zone's shoulders, `extra` and the growth) the original
+//! curve itself may move against σ, and P' equals C' at the joins, so there
+//! ℓ_k = min(0, min σ·C'(s) over the part of the support of d_k outside the core): P
 //! never reverses faster than the original path did there.
 //!
 //! **Growth.** When the QP is infeasible (first with C³ joins when asked, then with C²
 //! joins), the patch is widened by 1, 2, 4, 8, … more CL points on each side and solved
-//! again, up to the path ends or `max_patch_length_mm`. A widening that cannot pass the
-//! necessary test |C_a(s_a) − C_b(s_b)| ≤ v·(s_a − s_b) is skipped without a solve.
+//! again, up to the path ends or `max_patch_length_mm`. A widening that cannot pass a
+//! necessary test (the change |C_a(s_a) − C_b(s_b)| must be within reach of a velocity
+//! profile starting and ending at the join slopes with |C'| ≤ v, |C''| ≤ a) is skipped
+//! without a solve.
 
 use crate::{
     analysis::Zone,
@@ -114,6 +118,10 @@ pub const MIN_SPAN_FRACTION: f64 = 0.05;
 
 /// Most attempts (join-window enlargements plus patch widenings) before giving up.
 pub const MAX_ATTEMPTS: usize = 24;
+
+/// Relative slack of the reachability test that skips hopeless widenings (the trapezoid
+/// rule under-estimates the integral of the concave velocity envelope slightly).
+pub const REACH_SLACK: f64 = 1e-3;
 
 /// Probes per support interval when computing the monotonicity floor ℓ_k in the
 /// extensions.
@@ -274,9 +282,13 @@ fn g16_patch_detail(
             });
         }
 
-        // Necessary condition of |P'| ≤ v: skip hopeless widenings without a solve.
+        // Necessary condition of |P'| ≤ v, |P''| ≤ a with the join slopes: skip hopeless
+        // widenings without a solve.
         let gap = ca.eval(s_a) - cb.eval(s_b);
-        let hopeless = gap.abs() > lim.v * (s_a - s_b);
+        let (vb, va) = (cb.eval_derivs(s_b)[1], ca.eval_derivs(s_a)[1]);
+        let sg = if gap >= 0.0 { 1.0 } else { -1.0 };
+        let reach = reachable(s_a - s_b, sg * vb, sg * va, lim.v, lim.a);
+        let hopeless = gap.abs() > reach * (1.0 + REACH_SLACK);
         let solved = if hopeless {
             None
         } else {
@@ -342,6 +354,19 @@ fn g16_patch_detail(
         grow = (2 * grow).max(1);
     }
     Err(PatchFailure::Solver(stats))
+}
+
+/// Largest change of C over a patch of length `len` (mm) that starts with slope `v0` and
+/// ends with slope `v1` (°/mm) under |C'| ≤ `v`, |C''| ≤ `a`: the integral of the
+/// velocity envelope min(v, v0 + a·s, v1 + a·(len − s)) (a double integrator; the jerk
+/// bound only lowers it, so this is a necessary condition for the QP).
+fn reachable(len: f64, v0: f64, v1: f64, v: f64, a: f64) -> f64 {
+    const N: usize = 256;
+    let u = |s: f64| v.min(v0 + a * s).min(v1 + a * (len - s));
+    let dx = len / N as f64;
+    (0..N)
+        .map(|k| 0.5 * (u(k as f64 * dx) + u((k + 1) as f64 * dx)) * dx)
+        .sum()
 }
 
 /// Median of the CL spacings between points `lo..=hi`, mm.
@@ -848,6 +873,16 @@ mod tests {
         assert_eq!(a.qp.solves, 1);
         let b = g16_patch(&case[0], &case[1], &case[2], &zone, 3, &lim, &opts).unwrap();
         assert_eq!(b.last - b.first, a.last - a.first + 6);
+    }
+
+    #[test]
+    fn reachable_matches_the_trapezoid_profile() {
+        // From rest to rest: accelerate over v/a, cruise, decelerate: v·L − v²/a.
+        let (v, a, len) = (3.0, 0.5, 40.0);
+        let want = v * len - v * v / a;
+        assert!((reachable(len, 0.0, 0.0, v, a) - want).abs() < 1e-3 * want);
+        // Starting against the motion costs reach.
+        assert!(reachable(len, -1.0, 0.0, v, a) < want);
     }
 
     #[test]
