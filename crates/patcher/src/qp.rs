@@ -283,7 +283,7 @@ mod qp_builder_tests {
 
     #[test]
     fn builder_off_diagonal_square_is_symmetric() {
-        // minimise (x0 − x1 − 1)² + 1e-3·(x0² + x1²): x0 = −x1 = 1/(2 + 2e-3). A lower
+        // minimise (x0 − x1 − 1)² + 1e-3·(x0² + x1²): x0 = −x1 = 1/(2 + 1e-3). A lower
         // triangular H would be read wrongly by clarabel and miss this.
         let mut qp = QpBuilder::new(2);
         qp.add_square(&[(1, -1.0), (0, 1.0)], 1.0, 1.0);
@@ -291,7 +291,7 @@ mod qp_builder_tests {
         qp.add_square(&[(1, 1.0)], 1e-3, 0.0);
         let mut st = QpStats::default();
         let x = qp.solve(&mut st).unwrap();
-        let want = 1.0 / (2.0 + 2e-3);
+        let want = 1.0 / (2.0 + 1e-3);
         assert!(
             (x[0] - want).abs() < 1e-6 && (x[1] + want).abs() < 1e-6,
             "{x:?}"
