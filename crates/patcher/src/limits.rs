@@ -21,6 +21,10 @@ impl CLimits {
         let f = feed_mm_min / 60.0;
         let l = machine.limit(Axis::C);
         let k = 1.0 - margin;
-        CLimits { v: k * l.v / f, a: k * l.a / (f * f), j: k * l.j / (f * f * f) }
+        CLimits {
+            v: k * l.v / f,
+            a: k * l.a / (f * f),
+            j: k * l.j / (f * f * f),
+        }
     }
 }
