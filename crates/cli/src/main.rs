@@ -29,6 +29,7 @@ enum Command {
 }
 
 #[derive(clap::Args)]
+#[command(allow_negative_numbers = true)]
 pub(crate) struct PatchArgs {
     /// NC programs, or folders of them (with --out-dir).
     #[arg(required = true)]
@@ -84,6 +85,7 @@ pub(crate) struct PatchArgs {
 }
 
 #[derive(clap::Args)]
+#[command(allow_negative_numbers = true)]
 struct AnalyzeArgs {
     /// NC program (Heidenhain ISO, Sinumerik or Fanuc G-code).
     file: PathBuf,
