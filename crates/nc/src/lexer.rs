@@ -234,18 +234,45 @@ impl<'a> Lexer<'a> {
         self.end
     }
 
-    /// Scan `[sign] [0-9.]*` from `i`: (end of sign, end of number).
-    fn scan_number(&self, i: usize) -> (usize, usize) {
+    /// Scan `[sign] [0-9.]*` from `i`: (end of sign, end of number, value if it could be
+    /// computed exactly on the way — a well-formed number of at most 15 significant
+    /// digits and 22 decimals; `None` leaves it to [`parse_number`]).
+    fn scan_number(&self, i: usize) -> (usize, usize, Option<f64>) {
         let b = self.bytes;
         let mut e = i;
+        let neg = e < self.end && b[e] == b'-';
         if e < self.end && matches!(b[e], b'+' | b'-') {
             e += 1;
         }
         let digits_start = e;
-        while e < self.end && (b[e].is_ascii_digit() || b[e] == b'.') {
+        let mut mantissa: u64 = 0;
+        let mut frac = 0usize;
+        let mut points = 0usize;
+        while e < self.end {
+            let c = b[e];
+            let d = c.wrapping_sub(b'0');
+            if d < 10 {
+                // Wraps only past 19 digits, which the check below sends to the slow path.
+                mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
+                frac += points;
+            } else if c == b'.' {
+                points += 1;
+            } else {
+                break;
+            }
             e += 1;
         }
-        (digits_start, e)
+        let n = e - digits_start;
+        let fast = points <= 1
+            && n > points
+            && n - points <= 19
+            && mantissa < (1 << 53)
+            && frac < POW10.len();
+        let value = fast.then(|| {
+            let m = mantissa as f64 / POW10[frac];
+            if neg { -m } else { m }
+        });
+        (digits_start, e, value)
     }
 
     fn word(&mut self, p: usize, letter: u8) -> Option<Result<Token, LexError>> {
@@ -254,7 +281,7 @@ impl<'a> Lexer<'a> {
         let q = p + 1;
         let eq = q < self.end && b[q] == b'=';
         let ns = if eq { q + 1 } else { q };
-        let (ds, e) = self.scan_number(ns);
+        let (ds, e, fast) = self.scan_number(ns);
         let followed_by_expr = e < self.end
             && matches!(
                 b[e],
@@ -313,7 +340,7 @@ impl<'a> Lexer<'a> {
                 Token::Other { span: p..q }
             }));
         }
-        let value = match parse_number(&b[ns..e]) {
+        let value = match fast.or_else(|| parse_number(&b[ns..e])) {
             Some(v) => v,
             None => {
                 return self.err(
@@ -488,6 +515,41 @@ mod tests {
         }
         for s in ["", ".", "+", "-", "1..2", "1.2.", "+-1", "1e5", "--1", " 1"] {
             assert_eq!(parse_number(s.as_bytes()), None, "{s}");
+        }
+    }
+
+    #[test]
+    fn word_values_match_std_parse() {
+        let mut x = 0.123_456_789_f64;
+        for k in 0..20_000 {
+            x = (x * 7919.0 + 0.618).fract();
+            let v = (x - 0.5) * 10f64.powi(k % 12 - 3);
+            for text in [
+                format!("{:.*}", k as usize % 9, v),
+                format!("{:+.3}", v),
+                format!("{v}"),
+            ] {
+                let src = format!("C{text}");
+                let t = lex(&src);
+                let expect: f64 = text.parse().unwrap();
+                assert!(
+                    matches!(t[0], Token::Word { value, .. } if value.to_bits() == expect.to_bits()),
+                    "{src}"
+                );
+            }
+        }
+        for text in [
+            "123456789012345678",
+            "0.000000000000000000000001",
+            "00000000000000000000001.5",
+            "-0",
+        ] {
+            let t = lex(&format!("X{text}"));
+            let expect: f64 = text.parse().unwrap();
+            assert!(
+                matches!(t[0], Token::Word { value, .. } if value.to_bits() == expect.to_bits()),
+                "{text}"
+            );
         }
     }
 

@@ -99,18 +99,15 @@ pub fn parse(bytes: Vec<u8>, dialect: Dialect) -> Result<Program, ParseError> {
     let mut start = 0;
     let mut line = 1;
     while start < n {
-        let (end, next) = match bytes[start..].iter().position(|&b| b == b'\n') {
-            Some(k) => {
-                let nl = start + k;
-                (
-                    if nl > start && bytes[nl - 1] == b'\r' {
-                        nl - 1
-                    } else {
-                        nl
-                    },
-                    nl + 1,
-                )
-            }
+        let (end, next) = match find_newline(&bytes, start) {
+            Some(nl) => (
+                if nl > start && bytes[nl - 1] == b'\r' {
+                    nl - 1
+                } else {
+                    nl
+                },
+                nl + 1,
+            ),
             None => (n, n),
         };
         let block = interp.block(&bytes, start..end, line, &mut words)?;
@@ -124,6 +121,28 @@ pub fn parse(bytes: Vec<u8>, dialect: Dialect) -> Result<Program, ParseError> {
         words,
         dialect,
     })
+}
+
+/// Offset of the first `\n` at or after `from`, eight bytes at a time.
+fn find_newline(bytes: &[u8], from: usize) -> Option<usize> {
+    const LO: u64 = 0x0101_0101_0101_0101;
+    const HI: u64 = 0x8080_8080_8080_8080;
+    const NL: u64 = LO * b'\n' as u64;
+    let mut i = from;
+    while let Some(chunk) = bytes.get(i..i + 8) {
+        let x = u64::from_le_bytes(chunk.try_into().unwrap_or([0; 8])) ^ NL;
+        // The lowest set bit marks the first zero byte of x, i.e. the first newline.
+        let t = x.wrapping_sub(LO) & !x & HI;
+        if t != 0 {
+            return Some(i + (t.trailing_zeros() / 8) as usize);
+        }
+        i += 8;
+    }
+    bytes
+        .get(i..)?
+        .iter()
+        .position(|&b| b == b'\n')
+        .map(|k| i + k)
 }
 
 /// Guess the dialect from the first 64 KiB: a `*` block end or a `%NAME G71` header →
@@ -454,6 +473,18 @@ mod tests {
         );
         assert_eq!(p("X1\n").blocks.len(), 1);
         assert!(p("").blocks.is_empty());
+    }
+
+    #[test]
+    fn newline_search() {
+        let text = b"0123456789\nabcdefghijklmnopqrstuvwxyz\n\x8a\n";
+        for from in 0..text.len() + 2 {
+            let naive = text
+                .get(from..)
+                .and_then(|t| t.iter().position(|&b| b == b'\n'))
+                .map(|k| from + k);
+            assert_eq!(find_newline(text, from), naive, "{from}");
+        }
     }
 
     #[test]
