@@ -18,10 +18,12 @@ const KB: usize = 2;
 pub(crate) const W: usize = 2 * KB + 1;
 
 /// An n×n matrix with `A(i, j) = rows[i][j + 2 − i]` for `|i − j| ≤ 2`, factored in place
-/// as `A = L·U` (L unit lower, U upper; both stored in the band).
+/// as `A = L·U` (L unit lower, U upper; both stored in the band, U's diagonal also as
+/// reciprocals so the substitutions multiply instead of divide).
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct BandedLu {
     lu: Vec<[f64; W]>,
+    inv_diag: Vec<f64>,
 }
 
 impl BandedLu {
@@ -29,24 +31,40 @@ impl BandedLu {
     /// non-finite pivot returns its row index.
     pub(crate) fn factor(mut a: Vec<[f64; W]>) -> Result<BandedLu, usize> {
         let n = a.len();
+        // Clear the corners that lie outside the matrix, so the loops need no masks.
+        for (i, row) in a.iter_mut().enumerate() {
+            for (d, v) in row.iter_mut().enumerate() {
+                let j = (i + d).wrapping_sub(KB);
+                if j >= n {
+                    *v = 0.0;
+                }
+            }
+        }
+        let mut inv_diag = vec![0.0; n];
         for k in 0..n {
             let piv = a[k][KB];
             if !(piv.is_finite() && piv.abs() >= f64::MIN_POSITIVE) {
                 return Err(k);
             }
-            let end = (k + KB + 1).min(n);
-            let urow = a[k];
-            for i in k + 1..end {
-                let l = a[i][k + KB - i] / piv;
-                a[i][k + KB - i] = l;
-                if l != 0.0 {
-                    for j in k + 1..end {
-                        a[i][j + KB - i] -= l * urow[j + KB - k];
-                    }
-                }
+            let inv = 1.0 / piv;
+            inv_diag[k] = inv;
+            let (u3, u4) = (a[k][3], a[k][4]);
+            if k + 1 < n {
+                let r = &mut a[k + 1];
+                let l = r[1] * inv;
+                r[1] = l;
+                r[2] -= l * u3;
+                r[3] -= l * u4;
+            }
+            if k + 2 < n {
+                let r = &mut a[k + 2];
+                let l = r[0] * inv;
+                r[0] = l;
+                r[1] -= l * u3;
+                r[2] -= l * u4;
             }
         }
-        Ok(BandedLu { lu: a })
+        Ok(BandedLu { lu: a, inv_diag })
     }
 
     /// Order of the matrix.
@@ -58,21 +76,22 @@ impl BandedLu {
     /// Solve `A x = b` in place (`b.len() == n`).
     pub(crate) fn solve_in_place(&self, b: &mut [f64]) {
         let a = &self.lu;
-        let n = a.len();
-        debug_assert_eq!(b.len(), n);
-        for i in 0..n {
-            let mut v = b[i];
-            for k in i.saturating_sub(KB)..i {
-                v -= a[i][k + KB - i] * b[k];
-            }
-            b[i] = v;
+        assert_eq!(b.len(), a.len());
+        // L y = b: y_i = b_i − L(i,i−1)·y_{i−1} − L(i,i−2)·y_{i−2} (corners are zero).
+        let (mut y2, mut y1) = (0.0, 0.0);
+        for (bi, r) in b.iter_mut().zip(a) {
+            let y = *bi - r[1] * y1 - r[0] * y2;
+            *bi = y;
+            y2 = y1;
+            y1 = y;
         }
-        for i in (0..n).rev() {
-            let mut v = b[i];
-            for j in i + 1..(i + KB + 1).min(n) {
-                v -= a[i][j + KB - i] * b[j];
-            }
-            b[i] = v / a[i][KB];
+        // U x = y: x_i = (y_i − U(i,i+1)·x_{i+1} − U(i,i+2)·x_{i+2}) / U(i,i).
+        let (mut x1, mut x2) = (0.0, 0.0);
+        for ((bi, r), inv) in b.iter_mut().zip(a).zip(&self.inv_diag).rev() {
+            let x = (*bi - r[3] * x1 - r[4] * x2) * inv;
+            *bi = x;
+            x2 = x1;
+            x1 = x;
         }
     }
 
@@ -80,18 +99,26 @@ impl BandedLu {
     pub(crate) fn solve_transpose_in_place(&self, b: &mut [f64]) {
         let a = &self.lu;
         let n = a.len();
-        debug_assert_eq!(b.len(), n);
+        assert_eq!(b.len(), n);
+        // Uᵀ w = b: w_j = (b_j − U(j−1,j)·w_{j−1} − U(j−2,j)·w_{j−2}) / U(j,j).
         for j in 0..n {
             let mut v = b[j];
-            for i in j.saturating_sub(KB)..j {
-                v -= a[i][j + KB - i] * b[i];
+            if j >= 1 {
+                v -= a[j - 1][3] * b[j - 1];
             }
-            b[j] = v / a[j][KB];
+            if j >= 2 {
+                v -= a[j - 2][4] * b[j - 2];
+            }
+            b[j] = v * self.inv_diag[j];
         }
+        // Lᵀ z = w: z_k = w_k − L(k+1,k)·z_{k+1} − L(k+2,k)·z_{k+2}.
         for k in (0..n).rev() {
             let mut v = b[k];
-            for i in k + 1..(k + KB + 1).min(n) {
-                v -= a[i][k + KB - i] * b[i];
+            if k + 1 < n {
+                v -= a[k + 1][1] * b[k + 1];
+            }
+            if k + 2 < n {
+                v -= a[k + 2][0] * b[k + 2];
             }
             b[k] = v;
         }
