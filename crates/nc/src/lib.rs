@@ -3,7 +3,7 @@
 //! [`parse`] reads a program as bytes (any encoding; only ASCII is interpreted) into
 //! blocks and words, each word keeping its byte span, with the modal state after every
 //! block. [`runs`] groups G1 motion into runs with the cumulative tool-tip path length s.
-//! [`write`] renders the program with chosen words changed or inserted in the file's own
+//! [`write()`] renders the program with chosen words changed or inserted in the file's own
 //! number style; every other byte is copied unchanged, so `write(&parse(b)?, &[]) == b`.
 //!
 //! Units: linear values and s in mm (inch programs, G20/G70, are converted on read),

@@ -1,4 +1,32 @@
 //! Modal state tracked block by block.
+//!
+//! How a block changes the state (all dialects unless named):
+//! - motion: `G0 G1 G2 G3` (also `G00`…`G03`);
+//! - `G90`/`G91` absolute/incremental (incremental from an unknown position stays
+//!   unknown); `G20`/`G21`, `G70`/`G71`, `G700`/`G710` inch/metric (also read from a `%NAME
+//!   G71` header): in inch mode X Y Z and F are multiplied by 25.4 on read;
+//! - TCPM: `M128`/`M129`, `TRAORI`/`TRAFOOF`, `G43.4`/`G43.5`/`G49`;
+//! - F in mm/min under `G94`; under `G93` (inverse time) or `G95` (per revolution) the
+//!   feed is `None`, and after returning to `G94` it is `None` until the next F;
+//! - axis words X Y Z A B C set positions in moves (and in a block without any motion mode
+//!   yet, which is then not counted as a move);
+//! - datum shifts — Heidenhain `G54`/`G53` with or without axis words, `G92`, `G10`, `G52`,
+//!   `G68`/`G69`, `G50`/`G51`, Sinumerik `TRANS`/`ATRANS`/`ROT`/`SCALE`/`MIRROR`… — are not
+//!   moves; afterwards X Y Z are unknown, and so is every rotary axis named in the block;
+//! - reference and machine-coordinate moves (`G28`, `G30`, Fanuc/Sinumerik `G53`, `SUPA`)
+//!   move but leave X Y Z (and named rotary axes) unknown;
+//! - work-offset selection (Fanuc/Sinumerik `G54`…`G59`, `G500`, `G505`…`G599`) makes
+//!   X Y Z unknown, then the block's own axis words apply in the new frame;
+//! - `G4` dwell and `G65`/`G66` macro calls take axis letters as arguments (a macro call
+//!   makes every position unknown).
+//!
+//! A block breaks runs ([`crate::Block::breaks_run`]) if it moves other than by G1, has
+//! a T, D, H, U, V, W, P, Q, L or E word, an M code other than spindle/coolant
+//! (`M3 M4 M5 M7 M8 M9 M13 M14`) and TCPM, a G code outside motion, plane, units,
+//! absolute/incremental, `G40 G60 G61 G64 G641`…`G645 G80 G94`, an identifier other than
+//! `MSG` (e.g. `CYCLE800`), a non-numeric `T=`/`D=`… assignment, a `/` block-delete
+//! marker, or changes the TCPM state, feed mode or datum. Comments, empty lines, `%`
+//! lines, S words and spindle/coolant M codes never do.
 
 /// Motion mode (modal G group 1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

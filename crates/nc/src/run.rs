@@ -24,7 +24,7 @@ pub enum RunBreak {
 pub struct Run {
     /// Block index of each point (see type docs).
     pub blocks: Vec<usize>,
-    /// Cumulative tool-tip path length at each point, mm (s[0] = 0, strictly increasing).
+    /// Cumulative tool-tip path length at each point, mm (`s[0] = 0`, strictly increasing).
     pub s_mm: Vec<f64>,
     /// Position of each point: X Y Z (mm), A B C (degrees), `None` where never programmed.
     pub pos: Vec<[Option<f64>; 6]>,
