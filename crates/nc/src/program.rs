@@ -70,6 +70,13 @@ impl Program {
     pub fn block_words(&self, block: usize) -> &[Word] {
         &self.words[self.blocks[block].words.clone()]
     }
+    /// The modal state in force before `block` (the state after the previous block, or the
+    /// power-on default for the first).
+    pub fn state_before(&self, block: usize) -> Modal {
+        block
+            .checked_sub(1)
+            .map_or_else(Modal::default, |b| self.blocks[b].state)
+    }
     /// The word with `letter` in a block, if any (the last one if repeated).
     pub fn word(&self, block: usize, letter: u8) -> Option<&Word> {
         self.block_words(block)
@@ -512,6 +519,13 @@ mod tests {
         assert!(st[4].tcpm && prog.blocks[4].breaks_run);
         assert!(!st[5].tcpm && prog.blocks[5].breaks_run);
         assert!(!prog.blocks[1].breaks_run && prog.blocks[1].is_move);
+    }
+
+    #[test]
+    fn state_before() {
+        let prog = p("G1 X1\nX2\n");
+        assert_eq!(prog.state_before(0), Modal::default());
+        assert_eq!(prog.state_before(1).pos[X], Some(1.0));
     }
 
     #[test]
