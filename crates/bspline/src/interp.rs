@@ -138,6 +138,17 @@ impl NotAKnotSystem {
             rows[n - 1][2] = 1.0;
             for (i, row) in rows.iter_mut().enumerate().take(n - 1).skip(1) {
                 let span = (i + 2).clamp(3, n - 1);
+                if (2..n - 2).contains(&i) {
+                    // s_i is the knot u_j (j = span): the three cubics alive there in closed
+                    // form (2 divisions instead of the recurrence's 6).
+                    let u = &knots[span - 2..span + 3];
+                    let (um2, um1, u0, u1, u2) = (u[0], u[1], u[2], u[3], u[4]);
+                    let w = u1 - um1;
+                    let n0 = (u1 - u0) * (u1 - u0) / ((u1 - um2) * w);
+                    let n2 = (u0 - um1) * (u0 - um1) / ((u2 - um1) * w);
+                    *row = [0.0, n0, 1.0 - n0 - n2, n2, 0.0];
+                    continue;
+                }
                 let b = basis_funs(&knots, 3, span, s[i]);
                 for (k, &bk) in b.iter().enumerate() {
                     // Column span − 3 + k; band offset column − i + 2.
