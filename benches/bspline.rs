@@ -6,8 +6,7 @@ use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use polepatch_bspline::{
-    NotAKnotSystem, fit_least_squares, interpolate_not_a_knot, knots::clamped_cubic,
-    sample_params,
+    NotAKnotSystem, fit_least_squares, interpolate_not_a_knot, knots::clamped_cubic, sample_params,
 };
 
 /// CL-point-like data: ~0.5 mm spacing (±10 %), a C-axis-like signal in degrees.
@@ -39,7 +38,9 @@ fn interpolation(c: &mut Criterion) {
     let mut g = c.benchmark_group("bspline/not_a_knot_system");
     let (s, y) = data(1_000);
     let sys = NotAKnotSystem::new(&s).unwrap();
-    g.bench_function("solve_1000", |b| b.iter(|| sys.solve(black_box(&y)).unwrap()));
+    g.bench_function("solve_1000", |b| {
+        b.iter(|| sys.solve(black_box(&y)).unwrap())
+    });
     g.bench_function("data_row_1000", |b| {
         b.iter(|| sys.data_row(black_box(250.3), black_box(2)))
     });
@@ -83,7 +84,9 @@ fn evaluation(c: &mut Criterion) {
 
 fn least_squares(c: &mut Criterion) {
     let (s, y) = data(2_000);
-    let breaks: Vec<f64> = (0..=100).map(|i| s[0] + (s[1999] - s[0]) * i as f64 / 100.0).collect();
+    let breaks: Vec<f64> = (0..=100)
+        .map(|i| s[0] + (s[1999] - s[0]) * i as f64 / 100.0)
+        .collect();
     let knots = clamped_cubic(&breaks);
     let mut g = c.benchmark_group("bspline/fit_least_squares");
     g.bench_function("2000_points_102_coeffs", |b| {
