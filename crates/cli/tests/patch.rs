@@ -5,6 +5,7 @@
 
 mod common;
 use common::*;
+use polepatch::kinematics::Axis;
 use polepatch::patcher::PatchOptions;
 use polepatch_fixturegen::{Dialect, Pass, program};
 
@@ -49,27 +50,68 @@ fn seeded_random_near_pole_passes() {
     let machines = machines();
     let opts = PatchOptions::default();
     for case in 0..40 {
+        let m = &machines[(rng.next() * 2.0) as usize % 2];
+        let feed_mm_min: f64 = rng.pick(&[800.0, 1500.0, 2000.0, 3000.0, 5000.0]);
+        // Near the pole the tool axis' azimuth turns by up to 180°; with C-only changes C
+        // must make that turn at |C_s| ≤ V/F, so a run shorter than ~180°/(V/F) cannot
+        // reach feed whatever the patch. Draw runs long enough for a patch to exist (the
+        // impossible case has its own test below).
+        let v_deg_mm = m.limit(Axis::C).v / (feed_mm_min / 60.0);
+        let length_mm = (20.0 + 60.0 * rng.next()).max(1.5 * 180.0 / v_deg_mm + 10.0);
+        let spacing_mm = rng.pick(&[0.25f64, 0.5, 1.0]).max(length_mm / 300.0);
         let pass = Pass {
             pole_distance_deg: rng.pick(&[0.0, 0.001, 0.05, 0.3, 1.0, 2.5, 4.0])
                 * (0.5 + rng.next()),
             circle_radius_deg: 5.0 + 25.0 * rng.next(),
             half_sweep_deg: 30.0 + 60.0 * rng.next(),
             azimuth_deg: 360.0 * rng.next(),
-            length_mm: 20.0 + 60.0 * rng.next(),
-            spacing_mm: rng.pick(&[0.25, 0.5, 1.0]),
-            feed_mm_min: rng.pick(&[800.0, 1500.0, 2000.0, 3000.0, 5000.0]),
+            length_mm,
+            spacing_mm,
+            feed_mm_min,
             b_axis: rng.next() < 0.5,
             domain_rule: rng.next() < 0.5,
             rotary_decimals: rng.pick(&[3, 4]),
         };
         let dialect = rng.pick(&Dialect::ALL);
         let text = program(&pass, dialect, "CASE");
-        let m = &machines[(rng.next() * 2.0) as usize % 2];
         check_patch(
-            &format!("case {case}: {pass:?} {dialect:?}"),
+            &format!("case {case} on {}: {pass:?} {dialect:?}", m.name),
             text.as_bytes(),
             m,
             &opts,
         );
     }
+}
+
+/// A run far too short for C to turn at F5000 on the UCP710 (V/F = 1.44 °/mm, 63 mm):
+/// no patch can reach feed. The best improvement is kept, reported as such, and nothing
+/// gets worse.
+#[test]
+fn impossible_zone_keeps_the_best_improvement() {
+    let pass = Pass {
+        pole_distance_deg: 0.0015,
+        circle_radius_deg: 16.1,
+        half_sweep_deg: 80.7,
+        azimuth_deg: 124.0,
+        length_mm: 63.6,
+        spacing_mm: 0.5,
+        feed_mm_min: 5000.0,
+        b_axis: true,
+        domain_rule: false,
+        rotary_decimals: 3,
+    };
+    let text = program(&pass, Dialect::Fanuc, "SHORT");
+    let m = polepatch::kinematics::Machine::builtin("mikron-ucp710").unwrap();
+    let lp = load_bytes(text.as_bytes(), "short", &m);
+    let (edits, report) = polepatch::job::patch_program(&lp, &m, &PatchOptions::default());
+    assert!(!report.zones.is_empty());
+    for z in &report.zones {
+        assert_ne!(z.outcome, "reached", "{z:?}");
+        assert!(z.after.c_ratio >= z.before.c_ratio, "{z:?}");
+    }
+    let out = polepatch::nc::write(&lp.program, &edits);
+    assert_only_c_words_differ("short", text.as_bytes(), &out);
+    let before = c_ratios_and_zones(&lp, &m, 5.0);
+    let after = c_ratios_and_zones(&load_bytes(&out, "short", &m), &m, 5.0);
+    assert!(after[0].0 >= before[0].0, "{before:?} → {after:?}");
 }

@@ -23,7 +23,8 @@ pub struct PatchOptions {
     /// Longest patch, mm; `None` = up to the whole run. Default `None`.
     pub max_patch_length_mm: Option<f64>,
     /// Allow a 360° multiple offset of C after the singular point when it shortens the
-    /// join (the rest of the run then carries the offset). Default true.
+    /// join. The rest of the run then carries the offset, and the move after the run has to
+    /// turn C the extra revolution back, so it is off by default. Default false.
     pub allow_c_offset: bool,
 }
 
@@ -38,7 +39,7 @@ impl Default for PatchOptions {
             c_decimals: 3,
             max_decimals: 4,
             max_patch_length_mm: None,
-            allow_c_offset: true,
+            allow_c_offset: false,
         }
     }
 }

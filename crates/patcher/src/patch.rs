@@ -133,7 +133,8 @@ pub(crate) fn patch_path_with(
     let mut cur = c0.clone();
     let mut changed = vec![false; n];
     let mut done: Vec<(Zone, Option<Checked>, Outcome, QpStats)> = Vec::new();
-    let mut lower = 0;
+    // Point 0 is where the run starts: it belongs to the block before the run and is never moved.
+    let mut lower = 1;
     for zone in merge_zones(&analysis.zones) {
         let mut stats = QpStats::default();
         let (kept, outcome) = match ctx.patch_zone(&cur, &zone, lower, &mut stats) {

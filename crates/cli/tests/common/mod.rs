@@ -4,7 +4,8 @@
 use polepatch::job::{FileReport, patch_program};
 use polepatch::kinematics::{Axis, Machine};
 use polepatch::nc::{Dialect, parse};
-use polepatch::patcher::{AnalysisOptions, PatchOptions, analyze_path};
+use polepatch::patcher::direct::deviation_bound_sampled;
+use polepatch::patcher::{AnalysisOptions, CLimits, PatchOptions, analyze_path};
 use polepatch::program::{LoadedProgram, load};
 use std::path::{Path, PathBuf};
 
@@ -183,6 +184,20 @@ pub fn check_patch(
         );
     }
     (report, out)
+}
+
+/// The smallest max orientation deviation with which C-only changes at points 1.. of run
+/// `r` reach feed on C, or `None` when no such change exists.
+pub fn reachable_bound_deg(lp: &LoadedProgram, r: usize, machine: &Machine) -> Option<f64> {
+    let path = lp.runs[r].path.as_ref().ok()?;
+    let n = path.s_mm.len();
+    let p: Vec<f64> = path.axes.iter().map(|q| q[Axis::Primary.index()]).collect();
+    let c: Vec<f64> = path.axes.iter().map(|q| q[Axis::C.index()]).collect();
+    let lim = CLimits::new(machine, path.feed_mm_min, 0.0);
+    let step = path.feed_mm_min / 60.0 * machine.tcy_s;
+    deviation_bound_sampled(&path.s_mm, &p, &c, 1, n - 1, &lim, step)
+        .ok()
+        .map(|b| b.0)
 }
 
 pub fn machines() -> Vec<Machine> {
