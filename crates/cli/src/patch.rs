@@ -146,7 +146,10 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
     }
     print_summary(&ok);
     for rep in &ok {
-        for w in rep.warnings.iter().chain(&rep.skipped_runs) {
+        for w in &rep.warnings {
+            eprintln!("polepatch: warning: {w}");
+        }
+        for w in &rep.skipped_runs {
             eprintln!("polepatch: warning: {}: {w}", rep.file);
         }
     }
