@@ -26,6 +26,9 @@ enum Command {
     Analyze(AnalyzeArgs),
     /// Rewrite the C words near the pole so that C reaches the programmed feed.
     Patch(PatchArgs),
+    /// Quality suite: analyze and patch every program × machine, compare the deviation
+    /// with the best possible for C-only changes, and print one table.
+    Bench(bench_cmd::BenchArgs),
 }
 
 #[derive(clap::Args)]
@@ -111,6 +114,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Analyze(args) => analyze(args),
         Command::Patch(args) => patch::run(args),
+        Command::Bench(args) => bench_cmd::run(args),
     };
     match result {
         Ok(code) => code,
@@ -121,6 +125,7 @@ fn main() -> ExitCode {
     }
 }
 
+mod bench_cmd;
 mod patch;
 
 pub(crate) fn machine(name: &str) -> Result<Machine> {

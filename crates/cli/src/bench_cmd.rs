@@ -1,0 +1,380 @@
+//! `polepatch bench`: the quality suite's command line, table, CSV, JSON and plots.
+
+use crate::{check_positive, machine};
+use anyhow::{Context, Result, bail};
+use polepatch::bench::{BenchOptions, BenchReport, BenchZone, RATIO_TARGET, plot};
+use polepatch::job::{FiguresRow, write_atomic};
+use polepatch::kinematics::Machine;
+use polepatch::patcher::PatchOptions;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Arguments of `polepatch bench`.
+#[derive(clap::Args)]
+#[command(allow_negative_numbers = true)]
+pub(crate) struct BenchArgs {
+    /// NC programs or folders of them (default: fixtures/ of the repository, run from its root).
+    paths: Vec<PathBuf>,
+    /// Machines, repeatable: built-in names or TOML files (default: both built-in machines).
+    #[arg(long, short)]
+    machine: Vec<String>,
+    /// Write the per-zone rows as CSV to this file.
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// Write the whole suite as one JSON document to this file.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Write one SVG per zone into this folder.
+    #[arg(long)]
+    plots: Option<PathBuf>,
+    /// Feed in mm/min for runs with no F in force.
+    #[arg(long)]
+    feed: Option<f64>,
+    /// Singular cone, degrees.
+    #[arg(long, default_value_t = 5.0)]
+    cone: f64,
+    /// Interpolation cycle time override, ms (default: the machine's).
+    #[arg(long)]
+    tcy_ms: Option<f64>,
+    /// Safety margin on the C limits of the patch, as a fraction.
+    #[arg(long, default_value_t = 0.02)]
+    margin: f64,
+    /// Skip the deviation bound (its LPs take most of the time).
+    #[arg(long)]
+    no_bound: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    jobs: Option<usize>,
+}
+
+/// Files of the inputs: folders expand recursively (hidden entries skipped), sorted.
+fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
+    for input in inputs {
+        if !input.is_dir() {
+            if !input.exists() {
+                bail!("{}: no such file or folder", input.display());
+            }
+            out.push(input.clone());
+            continue;
+        }
+        let mut found = Vec::new();
+        let mut stack = vec![input.clone()];
+        while let Some(dir) = stack.pop() {
+            for e in std::fs::read_dir(&dir)
+                .with_context(|| format!("cannot read folder {}", dir.display()))?
+            {
+                let p = e?.path();
+                if p.file_name()
+                    .is_some_and(|n| n.to_string_lossy().starts_with('.'))
+                {
+                    continue;
+                }
+                if p.is_dir() {
+                    stack.push(p);
+                } else {
+                    found.push(p);
+                }
+            }
+        }
+        found.sort();
+        out.extend(found);
+    }
+    Ok(out)
+}
+
+pub(crate) fn run(args: BenchArgs) -> Result<ExitCode> {
+    check_positive("--feed", args.feed)?;
+    check_positive("--tcy-ms", args.tcy_ms)?;
+    check_positive("--cone", Some(args.cone))?;
+    if !(0.0..0.5).contains(&args.margin) {
+        bail!("--margin must be in [0, 0.5), got {}", args.margin);
+    }
+    let paths = if args.paths.is_empty() {
+        let d = PathBuf::from("fixtures");
+        if !d.is_dir() {
+            bail!(
+                "no PATHS given and there is no fixtures/ folder here: run from the repository root or name the programs"
+            );
+        }
+        vec![d]
+    } else {
+        args.paths.clone()
+    };
+    let files = expand(&paths)?;
+    if files.is_empty() {
+        bail!("no input files");
+    }
+    let machines: Vec<Machine> = if args.machine.is_empty() {
+        Machine::builtin_names()
+            .iter()
+            .map(|n| machine(n))
+            .collect::<Result<_>>()?
+    } else {
+        args.machine
+            .iter()
+            .map(|n| machine(n))
+            .collect::<Result<_>>()?
+    };
+    let opts = BenchOptions {
+        patch: PatchOptions {
+            cone_deg: args.cone,
+            tcy_s: args.tcy_ms.map(|ms| ms / 1000.0),
+            margin: args.margin,
+            ..PatchOptions::default()
+        },
+        feed_fallback_mm_min: args.feed,
+        skip_bound: args.no_bound,
+        plots: args.plots.is_some(),
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.jobs.unwrap_or(0))
+        .build()
+        .context("starting worker threads")?;
+    let report = pool.install(|| polepatch::bench::run(&files, &machines, &opts));
+
+    print!("{}", table(&report));
+    for e in &report.errors {
+        eprintln!("polepatch: error: {} on {}: {}", e.file, e.machine, e.error);
+    }
+    if let Some(path) = &args.json {
+        let doc = serde_json::to_string_pretty(&report)?;
+        write_atomic(path, doc.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if let Some(path) = &args.csv {
+        write_atomic(path, &csv_rows(&report)?)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if let Some(dir) = &args.plots {
+        let n = write_plots(&report, dir)?;
+        eprintln!("polepatch: {n} plot(s) written to {}", dir.display());
+    }
+    Ok(if report.errors.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+fn short_name(file: &str) -> String {
+    Path::new(file)
+        .file_name()
+        .map_or(file.to_string(), |n| n.to_string_lossy().into_owned())
+}
+
+/// `before → after` of a figure, 3 decimals.
+pub(crate) fn arrow(before: f64, after: f64) -> String {
+    format!("{before:.3} → {after:.3}")
+}
+
+fn bound_text(z: &BenchZone) -> String {
+    match (z.bound.status.as_str(), z.bound.bound_deg) {
+        ("ok", Some(b)) => format!("{b:.3}"),
+        ("unreachable", _) => "unreachable".into(),
+        ("skipped", _) => "-".into(),
+        _ => "error".into(),
+    }
+}
+
+fn ratio_text(z: &BenchZone) -> String {
+    match z.ratio {
+        Some(r) => format!("{r:.3}"),
+        None => "—".into(),
+    }
+}
+
+/// The table: one row per zone (a program × machine with no zone gets one row saying so),
+/// then the headline figures.
+pub(crate) fn table(report: &BenchReport) -> String {
+    use std::fmt::Write;
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{:<30} {:<13} {:>3} {:>11} {:>15} {:>15} {:>15} {:>21} {:>7} {:>11} {:>6} {:>6} {:>8} {:>8}",
+        "file",
+        "machine",
+        "run",
+        "lines",
+        "C ratio",
+        "primary ratio",
+        "overall ratio",
+        "time s (L/F)",
+        "dev °",
+        "bound °",
+        "ours/b",
+        "points",
+        "len mm",
+        "solve ms"
+    );
+    for case in &report.cases {
+        let name = short_name(&case.file);
+        if case.zones.is_empty() {
+            let _ = writeln!(
+                out,
+                "{name:<30} {:<13} {:>3} {:>11} no zone",
+                case.machine, "-", "-"
+            );
+            continue;
+        }
+        for z in &case.zones {
+            let r = &z.row;
+            let f = |g: fn(&FiguresRow) -> f64| arrow(g(&r.before), g(&r.after));
+            let _ = writeln!(
+                out,
+                "{name:<30} {:<13} {:>3} {:>11} {:>15} {:>15} {:>15} {:>21} {:>7.3} {:>11} {:>6} {:>6} {:>8.3} {:>8.3}",
+                case.machine,
+                r.run,
+                format!("{}–{}", r.lines[0], r.lines[1]),
+                f(|x| x.c_ratio),
+                f(|x| x.primary_ratio),
+                f(|x| x.overall_ratio),
+                format!(
+                    "{} ({:.3})",
+                    arrow(r.before.time_s, r.after.time_s),
+                    r.ideal_time_s
+                ),
+                r.max_deviation_deg,
+                bound_text(z),
+                ratio_text(z),
+                r.points_modified,
+                r.patch_length_mm,
+                r.solve_time_ms,
+            );
+        }
+    }
+    let s = report.summary();
+    let opt = |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{v:.3}"));
+    let _ = writeln!(
+        out,
+        "\n{} program × machine case(s), {} zone(s): {} reach feed on C; bound unreachable for {}.",
+        report.cases.len(),
+        s.zones,
+        s.reached,
+        s.unreachable
+    );
+    let _ = writeln!(
+        out,
+        "ours/bound over {} zone(s): median {}, worst {}; {} within {RATIO_TARGET} (SPEC §6).",
+        s.ratios,
+        opt(s.ratio_median),
+        opt(s.ratio_worst),
+        s.ratio_within_target
+    );
+    out
+}
+
+fn csv_rows(report: &BenchReport) -> Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record([
+        "file",
+        "machine",
+        "run",
+        "first_line",
+        "last_line",
+        "kind",
+        "min_abs_primary_deg",
+        "c_ratio_before",
+        "c_ratio_after",
+        "primary_ratio_before",
+        "primary_ratio_after",
+        "overall_ratio_before",
+        "overall_ratio_after",
+        "limiting_before",
+        "limiting_after",
+        "time_before_s",
+        "time_after_s",
+        "ideal_time_s",
+        "max_deviation_deg",
+        "points_modified",
+        "patch_length_mm",
+        "outcome",
+        "method",
+        "qp_status",
+        "qp_iterations",
+        "qp_solves",
+        "solve_time_ms",
+        "decimals",
+        "c_offset_deg",
+        "bound_deg",
+        "ratio",
+    ])?;
+    for z in report.zones() {
+        let r = &z.row;
+        let lim = |f: &FiguresRow| {
+            format!(
+                "{}:{}",
+                f.limiting_axis.clone().unwrap_or_else(|| "-".into()),
+                f.limiting_limit
+            )
+        };
+        w.write_record([
+            r.file.clone(),
+            z.machine.clone(),
+            r.run.to_string(),
+            r.lines[0].to_string(),
+            r.lines[1].to_string(),
+            r.kind.to_string(),
+            format!("{:.6}", r.min_abs_primary_deg),
+            format!("{:.6}", r.before.c_ratio),
+            format!("{:.6}", r.after.c_ratio),
+            format!("{:.6}", r.before.primary_ratio),
+            format!("{:.6}", r.after.primary_ratio),
+            format!("{:.6}", r.before.overall_ratio),
+            format!("{:.6}", r.after.overall_ratio),
+            lim(&r.before),
+            lim(&r.after),
+            format!("{:.6}", r.before.time_s),
+            format!("{:.6}", r.after.time_s),
+            format!("{:.6}", r.ideal_time_s),
+            format!("{:.6}", r.max_deviation_deg),
+            r.points_modified.to_string(),
+            format!("{:.3}", r.patch_length_mm),
+            r.outcome.to_string(),
+            r.method.to_string(),
+            r.qp_status.clone(),
+            r.qp_iterations.to_string(),
+            r.qp_solves.to_string(),
+            format!("{:.3}", r.solve_time_ms),
+            r.decimals.to_string(),
+            format!("{}", r.c_offset_deg),
+            match (z.bound.status.as_str(), z.bound.bound_deg) {
+                ("ok", Some(b)) => format!("{b:.6}"),
+                (s, _) => s.to_string(),
+            },
+            z.ratio.map_or(String::new(), |v| format!("{v:.6}")),
+        ])?;
+    }
+    Ok(w.into_inner()?)
+}
+
+/// One SVG per zone with plot data: `<file-stem>-<machine>-run<r>-zone<k>.svg`, k counting
+/// the zones of the run from 1.
+fn write_plots(report: &BenchReport, dir: &Path) -> Result<usize> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let mut n = 0;
+    for case in &report.cases {
+        let stem = Path::new(&case.file)
+            .file_stem()
+            .map_or("program".to_string(), |s| s.to_string_lossy().into_owned());
+        let mut k = 0;
+        let mut last_run = 0;
+        for z in &case.zones {
+            if z.row.run != last_run {
+                k = 0;
+                last_run = z.row.run;
+            }
+            k += 1;
+            let Some(p) = &z.plot else { continue };
+            let svg = plot::render_svg(p).map_err(anyhow::Error::msg)?;
+            let path = dir.join(format!(
+                "{stem}-{}-run{}-zone{k}.svg",
+                case.machine, z.row.run
+            ));
+            write_atomic(&path, svg.as_bytes())
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            n += 1;
+        }
+    }
+    Ok(n)
+}
