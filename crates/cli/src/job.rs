@@ -241,7 +241,7 @@ fn restore_modal_c(program: &Program, edits: &mut Vec<Edit>, decimals: usize) {
         if edited.contains(&b) || program.word(b, b'C').is_some() {
             continue;
         }
-        if let Some(c) = program.blocks[b].state.pos[modal::C] {
+        if let Some(c) = program.state(b).pos[modal::C] {
             extra.push(Edit {
                 block: b,
                 letter: b'C',

@@ -89,3 +89,100 @@ impl Default for Modal {
         }
     }
 }
+
+/// [`Modal`] as the program stores it: 64 bytes instead of 120 (one bit per known value
+/// instead of an `Option` tag on each), converted losslessly both ways.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct PackedModal {
+    /// Positions; meaningful where bit `i` of `known` is set.
+    pos: [f64; 6],
+    /// Feed, mm/min; meaningful where bit 6 of `known` is set.
+    feed_mm_min: f64,
+    /// Bits 0–5: `pos[i]` is known; bit 6: the feed is known.
+    known: u8,
+    /// Bits 0–2: motion (0 none … 4 G3); bit 3 TCPM; bit 4 incremental; bit 5 inch.
+    flags: u8,
+}
+
+impl PackedModal {
+    pub(crate) fn pack(m: &Modal) -> Self {
+        let mut pos = [0.0; 6];
+        let mut known = 0u8;
+        for (i, p) in m.pos.iter().enumerate() {
+            if let Some(v) = *p {
+                pos[i] = v;
+                known |= 1 << i;
+            }
+        }
+        if m.feed_mm_min.is_some() {
+            known |= 1 << 6;
+        }
+        let motion = match m.motion {
+            Motion::None => 0,
+            Motion::Rapid => 1,
+            Motion::Linear => 2,
+            Motion::ArcCw => 3,
+            Motion::ArcCcw => 4,
+        };
+        PackedModal {
+            pos,
+            feed_mm_min: m.feed_mm_min.unwrap_or(0.0),
+            known,
+            flags: motion
+                | u8::from(m.tcpm) << 3
+                | u8::from(m.incremental) << 4
+                | u8::from(m.inch) << 5,
+        }
+    }
+
+    pub(crate) fn unpack(&self) -> Modal {
+        let bit = |i: u32| self.known & (1 << i) != 0;
+        Modal {
+            motion: match self.flags & 7 {
+                0 => Motion::None,
+                1 => Motion::Rapid,
+                2 => Motion::Linear,
+                3 => Motion::ArcCw,
+                _ => Motion::ArcCcw,
+            },
+            pos: std::array::from_fn(|i| bit(i as u32).then_some(self.pos[i])),
+            feed_mm_min: bit(6).then_some(self.feed_mm_min),
+            tcpm: self.flags & 8 != 0,
+            incremental: self.flags & 16 != 0,
+            inch: self.flags & 32 != 0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn packing_is_lossless() {
+        assert_eq!(std::mem::size_of::<PackedModal>(), 64);
+        let mut m = Modal::default();
+        assert_eq!(PackedModal::pack(&m).unpack(), m);
+        for (k, motion) in [
+            Motion::None,
+            Motion::Rapid,
+            Motion::Linear,
+            Motion::ArcCw,
+            Motion::ArcCcw,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            m.motion = motion;
+            m.pos[k] = Some(-0.0);
+            m.pos[5 - k] = Some(f64::MAX);
+            m.feed_mm_min = (k % 2 == 0).then_some(1e-300 * k as f64);
+            m.tcpm = k % 2 == 1;
+            m.incremental = k % 3 == 1;
+            m.inch = k >= 3;
+            let back = PackedModal::pack(&m).unpack();
+            assert_eq!(back, m);
+            assert_eq!(back.pos[k].map(f64::to_bits), Some((-0.0f64).to_bits()));
+        }
+    }
+}

@@ -3,7 +3,7 @@
 use crate::{
     error::ParseError,
     lexer::{Lexer, Token},
-    modal::{A, B, C, Modal, Motion, X, Y, Z},
+    modal::{A, B, C, Modal, Motion, PackedModal, X, Y, Z},
 };
 use std::ops::Range;
 
@@ -22,34 +22,69 @@ pub enum Dialect {
 }
 
 /// One address word such as `C+148.494`, `X-.5`, `G01`, `X=10`.
+///
+/// Offsets are `u32` (a program is at most 4 GiB, see [`parse`]) so that a word takes 24
+/// bytes: a large program holds millions of them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Word {
     /// Upper-case letter.
     pub letter: u8,
-    /// Bytes of the whole word (letter to last digit) in the file.
-    pub span: Range<usize>,
-    /// Bytes of the number (sign included) in the file.
-    pub value_span: Range<usize>,
+    /// Byte offset of the letter in the file.
+    pub start: u32,
+    /// Byte offset of the number (its sign, if any) in the file.
+    pub value_start: u32,
+    /// Byte offset just past the last digit.
+    pub end: u32,
     /// Numeric value as written (no unit conversion).
     pub value: f64,
 }
 
+impl Word {
+    /// Bytes of the whole word (letter to last digit) in the file.
+    pub fn span(&self) -> Range<usize> {
+        self.start as usize..self.end as usize
+    }
+    /// Bytes of the number (sign included) in the file.
+    pub fn value_span(&self) -> Range<usize> {
+        self.value_start as usize..self.end as usize
+    }
+}
+
 /// One line of the file (a block, a comment line, a `%` line, or empty).
+///
+/// 32 bytes: offsets are `u32`, and the modal state is kept once per change in the
+/// [`Program`] (read it with [`Program::state`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Block {
     /// 1-based line number.
     pub line: usize,
-    /// Bytes of the line, without its line ending.
-    pub span: Range<usize>,
-    /// Indices into [`Program::words`] of this block's words.
-    pub words: Range<usize>,
-    /// Modal state after this block.
-    pub state: Modal,
+    start: u32,
+    end: u32,
+    words_start: u32,
+    words_end: u32,
+    /// Index of the modal state after this block in the program's state table.
+    state: u32,
     /// The block moves the tool tip or a rotary axis (a G0/G1/G2/G3 move with axis words,
     /// not a datum shift or other non-move use of axis letters).
     pub is_move: bool,
     /// Why this block ends any run of G1 motion (beyond being a non-G1 move), if it does.
     pub breaks_run: bool,
+}
+
+impl Block {
+    /// Bytes of the line, without its line ending.
+    pub fn span(&self) -> Range<usize> {
+        self.start as usize..self.end as usize
+    }
+    /// Indices into [`Program::words`] of this block's words.
+    pub fn words(&self) -> Range<usize> {
+        self.words_start as usize..self.words_end as usize
+    }
+    /// Index of the block's modal state in the program's state table: equal indices of
+    /// neighbouring blocks mean an equal state (states are stored once per change).
+    pub(crate) fn state_index(&self) -> u32 {
+        self.state
+    }
 }
 
 /// A parsed program. Owns the bytes it was parsed from.
@@ -63,19 +98,25 @@ pub struct Program {
     pub words: Vec<Word>,
     /// Dialect used.
     pub dialect: Dialect,
+    /// Modal states, one per change: block `b`'s state is `states[blocks[b].state]`.
+    states: Vec<PackedModal>,
 }
 
 impl Program {
     /// The words of a block.
     pub fn block_words(&self, block: usize) -> &[Word] {
-        &self.words[self.blocks[block].words.clone()]
+        &self.words[self.blocks[block].words()]
+    }
+    /// The modal state after `block`.
+    pub fn state(&self, block: usize) -> Modal {
+        self.states[self.blocks[block].state as usize].unpack()
     }
     /// The modal state in force before `block` (the state after the previous block, or the
     /// power-on default for the first).
     pub fn state_before(&self, block: usize) -> Modal {
         block
             .checked_sub(1)
-            .map_or_else(Modal::default, |b| self.blocks[b].state)
+            .map_or_else(Modal::default, |b| self.state(b))
     }
     /// The word with `letter` in a block, if any (the last one if repeated).
     pub fn word(&self, block: usize, letter: u8) -> Option<&Word> {
@@ -95,13 +136,28 @@ impl Program {
 /// the last newline is not. See [`crate::lexer`] for the token rules and
 /// [`crate::modal`] for how the modal state follows the blocks.
 pub fn parse(bytes: Vec<u8>, dialect: Dialect) -> Result<Program, ParseError> {
+    if u32::try_from(bytes.len()).is_err() {
+        return Err(ParseError::at(
+            1,
+            1,
+            format!(
+                "the file has {} bytes; polepatch reads programs of at most 4 GiB",
+                bytes.len()
+            ),
+        ));
+    }
     let dialect = match dialect {
         Dialect::Auto => detect(&bytes),
         d => d,
     };
-    let mut blocks = Vec::with_capacity(bytes.len() / 32 + 1);
-    let mut words = Vec::with_capacity(bytes.len() / 8 + 1);
+    // Reserved from the size: lines of NC code are rarely shorter than 24 bytes or words
+    // than 6; untouched capacity costs address space only, a reallocation a copy.
+    let mut blocks = Vec::with_capacity(bytes.len() / 24 + 1);
+    let mut words = Vec::with_capacity(bytes.len() / 6 + 1);
+    let mut states = Vec::with_capacity(bytes.len() / 24 + 1);
     let mut interp = Interpreter::new(dialect);
+    let mut last = interp.modal;
+    states.push(PackedModal::pack(&last));
     let n = bytes.len();
     let mut start = 0;
     let mut line = 1;
@@ -117,7 +173,13 @@ pub fn parse(bytes: Vec<u8>, dialect: Dialect) -> Result<Program, ParseError> {
             ),
             None => (n, n),
         };
-        let block = interp.block(&bytes, start..end, line, &mut words)?;
+        let mut block = interp.block(&bytes, start..end, line, &mut words)?;
+        if interp.modal != last {
+            last = interp.modal;
+            states.push(PackedModal::pack(&last));
+        }
+        // At most one state per block plus the initial one, so at most 2^32 - 1.
+        block.state = (states.len() - 1) as u32;
         blocks.push(block);
         start = next;
         line += 1;
@@ -127,6 +189,7 @@ pub fn parse(bytes: Vec<u8>, dialect: Dialect) -> Result<Program, ParseError> {
         blocks,
         words,
         dialect,
+        states,
     })
 }
 
@@ -354,10 +417,12 @@ impl Interpreter {
                         // T tool, D/H offsets, U V W axes, P Q L E parameters.
                         _ => s.breaks = true,
                     }
+                    // Offsets fit: `parse` rejects files of 4 GiB and more.
                     words.push(Word {
                         letter,
-                        span,
-                        value_span,
+                        start: span.start as u32,
+                        value_start: value_span.start as u32,
+                        end: span.end as u32,
                         value,
                     });
                 }
@@ -383,6 +448,7 @@ impl Interpreter {
         Ok(self.apply(s, line, span, first_word..words.len()))
     }
 
+    /// Update the modal state; the block's `state` index is set by the caller.
     fn apply(&mut self, s: Scan, line: usize, span: Range<usize>, words: Range<usize>) -> Block {
         let m = &mut self.modal;
         let mut breaks = s.breaks;
@@ -447,11 +513,14 @@ impl Interpreter {
                 }
             }
         }
+        // Offsets fit: `parse` rejects files of 4 GiB and more.
         Block {
             line,
-            span,
-            words,
-            state: *m,
+            start: span.start as u32,
+            end: span.end as u32,
+            words_start: words.start as u32,
+            words_end: words.end as u32,
+            state: 0,
             is_move,
             breaks_run: breaks,
         }
@@ -470,14 +539,11 @@ mod tests {
     fn lines_and_endings() {
         let prog = p("G1 X1\r\nY2\n\nZ3");
         assert_eq!(prog.blocks.len(), 4);
-        assert_eq!(prog.blocks[0].span, 0..5);
-        assert_eq!(prog.blocks[1].span, 7..9);
-        assert_eq!(prog.blocks[2].span, 10..10);
-        assert_eq!(prog.blocks[3].span, 11..13);
-        assert_eq!(
-            prog.blocks[3].state.pos[..3],
-            [Some(1.0), Some(2.0), Some(3.0)]
-        );
+        assert_eq!(prog.blocks[0].span(), 0..5);
+        assert_eq!(prog.blocks[1].span(), 7..9);
+        assert_eq!(prog.blocks[2].span(), 10..10);
+        assert_eq!(prog.blocks[3].span(), 11..13);
+        assert_eq!(prog.state(3).pos[..3], [Some(1.0), Some(2.0), Some(3.0)]);
         assert_eq!(p("X1\n").blocks.len(), 1);
         assert!(p("").blocks.is_empty());
     }
@@ -504,7 +570,7 @@ mod tests {
     #[test]
     fn modal_state() {
         let prog = p("G21 G90 G1 X1 Y2 Z3 F100\nG91 X1 C10\nG90 G20 X1 F10\nG0 Z1\nM128\nG49\n");
-        let st: Vec<Modal> = prog.blocks.iter().map(|b| b.state).collect();
+        let st: Vec<Modal> = (0..prog.blocks.len()).map(|b| prog.state(b)).collect();
         assert_eq!(st[0].feed_mm_min, Some(100.0));
         assert_eq!(st[1].pos[X], Some(2.0));
         assert_eq!(
@@ -534,8 +600,8 @@ mod tests {
             p("%P G71 *\nN10 G01 X+1 Y+2 Z+3 A+5 F100 *\nN20 G54 X+1 Y+2 Z+3 *\nN30 X+4 *\n");
         let b = &prog.blocks[2];
         assert!(!b.is_move && b.breaks_run);
-        assert_eq!(b.state.pos, [None, None, None, Some(5.0), None, None]);
-        assert_eq!(prog.blocks[3].state.pos[X], Some(4.0));
+        assert_eq!(prog.state(2).pos, [None, None, None, Some(5.0), None, None]);
+        assert_eq!(prog.state(3).pos[X], Some(4.0));
         assert!(prog.blocks[3].is_move && !prog.blocks[3].breaks_run);
     }
 
@@ -544,7 +610,7 @@ mod tests {
         let prog = p("G1 X1 Y2 Z3\nG54 G0 X5 Y6 (SELECT)\n");
         let b = &prog.blocks[1];
         assert!(b.is_move && b.breaks_run);
-        assert_eq!(b.state.pos[..3], [Some(5.0), Some(6.0), None]);
+        assert_eq!(prog.state(1).pos[..3], [Some(5.0), Some(6.0), None]);
     }
 
     #[test]
@@ -628,6 +694,6 @@ mod tests {
             Dialect::Auto,
         )
         .unwrap();
-        assert_eq!(prog.blocks[1].state.pos[Y], Some(2.0));
+        assert_eq!(prog.state(1).pos[Y], Some(2.0));
     }
 }

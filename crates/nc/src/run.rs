@@ -86,8 +86,17 @@ pub fn runs(program: &Program) -> Vec<Run> {
         tcpm: st.tcpm,
         ended_by: RunBreak::End,
     };
+    let mut cur_state = Modal::default();
     for (i, b) in program.blocks.iter().enumerate() {
-        let st = &b.state;
+        if b.state_index()
+            != program
+                .blocks
+                .get(i.wrapping_sub(1))
+                .map_or(0, |p| p.state_index())
+        {
+            cur_state = program.state(i);
+        }
+        let st = &cur_state;
         if b.breaks_run {
             finish(&mut cur, RunBreak::Block, &mut out);
         } else if b.is_move {

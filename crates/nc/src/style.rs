@@ -50,9 +50,9 @@ impl Evidence {
         };
         let bytes = &program.bytes[..];
         for w in program.words.iter().filter(|w| pick(w.letter)) {
-            let text = &bytes[w.value_span.clone()];
+            let text = &bytes[w.value_span()];
             e.words += 1;
-            if w.value_span.start > w.span.start + 1 {
+            if w.value_start > w.start + 1 {
                 e.equals += 1;
             }
             let (sign, body) = match text.first() {

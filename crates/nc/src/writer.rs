@@ -62,8 +62,8 @@ pub fn write(program: &Program, edits: &[Edit]) -> Vec<u8> {
         let own_rank = rank(letter);
         if let Some(w) = program.word(e.block, letter) {
             splices.push((
-                w.value_span.start,
-                w.value_span.end,
+                w.value_span().start,
+                w.value_span().end,
                 own_rank,
                 number.into_bytes(),
             ));
@@ -79,10 +79,10 @@ pub fn write(program: &Program, edits: &[Edit]) -> Vec<u8> {
             Some(a) => {
                 let gap_before = a
                     .checked_sub(1)
-                    .map(|p| &bytes[words[p].span.end..words[a].span.start]);
+                    .map(|p| &bytes[words[p].span().end..words[a].span().start]);
                 let gap_after = words
                     .get(a + 1)
-                    .map(|n| &bytes[words[a].span.end..n.span.start]);
+                    .map(|n| &bytes[words[a].span().end..n.span().start]);
                 let blank = |g: &&[u8]| g.iter().all(|&b| b == b' ' || b == b'\t');
                 match gap_before.filter(blank).or(gap_after.filter(blank)) {
                     Some(g) => text.extend_from_slice(g),
@@ -90,16 +90,16 @@ pub fn write(program: &Program, edits: &[Edit]) -> Vec<u8> {
                         text.extend_from_slice(default_gap.get_or_insert_with(|| file_gap(program)))
                     }
                 }
-                words[a].span.end
+                words[a].span().end
             }
-            None => program.blocks[e.block].span.start,
+            None => program.blocks[e.block].span().start,
         };
         text.push(letter);
         if style.equals {
             text.push(b'=');
         }
         text.extend_from_slice(number.as_bytes());
-        if anchor.is_none() && !program.blocks[e.block].span.is_empty() {
+        if anchor.is_none() && !program.blocks[e.block].span().is_empty() {
             text.push(b' ');
         }
         splices.push((at, at, own_rank, text));
@@ -127,9 +127,9 @@ fn rank(letter: u8) -> usize {
 fn file_gap(program: &Program) -> &'static [u8] {
     let (mut spaced, mut tight) = (0usize, 0usize);
     for b in &program.blocks {
-        let ws = &program.words[b.words.clone()];
+        let ws = &program.words[b.words()];
         for pair in ws.windows(2) {
-            if pair[0].span.end == pair[1].span.start {
+            if pair[0].end == pair[1].start {
                 tight += 1;
             } else {
                 spaced += 1;

@@ -111,7 +111,7 @@ fn sing_runs() {
     // N60 is a datum shift, not a move; N80 is kept out of every run's motion.
     let n60 = block_of(&p, 60.0);
     assert!(!p.blocks[n60].is_move && p.blocks[n60].breaks_run);
-    assert_eq!(p.blocks[n60].state.pos[..3], [None, None, None]);
+    assert_eq!(p.state(n60).pos[..3], [None, None, None]);
 }
 
 #[test]
@@ -213,7 +213,7 @@ fn fanuc_fixture_and_modal_omission() {
     let n90 = block_of(&p, 90.0);
     let n120 = block_of(&p, 120.0);
     // C is modal: N90 keeps N80's C.
-    assert_eq!(p.blocks[n90].state.pos[modal::C], Some(52.5));
+    assert_eq!(p.state(n90).pos[modal::C], Some(52.5));
     let st = NumberStyle::of(&p, b'C');
     assert!(!st.plus_sign && st.trailing_point && st.strip_trailing_zeros && !st.leading_zero);
     let edits = [
@@ -238,7 +238,7 @@ fn fanuc_fixture_and_modal_omission() {
     assert_eq!(out, expect);
     // The rewritten program reads back with the new values.
     let back = parse(out.into_bytes(), Dialect::Auto).unwrap();
-    assert_eq!(back.blocks[n120].state.pos[modal::C], Some(150.5));
+    assert_eq!(back.state(n120).pos[modal::C], Some(150.5));
 }
 
 #[test]
@@ -262,6 +262,6 @@ fn heidenhain_non_utf8_fixture() {
     );
     let mut expect = p.bytes.clone();
     let w = p.word(b, b'C').unwrap();
-    expect.splice(w.value_span.clone(), b"+30".iter().copied());
+    expect.splice(w.value_span(), b"+30".iter().copied());
     assert_eq!(out, expect);
 }

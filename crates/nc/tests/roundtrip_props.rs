@@ -87,14 +87,14 @@ fn check_c_edit(
     );
     let bytes = &program.bytes;
     let new = style.render(value, 3);
-    prop_assert_eq!(&out[..w.value_span.start], &bytes[..w.value_span.start]);
+    prop_assert_eq!(&out[..w.value_span().start], &bytes[..w.value_span().start]);
     prop_assert_eq!(
-        &out[w.value_span.start..w.value_span.start + new.len()],
+        &out[w.value_span().start..w.value_span().start + new.len()],
         new.as_bytes()
     );
     prop_assert_eq!(
-        &out[w.value_span.start + new.len()..],
-        &bytes[w.value_span.end..]
+        &out[w.value_span().start + new.len()..],
+        &bytes[w.value_span().end..]
     );
     let back = parse(out, program.dialect).map_err(|e| TestCaseError::fail(e.to_string()))?;
     prop_assert_eq!(

@@ -85,8 +85,8 @@ pub fn assert_only_c_words_differ(name: &str, inp: &[u8], out: &[u8]) {
         "{name}: block count changed"
     );
     for (ba, bb) in a.blocks.iter().zip(&b.blocks) {
-        let la = &inp[ba.span.clone()];
-        let lb = &out[bb.span.clone()];
+        let la = &inp[ba.span()];
+        let lb = &out[bb.span()];
         if la == lb {
             continue;
         }
@@ -94,13 +94,13 @@ pub fn assert_only_c_words_differ(name: &str, inp: &[u8], out: &[u8]) {
             .block_words(a.blocks.iter().position(|x| x == ba).unwrap())
             .iter()
             .find(|w| w.letter == b'C')
-            .map(|w| w.span.start - ba.span.start..w.span.end - ba.span.start);
+            .map(|w| w.span().start - ba.span().start..w.span().end - ba.span().start);
         let ib = b.blocks.iter().position(|x| x == bb).unwrap();
         let cb = b
             .block_words(ib)
             .iter()
             .find(|w| w.letter == b'C')
-            .map(|w| w.span.start - bb.span.start..w.span.end - bb.span.start);
+            .map(|w| w.span().start - bb.span().start..w.span().end - bb.span().start);
         assert!(
             cb.is_some(),
             "{name} line {}: changed without a C word",
@@ -121,13 +121,13 @@ pub fn assert_only_c_words_differ(name: &str, inp: &[u8], out: &[u8]) {
         .blocks
         .iter()
         .zip(a.blocks.iter().skip(1))
-        .map(|(x, y)| &inp[x.span.end..y.span.start])
+        .map(|(x, y)| &inp[x.span().end..y.span().start])
         .collect();
     let ends_b: Vec<&[u8]> = b
         .blocks
         .iter()
         .zip(b.blocks.iter().skip(1))
-        .map(|(x, y)| &out[x.span.end..y.span.start])
+        .map(|(x, y)| &out[x.span().end..y.span().start])
         .collect();
     assert_eq!(ends_a, ends_b, "{name}: line endings changed");
 }
