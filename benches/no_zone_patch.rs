@@ -1,0 +1,59 @@
+//! The whole no-zone path of `polepatch patch` minus the file system: parse → runs and
+//! paths (`program::load`) → `patch_path` per run (`job::patch_program`) → write. Run:
+//! `cargo bench -p polepatch-benches --bench no_zone_patch -- --warm-up-time 1 --measurement-time 5`
+//! Figures are written up in docs/performance-nc.md.
+
+use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use polepatch::job::patch_program;
+use polepatch::program::{load, parse_program};
+use polepatch_benches::{Style, no_zone_program};
+use polepatch_kinematics::Machine;
+use polepatch_patcher::PatchOptions;
+
+/// Size of the generated program, bytes.
+const SIZE: usize = 20 << 20;
+
+fn no_zone(c: &mut Criterion) {
+    let machine = Machine::builtin("mikron-hsm600").expect("built-in machine");
+    let primary = machine.primary_letter();
+    let opts = PatchOptions::default();
+    let mut g = c.benchmark_group("no_zone_patch");
+    g.sample_size(10);
+    for (name, style) in [("heidenhain", Style::Heidenhain), ("fanuc", Style::Fanuc)] {
+        let text = no_zone_program(SIZE, style, primary);
+        g.throughput(Throughput::Bytes(text.len() as u64));
+        g.bench_with_input(BenchmarkId::new("pipeline", name), &text, |b, text| {
+            b.iter_batched(
+                || text.clone(),
+                |input| {
+                    let program = parse_program(input, "bench").expect("parses");
+                    let lp = load(program, "bench", &machine, None).expect("has runs");
+                    let (edits, report) = patch_program(&lp, &machine, &opts);
+                    assert!(edits.is_empty() && report.zones.is_empty(), "no zone");
+                    let out = polepatch::nc::write(&lp.program, &edits);
+                    assert_eq!(out.len(), text.len());
+                    (lp, out)
+                },
+                BatchSize::PerIteration,
+            )
+        });
+        // The analysis alone, from a parsed program: runs, paths, patch_path per run.
+        let parsed = parse_program(text.clone(), "bench").expect("parses");
+        g.bench_with_input(BenchmarkId::new("runs_and_patch", name), &parsed, |b, p| {
+            b.iter_batched(
+                || p.clone(),
+                |program| {
+                    let lp = load(program, "bench", &machine, None).expect("has runs");
+                    let (edits, _) = patch_program(&lp, &machine, &opts);
+                    assert!(edits.is_empty());
+                    lp
+                },
+                BatchSize::PerIteration,
+            )
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, no_zone);
+criterion_main!(benches);
