@@ -27,6 +27,9 @@ pub(crate) struct BenchArgs {
     /// Write one SVG per zone into this folder.
     #[arg(long)]
     plots: Option<PathBuf>,
+    /// Plot only the programs whose file name contains this text.
+    #[arg(long, requires = "plots")]
+    plot_only: Option<String>,
     /// Feed in mm/min for runs with no F in force.
     #[arg(long)]
     feed: Option<f64>,
@@ -147,7 +150,7 @@ pub(crate) fn run(args: BenchArgs) -> Result<ExitCode> {
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     if let Some(dir) = &args.plots {
-        let n = write_plots(&report, dir)?;
+        let n = write_plots(&report, dir, args.plot_only.as_deref())?;
         eprintln!("polepatch: {n} plot(s) written to {}", dir.display());
     }
     Ok(if report.errors.is_empty() {
@@ -349,11 +352,14 @@ fn csv_rows(report: &BenchReport) -> Result<Vec<u8>> {
 }
 
 /// One SVG per zone with plot data: `<file-stem>-<machine>-run<r>-zone<k>.svg`, k counting
-/// the zones of the run from 1.
-fn write_plots(report: &BenchReport, dir: &Path) -> Result<usize> {
+/// the zones of the run from 1; with `only`, just the files whose name contains it.
+fn write_plots(report: &BenchReport, dir: &Path, only: Option<&str>) -> Result<usize> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut n = 0;
     for case in &report.cases {
+        if only.is_some_and(|o| !short_name(&case.file).contains(o)) {
+            continue;
+        }
         let stem = Path::new(&case.file)
             .file_stem()
             .map_or("program".to_string(), |s| s.to_string_lossy().into_owned());

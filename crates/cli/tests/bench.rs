@@ -276,3 +276,42 @@ fn csv_has_bound_and_ratio_columns() {
     let ratio: f64 = row[header.len() - 1].parse().unwrap();
     assert!(bound > 0.0 && ratio >= 1.0 - 1e-6, "{row:?}");
 }
+
+/// The table rows of `docs/quality.md` for the dialect fixtures, without the measured
+/// solve time (last column).
+fn doc_rows(text: &str, files: &[&str]) -> Vec<String> {
+    text.lines()
+        .filter(|l| files.iter().any(|f| l.starts_with(f)))
+        .map(|l| {
+            let mut cols: Vec<&str> = l.split_whitespace().collect();
+            if !l.contains("no zone") {
+                cols.pop();
+            }
+            cols.join(" ")
+        })
+        .collect()
+}
+
+#[test]
+fn docs_quality_table_matches_a_fresh_run() {
+    let files = ["fanuc.nc", "heidenhain_latin1.I", "sinumerik.mpf"];
+    let doc = std::fs::read_to_string(root().join("docs/quality.md")).unwrap();
+    let out = bin()
+        .arg("bench")
+        .arg(root().join("fixtures/dialects"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let fresh = String::from_utf8(out.stdout).unwrap();
+    let want = doc_rows(&doc, &files);
+    assert_eq!(want.len(), 6, "docs/quality.md lacks the dialect rows");
+    assert_eq!(
+        doc_rows(&fresh, &files),
+        want,
+        "docs/quality.md is stale: regenerate it with the command at its top"
+    );
+}
