@@ -1,43 +1,69 @@
-//! The direct formulation: a QP on the CL C values through the analysis spline, and the
-//! lower bound on the orientation deviation (SPEC §6, bench).
+//! The direct formulation: a sparse QP on the CL C values through the analysis spline
+//! written in Hermite form, and the lower bound on the orientation deviation (SPEC §6).
+//!
+//! # The analysis spline in Hermite form
+//!
+//! The analysis spline of C (SPEC §2) is the not-a-knot cubic interpolant of the C values
+//! y_k over s. On the span `[s_k, s_{k+1}]`, `h_k = s_{k+1} − s_k`, `τ = s − s_k`, with the
+//! knot slopes `m_k` and the secant `σ_k = (y_{k+1} − y_k)/h_k`:
+//!
+//! ```text
+//! q(τ)    = y_k + m_k τ + c2 τ² + c3 τ³
+//! c2      = (3σ_k − 2m_k − m_{k+1}) / h_k
+//! c3      = (m_k + m_{k+1} − 2σ_k) / h_k²
+//! q'(τ)   = m_k + 2c2 τ + 3c3 τ²,   q''(τ) = 2c2 + 6c3 τ,   q''' = 6c3
+//! ```
+//!
+//! Every derivative at a point of span k is a linear form in the four unknowns
+//! `y_k, y_{k+1}, m_k, m_{k+1}`. The slopes are tied to the values by C² continuity at each
+//! interior knot k (tridiagonal):
+//!
+//! ```text
+//! h_k m_{k−1} + 2(h_{k−1} + h_k) m_k + h_{k−1} m_{k+1} = 3(h_k σ_{k−1} + h_{k−1} σ_k)
+//! ```
+//!
+//! and one condition at each end of the window `lo..=hi` of knots the QP sees:
+//! - at an end of the **path**, not-a-knot: `c3` of the end span equals `c3` of its
+//!   neighbour (the condition of `polepatch_bspline::interpolate_not_a_knot`); a path of 2
+//!   or 3 points is a line or a parabola, `c3 = 0` on every span (and `c2 = 0` for 2);
+//! - at a window end **inside** the path, the slope is fixed to the current spline's
+//!   (`interpolate_not_a_knot` on the window widened by [`WINDOW_POINTS`] more points).
+//!   A change of the values moves that slope by ≈ 0.27^[`WINDOW_POINTS`] of itself
+//!   (the not-a-knot system's decay per knot), which the caller's verification on the
+//!   whole path covers.
+//!
+//! [`Hermite`] builds these rows; its test checks them against `interpolate_not_a_knot`.
 //!
 //! # The direct QP
 //!
-//! The analysis spline of C (SPEC §2: the not-a-knot cubic interpolant of C over s) is
-//! linear in the C values, so are its derivatives. Write the new values at the points
-//! `i = first..=last` as `x_i = C_i + δ_i` (every other point fixed). For every functional
-//! `L` used below (a slope at a knot, a second derivative at a span end, a third derivative
-//! on a span, a Bernstein coefficient), `L(x) = L(C) + Σ_i L(e_i)·δ_i`, where `L(e_i)` is
-//! the response of the spline to the unit vector at point i. Responses are computed on a
-//! window of [`WINDOW_POINTS`] points either side of the range (the response decays by
-//! ≈ 0.27 per knot; the caller verifies on the whole path anyway).
-//!
-//! On a span `[u, w]`, `h = w − u`, the spline's `q'''` is a constant, `q''` is linear, `q'`
-//! is a quadratic with Bernstein coefficients
-//! `b0 = q'(u)`, `b1 = q'(u) + q''(u)·h/2 = 3σ − q'(u) − q'(w)` (σ the secant slope),
-//! `b2 = q'(w)`; by the convex-hull property `|b_k| ≤ v` gives `|q'| ≤ v` on the whole span,
-//! hence on every sample whatever the step F·Tcy.
-//!
-//! Variables `δ ∈ ℝ^m` (m = last − first + 1) and `t ∈ ℝ`:
+//! New values `y_i = C_i + δ_i` at `i = first..=last` (every other point fixed), the
+//! slopes `m_k` of the window `lo = first − W .. hi = last + W` (clipped to the path,
+//! W = [`WINDOW_POINTS`]) and `t`. On a span the quadratic q' has Bernstein coefficients
+//! `b0 = m_k`, `b1 = 3σ_k − m_k − m_{k+1}`, `b2 = m_{k+1}`; by the convex-hull property
+//! `|b_i| ≤ v` gives `|q'| ≤ v` on the whole span, hence on every sample whatever the step.
+//! `q''` is linear on a span (its ends bind) and `q'''` constant.
 //!
 //! ```text
 //! minimise    t + μ Σ_i (w_i² + ε)·δ_i²            w_i = |sin P_i|, μ = DEVIATION_QUAD_WEIGHT/m
-//! subject to  −t ≤ w_i·δ_i ≤ t                       (t ≥ largest approximate deviation)
+//! subject to  Hermite continuity and end rows        (equalities, above)
+//!             −t ≤ w_i·δ_i ≤ t                       (t ≥ largest approximate deviation)
 //!             t ≤ d                                  (only with opts.max_deviation_deg = Some(d))
-//!             |q'(s_k)|  ≤ v,  |q''(s_k)| ≤ a        every knot k of the constrained range
+//!             |m_k| ≤ v,  |q''(s_k)| ≤ a             every knot k of the constrained range
 //!             |b1(span)| ≤ v,  |q'''(span)| ≤ j      every span of the constrained range
-//!             σ·q'(s_k) ≥ 0, σ·b1 ≥ 0                knots/spans in [s(first), s(last)]
+//!             σ·m_k ≥ 0, σ·b1 ≥ 0                    knots/spans in [s(first), s(last)]
 //!                                                    (only with monotone = Some(σ))
 //! ```
 //!
 //! The constrained range is the spans in `[s(first − 3), s(last + 3)]` (clipped to the
-//! path). `(v, a, j)` are `lim` (V/F, A/F², J/F³, with the caller's margin). Each
-//! inequality row is divided by its bound so all rows have unit scale. The deviation of a
-//! point whose C changes by δ with P unchanged is `2·asin(|sin P|·|sin(δ/2)|)`; the QP uses
-//! its linearisation `|sin P|·|δ|`, which is never below the exact value for |δ| ≤ 180°
-//! up to the second order in |sin P| (so `t ≤ d` is a slightly conservative form of the
-//! exact limit for small P; the reported deviation always uses the exact formula).
-//! `ε` ([`PURE_POLE_REGULARISATION`]) keeps a point exactly at the pole (w = 0) from being
+//! path, [`CONSTRAINED_MARGIN_POINTS`]). `(v, a, j)` are `lim` (V/F, A/F², J/F³, with the
+//! caller's margin). Each inequality row is divided by its bound so all rows have unit
+//! scale; each continuity row by `h_{k−1} + h_k`. Every row touches at most 5 variables, so
+//! the KKT system clarabel factors is banded-sparse. The deviation of a point whose C
+//! changes by δ with P unchanged is `2·asin(|sin P|·|sin(δ/2)|)`; the QP uses its
+//! linearisation `|sin P|·|δ|`, which is never below the exact value for |δ| ≤ 180° up to
+//! the second order in |sin P| (so `t ≤ d` is a slightly conservative form of the exact
+//! limit for small P; the reported deviation always uses the exact formula). `ε`
+//! ([`PURE_POLE_REGULARISATION`]) keeps a point exactly at the pole (w = 0) from being
 //! free. The small quadratic (weight μ) pulls the points that do not bind the maximum back
 //! towards their original values.
 //!
@@ -47,20 +73,22 @@
 //! `first..=last` with the constraints checked on the samples (every `step_mm` on each span
 //! and at every knot), no monotonicity: since the deviation of point i is increasing in
 //! |δ_i| on [0°, 180°], `max_i dev_i ≤ T` ⇔ `|δ_i| ≤ g_i(T) = 2·asin(sin(T/2)/w_i)` (no
-//! bound when `sin(T/2) ≥ w_i`), an LP feasibility problem; bisection on T.
+//! bound when `sin(T/2) ≥ w_i`), an LP feasibility problem on the same Hermite rows;
+//! bisection on T.
 
 use crate::{
     candidate::{Candidate, PatchFailure},
     limits::CLimits,
     options::PatchOptions,
-    qp::{LeqRows, add_stats, solve_diag_qp},
+    qp::{QpBuilder, Row},
     report::QpStats,
-    verify::{NakSystem, span_coeffs, span_offsets},
+    verify::span_offsets,
 };
+use polepatch_bspline::interpolate_not_a_knot;
 
-/// Points of the path kept either side of the modified range to build the spline
-/// responses.
-pub const WINDOW_POINTS: usize = 24;
+/// Points of the path kept either side of the modified range as Hermite unknowns; beyond
+/// them the slope is fixed to the current spline's (module docs).
+pub const WINDOW_POINTS: usize = 16;
 
 /// Points either side of the modified range whose spans are constrained.
 pub const CONSTRAINED_MARGIN_POINTS: usize = 3;
@@ -72,159 +100,267 @@ pub const DEVIATION_QUAD_WEIGHT: f64 = 1e-4;
 /// Added to `sin² P` in the quadratic term so a point exactly at the pole stays determined.
 pub const PURE_POLE_REGULARISATION: f64 = 1e-6;
 
-/// Response coefficients smaller than this fraction of their row's largest are dropped.
-const DROP_REL: f64 = 1e-12;
-
 /// Sampling step of [`deviation_bound`], mm: finer than F·Tcy at the feeds of interest
 /// (F·Tcy = 0.033 mm at F2000 and Tcy 1 ms); use [`deviation_bound_sampled`] to give the
 /// analysis step.
 pub const BOUND_STEP_MM: f64 = 0.02;
 
-/// Bisection steps of [`deviation_bound`].
+/// Most bisection steps of [`deviation_bound`].
 pub const BOUND_BISECTIONS: usize = 25;
 
-/// The spline functionals of a window as linear maps of the modified values.
-struct Responses {
-    /// First path index of the window.
+/// [`deviation_bound`] stops bisecting when the bracket is narrower than this fraction of
+/// its upper end (the bound is then known to 0.01 %).
+pub const BOUND_REL_TOL: f64 = 1e-4;
+
+/// An affine form `Σ coeff·x[var] + c`.
+#[derive(Debug, Clone, Default)]
+struct Aff {
+    row: Row,
+    c: f64,
+}
+
+impl Aff {
+    fn constant(c: f64) -> Aff {
+        Aff { row: Vec::new(), c }
+    }
+    fn var(k: usize) -> Aff {
+        Aff {
+            row: vec![(k, 1.0)],
+            c: 0.0,
+        }
+    }
+    /// `Σ coef·form`.
+    fn sum(parts: &[(f64, &Aff)]) -> Aff {
+        let mut out = Aff::default();
+        for (a, f) in parts {
+            out.row.extend(f.row.iter().map(|&(k, v)| (k, a * v)));
+            out.c += a * f.c;
+        }
+        out
+    }
+    /// Value at `x`.
+    #[cfg(test)]
+    fn at(&self, x: &[f64]) -> f64 {
+        self.c + self.row.iter().map(|&(k, v)| v * x[k]).sum::<f64>()
+    }
+}
+
+/// The analysis spline of C on the window `lo..=hi` of a path in Hermite form, with the
+/// values at `first..=last` and the slopes at `lo..=hi` as unknowns (module docs).
+///
+/// Variables: `δ_i` (the change of C at point i, degrees) at index `i − first`, then the
+/// slope `m_k` (°/mm) at index `nd + k − lo`.
+pub(crate) struct Hermite<'a> {
+    s: &'a [f64],
+    c: &'a [f64],
+    first: usize,
+    last: usize,
     lo: usize,
-    /// Knots of the window.
-    s: Vec<f64>,
-    /// Base values and slopes (original C).
-    y0: Vec<f64>,
-    m0: Vec<f64>,
-    /// Slopes of the response to each unit vector, per variable.
-    m_unit: Vec<Vec<f64>>,
-    /// Local index of variable 0.
-    var0: usize,
+    hi: usize,
+    nd: usize,
+    /// Current spline's slope at `lo` / `hi` when that end is inside the path.
+    fixed: [Option<f64>; 2],
 }
 
-/// One span's `(q'(u), c2, c3)` as affine functions: base value and per-variable
-/// coefficients.
-struct SpanMaps {
-    h: f64,
-    m0: (f64, Vec<f64>),
-    m1: (f64, Vec<f64>),
-    c2: (f64, Vec<f64>),
-    c3: (f64, Vec<f64>),
-}
-
-impl Responses {
-    fn new(s_mm: &[f64], c_deg: &[f64], first: usize, last: usize) -> Responses {
-        let n = s_mm.len();
-        let lo = first.saturating_sub(WINDOW_POINTS);
-        let hi = (last + WINDOW_POINTS).min(n - 1);
-        let sys = NakSystem::new(&s_mm[lo..=hi]);
-        let y0 = c_deg[lo..=hi].to_vec();
-        let m0 = sys.slopes(&y0);
-        let nw = sys.len();
-        let mut e = vec![0.0; nw];
-        let m_unit = (first..=last)
-            .map(|i| {
-                e[i - lo] = 1.0;
-                let m = sys.slopes(&e);
-                e[i - lo] = 0.0;
-                m
-            })
-            .collect();
-        Responses {
+impl<'a> Hermite<'a> {
+    /// The window of `first..=last` widened by `window` points (clipped to the path).
+    pub(crate) fn new(
+        s: &'a [f64],
+        c: &'a [f64],
+        first: usize,
+        last: usize,
+        window: usize,
+    ) -> Result<Hermite<'a>, PatchFailure> {
+        let n = s.len();
+        if n < 2 || first > last || last >= n || c.len() != n {
+            return Err(PatchFailure::TooShort);
+        }
+        let lo = first.saturating_sub(window);
+        let hi = (last + window).min(n - 1);
+        let mut fixed = [None, None];
+        if lo > 0 || hi < n - 1 {
+            let lo2 = lo.saturating_sub(WINDOW_POINTS);
+            let hi2 = (hi + WINDOW_POINTS).min(n - 1);
+            let sp = interpolate_not_a_knot(&s[lo2..=hi2], &c[lo2..=hi2])
+                .map_err(|_| PatchFailure::TooShort)?;
+            if lo > 0 {
+                fixed[0] = Some(sp.eval_derivs(s[lo])[1]);
+            }
+            if hi < n - 1 {
+                fixed[1] = Some(sp.eval_derivs(s[hi])[1]);
+            }
+        }
+        Ok(Hermite {
+            s,
+            c,
+            first,
+            last,
             lo,
-            s: sys.knots().to_vec(),
-            y0,
-            m0,
-            m_unit,
-            var0: first - lo,
-        }
+            hi,
+            nd: last - first + 1,
+            fixed,
+        })
     }
 
-    fn vars(&self) -> usize {
-        self.m_unit.len()
+    /// Number of variables (changes, then slopes).
+    pub(crate) fn vars(&self) -> usize {
+        self.nd + self.hi - self.lo + 1
     }
 
-    /// Maps of local span k.
-    fn span(&self, k: usize) -> SpanMaps {
-        let (bm0, bc2, bc3, h) = span_coeffs(&self.s, &self.y0, &self.m0, k);
-        let nv = self.vars();
-        let mut m0 = vec![0.0; nv];
-        let mut m1 = vec![0.0; nv];
-        let mut c2 = vec![0.0; nv];
-        let mut c3 = vec![0.0; nv];
-        for i in 0..nv {
-            let mu = &self.m_unit[i];
-            let li = self.var0 + i;
-            let yk = if li == k { 1.0 } else { 0.0 };
-            let yk1 = if li == k + 1 { 1.0 } else { 0.0 };
-            let sl = (yk1 - yk) / h;
-            m0[i] = mu[k];
-            m1[i] = mu[k + 1];
-            c2[i] = (3.0 * sl - 2.0 * mu[k] - mu[k + 1]) / h;
-            c3[i] = (mu[k] + mu[k + 1] - 2.0 * sl) / (h * h);
-        }
-        SpanMaps {
-            h,
-            m0: (bm0, m0),
-            m1: (self.m0[k + 1], m1),
-            c2: (bc2, c2),
-            c3: (bc3, c3),
-        }
+    fn h(&self, k: usize) -> f64 {
+        self.s[k + 1] - self.s[k]
     }
 
-    /// Local spans constrained for the modified range `first..=last` (path indices).
-    fn constrained_spans(&self, first: usize, last: usize) -> std::ops::Range<usize> {
-        let n_local = self.s.len();
-        let a = first.saturating_sub(CONSTRAINED_MARGIN_POINTS).max(self.lo) - self.lo;
-        let b = (last + CONSTRAINED_MARGIN_POINTS).min(self.lo + n_local - 1) - self.lo;
-        a..b.max(a + 1).min(n_local - 1)
+    /// Value at path point k.
+    fn y(&self, k: usize) -> Aff {
+        let mut a = Aff::constant(self.c[k]);
+        if (self.first..=self.last).contains(&k) {
+            a.row.push((k - self.first, 1.0));
+        }
+        a
+    }
+
+    /// Slope at path knot k (lo ≤ k ≤ hi).
+    fn m(&self, k: usize) -> Aff {
+        Aff::var(self.nd + k - self.lo)
+    }
+
+    fn secant(&self, k: usize) -> Aff {
+        let h = self.h(k);
+        Aff::sum(&[(1.0 / h, &self.y(k + 1)), (-1.0 / h, &self.y(k))])
+    }
+
+    fn c2(&self, k: usize) -> Aff {
+        let h = self.h(k);
+        Aff::sum(&[
+            (3.0 / h, &self.secant(k)),
+            (-2.0 / h, &self.m(k)),
+            (-1.0 / h, &self.m(k + 1)),
+        ])
+    }
+
+    fn c3(&self, k: usize) -> Aff {
+        let h2 = self.h(k) * self.h(k);
+        Aff::sum(&[
+            (1.0 / h2, &self.m(k)),
+            (1.0 / h2, &self.m(k + 1)),
+            (-2.0 / h2, &self.secant(k)),
+        ])
+    }
+
+    /// `q'(s_k + τ)` on span k.
+    fn d1(&self, k: usize, tau: f64) -> Aff {
+        Aff::sum(&[
+            (1.0, &self.m(k)),
+            (2.0 * tau, &self.c2(k)),
+            (3.0 * tau * tau, &self.c3(k)),
+        ])
+    }
+
+    /// `q''(s_k + τ)` on span k.
+    fn d2(&self, k: usize, tau: f64) -> Aff {
+        Aff::sum(&[(2.0, &self.c2(k)), (6.0 * tau, &self.c3(k))])
+    }
+
+    /// `q'''` on span k.
+    fn d3(&self, k: usize) -> Aff {
+        Aff::sum(&[(6.0, &self.c3(k))])
+    }
+
+    /// Middle Bernstein coefficient of `q'` on span k: `3σ_k − m_k − m_{k+1}`.
+    fn b1(&self, k: usize) -> Aff {
+        Aff::sum(&[
+            (3.0, &self.secant(k)),
+            (-1.0, &self.m(k)),
+            (-1.0, &self.m(k + 1)),
+        ])
+    }
+
+    /// The rows tying the slopes to the values (each `form = 0`): C² continuity at every
+    /// interior knot, then the two end conditions (module docs).
+    fn equalities(&self) -> Vec<Aff> {
+        let (lo, hi) = (self.lo, self.hi);
+        let mut eqs = Vec::with_capacity(hi - lo + 1);
+        for k in lo + 1..hi {
+            let (ha, hb) = (self.h(k - 1), self.h(k));
+            let w = 1.0 / (ha + hb);
+            eqs.push(Aff::sum(&[
+                (hb * w, &self.m(k - 1)),
+                (2.0, &self.m(k)),
+                (ha * w, &self.m(k + 1)),
+                (-3.0 * hb * w, &self.secant(k - 1)),
+                (-3.0 * ha * w, &self.secant(k)),
+            ]));
+        }
+        let nw = hi - lo + 1;
+        let both_path_ends = self.fixed == [None, None];
+        if both_path_ends && nw <= 3 {
+            // A line (2 points) or a parabola (3 points).
+            for k in lo..hi {
+                eqs.push(Aff::sum(&[(self.h(k) * self.h(k), &self.c3(k))]));
+            }
+            if nw == 2 {
+                eqs.push(Aff::sum(&[(self.h(lo), &self.c2(lo))]));
+            }
+            return eqs;
+        }
+        let not_a_knot = |a: usize| {
+            let (ha, hb) = (self.h(a), self.h(a + 1));
+            Aff::sum(&[(ha * hb, &self.c3(a)), (-ha * hb, &self.c3(a + 1))])
+        };
+        eqs.push(match self.fixed[0] {
+            Some(m) => Aff::sum(&[(1.0, &self.m(lo)), (-m, &Aff::constant(1.0))]),
+            None => not_a_knot(lo),
+        });
+        eqs.push(match self.fixed[1] {
+            Some(m) => Aff::sum(&[(1.0, &self.m(hi)), (-m, &Aff::constant(1.0))]),
+            None => not_a_knot(hi - 2),
+        });
+        eqs
+    }
+
+    /// Path spans constrained for the modified range: those within
+    /// [`CONSTRAINED_MARGIN_POINTS`] of it, in the window.
+    fn constrained_spans(&self) -> std::ops::Range<usize> {
+        let a = self
+            .first
+            .saturating_sub(CONSTRAINED_MARGIN_POINTS)
+            .max(self.lo);
+        let b = (self.last + CONSTRAINED_MARGIN_POINTS).min(self.hi);
+        a..b.max(a + 1).min(self.hi)
+    }
+
+    /// A builder over the variables plus `extra` more, with the equalities.
+    fn builder(&self, extra: usize) -> QpBuilder {
+        let mut qp = QpBuilder::new(self.vars() + extra);
+        for e in self.equalities() {
+            qp.add_eq(&e.row, -e.c);
+        }
+        qp
     }
 }
 
-/// Linear combination `Σ coef_j·map_j` of affine maps.
-fn combine(parts: &[(f64, &(f64, Vec<f64>))]) -> (f64, Vec<f64>) {
-    let nv = parts[0].1.1.len();
-    let mut base = 0.0;
-    let mut lin = vec![0.0; nv];
-    for (c, (b, l)) in parts {
-        base += c * b;
-        for (o, v) in lin.iter_mut().zip(l) {
-            *o += c * v;
-        }
-    }
-    (base, lin)
-}
-
-/// Push `|base + lin·δ| ≤ bound` (two rows, scaled by 1/bound), or with `sign = Some(σ)`
-/// only `σ·(base + lin·δ) ≥ 0`.
-fn push_abs(rows: &mut LeqRows, f: &(f64, Vec<f64>), bound: f64) {
-    let (base, lin) = f;
-    let big = lin.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let keep = |v: f64| v.abs() > DROP_REL * big;
+/// Push `|f| ≤ bound` (two rows, scaled by 1/bound).
+fn push_abs(qp: &mut QpBuilder, f: &Aff, bound: f64) {
     for sgn in [1.0, -1.0] {
-        rows.push(
-            lin.iter()
-                .enumerate()
-                .filter(|(_, v)| keep(**v))
-                .map(|(i, v)| (i, sgn * v / bound)),
-            (bound - sgn * base) / bound,
-        );
+        let row: Row = f.row.iter().map(|&(k, v)| (k, sgn * v / bound)).collect();
+        qp.add_le(&row, (bound - sgn * f.c) / bound);
     }
 }
 
-fn push_sign(rows: &mut LeqRows, f: &(f64, Vec<f64>), sigma: f64) {
-    let (base, lin) = f;
-    let scale = lin
+/// Push `σ·f ≥ 0`, scaled by the form's largest coefficient.
+fn push_sign(qp: &mut QpBuilder, f: &Aff, sigma: f64) {
+    let scale = f
+        .row
         .iter()
-        .fold(base.abs(), |m, v| m.max(v.abs()))
+        .fold(f.c.abs(), |m, e| m.max(e.1.abs()))
         .max(1e-300);
-    rows.push(
-        lin.iter().enumerate().map(|(i, v)| (i, -sigma * v / scale)),
-        sigma * base / scale,
-    );
-}
-
-fn check_range(n: usize, first: usize, last: usize) -> Result<(), PatchFailure> {
-    if n < 2 || first > last || last >= n {
-        return Err(PatchFailure::TooShort);
-    }
-    Ok(())
+    let row: Row = f
+        .row
+        .iter()
+        .map(|&(k, v)| (k, -sigma * v / scale))
+        .collect();
+    qp.add_le(&row, sigma * f.c / scale);
 }
 
 /// New C values for points `first..=last` (others fixed) minimising the largest orientation
@@ -245,68 +381,56 @@ pub fn direct_patch(
     monotone: Option<f64>,
     opts: &PatchOptions,
 ) -> Result<Candidate, PatchFailure> {
-    check_range(s_mm.len(), first, last)?;
-    let r = Responses::new(s_mm, c_deg, first, last);
-    let nv = r.vars();
-    let t = nv; // index of the epigraph variable
-    let mut rows = LeqRows::default();
-    let spans = r.constrained_spans(first, last);
-    let (mon_lo, mon_hi) = (first - r.lo, last - r.lo);
+    let hm = Hermite::new(s_mm, c_deg, first, last, WINDOW_POINTS)?;
+    let nd = hm.nd;
+    let t = hm.vars(); // index of the epigraph variable
+    let mut qp = hm.builder(1);
+    let spans = hm.constrained_spans();
     for k in spans.clone() {
-        let sp = r.span(k);
-        // Knot k: slope and second derivative.
-        push_abs(&mut rows, &sp.m0, lim.v);
-        let d2u = combine(&[(2.0, &sp.c2)]);
-        push_abs(&mut rows, &d2u, lim.a);
-        // Span: middle Bernstein coefficient of q' and third derivative.
-        let b1 = combine(&[(1.0, &sp.m0), (sp.h, &sp.c2)]);
-        push_abs(&mut rows, &b1, lim.v);
-        push_abs(&mut rows, &combine(&[(6.0, &sp.c3)]), lim.j);
-        if k + 1 == spans.end {
-            push_abs(&mut rows, &sp.m1, lim.v);
-            let d2w = combine(&[(2.0, &sp.c2), (6.0 * sp.h, &sp.c3)]);
-            push_abs(&mut rows, &d2w, lim.a);
+        let h = hm.h(k);
+        push_abs(&mut qp, &hm.m(k), lim.v);
+        push_abs(&mut qp, &hm.d2(k, 0.0), lim.a);
+        let b1 = hm.b1(k);
+        push_abs(&mut qp, &b1, lim.v);
+        push_abs(&mut qp, &hm.d3(k), lim.j);
+        let end = k + 1 == spans.end;
+        if end {
+            push_abs(&mut qp, &hm.m(k + 1), lim.v);
+            push_abs(&mut qp, &hm.d2(k, h), lim.a);
         }
         if let Some(sigma) = monotone {
-            if k >= mon_lo && k <= mon_hi {
-                push_sign(&mut rows, &sp.m0, sigma);
+            if (first..=last).contains(&k) {
+                push_sign(&mut qp, &hm.m(k), sigma);
             }
-            if k >= mon_lo && k < mon_hi {
-                push_sign(&mut rows, &b1, sigma);
+            if k >= first && k < last {
+                push_sign(&mut qp, &b1, sigma);
             }
-            if k + 1 == spans.end && k < mon_hi && k + 1 >= mon_lo {
-                push_sign(&mut rows, &sp.m1, sigma);
+            if end && (first..=last).contains(&(k + 1)) {
+                push_sign(&mut qp, &hm.m(k + 1), sigma);
             }
         }
     }
-    let w: Vec<f64> = (first..=last)
-        .map(|i| p_deg[i].to_radians().sin().abs())
-        .collect();
-    for (i, wi) in w.iter().enumerate() {
-        rows.push([(i, *wi), (t, -1.0)], 0.0);
-        rows.push([(i, -*wi), (t, -1.0)], 0.0);
+    let mu = DEVIATION_QUAD_WEIGHT / nd as f64;
+    for i in 0..nd {
+        let w = p_deg[first + i].to_radians().sin().abs();
+        qp.add_le(&[(i, w), (t, -1.0)], 0.0);
+        qp.add_le(&[(i, -w), (t, -1.0)], 0.0);
+        qp.add_square(&[(i, 1.0)], mu * (w * w + PURE_POLE_REGULARISATION), 0.0);
     }
     if let Some(d) = opts.max_deviation_deg {
-        rows.push([(t, 1.0)], d);
+        qp.add_le(&[(t, 1.0)], d);
     }
-    let mu = DEVIATION_QUAD_WEIGHT / nv as f64;
-    let mut p_diag: Vec<f64> = w
-        .iter()
-        .map(|wi| 2.0 * mu * (wi * wi + PURE_POLE_REGULARISATION))
-        .collect();
-    p_diag.push(0.0);
-    let mut q = vec![0.0; nv + 1];
-    q[t] = 1.0;
-    let (x, stats) = solve_diag_qp(&p_diag, &q, &rows);
-    match x {
-        Some(x) => Ok(Candidate {
+    qp.add_linear(t, 1.0);
+    let mut stats = QpStats::default();
+    match qp.solve(&mut stats) {
+        Ok(x) => Ok(Candidate {
             first,
             last,
-            c_deg: (0..nv).map(|i| c_deg[first + i] + x[i]).collect(),
+            c_deg: (0..nd).map(|i| c_deg[first + i] + x[i]).collect(),
             c_offset_deg: 0.0,
             qp: stats,
         }),
-        None => Err(PatchFailure::Solver(stats)),
+        Err(_) => Err(PatchFailure::Solver(stats)),
     }
 }
 
@@ -335,8 +459,9 @@ pub fn deviation_bound(
 /// [`deviation_bound`] with the constraints on the samples every `step_mm` (> 0) of each
 /// span of the constrained range (spans within [`CONSTRAINED_MARGIN_POINTS`] of the range)
 /// and at every knot: pass the analysis step F·Tcy to get the bound for what the
-/// verification checks. Bisection ([`BOUND_BISECTIONS`] steps) on the exact deviation, an
-/// LP feasibility problem per step (module docs); returns the smallest feasible T found.
+/// verification checks. Bisection (at most [`BOUND_BISECTIONS`] steps, to
+/// [`BOUND_REL_TOL`]) on the exact deviation, an LP feasibility problem per step (module
+/// docs); returns the smallest feasible T found.
 pub fn deviation_bound_sampled(
     s_mm: &[f64],
     p_deg: &[f64],
@@ -346,60 +471,54 @@ pub fn deviation_bound_sampled(
     lim: &CLimits,
     step_mm: f64,
 ) -> Result<(f64, QpStats), PatchFailure> {
-    check_range(s_mm.len(), first, last)?;
     if step_mm.is_nan() || step_mm <= 0.0 {
         return Err(PatchFailure::TooShort);
     }
-    let r = Responses::new(s_mm, c_deg, first, last);
-    let nv = r.vars();
-    let spans = r.constrained_spans(first, last);
-    let mut spline_rows = LeqRows::default();
+    let hm = Hermite::new(s_mm, c_deg, first, last, WINDOW_POINTS)?;
+    let nd = hm.nd;
+    let mut base = hm.builder(0);
+    let spans = hm.constrained_spans();
     let mut ts = Vec::new();
     for k in spans.clone() {
-        let sp = r.span(k);
-        span_offsets(sp.h, step_mm, k + 1 == spans.end, &mut ts);
+        span_offsets(hm.h(k), step_mm, k + 1 == spans.end, &mut ts);
         for &tau in &ts {
-            let d1 = combine(&[
-                (1.0, &sp.m0),
-                (2.0 * tau, &sp.c2),
-                (3.0 * tau * tau, &sp.c3),
-            ]);
-            push_abs(&mut spline_rows, &d1, lim.v);
-            let d2 = combine(&[(2.0, &sp.c2), (6.0 * tau, &sp.c3)]);
-            push_abs(&mut spline_rows, &d2, lim.a);
+            push_abs(&mut base, &hm.d1(k, tau), lim.v);
+            push_abs(&mut base, &hm.d2(k, tau), lim.a);
         }
-        push_abs(&mut spline_rows, &combine(&[(6.0, &sp.c3)]), lim.j);
+        push_abs(&mut base, &hm.d3(k), lim.j);
     }
     let w: Vec<f64> = (first..=last)
         .map(|i| p_deg[i].to_radians().sin().abs())
         .collect();
     let mut stats = QpStats::default();
-    let feasible = |tdeg: f64, stats: &mut QpStats| -> bool {
-        let mut rows = spline_rows.clone();
+    let mut feasible = |tdeg: f64| -> bool {
+        let mut qp = base.clone();
         let st = (tdeg.to_radians() / 2.0).sin();
         for (i, wi) in w.iter().enumerate() {
             if st < *wi {
                 let g = 2.0 * (st / wi).asin().to_degrees();
-                rows.push([(i, 1.0)], g);
-                rows.push([(i, -1.0)], g);
+                qp.add_le(&[(i, 1.0)], g);
+                qp.add_le(&[(i, -1.0)], g);
             }
         }
-        let (x, st) = solve_diag_qp(&vec![0.0; nv], &vec![0.0; nv], &rows);
-        add_stats(stats, &st);
-        x.is_some()
+        qp.solve(&mut stats).is_ok()
     };
+    debug_assert_eq!(w.len(), nd);
     let wmax = w.iter().fold(0.0f64, |m, v| m.max(*v));
     let mut hi = 2.0 * wmax.min(1.0).asin().to_degrees() + 1e-9;
-    if !feasible(hi, &mut stats) {
+    if !feasible(hi) {
         return Err(PatchFailure::Solver(stats));
     }
-    if feasible(0.0, &mut stats) {
+    if feasible(0.0) {
         return Ok((0.0, stats));
     }
     let mut lo = 0.0;
     for _ in 0..BOUND_BISECTIONS {
+        if hi - lo <= BOUND_REL_TOL * hi {
+            break;
+        }
         let mid = 0.5 * (lo + hi);
-        if feasible(mid, &mut stats) {
+        if feasible(mid) {
             hi = mid;
         } else {
             lo = mid;
@@ -453,6 +572,74 @@ mod tests {
             v: k * 120.0 / f,
             a: k * 0.83 * 360.0 / (f * f),
             j: k * 50.0 * 360.0 / (f * f * f),
+        }
+    }
+
+    /// Uneven knots and non-polynomial data.
+    fn data(n: usize) -> (Vec<f64>, Vec<f64>) {
+        let s: Vec<f64> = (0..n)
+            .map(|i| i as f64 * 0.8 + (i as f64 * 1.3).sin() * 0.2)
+            .collect();
+        let y = s.iter().map(|t| (t * 1.7).cos() * 10.0 + 3.0 * t).collect();
+        (s, y)
+    }
+
+    /// The Hermite rows describe `interpolate_not_a_knot`'s curve: its knot slopes satisfy
+    /// every equality, there is one equality per slope, and the derivative forms evaluate
+    /// to its derivatives, on whole paths (not-a-knot ends, 2..5 and 40 points) and on a
+    /// cut window (fixed end slopes).
+    #[test]
+    fn hermite_rows_match_interpolate_not_a_knot() {
+        for n in [2usize, 3, 4, 5, 40] {
+            let (s, y) = data(n);
+            let sp = interpolate_not_a_knot(&s, &y).unwrap();
+            for (first, last, window) in [(0, n - 1, WINDOW_POINTS), (n / 2, n / 2, 3)] {
+                let hm = Hermite::new(&s, &y, first, last, window).unwrap();
+                let mut x = vec![0.0; hm.vars()];
+                for k in hm.lo..=hm.hi {
+                    x[hm.nd + k - hm.lo] = sp.eval_derivs(s[k])[1];
+                }
+                let eqs = hm.equalities();
+                assert_eq!(eqs.len(), hm.hi - hm.lo + 1, "n {n}");
+                for e in &eqs {
+                    assert!(e.at(&x).abs() < 1e-8, "n {n}: residual {}", e.at(&x));
+                }
+                for k in hm.lo..hm.hi {
+                    let h = hm.h(k);
+                    for tau in [0.0, h / 3.0, 0.99 * h] {
+                        let d = sp.eval_derivs(hm.s[k] + tau);
+                        assert!((hm.d1(k, tau).at(&x) - d[1]).abs() < 1e-8);
+                        assert!((hm.d2(k, tau).at(&x) - d[2]).abs() < 1e-7);
+                    }
+                    let d3 = sp.eval_derivs(hm.s[k] + h / 2.0)[3];
+                    assert!((hm.d3(k).at(&x) - d3).abs() < 1e-6);
+                }
+            }
+        }
+    }
+
+    /// Planted response: fixing δ at one point, the slopes the QP's equalities determine
+    /// are those of the interpolant of the changed data (the equalities have a unique
+    /// solution and it is the right one).
+    #[test]
+    fn hermite_response_is_the_spline_of_the_changed_data() {
+        let (s, y) = data(60);
+        let (first, last) = (28, 32);
+        let hm = Hermite::new(&s, &y, first, last, WINDOW_POINTS).unwrap();
+        let mut qp = hm.builder(0);
+        let delta = [0.0, 3.0, -7.0, 1.0, 0.0];
+        for (i, d) in delta.iter().enumerate() {
+            qp.add_eq(&[(i, 1.0)], *d);
+        }
+        let x = qp.solve(&mut QpStats::default()).unwrap();
+        let mut y2 = y.clone();
+        for (i, d) in delta.iter().enumerate() {
+            y2[first + i] += d;
+        }
+        let sp = interpolate_not_a_knot(&s, &y2).unwrap();
+        for k in hm.lo..=hm.hi {
+            let m = sp.eval_derivs(s[k])[1];
+            assert!((x[hm.nd + k - hm.lo] - m).abs() < 1e-5, "knot {k}");
         }
     }
 

@@ -728,7 +728,12 @@ mod tests {
     /// Patch, check the patch curve against every promise, and return the figures.
     fn check_case(name: &str, [s, p, c]: &[Vec<f64>; 3], lim: &CLimits) -> Figures {
         let zone = zone_of(s, p, c, lim).expect("planted case has a zone");
-        let opts = PatchOptions::default();
+        // The G16 method as the paper has it: C after the split may take a 360° offset
+        // (off by default since it moves the rest of the run; see flip_without_offset_has_no_join).
+        let opts = PatchOptions {
+            allow_c_offset: true,
+            ..PatchOptions::default()
+        };
         let (cand, curve) = g16_patch_detail(s, p, c, &zone, 0, lim, &opts)
             .unwrap_or_else(|e| panic!("{name}: {e:?}"));
         let tol = 1e-6;
@@ -868,7 +873,12 @@ mod tests {
         let case = planted(201, 1.0, 1.0, 15.0, true);
         let lim = ucp710(2000.0);
         let zone = zone_of(&case[0], &case[1], &case[2], &lim).unwrap();
-        let opts = PatchOptions::default();
+        // The G16 method as the paper has it: C after the split may take a 360° offset
+        // (off by default since it moves the rest of the run; see flip_without_offset_has_no_join).
+        let opts = PatchOptions {
+            allow_c_offset: true,
+            ..PatchOptions::default()
+        };
         let a = g16_patch(&case[0], &case[1], &case[2], &zone, 0, &lim, &opts).unwrap();
         assert_eq!(a.qp.solves, 1);
         let b = g16_patch(&case[0], &case[1], &case[2], &zone, 3, &lim, &opts).unwrap();

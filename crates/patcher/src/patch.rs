@@ -1,16 +1,22 @@
 //! Orchestration: detect, patch, verify, extend, never worse.
 //!
 //! For each singular zone (in path order, on the C values already updated by the zones
-//! before it), candidates are tried from the smallest patch up: the G16 patch
-//! ([`crate::g16::g16_patch`]) with `extra` = 0, 1, 2, 4, 8, … CL points beyond its joins,
-//! and after each G16 attempt the direct QP ([`crate::direct::direct_patch`]) over the
-//! same point range (the zone widened by `extra` when G16 gave none), monotone with the
-//! sign of the net change, then without monotonicity. A candidate is applied, rounded as
-//! written (`c_decimals`, then one more decimal at a time up to `max_decimals` when only
-//! the rounding breaks it) and verified ([`crate::verify::verify_c_change`]): C reaches
-//! feed around the patch and no sample gets worse. The first candidate that passes is
-//! kept; when none does within the limits, the best improvement (if any) is kept, else
-//! the zone is left as it was.
+//! before it), candidates are tried at widening levels `extra` = 0, 1, 2, 4, 8, …: the
+//! G16 patch ([`crate::g16::g16_patch`]) with `extra` CL points beyond its joins, and the
+//! direct QP ([`crate::direct::direct_patch`]) over the hull of the zone widened by
+//! `extra`, the G16 patch's range and the previous level's direct range, monotone with the
+//! sign of the net change, then (only if that does not pass) without monotonicity. A
+//! candidate is applied, rounded as written (`c_decimals`, then one more decimal at a time
+//! up to `max_decimals` when only the rounding breaks it) and verified
+//! ([`crate::verify::verify_c_change`]): C reaches feed around the patch and no sample gets
+//! worse.
+//!
+//! **Selection (SPEC §6).** Of the passing candidates the one with the smallest exact max
+//! orientation deviation ([`orientation_deviation_deg`]) is kept. Widening goes on after
+//! the first pass while a level lowers the best deviation by at least
+//! [`DEVIATION_IMPROVEMENT_MIN`], for at most [`MAX_LEVELS_AFTER_PASS`] levels. When no
+//! candidate passes within the limits, the best improvement (if any) is kept, else the
+//! zone is left as it was.
 
 use crate::{
     analysis::{AnalysisOptions, RATIO_TOL, Zone, ZoneKind, analyze_path, validate},
@@ -43,9 +49,18 @@ pub struct PatchResult {
 /// Zones closer than this many points are patched as one.
 const MERGE_GAP_POINTS: usize = 2 * CORE_MARGIN_POINTS;
 
-/// Largest range the direct QP is tried on, points (its constraint rows are dense in the
-/// modified values).
+/// Largest range the direct QP is tried on, points (its rows are sparse, but a wider
+/// range than this is not a patch any more).
 pub const DIRECT_MAX_POINTS: usize = 400;
+
+/// A widening level after the first passing candidate that lowers the best max
+/// orientation deviation by less than this fraction of it ends the search (the direct QP's
+/// min-max over a growing range only goes down, and levels off within a few levels).
+pub const DEVIATION_IMPROVEMENT_MIN: f64 = 0.05;
+
+/// Most widening levels tried after the level of the first passing candidate (a cap on
+/// the extra solves the improvement search may cost).
+pub const MAX_LEVELS_AFTER_PASS: usize = 3;
 
 /// Points of path either side of a zone's range analysed for its report figures.
 const FIGURE_MARGIN_POINTS: usize = 30;
@@ -251,6 +266,16 @@ struct Ctx<'a> {
 impl Ctx<'_> {
     /// Try candidates for `zone` on the current values `cur`, not touching points before
     /// `lower`. `Some((kept, reached))`, or `None` when nothing better was found.
+    ///
+    /// Widening levels `extra` = 0, 1, 2, 4, …: at each, the G16 patch widened by `extra`
+    /// and the direct QP over the hull of the zone widened by `extra`, the G16 patch's
+    /// range and the previous level's direct range (so the direct range only grows and its
+    /// min-max deviation can only go down), monotone first, without monotonicity only
+    /// when the monotone candidate does not pass. Among the passing candidates the one with
+    /// the smallest exact max deviation is kept. The widening stops at the first level
+    /// after a pass that lowers the best deviation by less than
+    /// [`DEVIATION_IMPROVEMENT_MIN`], after [`MAX_LEVELS_AFTER_PASS`] levels past the
+    /// first pass, or at the run's ends / `max_patch_length_mm`.
     fn patch_zone(
         &self,
         cur: &[f64],
@@ -260,23 +285,34 @@ impl Ctx<'_> {
     ) -> Option<(Checked, bool)> {
         let n = self.s.len();
         let mut best: Option<Checked> = None;
+        let mut passed: Option<(Checked, f64)> = None;
+        let mut direct_range: Option<(usize, usize)> = None;
+        let mut levels_after_pass = 0usize;
         let mut extra = 0usize;
         loop {
-            let mut range = (
+            let zone_range = (
                 zone.first.saturating_sub(extra).max(lower),
                 (zone.last + extra).min(n - 1),
             );
-            if range.0 > range.1 {
+            if zone_range.0 > zone_range.1 {
                 break;
             }
+            let best_before = passed.as_ref().map(|p| p.1);
+            let mut range = zone_range;
+            let consider = |c: Checked, passed: &mut Option<(Checked, f64)>| {
+                let dev = self.max_deviation(cur, &c);
+                if passed.as_ref().is_none_or(|p| dev < p.1) {
+                    *passed = Some((c, dev));
+                }
+            };
             if self.methods.g16 {
                 match g16_patch(self.s, &self.p, cur, zone, extra, &self.lim, self.opts) {
                     Ok(c) => {
                         add_stats(stats, &c.qp);
                         if c.first >= lower && c.last < n && c.first <= c.last {
-                            range = (c.first, c.last);
+                            range = (range.0.min(c.first), range.1.max(c.last));
                             if let Some(ok) = self.check(cur, &c, Method::G16Patch, &mut best) {
-                                return Some((ok, true));
+                                consider(ok, &mut passed);
                             }
                         }
                     }
@@ -284,7 +320,11 @@ impl Ctx<'_> {
                     Err(_) => {}
                 }
             }
+            if let Some(d) = direct_range {
+                range = (range.0.min(d.0), range.1.max(d.1));
+            }
             if self.methods.direct && range.1 - range.0 < DIRECT_MAX_POINTS {
+                direct_range = Some(range);
                 let (first, last) = range;
                 let net = cur[last] - cur[first];
                 let sigma = (net.abs() > 1e-9).then(|| net.signum());
@@ -300,13 +340,25 @@ impl Ctx<'_> {
                         Ok(c) => {
                             add_stats(stats, &c.qp);
                             if let Some(ok) = self.check(cur, &c, Method::Direct, &mut best) {
-                                return Some((ok, true));
+                                consider(ok, &mut passed);
+                                break;
                             }
                         }
                         Err(PatchFailure::Solver(st)) => add_stats(stats, &st),
                         Err(_) => {}
                     }
                 }
+            }
+            if let Some((_, dev)) = &passed {
+                if let Some(prev) = best_before
+                    && prev - dev < DEVIATION_IMPROVEMENT_MIN * prev
+                {
+                    break;
+                }
+                if *dev == 0.0 || levels_after_pass >= MAX_LEVELS_AFTER_PASS {
+                    break;
+                }
+                levels_after_pass += 1;
             }
             let at_ends = range.0 <= lower && range.1 >= n - 1;
             let too_long = self
@@ -318,7 +370,18 @@ impl Ctx<'_> {
             }
             extra = if extra == 0 { 1 } else { 2 * extra };
         }
-        best.map(|b| (b, false))
+        match passed {
+            Some((c, _)) => Some((c, true)),
+            None => best.map(|b| (b, false)),
+        }
+    }
+
+    /// Largest exact orientation deviation of a checked candidate against `cur`.
+    fn max_deviation(&self, cur: &[f64], c: &Checked) -> f64 {
+        (c.first..=c.last)
+            .zip(&c.values)
+            .map(|(i, v)| orientation_deviation_deg(self.p[i], v - cur[i]))
+            .fold(0.0, f64::max)
     }
 
     /// Round and verify a candidate; `Some` when it passes, else it may become `best`.

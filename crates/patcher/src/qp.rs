@@ -1,5 +1,5 @@
-//! Small clarabel helpers: inequality rows `a·x ≤ b`, a diagonal quadratic objective, one
-//! timed solve.
+//! Small clarabel helpers: a QP builder with sparse rows, the solver settings, one timed
+//! solve.
 
 use crate::report::QpStats;
 use clarabel::algebra::CscMatrix;
@@ -8,93 +8,20 @@ use clarabel::solver::{
 };
 use std::time::Instant;
 
-/// Rows `a·x ≤ b` in triplet form.
-#[derive(Debug, Clone, Default)]
-pub(crate) struct LeqRows {
-    rows: Vec<usize>,
-    cols: Vec<usize>,
-    vals: Vec<f64>,
-    b: Vec<f64>,
-}
+/// Clarabel's iteration cap. The patcher's QPs converge or prove infeasibility in 10–30
+/// iterations; one that has not after this many is reported as not solved rather than
+/// ground on (clarabel's default is 200). Tolerances stay at clarabel's defaults (1e-8):
+/// looser ones change which candidates pass verification.
+pub(crate) const SOLVER_MAX_ITER: u32 = 60;
 
-impl LeqRows {
-    /// Add the row `Σ val·x[col] ≤ b`.
-    pub(crate) fn push(&mut self, terms: impl IntoIterator<Item = (usize, f64)>, b: f64) {
-        let r = self.b.len();
-        for (c, v) in terms {
-            if v != 0.0 {
-                self.rows.push(r);
-                self.cols.push(c);
-                self.vals.push(v);
-            }
-        }
-        self.b.push(b);
-    }
-
-    /// Number of rows.
-    pub(crate) fn len(&self) -> usize {
-        self.b.len()
-    }
-}
-
-/// Minimise `½ Σ p_diag[i]·x_i² + q·x` subject to `rows`; `Some(x)` when clarabel reports
-/// `Solved` or `AlmostSolved`. The stats of this one solve come back either way.
-pub(crate) fn solve_diag_qp(
-    p_diag: &[f64],
-    q: &[f64],
-    rows: &LeqRows,
-) -> (Option<Vec<f64>>, QpStats) {
-    let n = q.len();
-    let started = Instant::now();
-    // A diagonal P is upper triangular, as clarabel requires.
-    let pi: Vec<usize> = (0..n).filter(|&i| p_diag[i] != 0.0).collect();
-    let p = CscMatrix::new_from_triplets(
-        n,
-        n,
-        pi.clone(),
-        pi.clone(),
-        pi.iter().map(|&i| p_diag[i]).collect(),
-    );
-    let a = CscMatrix::new_from_triplets(
-        rows.len(),
-        n,
-        rows.rows.clone(),
-        rows.cols.clone(),
-        rows.vals.clone(),
-    );
-    let mut stats = QpStats {
-        status: String::new(),
-        iterations: 0,
-        solves: 1,
-        solve_time_s: 0.0,
-    };
-    if p.check_format().is_err() || a.check_format().is_err() {
-        stats.status = "BadMatrix".into();
-        return (None, stats);
-    }
-    let settings = DefaultSettings {
+/// The settings every patcher solve uses: quiet, [`SOLVER_MAX_ITER`], the rest clarabel's
+/// defaults.
+pub(crate) fn settings() -> DefaultSettings<f64> {
+    DefaultSettings {
         verbose: false,
+        max_iter: SOLVER_MAX_ITER,
         ..DefaultSettings::default()
-    };
-    let cones = [NonnegativeConeT(rows.len())];
-    let mut solver = match DefaultSolver::new(&p, q, &a, &rows.b, &cones, settings) {
-        Ok(s) => s,
-        Err(e) => {
-            stats.status = format!("SetupError({e})");
-            stats.solve_time_s = started.elapsed().as_secs_f64();
-            return (None, stats);
-        }
-    };
-    solver.solve();
-    let sol = &solver.solution;
-    stats.status = format!("{:?}", sol.status);
-    stats.iterations = sol.iterations;
-    stats.solve_time_s = started.elapsed().as_secs_f64();
-    let ok = matches!(
-        sol.status,
-        SolverStatus::Solved | SolverStatus::AlmostSolved
-    );
-    (ok.then(|| sol.x.clone()), stats)
+    }
 }
 
 /// Add `other` into `acc` (sums; status of the latest).
@@ -200,11 +127,12 @@ impl QpBuilder {
         self.le.push((compact(row), rhs));
     }
 
-    /// Solve with clarabel (quiet), adding this solve's figures to `stats` (status of this
-    /// solve, iterations, one solve, clarabel's solve time). `Ok(x)` when clarabel reports
+    /// Solve with clarabel ([`settings`]), adding this solve's figures to `stats` (status of
+    /// this solve, iterations, one solve, wall time of setup and solve). `Ok(x)` when clarabel reports
     /// `Solved` or `AlmostSolved`, otherwise its status.
     pub(crate) fn solve(&self, stats: &mut QpStats) -> Result<Vec<f64>, SolverStatus> {
         use clarabel::solver::SupportedConeT::ZeroConeT;
+        let started = Instant::now();
         let n = self.n;
         let h = CscMatrix::new_from_triplets(
             n,
@@ -236,11 +164,7 @@ impl QpBuilder {
             stats.status = "BadMatrix".into();
             return Err(SolverStatus::NumericalError);
         }
-        let settings = DefaultSettings {
-            verbose: false,
-            ..DefaultSettings::default()
-        };
-        let mut solver = match DefaultSolver::new(&h, &self.q, &a, &b, &cones, settings) {
+        let mut solver = match DefaultSolver::new(&h, &self.q, &a, &b, &cones, settings()) {
             Ok(s) => s,
             Err(e) => {
                 stats.status = format!("SetupError({e})");
@@ -252,7 +176,7 @@ impl QpBuilder {
         stats.status = format!("{:?}", sol.status);
         stats.iterations += sol.iterations;
         stats.solves += 1;
-        stats.solve_time_s += sol.solve_time;
+        stats.solve_time_s += started.elapsed().as_secs_f64();
         match sol.status {
             SolverStatus::Solved | SolverStatus::AlmostSolved => Ok(sol.x.clone()),
             s => Err(s),
