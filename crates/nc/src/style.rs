@@ -43,107 +43,50 @@ struct Evidence {
 }
 
 impl Evidence {
-    /// Evidence of `letter` words and of all axis words (X Y Z A B C), in one pass over
-    /// the words.
-    fn collect(program: &Program, letter: u8) -> (Evidence, Evidence) {
-        let fresh = || Evidence {
+    fn collect(program: &Program, pick: impl Fn(u8) -> bool) -> Evidence {
+        let mut e = Evidence {
             min_decimals: usize::MAX,
             ..Evidence::default()
         };
-        let (mut own, mut axes) = (fresh(), fresh());
         let bytes = &program.bytes[..];
-        for w in &program.words {
-            let is_own = w.letter == letter;
-            let is_axis = AXES.contains(&w.letter);
-            if !(is_own || is_axis) {
-                continue;
+        for w in program.words.iter().filter(|w| pick(w.letter)) {
+            let text = &bytes[w.value_span()];
+            e.words += 1;
+            if w.value_start > w.start + 1 {
+                e.equals += 1;
             }
-            let word = WordEvidence::of(&bytes[w.value_span()], w.value_start > w.start + 1);
-            if is_own {
-                own.add(&word);
+            let (sign, body) = match text.first() {
+                Some(b'+') => (Some(b'+'), &text[1..]),
+                Some(b'-') => (Some(b'-'), &text[1..]),
+                _ => (None, text),
+            };
+            match sign {
+                Some(b'+') => e.plus += 1,
+                None => e.unsigned += 1,
+                _ => {}
             }
-            if is_axis {
-                axes.add(&word);
+            let (decimals, has_point) = match body.iter().position(|&b| b == b'.') {
+                Some(k) => (body.len() - k - 1, true),
+                None => (0, false),
+            };
+            e.max_decimals = e.max_decimals.max(decimals);
+            e.min_decimals = e.min_decimals.min(decimals);
+            if decimals > 0 && body.last() == Some(&b'0') {
+                e.trailing_zero += 1;
+            }
+            if decimals == 0 {
+                if has_point {
+                    e.point += 1;
+                } else {
+                    e.no_point += 1;
+                }
+            } else if body.first() == Some(&b'.') {
+                e.no_zero += 1;
+            } else if body.first() == Some(&b'0') && body.get(1) == Some(&b'.') {
+                e.zero += 1;
             }
         }
-        (own, axes)
-    }
-
-    fn add(&mut self, w: &WordEvidence) {
-        self.words += 1;
-        self.equals += usize::from(w.equals);
-        match w.sign {
-            Some(b'+') => self.plus += 1,
-            None => self.unsigned += 1,
-            _ => {}
-        }
-        self.max_decimals = self.max_decimals.max(w.decimals);
-        self.min_decimals = self.min_decimals.min(w.decimals);
-        self.trailing_zero += usize::from(w.trailing_zero);
-        match w.kind {
-            Kind::Point => self.point += 1,
-            Kind::NoPoint => self.no_point += 1,
-            Kind::NoZero => self.no_zero += 1,
-            Kind::Zero => self.zero += 1,
-            Kind::Other => {}
-        }
-    }
-}
-
-/// What one word's number shows.
-struct WordEvidence {
-    sign: Option<u8>,
-    decimals: usize,
-    trailing_zero: bool,
-    kind: Kind,
-    equals: bool,
-}
-
-/// How a number is written around its point.
-enum Kind {
-    /// Whole number with a trailing point (`180.`).
-    Point,
-    /// Whole number without a point (`180`).
-    NoPoint,
-    /// Below 1 without the leading zero (`.5`).
-    NoZero,
-    /// Below 1 with the leading zero (`0.5`).
-    Zero,
-    /// Anything else (`12.5`).
-    Other,
-}
-
-impl WordEvidence {
-    fn of(text: &[u8], equals: bool) -> Self {
-        let (sign, body) = match text.first() {
-            Some(b'+') => (Some(b'+'), &text[1..]),
-            Some(b'-') => (Some(b'-'), &text[1..]),
-            _ => (None, text),
-        };
-        let (decimals, has_point) = match body.iter().position(|&b| b == b'.') {
-            Some(k) => (body.len() - k - 1, true),
-            None => (0, false),
-        };
-        let kind = if decimals == 0 {
-            if has_point {
-                Kind::Point
-            } else {
-                Kind::NoPoint
-            }
-        } else if body.first() == Some(&b'.') {
-            Kind::NoZero
-        } else if body.first() == Some(&b'0') && body.get(1) == Some(&b'.') {
-            Kind::Zero
-        } else {
-            Kind::Other
-        };
-        WordEvidence {
-            sign,
-            decimals,
-            trailing_zero: decimals > 0 && body.last() == Some(&b'0'),
-            kind,
-            equals,
-        }
+        e
     }
 }
 
@@ -178,7 +121,8 @@ impl NumberStyle {
     /// - `equals`: a word is written `C=…`.
     pub fn of(program: &Program, letter: u8) -> NumberStyle {
         let letter = letter.to_ascii_uppercase();
-        let (own, axes) = Evidence::collect(program, letter);
+        let own = Evidence::collect(program, |l| l == letter);
+        let axes = Evidence::collect(program, |l| AXES.contains(&l));
         let main = if own.words > 0 { &own } else { &axes };
         let plus = if main.plus + main.unsigned > 0 {
             main
