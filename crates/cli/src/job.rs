@@ -137,11 +137,12 @@ pub struct FileReport {
     pub machine: String,
     /// C words changed or inserted.
     pub words_changed: usize,
-    /// Decimal places of the file's C words.
-    pub file_c_decimals: usize,
+    /// Decimal places of the file's C words (`None` when no run came near the pole, so
+    /// the file's style was not read).
+    pub file_c_decimals: Option<usize>,
     /// Decimal places written for changed C words (more than the file's when its
     /// precision could not hold Equation 6).
-    pub written_c_decimals: usize,
+    pub written_c_decimals: Option<usize>,
     /// Runs not analysed, and why.
     pub skipped_runs: Vec<String>,
     /// Notes for the user.
@@ -164,6 +165,42 @@ pub fn patch_program(
     opts: &PatchOptions,
 ) -> (Vec<Edit>, FileReport) {
     let program = &lp.program;
+    // The file's C style is only needed when some run comes near the pole; reading it costs
+    // a pass over every word, so a program without such a run skips it.
+    let near_pole = lp.runs.iter().any(|r| {
+        r.path.as_ref().is_ok_and(|p| {
+            p.axes
+                .iter()
+                .any(|q| q[polepatch_kinematics::Axis::Primary.index()].abs() <= opts.cone_deg)
+        })
+    });
+    if !near_pole {
+        let skipped = lp
+            .runs
+            .iter()
+            .enumerate()
+            .filter_map(|(r, rp)| {
+                rp.path
+                    .as_ref()
+                    .err()
+                    .map(|problem| skipped_run(lp, r, problem))
+            })
+            .collect();
+        return (
+            Vec::new(),
+            FileReport {
+                file: lp.name.clone(),
+                output: None,
+                machine: machine.name.clone(),
+                words_changed: 0,
+                file_c_decimals: None,
+                written_c_decimals: None,
+                skipped_runs: skipped,
+                warnings: lp.warnings.clone(),
+                zones: Vec::new(),
+            },
+        );
+    }
     let style = NumberStyle::of(program, b'C');
     let opts = PatchOptions {
         c_decimals: style.decimals,
@@ -178,12 +215,7 @@ pub fn patch_program(
         let path = match &rp.path {
             Ok(p) => p,
             Err(problem) => {
-                skipped.push(format!(
-                    "run {} (lines {}–{}): {problem}",
-                    r + 1,
-                    lp.line_of(r, 0),
-                    lp.line_of(r, rp.run.len() - 1)
-                ));
+                skipped.push(skipped_run(lp, r, problem));
                 continue;
             }
         };
@@ -220,13 +252,22 @@ pub fn patch_program(
         output: None,
         machine: machine.name.clone(),
         words_changed: edits.len(),
-        file_c_decimals: style.decimals,
-        written_c_decimals: written_decimals,
+        file_c_decimals: Some(style.decimals),
+        written_c_decimals: Some(written_decimals),
         skipped_runs: skipped,
         warnings: lp.warnings.clone(),
         zones: rows,
     };
     (edits, report)
+}
+
+fn skipped_run(lp: &LoadedProgram, r: usize, problem: &crate::program::RunProblem) -> String {
+    format!(
+        "run {} (lines {}–{}): {problem}",
+        r + 1,
+        lp.line_of(r, 0),
+        lp.line_of(r, lp.runs[r].run.len() - 1)
+    )
 }
 
 /// A block after an edited one that relied on modal C (no C word) would now inherit the new
@@ -269,7 +310,12 @@ pub fn patch_file(
     let program = read_program(input)?;
     let lp = load(program, &name, machine, feed_fallback_mm_min)?;
     let (edits, mut report) = patch_program(&lp, machine, opts);
-    let bytes = polepatch_nc::write(&lp.program, &edits);
+    // No edit: the input bytes are the output (nc::write would copy them unchanged).
+    let bytes: std::borrow::Cow<[u8]> = if edits.is_empty() {
+        std::borrow::Cow::Borrowed(&lp.program.bytes)
+    } else {
+        std::borrow::Cow::Owned(polepatch_nc::write(&lp.program, &edits))
+    };
     write_atomic(output, &bytes).map_err(|source| JobError::Write {
         path: output.display().to_string(),
         source,

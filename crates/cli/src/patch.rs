@@ -302,10 +302,12 @@ fn print_summary(reports: &[&FileReport]) {
             rep.zones.iter().map(|z| z.points_modified).sum::<usize>(),
             rep.words_changed,
         );
-        if rep.written_c_decimals > rep.file_c_decimals {
+        if let (Some(written), Some(file)) = (rep.written_c_decimals, rep.file_c_decimals)
+            && written > file
+        {
             println!(
                 "  note: C written with {} decimals (the file uses {}) so that Equation 6 holds on the written values",
-                rep.written_c_decimals, rep.file_c_decimals
+                written, file
             );
         }
     }
