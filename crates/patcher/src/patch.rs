@@ -276,6 +276,11 @@ impl Ctx<'_> {
     /// after a pass that lowers the best deviation by less than
     /// [`DEVIATION_IMPROVEMENT_MIN`], after [`MAX_LEVELS_AFTER_PASS`] levels past the
     /// first pass, or at the run's ends / `max_patch_length_mm`.
+    ///
+    /// Needless solves are cut: the direct QP is not solved again on the range of the
+    /// previous level (same problem, same answer), and once the G16 patch fails (no join, or
+    /// infeasible after its own widening to the run's ends) it is not tried at wider levels,
+    /// which would repeat that widening.
     fn patch_zone(
         &self,
         cur: &[f64],
@@ -288,6 +293,7 @@ impl Ctx<'_> {
         let mut passed: Option<(Checked, f64)> = None;
         let mut direct_range: Option<(usize, usize)> = None;
         let mut levels_after_pass = 0usize;
+        let mut g16_gave_up = false;
         let mut extra = 0usize;
         loop {
             let zone_range = (
@@ -305,7 +311,7 @@ impl Ctx<'_> {
                     *passed = Some((c, dev));
                 }
             };
-            if self.methods.g16 {
+            if self.methods.g16 && !g16_gave_up {
                 match g16_patch(self.s, &self.p, cur, zone, extra, &self.lim, self.opts) {
                     Ok(c) => {
                         add_stats(stats, &c.qp);
@@ -316,14 +322,20 @@ impl Ctx<'_> {
                             }
                         }
                     }
-                    Err(PatchFailure::Solver(st)) => add_stats(stats, &st),
-                    Err(_) => {}
+                    Err(PatchFailure::Solver(st)) => {
+                        add_stats(stats, &st);
+                        g16_gave_up = true;
+                    }
+                    Err(_) => g16_gave_up = true,
                 }
             }
             if let Some(d) = direct_range {
                 range = (range.0.min(d.0), range.1.max(d.1));
             }
-            if self.methods.direct && range.1 - range.0 < DIRECT_MAX_POINTS {
+            if self.methods.direct
+                && range.1 - range.0 < DIRECT_MAX_POINTS
+                && direct_range != Some(range)
+            {
                 direct_range = Some(range);
                 let (first, last) = range;
                 let net = cur[last] - cur[first];
