@@ -54,6 +54,9 @@
 //!                                                    (only with monotone = Some(σ))
 //! ```
 //!
+//! Before solving, a necessary condition skips a certainly infeasible QP: when the ends a, b
+//! of the constrained range are fixed points, `|C_b − C_a| ≤ v·(s_b − s_a)`.
+//!
 //! The constrained range is the spans in `[s(first − 3), s(last + 3)]` (clipped to the
 //! path, [`CONSTRAINED_MARGIN_POINTS`]). `(v, a, j)` are `lim` (V/F, A/F², J/F³, with the
 //! caller's margin). Each inequality row is divided by its bound so all rows have unit
@@ -382,10 +385,16 @@ pub fn direct_patch(
     opts: &PatchOptions,
 ) -> Result<Candidate, PatchFailure> {
     let hm = Hermite::new(s_mm, c_deg, first, last, WINDOW_POINTS)?;
+    let spans = hm.constrained_spans();
+    if !within_reach(s_mm, c_deg, first, last, &spans, lim.v) {
+        return Err(PatchFailure::Solver(QpStats {
+            status: "NotSolved (net change beyond v·length)".into(),
+            ..QpStats::default()
+        }));
+    }
     let nd = hm.nd;
     let t = hm.vars(); // index of the epigraph variable
     let mut qp = hm.builder(1);
-    let spans = hm.constrained_spans();
     for k in spans.clone() {
         let h = hm.h(k);
         push_abs(&mut qp, &hm.m(k), lim.v);
@@ -432,6 +441,25 @@ pub fn direct_patch(
         }),
         Err(_) => Err(PatchFailure::Solver(stats)),
     }
+}
+
+/// Necessary condition for the direct QP: when both ends `a`, `b` of the constrained spans
+/// are fixed points (outside `first..=last`), `|q'| ≤ v` on `[s_a, s_b]` needs
+/// `|C_b − C_a| ≤ v·(s_b − s_a)`. `false` only when the QP is certainly infeasible, so
+/// the solve can be skipped.
+fn within_reach(
+    s: &[f64],
+    c: &[f64],
+    first: usize,
+    last: usize,
+    spans: &std::ops::Range<usize>,
+    v: f64,
+) -> bool {
+    let (a, b) = (spans.start, spans.end);
+    if a >= first || b <= last {
+        return true;
+    }
+    (c[b] - c[a]).abs() <= v * (s[b] - s[a])
 }
 
 /// Exact orientation deviation, degrees, of a point at primary `p_deg` whose C changes by
@@ -641,6 +669,36 @@ mod tests {
             let m = sp.eval_derivs(s[k])[1];
             assert!((x[hm.nd + k - hm.lo] - m).abs() < 1e-5, "knot {k}");
         }
+    }
+
+    /// Planted: C must turn 90° between the fixed points 6 mm apart at |C_s| ≤ 3°/mm: no
+    /// solve, a reported failure; at 20°/mm the test lets it through.
+    #[test]
+    fn net_change_beyond_reach_skips_the_solve() {
+        let s: Vec<f64> = (0..41).map(|i| i as f64 * 0.5).collect();
+        let c: Vec<f64> = s
+            .iter()
+            .map(|&x| if x < 10.0 { 0.0 } else { 90.0 })
+            .collect();
+        let p = vec![1.0; s.len()];
+        let lim = |v: f64| CLimits { v, a: 1e3, j: 1e5 };
+        let r = direct_patch(
+            &s,
+            &p,
+            &c,
+            17,
+            23,
+            &lim(3.0),
+            None,
+            &PatchOptions::default(),
+        );
+        match r {
+            Err(PatchFailure::Solver(st)) => assert_eq!(st.solves, 0, "{st:?}"),
+            other => panic!("expected a skipped solve, got {other:?}"),
+        }
+        let spans = 14..26;
+        assert!(within_reach(&s, &c, 17, 23, &spans, 20.0));
+        assert!(!within_reach(&s, &c, 17, 23, &spans, 3.0));
     }
 
     #[test]
