@@ -75,11 +75,16 @@ fn span_min_ratios(
     }
     let mut d = vec![[0.0; 4]; at.len()];
     pp.eval_derivs_sorted(&at, &mut d);
-    let mut out = vec![f64::INFINITY; n - 1];
+    // The ratio is decreasing in each |derivative|, so the span's least ratio is the ratio
+    // of its largest |q'|, |q''|, |q'''|: one sqrt and one cbrt per span, not per sample.
+    let mut peak = vec![[0.0f64; 3]; n - 1];
     for (k, e) in span_of.iter().zip(&d) {
-        out[*k] = out[*k].min(c_ratio(lim, [e[1], e[2], e[3]]));
+        let pk = &mut peak[*k];
+        for (m, v) in pk.iter_mut().zip(&e[1..]) {
+            *m = m.max(v.abs());
+        }
     }
-    Some(out)
+    Some(peak.into_iter().map(|pk| c_ratio(lim, pk)).collect())
 }
 
 /// Verdict of [`verify_c_change`].
