@@ -8,7 +8,7 @@
 //! orientation deviation (degrees, exact formula `2·asin(|sin P|·|sin(ΔC/2)|)`) over C-only
 //! changes at the existing CL points such that the analysis spline of C meets
 //! |C_s| ≤ V/F, |C_ss| ≤ A/F², |C_sss| ≤ J/F³ (no margin) on every sample F·Tcy:
-//! [`deviation_bound_sampled`], an LP bisection. The movable points are the zone's range
+//! [`deviation_bound_zone`], an LP bisection. The movable points are the zone's range
 //! widened to the whole run, `1..=n−1` (point 0 belongs to the block before the run and is
 //! never moved). When a run holds several zones, each zone's range reaches only to the
 //! midpoints between it and its neighbours (the neighbours' points stay fixed), so that
@@ -25,7 +25,7 @@ use crate::job::{FileReport, ZoneRow, patch_program};
 use crate::program::{InputError, LoadedProgram, load, parse_program, read_program};
 use crate::report::{AnalyzeReport, analyze_program};
 use polepatch_kinematics::{Axis, Machine};
-use polepatch_patcher::direct::deviation_bound_sampled;
+use polepatch_patcher::direct::deviation_bound_zone;
 use polepatch_patcher::{AnalysisOptions, CLimits, PatchFailure, PatchOptions, analyze_path};
 use serde::Serialize;
 use std::path::Path as FsPath;
@@ -277,7 +277,7 @@ pub fn bench_program(
                 time_ms: 0.0,
             }
         } else {
-            zone_bound(lp, r, lo, hi, machine, opts)
+            zone_bound(lp, r, lo, hi, (first, last), machine, opts)
         };
         let ratio = match bound.bound_deg {
             Some(b) if b > 0.0 && row.outcome == "reached" => Some(row.max_deviation_deg / b),
@@ -325,6 +325,7 @@ fn zone_bound(
     r: usize,
     lo: usize,
     hi: usize,
+    zone: (usize, usize),
     machine: &Machine,
     opts: &BenchOptions,
 ) -> ZoneBound {
@@ -343,7 +344,7 @@ fn zone_bound(
     let lim = CLimits::new(machine, path.feed_mm_min, 0.0);
     let step_mm = path.feed_mm_min / 60.0 * opts.patch.tcy_s.unwrap_or(machine.tcy_s);
     let t0 = Instant::now();
-    let result = deviation_bound_sampled(&path.s_mm, &p, &c, lo, hi, &lim, step_mm);
+    let result = deviation_bound_zone(&path.s_mm, &p, &c, lo, hi, zone, &lim, step_mm);
     let time_ms = t0.elapsed().as_secs_f64() * 1e3;
     match result {
         Ok((b, st)) => ZoneBound {

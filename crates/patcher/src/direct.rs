@@ -499,6 +499,45 @@ pub fn deviation_bound_sampled(
     lim: &CLimits,
     step_mm: f64,
 ) -> Result<(f64, QpStats), PatchFailure> {
+    deviation_bound_in(s_mm, p_deg, c_deg, first, last, None, lim, step_mm)
+}
+
+/// The bound of one zone, as the patcher is held to it: [`deviation_bound_sampled`] with
+/// the limits `lim` strict only on the samples within `s_mm[zone.0] ..= s_mm[zone.1]`
+/// (the zone must reach feed there); on every other constrained sample each derivative
+/// may keep the size it had before (`|q⁽ᵏ⁾| ≤ max(limit, |q⁽ᵏ⁾_before|)`: nowhere worse),
+/// which is still a linear constraint. Points `first..=last` are movable.
+#[allow(clippy::too_many_arguments)]
+pub fn deviation_bound_zone(
+    s_mm: &[f64],
+    p_deg: &[f64],
+    c_deg: &[f64],
+    first: usize,
+    last: usize,
+    zone: (usize, usize),
+    lim: &CLimits,
+    step_mm: f64,
+) -> Result<(f64, QpStats), PatchFailure> {
+    if zone.0 > zone.1 || zone.1 >= s_mm.len() {
+        return Err(PatchFailure::TooShort);
+    }
+    deviation_bound_in(s_mm, p_deg, c_deg, first, last, Some(zone), lim, step_mm)
+}
+
+/// Relative slack on "not worse than before" outside the zone (round-off only).
+const BEFORE_SLACK: f64 = 1e-9;
+
+#[allow(clippy::too_many_arguments)]
+fn deviation_bound_in(
+    s_mm: &[f64],
+    p_deg: &[f64],
+    c_deg: &[f64],
+    first: usize,
+    last: usize,
+    zone: Option<(usize, usize)>,
+    lim: &CLimits,
+    step_mm: f64,
+) -> Result<(f64, QpStats), PatchFailure> {
     if step_mm.is_nan() || step_mm <= 0.0 {
         return Err(PatchFailure::TooShort);
     }
@@ -506,14 +545,34 @@ pub fn deviation_bound_sampled(
     let nd = hm.nd;
     let mut base = hm.builder(0);
     let spans = hm.constrained_spans();
+    // The analysis spline before any change, for "not worse" outside the zone.
+    let before = match zone {
+        Some(_) => Some(
+            interpolate_not_a_knot(s_mm, c_deg)
+                .map_err(|_| PatchFailure::TooShort)?
+                .to_pp(),
+        ),
+        None => None,
+    };
+    let relaxed = |t: f64, d: usize, limit: f64| -> f64 {
+        match (zone, &before) {
+            (Some((a, b)), Some(pp)) if t < s_mm[a] || t > s_mm[b] => {
+                limit.max(pp.eval_derivs(t)[d].abs() * (1.0 + BEFORE_SLACK))
+            }
+            _ => limit,
+        }
+    };
     let mut ts = Vec::new();
     for k in spans.clone() {
         span_offsets(hm.h(k), step_mm, k + 1 == spans.end, &mut ts);
         for &tau in &ts {
-            push_abs(&mut base, &hm.d1(k, tau), lim.v);
-            push_abs(&mut base, &hm.d2(k, tau), lim.a);
+            let t = s_mm[k] + tau;
+            push_abs(&mut base, &hm.d1(k, tau), relaxed(t, 1, lim.v));
+            push_abs(&mut base, &hm.d2(k, tau), relaxed(t, 2, lim.a));
         }
-        push_abs(&mut base, &hm.d3(k), lim.j);
+        // The third derivative is constant on the span: take it at the span's middle.
+        let mid = 0.5 * (s_mm[k] + s_mm[k + 1]);
+        push_abs(&mut base, &hm.d3(k), relaxed(mid, 3, lim.j));
     }
     let w: Vec<f64> = (first..=last)
         .map(|i| p_deg[i].to_radians().sin().abs())

@@ -46,6 +46,10 @@ pub struct PatchResult {
     pub zones: Vec<ZoneReport>,
 }
 
+/// Factors applied to `PatchOptions::margin`, in order, when no candidate passes
+/// verification: the configured margin, a quarter of it, none.
+pub const MARGIN_LADDER: [f64; 3] = [1.0, 0.25, 0.0];
+
 /// Zones closer than this many points are patched as one.
 const MERGE_GAP_POINTS: usize = 2 * CORE_MARGIN_POINTS;
 
@@ -139,7 +143,7 @@ pub(crate) fn patch_path_with(
     let ctx = Ctx {
         s: &path.s_mm,
         p: path.axes.iter().map(|q| q[pi]).collect(),
-        lim: CLimits::new(machine, path.feed_mm_min, opts.margin),
+        lim: std::cell::Cell::new(CLimits::new(machine, path.feed_mm_min, opts.margin)),
         lim0: CLimits::new(machine, path.feed_mm_min, 0.0),
         step: analysis.step_mm,
         opts,
@@ -152,7 +156,36 @@ pub(crate) fn patch_path_with(
     let mut lower = 1;
     for zone in merge_zones(&analysis.zones) {
         let mut stats = QpStats::default();
-        let (kept, outcome) = match ctx.patch_zone(&cur, &zone, lower, &mut stats) {
+        // The margin only guards the solvers' aim against projection and rounding; what
+        // counts is the verification on the written values, without margin. When nothing
+        // passes with the configured margin, aim closer to the limits before giving up.
+        let mut found: Option<(Checked, bool)> = None;
+        for factor in MARGIN_LADDER {
+            ctx.lim.set(CLimits::new(
+                machine,
+                path.feed_mm_min,
+                opts.margin * factor,
+            ));
+            match ctx.patch_zone(&cur, &zone, lower, &mut stats) {
+                Some((c, true)) => {
+                    found = Some((c, true));
+                    break;
+                }
+                Some((c, false)) => {
+                    let better = found.as_ref().is_none_or(|(b, _)| {
+                        c.verdict.core_min_after > b.verdict.core_min_after + RATIO_TOL
+                    });
+                    if better {
+                        found = Some((c, false));
+                    }
+                }
+                None => {}
+            }
+            if opts.margin == 0.0 {
+                break;
+            }
+        }
+        let (kept, outcome) = match found {
             Some((c, true)) => (Some(c), Outcome::Reached),
             Some((c, false)) => (Some(c), Outcome::Improved),
             None => (None, Outcome::Unchanged),
@@ -254,8 +287,9 @@ fn merge_zones(zones: &[Zone]) -> Vec<Zone> {
 struct Ctx<'a> {
     s: &'a [f64],
     p: Vec<f64>,
-    /// Limits with the margin (what the solvers aim at).
-    lim: CLimits,
+    /// Limits with the margin (what the solvers aim at); lowered along
+    /// [`MARGIN_LADDER`] when no candidate passes.
+    lim: std::cell::Cell<CLimits>,
     /// Limits without margin (what the verification checks).
     lim0: CLimits,
     step: f64,
@@ -312,7 +346,15 @@ impl Ctx<'_> {
                 }
             };
             if self.methods.g16 && !g16_gave_up {
-                match g16_patch(self.s, &self.p, cur, zone, extra, &self.lim, self.opts) {
+                match g16_patch(
+                    self.s,
+                    &self.p,
+                    cur,
+                    zone,
+                    extra,
+                    &self.lim.get(),
+                    self.opts,
+                ) {
                     Ok(c) => {
                         add_stats(stats, &c.qp);
                         if c.first >= lower && c.last < n && c.first <= c.last {
@@ -347,7 +389,14 @@ impl Ctx<'_> {
                 };
                 for &mono in tries {
                     match direct_patch(
-                        self.s, &self.p, cur, first, last, &self.lim, mono, self.opts,
+                        self.s,
+                        &self.p,
+                        cur,
+                        first,
+                        last,
+                        &self.lim.get(),
+                        mono,
+                        self.opts,
                     ) {
                         Ok(c) => {
                             add_stats(stats, &c.qp);
