@@ -9,7 +9,7 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use polepatch_kinematics::Machine;
 use polepatch_nc::{Dialect, modal, parse, runs};
-use polepatch_patcher::{Path, PatchOptions, patch_path};
+use polepatch_patcher::{PatchOptions, Path, patch_path};
 
 /// The runs of a fixture that have zones on `machine`, as the CLI builds them.
 fn zone_runs(file: &str, machine: &Machine) -> Vec<Path> {
@@ -48,7 +48,10 @@ fn zone_solve(c: &mut Criterion) {
     let cases = [
         ("sing", "fixtures/c17/SING.I"),
         ("ac-flip-d2", "fixtures/generated/heidenhain-ac-flip-d2.I"),
-        ("ac-swing-d0.5", "fixtures/generated/heidenhain-ac-swing-d0.5.I"),
+        (
+            "ac-swing-d0.5",
+            "fixtures/generated/heidenhain-ac-swing-d0.5.I",
+        ),
     ];
     let opts = PatchOptions::default();
     let mut g = c.benchmark_group("patcher/zone_solve");
@@ -57,7 +60,10 @@ fn zone_solve(c: &mut Criterion) {
         for (label, file) in cases {
             for (k, path) in zone_runs(file, &m).into_iter().enumerate() {
                 let zones = patch_path(&path, &m, &opts).unwrap().zones.len();
-                eprintln!("{label}/{mname}/run{k}: {zones} zone(s), {} points", path.s_mm.len());
+                eprintln!(
+                    "{label}/{mname}/run{k}: {zones} zone(s), {} points",
+                    path.s_mm.len()
+                );
                 g.bench_function(format!("{label}/{mname}/run{k}"), |b| {
                     b.iter(|| patch_path(black_box(&path), &m, &opts).unwrap())
                 });
