@@ -115,3 +115,23 @@ fn impossible_zone_keeps_the_best_improvement() {
     let after = c_ratios_and_zones(&load_bytes(&out, "short", &m), &m, 5.0);
     assert!(after[0].0 >= before[0].0, "{before:?} → {after:?}");
 }
+
+/// A zigzag finishing program: many runs, one zone each, patched in one file.
+#[test]
+fn zigzag_program_with_many_zones() {
+    let base = Pass {
+        domain_rule: true,
+        ..Pass::default()
+    };
+    let text =
+        polepatch_fixturegen::zigzag_program(&base, 8, &[0.1, 0.5, 1.0, 2.0, 4.0, 0.05], "ZIGZAG");
+    for m in machines() {
+        let (rep, _) = check_patch("zigzag", text.as_bytes(), &m, &PatchOptions::default());
+        assert!(
+            rep.zones.len() >= 6,
+            "{} zones on {}",
+            rep.zones.len(),
+            m.name
+        );
+    }
+}

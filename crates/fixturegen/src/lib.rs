@@ -295,3 +295,65 @@ pub fn program(p: &Pass, dialect: Dialect, name: &str) -> String {
     }
     out
 }
+
+/// A zigzag finishing program in Heidenhain ISO: `passes` parallel passes (alternating
+/// direction, 2 mm apart in Y), each its own G1 run between rapid moves, the k-th passing
+/// at `pole_distances_deg[k % len]` from the pole — a program with many singular zones.
+pub fn zigzag_program(
+    base: &Pass,
+    passes: usize,
+    pole_distances_deg: &[f64],
+    name: &str,
+) -> String {
+    let pl = if base.b_axis { 'B' } else { 'A' };
+    let d = base.rotary_decimals;
+    let mut out = format!("%{name} G71 *\n");
+    let mut n = 10;
+    let mut line = |s: String| {
+        let _ = writeln!(out, "N{n} {s} *");
+        n += 10;
+    };
+    line("G90".into());
+    line("T1 M6".into());
+    line("S12000 M3".into());
+    line("M128".into());
+    for k in 0..passes {
+        let pass = Pass {
+            pole_distance_deg: pole_distances_deg[k % pole_distances_deg.len().max(1)],
+            ..base.clone()
+        };
+        let mut j = joints(&pass);
+        if k % 2 == 1 {
+            j.reverse();
+        }
+        let y = 2.0 * k as f64;
+        let q0 = j[0];
+        line(format!(
+            "G00 X{} Y{} Z+10 {pl}{} C{}",
+            num(q0[0], 3, true),
+            num(y, 3, true),
+            num(q0[3], d, true),
+            num(q0[4], d, true)
+        ));
+        line(format!(
+            "G01 Z{} F{}",
+            num(q0[2], 3, true),
+            num(base.feed_mm_min, 0, false)
+        ));
+        for q in &j[1..] {
+            line(format!(
+                "X{} Y{} Z{} {pl}{} C{}",
+                num(q[0], 3, true),
+                num(y, 3, true),
+                num(q[2], 3, true),
+                num(q[3], d, true),
+                num(q[4], d, true)
+            ));
+        }
+        line("G00 Z+10".into());
+    }
+    line("M129".into());
+    line("M30".into());
+    line(format!("%{name} G71"));
+    out
+}

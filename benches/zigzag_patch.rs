@@ -1,0 +1,36 @@
+//! Whole-file patch of a zigzag program with many zones: parse, runs, patch every run,
+//! write (the `polepatch patch` job without the file system).
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use polepatch::job::patch_program;
+use polepatch::kinematics::Machine;
+use polepatch::patcher::PatchOptions;
+use polepatch::program::{load, parse_program};
+use polepatch_fixturegen::{Pass, zigzag_program};
+
+fn zigzag(c: &mut Criterion) {
+    // 12 passes at F2000, 1 mm spacing, 0.1°–4° from the pole, domain-rule post (A flips).
+    let base = Pass {
+        domain_rule: true,
+        ..Pass::default()
+    };
+    let text = zigzag_program(&base, 12, &[0.1, 0.5, 1.0, 2.0, 4.0, 0.05], "ZIGZAG");
+    let mut group = c.benchmark_group("zigzag_patch");
+    group.sample_size(10);
+    for name in ["mikron-ucp710", "mikron-hsm600"] {
+        let machine = Machine::builtin(name).unwrap();
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let program = parse_program(text.clone().into_bytes(), "zigzag").unwrap();
+                let lp = load(program, "zigzag", &machine, None).unwrap();
+                let (edits, report) = patch_program(&lp, &machine, &PatchOptions::default());
+                let out = polepatch::nc::write(&lp.program, &edits);
+                (out.len(), report.zones.len())
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, zigzag);
+criterion_main!(benches);
