@@ -3,7 +3,7 @@
 use crate::{check_positive, machine};
 use anyhow::{Context, Result, bail};
 use polepatch::bench::{BenchOptions, BenchReport, BenchZone, RATIO_TARGET, plot};
-use polepatch::job::{FiguresRow, write_atomic};
+use polepatch::job::{FiguresRow, ZoneRow, write_atomic};
 use polepatch::kinematics::Machine;
 use polepatch::patcher::PatchOptions;
 use std::path::{Path, PathBuf};
@@ -269,84 +269,19 @@ pub(crate) fn table(report: &BenchReport) -> String {
 
 fn csv_rows(report: &BenchReport) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record([
-        "file",
-        "machine",
-        "run",
-        "first_line",
-        "last_line",
-        "kind",
-        "min_abs_primary_deg",
-        "c_ratio_before",
-        "c_ratio_after",
-        "primary_ratio_before",
-        "primary_ratio_after",
-        "overall_ratio_before",
-        "overall_ratio_after",
-        "limiting_before",
-        "limiting_after",
-        "time_before_s",
-        "time_after_s",
-        "ideal_time_s",
-        "max_deviation_deg",
-        "points_modified",
-        "patch_length_mm",
-        "outcome",
-        "method",
-        "qp_status",
-        "qp_iterations",
-        "qp_solves",
-        "solve_time_ms",
-        "decimals",
-        "c_offset_deg",
-        "bound_deg",
-        "ratio",
-    ])?;
+    let mut header = vec!["file", "machine"];
+    header.extend(ZoneRow::CSV_COLUMNS);
+    header.extend(["bound_deg", "ratio"]);
+    w.write_record(&header)?;
     for z in report.zones() {
-        let r = &z.row;
-        let lim = |f: &FiguresRow| {
-            format!(
-                "{}:{}",
-                f.limiting_axis.clone().unwrap_or_else(|| "-".into()),
-                f.limiting_limit
-            )
-        };
-        w.write_record([
-            r.file.clone(),
-            z.machine.clone(),
-            r.run.to_string(),
-            r.lines[0].to_string(),
-            r.lines[1].to_string(),
-            r.kind.to_string(),
-            format!("{:.6}", r.min_abs_primary_deg),
-            format!("{:.6}", r.before.c_ratio),
-            format!("{:.6}", r.after.c_ratio),
-            format!("{:.6}", r.before.primary_ratio),
-            format!("{:.6}", r.after.primary_ratio),
-            format!("{:.6}", r.before.overall_ratio),
-            format!("{:.6}", r.after.overall_ratio),
-            lim(&r.before),
-            lim(&r.after),
-            format!("{:.6}", r.before.time_s),
-            format!("{:.6}", r.after.time_s),
-            format!("{:.6}", r.ideal_time_s),
-            format!("{:.6}", r.max_deviation_deg),
-            r.points_modified.to_string(),
-            format!("{:.3}", r.patch_length_mm),
-            r.outcome.to_string(),
-            r.method.to_string(),
-            r.qp_status.clone(),
-            r.qp_iterations.to_string(),
-            r.qp_solves.to_string(),
-            format!("{:.3}", r.solve_time_ms),
-            r.decimals.to_string(),
-            format!("{}", r.c_offset_deg),
-            match (z.bound.status.as_str(), z.bound.bound_deg) {
-                ("ok", Some(b)) => format!("{b:.6}"),
-                (s, _) => s.to_string(),
-            },
-            z.ratio.map_or(String::new(), |v| format!("{v:.6}")),
-        ])?;
+        let mut rec = vec![z.row.file.clone(), z.machine.clone()];
+        rec.extend(z.row.csv_fields());
+        rec.push(match (z.bound.status.as_str(), z.bound.bound_deg) {
+            ("ok", Some(b)) => format!("{b:.6}"),
+            (s, _) => s.to_string(),
+        });
+        rec.push(z.ratio.map_or(String::new(), |v| format!("{v:.6}")));
+        w.write_record(&rec)?;
     }
     Ok(w.into_inner()?)
 }

@@ -100,6 +100,77 @@ fn method_name(m: Method) -> &'static str {
 }
 
 impl ZoneRow {
+    /// CSV column names of [`ZoneRow::csv_fields`] (the row's fields after `file`).
+    pub const CSV_COLUMNS: [&'static str; 27] = [
+        "run",
+        "first_line",
+        "last_line",
+        "kind",
+        "min_abs_primary_deg",
+        "c_ratio_before",
+        "c_ratio_after",
+        "primary_ratio_before",
+        "primary_ratio_after",
+        "overall_ratio_before",
+        "overall_ratio_after",
+        "limiting_before",
+        "limiting_after",
+        "time_before_s",
+        "time_after_s",
+        "ideal_time_s",
+        "max_deviation_deg",
+        "points_modified",
+        "patch_length_mm",
+        "outcome",
+        "method",
+        "qp_status",
+        "qp_iterations",
+        "qp_solves",
+        "solve_time_ms",
+        "decimals",
+        "c_offset_deg",
+    ];
+
+    /// The row as CSV fields, in [`ZoneRow::CSV_COLUMNS`] order.
+    pub fn csv_fields(&self) -> Vec<String> {
+        let lim = |f: &FiguresRow| {
+            format!(
+                "{}:{}",
+                f.limiting_axis.as_deref().unwrap_or("-"),
+                f.limiting_limit
+            )
+        };
+        vec![
+            self.run.to_string(),
+            self.lines[0].to_string(),
+            self.lines[1].to_string(),
+            self.kind.to_string(),
+            format!("{:.6}", self.min_abs_primary_deg),
+            format!("{:.6}", self.before.c_ratio),
+            format!("{:.6}", self.after.c_ratio),
+            format!("{:.6}", self.before.primary_ratio),
+            format!("{:.6}", self.after.primary_ratio),
+            format!("{:.6}", self.before.overall_ratio),
+            format!("{:.6}", self.after.overall_ratio),
+            lim(&self.before),
+            lim(&self.after),
+            format!("{:.6}", self.before.time_s),
+            format!("{:.6}", self.after.time_s),
+            format!("{:.6}", self.ideal_time_s),
+            format!("{:.6}", self.max_deviation_deg),
+            self.points_modified.to_string(),
+            format!("{:.3}", self.patch_length_mm),
+            self.outcome.to_string(),
+            self.method.to_string(),
+            self.qp_status.clone(),
+            self.qp_iterations.to_string(),
+            self.qp_solves.to_string(),
+            format!("{:.3}", self.solve_time_ms),
+            self.decimals.to_string(),
+            format!("{}", self.c_offset_deg),
+        ]
+    }
+
     fn new(lp: &LoadedProgram, run: usize, z: &ZoneReport) -> Self {
         let pl = lp.primary_letter;
         ZoneRow {

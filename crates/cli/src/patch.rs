@@ -3,7 +3,7 @@
 use crate::{PatchArgs, check_positive, machine};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
-use polepatch::job::{FileReport, JobError, patch_file, write_atomic};
+use polepatch::job::{FileReport, JobError, ZoneRow, patch_file, write_atomic};
 use polepatch::patcher::PatchOptions;
 use rayon::prelude::*;
 use std::io::IsTerminal;
@@ -179,75 +179,14 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
 
 fn csv_rows(reports: &[&FileReport]) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record([
-        "file",
-        "run",
-        "first_line",
-        "last_line",
-        "kind",
-        "min_abs_primary_deg",
-        "c_ratio_before",
-        "c_ratio_after",
-        "primary_ratio_before",
-        "primary_ratio_after",
-        "overall_ratio_before",
-        "overall_ratio_after",
-        "limiting_before",
-        "limiting_after",
-        "time_before_s",
-        "time_after_s",
-        "ideal_time_s",
-        "max_deviation_deg",
-        "points_modified",
-        "patch_length_mm",
-        "outcome",
-        "method",
-        "qp_status",
-        "qp_iterations",
-        "qp_solves",
-        "solve_time_ms",
-        "decimals",
-        "c_offset_deg",
-    ])?;
+    let mut header = vec!["file"];
+    header.extend(ZoneRow::CSV_COLUMNS);
+    w.write_record(&header)?;
     for rep in reports {
         for z in &rep.zones {
-            let lim = |f: &polepatch::job::FiguresRow| {
-                format!(
-                    "{}:{}",
-                    f.limiting_axis.clone().unwrap_or_else(|| "-".into()),
-                    f.limiting_limit
-                )
-            };
-            w.write_record([
-                z.file.clone(),
-                z.run.to_string(),
-                z.lines[0].to_string(),
-                z.lines[1].to_string(),
-                z.kind.to_string(),
-                format!("{:.6}", z.min_abs_primary_deg),
-                format!("{:.6}", z.before.c_ratio),
-                format!("{:.6}", z.after.c_ratio),
-                format!("{:.6}", z.before.primary_ratio),
-                format!("{:.6}", z.after.primary_ratio),
-                format!("{:.6}", z.before.overall_ratio),
-                format!("{:.6}", z.after.overall_ratio),
-                lim(&z.before),
-                lim(&z.after),
-                format!("{:.6}", z.before.time_s),
-                format!("{:.6}", z.after.time_s),
-                format!("{:.6}", z.ideal_time_s),
-                format!("{:.6}", z.max_deviation_deg),
-                z.points_modified.to_string(),
-                format!("{:.3}", z.patch_length_mm),
-                z.outcome.to_string(),
-                z.method.to_string(),
-                z.qp_status.clone(),
-                z.qp_iterations.to_string(),
-                z.qp_solves.to_string(),
-                format!("{:.3}", z.solve_time_ms),
-                z.decimals.to_string(),
-                format!("{}", z.c_offset_deg),
-            ])?;
+            let mut rec = vec![z.file.clone()];
+            rec.extend(z.csv_fields());
+            w.write_record(&rec)?;
         }
     }
     Ok(w.into_inner()?)
