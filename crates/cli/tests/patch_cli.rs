@@ -1,0 +1,169 @@
+//! `polepatch patch` as a user runs it: one file, a folder batch, --strict, refusals.
+
+mod common;
+use common::{assert_only_c_words_differ, root};
+use polepatch_fixturegen::{Dialect, Pass, program};
+use std::path::PathBuf;
+use std::process::Command;
+
+fn polepatch(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_polepatch"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("polepatch-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn one_file_with_report() {
+    let dir = temp_dir("one");
+    let out = dir.join("SING.out.I");
+    let report = dir.join("r.json");
+    let (code, stdout, err) = polepatch(&[
+        "patch",
+        "fixtures/c17/SING.I",
+        "-o",
+        out.to_str().unwrap(),
+        "--machine",
+        "mikron-ucp710",
+        "--report",
+        report.to_str().unwrap(),
+        "--strict",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("SING.I"), "{stdout}");
+    let input = std::fs::read(root().join("fixtures/c17/SING.I")).unwrap();
+    assert_only_c_words_differ("SING", &input, &std::fs::read(&out).unwrap());
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    let zones = doc["zones"].as_array().unwrap();
+    assert_eq!(zones.len(), 1);
+    assert_eq!(zones[0]["outcome"], "reached");
+    assert_eq!(zones[0]["after"]["c_ratio"].as_f64().unwrap(), 1.0);
+    // Nothing but the output and the report in the folder: no temporary file left behind.
+    let mut names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["SING.out.I", "r.json"]);
+}
+
+#[test]
+fn folder_batch_with_csv() {
+    let dir = temp_dir("batch");
+    let out = dir.join("out");
+    let csv = dir.join("zones.csv");
+    let (code, stdout, err) = polepatch(&[
+        "patch",
+        "fixtures/c17",
+        "fixtures/dialects",
+        "--out-dir",
+        out.to_str().unwrap(),
+        "--machine",
+        "mikron-hsm600",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    for f in [
+        "c17/SING.I",
+        "c17/NON_SING.I",
+        "dialects/fanuc.nc",
+        "dialects/sinumerik.mpf",
+    ] {
+        assert!(out.join(f).exists(), "{f} missing; stdout: {stdout}");
+    }
+    // The program without zone is byte-identical.
+    assert_eq!(
+        std::fs::read(out.join("c17/NON_SING.I")).unwrap(),
+        std::fs::read(root().join("fixtures/c17/NON_SING.I")).unwrap()
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.starts_with("file,run,first_line"), "{text}");
+    assert!(text.lines().count() >= 4, "{text}");
+}
+
+#[test]
+fn strict_exits_2_when_a_zone_stays_below_feed() {
+    // 63 mm at F5000 on the UCP710: C cannot turn in time (tests/patch.rs has the proof).
+    let pass = Pass {
+        pole_distance_deg: 0.0015,
+        circle_radius_deg: 16.1,
+        half_sweep_deg: 80.7,
+        azimuth_deg: 124.0,
+        length_mm: 63.6,
+        spacing_mm: 0.5,
+        feed_mm_min: 5000.0,
+        b_axis: true,
+        domain_rule: false,
+        rotary_decimals: 3,
+    };
+    let dir = temp_dir("strict");
+    let input = dir.join("short.nc");
+    std::fs::write(&input, program(&pass, Dialect::Fanuc, "SHORT")).unwrap();
+    let out = dir.join("short.out.nc");
+    let args = [
+        "patch",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--machine",
+        "mikron-ucp710",
+    ];
+    let (code, _, err) = polepatch(&args);
+    assert_eq!(code, 0, "{err}");
+    let mut strict = args.to_vec();
+    strict.push("--strict");
+    let (code, _, err) = polepatch(&strict);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("stay below feed"), "{err}");
+}
+
+#[test]
+fn refusals() {
+    let dir = temp_dir("refuse");
+    let input = dir.join("SING.I");
+    std::fs::copy(root().join("fixtures/c17/SING.I"), &input).unwrap();
+    let before = std::fs::read(&input).unwrap();
+    let (code, _, err) = polepatch(&[
+        "patch",
+        input.to_str().unwrap(),
+        "-o",
+        input.to_str().unwrap(),
+        "--machine",
+        "mikron-ucp710",
+    ]);
+    assert_eq!(code, 1);
+    assert!(err.contains("would overwrite the input"), "{err}");
+    assert_eq!(std::fs::read(&input).unwrap(), before);
+    // A syntax error: no output file at all.
+    let bad = dir.join("bad.nc");
+    std::fs::write(&bad, "G1 X0 Y0 Z0 A1 C0 F1000\nX1 C1..5\n").unwrap();
+    let out = dir.join("bad.out.nc");
+    let (code, _, err) = polepatch(&[
+        "patch",
+        bad.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--machine",
+        "mikron-ucp710",
+    ]);
+    assert_eq!(code, 1);
+    assert!(err.contains("bad.nc:2:"), "{err}");
+    assert!(!out.exists());
+    let (code, _, err) = polepatch(&["patch", "fixtures/c17/SING.I", "--machine", "mikron-ucp710"]);
+    assert_eq!(code, 1);
+    assert!(err.contains("-o OUTPUT"), "{err}");
+}
