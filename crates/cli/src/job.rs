@@ -387,7 +387,7 @@ pub fn patch_file(
     } else {
         std::borrow::Cow::Owned(polepatch_nc::write(&lp.program, &edits))
     };
-    write_atomic(output, &bytes).map_err(|source| JobError::Write {
+    write_atomic_like(output, &bytes, Some(input)).map_err(|source| JobError::Write {
         path: output.display().to_string(),
         source,
     })?;
@@ -403,16 +403,45 @@ fn same_file(a: &FsPath, b: &FsPath) -> bool {
 }
 
 /// Write `bytes` to `path` through a temporary file in the same folder and a rename.
-pub fn write_atomic(path: &FsPath, bytes: &[u8]) -> std::io::Result<()> {
+/// The file gets the permissions of the file it replaces, else those of `like` (the
+/// input), else rw-r--r-- — not the temporary file's owner-only mode.
+pub fn write_atomic_like(
+    path: &FsPath,
+    bytes: &[u8],
+    like: Option<&FsPath>,
+) -> std::io::Result<()> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => FsPath::new("."),
     };
+    let perms = std::fs::metadata(path)
+        .or_else(|e| like.map_or(Err(e), std::fs::metadata))
+        .map(|m| m.permissions())
+        .ok();
     let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
     tmp.write_all(bytes)?;
     tmp.as_file().sync_all()?;
+    if let Some(perms) = perms.or_else(default_permissions) {
+        tmp.as_file().set_permissions(perms)?;
+    }
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
+}
+
+/// [`write_atomic_like`] without a model file (reports, CSV).
+pub fn write_atomic(path: &FsPath, bytes: &[u8]) -> std::io::Result<()> {
+    write_atomic_like(path, bytes, None)
+}
+
+#[cfg(unix)]
+fn default_permissions() -> Option<std::fs::Permissions> {
+    use std::os::unix::fs::PermissionsExt;
+    Some(std::fs::Permissions::from_mode(0o644))
+}
+
+#[cfg(not(unix))]
+fn default_permissions() -> Option<std::fs::Permissions> {
+    None
 }
 
 /// Errors of a patch job.

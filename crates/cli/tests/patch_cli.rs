@@ -51,6 +51,14 @@ fn one_file_with_report() {
     assert_eq!(zones.len(), 1);
     assert_eq!(zones[0]["outcome"], "reached");
     assert_eq!(zones[0]["after"]["c_ratio"].as_f64().unwrap(), 1.0);
+    // The output has the input's permissions, not the temporary file's owner-only mode.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = |p: &std::path::Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode(&out), mode(&root().join("fixtures/c17/SING.I")));
+        assert_eq!(mode(&report), 0o644);
+    }
     // Nothing but the output and the report in the folder: no temporary file left behind.
     let mut names: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()
