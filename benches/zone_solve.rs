@@ -8,7 +8,7 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use polepatch_kinematics::Machine;
-use polepatch_nc::{Dialect, modal, parse, runs};
+use polepatch_nc::{Dialect, modal, parse, primary_in_use, runs};
 use polepatch_patcher::{PatchOptions, Path, patch_path};
 
 /// The runs of a fixture that have zones on `machine`, as the CLI builds them.
@@ -17,25 +17,18 @@ fn zone_runs(file: &str, machine: &Machine) -> Vec<Path> {
     let bytes = std::fs::read(root.join(file)).expect("fixture");
     let prog = parse(bytes, Dialect::Auto).expect("parsable fixture");
     let rs = runs(&prog);
-    let has = |i: usize| rs.iter().any(|r| r.pos.iter().any(|p| p[i].is_some()));
-    let (own, other) = match machine.primary_letter() {
-        'A' => (modal::A, modal::B),
-        _ => (modal::B, modal::A),
+    let own = if machine.primary_letter() == 'A' {
+        modal::A
+    } else {
+        modal::B
     };
-    let pi = if !has(own) && has(other) { other } else { own };
+    let pi = primary_in_use(&rs, own);
     let opts = PatchOptions::default();
     rs.iter()
         .filter_map(|r| {
             let path = Path {
                 s_mm: r.s_mm.clone(),
-                axes: r
-                    .pos
-                    .iter()
-                    .map(|p| {
-                        let v = |i: usize| p[i].unwrap_or(0.0);
-                        [v(modal::X), v(modal::Y), v(modal::Z), v(pi), v(modal::C)]
-                    })
-                    .collect(),
+                axes: r.axes5(pi),
                 feed_mm_min: r.feed_mm_min?,
             };
             let res = patch_path(&path, machine, &opts).ok()?;

@@ -126,25 +126,26 @@ pub fn load(
             path: name.to_string(),
         });
     }
-    let has = |idx: usize| runs.iter().any(|r| r.pos.iter().any(|p| p[idx].is_some()));
-    let (own, other, own_letter, other_letter) = match machine.primary_letter() {
-        'A' => (modal::A, modal::B, b'A', b'B'),
-        _ => (modal::B, modal::A, b'B', b'A'),
+    let letter = |i: usize| if i == modal::A { b'A' } else { b'B' };
+    let own = if machine.primary_letter() == 'A' {
+        modal::A
+    } else {
+        modal::B
     };
+    let p_idx = polepatch_nc::primary_in_use(&runs, own);
+    let primary_letter = letter(p_idx);
     let mut warnings = Vec::new();
-    let (p_idx, primary_letter) = if !has(own) && has(other) {
+    if p_idx != own {
         warnings.push(format!(
             "{name}: the program uses {} but machine {} has {}: {}'s limits are applied to {}",
-            other_letter as char,
+            primary_letter as char,
             machine.name,
-            own_letter as char,
-            own_letter as char,
-            other_letter as char
+            letter(own) as char,
+            letter(own) as char,
+            primary_letter as char
         ));
-        (other, other_letter)
-    } else {
-        (own, own_letter)
-    };
+    }
+    let has = |idx: usize| runs.iter().any(|r| r.uses(idx));
     if !has(p_idx) && !has(modal::C) {
         return Err(InputError::NoRotary {
             path: name.to_string(),
@@ -160,14 +161,7 @@ pub fn load(
                 .ok_or(RunProblem::NoFeed)
                 .map(|feed| Path {
                     s_mm: run.s_mm.clone(),
-                    axes: run
-                        .pos
-                        .iter()
-                        .map(|p| {
-                            let v = |i: usize| p[i].unwrap_or(0.0);
-                            [v(modal::X), v(modal::Y), v(modal::Z), v(p_idx), v(modal::C)]
-                        })
-                        .collect(),
+                    axes: run.axes5(p_idx),
                     feed_mm_min: feed,
                 });
             RunPath { run, path }

@@ -20,6 +20,6 @@ pub mod writer;
 pub use error::ParseError;
 pub use modal::{Modal, Motion};
 pub use program::{Block, Dialect, Program, Word, parse};
-pub use run::{Run, RunBreak, runs};
+pub use run::{Run, RunBreak, primary_in_use, runs};
 pub use style::NumberStyle;
 pub use writer::{Edit, write};

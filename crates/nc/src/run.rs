@@ -151,6 +151,40 @@ fn xyz(pos: &[Option<f64>; 6]) -> Option<[f64; 3]> {
     Some([pos[X]?, pos[Y]?, pos[Z]?])
 }
 
+impl Run {
+    /// Per point `[X, Y, Z, P, C]` (mm, mm, mm, degrees, degrees), P the tilting axis at
+    /// index `primary` of [`Run::pos`] (`modal::A` or `modal::B`). A value never programmed
+    /// reads as 0.
+    pub fn axes5(&self, primary: usize) -> Vec<[f64; 5]> {
+        use crate::modal::{C, X, Y, Z};
+        self.pos
+            .iter()
+            .map(|p| {
+                let v = |i: usize| p[i].unwrap_or(0.0);
+                [v(X), v(Y), v(Z), v(primary), v(C)]
+            })
+            .collect()
+    }
+
+    /// Whether any point of the run has a value at index `axis` of [`Run::pos`].
+    pub fn uses(&self, axis: usize) -> bool {
+        self.pos.iter().any(|p| p[axis].is_some())
+    }
+}
+
+/// The tilting axis the runs use: `preferred` (`modal::A` or `modal::B`, the machine's),
+/// unless the runs never program it but do program the other tilting letter.
+pub fn primary_in_use(runs: &[Run], preferred: usize) -> usize {
+    use crate::modal::{A, B};
+    let other = if preferred == A { B } else { A };
+    let has = |i: usize| runs.iter().any(|r| r.uses(i));
+    if !has(preferred) && has(other) {
+        other
+    } else {
+        preferred
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -205,5 +239,21 @@ mod tests {
         assert_eq!(r.len(), 2);
         assert_eq!(r[0].blocks, vec![1, 2]);
         assert_eq!(r[1].blocks, vec![4, 5]);
+    }
+
+    #[test]
+    fn primary_in_use_prefers_the_machine_letter_and_falls_back() {
+        let prog = crate::parse(
+            b"G1 X0 Y0 Z0 B5 C0 F1000\nX1 B4 C10\nX2 B3 C20\n".to_vec(),
+            crate::Dialect::Auto,
+        )
+        .unwrap();
+        let rs = runs(&prog);
+        assert_eq!(primary_in_use(&rs, crate::modal::A), crate::modal::B);
+        assert_eq!(primary_in_use(&rs, crate::modal::B), crate::modal::B);
+        assert_eq!(
+            rs[0].axes5(crate::modal::B).last().unwrap(),
+            &[2.0, 0.0, 0.0, 3.0, 20.0]
+        );
     }
 }

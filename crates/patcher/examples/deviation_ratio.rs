@@ -13,7 +13,7 @@
 //! deviation of `patch_path`'s written values. Prints a Markdown table.
 
 use polepatch_kinematics::Machine;
-use polepatch_nc::{Dialect, modal, parse, runs};
+use polepatch_nc::{Dialect, modal, parse, primary_in_use, runs};
 use polepatch_patcher::{
     CLimits, Outcome, PatchOptions, Path, direct::deviation_bound_sampled,
     direct::orientation_deviation_deg, patch_path,
@@ -53,24 +53,17 @@ fn main() {
         for mname in ["mikron-ucp710", "mikron-hsm600"] {
             let m = Machine::builtin(mname).unwrap();
             let rs = runs(&prog);
-            let has = |i: usize| rs.iter().any(|r| r.pos.iter().any(|p| p[i].is_some()));
-            let (own, other) = match m.primary_letter() {
-                'A' => (modal::A, modal::B),
-                _ => (modal::B, modal::A),
+            let own = if m.primary_letter() == 'A' {
+                modal::A
+            } else {
+                modal::B
             };
-            let pi = if !has(own) && has(other) { other } else { own };
+            let pi = primary_in_use(&rs, own);
             for r in &rs {
                 let Some(feed) = r.feed_mm_min else { continue };
                 let path = Path {
                     s_mm: r.s_mm.clone(),
-                    axes: r
-                        .pos
-                        .iter()
-                        .map(|p| {
-                            let v = |i: usize| p[i].unwrap_or(0.0);
-                            [v(modal::X), v(modal::Y), v(modal::Z), v(pi), v(modal::C)]
-                        })
-                        .collect(),
+                    axes: r.axes5(pi),
                     feed_mm_min: feed,
                 };
                 if path.s_mm.len() < 2 {
