@@ -1,14 +1,14 @@
-//! The whole no-zone path of `polepatch patch` minus the file system: parse → runs and
-//! paths (`program::load`) → `patch_path` per run (`job::patch_program`) → write. Run:
+//! The whole no-zone path of `polepatch patch` minus the file system: `polepatch::patch_nc`
+//! (parse → runs and paths → `patch_path` per run → write), and the analysis alone from a
+//! parsed program (`program::load` → `patch_program`). Run:
 //! `cargo bench -p polepatch-benches --bench no_zone_patch -- --warm-up-time 1 --measurement-time 5`
 //! Figures are written up in docs/performance-nc.md.
 
 use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use polepatch::job::patch_program;
 use polepatch::program::{load, parse_program};
+use polepatch::{PatchOptions, patch_nc, patch_program};
 use polepatch_benches::{Style, no_zone_program};
 use polepatch_kinematics::Machine;
-use polepatch_patcher::PatchOptions;
 
 /// Size of the generated program, bytes.
 const SIZE: usize = 20 << 20;
@@ -16,7 +16,10 @@ const SIZE: usize = 20 << 20;
 fn no_zone(c: &mut Criterion) {
     let machine = Machine::builtin("mikron-hsm600").expect("built-in machine");
     let primary = machine.primary_letter();
-    let opts = PatchOptions::default();
+    let opts = PatchOptions {
+        name: "bench".into(),
+        ..PatchOptions::default()
+    };
     let mut g = c.benchmark_group("no_zone_patch");
     g.sample_size(10);
     for (name, style) in [("heidenhain", Style::Heidenhain), ("fanuc", Style::Fanuc)] {
@@ -26,13 +29,13 @@ fn no_zone(c: &mut Criterion) {
             b.iter_batched(
                 || text.clone(),
                 |input| {
-                    let program = parse_program(input, "bench").expect("parses");
-                    let lp = load(program, "bench", &machine, None).expect("has runs");
-                    let (edits, report) = patch_program(&lp, &machine, &opts);
-                    assert!(edits.is_empty() && report.zones.is_empty(), "no zone");
-                    let out = polepatch::nc::write(&lp.program, &edits);
+                    let (out, report) = patch_nc(&input, &machine, &opts).expect("parses");
+                    assert!(
+                        report.words_changed == 0 && report.zones.is_empty(),
+                        "no zone"
+                    );
                     assert_eq!(out.len(), text.len());
-                    (lp, out)
+                    (input, out)
                 },
                 BatchSize::PerIteration,
             )
@@ -44,7 +47,7 @@ fn no_zone(c: &mut Criterion) {
                 || p.clone(),
                 |program| {
                     let lp = load(program, "bench", &machine, None).expect("has runs");
-                    let (edits, _) = patch_program(&lp, &machine, &opts);
+                    let (edits, _) = patch_program(&lp, &machine, &opts.patch);
                     assert!(edits.is_empty());
                     lp
                 },

@@ -2,10 +2,8 @@
 //! write (the `polepatch patch` job without the file system).
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use polepatch::job::patch_program;
 use polepatch::kinematics::Machine;
-use polepatch::patcher::PatchOptions;
-use polepatch::program::{load, parse_program};
+use polepatch::{PatchOptions, patch_nc};
 use polepatch_fixturegen::{Pass, zigzag_program};
 
 fn zigzag(c: &mut Criterion) {
@@ -21,10 +19,8 @@ fn zigzag(c: &mut Criterion) {
         let machine = Machine::builtin(name).unwrap();
         group.bench_function(name, |b| {
             b.iter(|| {
-                let program = parse_program(text.clone().into_bytes(), "zigzag").unwrap();
-                let lp = load(program, "zigzag", &machine, None).unwrap();
-                let (edits, report) = patch_program(&lp, &machine, &PatchOptions::default());
-                let out = polepatch::nc::write(&lp.program, &edits);
+                let (out, report) =
+                    patch_nc(text.as_bytes(), &machine, &PatchOptions::default()).unwrap();
                 (out.len(), report.zones.len())
             })
         });

@@ -21,9 +21,10 @@
 
 pub mod plot;
 
-use crate::job::{FileReport, ZoneRow, patch_program};
-use crate::program::{InputError, LoadedProgram, load, parse_program, read_program};
-use crate::report::{AnalyzeReport, analyze_program};
+use crate::files::{JobError, read};
+use polepatch::program::{LoadedProgram, load_nc};
+use polepatch::report::{AnalyzeReport, analyze_program};
+use polepatch::{Error, FileReport, ZoneRow, patch_loaded};
 use polepatch_kinematics::{Axis, Machine};
 use polepatch_patcher::direct::deviation_bound_zone;
 use polepatch_patcher::{AnalysisOptions, CLimits, PatchFailure, PatchOptions, analyze_path};
@@ -89,8 +90,8 @@ pub struct BenchCase {
     pub zones_analyzed: usize,
     /// C words changed or inserted by the patch.
     pub words_changed: usize,
-    /// Runs not analysed or not patched, and why.
-    pub skipped_runs: Vec<String>,
+    /// Runs left as they are, and why.
+    pub untouched_runs: Vec<polepatch::UntouchedRun>,
     /// Notes (as `patch` prints them).
     pub warnings: Vec<String>,
     /// Wall time of the patch of the whole program, ms.
@@ -209,11 +210,10 @@ pub fn bench_file(
     file: &FsPath,
     machine: &Machine,
     opts: &BenchOptions,
-) -> Result<BenchCase, InputError> {
+) -> Result<BenchCase, JobError> {
     let name = file.display().to_string();
-    let program = read_program(file)?;
-    let lp = load(program, &name, machine, opts.feed_fallback_mm_min)?;
-    bench_program(&lp, machine, opts)
+    let lp = load_nc(read(file)?, &name, machine, opts.feed_fallback_mm_min)?;
+    Ok(bench_program(&lp, machine, opts)?)
 }
 
 /// Analyse, patch and bound one loaded program.
@@ -221,7 +221,7 @@ pub fn bench_program(
     lp: &LoadedProgram,
     machine: &Machine,
     opts: &BenchOptions,
-) -> Result<BenchCase, InputError> {
+) -> Result<BenchCase, Error> {
     let aopts = AnalysisOptions {
         cone_deg: opts.patch.cone_deg,
         tcy_s: opts.patch.tcy_s,
@@ -235,14 +235,17 @@ pub fn bench_program(
         .map(|f| f.zones.len())
         .sum();
     let t0 = Instant::now();
-    let (edits, report): (_, FileReport) = patch_program(lp, machine, &opts.patch);
+    let (bytes, report): (_, FileReport) = patch_loaded(lp, machine, &opts.patch);
     let patch_time_ms = t0.elapsed().as_secs_f64() * 1e3;
 
     // The program as written, read back: the "after" of the plots.
-    let after = if opts.plots && !edits.is_empty() {
-        let bytes = polepatch_nc::write(&lp.program, &edits);
-        let program = parse_program(bytes, &lp.name)?;
-        Some(load(program, &lp.name, machine, opts.feed_fallback_mm_min)?)
+    let after = if opts.plots && report.words_changed > 0 {
+        Some(load_nc(
+            bytes,
+            &lp.name,
+            machine,
+            opts.feed_fallback_mm_min,
+        )?)
     } else {
         None
     };
@@ -301,7 +304,7 @@ pub fn bench_program(
         machine: machine.name.clone(),
         zones_analyzed,
         words_changed: report.words_changed,
-        skipped_runs: report.skipped_runs,
+        untouched_runs: report.untouched_runs,
         warnings: report.warnings,
         patch_time_ms,
         zones,

@@ -2,10 +2,11 @@
 
 use crate::{check_positive, machine};
 use anyhow::{Context, Result, bail};
-use polepatch::bench::{BenchOptions, BenchReport, BenchZone, RATIO_TARGET, plot};
-use polepatch::job::{FiguresRow, ZoneRow, write_atomic};
 use polepatch::kinematics::Machine;
+use polepatch::patch::{FiguresRow, ZoneRow};
 use polepatch::patcher::PatchOptions;
+use polepatch_cli::bench::{BenchOptions, BenchReport, BenchZone, RATIO_TARGET, plot};
+use polepatch_cli::files::write_atomic;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -134,7 +135,7 @@ pub(crate) fn run(args: BenchArgs) -> Result<ExitCode> {
         .num_threads(args.jobs.unwrap_or(0))
         .build()
         .context("starting worker threads")?;
-    let report = pool.install(|| polepatch::bench::run(&files, &machines, &opts));
+    let report = pool.install(|| polepatch_cli::bench::run(&files, &machines, &opts));
 
     print!("{}", table(&report));
     for e in &report.errors {

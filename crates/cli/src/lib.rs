@@ -1,16 +1,6 @@
-//! polepatch: find and patch the places where the C axis slows a table-table 5-axis machine
-//! near the pole.
-//!
-//! This facade re-exports the crates and holds the glue from NC programs to the in-memory
-//! paths of the patcher ([`program`]), the report documents ([`report`]) and the quality
-//! suite ([`bench`]).
-
-pub use polepatch_bspline as bspline;
-pub use polepatch_kinematics as kinematics;
-pub use polepatch_nc as nc;
-pub use polepatch_patcher as patcher;
+//! The `polepatch` command line's library part: file jobs (read, patch through
+//! [`polepatch::patch_loaded`], write atomically) and the quality suite behind
+//! `polepatch bench`. The pipeline itself lives in the `polepatch` library crate.
 
 pub mod bench;
-pub mod job;
-pub mod program;
-pub mod report;
+pub mod files;

@@ -4,8 +4,9 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use polepatch::kinematics::{Axis, Machine};
 use polepatch::patcher::AnalysisOptions;
-use polepatch::program::{load, read_program};
+use polepatch::program::load_nc;
 use polepatch::report::{AnalyzeReport, analyze_program, axis_letter};
+use polepatch_cli::files;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -79,9 +80,10 @@ pub(crate) struct PatchArgs {
     /// Do not ask for third-derivative continuity at the joins.
     #[arg(long)]
     pub(crate) no_jerk_continuity: bool,
-    /// Never add a 360° multiple to C after a zone.
+    /// Allow a 360° multiple offset of C after a zone when it shortens the join (off by
+    /// default: the move after the run would then turn C the extra revolution back).
     #[arg(long)]
-    pub(crate) no_c_offset: bool,
+    pub(crate) c_offset: bool,
     /// Worker threads for batches (default: all cores).
     #[arg(long)]
     pub(crate) jobs: Option<usize>,
@@ -146,9 +148,8 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
     check_positive("--tcy-ms", args.tcy_ms)?;
     check_positive("--cone", Some(args.cone))?;
     let machine = machine(&args.machine)?;
-    let program = read_program(&args.file)?;
     let name = args.file.display().to_string();
-    let lp = load(program, &name, &machine, args.feed)?;
+    let lp = load_nc(files::read(&args.file)?, &name, &machine, args.feed)?;
     let opts = AnalysisOptions {
         cone_deg: args.cone,
         tcy_s: args.tcy_ms.map(|ms| ms / 1000.0),

@@ -3,8 +3,9 @@
 use crate::{PatchArgs, check_positive, machine};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
-use polepatch::job::{FileReport, JobError, ZoneRow, patch_file, write_atomic};
 use polepatch::patcher::PatchOptions;
+use polepatch::{FileReport, ZoneRow};
+use polepatch_cli::files::{JobError, patch_file, write_atomic};
 use rayon::prelude::*;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -33,7 +34,7 @@ fn options(args: &PatchArgs) -> Result<PatchOptions> {
         third_derivative_continuity: !args.no_jerk_continuity,
         max_decimals: args.max_decimals,
         max_patch_length_mm: args.max_patch_length,
-        allow_c_offset: !args.no_c_offset,
+        allow_c_offset: args.c_offset,
         ..PatchOptions::default()
     })
 }
@@ -149,8 +150,11 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
         for w in &rep.warnings {
             eprintln!("polepatch: warning: {w}");
         }
-        for w in &rep.skipped_runs {
-            eprintln!("polepatch: warning: {}: {w}", rep.file);
+        for u in &rep.untouched_runs {
+            eprintln!(
+                "polepatch: warning: {}: run {}, lines {}–{}: {}",
+                rep.file, u.run, u.lines[0], u.lines[1], u.message
+            );
         }
     }
     if let Some(path) = &args.report {
@@ -167,6 +171,13 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     let below: usize = ok.iter().map(|r| r.zones_below_feed()).sum();
+    let no_tcpm: usize = ok.iter().map(|r| r.runs_left_without_tcpm()).sum();
+    if no_tcpm > 0 {
+        eprintln!(
+            "polepatch: {no_tcpm} run(s) with singular zones left as they are: no TCPM active, \
+             X Y Z are machine coordinates (changing rotary words alone would gouge)"
+        );
+    }
     if failed > 0 {
         return Ok(ExitCode::from(1));
     }
@@ -199,11 +210,9 @@ fn print_summary(reports: &[&FileReport]) {
     );
     for rep in reports {
         let reached = rep.zones.iter().filter(|z| z.outcome == "reached").count();
-        let min = |f: &dyn Fn(&polepatch::job::ZoneRow) -> f64| {
-            rep.zones.iter().map(f).fold(f64::INFINITY, f64::min)
-        };
-        let sum =
-            |f: &dyn Fn(&polepatch::job::ZoneRow) -> f64| rep.zones.iter().map(f).sum::<f64>();
+        let min =
+            |f: &dyn Fn(&ZoneRow) -> f64| rep.zones.iter().map(f).fold(f64::INFINITY, f64::min);
+        let sum = |f: &dyn Fn(&ZoneRow) -> f64| rep.zones.iter().map(f).sum::<f64>();
         let name = Path::new(&rep.file)
             .file_name()
             .map_or(rep.file.clone(), |n| n.to_string_lossy().into_owned());

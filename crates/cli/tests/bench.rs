@@ -1,8 +1,8 @@
 //! `polepatch bench`: the suite agrees with `polepatch patch --report`, the bound is a lower
 //! bound, the plots are SVG, and the command fails clearly without inputs.
 
-use polepatch::bench::{BenchOptions, run};
 use polepatch::kinematics::Machine;
+use polepatch_cli::bench::{BenchOptions, run};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;

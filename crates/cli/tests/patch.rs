@@ -103,13 +103,12 @@ fn impossible_zone_keeps_the_best_improvement() {
     let text = program(&pass, Dialect::Fanuc, "SHORT");
     let m = polepatch::kinematics::Machine::builtin("mikron-ucp710").unwrap();
     let lp = load_bytes(text.as_bytes(), "short", &m);
-    let (edits, report) = polepatch::job::patch_program(&lp, &m, &PatchOptions::default());
+    let (out, report) = polepatch::patch_loaded(&lp, &m, &PatchOptions::default());
     assert!(!report.zones.is_empty());
     for z in &report.zones {
         assert_ne!(z.outcome, "reached", "{z:?}");
         assert!(z.after.c_ratio >= z.before.c_ratio, "{z:?}");
     }
-    let out = polepatch::nc::write(&lp.program, &edits);
     assert_only_c_words_differ("short", text.as_bytes(), &out);
     let before = c_ratios_and_zones(&lp, &m, 5.0);
     let after = c_ratios_and_zones(&load_bytes(&out, "short", &m), &m, 5.0);

@@ -175,3 +175,40 @@ fn refusals() {
     assert_eq!(code, 1);
     assert!(err.contains("-o OUTPUT"), "{err}");
 }
+
+/// Issue 10's check: `SING.I` without `M128` (X Y Z are machine coordinates): no rotary
+/// word changes, a clear report line, exit 0; exit 2 with --strict.
+#[test]
+fn no_tcpm_is_never_patched() {
+    let dir = temp_dir("notcpm");
+    let input = dir.join("SING_noM128.I");
+    let text = std::fs::read_to_string(root().join("fixtures/c17/SING.I")).unwrap();
+    std::fs::write(&input, text.replace("N65 M128 *\n", "")).unwrap();
+    let out = dir.join("out.I");
+    let report = dir.join("r.json");
+    let args = [
+        "patch",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--machine",
+        "mikron-ucp710",
+        "--report",
+        report.to_str().unwrap(),
+    ];
+    let (code, _, err) = polepatch(&args);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(std::fs::read(&out).unwrap(), std::fs::read(&input).unwrap());
+    assert!(err.contains("run 1, lines 12–66: no TCPM active"), "{err}");
+    assert!(
+        err.contains("1 run(s) with singular zones left as they are"),
+        "{err}"
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert_eq!(doc["words_changed"], 0);
+    assert_eq!(doc["untouched_runs"][0]["reason"], "no-tcpm");
+    let mut strict = args.to_vec();
+    strict.push("--strict");
+    let (code, _, err) = polepatch(&strict);
+    assert_eq!(code, 2, "{err}");
+}

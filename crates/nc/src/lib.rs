@@ -12,6 +12,7 @@
 pub mod error;
 pub mod lexer;
 pub mod modal;
+pub mod plan;
 pub mod program;
 pub mod run;
 pub mod style;
@@ -19,6 +20,7 @@ pub mod writer;
 
 pub use error::ParseError;
 pub use modal::{Modal, Motion};
+pub use plan::restore_modal;
 pub use program::{Block, Dialect, Program, Word, parse};
 pub use run::{Run, RunBreak, primary_in_use, runs};
 pub use style::NumberStyle;

@@ -19,6 +19,6 @@ pub use analysis::{AnalysisOptions, RunAnalysis, Sample, Zone, ZoneKind, analyze
 pub use candidate::{Candidate, PatchFailure};
 pub use limits::CLimits;
 pub use options::PatchOptions;
-pub use patch::{PatchResult, patch_path};
+pub use patch::{PatchResult, patch_path, report_unpatched};
 pub use path::{Path, PathError};
 pub use report::{Method, Outcome, QpStats, ZoneFigures, ZoneReport};

@@ -17,6 +17,8 @@ pub struct PatchOptions {
     /// Decimal places of the file's C words (values are verified rounded to these).
     /// Default 3.
     pub c_decimals: usize,
+    /// Decimal places of the file's primary-axis words (A or B). Default 3.
+    pub p_decimals: usize,
     /// Most decimal places polepatch may write when the file's precision cannot hold
     /// Equation 6. Default 4.
     pub max_decimals: usize,
@@ -37,6 +39,7 @@ impl Default for PatchOptions {
             margin: 0.02,
             third_derivative_continuity: true,
             c_decimals: 3,
+            p_decimals: 3,
             max_decimals: 4,
             max_patch_length_mm: None,
             allow_c_offset: false,

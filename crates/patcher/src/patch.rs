@@ -32,18 +32,90 @@ use crate::{
 };
 use polepatch_kinematics::{Axis, LimitKind, Machine};
 
-/// Result of patching one path.
+/// Result of patching one path: the values of both rotary axes as they must be written.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PatchResult {
-    /// C per point, degrees, as it must be written (rounded to `decimals` where changed;
+    /// Primary axis (A or B) per point, degrees, as it must be written (rounded to
+    /// `p_decimals` where changed; the input value where unchanged).
+    pub p_deg: Vec<f64>,
+    /// Which points' primary value changed.
+    pub p_changed: Vec<bool>,
+    /// Decimal places to write the changed primary values with (≥ `opts.p_decimals`).
+    pub p_decimals: usize,
+    /// C per point, degrees, as it must be written (rounded to `c_decimals` where changed;
     /// the input value where unchanged).
     pub c_deg: Vec<f64>,
-    /// Which points changed.
-    pub changed: Vec<bool>,
+    /// Which points' C changed.
+    pub c_changed: Vec<bool>,
     /// Decimal places to write the changed C values with (≥ `opts.c_decimals`).
-    pub decimals: usize,
+    pub c_decimals: usize,
     /// One row per zone.
     pub zones: Vec<ZoneReport>,
+}
+
+impl PatchResult {
+    /// The path unchanged: no zone, every value as it was.
+    pub fn unchanged(path: &Path, opts: &PatchOptions) -> PatchResult {
+        let n = path.s_mm.len();
+        PatchResult {
+            p_deg: path.axes.iter().map(|q| q[Axis::Primary.index()]).collect(),
+            p_changed: vec![false; n],
+            p_decimals: opts.p_decimals,
+            c_deg: path.axes.iter().map(|q| q[Axis::C.index()]).collect(),
+            c_changed: vec![false; n],
+            c_decimals: opts.c_decimals,
+            zones: Vec::new(),
+        }
+    }
+    /// Whether any value changed.
+    pub fn any_change(&self) -> bool {
+        self.p_changed.iter().chain(&self.c_changed).any(|&c| c)
+    }
+}
+
+/// The singular zones of `path` reported as they are, without patching: what a run that
+/// must not be patched (no TCPM, say) reports. Every zone is [`Outcome::Unchanged`] with
+/// [`Method::None`]; its figures before and after are the same.
+pub fn report_unpatched(
+    path: &Path,
+    machine: &Machine,
+    opts: &PatchOptions,
+) -> Result<Vec<ZoneReport>, PathError> {
+    validate(path)?;
+    let pi = Axis::Primary.index();
+    if !path.axes.iter().any(|q| q[pi].abs() <= opts.cone_deg) {
+        return Ok(Vec::new());
+    }
+    let aopts = AnalysisOptions {
+        cone_deg: opts.cone_deg,
+        tcy_s: opts.tcy_s,
+        keep_samples: false,
+    };
+    let analysis = analyze_path(path, machine, &aopts)?;
+    merge_zones(&analysis.zones)
+        .into_iter()
+        .map(|zone| {
+            let f = zone_figures(path, machine, &aopts, zone.first, zone.last)?;
+            Ok(ZoneReport {
+                first: zone.first,
+                last: zone.last,
+                kind: zone.kind,
+                min_abs_primary_deg: zone.min_abs_primary_deg,
+                before: f,
+                after: f,
+                ideal_time_s: (path.s_mm[zone.last] - path.s_mm[zone.first])
+                    / (path.feed_mm_min / 60.0),
+                max_deviation_deg: 0.0,
+                points_modified: 0,
+                patch_length_mm: 0.0,
+                outcome: Outcome::Unchanged,
+                method: Method::None,
+                qp: QpStats::default(),
+                decimals: opts.c_decimals,
+                c_offset_deg: 0.0,
+            })
+        })
+        .collect()
 }
 
 /// Factors applied to `PatchOptions::margin`, in order, when no candidate passes
@@ -121,15 +193,9 @@ pub(crate) fn patch_path_with(
     validate(path)?;
     let n = path.s_mm.len();
     let c0: Vec<f64> = path.axes.iter().map(|q| q[Axis::C.index()]).collect();
-    let unchanged = |c_deg: Vec<f64>| PatchResult {
-        c_deg,
-        changed: vec![false; n],
-        decimals: opts.c_decimals,
-        zones: Vec::new(),
-    };
     let pi = Axis::Primary.index();
     if !path.axes.iter().any(|q| q[pi].abs() <= opts.cone_deg) {
-        return Ok(unchanged(c0));
+        return Ok(PatchResult::unchanged(path, opts));
     }
     let aopts = AnalysisOptions {
         cone_deg: opts.cone_deg,
@@ -138,7 +204,7 @@ pub(crate) fn patch_path_with(
     };
     let analysis = analyze_path(path, machine, &aopts)?;
     if analysis.zones.is_empty() {
-        return Ok(unchanged(c0));
+        return Ok(PatchResult::unchanged(path, opts));
     }
     let ctx = Ctx {
         s: &path.s_mm,
@@ -252,9 +318,12 @@ pub(crate) fn patch_path_with(
         });
     }
     Ok(PatchResult {
+        p_deg: ctx.p.clone(),
+        p_changed: vec![false; n],
+        p_decimals: opts.p_decimals,
         c_deg: cur,
-        changed,
-        decimals,
+        c_changed: changed,
+        c_decimals: decimals,
         zones: reports,
     })
 }
@@ -643,7 +712,7 @@ mod tests {
         // Only C changes, and `changed` says where.
         for (i, (a, b)) in path.axes.iter().zip(&after_path.axes).enumerate() {
             assert_eq!(a[..4], b[..4]);
-            assert_eq!(res.changed[i], a[4] != b[4]);
+            assert_eq!(res.c_changed[i], a[4] != b[4]);
         }
         let after = analyze_path(&after_path, m, &AnalysisOptions::default()).unwrap();
         // Never worse on C.
@@ -729,7 +798,7 @@ mod tests {
         }
         let res = patch_path(&path, &m, &PatchOptions::default()).unwrap();
         assert!(res.zones.is_empty());
-        assert!(res.changed.iter().all(|c| !c));
+        assert!(!res.any_change());
         let c: Vec<f64> = path.axes.iter().map(|q| q[4]).collect();
         assert_eq!(res.c_deg, c);
     }

@@ -1,12 +1,12 @@
 //! Shared checks of the patch tests.
 #![allow(dead_code)]
 
-use polepatch::job::{FileReport, patch_program};
 use polepatch::kinematics::{Axis, Machine};
 use polepatch::nc::{Dialect, parse};
 use polepatch::patcher::direct::deviation_bound_zone;
 use polepatch::patcher::{AnalysisOptions, CLimits, PatchOptions, analyze_path};
-use polepatch::program::{LoadedProgram, load};
+use polepatch::program::{LoadedProgram, load_nc};
+use polepatch::{FileReport, patch_loaded};
 use std::path::{Path, PathBuf};
 
 pub fn root() -> PathBuf {
@@ -35,8 +35,7 @@ pub fn fixtures() -> Vec<PathBuf> {
 }
 
 pub fn load_bytes(bytes: &[u8], name: &str, machine: &Machine) -> LoadedProgram {
-    let program = parse(bytes.to_vec(), Dialect::Auto).unwrap_or_else(|e| panic!("{name}: {e}"));
-    load(program, name, machine, None).unwrap_or_else(|e| panic!("{name}: {e}"))
+    load_nc(bytes.to_vec(), name, machine, None).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
 /// Per run: (lowest C ratio, number of zones) as `polepatch analyze` sees the program.
@@ -141,8 +140,7 @@ pub fn check_patch(
 ) -> (FileReport, Vec<u8>) {
     let lp = load_bytes(bytes, name, machine);
     let before = c_ratios_and_zones(&lp, machine, opts.cone_deg);
-    let (edits, report) = patch_program(&lp, machine, opts);
-    let out = polepatch::nc::write(&lp.program, &edits);
+    let (out, report) = patch_loaded(&lp, machine, opts);
     if before.iter().all(|r| r.1 == 0) {
         assert_eq!(
             out, bytes,
@@ -168,8 +166,7 @@ pub fn check_patch(
                     max_decimals: 8,
                     ..opts.clone()
                 };
-                let (edits, _) = patch_program(&lp, machine, &fine);
-                let out = polepatch::nc::write(&lp.program, &edits);
+                let (out, _) = patch_loaded(&lp, machine, &fine);
                 let zones_left =
                     c_ratios_and_zones(&load_bytes(&out, name, machine), machine, opts.cone_deg)[k]
                         .1;

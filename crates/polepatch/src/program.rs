@@ -1,47 +1,9 @@
-//! From an NC file to the patcher's paths: read, parse, group into runs, pick the axes.
+//! From NC bytes to the patcher's paths: parse, group into runs, pick the axes.
 
+use crate::error::Error;
 use polepatch_kinematics::Machine;
-use polepatch_nc::{Dialect, ParseError, Program, Run, modal};
+use polepatch_nc::{Dialect, Program, Run, modal};
 use polepatch_patcher::Path;
-use std::path::Path as FsPath;
-
-/// Bad input at the file level.
-#[derive(Debug, thiserror::Error)]
-pub enum InputError {
-    /// The file could not be read.
-    #[error("cannot read {path}: {source}")]
-    Io {
-        /// File.
-        path: String,
-        /// Cause.
-        source: std::io::Error,
-    },
-    /// Syntax error with line and column.
-    #[error("{0}")]
-    Parse(#[from] ParseError),
-    /// Nothing but whitespace.
-    #[error("{path}: empty program")]
-    Empty {
-        /// File.
-        path: String,
-    },
-    /// No G1 motion at all.
-    #[error("{path}: no G1 motion to analyse")]
-    NoRuns {
-        /// File.
-        path: String,
-    },
-    /// No rotary axis words in any G1 run.
-    #[error(
-        "{path}: no rotary axis words ({primary} or C) in any G1 run; is this a 5-axis program?"
-    )]
-    NoRotary {
-        /// File.
-        path: String,
-        /// The machine's primary letter.
-        primary: char,
-    },
-}
 
 /// Why one run cannot be analysed (the others still can).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -69,10 +31,10 @@ pub struct RunPath {
     pub path: Result<Path, RunProblem>,
 }
 
-/// A program read from a file, with its runs as paths for a machine.
+/// A parsed program with its runs as paths for a machine.
 #[derive(Debug, Clone)]
 pub struct LoadedProgram {
-    /// File name as given.
+    /// Name used in messages and reports (a file name, or what the caller chose).
     pub name: String,
     /// The parsed program.
     pub program: Program,
@@ -90,26 +52,47 @@ impl LoadedProgram {
     pub fn line_of(&self, r: usize, k: usize) -> usize {
         self.program.blocks[self.runs[r].run.blocks[k]].line
     }
+    /// File lines of the first and last point of run `r`.
+    pub fn lines_of_run(&self, r: usize) -> [usize; 2] {
+        [
+            self.line_of(r, 0),
+            self.line_of(r, self.runs[r].run.len() - 1),
+        ]
+    }
+    /// Index of the primary letter in [`polepatch_nc::Modal::pos`].
+    pub fn primary_index(&self) -> usize {
+        if self.primary_letter == b'A' {
+            modal::A
+        } else {
+            modal::B
+        }
+    }
 }
 
-/// Read and parse `file`.
-pub fn read_program(file: &FsPath) -> Result<Program, InputError> {
-    let name = file.display().to_string();
-    let bytes = std::fs::read(file).map_err(|source| InputError::Io {
-        path: name.clone(),
-        source,
-    })?;
-    parse_program(bytes, &name)
-}
-
-/// Parse bytes named `name` (for messages).
-pub fn parse_program(bytes: Vec<u8>, name: &str) -> Result<Program, InputError> {
+/// Parse `bytes` named `name` (for messages).
+pub fn parse_program(bytes: Vec<u8>, name: &str) -> Result<Program, Error> {
     if bytes.iter().all(|b| b.is_ascii_whitespace()) {
-        return Err(InputError::Empty {
+        return Err(Error::Empty {
             path: name.to_string(),
         });
     }
-    polepatch_nc::parse(bytes, Dialect::Auto).map_err(|e| InputError::Parse(e.with_path(name)))
+    polepatch_nc::parse(bytes, Dialect::Auto).map_err(|e| Error::Parse(e.with_path(name)))
+}
+
+/// Parse `bytes` and build each run's path for `machine`; `feed_fallback_mm_min` is used
+/// for runs with no F in force.
+pub fn load_nc(
+    bytes: Vec<u8>,
+    name: &str,
+    machine: &Machine,
+    feed_fallback_mm_min: Option<f64>,
+) -> Result<LoadedProgram, Error> {
+    load(
+        parse_program(bytes, name)?,
+        name,
+        machine,
+        feed_fallback_mm_min,
+    )
 }
 
 /// Group a parsed program into runs and build each run's path for `machine`.
@@ -119,10 +102,10 @@ pub fn load(
     name: &str,
     machine: &Machine,
     feed_fallback_mm_min: Option<f64>,
-) -> Result<LoadedProgram, InputError> {
+) -> Result<LoadedProgram, Error> {
     let runs = polepatch_nc::runs(&program);
     if runs.is_empty() {
-        return Err(InputError::NoRuns {
+        return Err(Error::NoRuns {
             path: name.to_string(),
         });
     }
@@ -147,7 +130,7 @@ pub fn load(
     }
     let has = |idx: usize| runs.iter().any(|r| r.uses(idx));
     if !has(p_idx) && !has(modal::C) {
-        return Err(InputError::NoRotary {
+        return Err(Error::NoRotary {
             path: name.to_string(),
             primary: machine.primary_letter(),
         });

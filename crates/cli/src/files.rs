@@ -1,0 +1,119 @@
+//! Files: read an NC program, patch it through the library, write the output safely.
+
+use polepatch::kinematics::Machine;
+use polepatch::program::load_nc;
+use polepatch::{Error, FileReport, patch_loaded};
+use polepatch_patcher::PatchOptions;
+use std::io::Write;
+use std::path::Path as FsPath;
+
+/// Errors of a file job.
+#[derive(Debug, thiserror::Error)]
+pub enum JobError {
+    /// The file could not be read.
+    #[error("cannot read {path}: {source}")]
+    Read {
+        /// File.
+        path: String,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// Bad input.
+    #[error(transparent)]
+    Input(#[from] Error),
+    /// The output could not be written.
+    #[error("cannot write {path}: {source}")]
+    Write {
+        /// Output path.
+        path: String,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// Output and input are the same file.
+    #[error("{path}: the output would overwrite the input; polepatch never modifies its input")]
+    Overwrite {
+        /// Path.
+        path: String,
+    },
+}
+
+/// Read a file's bytes.
+pub fn read(path: &FsPath) -> Result<Vec<u8>, JobError> {
+    std::fs::read(path).map_err(|source| JobError::Read {
+        path: path.display().to_string(),
+        source,
+    })
+}
+
+/// Read, patch and write one file. The output is written to a temporary file beside it and
+/// renamed on success: nothing half-written, the input never touched.
+pub fn patch_file(
+    input: &FsPath,
+    output: &FsPath,
+    machine: &Machine,
+    opts: &PatchOptions,
+    feed_fallback_mm_min: Option<f64>,
+) -> Result<FileReport, JobError> {
+    let name = input.display().to_string();
+    if same_file(input, output) {
+        return Err(JobError::Overwrite { path: name });
+    }
+    let lp = load_nc(read(input)?, &name, machine, feed_fallback_mm_min)?;
+    let (bytes, mut report) = patch_loaded(&lp, machine, opts);
+    write_atomic_like(output, &bytes, Some(input)).map_err(|source| JobError::Write {
+        path: output.display().to_string(),
+        source,
+    })?;
+    report.output = Some(output.display().to_string());
+    Ok(report)
+}
+
+/// Whether two paths name the same existing file.
+pub fn same_file(a: &FsPath, b: &FsPath) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
+}
+
+/// Write `bytes` to `path` through a temporary file in the same folder and a rename.
+/// The file gets the permissions of the file it replaces, else those of `like` (the
+/// input), else rw-r--r-- — not the temporary file's owner-only mode.
+pub fn write_atomic_like(
+    path: &FsPath,
+    bytes: &[u8],
+    like: Option<&FsPath>,
+) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => FsPath::new("."),
+    };
+    let perms = std::fs::metadata(path)
+        .or_else(|e| like.map_or(Err(e), std::fs::metadata))
+        .map(|m| m.permissions())
+        .ok();
+    let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
+    tmp.write_all(bytes)?;
+    tmp.as_file().sync_all()?;
+    if let Some(perms) = perms.or_else(default_permissions) {
+        tmp.as_file().set_permissions(perms)?;
+    }
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
+
+/// [`write_atomic_like`] without a model file (reports, CSV).
+pub fn write_atomic(path: &FsPath, bytes: &[u8]) -> std::io::Result<()> {
+    write_atomic_like(path, bytes, None)
+}
+
+#[cfg(unix)]
+fn default_permissions() -> Option<std::fs::Permissions> {
+    use std::os::unix::fs::PermissionsExt;
+    Some(std::fs::Permissions::from_mode(0o644))
+}
+
+#[cfg(not(unix))]
+fn default_permissions() -> Option<std::fs::Permissions> {
+    None
+}

@@ -1,0 +1,50 @@
+//! Bad input at the program level (an error), kept apart from numerical outcomes (a zone
+//! that stays below feed is a status in the report, not an error).
+
+use polepatch_nc::ParseError;
+
+/// Why a program cannot be analysed or patched at all.
+///
+/// Messages name the file when the caller gave one (`PatchOptions::name`), and the line
+/// and column where the input is at fault.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// Syntax error with line and column.
+    #[error("{0}")]
+    Parse(#[from] ParseError),
+    /// Nothing but whitespace.
+    #[error("{path}: empty program")]
+    Empty {
+        /// File (or the name given for in-memory input).
+        path: String,
+    },
+    /// No G1 motion at all.
+    #[error("{path}: no G1 motion to analyse")]
+    NoRuns {
+        /// File.
+        path: String,
+    },
+    /// No rotary axis words in any G1 run.
+    #[error(
+        "{path}: no rotary axis words ({primary} or C) in any G1 run; is this a 5-axis program?"
+    )]
+    NoRotary {
+        /// File.
+        path: String,
+        /// The machine's primary letter.
+        primary: char,
+    },
+    /// The program uses something polepatch does not support, at a line.
+    #[error("{path}:{line}: {what}")]
+    Unsupported {
+        /// File.
+        path: String,
+        /// 1-based line.
+        line: usize,
+        /// What is not supported and why.
+        what: String,
+    },
+    /// Bad options (a value out of range), named.
+    #[error("{0}")]
+    Options(String),
+}

@@ -1,0 +1,115 @@
+//! polepatch: find and patch the places where the rotary axes slow a table-table 5-axis
+//! machine near the pole — as a library, bytes in and bytes out.
+//!
+//! ```no_run
+//! use polepatch::{PatchOptions, kinematics::Machine, patch_nc};
+//! let machine = Machine::builtin("mikron-ucp710").unwrap();
+//! let input = std::fs::read("SING.I").unwrap();
+//! let (output, report) = patch_nc(&input, &machine, &PatchOptions::default()).unwrap();
+//! assert_eq!(report.zones_below_feed(), 0);
+//! # let _ = output;
+//! ```
+//!
+//! [`patch_nc`] and [`analyze_nc`] are the entry points for NC programs held in memory;
+//! [`program::load_nc`] + [`patch::patch_loaded`] the same in two steps for callers that
+//! want the parsed program too (the quality suite). CAM plugins that hold CL points rather
+//! than a file use the patcher directly on a [`patcher::Path`].
+//!
+//! This crate does no file I/O and depends on no command-line crate: the `polepatch`
+//! binary (`polepatch-cli`) and the C ABI (`polepatch-capi`) are thin layers over it.
+
+pub use polepatch_bspline as bspline;
+pub use polepatch_kinematics as kinematics;
+pub use polepatch_nc as nc;
+pub use polepatch_patcher as patcher;
+
+pub mod error;
+pub mod patch;
+pub mod program;
+pub mod report;
+
+pub use error::Error;
+pub use patch::{FileReport, UntouchedReason, UntouchedRun, ZoneRow, patch_loaded, patch_program};
+pub use report::AnalyzeReport;
+
+use polepatch_kinematics::Machine;
+use polepatch_patcher::AnalysisOptions;
+
+/// Options of [`patch_nc`]. Plain struct; see each field for its default.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PatchOptions {
+    /// Options of the patcher (cone, margin, decimals, …). Default: [`patcher::PatchOptions`]'s.
+    /// Its `c_decimals` and `p_decimals` are read from the file and need not be set.
+    pub patch: patcher::PatchOptions,
+    /// Feed, mm/min, for runs with no F in force. Default `None` (such runs are reported
+    /// and left as they are).
+    pub feed_fallback_mm_min: Option<f64>,
+    /// Name of the input in messages and in the report (`file`). Default `"input"`.
+    pub name: String,
+}
+
+impl Default for PatchOptions {
+    fn default() -> Self {
+        PatchOptions {
+            patch: patcher::PatchOptions::default(),
+            feed_fallback_mm_min: None,
+            name: "input".to_string(),
+        }
+    }
+}
+
+/// Options of [`analyze_nc`]. Plain struct; see each field for its default.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AnalyzeOptions {
+    /// Options of the analysis (cone, Tcy). Default: [`AnalysisOptions`]'s.
+    pub analysis: AnalysisOptions,
+    /// Feed, mm/min, for runs with no F in force. Default `None`.
+    pub feed_fallback_mm_min: Option<f64>,
+    /// Name of the input in messages and in the report. Default `"input"`.
+    pub name: String,
+}
+
+impl Default for AnalyzeOptions {
+    fn default() -> Self {
+        AnalyzeOptions {
+            analysis: AnalysisOptions::default(),
+            feed_fallback_mm_min: None,
+            name: "input".to_string(),
+        }
+    }
+}
+
+/// Patch an NC program held in memory: the rewritten bytes (identical to `bytes` except
+/// the rotary words that had to change) and the report.
+///
+/// Bad input (syntax errors with line and column, an empty program, no G1 motion, no
+/// rotary words) is an [`Error`]; a zone that cannot reach feed is a status in the report.
+pub fn patch_nc(
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &PatchOptions,
+) -> Result<(Vec<u8>, FileReport), Error> {
+    let lp = program::load_nc(
+        bytes.to_vec(),
+        &opts.name,
+        machine,
+        opts.feed_fallback_mm_min,
+    )?;
+    Ok(patch_loaded(&lp, machine, &opts.patch))
+}
+
+/// Equation 6 along every run of an NC program held in memory (what `polepatch analyze`
+/// prints).
+pub fn analyze_nc(
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &AnalyzeOptions,
+) -> Result<AnalyzeReport, Error> {
+    let lp = program::load_nc(
+        bytes.to_vec(),
+        &opts.name,
+        machine,
+        opts.feed_fallback_mm_min,
+    )?;
+    Ok(report::analyze_program(&lp, machine, &opts.analysis))
+}

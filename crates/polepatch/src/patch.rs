@@ -1,0 +1,496 @@
+//! Patching a whole program: runs → patcher → edits → bytes.
+//!
+//! [`patch_program`] is the one pipeline: every caller (the `polepatch` binary, `bench`,
+//! the criterion benches, the tests, the C ABI) goes through it, by way of
+//! [`crate::patch_nc`] for bytes or [`patch_loaded`] for a program already loaded.
+//!
+//! # What is never patched
+//! A run whose X Y Z are machine coordinates (no TCPM: M128, TRAORI, G43.4 not active) is
+//! analysed and reported but left byte-identical: on a table-table machine without TCPM,
+//! changing a rotary value while X Y Z stay moves the part under the tool (a gouge).
+//! A run in incremental mode (G91) is left the same way: a changed value there would shift
+//! every later position. Both appear in [`FileReport::untouched_runs`] when they hold a
+//! singular zone.
+
+use crate::program::{LoadedProgram, RunProblem};
+use crate::report::{axis_letter, limit_name, zone_kind_name};
+use polepatch_kinematics::Machine;
+use polepatch_nc::{Edit, NumberStyle};
+use polepatch_patcher::{
+    Method, Outcome, PatchOptions, ZoneFigures, ZoneReport, patch_path, report_unpatched,
+};
+use serde::Serialize;
+
+/// Equation-6 figures of a zone, with axis letters (report form of [`ZoneFigures`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct FiguresRow {
+    /// Lowest C-limited ratio.
+    pub c_ratio: f64,
+    /// Lowest primary-limited ratio.
+    pub primary_ratio: f64,
+    /// Lowest overall ratio.
+    pub overall_ratio: f64,
+    /// Limiting axis letter (`null`: the feed).
+    pub limiting_axis: Option<String>,
+    /// `V`, `A`, `J` or `F`.
+    pub limiting_limit: &'static str,
+    /// Estimated time over the zone, s.
+    pub time_s: f64,
+}
+
+impl FiguresRow {
+    fn new(f: &ZoneFigures, primary_letter: u8) -> Self {
+        FiguresRow {
+            c_ratio: f.c_ratio,
+            primary_ratio: f.primary_ratio,
+            overall_ratio: f.overall_ratio,
+            limiting_axis: f.limiting_axis.map(|a| axis_letter(a, primary_letter)),
+            limiting_limit: limit_name(f.limiting_kind),
+            time_s: f.time_s,
+        }
+    }
+}
+
+/// One zone of one file (a report row; also the CSV row, flattened).
+#[derive(Debug, Clone, Serialize)]
+pub struct ZoneRow {
+    /// Input file.
+    pub file: String,
+    /// Run number, from 1.
+    pub run: usize,
+    /// File lines of the first and last point of the zone/patch.
+    pub lines: [usize; 2],
+    /// `A-flip` or `C-swing`.
+    pub kind: &'static str,
+    /// Smallest |primary|, degrees.
+    pub min_abs_primary_deg: f64,
+    /// Before patching.
+    pub before: FiguresRow,
+    /// After patching, on the values as written.
+    pub after: FiguresRow,
+    /// L/F over the zone, s.
+    pub ideal_time_s: f64,
+    /// Largest orientation deviation, degrees.
+    pub max_deviation_deg: f64,
+    /// Points whose C changed.
+    pub points_modified: usize,
+    /// Patched length, mm.
+    pub patch_length_mm: f64,
+    /// `reached`, `improved` or `unchanged`.
+    pub outcome: &'static str,
+    /// `g16-patch`, `direct` or `none`.
+    pub method: &'static str,
+    /// Last solver status.
+    pub qp_status: String,
+    /// Interior-point iterations, summed.
+    pub qp_iterations: u32,
+    /// QP solves.
+    pub qp_solves: u32,
+    /// Solve time, ms, summed.
+    pub solve_time_ms: f64,
+    /// Decimal places written for the changed C words.
+    pub decimals: usize,
+    /// 360° multiple added to C after the zone.
+    pub c_offset_deg: f64,
+}
+
+/// Report name of an outcome.
+pub fn outcome_name(o: Outcome) -> &'static str {
+    match o {
+        Outcome::Reached => "reached",
+        Outcome::Improved => "improved",
+        Outcome::Unchanged => "unchanged",
+    }
+}
+
+fn method_name(m: Method) -> &'static str {
+    match m {
+        Method::G16Patch => "g16-patch",
+        Method::Direct => "direct",
+        Method::None => "none",
+    }
+}
+
+impl ZoneRow {
+    /// CSV column names of [`ZoneRow::csv_fields`] (the row's fields after `file`).
+    pub const CSV_COLUMNS: [&'static str; 27] = [
+        "run",
+        "first_line",
+        "last_line",
+        "kind",
+        "min_abs_primary_deg",
+        "c_ratio_before",
+        "c_ratio_after",
+        "primary_ratio_before",
+        "primary_ratio_after",
+        "overall_ratio_before",
+        "overall_ratio_after",
+        "limiting_before",
+        "limiting_after",
+        "time_before_s",
+        "time_after_s",
+        "ideal_time_s",
+        "max_deviation_deg",
+        "points_modified",
+        "patch_length_mm",
+        "outcome",
+        "method",
+        "qp_status",
+        "qp_iterations",
+        "qp_solves",
+        "solve_time_ms",
+        "decimals",
+        "c_offset_deg",
+    ];
+
+    /// The row as CSV fields, in [`ZoneRow::CSV_COLUMNS`] order.
+    pub fn csv_fields(&self) -> Vec<String> {
+        let lim = |f: &FiguresRow| {
+            format!(
+                "{}:{}",
+                f.limiting_axis.as_deref().unwrap_or("-"),
+                f.limiting_limit
+            )
+        };
+        vec![
+            self.run.to_string(),
+            self.lines[0].to_string(),
+            self.lines[1].to_string(),
+            self.kind.to_string(),
+            format!("{:.6}", self.min_abs_primary_deg),
+            format!("{:.6}", self.before.c_ratio),
+            format!("{:.6}", self.after.c_ratio),
+            format!("{:.6}", self.before.primary_ratio),
+            format!("{:.6}", self.after.primary_ratio),
+            format!("{:.6}", self.before.overall_ratio),
+            format!("{:.6}", self.after.overall_ratio),
+            lim(&self.before),
+            lim(&self.after),
+            format!("{:.6}", self.before.time_s),
+            format!("{:.6}", self.after.time_s),
+            format!("{:.6}", self.ideal_time_s),
+            format!("{:.6}", self.max_deviation_deg),
+            self.points_modified.to_string(),
+            format!("{:.3}", self.patch_length_mm),
+            self.outcome.to_string(),
+            self.method.to_string(),
+            self.qp_status.clone(),
+            self.qp_iterations.to_string(),
+            self.qp_solves.to_string(),
+            format!("{:.3}", self.solve_time_ms),
+            self.decimals.to_string(),
+            format!("{}", self.c_offset_deg),
+        ]
+    }
+
+    fn new(lp: &LoadedProgram, run: usize, z: &ZoneReport) -> Self {
+        let pl = lp.primary_letter;
+        ZoneRow {
+            file: lp.name.clone(),
+            run: run + 1,
+            lines: [lp.line_of(run, z.first), lp.line_of(run, z.last)],
+            kind: zone_kind_name(z.kind),
+            min_abs_primary_deg: z.min_abs_primary_deg,
+            before: FiguresRow::new(&z.before, pl),
+            after: FiguresRow::new(&z.after, pl),
+            ideal_time_s: z.ideal_time_s,
+            max_deviation_deg: z.max_deviation_deg,
+            points_modified: z.points_modified,
+            patch_length_mm: z.patch_length_mm,
+            outcome: outcome_name(z.outcome),
+            method: method_name(z.method),
+            qp_status: z.qp.status.clone(),
+            qp_iterations: z.qp.iterations,
+            qp_solves: z.qp.solves,
+            solve_time_ms: z.qp.solve_time_s * 1e3,
+            decimals: z.decimals,
+            c_offset_deg: z.c_offset_deg,
+        }
+    }
+}
+
+/// Why a run was left as it is although polepatch could have looked at it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum UntouchedReason {
+    /// No TCPM active: X Y Z are machine coordinates, so rotary words cannot change alone.
+    NoTcpm,
+    /// Incremental mode (G91): a changed value would shift every later position.
+    Incremental,
+    /// No feed in force and none given.
+    NoFeed,
+    /// The run's values could not be analysed (a path error).
+    Invalid,
+}
+
+/// A run left byte-identical, and why.
+#[derive(Debug, Clone, Serialize)]
+pub struct UntouchedRun {
+    /// Run number, from 1.
+    pub run: usize,
+    /// File lines of the first and last point.
+    pub lines: [usize; 2],
+    /// Why.
+    pub reason: UntouchedReason,
+    /// Singular zones the run holds (reported in [`FileReport::zones`] as `unchanged`).
+    pub zones: usize,
+    /// The message for people.
+    pub message: String,
+}
+
+/// What patching one program did (the JSON of `polepatch patch --report`).
+#[derive(Debug, Clone, Serialize)]
+pub struct FileReport {
+    /// Input file (or the name given for in-memory input).
+    pub file: String,
+    /// Output file (when written; set by the caller that writes it).
+    pub output: Option<String>,
+    /// Machine name.
+    pub machine: String,
+    /// Words changed or inserted.
+    pub words_changed: usize,
+    /// Decimal places of the file's C words (`None` when no run came near the pole, so
+    /// the file's style was not read).
+    pub file_c_decimals: Option<usize>,
+    /// Decimal places written for changed C words (more than the file's when its
+    /// precision could not hold Equation 6).
+    pub written_c_decimals: Option<usize>,
+    /// Runs left as they are (no TCPM, G91, no feed, invalid values), with why.
+    pub untouched_runs: Vec<UntouchedRun>,
+    /// Notes for the user.
+    pub warnings: Vec<String>,
+    /// One row per zone.
+    pub zones: Vec<ZoneRow>,
+}
+
+impl FileReport {
+    /// Zones that stay below feed (including those of untouched runs).
+    pub fn zones_below_feed(&self) -> usize {
+        self.zones.iter().filter(|z| z.outcome != "reached").count()
+    }
+    /// Runs left because no TCPM is active although they hold a singular zone.
+    pub fn runs_left_without_tcpm(&self) -> usize {
+        self.untouched_runs
+            .iter()
+            .filter(|u| u.reason == UntouchedReason::NoTcpm && u.zones > 0)
+            .count()
+    }
+}
+
+/// Patch a loaded program: the edits to write and the report.
+///
+/// `opts.c_decimals` and `opts.p_decimals` are taken from the file (its number style);
+/// `opts.max_decimals` is raised to the file's decimals when lower.
+pub fn patch_program(
+    lp: &LoadedProgram,
+    machine: &Machine,
+    opts: &PatchOptions,
+) -> (Vec<Edit>, FileReport) {
+    let program = &lp.program;
+    let mut report = FileReport {
+        file: lp.name.clone(),
+        output: None,
+        machine: machine.name.clone(),
+        words_changed: 0,
+        file_c_decimals: None,
+        written_c_decimals: None,
+        untouched_runs: Vec::new(),
+        warnings: lp.warnings.clone(),
+        zones: Vec::new(),
+    };
+    // The file's number style is only needed when some run comes near the pole; reading
+    // it costs a pass over every word, so a program without such a run skips it.
+    let pi = polepatch_kinematics::Axis::Primary.index();
+    let near_pole = lp.runs.iter().any(|r| {
+        r.path
+            .as_ref()
+            .is_ok_and(|p| p.axes.iter().any(|q| q[pi].abs() <= opts.cone_deg))
+    });
+    if !near_pole {
+        for (r, rp) in lp.runs.iter().enumerate() {
+            if let Err(problem) = &rp.path {
+                report.untouched_runs.push(untouched(
+                    lp,
+                    r,
+                    problem_reason(problem),
+                    0,
+                    problem.to_string(),
+                ));
+            }
+        }
+        return (Vec::new(), report);
+    }
+    let c_style = NumberStyle::of(program, b'C');
+    let p_style = NumberStyle::of(program, lp.primary_letter);
+    let opts = PatchOptions {
+        c_decimals: c_style.decimals,
+        p_decimals: p_style.decimals,
+        max_decimals: opts
+            .max_decimals
+            .max(c_style.decimals)
+            .max(p_style.decimals),
+        ..opts.clone()
+    };
+    let mut edits: Vec<Edit> = Vec::new();
+    let mut written_c = c_style.decimals;
+    for (r, rp) in lp.runs.iter().enumerate() {
+        let path = match &rp.path {
+            Ok(p) => p,
+            Err(problem) => {
+                report.untouched_runs.push(untouched(
+                    lp,
+                    r,
+                    problem_reason(problem),
+                    0,
+                    problem.to_string(),
+                ));
+                continue;
+            }
+        };
+        let incremental = rp
+            .run
+            .blocks
+            .iter()
+            .skip(1)
+            .any(|&b| program.state(b).incremental);
+        let leave = if !rp.run.tcpm {
+            Some((
+                UntouchedReason::NoTcpm,
+                "no TCPM active (M128, TRAORI or G43.4) — X Y Z are machine coordinates; \
+                 changing rotary words alone would move the part under the tool, so the run is \
+                 left as it is (give the machine's kinematic chain to patch it)",
+            ))
+        } else if incremental {
+            Some((
+                UntouchedReason::Incremental,
+                "incremental mode (G91) — a changed value would shift every later position; \
+                 polepatch patches absolute (G90) programs only; left as it is",
+            ))
+        } else {
+            None
+        };
+        if let Some((reason, message)) = leave {
+            match report_unpatched(path, machine, &opts) {
+                Ok(zones) => {
+                    if !zones.is_empty() {
+                        report
+                            .zones
+                            .extend(zones.iter().map(|z| ZoneRow::new(lp, r, z)));
+                        report.untouched_runs.push(untouched(
+                            lp,
+                            r,
+                            reason,
+                            zones.len(),
+                            message.to_string(),
+                        ));
+                    }
+                }
+                Err(e) => report.untouched_runs.push(untouched(
+                    lp,
+                    r,
+                    UntouchedReason::Invalid,
+                    0,
+                    e.to_string(),
+                )),
+            }
+            continue;
+        }
+        let result = match patch_path(path, machine, &opts) {
+            Ok(res) => res,
+            Err(e) => {
+                report.untouched_runs.push(untouched(
+                    lp,
+                    r,
+                    UntouchedReason::Invalid,
+                    0,
+                    e.to_string(),
+                ));
+                continue;
+            }
+        };
+        report
+            .zones
+            .extend(result.zones.iter().map(|z| ZoneRow::new(lp, r, z)));
+        let letters = [
+            (
+                lp.primary_letter,
+                &result.p_deg,
+                &result.p_changed,
+                result.p_decimals,
+            ),
+            (b'C', &result.c_deg, &result.c_changed, result.c_decimals),
+        ];
+        for (letter, values, changed, decimals) in letters {
+            for k in 0..rp.run.len() {
+                if !changed[k] {
+                    continue;
+                }
+                if k == 0 {
+                    // Point 0 belongs to the block before the run; the patcher never moves it.
+                    debug_assert!(false, "patcher changed the start point of a run");
+                    continue;
+                }
+                if letter == b'C' {
+                    written_c = written_c.max(decimals);
+                }
+                edits.push(Edit {
+                    block: rp.run.blocks[k],
+                    letter,
+                    value: values[k],
+                    decimals,
+                });
+            }
+        }
+    }
+    let file_decimals = |l: u8| {
+        if l == b'C' {
+            c_style.decimals
+        } else {
+            p_style.decimals
+        }
+    };
+    polepatch_nc::restore_modal(program, &mut edits, &file_decimals);
+    edits.sort_by_key(|e| (e.block, e.letter));
+    report.words_changed = edits.len();
+    report.file_c_decimals = Some(c_style.decimals);
+    report.written_c_decimals = Some(written_c);
+    (edits, report)
+}
+
+fn problem_reason(p: &RunProblem) -> UntouchedReason {
+    match p {
+        RunProblem::NoFeed => UntouchedReason::NoFeed,
+    }
+}
+
+fn untouched(
+    lp: &LoadedProgram,
+    r: usize,
+    reason: UntouchedReason,
+    zones: usize,
+    message: String,
+) -> UntouchedRun {
+    UntouchedRun {
+        run: r + 1,
+        lines: lp.lines_of_run(r),
+        reason,
+        zones,
+        message,
+    }
+}
+
+/// Patch a loaded program and render the output bytes: `(output, report)`. The output
+/// is the input bytes, unchanged, when nothing was changed.
+pub fn patch_loaded(
+    lp: &LoadedProgram,
+    machine: &Machine,
+    opts: &PatchOptions,
+) -> (Vec<u8>, FileReport) {
+    let (edits, report) = patch_program(lp, machine, opts);
+    let bytes = if edits.is_empty() {
+        lp.program.bytes.clone()
+    } else {
+        polepatch_nc::write(&lp.program, &edits)
+    };
+    (bytes, report)
+}

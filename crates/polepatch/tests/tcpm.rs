@@ -1,0 +1,136 @@
+//! A run whose X Y Z are machine coordinates (no TCPM) is never patched by changing rotary
+//! words alone (SPEC §6, issue 10): on a table-table machine that would move the part under
+//! the tool. Regression tests named after what broke: `SING.I` without its `M128` line was
+//! patched exactly like the original.
+
+use polepatch::kinematics::Machine;
+use polepatch::{PatchOptions, UntouchedReason, patch_nc};
+
+fn sing() -> Vec<u8> {
+    std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/c17/SING.I"
+    ))
+    .unwrap()
+}
+
+fn without_line(bytes: &[u8], needle: &str) -> Vec<u8> {
+    let text = String::from_utf8_lossy(bytes);
+    let kept: Vec<&str> = text
+        .split_inclusive('\n')
+        .filter(|l| !l.contains(needle))
+        .collect();
+    assert_eq!(
+        kept.len() + 1,
+        text.split_inclusive('\n').count(),
+        "{needle} once"
+    );
+    kept.concat().into_bytes()
+}
+
+#[test]
+fn sing_without_m128_is_left_byte_identical_and_reported() {
+    let input = without_line(&sing(), "M128");
+    for name in Machine::builtin_names() {
+        let m = Machine::builtin(name).unwrap();
+        let (out, report) = patch_nc(&input, &m, &PatchOptions::default()).unwrap();
+        assert_eq!(out, input, "{name}: no byte may change");
+        assert_eq!(report.words_changed, 0);
+        assert_eq!(report.runs_left_without_tcpm(), 1, "{report:#?}");
+        let u = &report.untouched_runs[0];
+        assert_eq!(u.reason, UntouchedReason::NoTcpm);
+        assert!(u.message.contains("no TCPM"), "{}", u.message);
+        assert!(u.zones >= 1);
+        // The zone is still reported, as below feed and unchanged.
+        assert!(!report.zones.is_empty());
+        for z in &report.zones {
+            assert_eq!(z.outcome, "unchanged");
+            assert_eq!(z.points_modified, 0);
+            assert!(z.before.c_ratio < 1.0);
+        }
+        assert_eq!(report.zones_below_feed(), report.zones.len());
+    }
+}
+
+/// The same program with TCPM on is patched (the guard is about TCPM, not the file).
+#[test]
+fn sing_with_m128_is_patched() {
+    let m = Machine::builtin("mikron-ucp710").unwrap();
+    let (out, report) = patch_nc(&sing(), &m, &PatchOptions::default()).unwrap();
+    assert_ne!(out, sing());
+    assert!(
+        report.untouched_runs.is_empty(),
+        "{:?}",
+        report.untouched_runs
+    );
+    assert!(report.zones.iter().all(|z| z.outcome == "reached"));
+}
+
+/// TCPM switched off inside the program (M129 before the cut) leaves that run alone; the
+/// Fanuc and Sinumerik spellings are read the same way.
+#[test]
+fn tcpm_off_in_every_dialect() {
+    let m = Machine::builtin("mikron-ucp710").unwrap();
+    let heid = String::from_utf8(sing())
+        .unwrap()
+        .replace("N65 M128 *", "N65 M129 *");
+    let fanuc = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/generated/fanuc-ac-swing-d0.5.nc"
+    ))
+    .unwrap()
+    .replace("G43.4 H1", "G49");
+    let sin = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/generated/sinumerik-ac-swing-d0.5.mpf"
+    ))
+    .unwrap()
+    .replace("TRAORI", "TRAFOOF");
+    for (label, text) in [("heidenhain", heid), ("fanuc", fanuc), ("sinumerik", sin)] {
+        let (out, report) = patch_nc(text.as_bytes(), &m, &PatchOptions::default()).unwrap();
+        assert_eq!(out, text.as_bytes(), "{label}");
+        assert!(report.runs_left_without_tcpm() >= 1, "{label}: {report:#?}");
+    }
+}
+
+/// `%SING`'s cut (N110–N610) written in incremental mode (G91) after an absolute start:
+/// left alone with a reason (a changed value would shift every later position).
+#[test]
+fn incremental_runs_are_left_alone() {
+    let m = Machine::builtin("mikron-ucp710").unwrap();
+    let sing = String::from_utf8(sing()).unwrap();
+    let word = |line: &str, l: char| -> f64 {
+        line.split(' ')
+            .find_map(|w| w.strip_prefix(l))
+            .map_or(0.0, |v| v.parse().unwrap())
+    };
+    let cut: Vec<[f64; 5]> = sing
+        .lines()
+        .filter(|l| l.contains(" Z-8 ") && l.contains(" Y+0 "))
+        .map(|l| ['X', 'Y', 'Z', 'A', 'C'].map(|c| word(l, c)))
+        .collect();
+    assert_eq!(cut.len(), 51);
+    let mut text = String::from("%INC G71 *\nN1 M128 *\n");
+    let p0 = cut[0];
+    text += &format!(
+        "N2 G90 G01 X{:+} Y{:+} Z{:+} A{:+} C{:+} F2000 *\nN3 G91 *\n",
+        p0[0], p0[1], p0[2], p0[3], p0[4]
+    );
+    for (k, w) in cut.windows(2).enumerate() {
+        let d: Vec<f64> = (0..5).map(|i| w[1][i] - w[0][i]).collect();
+        text += &format!("N{} X{:+.3} A{:+.3} C{:+.3} *\n", k + 4, d[0], d[3], d[4]);
+    }
+    text += "N999 M30 *\n";
+    let (out, report) = patch_nc(text.as_bytes(), &m, &PatchOptions::default()).unwrap();
+    assert_eq!(out, text.as_bytes());
+    assert!(!report.untouched_runs.is_empty(), "{report:#?}");
+    assert!(
+        report
+            .untouched_runs
+            .iter()
+            .all(|u| u.reason == UntouchedReason::Incremental && u.zones >= 1),
+        "{:?}",
+        report.untouched_runs
+    );
+    assert!(report.untouched_runs[0].message.contains("G91"));
+}
