@@ -70,6 +70,14 @@ pub fn axis_feed_bound(limits: &AxisLimits, d: [f64; 3]) -> AxisBound {
     AxisBound { feed_mm_s, kind }
 }
 
+/// The feed ratio of one axis: `min(1, bound / F)` with the bound of
+/// [`axis_feed_bound`] and `feed_mm_s` the programmed feed F (mm/s, positive). A NaN or
+/// infinite derivative gives 0, never NaN.
+#[inline]
+pub fn axis_feed_ratio(limits: &AxisLimits, d: [f64; 3], feed_mm_s: f64) -> f64 {
+    (axis_feed_bound(limits, d).feed_mm_s / feed_mm_s).min(1.0)
+}
+
 /// `limit / |derivative|` with +∞ for a zero derivative and 0 for a NaN or infinite one.
 #[inline]
 fn term(limit: f64, derivative: f64) -> f64 {
@@ -219,6 +227,16 @@ mod tests {
         let f = feed_bound(&m, &d, 50.0);
         assert_eq!((f.feed_mm_s, f.ratio), (0.0, 0.0));
         assert_eq!((f.axis, f.kind), (Some(Axis::C), LimitKind::Jerk));
+    }
+
+    #[test]
+    fn axis_ratio_is_the_bound_over_f_capped_at_one() {
+        // Bound 25 mm/s (velocity, as in `velocity_binds`).
+        let d = [-4.0, 0.01, 1e-3];
+        assert_eq!(axis_feed_ratio(&LIM, d, 50.0), 0.5);
+        assert_eq!(axis_feed_ratio(&LIM, d, 20.0), 1.0);
+        assert_eq!(axis_feed_ratio(&LIM, [0.0; 3], 20.0), 1.0);
+        assert_eq!(axis_feed_ratio(&LIM, [f64::NAN, 0.0, 0.0], 20.0), 0.0);
     }
 
     #[test]

@@ -26,6 +26,53 @@ pub fn forward(machine: &Machine, p_deg: f64, c_deg: f64) -> [f64; 3] {
     }
 }
 
+/// The tool axis and its partial derivatives with respect to the primary angle and C,
+/// per **degree**: `(o_wp, ∂o_wp/∂P, ∂o_wp/∂C)`. With `h = sp·sin P`, `γ = sc·C`:
+///
+/// ```text
+/// A:  ∂o/∂P = (sp cos P sin γ, −sp cos P cos γ, −sin P)·π/180
+///     ∂o/∂C = sc·(h cos γ, h sin γ, 0)·π/180
+/// B:  ∂o/∂P = (sp cos P cos γ,  sp cos P sin γ, −sin P)·π/180
+///     ∂o/∂C = sc·(−h sin γ, h cos γ, 0)·π/180
+/// ```
+///
+/// `∂o/∂P` is a unit vector (per radian) and `∂o/∂C` has length `|sin P|` (per radian),
+/// orthogonal to it: near the pole C barely moves the tool.
+pub fn forward_jacobian(machine: &Machine, p_deg: f64, c_deg: f64) -> [[f64; 3]; 3] {
+    let (sin_p, cos_p) = p_deg.to_radians().sin_cos();
+    let sp = machine.primary_sense;
+    let sc = machine.c_sense;
+    let (sin_c, cos_c) = (sc * c_deg).to_radians().sin_cos();
+    let h = sp * sin_p;
+    let k = std::f64::consts::PI / 180.0;
+    match machine.primary {
+        PrimaryAxis::A => [
+            [h * sin_c, -h * cos_c, cos_p],
+            [k * sp * cos_p * sin_c, -k * sp * cos_p * cos_c, -k * sin_p],
+            [k * sc * h * cos_c, k * sc * h * sin_c, 0.0],
+        ],
+        PrimaryAxis::B => [
+            [h * cos_c, h * sin_c, cos_p],
+            [k * sp * cos_p * cos_c, k * sp * cos_p * sin_c, -k * sin_p],
+            [-k * sc * h * sin_c, k * sc * h * cos_c, 0.0],
+        ],
+    }
+}
+
+/// The angle between two tool axes, degrees, in [0, 180]: `atan2(|a × b|, a·b)`, accurate
+/// for tiny and near-180° angles alike (`acos` of the dot product is not). The vectors need
+/// not be normalised; a zero vector gives 0.
+pub fn angle_between_deg(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let cross = [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ];
+    let sin = (cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]).sqrt();
+    let cos = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    sin.atan2(cos).to_degrees()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -89,5 +136,48 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The Jacobian against central finite differences, every machine kind, angles
+    /// including the pole and C at ±180°.
+    #[test]
+    fn jacobian_matches_finite_differences() {
+        let h = 1e-6;
+        for m in crate::testutil::all_kinds() {
+            for &p in &ANGLES_DEG {
+                for &c in &ANGLES_DEG {
+                    let [o, dp, dc] = forward_jacobian(&m, p, c);
+                    assert_close(o, forward(&m, p, c), "value");
+                    let fp = |a: f64| forward(&m, a, c);
+                    let fc = |a: f64| forward(&m, p, a);
+                    for k in 0..3 {
+                        let np = (fp(p + h)[k] - fp(p - h)[k]) / (2.0 * h);
+                        let nc = (fc(c + h)[k] - fc(c - h)[k]) / (2.0 * h);
+                        assert!((np - dp[k]).abs() < 1e-8, "dP {k} at P={p} C={c}");
+                        assert!((nc - dc[k]).abs() < 1e-8, "dC {k} at P={p} C={c}");
+                    }
+                    let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                    let per_rad = 180.0 / std::f64::consts::PI;
+                    assert!((norm(dp) * per_rad - 1.0).abs() < 1e-12);
+                    assert!((norm(dc) * per_rad - p.to_radians().sin().abs()).abs() < 1e-12);
+                }
+            }
+        }
+    }
+
+    /// The angle is exact for planted pairs, tiny or near 180°.
+    #[test]
+    fn angle_between_planted() {
+        let m = Machine::builtin("mikron-ucp710").unwrap();
+        for d in [0.0, 1e-9, 1e-4, 0.3, 45.0, 179.9999] {
+            let a = forward(&m, 10.0, 30.0);
+            let b = forward(&m, 10.0 + d, 30.0);
+            assert!((angle_between_deg(a, b) - d).abs() < 1e-9, "{d}");
+        }
+        // Same axis, other branch: 0.
+        let a = forward(&m, 3.0, 20.0);
+        let b = forward(&m, -3.0, 200.0);
+        assert!(angle_between_deg(a, b) < 1e-12);
+        assert_eq!(angle_between_deg([0.0; 3], [0.0, 0.0, 1.0]), 0.0);
     }
 }

@@ -27,8 +27,8 @@ pub mod tolerances;
 #[cfg(test)]
 mod testutil;
 
-pub use feed::{AxisBound, FeedBound, LimitKind, axis_feed_bound, feed_bound};
-pub use forward::forward;
+pub use feed::{AxisBound, FeedBound, LimitKind, axis_feed_bound, axis_feed_ratio, feed_bound};
+pub use forward::{angle_between_deg, forward, forward_jacobian};
 pub use inverse::{
     BranchRule, IkSolution, domain_rule_index, inverse, inverse_path, unwrap_near_deg, wrap_deg,
 };
