@@ -1,23 +1,27 @@
-//! The quality suite behind `polepatch bench` (SPEC §5, §6): every program × machine through
-//! the same code paths as `analyze` ([`analyze_program`]) and `patch` ([`patch_program`]),
-//! with a lower bound on the orientation deviation for every zone.
+//! The quality suite behind `polepatch bench` (SPEC §5, §6, issue 8 §5): every program ×
+//! machine × strategy through the same code paths as `analyze` ([`analyze_program`]) and
+//! `patch` ([`patch_loaded`]), each zone measured against a reference.
 //!
-//! # The bound
+//! # Strategies
+//! [`BenchStrategy::Polepatch`] is what `polepatch patch` does by default (both rotary
+//! axes); [`BenchStrategy::OnlyC`] is `--only-c` (G16's method); the peers
+//! [`BenchStrategy::Freeze`], [`BenchStrategy::Linearize`], [`BenchStrategy::Smooth`] are
+//! the pole strategies CAM posts and controllers document ([`polepatch_patcher::peers`]),
+//! applied through the same pipeline and scored by the same Equation-6 analysis.
 //!
-//! For a zone in run `r` with points `0..n`, the bound is the smallest possible largest
-//! orientation deviation (degrees, exact formula `2·asin(|sin P|·|sin(ΔC/2)|)`) over C-only
-//! changes at the existing CL points such that the analysis spline of C meets
-//! |C_s| ≤ V/F, |C_ss| ≤ A/F², |C_sss| ≤ J/F³ (no margin) on every sample F·Tcy:
-//! [`deviation_bound_zone`], an LP bisection. The movable points are the zone's range
-//! widened to the whole run, `1..=n−1` (point 0 belongs to the block before the run and is
-//! never moved). When a run holds several zones, each zone's range reaches only to the
-//! midpoints between it and its neighbours (the neighbours' points stay fixed), so that
-//! each zone gets its own bound.
+//! # The reference of a zone
+//! - For the strategies that may change both rotary axes: [`zone_reference`] — the best
+//!   orientation change **found** by several exact methods, each with more effort than the
+//!   patcher spends (re-selection; the joint SCP from four starts over the zone's whole
+//!   territory, no margin, unrounded), or a proof that no values reach feed. It is an
+//!   upper bound on the optimum (the problem is not convex), not a lower bound: `ours /
+//!   reference < 1` means polepatch beat every reference start.
+//! - For `only-c`: the LP bound of [`deviation_bound_zone`] — the exact minimum for C-only
+//!   changes at the CL points (a true lower bound for that method).
 //!
-//! The patcher's deviation is compared with the bound only for zones it reached: a zone
-//! left below feed did not solve the same problem. `ours / bound ≥ 1` up to the
-//! bisection tolerance whenever the patch is feasible for the bound's constraints; SPEC §6
-//! asks for `≤ 1.25`.
+//! A zone's territory is its run (from its second point; the last too when
+//! `polepatch::end_pose` frees it), cut at the midpoints between it and the run's other
+//! zones so that each zone gets its own reference.
 
 pub mod plot;
 
@@ -27,68 +31,158 @@ use polepatch::report::{AnalyzeReport, analyze_program};
 use polepatch::{Error, FileReport, ZoneRow, patch_loaded};
 use polepatch_kinematics::{Axis, Machine};
 use polepatch_patcher::direct::deviation_bound_zone;
-use polepatch_patcher::{AnalysisOptions, CLimits, PatchFailure, PatchOptions, analyze_path};
+use polepatch_patcher::reference::{Reference, zone_reference};
+use polepatch_patcher::{
+    AnalysisOptions, CLimits, PatchAxes, PatchFailure, PatchOptions, Strategy, Zone, analyze_path,
+};
 use serde::Serialize;
 use std::path::Path as FsPath;
 use std::time::Instant;
 
+/// A strategy of the suite (module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BenchStrategy {
+    /// polepatch, both rotary axes (the default of `polepatch patch`).
+    Polepatch,
+    /// polepatch `--only-c` (G16's C-only method).
+    OnlyC,
+    /// C held inside the cone (ModuleWorks FREEZE, Fanuc tool posture control).
+    Freeze,
+    /// C linear in s across the cone (ModuleWorks LINEAR_INTERPOLATION, Fusion
+    /// LINEARIZE_ROTARY).
+    Linearize,
+    /// A cubic C blend across the cone (ModuleWorks SMOOTH_INTERPOLATION).
+    Smooth,
+}
+
+impl BenchStrategy {
+    /// Every strategy, polepatch's first.
+    pub const ALL: [BenchStrategy; 5] = [
+        BenchStrategy::Polepatch,
+        BenchStrategy::OnlyC,
+        BenchStrategy::Freeze,
+        BenchStrategy::Linearize,
+        BenchStrategy::Smooth,
+    ];
+    /// The name on the command line and in tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            BenchStrategy::Polepatch => "polepatch",
+            BenchStrategy::OnlyC => "only-c",
+            BenchStrategy::Freeze => "freeze",
+            BenchStrategy::Linearize => "linearize",
+            BenchStrategy::Smooth => "smooth",
+        }
+    }
+    /// The strategy of a name.
+    pub fn from_name(name: &str) -> Option<BenchStrategy> {
+        BenchStrategy::ALL.into_iter().find(|s| s.name() == name)
+    }
+    /// The patch options of this strategy from the suite's.
+    pub fn options(self, base: &PatchOptions) -> PatchOptions {
+        let (axes, strategy) = match self {
+            BenchStrategy::Polepatch => (PatchAxes::Both, Strategy::Polepatch),
+            BenchStrategy::OnlyC => (PatchAxes::OnlyC, Strategy::Polepatch),
+            BenchStrategy::Freeze => (PatchAxes::Both, Strategy::Freeze),
+            BenchStrategy::Linearize => (PatchAxes::Both, Strategy::Linearize),
+            BenchStrategy::Smooth => (PatchAxes::Both, Strategy::Smooth),
+        };
+        PatchOptions {
+            axes,
+            strategy,
+            ..base.clone()
+        }
+    }
+    /// Whether "reaching feed" means both rotary axes (all but `only-c`).
+    pub fn both_axes(self) -> bool {
+        self != BenchStrategy::OnlyC
+    }
+}
+
 /// Options of the suite. Plain struct; see each field for its default.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct BenchOptions {
     /// Options of the patch (the same as `polepatch patch`). Default: [`PatchOptions`]'s.
     pub patch: PatchOptions,
+    /// Strategies to run. Default: `[Polepatch]`.
+    pub strategies: Vec<BenchStrategy>,
     /// Feed, mm/min, for runs with no F in force. Default `None`.
     pub feed_fallback_mm_min: Option<f64>,
-    /// Skip the bound LPs (faster). Default false.
+    /// Skip the references (faster). Default false.
     pub skip_bound: bool,
     /// Keep the data of the per-zone plots ([`BenchZone::plot`]). Default false.
     pub plots: bool,
 }
 
-/// The deviation bound of one zone.
+impl Default for BenchOptions {
+    fn default() -> Self {
+        BenchOptions {
+            patch: PatchOptions::default(),
+            strategies: vec![BenchStrategy::Polepatch],
+            feed_fallback_mm_min: None,
+            skip_bound: false,
+            plots: false,
+        }
+    }
+}
+
+/// The reference of one zone (module docs).
 #[derive(Debug, Clone, Serialize)]
 pub struct ZoneBound {
-    /// `ok`, `unreachable` (no C-only change of the range reaches feed), `skipped`, or
+    /// `best-found` (both axes: the best of several exact methods, an upper bound of the
+    /// optimum) or `c-only-lp` (the LP bound for C-only changes, a lower bound).
+    pub kind: &'static str,
+    /// `ok`, `unreachable` (proven: no values reach feed), `failed`, `skipped`, or
     /// `error: …`.
     pub status: String,
-    /// The bound, degrees (`ok` only).
+    /// The reference deviation, degrees (`ok` only).
     pub bound_deg: Option<f64>,
-    /// File lines of the first and last movable point of the bound's range.
+    /// The method that found it (`best-found` only): `reselect`, `as-is`,
+    /// `other-branch`, `freeze`, `linearize`.
+    pub method: Option<&'static str>,
+    /// File lines of the first and last movable point of the reference's territory.
     pub lines: [usize; 2],
-    /// LP solves of the bisection.
-    pub lp_solves: u32,
-    /// Wall time of the bisection, ms.
+    /// Wall time, ms.
     pub time_ms: f64,
 }
 
-/// One zone of the suite: the `patch` report row, its bound and the ratio.
+/// One zone of the suite: the `patch` report row, its reference and the ratio.
 #[derive(Debug, Clone, Serialize)]
 pub struct BenchZone {
     /// Machine name.
     pub machine: String,
+    /// Strategy.
+    pub strategy: BenchStrategy,
     /// The row `polepatch patch --report` writes for this zone.
     #[serde(flatten)]
     pub row: ZoneRow,
-    /// The best possible deviation for C-only changes.
+    /// Whether the zone reaches feed on C (after, on the values as written).
+    pub at_feed_c: bool,
+    /// Whether it reaches feed on both rotary axes.
+    pub at_feed_both: bool,
+    /// The zone's reference.
     pub bound: ZoneBound,
-    /// `max_deviation_deg / bound_deg` for a reached zone with a positive bound (`None`
-    /// otherwise).
+    /// `max_deviation_deg / reference` for a zone at feed (both axes for the strategies
+    /// that change both, C for `only-c`) with a positive reference (`None` otherwise).
     pub ratio: Option<f64>,
     /// Plot data (with [`BenchOptions::plots`]).
     #[serde(skip)]
     pub plot: Option<plot::ZonePlot>,
 }
 
-/// One program on one machine.
+/// One program on one machine with one strategy.
 #[derive(Debug, Clone, Serialize)]
 pub struct BenchCase {
     /// Input file.
     pub file: String,
     /// Machine name.
     pub machine: String,
+    /// Strategy.
+    pub strategy: BenchStrategy,
     /// Zones `polepatch analyze` finds.
     pub zones_analyzed: usize,
-    /// C words changed or inserted by the patch.
+    /// Words changed or inserted.
     pub words_changed: usize,
     /// Runs left as they are, and why.
     pub untouched_runs: Vec<polepatch::UntouchedRun>,
@@ -96,7 +190,11 @@ pub struct BenchCase {
     pub warnings: Vec<String>,
     /// Wall time of the patch of the whole program, ms.
     pub patch_time_ms: f64,
-    /// One entry per zone patched.
+    /// Estimated machining time of the runs that hold a zone, before and after, s (∫ds/ṡ
+    /// over the whole runs, the written program analysed), and their ideal L/F: the same
+    /// stretch for every strategy.
+    pub time_s: [f64; 3],
+    /// One entry per zone.
     pub zones: Vec<BenchZone>,
 }
 
@@ -114,33 +212,42 @@ pub struct BenchError {
 /// The whole suite.
 #[derive(Debug, Clone, Serialize)]
 pub struct BenchReport {
-    /// Cases in input order, machine by machine within a file.
+    /// Cases in input order: file, then machine, then strategy.
     pub cases: Vec<BenchCase>,
     /// Inputs that failed.
     pub errors: Vec<BenchError>,
 }
 
-/// Headline figures of a suite.
+/// Headline figures of one strategy.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Summary {
-    /// Zones patched.
+    /// Zones.
     pub zones: usize,
-    /// Zones whose C reaches feed after the patch.
-    pub reached: usize,
-    /// Zones whose bound is `unreachable`.
+    /// Zones at feed on C.
+    pub at_feed_c: usize,
+    /// Zones at feed on both rotary axes.
+    pub at_feed_both: usize,
+    /// Zones whose reference is `unreachable`.
     pub unreachable: usize,
     /// Zones with a ratio.
     pub ratios: usize,
-    /// Median of ours/bound.
+    /// Median of ours/reference.
     pub ratio_median: Option<f64>,
-    /// Largest ours/bound.
+    /// Largest ours/reference.
     pub ratio_worst: Option<f64>,
-    /// Zones with ours/bound ≤ 1.25 (SPEC §6).
+    /// Zones with ours/reference ≤ [`RATIO_TARGET`] (SPEC §6).
     pub ratio_within_target: usize,
+    /// Largest orientation change, degrees.
+    pub max_deviation_deg: f64,
+    /// Estimated time of the runs holding zones before and after, and L/F, s.
+    pub time_s: [f64; 3],
 }
 
-/// SPEC §6: ours within this factor of the bound.
+/// SPEC §6: ours within this factor of the reference.
 pub const RATIO_TARGET: f64 = 1.25;
+
+/// A zone is at feed when its ratio after is at least 1 − this.
+pub const AT_FEED_TOL: f64 = 1e-9;
 
 impl BenchReport {
     /// Every zone of every case.
@@ -148,9 +255,21 @@ impl BenchReport {
         self.cases.iter().flat_map(|c| c.zones.iter())
     }
 
-    /// The headline figures.
-    pub fn summary(&self) -> Summary {
-        let mut ratios: Vec<f64> = self.zones().filter_map(|z| z.ratio).collect();
+    /// The strategies present, in order.
+    pub fn strategies(&self) -> Vec<BenchStrategy> {
+        let mut out: Vec<BenchStrategy> = Vec::new();
+        for c in &self.cases {
+            if !out.contains(&c.strategy) {
+                out.push(c.strategy);
+            }
+        }
+        out
+    }
+
+    /// The headline figures of one strategy.
+    pub fn summary(&self, strategy: BenchStrategy) -> Summary {
+        let zones: Vec<&BenchZone> = self.zones().filter(|z| z.strategy == strategy).collect();
+        let mut ratios: Vec<f64> = zones.iter().filter_map(|z| z.ratio).collect();
         ratios.sort_by(f64::total_cmp);
         let median = (!ratios.is_empty()).then(|| {
             let m = ratios.len() / 2;
@@ -160,29 +279,42 @@ impl BenchReport {
                 0.5 * (ratios[m - 1] + ratios[m])
             }
         });
+        let mut time_s = [0.0; 3];
+        for c in self.cases.iter().filter(|c| c.strategy == strategy) {
+            for (t, v) in time_s.iter_mut().zip(c.time_s) {
+                *t += v;
+            }
+        }
         Summary {
-            zones: self.zones().count(),
-            reached: self.zones().filter(|z| z.row.outcome == "reached").count(),
-            unreachable: self
-                .zones()
+            zones: zones.len(),
+            at_feed_c: zones.iter().filter(|z| z.at_feed_c).count(),
+            at_feed_both: zones.iter().filter(|z| z.at_feed_both).count(),
+            unreachable: zones
+                .iter()
                 .filter(|z| z.bound.status == "unreachable")
                 .count(),
             ratios: ratios.len(),
             ratio_median: median,
             ratio_worst: ratios.last().copied(),
             ratio_within_target: ratios.iter().filter(|&&r| r <= RATIO_TARGET).count(),
+            max_deviation_deg: zones
+                .iter()
+                .map(|z| z.row.max_deviation_deg)
+                .fold(0.0, f64::max),
+            time_s,
         }
     }
 }
 
-/// Run the suite on `files` × `machines`, cases in parallel (rayon's current pool).
+/// Run the suite on `files` × `machines` × `opts.strategies`, program × machine pairs in
+/// parallel (rayon's current pool).
 pub fn run(files: &[std::path::PathBuf], machines: &[Machine], opts: &BenchOptions) -> BenchReport {
     use rayon::prelude::*;
     let pairs: Vec<(&std::path::PathBuf, &Machine)> = files
         .iter()
         .flat_map(|f| machines.iter().map(move |m| (f, m)))
         .collect();
-    let results: Vec<Result<BenchCase, BenchError>> = pairs
+    let results: Vec<Result<Vec<BenchCase>, BenchError>> = pairs
         .par_iter()
         .map(|(f, m)| {
             bench_file(f, m, opts).map_err(|e| BenchError {
@@ -198,7 +330,7 @@ pub fn run(files: &[std::path::PathBuf], machines: &[Machine], opts: &BenchOptio
     };
     for r in results {
         match r {
-            Ok(c) => report.cases.push(c),
+            Ok(c) => report.cases.extend(c),
             Err(e) => report.errors.push(e),
         }
     }
@@ -210,18 +342,36 @@ pub fn bench_file(
     file: &FsPath,
     machine: &Machine,
     opts: &BenchOptions,
-) -> Result<BenchCase, JobError> {
+) -> Result<Vec<BenchCase>, JobError> {
     let name = file.display().to_string();
     let lp = load_nc(read(file)?, &name, machine, opts.feed_fallback_mm_min)?;
     Ok(bench_program(&lp, machine, opts)?)
 }
 
-/// Analyse, patch and bound one loaded program.
+/// The analysis zones of every run (original values), for the references.
+fn analysis_zones(lp: &LoadedProgram, machine: &Machine, opts: &PatchOptions) -> Vec<Vec<Zone>> {
+    let aopts = AnalysisOptions {
+        cone_deg: opts.cone_deg,
+        tcy_s: opts.tcy_s,
+        keep_samples: false,
+    };
+    lp.runs
+        .iter()
+        .map(|rp| match &rp.path {
+            Ok(p) => analyze_path(p, machine, &aopts)
+                .map(|a| polepatch_patcher::patch::merged_zones(&a.zones))
+                .unwrap_or_default(),
+            Err(_) => Vec::new(),
+        })
+        .collect()
+}
+
+/// Analyse, patch with every strategy, and measure one loaded program.
 pub fn bench_program(
     lp: &LoadedProgram,
     machine: &Machine,
     opts: &BenchOptions,
-) -> Result<BenchCase, Error> {
+) -> Result<Vec<BenchCase>, Error> {
     let aopts = AnalysisOptions {
         cone_deg: opts.patch.cone_deg,
         tcy_s: opts.patch.tcy_s,
@@ -234,81 +384,106 @@ pub fn bench_program(
         .filter_map(|r| r.figures.as_ref())
         .map(|f| f.zones.len())
         .sum();
-    let t0 = Instant::now();
-    let (bytes, report): (_, FileReport) = patch_loaded(lp, machine, &opts.patch);
-    let patch_time_ms = t0.elapsed().as_secs_f64() * 1e3;
-
-    // The program as written, read back: the "after" of the plots.
-    let after = if opts.plots && report.words_changed > 0 {
-        Some(load_nc(
-            bytes,
-            &lp.name,
-            machine,
-            opts.feed_fallback_mm_min,
-        )?)
-    } else {
-        None
-    };
-
-    let mut zones = Vec::with_capacity(report.zones.len());
-    for row in &report.zones {
-        let r = row.run - 1;
-        let (first, last) = point_range(lp, r, row.lines);
-        // Neighbouring zones of the same run bound this zone's territory.
-        let same_run: Vec<(usize, usize)> = report
-            .zones
-            .iter()
-            .filter(|z| z.run == row.run)
-            .map(|z| point_range(lp, r, z.lines))
-            .collect();
-        let n = lp.runs[r].run.len();
-        let mut lo = 1;
-        let mut hi = n - 1;
-        for &(f, l) in &same_run {
-            if l < first {
-                lo = lo.max((l + first) / 2 + 1);
-            } else if f > last {
-                hi = hi.min((last + f) / 2);
-            }
-        }
-        let bound = if opts.skip_bound {
-            ZoneBound {
-                status: "skipped".into(),
-                bound_deg: None,
-                lines: [lp.line_of(r, lo), lp.line_of(r, hi)],
-                lp_solves: 0,
-                time_ms: 0.0,
-            }
-        } else {
-            zone_bound(lp, r, lo, hi, (first, last), machine, opts)
-        };
-        let ratio = match bound.bound_deg {
-            Some(b) if b > 0.0 && row.outcome == "reached" => Some(row.max_deviation_deg / b),
-            _ => None,
-        };
-        let plot = if opts.plots {
-            plot_data(lp, after.as_ref(), r, first, last, machine, opts)
+    let zones = analysis_zones(lp, machine, &opts.patch);
+    // References, computed once per zone and strategy kind (both axes / C only).
+    let mut refs: std::collections::HashMap<(usize, usize, bool), ZoneBound> =
+        std::collections::HashMap::new();
+    let mut cases = Vec::new();
+    for &strategy in &opts.strategies {
+        let popts = strategy.options(&opts.patch);
+        let t0 = Instant::now();
+        let (bytes, report): (_, FileReport) = patch_loaded(lp, machine, &popts);
+        let patch_time_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let after = if report.words_changed > 0 {
+            Some(load_nc(
+                bytes,
+                &lp.name,
+                machine,
+                opts.feed_fallback_mm_min,
+            )?)
         } else {
             None
         };
-        zones.push(BenchZone {
+        // The time of every run with a zone, before and after (XYZ never change, so runs
+        // match one to one).
+        let after_analysis = after.as_ref().map(|a| analyze_program(a, machine, &aopts));
+        let mut time_s = [0.0; 3];
+        for (r, rr) in analysis.runs.iter().enumerate() {
+            let (Some(fb), false) = (&rr.figures, zones[r].is_empty()) else {
+                continue;
+            };
+            let fa = after_analysis
+                .as_ref()
+                .and_then(|a| a.runs.get(r))
+                .and_then(|x| x.figures.as_ref())
+                .unwrap_or(fb);
+            time_s[0] += fb.time_s;
+            time_s[1] += fa.time_s;
+            time_s[2] += fb.ideal_time_s;
+        }
+        let after = if opts.plots { after } else { None };
+        let mut out = Vec::with_capacity(report.zones.len());
+        for row in &report.zones {
+            let r = row.run - 1;
+            let (first, last) = point_range(lp, r, row.lines);
+            // The analysis zone this row is about (the one of least |P| it overlaps).
+            let zone = zones[r]
+                .iter()
+                .filter(|z| z.first <= last && z.last >= first)
+                .min_by(|a, b| a.min_abs_primary_deg.total_cmp(&b.min_abs_primary_deg))
+                .cloned();
+            let at_feed_c = row.after.c_ratio >= 1.0 - AT_FEED_TOL;
+            let at_feed_both = at_feed_c && row.after.primary_ratio >= 1.0 - AT_FEED_TOL;
+            let both = strategy.both_axes();
+            let bound = match (&zone, opts.skip_bound) {
+                (Some(z), false) => refs
+                    .entry((r, z.first, both))
+                    .or_insert_with(|| reference(lp, r, z, &zones[r], machine, &opts.patch, both))
+                    .clone(),
+                _ => ZoneBound {
+                    kind: if both { "best-found" } else { "c-only-lp" },
+                    status: "skipped".into(),
+                    bound_deg: None,
+                    method: None,
+                    lines: row.lines,
+                    time_ms: 0.0,
+                },
+            };
+            let at_feed = if both { at_feed_both } else { at_feed_c };
+            let ratio = match bound.bound_deg {
+                Some(b) if b > 0.0 && at_feed => Some(row.max_deviation_deg / b),
+                _ => None,
+            };
+            let plot = if opts.plots {
+                plot_data(lp, after.as_ref(), r, first, last, machine, &opts.patch)
+            } else {
+                None
+            };
+            out.push(BenchZone {
+                machine: machine.name.clone(),
+                strategy,
+                row: row.clone(),
+                at_feed_c,
+                at_feed_both,
+                bound,
+                ratio,
+                plot,
+            });
+        }
+        cases.push(BenchCase {
+            file: lp.name.clone(),
             machine: machine.name.clone(),
-            row: row.clone(),
-            bound,
-            ratio,
-            plot,
+            strategy,
+            zones_analyzed,
+            words_changed: report.words_changed,
+            untouched_runs: report.untouched_runs,
+            warnings: report.warnings,
+            patch_time_ms,
+            time_s,
+            zones: out,
         });
     }
-    Ok(BenchCase {
-        file: lp.name.clone(),
-        machine: machine.name.clone(),
-        zones_analyzed,
-        words_changed: report.words_changed,
-        untouched_runs: report.untouched_runs,
-        warnings: report.warnings,
-        patch_time_ms,
-        zones,
-    })
+    Ok(cases)
 }
 
 /// Point indices in run `r` of the file lines `[first, last]` of a report row.
@@ -322,56 +497,98 @@ fn point_range(lp: &LoadedProgram, r: usize, lines: [usize; 2]) -> (usize, usize
     (first, last.max(first))
 }
 
-/// The bound LP over points `lo..=hi` of run `r` (module docs).
-fn zone_bound(
+/// The reference of `zone` of run `r` (module docs): its territory, then the joint
+/// reference (`both`) or the C-only LP bound.
+fn reference(
     lp: &LoadedProgram,
     r: usize,
-    lo: usize,
-    hi: usize,
-    zone: (usize, usize),
+    zone: &Zone,
+    run_zones: &[Zone],
     machine: &Machine,
-    opts: &BenchOptions,
+    opts: &PatchOptions,
+    both: bool,
 ) -> ZoneBound {
+    let n = lp.runs[r].run.len();
+    let end = if polepatch::end_pose::end_pose_is_free(lp, r) {
+        n - 1
+    } else {
+        n - 2
+    };
+    let (mut lo, mut hi) = (1, end);
+    for z in run_zones {
+        if z.last < zone.first {
+            lo = lo.max((z.last + zone.first) / 2 + 1);
+        } else if z.first > zone.last {
+            hi = hi.min((zone.last + z.first) / 2);
+        }
+    }
     let lines = [lp.line_of(r, lo), lp.line_of(r, hi)];
+    let kind = if both { "best-found" } else { "c-only-lp" };
+    let mut out = ZoneBound {
+        kind,
+        status: "skipped".into(),
+        bound_deg: None,
+        method: None,
+        lines,
+        time_ms: 0.0,
+    };
     let Ok(path) = &lp.runs[r].path else {
-        return ZoneBound {
-            status: "error: run not analysed".into(),
-            bound_deg: None,
-            lines,
-            lp_solves: 0,
-            time_ms: 0.0,
-        };
+        out.status = "error: run not analysed".into();
+        return out;
     };
     let p: Vec<f64> = path.axes.iter().map(|q| q[Axis::Primary.index()]).collect();
     let c: Vec<f64> = path.axes.iter().map(|q| q[Axis::C.index()]).collect();
-    let lim = CLimits::new(machine, path.feed_mm_min, 0.0);
-    let step_mm = path.feed_mm_min / 60.0 * opts.patch.tcy_s.unwrap_or(machine.tcy_s);
+    let step_mm = path.feed_mm_min / 60.0 * opts.tcy_s.unwrap_or(machine.tcy_s);
     let t0 = Instant::now();
-    let result = deviation_bound_zone(&path.s_mm, &p, &c, lo, hi, zone, &lim, step_mm);
-    let time_ms = t0.elapsed().as_secs_f64() * 1e3;
-    match result {
-        Ok((b, st)) => ZoneBound {
-            status: "ok".into(),
-            bound_deg: Some(b),
-            lines,
-            lp_solves: st.solves,
-            time_ms,
-        },
-        Err(PatchFailure::Solver(st)) => ZoneBound {
-            status: "unreachable".into(),
-            bound_deg: None,
-            lines,
-            lp_solves: st.solves,
-            time_ms,
-        },
-        Err(e) => ZoneBound {
-            status: format!("error: {e:?}"),
-            bound_deg: None,
-            lines,
-            lp_solves: 0,
-            time_ms,
-        },
+    if both {
+        let res = zone_reference(
+            &path.s_mm,
+            &p,
+            &c,
+            zone,
+            lo,
+            hi,
+            machine,
+            path.feed_mm_min,
+            step_mm,
+            opts.max_decimals,
+        );
+        out.status = match res {
+            Ok(Reference::Best {
+                deviation_deg,
+                method,
+            }) => {
+                out.bound_deg = Some(deviation_deg);
+                out.method = Some(method);
+                "ok".into()
+            }
+            Ok(Reference::Unreachable) => "unreachable".into(),
+            Ok(Reference::Failed) => "failed".into(),
+            Err(e) => format!("error: {e:?}"),
+        };
+    } else {
+        let lim = CLimits::new(machine, path.feed_mm_min, 0.0);
+        let res = deviation_bound_zone(
+            &path.s_mm,
+            &p,
+            &c,
+            lo,
+            hi,
+            (zone.first, zone.last),
+            &lim,
+            step_mm,
+        );
+        out.status = match res {
+            Ok((b, _)) => {
+                out.bound_deg = Some(b);
+                "ok".into()
+            }
+            Err(PatchFailure::Solver(_)) => "unreachable".into(),
+            Err(e) => format!("error: {e:?}"),
+        };
     }
+    out.time_ms = t0.elapsed().as_secs_f64() * 1e3;
+    out
 }
 
 /// The plot data of the zone at points `first..=last` of run `r`: the zone ± half its
@@ -383,7 +600,7 @@ fn plot_data(
     first: usize,
     last: usize,
     machine: &Machine,
-    opts: &BenchOptions,
+    opts: &PatchOptions,
 ) -> Option<plot::ZonePlot> {
     let pb = before.runs[r].path.as_ref().ok()?;
     let pa = match after {
@@ -399,8 +616,8 @@ fn plot_data(
     let lo = first.saturating_sub(half);
     let hi = (last + half).min(n - 1);
     let aopts = AnalysisOptions {
-        cone_deg: opts.patch.cone_deg,
-        tcy_s: opts.patch.tcy_s,
+        cone_deg: opts.cone_deg,
+        tcy_s: opts.tcy_s,
         keep_samples: true,
     };
     let ab = analyze_path(pb, machine, &aopts).ok()?;
@@ -419,7 +636,7 @@ fn plot_data(
             })
             .collect()
     };
-    let curve = |sp: &polepatch_bspline::BSpline| -> Vec<(f64, f64)> {
+    let curve = |sp: &polepatch_patcher::spline::AnalysisSpline| -> Vec<(f64, f64)> {
         let m = 400;
         (0..=m)
             .map(|k| {
@@ -428,7 +645,10 @@ fn plot_data(
             })
             .collect()
     };
-    let ci = Axis::C.index();
+    let (ci, pi) = (Axis::C.index(), Axis::Primary.index());
+    let points = |p: &polepatch_patcher::Path, i: usize| -> Vec<(f64, f64)> {
+        (lo..=hi).map(|k| (s[k], p.axes[k][i])).collect()
+    };
     Some(plot::ZonePlot {
         title: format!(
             "{} on {}, run {}, lines {}–{}",
@@ -442,10 +662,14 @@ fn plot_data(
         ),
         primary_letter: before.primary_letter as char,
         zone_s_mm: (s[first], s[last]),
-        c_points_before: (lo..=hi).map(|k| (s[k], pb.axes[k][ci])).collect(),
-        c_points_after: (lo..=hi).map(|k| (s[k], pa.axes[k][ci])).collect(),
+        c_points_before: points(pb, ci),
+        c_points_after: points(pa, ci),
         c_curve_before: curve(&sb[ci]),
         c_curve_after: curve(&sa[ci]),
+        p_points_before: points(pb, pi),
+        p_points_after: points(pa, pi),
+        p_curve_before: curve(&sb[pi]),
+        p_curve_after: curve(&sa[pi]),
         ratio_before: window(&ab.samples),
         ratio_after: window(&aa.samples),
     })

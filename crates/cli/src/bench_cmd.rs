@@ -5,7 +5,9 @@ use anyhow::{Context, Result, bail};
 use polepatch::kinematics::Machine;
 use polepatch::patch::{FiguresRow, ZoneRow};
 use polepatch::patcher::PatchOptions;
-use polepatch_cli::bench::{BenchOptions, BenchReport, BenchZone, RATIO_TARGET, plot};
+use polepatch_cli::bench::{
+    BenchOptions, BenchReport, BenchStrategy, BenchZone, RATIO_TARGET, plot,
+};
 use polepatch_cli::files::write_atomic;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -43,7 +45,11 @@ pub(crate) struct BenchArgs {
     /// Safety margin on the C limits of the patch, as a fraction.
     #[arg(long, default_value_t = 0.02)]
     margin: f64,
-    /// Skip the deviation bound (its LPs take most of the time).
+    /// Strategies to compare, repeatable: polepatch (the default of `patch`), only-c,
+    /// freeze, linearize, smooth, or all (default: polepatch).
+    #[arg(long)]
+    strategy: Vec<String>,
+    /// Skip the references (their solves take most of the time).
     #[arg(long)]
     no_bound: bool,
     /// Worker threads (default: all cores).
@@ -120,6 +126,23 @@ pub(crate) fn run(args: BenchArgs) -> Result<ExitCode> {
             .map(|n| machine(n))
             .collect::<Result<_>>()?
     };
+    let mut strategies = Vec::new();
+    for name in &args.strategy {
+        if name == "all" {
+            strategies.extend(BenchStrategy::ALL);
+            continue;
+        }
+        match BenchStrategy::from_name(name) {
+            Some(s) => strategies.push(s),
+            None => bail!(
+                "unknown strategy '{name}': polepatch, only-c, freeze, linearize, smooth or all"
+            ),
+        }
+    }
+    if strategies.is_empty() {
+        strategies.push(BenchStrategy::Polepatch);
+    }
+    strategies.dedup();
     let opts = BenchOptions {
         patch: PatchOptions {
             cone_deg: args.cone,
@@ -127,6 +150,7 @@ pub(crate) fn run(args: BenchArgs) -> Result<ExitCode> {
             margin: args.margin,
             ..PatchOptions::default()
         },
+        strategies,
         feed_fallback_mm_min: args.feed,
         skip_bound: args.no_bound,
         plots: args.plots.is_some(),
@@ -188,25 +212,33 @@ fn ratio_text(z: &BenchZone) -> String {
     }
 }
 
-/// The table: one row per zone (a program × machine with no zone gets one row saying so),
-/// then the headline figures.
+fn yes(b: bool) -> &'static str {
+    if b { "yes" } else { "no" }
+}
+
+/// The tables: one row per zone and strategy (a program × machine with no zone gets one
+/// row saying so); the strategies side by side per program × machine; the headline figures
+/// per strategy.
 pub(crate) fn table(report: &BenchReport) -> String {
     use std::fmt::Write;
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "{:<30} {:<13} {:>3} {:>11} {:>15} {:>15} {:>15} {:>21} {:>7} {:>11} {:>6} {:>6} {:>8} {:>8}",
+        "{:<30} {:<13} {:<9} {:>3} {:>11} {:>15} {:>15} {:>15} {:>4} {:>4} {:>21} {:>7} {:>11} {:>6} {:>6} {:>8} {:>8}",
         "file",
         "machine",
+        "strategy",
         "run",
         "lines",
         "C ratio",
         "primary ratio",
         "overall ratio",
+        "C✓",
+        "A✓",
         "time s (L/F)",
         "dev °",
-        "bound °",
-        "ours/b",
+        "ref °",
+        "ours/r",
         "points",
         "len mm",
         "solve ms"
@@ -216,8 +248,11 @@ pub(crate) fn table(report: &BenchReport) -> String {
         if case.zones.is_empty() {
             let _ = writeln!(
                 out,
-                "{name:<30} {:<13} {:>3} {:>11} no zone",
-                case.machine, "-", "-"
+                "{name:<30} {:<13} {:<9} {:>3} {:>11} no zone",
+                case.machine,
+                case.strategy.name(),
+                "-",
+                "-"
             );
             continue;
         }
@@ -226,13 +261,16 @@ pub(crate) fn table(report: &BenchReport) -> String {
             let f = |g: fn(&FiguresRow) -> f64| arrow(g(&r.before), g(&r.after));
             let _ = writeln!(
                 out,
-                "{name:<30} {:<13} {:>3} {:>11} {:>15} {:>15} {:>15} {:>21} {:>7.3} {:>11} {:>6} {:>6} {:>8.3} {:>8.3}",
+                "{name:<30} {:<13} {:<9} {:>3} {:>11} {:>15} {:>15} {:>15} {:>4} {:>4} {:>21} {:>7.3} {:>11} {:>6} {:>6} {:>8.3} {:>8.3}",
                 case.machine,
+                case.strategy.name(),
                 r.run,
                 format!("{}–{}", r.lines[0], r.lines[1]),
                 f(|x| x.c_ratio),
                 f(|x| x.primary_ratio),
                 f(|x| x.overall_ratio),
+                yes(z.at_feed_c),
+                yes(z.at_feed_both),
                 format!(
                     "{} ({:.3})",
                     arrow(r.before.time_s, r.after.time_s),
@@ -247,36 +285,102 @@ pub(crate) fn table(report: &BenchReport) -> String {
             );
         }
     }
-    let s = report.summary();
+    let strategies = report.strategies();
+    if strategies.len() > 1 {
+        let _ = writeln!(
+            out,
+            "\nSide by side (zones at feed on C / on both rotary axes, of all zones; largest deviation °; estimated time of the runs with zones, s):"
+        );
+        let mut head = format!("{:<30} {:<13}", "file", "machine");
+        for s in &strategies {
+            let _ = write!(head, " {:>26}", s.name());
+        }
+        let _ = writeln!(out, "{head}");
+        let mut k = 0;
+        while k < report.cases.len() {
+            let (file, machine) = (&report.cases[k].file, &report.cases[k].machine);
+            let mut line = format!("{:<30} {:<13}", short_name(file), machine);
+            while k < report.cases.len()
+                && &report.cases[k].file == file
+                && &report.cases[k].machine == machine
+            {
+                let c = &report.cases[k];
+                let zc = c.zones.iter().filter(|z| z.at_feed_c).count();
+                let zb = c.zones.iter().filter(|z| z.at_feed_both).count();
+                let dev = c
+                    .zones
+                    .iter()
+                    .map(|z| z.row.max_deviation_deg)
+                    .fold(0.0, f64::max);
+                let _ = write!(
+                    line,
+                    " {:>26}",
+                    format!(
+                        "{zc}/{zb} of {} {dev:.3}° {:.3}s",
+                        c.zones.len(),
+                        c.time_s[1]
+                    )
+                );
+                k += 1;
+            }
+            let _ = writeln!(out, "{line}");
+        }
+    }
     let opt = |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{v:.3}"));
-    let _ = writeln!(
-        out,
-        "\n{} program × machine case(s), {} zone(s): {} reach feed on C; bound unreachable for {}.",
-        report.cases.len(),
-        s.zones,
-        s.reached,
-        s.unreachable
-    );
-    let _ = writeln!(
-        out,
-        "ours/bound over {} zone(s): median {}, worst {}; {} within {RATIO_TARGET} (SPEC §6).",
-        s.ratios,
-        opt(s.ratio_median),
-        opt(s.ratio_worst),
-        s.ratio_within_target
-    );
+    for strategy in strategies {
+        let s = report.summary(strategy);
+        let reference = if strategy.both_axes() {
+            "best found (both axes)"
+        } else {
+            "C-only LP bound"
+        };
+        let _ = writeln!(
+            out,
+            "\n{}: {} zone(s): {} at feed on C, {} on both rotary axes; reference unreachable for {}; largest deviation {:.3}°; time of the runs with zones {:.3} → {:.3} s (L/F {:.3} s).",
+            strategy.name(),
+            s.zones,
+            s.at_feed_c,
+            s.at_feed_both,
+            s.unreachable,
+            s.max_deviation_deg,
+            s.time_s[0],
+            s.time_s[1],
+            s.time_s[2]
+        );
+        let _ = writeln!(
+            out,
+            "  ours/reference ({reference}) over {} zone(s): median {}, worst {}; {} within {RATIO_TARGET} (SPEC §6).",
+            s.ratios,
+            opt(s.ratio_median),
+            opt(s.ratio_worst),
+            s.ratio_within_target
+        );
+    }
     out
 }
 
 fn csv_rows(report: &BenchReport) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    let mut header = vec!["file", "machine"];
+    let mut header = vec!["file", "machine", "strategy"];
     header.extend(ZoneRow::CSV_COLUMNS);
-    header.extend(["bound_deg", "ratio"]);
+    header.extend([
+        "at_feed_c",
+        "at_feed_both",
+        "reference_kind",
+        "bound_deg",
+        "ratio",
+    ]);
     w.write_record(&header)?;
     for z in report.zones() {
-        let mut rec = vec![z.row.file.clone(), z.machine.clone()];
+        let mut rec = vec![
+            z.row.file.clone(),
+            z.machine.clone(),
+            z.strategy.name().to_string(),
+        ];
         rec.extend(z.row.csv_fields());
+        rec.push(z.at_feed_c.to_string());
+        rec.push(z.at_feed_both.to_string());
+        rec.push(z.bound.kind.to_string());
         rec.push(match (z.bound.status.as_str(), z.bound.bound_deg) {
             ("ok", Some(b)) => format!("{b:.6}"),
             (s, _) => s.to_string(),
@@ -309,8 +413,12 @@ fn write_plots(report: &BenchReport, dir: &Path, only: Option<&str>) -> Result<u
             k += 1;
             let Some(p) = &z.plot else { continue };
             let svg = plot::render_svg(p).map_err(anyhow::Error::msg)?;
+            let suffix = match case.strategy {
+                BenchStrategy::Polepatch => String::new(),
+                s => format!("-{}", s.name()),
+            };
             let path = dir.join(format!(
-                "{stem}-{}-run{}-zone{k}.svg",
+                "{stem}-{}-run{}-zone{k}{suffix}.svg",
                 case.machine, z.row.run
             ));
             write_atomic(&path, svg.as_bytes())

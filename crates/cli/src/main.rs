@@ -72,11 +72,15 @@ pub(crate) struct PatchArgs {
     #[arg(long, default_value_t = 0.02)]
     pub(crate) margin: f64,
     /// Most decimal places to write for C when the file's precision cannot hold Equation 6.
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = 6)]
     pub(crate) max_decimals: usize,
     /// Longest patch, mm (default: up to the whole run).
     #[arg(long)]
     pub(crate) max_patch_length: Option<f64>,
+    /// Change C only, never the primary axis (G16's method). Default: both rotary axes may
+    /// change (re-selecting the IK branch where that suffices), so that both reach feed.
+    #[arg(long)]
+    pub(crate) only_c: bool,
     /// Do not ask for third-derivative continuity at the joins.
     #[arg(long)]
     pub(crate) no_jerk_continuity: bool,

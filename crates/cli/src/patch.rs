@@ -3,7 +3,7 @@
 use crate::{PatchArgs, check_positive, machine};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
-use polepatch::patcher::PatchOptions;
+use polepatch::patcher::{PatchAxes, PatchOptions};
 use polepatch::{FileReport, ZoneRow};
 use polepatch_cli::files::{JobError, patch_file, write_atomic};
 use rayon::prelude::*;
@@ -35,6 +35,11 @@ fn options(args: &PatchArgs) -> Result<PatchOptions> {
         max_decimals: args.max_decimals,
         max_patch_length_mm: args.max_patch_length,
         allow_c_offset: args.c_offset,
+        axes: if args.only_c {
+            PatchAxes::OnlyC
+        } else {
+            PatchAxes::Both
+        },
         ..PatchOptions::default()
     })
 }

@@ -1,12 +1,24 @@
-//! Issue-4 invariants on every fixture and both built-in machines, and on seeded random
-//! near-pole passes: every zone reaches feed on C when the written file is read back and
-//! analysed; only C words differ; a program without zone comes out byte-identical; no run's
-//! C ratio gets worse.
+//! The patcher's invariants on every fixture and both built-in machines, and on seeded
+//! random near-pole passes, for both methods:
+//! - default (issue 8): every zone reaches feed on both rotary axes when the written file
+//!   is read back and analysed; only rotary words differ; nothing gets worse anywhere;
+//! - `--only-c` (issue 4): every zone reaches feed on C; only C words differ; no run's C
+//!   ratio gets worse.
+//!
+//! Either way a program without zone comes out byte-identical.
 
 mod common;
 use common::*;
 use polepatch::kinematics::Axis;
-use polepatch::patcher::PatchOptions;
+use polepatch::patcher::{PatchAxes, PatchOptions};
+
+/// The options of the C-only method, otherwise the defaults.
+fn only_c() -> PatchOptions {
+    PatchOptions {
+        axes: PatchAxes::OnlyC,
+        ..PatchOptions::default()
+    }
+}
 use polepatch_fixturegen::{Dialect, Pass, program};
 
 #[test]
@@ -17,13 +29,14 @@ fn every_fixture_on_both_machines() {
         "expected the committed fixture set, found {}",
         files.len()
     );
-    let opts = PatchOptions::default();
     let mut zones = 0;
     for f in &files {
         let bytes = std::fs::read(f).unwrap();
         for m in machines() {
-            let (rep, _) = check_patch(&name_of(f), &bytes, &m, &opts);
-            zones += rep.zones.len();
+            for opts in [PatchOptions::default(), only_c()] {
+                let (rep, _) = check_patch(&name_of(f), &bytes, &m, &opts);
+                zones += rep.zones.len();
+            }
         }
     }
     assert!(zones > 0);
@@ -74,45 +87,94 @@ fn seeded_random_near_pole_passes() {
         };
         let dialect = rng.pick(&Dialect::ALL);
         let text = program(&pass, dialect, "CASE");
-        check_patch(
-            &format!("case {case} on {}: {pass:?} {dialect:?}", m.name),
-            text.as_bytes(),
-            m,
-            &opts,
-        );
+        for opts in [&opts, &only_c()] {
+            check_patch(
+                &format!("case {case} on {}: {pass:?} {dialect:?}", m.name),
+                text.as_bytes(),
+                m,
+                opts,
+            );
+        }
     }
 }
 
-/// A run far too short for C to turn at F5000 on the UCP710 (V/F = 1.44 °/mm, 63 mm):
-/// no patch can reach feed. The best improvement is kept, reported as such, and nothing
-/// gets worse.
+/// A pass 1° from the pole on a 5° circle, 15 mm long at F5000 on the UCP710, followed by
+/// a move that programs the rotary axes with a linear move (so its last point must stay,
+/// `polepatch::end_pose`): the tool axis must turn far more than A and C can in 15 mm.
+/// No values of the run's points reach feed — the convex feasibility LP proves it — and
+/// both methods keep what they have (best improvement or nothing), never worse.
 #[test]
 fn impossible_zone_keeps_the_best_improvement() {
     let pass = Pass {
-        pole_distance_deg: 0.0015,
-        circle_radius_deg: 16.1,
-        half_sweep_deg: 80.7,
-        azimuth_deg: 124.0,
-        length_mm: 63.6,
+        pole_distance_deg: 1.0,
+        circle_radius_deg: 5.0,
+        half_sweep_deg: 80.0,
+        azimuth_deg: 0.0,
+        length_mm: 15.0,
         spacing_mm: 0.5,
         feed_mm_min: 5000.0,
-        b_axis: true,
+        b_axis: false,
         domain_rule: false,
         rotary_decimals: 3,
     };
-    let text = program(&pass, Dialect::Fanuc, "SHORT");
+    let text =
+        program(&pass, Dialect::Fanuc, "SHORT").replace("\nG49\n", "\nG0 Z50. A0. C0.\nG49\n");
     let m = polepatch::kinematics::Machine::builtin("mikron-ucp710").unwrap();
     let lp = load_bytes(text.as_bytes(), "short", &m);
-    let (out, report) = polepatch::patch_loaded(&lp, &m, &PatchOptions::default());
-    assert!(!report.zones.is_empty());
-    for z in &report.zones {
-        assert_ne!(z.outcome, "reached", "{z:?}");
-        assert!(z.after.c_ratio >= z.before.c_ratio, "{z:?}");
+    assert!(!polepatch::end_pose::end_pose_is_free(&lp, 0));
+    // The proof: with the last point fixed, no values of points 1..n−2 reach feed.
+    let path = lp.runs[0].path.as_ref().unwrap();
+    let n = path.s_mm.len();
+    let p: Vec<f64> = path.axes.iter().map(|q| q[Axis::Primary.index()]).collect();
+    let c: Vec<f64> = path.axes.iter().map(|q| q[Axis::C.index()]).collect();
+    let reachable = polepatch::patcher::reference::reachable(
+        &path.s_mm,
+        &p,
+        &c,
+        1,
+        n - 2,
+        0..n - 1,
+        &m,
+        path.feed_mm_min,
+        path.feed_mm_min / 60.0 * m.tcy_s,
+        PatchOptions::default().max_decimals,
+    )
+    .unwrap();
+    assert!(!reachable, "the planted zone must be unreachable");
+    for opts in [PatchOptions::default(), only_c()] {
+        let (out, report) = polepatch::patch_loaded(&lp, &m, &opts);
+        assert!(!report.zones.is_empty());
+        for z in &report.zones {
+            assert_ne!(z.outcome, "reached", "{z:?}");
+            assert!(z.after.c_ratio >= z.before.c_ratio, "{z:?}");
+            assert!(z.after.primary_ratio >= z.before.primary_ratio, "{z:?}");
+        }
+        assert_only_rotary_words_differ("short", text.as_bytes(), &out);
+        let before = c_ratios_and_zones(&lp, &m, 5.0);
+        let after = c_ratios_and_zones(&load_bytes(&out, "short", &m), &m, 5.0);
+        assert!(after[0].0 >= before[0].0, "{before:?} → {after:?}");
     }
-    assert_only_c_words_differ("short", text.as_bytes(), &out);
-    let before = c_ratios_and_zones(&lp, &m, 5.0);
-    let after = c_ratios_and_zones(&load_bytes(&out, "short", &m), &m, 5.0);
-    assert!(after[0].0 >= before[0].0, "{before:?} → {after:?}");
+}
+
+/// With both axes free but the orientation change capped far below what any patch needs
+/// (`max_deviation_deg`), `%SING` cannot reach feed: the zone keeps its best improvement
+/// within the cap (or its values), and no sample of any axis gets worse.
+#[test]
+fn capped_deviation_keeps_the_best_improvement() {
+    let bytes = std::fs::read(root().join("fixtures/c17/SING.I")).unwrap();
+    let m = polepatch::kinematics::Machine::builtin("mikron-ucp710").unwrap();
+    let opts = PatchOptions {
+        max_deviation_deg: Some(0.05),
+        ..PatchOptions::default()
+    };
+    let lp = load_bytes(&bytes, "SING", &m);
+    let (out, report) = polepatch::patch_loaded(&lp, &m, &opts);
+    assert_eq!(report.zones.len(), 1);
+    let z = &report.zones[0];
+    assert_ne!(z.outcome, "reached", "{z:?}");
+    assert!(z.max_deviation_deg <= 0.05 + 1e-9, "{z:?}");
+    assert!(z.after.c_ratio >= z.before.c_ratio && z.after.primary_ratio >= z.before.primary_ratio);
+    assert_only_rotary_words_differ("SING", &bytes, &out);
 }
 
 /// A zigzag finishing program: many runs, one zone each, patched in one file.
@@ -125,12 +187,14 @@ fn zigzag_program_with_many_zones() {
     let text =
         polepatch_fixturegen::zigzag_program(&base, 8, &[0.1, 0.5, 1.0, 2.0, 4.0, 0.05], "ZIGZAG");
     for m in machines() {
-        let (rep, _) = check_patch("zigzag", text.as_bytes(), &m, &PatchOptions::default());
-        assert!(
-            rep.zones.len() >= 6,
-            "{} zones on {}",
-            rep.zones.len(),
-            m.name
-        );
+        for opts in [PatchOptions::default(), only_c()] {
+            let (rep, _) = check_patch("zigzag", text.as_bytes(), &m, &opts);
+            assert!(
+                rep.zones.len() >= 6,
+                "{} zones on {}",
+                rep.zones.len(),
+                m.name
+            );
+        }
     }
 }

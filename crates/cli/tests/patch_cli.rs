@@ -1,7 +1,7 @@
 //! `polepatch patch` as a user runs it: one file, a folder batch, --strict, refusals.
 
 mod common;
-use common::{assert_only_c_words_differ, root};
+use common::{assert_only_rotary_words_differ, root};
 use polepatch_fixturegen::{Dialect, Pass, program};
 use std::path::PathBuf;
 use std::process::Command;
@@ -45,12 +45,15 @@ fn one_file_with_report() {
     assert_eq!(code, 0, "{err}");
     assert!(stdout.contains("SING.I"), "{stdout}");
     let input = std::fs::read(root().join("fixtures/c17/SING.I")).unwrap();
-    assert_only_c_words_differ("SING", &input, &std::fs::read(&out).unwrap());
+    assert_only_rotary_words_differ("SING", &input, &std::fs::read(&out).unwrap());
     let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
     let zones = doc["zones"].as_array().unwrap();
     assert_eq!(zones.len(), 1);
     assert_eq!(zones[0]["outcome"], "reached");
+    // Issue 8: A and C both reach feed on SING (A's jerk held the C-only patch at 0.607).
     assert_eq!(zones[0]["after"]["c_ratio"].as_f64().unwrap(), 1.0);
+    assert_eq!(zones[0]["after"]["primary_ratio"].as_f64().unwrap(), 1.0);
+    assert!(zones[0]["primary_points_modified"].as_u64().unwrap() > 0);
     // The output has the input's permissions, not the temporary file's owner-only mode.
     #[cfg(unix)]
     {
@@ -105,22 +108,25 @@ fn folder_batch_with_csv() {
 
 #[test]
 fn strict_exits_2_when_a_zone_stays_below_feed() {
-    // 63 mm at F5000 on the UCP710: C cannot turn in time (tests/patch.rs has the proof).
+    // 15 mm at F5000 on the UCP710 with the last point held by the move after it: no values
+    // reach feed (tests/patch.rs has the proof).
     let pass = Pass {
-        pole_distance_deg: 0.0015,
-        circle_radius_deg: 16.1,
-        half_sweep_deg: 80.7,
-        azimuth_deg: 124.0,
-        length_mm: 63.6,
+        pole_distance_deg: 1.0,
+        circle_radius_deg: 5.0,
+        half_sweep_deg: 80.0,
+        azimuth_deg: 0.0,
+        length_mm: 15.0,
         spacing_mm: 0.5,
         feed_mm_min: 5000.0,
-        b_axis: true,
+        b_axis: false,
         domain_rule: false,
         rotary_decimals: 3,
     };
     let dir = temp_dir("strict");
     let input = dir.join("short.nc");
-    std::fs::write(&input, program(&pass, Dialect::Fanuc, "SHORT")).unwrap();
+    let text =
+        program(&pass, Dialect::Fanuc, "SHORT").replace("\nG49\n", "\nG0 Z50. A0. C0.\nG49\n");
+    std::fs::write(&input, text).unwrap();
     let out = dir.join("short.out.nc");
     let args = [
         "patch",
@@ -137,6 +143,32 @@ fn strict_exits_2_when_a_zone_stays_below_feed() {
     let (code, _, err) = polepatch(&strict);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("stay below feed"), "{err}");
+}
+
+/// Issue 8: `--only-c` keeps G16's C-only method and reproduces its output byte for byte
+/// (the golden files were written by polepatch before the joint method existed).
+#[test]
+fn only_c_reproduces_the_c_only_output() {
+    let dir = temp_dir("onlyc");
+    for m in ["mikron-ucp710", "mikron-hsm600"] {
+        let out = dir.join(format!("SING.{m}.I"));
+        let (code, _, err) = polepatch(&[
+            "patch",
+            "fixtures/c17/SING.I",
+            "-o",
+            out.to_str().unwrap(),
+            "--machine",
+            m,
+            "--only-c",
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let golden = root().join(format!("crates/cli/tests/data/SING.only-c.{m}.I"));
+        assert_eq!(
+            std::fs::read(&out).unwrap(),
+            std::fs::read(golden).unwrap(),
+            "{m}: --only-c output changed"
+        );
+    }
 }
 
 #[test]

@@ -2,7 +2,7 @@
 //! singular zones (SPEC §3 step 2).
 
 use crate::path::{Path, PathError};
-use polepatch_bspline::{BSpline, interpolate_not_a_knot, sample_params};
+use crate::spline::{AnalysisSpline, SplineSystem, span_offsets};
 use polepatch_kinematics::{Axis, FeedBound, LimitKind, Machine, axis_feed_bound, feed_bound};
 
 /// Options of [`analyze_path`].
@@ -142,22 +142,28 @@ pub fn validate(path: &Path) -> Result<(), PathError> {
     Ok(())
 }
 
-/// The analysis splines of the five axes (not-a-knot interpolants over s).
-pub fn axis_splines(path: &Path) -> Result<Vec<BSpline>, PathError> {
+/// The analysis splines of the five axes ([`crate::spline`]), on one factored system.
+pub fn axis_splines(path: &Path) -> Result<Vec<AnalysisSpline>, PathError> {
+    let sys = SplineSystem::new(&path.s_mm)?;
     (0..5)
         .map(|k| {
             let y: Vec<f64> = path.axes.iter().map(|q| q[k]).collect();
-            interpolate_not_a_knot(&path.s_mm, &y).map_err(|e| PathError::Spline(e.to_string()))
+            sys.fit(&y)
         })
         .collect()
 }
 
-/// Sample parameters of span `i` (`[s_i, s_{i+1})`, plus `s_{n-1}` on the last span).
-fn span_samples(s: &[f64], i: usize, step: f64, out: &mut Vec<(f64, usize)>) {
-    let ts = sample_params(s[i], s[i + 1], step);
-    let last = i + 2 == s.len();
-    let take = if last { ts.len() } else { ts.len() - 1 };
-    out.extend(ts[..take].iter().map(|&t| (t, i)));
+/// Sample parameters of span `i` ([`span_offsets`]: `[s_i, s_{i+1})`, plus `s_{n-1}` on
+/// the last span), with the span index.
+fn span_samples(
+    s: &[f64],
+    i: usize,
+    step: f64,
+    scratch: &mut Vec<f64>,
+    out: &mut Vec<(f64, usize)>,
+) {
+    span_offsets(s[i + 1] - s[i], step, i + 2 == s.len(), scratch);
+    out.extend(scratch.iter().map(|&t| (s[i] + t, i)));
 }
 
 /// Analyse a run: the not-a-knot spline of each axis over s, sampled every F·Tcy and at
@@ -180,10 +186,11 @@ pub fn analyze_path(
 
     let mut acc = Accumulator::new(n, feed_mm_s, opts.keep_samples);
     let mut params: Vec<(f64, usize)> = Vec::with_capacity(CHUNK + 64);
+    let mut scratch = Vec::new();
     let mut ts: Vec<f64> = Vec::with_capacity(CHUNK + 64);
     let mut derivs: Vec<Vec<[f64; 4]>> = (0..5).map(|_| Vec::with_capacity(CHUNK + 64)).collect();
     for i in 0..n - 1 {
-        span_samples(s, i, step_mm, &mut params);
+        span_samples(s, i, step_mm, &mut scratch, &mut params);
         if params.len() >= CHUNK || i + 2 == n {
             ts.clear();
             ts.extend(params.iter().map(|p| p.0));
@@ -260,6 +267,7 @@ impl Accumulator {
         for axis in Axis::ALL {
             let k = axis.index();
             let b = axis_feed_bound(machine.limit(axis), d[k]);
+            // = axis_feed_ratio(…): the bound is needed for its kind too.
             let r = (b.feed_mm_s / self.feed_mm_s).min(1.0);
             axis_ratio[k] = r;
             if r < self.axis_min[k].0 {

@@ -1,10 +1,26 @@
 //! Options of the patcher.
 
+/// Which rotary axes the patcher may change.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub enum PatchAxes {
+    /// The primary axis and C (re-selecting the IK branch where that suffices): the machine
+    /// reaches the programmed feed on both rotary axes. The default.
+    #[default]
+    Both,
+    /// C only, the primary axis as programmed (G16's method, `--only-c`).
+    OnlyC,
+}
+
 /// Options of [`crate::patch_path`]. Plain struct: every field public, documented default.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PatchOptions {
     /// Singular cone, degrees: a zone needs a point with |primary| ≤ this. Default 5.
     pub cone_deg: f64,
+    /// Which rotary axes may change. Default [`PatchAxes::Both`].
+    pub axes: PatchAxes,
+    /// polepatch's method, or a peer's rule for comparison ([`crate::peers`]). Default
+    /// [`Strategy::Polepatch`].
+    pub strategy: crate::peers::Strategy,
     /// Largest orientation deviation allowed at any point, degrees; `None` = no limit
     /// (the deviation is still minimised). Default `None`.
     pub max_deviation_deg: Option<f64>,
@@ -20,10 +36,18 @@ pub struct PatchOptions {
     /// Decimal places of the file's primary-axis words (A or B). Default 3.
     pub p_decimals: usize,
     /// Most decimal places polepatch may write when the file's precision cannot hold
-    /// Equation 6. Default 4.
+    /// Equation 6 (the joint method also aims within the limits by what rounding to this
+    /// many decimals can add). Default 6: at 0.5 mm spacing and F3000 the UCP710's A jerk
+    /// budget (J/F³ = 0.0144 °/mm³) is eaten to 28 % by rounding to 4 decimals, to 0.3 % by
+    /// rounding to 6. The machine's control must accept that many.
     pub max_decimals: usize,
     /// Longest patch, mm; `None` = up to the whole run. Default `None`.
     pub max_patch_length_mm: Option<f64>,
+    /// Keep the path's last point as it is, like its first (default false). A caller sets
+    /// it when what follows the path depends on the pose the path ends in (the NC pipeline
+    /// decides per run: see `polepatch::end_pose`); otherwise the last point may change,
+    /// and the path may end on the other IK branch.
+    pub keep_last_point: bool,
     /// Allow a 360° multiple offset of C after the singular point when it shortens the
     /// join. The rest of the run then carries the offset, and the move after the run has to
     /// turn C the extra revolution back, so it is off by default. Default false.
@@ -34,14 +58,17 @@ impl Default for PatchOptions {
     fn default() -> Self {
         PatchOptions {
             cone_deg: 5.0,
+            axes: PatchAxes::Both,
+            strategy: crate::peers::Strategy::Polepatch,
             max_deviation_deg: None,
             tcy_s: None,
             margin: 0.02,
             third_derivative_continuity: true,
             c_decimals: 3,
             p_decimals: 3,
-            max_decimals: 4,
+            max_decimals: 6,
             max_patch_length_mm: None,
+            keep_last_point: false,
             allow_c_offset: false,
         }
     }

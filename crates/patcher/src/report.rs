@@ -35,6 +35,13 @@ pub enum Outcome {
 /// Which formulation produced the written values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub enum Method {
+    /// Branch re-selection alone: the points after the program's IK-branch switch moved to
+    /// the other branch, `(P, C) → (−P, C ± 180°)` (no orientation change).
+    Reselect,
+    /// The joint patch of the primary axis and C ([`crate::joint`]).
+    Joint,
+    /// A peer strategy's rule ([`crate::peers`]), for the quality suite.
+    Peer,
     /// G16 patch spline joined to C_b and C_a, CL points projected onto it.
     G16Patch,
     /// QP directly on the CL C values through the analysis spline (fallback).
@@ -43,11 +50,101 @@ pub enum Method {
     None,
 }
 
+/// How a solve ended: clarabel's `SolverStatus`, plus polepatch's own outcomes of a solve
+/// that was not run. A numerical outcome, not an error (SPEC: bad input is kept apart).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize)]
+pub enum QpStatus {
+    /// No solve was made.
+    #[default]
+    NotRun,
+    /// Solved to clarabel's default tolerances.
+    Solved,
+    /// Solved to reduced accuracy.
+    AlmostSolved,
+    /// Proven primal infeasible (no patch satisfies the constraints).
+    PrimalInfeasible,
+    /// Proven dual infeasible (unbounded; a modelling error if it happens).
+    DualInfeasible,
+    /// Primal infeasible to reduced accuracy.
+    AlmostPrimalInfeasible,
+    /// Dual infeasible to reduced accuracy.
+    AlmostDualInfeasible,
+    /// The iteration cap was reached.
+    MaxIterations,
+    /// The time cap was reached.
+    MaxTime,
+    /// clarabel stopped on a numerical error.
+    NumericalError,
+    /// clarabel stopped for lack of progress.
+    InsufficientProgress,
+    /// Not solved: a necessary condition showed the problem infeasible beforehand.
+    SkippedInfeasible,
+    /// The problem could not be set up (malformed matrices).
+    SetupError,
+}
+
+impl QpStatus {
+    /// clarabel's status as ours.
+    pub fn from_clarabel(s: clarabel::solver::SolverStatus) -> QpStatus {
+        use clarabel::solver::SolverStatus as S;
+        match s {
+            S::Unsolved | S::CallbackTerminated => QpStatus::NotRun,
+            S::Solved => QpStatus::Solved,
+            S::AlmostSolved => QpStatus::AlmostSolved,
+            S::PrimalInfeasible => QpStatus::PrimalInfeasible,
+            S::DualInfeasible => QpStatus::DualInfeasible,
+            S::AlmostPrimalInfeasible => QpStatus::AlmostPrimalInfeasible,
+            S::AlmostDualInfeasible => QpStatus::AlmostDualInfeasible,
+            S::MaxIterations => QpStatus::MaxIterations,
+            S::MaxTime => QpStatus::MaxTime,
+            S::NumericalError => QpStatus::NumericalError,
+            S::InsufficientProgress => QpStatus::InsufficientProgress,
+        }
+    }
+    /// A usable solution came back (`Solved` or `AlmostSolved`).
+    pub fn is_solved(self) -> bool {
+        matches!(self, QpStatus::Solved | QpStatus::AlmostSolved)
+    }
+    /// Infeasibility was proven (by the solver, or beforehand).
+    pub fn is_infeasible(self) -> bool {
+        matches!(
+            self,
+            QpStatus::PrimalInfeasible
+                | QpStatus::AlmostPrimalInfeasible
+                | QpStatus::SkippedInfeasible
+        )
+    }
+    /// The name used in reports (the variant's name).
+    pub fn name(self) -> &'static str {
+        match self {
+            QpStatus::NotRun => "NotRun",
+            QpStatus::Solved => "Solved",
+            QpStatus::AlmostSolved => "AlmostSolved",
+            QpStatus::PrimalInfeasible => "PrimalInfeasible",
+            QpStatus::DualInfeasible => "DualInfeasible",
+            QpStatus::AlmostPrimalInfeasible => "AlmostPrimalInfeasible",
+            QpStatus::AlmostDualInfeasible => "AlmostDualInfeasible",
+            QpStatus::MaxIterations => "MaxIterations",
+            QpStatus::MaxTime => "MaxTime",
+            QpStatus::NumericalError => "NumericalError",
+            QpStatus::InsufficientProgress => "InsufficientProgress",
+            QpStatus::SkippedInfeasible => "SkippedInfeasible",
+            QpStatus::SetupError => "SetupError",
+        }
+    }
+}
+
+impl std::fmt::Display for QpStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// Solver statistics, summed over every solve made for the zone.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct QpStats {
-    /// Status of the last solve (clarabel's `SolverStatus` as text).
-    pub status: String,
+    /// Status of the last solve.
+    pub status: QpStatus,
     /// Interior-point iterations, summed.
     pub iterations: u32,
     /// Number of QP solves.
@@ -67,7 +164,9 @@ pub struct ZoneReport {
     pub kind: ZoneKind,
     /// Smallest |primary| in the zone, degrees.
     pub min_abs_primary_deg: f64,
-    /// Figures before patching over `[s(first), s(last)]`.
+    /// Figures before patching: over `[s(first), s(last)]` for the C-only method, over the
+    /// zone ± `verify::CORE_MARGIN_POINTS` (the stretch that must reach feed) for the joint
+    /// method.
     pub before: ZoneFigures,
     /// Figures after patching, same s range, on the values as written.
     pub after: ZoneFigures,
@@ -75,8 +174,13 @@ pub struct ZoneReport {
     pub ideal_time_s: f64,
     /// Largest orientation deviation of a modified point, degrees.
     pub max_deviation_deg: f64,
-    /// Points whose C changed.
+    /// Points of the zone's range whose primary axis or C changed.
     pub points_modified: usize,
+    /// Points of the zone's range whose primary axis changed.
+    pub primary_points_modified: usize,
+    /// Points after the range re-selected onto the other IK branch as a block (same tool
+    /// axes, both words rewritten).
+    pub reselected_points: usize,
     /// Length of the patched s range, mm.
     pub patch_length_mm: f64,
     /// Outcome.
@@ -87,6 +191,8 @@ pub struct ZoneReport {
     pub qp: QpStats,
     /// Decimal places the modified C words need.
     pub decimals: usize,
+    /// Decimal places the modified primary-axis words need.
+    pub p_decimals: usize,
     /// 360° multiple added to C after the zone (0 when none).
     pub c_offset_deg: f64,
 }

@@ -1,107 +1,65 @@
-//! Verification of a C change against Equation 6 (SPEC §2), on the C axis alone.
+//! Verification of a change against Equation 6 (SPEC §2) on the values as written.
 //!
-//! The analysis spline of C is the not-a-knot interpolating cubic of the C values over s,
-//! built with `polepatch_bspline` ([`NotAKnotSystem`], factored once per window and solved
-//! for the values before and after) and evaluated in piecewise-polynomial form
-//! ([`polepatch_bspline::PpCubic::eval_derivs_sorted`]) on every span's samples.
-//!
-//! The C-limited ratio at a sample is `min(1, v/|q'|, sqrt(a/|q''|), cbrt(j/|q'''|))`
-//! with `(v, a, j)` the C limits at the programmed feed without margin
-//! ([`CLimits::new`] with margin 0): Equation 6 for C divided by F.
+//! For each axis checked, the analysis spline ([`crate::spline`]) of the values before and
+//! after is built on a window of the path around the change (one factored system, two fits
+//! per axis) and reduced to each span's peak |q'|, |q''|, |q'''| over its samples; the
+//! span's ratio is Equation 6 for that axis at the programmed feed
+//! ([`polepatch_kinematics::axis_feed_ratio`]), without margin.
 //!
 //! A window of the path is enough: the influence of a changed value on the spline decays
 //! by a factor ≈ 2 − √3 ≈ 0.27 per knot, so [`VERIFY_MARGIN_POINTS`] points either side of
 //! the change make the window spline equal to the whole-path spline to round-off where
 //! the checks are made.
 
-use crate::{analysis::RATIO_TOL, limits::CLimits};
-use polepatch_bspline::NotAKnotSystem;
+use crate::analysis::RATIO_TOL;
+use crate::spline::{SplineSystem, span_peaks};
+use polepatch_kinematics::{Axis, Machine, axis_feed_ratio};
 
 /// Points of unchanged path kept either side of a change when verifying it.
 pub const VERIFY_MARGIN_POINTS: usize = 30;
 
-/// Points either side of the modified range where the C ratio must reach 1.
+/// Points either side of the modified range where the ratios must reach 1.
 pub const CORE_MARGIN_POINTS: usize = 3;
 
 /// Spans next to a window end that was cut (not a path end) left out of the "never worse"
 /// comparison: there the window spline differs from the whole-path spline.
 const WINDOW_GUARD_SPANS: usize = 10;
 
-/// Slack of the "not lower than before" comparison (absorbs round-off).
-const NOT_WORSE_TOL: f64 = 1e-12;
+/// Resolution of the "not lower than before" comparison: a ratio may fall by this fraction
+/// of itself (0.01 %, a feed difference no controller resolves). It absorbs round-off, the
+/// solvers' own tolerance (clarabel's feasibility tolerance is relative to the problem's
+/// norms: with C changes of 100° the slope equalities hold to ~1e-7, which q''' multiplies
+/// by 6/h²) and what a change propagates, through the spline's decay, beyond the window a
+/// solver constrains.
+pub const NOT_WORSE_REL: f64 = 1e-4;
 
-/// Local sample offsets on a span of length `h` at `step`: `0, step, 2·step, … < h`, and
-/// `h` itself when `with_end` (the analysis sampling rule: every step and every knot).
-pub(crate) fn span_offsets(h: f64, step: f64, with_end: bool, out: &mut Vec<f64>) {
-    out.clear();
-    let count = (h / step).ceil().max(1.0) as usize;
-    for i in 0..count {
-        let t = i as f64 * step;
-        if t < h {
-            out.push(t);
-        }
-    }
-    if with_end {
-        out.push(h);
-    }
+/// One axis of a change: its values along the whole path before and after (degrees or
+/// mm, as written), and which axis it is (for its limits).
+#[derive(Debug, Clone, Copy)]
+pub struct AxisChange<'a> {
+    /// The axis (its machine limits apply).
+    pub axis: Axis,
+    /// Values before the change, one per path point.
+    pub before: &'a [f64],
+    /// Values after the change, one per path point.
+    pub after: &'a [f64],
 }
 
-/// C-limited Equation-6 ratio from `[q', q'', q''']` and the limits without margin.
-pub fn c_ratio(lim: &CLimits, d: [f64; 3]) -> f64 {
-    let rv = lim.v / d[0].abs();
-    let ra = (lim.a / d[1].abs()).sqrt();
-    let rj = (lim.j / d[2].abs()).cbrt();
-    rv.min(ra).min(rj).min(1.0)
-}
-
-/// Per-span minimum C ratio over the samples of every span of the spline of `y` on the
-/// knots of `sys` (`s`); `None` when the spline cannot be built (non-finite values).
-fn span_min_ratios(
-    sys: &NotAKnotSystem,
-    s: &[f64],
-    y: &[f64],
-    lim: &CLimits,
-    step_mm: f64,
-) -> Option<Vec<f64>> {
-    let pp = sys.solve(y).ok()?.to_pp();
-    let n = s.len();
-    let mut ts = Vec::new();
-    let mut at = Vec::new();
-    let mut span_of = Vec::new();
-    for k in 0..n - 1 {
-        span_offsets(s[k + 1] - s[k], step_mm, k + 2 == n, &mut ts);
-        at.extend(ts.iter().map(|t| s[k] + t));
-        span_of.extend(std::iter::repeat_n(k, ts.len()));
-    }
-    let mut d = vec![[0.0; 4]; at.len()];
-    pp.eval_derivs_sorted(&at, &mut d);
-    // The ratio is decreasing in each |derivative|, so the span's least ratio is the ratio
-    // of its largest |q'|, |q''|, |q'''|: one sqrt and one cbrt per span, not per sample.
-    let mut peak = vec![[0.0f64; 3]; n - 1];
-    for (k, e) in span_of.iter().zip(&d) {
-        let pk = &mut peak[*k];
-        for (m, v) in pk.iter_mut().zip(&e[1..]) {
-            *m = m.max(v.abs());
-        }
-    }
-    Some(peak.into_iter().map(|pk| c_ratio(lim, pk)).collect())
-}
-
-/// Verdict of [`verify_c_change`].
+/// Verdict of [`verify_change`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Verdict {
-    /// Lowest C ratio after the change over the core (modified points ±
-    /// [`CORE_MARGIN_POINTS`]).
+    /// Lowest ratio after the change over the core (modified points ±
+    /// [`CORE_MARGIN_POINTS`]), over every axis checked.
     pub core_min_after: f64,
-    /// Lowest C ratio before the change over the same core.
+    /// Lowest ratio before the change over the same core and axes.
     pub core_min_before: f64,
-    /// Whether some sample of the checked window got a C ratio below
-    /// `min(before, 1 − RATIO_TOL)`.
+    /// Whether some sample of the checked window got a ratio below
+    /// `min(before, 1 − RATIO_TOL)` on some axis.
     pub worse_somewhere: bool,
 }
 
 impl Verdict {
-    /// C reaches feed over the core and nothing got worse.
+    /// Every axis reaches feed over the core and nothing got worse.
     pub fn passes(&self) -> bool {
         self.core_min_after >= 1.0 - RATIO_TOL && !self.worse_somewhere
     }
@@ -110,107 +68,204 @@ impl Verdict {
     pub fn improves(&self) -> bool {
         !self.worse_somewhere && self.core_min_after > self.core_min_before
     }
+    /// The verdict of a change that could not be evaluated (non-finite values): fails.
+    pub fn failed() -> Verdict {
+        Verdict {
+            core_min_after: 0.0,
+            core_min_before: 0.0,
+            worse_somewhere: true,
+        }
+    }
 }
 
-/// Check a C change: `c_before` and `c_after` (whole path, degrees, as written) differ at
-/// most in `first..` (points `first..=last` modified, points after `last` possibly shifted
-/// by a 360° multiple). `lim` are the C limits at the programmed feed without margin,
-/// `step_mm` the sampling step F·Tcy.
+/// Per-span ratios of `y` on the window's system.
+fn span_ratios(
+    sys: &SplineSystem,
+    s: &[f64],
+    y: &[f64],
+    machine: &Machine,
+    axis: Axis,
+    feed_mm_s: f64,
+    step_mm: f64,
+) -> Option<Vec<f64>> {
+    let sp = sys.fit(y).ok()?;
+    let lim = machine.limit(axis);
+    Some(
+        span_peaks(s, &sp, step_mm)
+            .into_iter()
+            .map(|pk| axis_feed_ratio(lim, pk, feed_mm_s))
+            .collect(),
+    )
+}
+
+/// Check a change: for every entry of `changes`, the values before and after (whole path,
+/// as written) differ at most in `first..` (points `first..=last` modified, later points
+/// possibly changed as a block that keeps every derivative's size: a 360° offset of C, or
+/// a branch re-selection `(P, C) → (−P, C ± 180°)`).
+/// `feed_mm_s` is the programmed feed, `step_mm` the sampling step F·Tcy.
 ///
-/// C must reach feed (ratio ≥ 1 − [`RATIO_TOL`]) on every sample of the spans within
-/// [`CORE_MARGIN_POINTS`] points of the modified range, and no sample of the window may get
-/// a ratio below `min(before, 1 − RATIO_TOL)`.
-pub fn verify_c_change(
+/// Every axis must reach feed (ratio ≥ 1 − [`RATIO_TOL`]) on every sample of the spans
+/// within [`CORE_MARGIN_POINTS`] points of the modified range, and no sample of the window
+/// may get a ratio below `min(before, 1 − RATIO_TOL)` on any checked axis.
+#[allow(clippy::too_many_arguments)]
+pub fn verify_change(
     s_mm: &[f64],
-    c_before: &[f64],
-    c_after: &[f64],
+    changes: &[AxisChange],
     first: usize,
     last: usize,
-    lim: &CLimits,
+    machine: &Machine,
+    feed_mm_s: f64,
+    step_mm: f64,
+) -> Verdict {
+    verify_change_with_core(
+        s_mm,
+        changes,
+        (first, last),
+        (first, last),
+        machine,
+        feed_mm_s,
+        step_mm,
+    )
+}
+
+/// [`verify_change`] where the stretch that must reach feed is given apart from the
+/// modified points: every axis must reach feed on the spans within [`CORE_MARGIN_POINTS`]
+/// of `core` (a point range, inclusive), and nothing may get worse in the window around
+/// `core ∪ changed`. The joint method passes the zone as `core`: where the original was
+/// below feed the result must reach it; around it, where the program's own values (its
+/// rounding, say) may already exceed a limit, it may only not get worse.
+#[allow(clippy::too_many_arguments)]
+pub fn verify_change_with_core(
+    s_mm: &[f64],
+    changes: &[AxisChange],
+    changed: (usize, usize),
+    core: (usize, usize),
+    machine: &Machine,
+    feed_mm_s: f64,
     step_mm: f64,
 ) -> Verdict {
     let n = s_mm.len();
+    let first = changed.0.min(core.0);
+    let last = changed.1.max(core.1).min(n - 1);
     let lo = first.saturating_sub(VERIFY_MARGIN_POINTS);
     let hi = (last + 1 + VERIFY_MARGIN_POINTS).min(n - 1);
     let nw = hi - lo + 1;
     let s = &s_mm[lo..=hi];
-    let ratios = NotAKnotSystem::new(s).ok().and_then(|sys| {
-        Some((
-            span_min_ratios(&sys, s, &c_before[lo..=hi], lim, step_mm)?,
-            span_min_ratios(&sys, s, &c_after[lo..=hi], lim, step_mm)?,
-        ))
-    });
-    let Some((before, after)) = ratios else {
-        // No spline (non-finite values): fails.
-        return Verdict {
-            core_min_after: 0.0,
-            core_min_before: 0.0,
-            worse_somewhere: true,
-        };
+    let Ok(sys) = SplineSystem::new(s) else {
+        return Verdict::failed();
     };
-    let core_lo = first.saturating_sub(CORE_MARGIN_POINTS).max(lo) - lo;
-    let core_hi = (last + CORE_MARGIN_POINTS).min(hi) - lo; // knot index, exclusive span end
+    let core_lo = core.0.saturating_sub(CORE_MARGIN_POINTS).max(lo) - lo;
+    let core_hi = (core.1 + CORE_MARGIN_POINTS).min(hi) - lo; // knot index, exclusive span end
     let guard_lo = if lo > 0 { WINDOW_GUARD_SPANS } else { 0 };
     let guard_hi = if hi < n - 1 {
         (nw - 1).saturating_sub(WINDOW_GUARD_SPANS)
     } else {
         nw - 1
     };
-    let mut core_min_after = f64::INFINITY;
-    let mut core_min_before = f64::INFINITY;
-    let mut worse = false;
-    for k in 0..nw - 1 {
-        let in_core = k >= core_lo && k < core_hi.max(core_lo + 1);
-        if in_core {
-            core_min_after = core_min_after.min(after[k]);
-            core_min_before = core_min_before.min(before[k]);
-        }
-        if (in_core || (k >= guard_lo && k < guard_hi))
-            && after[k] < before[k].min(1.0 - RATIO_TOL) - NOT_WORSE_TOL
-        {
-            worse = true;
+    let mut v = Verdict {
+        core_min_after: f64::INFINITY,
+        core_min_before: f64::INFINITY,
+        worse_somewhere: false,
+    };
+    for ch in changes {
+        let ratios =
+            |y: &[f64]| span_ratios(&sys, s, &y[lo..=hi], machine, ch.axis, feed_mm_s, step_mm);
+        let (Some(before), Some(after)) = (ratios(ch.before), ratios(ch.after)) else {
+            return Verdict::failed();
+        };
+        for k in 0..nw - 1 {
+            let in_core = k >= core_lo && k < core_hi.max(core_lo + 1);
+            if in_core {
+                v.core_min_after = v.core_min_after.min(after[k]);
+                v.core_min_before = v.core_min_before.min(before[k]);
+            }
+            if (in_core || (k >= guard_lo && k < guard_hi))
+                && after[k] < before[k].min(1.0 - RATIO_TOL) * (1.0 - NOT_WORSE_REL)
+            {
+                v.worse_somewhere = true;
+            }
         }
     }
-    Verdict {
-        core_min_after,
-        core_min_before,
-        worse_somewhere: worse,
-    }
+    v
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// Planted: a line at slope v/2 reaches feed; raising one value so the spline's slope
-    /// exceeds v is found below feed in the core and worse than before.
+    fn ucp710() -> Machine {
+        Machine::builtin("mikron-ucp710").unwrap()
+    }
+
+    /// Planted: C on a line at half its velocity limit reaches feed; raising one value so
+    /// the spline's slope exceeds V/F is found below feed in the core and worse than before.
     #[test]
     fn planted_bump_fails_and_line_passes() {
+        let m = ucp710();
+        let feed_mm_s = 20.0;
+        // C: V = 120 °/s → V/F = 6 °/mm; a line at 3 °/mm.
         let s: Vec<f64> = (0..41).map(|i| i as f64 * 0.5).collect();
-        let lim = CLimits {
-            v: 2.0,
-            a: 50.0,
-            j: 1000.0,
+        let y: Vec<f64> = s.iter().map(|x| 3.0 * x).collect();
+        let c = |after: &[f64]| {
+            let ch = [AxisChange {
+                axis: Axis::C,
+                before: &y,
+                after,
+            }];
+            verify_change(&s, &ch, 20, 20, &m, feed_mm_s, 0.02)
         };
-        let y: Vec<f64> = s.to_vec();
-        let same = verify_c_change(&s, &y, &y, 20, 20, &lim, 0.05);
-        assert!(same.passes(), "{same:?}");
+        assert!(c(&y).passes(), "{:?}", c(&y));
         let mut bumped = y.clone();
         bumped[20] += 2.0;
-        let v = verify_c_change(&s, &y, &bumped, 20, 20, &lim, 0.05);
+        let v = c(&bumped);
         assert!(v.core_min_after < 1.0 && v.worse_somewhere, "{v:?}");
         assert!(!v.passes());
     }
 
-    /// The sample offsets: every step from 0, below h, and h itself on request.
+    /// Two axes: a change that frees C but breaks the primary fails; the verdict is the
+    /// worse of the two.
     #[test]
-    fn offsets_follow_the_sampling_rule() {
-        let mut o = Vec::new();
-        span_offsets(1.0, 0.3, false, &mut o);
-        assert_eq!(o.len(), 4);
-        span_offsets(1.0, 0.3, true, &mut o);
-        assert_eq!(*o.last().unwrap(), 1.0);
-        span_offsets(0.1, 0.3, false, &mut o);
-        assert_eq!(o, vec![0.0]);
+    fn every_checked_axis_counts() {
+        let m = ucp710();
+        let feed_mm_s = 20.0;
+        let s: Vec<f64> = (0..41).map(|i| i as f64 * 0.5).collect();
+        let line: Vec<f64> = s.iter().map(|x| 0.1 * x).collect();
+        let mut kinked = line.clone();
+        kinked[20] += 1.0; // A's jerk limit is 1800 °/s³: far beyond it at 20 mm/s
+        let only_c = [AxisChange {
+            axis: Axis::C,
+            before: &line,
+            after: &line,
+        }];
+        assert!(verify_change(&s, &only_c, 18, 22, &m, feed_mm_s, 0.02).passes());
+        let both = [
+            only_c[0],
+            AxisChange {
+                axis: Axis::Primary,
+                before: &line,
+                after: &kinked,
+            },
+        ];
+        let v = verify_change(&s, &both, 18, 22, &m, feed_mm_s, 0.02);
+        assert!(!v.passes() && v.worse_somewhere, "{v:?}");
+    }
+
+    /// Non-finite values fail, never pass.
+    #[test]
+    fn non_finite_values_fail() {
+        let m = ucp710();
+        let s: Vec<f64> = (0..10).map(f64::from).collect();
+        let y = vec![0.0; 10];
+        let mut bad = y.clone();
+        bad[5] = f64::NAN;
+        let ch = [AxisChange {
+            axis: Axis::C,
+            before: &y,
+            after: &bad,
+        }];
+        assert_eq!(
+            verify_change(&s, &ch, 5, 5, &m, 10.0, 0.01),
+            Verdict::failed()
+        );
     }
 }

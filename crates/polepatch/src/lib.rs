@@ -23,6 +23,7 @@ pub use polepatch_kinematics as kinematics;
 pub use polepatch_nc as nc;
 pub use polepatch_patcher as patcher;
 
+pub mod end_pose;
 pub mod error;
 pub mod patch;
 pub mod program;

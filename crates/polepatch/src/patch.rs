@@ -17,7 +17,7 @@ use crate::report::{axis_letter, limit_name, zone_kind_name};
 use polepatch_kinematics::Machine;
 use polepatch_nc::{Edit, NumberStyle};
 use polepatch_patcher::{
-    Method, Outcome, PatchOptions, ZoneFigures, ZoneReport, patch_path, report_unpatched,
+    Method, Outcome, PatchOptions, QpStatus, ZoneFigures, ZoneReport, patch_path, report_unpatched,
 };
 use serde::Serialize;
 
@@ -72,16 +72,24 @@ pub struct ZoneRow {
     pub ideal_time_s: f64,
     /// Largest orientation deviation, degrees.
     pub max_deviation_deg: f64,
-    /// Points whose C changed.
+    /// Points of the zone whose primary axis or C changed.
     pub points_modified: usize,
+    /// Points of the zone whose primary axis changed.
+    pub primary_points_modified: usize,
+    /// Whether the IK branch was re-selected (points put on the other branch, `(P, C) →
+    /// (−P, C ± 180°)`).
+    pub branch_reselected: bool,
+    /// Points after the zone re-selected onto the other branch as a block (both words
+    /// rewritten, tool axes unchanged).
+    pub reselected_points: usize,
     /// Patched length, mm.
     pub patch_length_mm: f64,
     /// `reached`, `improved` or `unchanged`.
     pub outcome: &'static str,
-    /// `g16-patch`, `direct` or `none`.
+    /// `reselect`, `joint`, `g16-patch`, `direct` or `none`.
     pub method: &'static str,
     /// Last solver status.
-    pub qp_status: String,
+    pub qp_status: QpStatus,
     /// Interior-point iterations, summed.
     pub qp_iterations: u32,
     /// QP solves.
@@ -90,6 +98,8 @@ pub struct ZoneRow {
     pub solve_time_ms: f64,
     /// Decimal places written for the changed C words.
     pub decimals: usize,
+    /// Decimal places written for the changed primary-axis words.
+    pub primary_decimals: usize,
     /// 360° multiple added to C after the zone.
     pub c_offset_deg: f64,
 }
@@ -105,6 +115,9 @@ pub fn outcome_name(o: Outcome) -> &'static str {
 
 fn method_name(m: Method) -> &'static str {
     match m {
+        Method::Reselect => "reselect",
+        Method::Joint => "joint",
+        Method::Peer => "peer",
         Method::G16Patch => "g16-patch",
         Method::Direct => "direct",
         Method::None => "none",
@@ -113,7 +126,7 @@ fn method_name(m: Method) -> &'static str {
 
 impl ZoneRow {
     /// CSV column names of [`ZoneRow::csv_fields`] (the row's fields after `file`).
-    pub const CSV_COLUMNS: [&'static str; 27] = [
+    pub const CSV_COLUMNS: [&'static str; 31] = [
         "run",
         "first_line",
         "last_line",
@@ -132,6 +145,9 @@ impl ZoneRow {
         "ideal_time_s",
         "max_deviation_deg",
         "points_modified",
+        "primary_points_modified",
+        "branch_reselected",
+        "reselected_points",
         "patch_length_mm",
         "outcome",
         "method",
@@ -140,6 +156,7 @@ impl ZoneRow {
         "qp_solves",
         "solve_time_ms",
         "decimals",
+        "primary_decimals",
         "c_offset_deg",
     ];
 
@@ -171,14 +188,18 @@ impl ZoneRow {
             format!("{:.6}", self.ideal_time_s),
             format!("{:.6}", self.max_deviation_deg),
             self.points_modified.to_string(),
+            self.primary_points_modified.to_string(),
+            self.branch_reselected.to_string(),
+            self.reselected_points.to_string(),
             format!("{:.3}", self.patch_length_mm),
             self.outcome.to_string(),
             self.method.to_string(),
-            self.qp_status.clone(),
+            self.qp_status.to_string(),
             self.qp_iterations.to_string(),
             self.qp_solves.to_string(),
             format!("{:.3}", self.solve_time_ms),
             self.decimals.to_string(),
+            self.primary_decimals.to_string(),
             format!("{}", self.c_offset_deg),
         ]
     }
@@ -196,14 +217,18 @@ impl ZoneRow {
             ideal_time_s: z.ideal_time_s,
             max_deviation_deg: z.max_deviation_deg,
             points_modified: z.points_modified,
+            primary_points_modified: z.primary_points_modified,
+            branch_reselected: z.reselected_points > 0 || z.method == Method::Reselect,
+            reselected_points: z.reselected_points,
             patch_length_mm: z.patch_length_mm,
             outcome: outcome_name(z.outcome),
             method: method_name(z.method),
-            qp_status: z.qp.status.clone(),
+            qp_status: z.qp.status,
             qp_iterations: z.qp.iterations,
             qp_solves: z.qp.solves,
             solve_time_ms: z.qp.solve_time_s * 1e3,
             decimals: z.decimals,
+            primary_decimals: z.p_decimals,
             c_offset_deg: z.c_offset_deg,
         }
     }
@@ -395,7 +420,11 @@ pub fn patch_program(
             }
             continue;
         }
-        let result = match patch_path(path, machine, &opts) {
+        let run_opts = PatchOptions {
+            keep_last_point: !crate::end_pose::end_pose_is_free(lp, r),
+            ..opts.clone()
+        };
+        let result = match patch_path(path, machine, &run_opts) {
             Ok(res) => res,
             Err(e) => {
                 report.untouched_runs.push(untouched(
@@ -449,7 +478,21 @@ pub fn patch_program(
             p_style.decimals
         }
     };
-    polepatch_nc::restore_modal(program, &mut edits, &file_decimals);
+    // Inside a run, a point that relied on a modal value keeps it; after a run nothing is
+    // written: its end point only moves when what follows does not depend on the pose
+    // (crate::end_pose).
+    let run_of: std::collections::HashMap<usize, usize> = lp
+        .runs
+        .iter()
+        .enumerate()
+        .flat_map(|(r, rp)| rp.run.blocks.iter().skip(1).map(move |&b| (b, r)))
+        .collect();
+    let same_run = |edited: usize, b: usize| {
+        run_of
+            .get(&edited)
+            .is_some_and(|r| run_of.get(&b) == Some(r))
+    };
+    polepatch_nc::restore_modal(program, &mut edits, &file_decimals, &same_run);
     edits.sort_by_key(|e| (e.block, e.letter));
     report.words_changed = edits.len();
     report.file_c_decimals = Some(c_style.decimals);

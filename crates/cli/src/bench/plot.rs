@@ -1,6 +1,6 @@
-//! Per-zone SVG plots of the suite (the pictures of G16 Figs. 8 and 10): C(s) before and
-//! after, and the Equation-6 feed ratio along s before and after with the limiting axis
-//! marked by colour.
+//! Per-zone SVG plots of the suite (the pictures of G16 Figs. 8 and 10): C(s) and the
+//! primary axis P(s) before and after, and the Equation-6 feed ratio along s before and
+//! after with the limiting axis marked by colour.
 
 use plotters::prelude::*;
 use polepatch_kinematics::Axis;
@@ -35,6 +35,14 @@ pub struct ZonePlot {
     pub c_curve_before: Vec<(f64, f64)>,
     /// The analysis spline of C after, sampled.
     pub c_curve_after: Vec<(f64, f64)>,
+    /// CL points (s mm, P °) before.
+    pub p_points_before: Vec<(f64, f64)>,
+    /// CL points (s mm, P °) after, as written.
+    pub p_points_after: Vec<(f64, f64)>,
+    /// The analysis spline of P before, sampled.
+    pub p_curve_before: Vec<(f64, f64)>,
+    /// The analysis spline of P after, sampled.
+    pub p_curve_after: Vec<(f64, f64)>,
     /// Equation-6 samples before.
     pub ratio_before: Vec<RatioSample>,
     /// Equation-6 samples after.
@@ -54,7 +62,7 @@ pub fn axis_colour(axis: Option<Axis>) -> RGBColor {
 }
 
 /// Width and height of a plot, pixels.
-pub const SIZE_PX: (u32, u32) = (900, 720);
+pub const SIZE_PX: (u32, u32) = (900, 1000);
 
 /// Render `p` as an SVG document.
 pub fn render_svg(p: &ZonePlot) -> Result<String, String> {
@@ -78,61 +86,62 @@ fn draw(p: &ZonePlot, buf: &mut String) -> Result<(), Box<dyn std::error::Error>
     let root = SVGBackend::with_string(buf, SIZE_PX).into_drawing_area();
     root.fill(&WHITE)?;
     let root = root.titled(&p.title, ("sans-serif", 18))?;
-    let (top, bottom) = root.split_vertically(SIZE_PX.1 / 2 - 10);
+    let areas = root.split_evenly((3, 1));
+    let (top, middle, bottom) = (&areas[0], &areas[1], &areas[2]);
     let (x0, x1) = range(p.c_curve_before.iter().map(|q| q.0));
-    let (y0, y1) = range(p.c_curve_before.iter().chain(&p.c_curve_after).map(|q| q.1));
     let blue = RGBColor(31, 119, 180);
     let red = RGBColor(214, 39, 40);
     let zone_fill = RGBColor(240, 240, 200);
 
-    // Top: C(s).
-    let mut chart = ChartBuilder::on(&top)
-        .margin(10)
-        .x_label_area_size(35)
-        .y_label_area_size(60)
-        .build_cartesian_2d(x0..x1, y0..y1)?;
-    chart
-        .configure_mesh()
-        .x_desc("s, mm")
-        .y_desc("C, °")
-        .draw()?;
-    chart.draw_series(std::iter::once(Rectangle::new(
-        [(p.zone_s_mm.0, y0), (p.zone_s_mm.1, y1)],
-        zone_fill.filled(),
-    )))?;
-    chart
-        .draw_series(LineSeries::new(
-            p.c_curve_before.iter().copied(),
-            blue.stroke_width(1),
-        ))?
-        .label("C before (analysis spline, CL points)")
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue));
-    chart.draw_series(
-        p.c_points_before
-            .iter()
-            .map(|&q| Circle::new(q, 2, blue.filled())),
-    )?;
-    chart
-        .draw_series(LineSeries::new(
-            p.c_curve_after.iter().copied(),
-            red.stroke_width(2),
-        ))?
-        .label("C after, as written")
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], red));
-    chart.draw_series(
-        p.c_points_after
-            .iter()
-            .map(|&q| Circle::new(q, 2, red.filled())),
-    )?;
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperLeft)
-        .draw()?;
+    // Top: C(s); middle: P(s).
+    let axis_panels = [
+        (
+            top,
+            "C, °".to_string(),
+            "C",
+            (&p.c_curve_before, &p.c_points_before),
+            (&p.c_curve_after, &p.c_points_after),
+        ),
+        (
+            middle,
+            format!("{}, °", p.primary_letter),
+            "primary",
+            (&p.p_curve_before, &p.p_points_before),
+            (&p.p_curve_after, &p.p_points_after),
+        ),
+    ];
+    for (area, desc, what, (cb, pb), (ca, pa)) in axis_panels {
+        let (y0, y1) = range(cb.iter().chain(ca.iter()).map(|q| q.1));
+        let mut chart = ChartBuilder::on(area)
+            .margin(10)
+            .x_label_area_size(35)
+            .y_label_area_size(60)
+            .build_cartesian_2d(x0..x1, y0..y1)?;
+        chart.configure_mesh().x_desc("s, mm").y_desc(desc).draw()?;
+        chart.draw_series(std::iter::once(Rectangle::new(
+            [(p.zone_s_mm.0, y0), (p.zone_s_mm.1, y1)],
+            zone_fill.filled(),
+        )))?;
+        chart
+            .draw_series(LineSeries::new(cb.iter().copied(), blue.stroke_width(1)))?
+            .label(format!("{what} before (analysis spline, CL points)"))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue));
+        chart.draw_series(pb.iter().map(|&q| Circle::new(q, 2, blue.filled())))?;
+        chart
+            .draw_series(LineSeries::new(ca.iter().copied(), red.stroke_width(2)))?
+            .label(format!("{what} after, as written"))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], red));
+        chart.draw_series(pa.iter().map(|&q| Circle::new(q, 2, red.filled())))?;
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperLeft)
+            .draw()?;
+    }
 
     // Bottom: the Equation-6 ratio, coloured by the limiting axis.
-    let mut chart = ChartBuilder::on(&bottom)
+    let mut chart = ChartBuilder::on(bottom)
         .margin(10)
         .x_label_area_size(35)
         .y_label_area_size(60)
@@ -223,7 +232,11 @@ mod tests {
             c_points_before: line.clone(),
             c_points_after: line.clone(),
             c_curve_before: line.clone(),
-            c_curve_after: line,
+            c_curve_after: line.clone(),
+            p_points_before: line.clone(),
+            p_points_after: line.clone(),
+            p_curve_before: line.clone(),
+            p_curve_after: line,
             ratio_before: samples.clone(),
             ratio_after: samples,
         };
@@ -232,5 +245,6 @@ mod tests {
         assert!(svg.trim_end().ends_with("</svg>"));
         assert!(svg.contains("<polyline") || svg.contains("<path"));
         assert!(svg.contains("C limits"));
+        assert!(svg.contains("primary after"), "the primary axis' panel");
     }
 }

@@ -4,7 +4,8 @@
 use polepatch::kinematics::{Axis, Machine};
 use polepatch::nc::{Dialect, parse};
 use polepatch::patcher::direct::deviation_bound_zone;
-use polepatch::patcher::{AnalysisOptions, CLimits, PatchOptions, analyze_path};
+use polepatch::patcher::verify::NOT_WORSE_REL;
+use polepatch::patcher::{AnalysisOptions, CLimits, PatchAxes, PatchOptions, Sample, analyze_path};
 use polepatch::program::{LoadedProgram, load_nc};
 use polepatch::{FileReport, patch_loaded};
 use std::path::{Path, PathBuf};
@@ -56,25 +57,31 @@ pub fn c_ratios_and_zones(lp: &LoadedProgram, machine: &Machine, cone: f64) -> V
         .collect()
 }
 
-/// Bytes of `line` with the C word at `span` removed (and one separator byte before it
-/// when `with_sep`).
-fn strip(line: &[u8], span: Option<std::ops::Range<usize>>, with_sep: bool) -> Vec<u8> {
-    match span {
-        None => line.to_vec(),
-        Some(r) => {
-            let start = if with_sep && r.start > 0 && line[r.start - 1] == b' ' {
-                r.start - 1
-            } else {
-                r.start
-            };
-            [&line[..start], &line[r.end..]].concat()
+/// Bytes of block `b` of a parsed program with every word whose letter is in `letters`
+/// removed, together with the blanks before it (an inserted word brings its separator).
+fn strip_words(p: &polepatch::nc::Program, b: usize, letters: &[u8]) -> Vec<u8> {
+    let span = p.blocks[b].span();
+    let bytes = &p.bytes;
+    let mut out = Vec::new();
+    let mut pos = span.start;
+    for w in p.block_words(b) {
+        if !letters.contains(&w.letter) {
+            continue;
         }
+        let mut start = w.span().start;
+        while start > pos && (bytes[start - 1] == b' ' || bytes[start - 1] == b'\t') {
+            start -= 1;
+        }
+        out.extend_from_slice(&bytes[pos..start]);
+        pos = w.span().end;
     }
+    out.extend_from_slice(&bytes[pos..span.end]);
+    out
 }
 
-/// Assert that `out` differs from `inp` only in C words (changed, or inserted where a
-/// block had none).
-pub fn assert_only_c_words_differ(name: &str, inp: &[u8], out: &[u8]) {
+/// Assert that `out` differs from `inp` only in words with the given letters (changed, or
+/// inserted where a block had none), line endings and all other bytes unchanged.
+pub fn assert_only_words_differ(name: &str, inp: &[u8], out: &[u8], letters: &[u8]) {
     let a = parse(inp.to_vec(), Dialect::Auto).unwrap();
     let b = parse(out.to_vec(), Dialect::Auto)
         .unwrap_or_else(|e| panic!("{name}: output does not parse: {e}"));
@@ -83,56 +90,217 @@ pub fn assert_only_c_words_differ(name: &str, inp: &[u8], out: &[u8]) {
         b.blocks.len(),
         "{name}: block count changed"
     );
-    for (ba, bb) in a.blocks.iter().zip(&b.blocks) {
-        let la = &inp[ba.span()];
-        let lb = &out[bb.span()];
-        if la == lb {
+    for (i, (ba, bb)) in a.blocks.iter().zip(&b.blocks).enumerate() {
+        if inp[ba.span()] == out[bb.span()] {
             continue;
         }
-        let ca = a
-            .block_words(a.blocks.iter().position(|x| x == ba).unwrap())
-            .iter()
-            .find(|w| w.letter == b'C')
-            .map(|w| w.span().start - ba.span().start..w.span().end - ba.span().start);
-        let ib = b.blocks.iter().position(|x| x == bb).unwrap();
-        let cb = b
-            .block_words(ib)
-            .iter()
-            .find(|w| w.letter == b'C')
-            .map(|w| w.span().start - bb.span().start..w.span().end - bb.span().start);
-        assert!(
-            cb.is_some(),
-            "{name} line {}: changed without a C word",
-            ba.line
-        );
-        let inserted = ca.is_none();
         assert_eq!(
-            strip(la, ca, false),
-            strip(lb, cb, inserted),
-            "{name} line {}: bytes other than the C word differ:\n  in:  {}\n  out: {}",
+            strip_words(&a, i, letters),
+            strip_words(&b, i, letters),
+            "{name} line {}: bytes other than the {} words differ:\n  in:  {}\n  out: {}",
             ba.line,
-            String::from_utf8_lossy(la),
-            String::from_utf8_lossy(lb)
+            String::from_utf8_lossy(letters),
+            String::from_utf8_lossy(&inp[ba.span()]),
+            String::from_utf8_lossy(&out[bb.span()])
         );
     }
     // Line endings and anything between blocks.
-    let ends_a: Vec<&[u8]> = a
-        .blocks
-        .iter()
-        .zip(a.blocks.iter().skip(1))
-        .map(|(x, y)| &inp[x.span().end..y.span().start])
-        .collect();
-    let ends_b: Vec<&[u8]> = b
-        .blocks
-        .iter()
-        .zip(b.blocks.iter().skip(1))
-        .map(|(x, y)| &out[x.span().end..y.span().start])
-        .collect();
-    assert_eq!(ends_a, ends_b, "{name}: line endings changed");
+    let ends = |p: &polepatch::nc::Program, t: &[u8]| -> Vec<Vec<u8>> {
+        p.blocks
+            .iter()
+            .zip(p.blocks.iter().skip(1))
+            .map(|(x, y)| t[x.span().end..y.span().start].to_vec())
+            .collect()
+    };
+    assert_eq!(ends(&a, inp), ends(&b, out), "{name}: line endings changed");
 }
 
-/// Patch `bytes` and check the invariants of issue 4. Returns the report.
+/// [`assert_only_words_differ`] for C words.
+pub fn assert_only_c_words_differ(name: &str, inp: &[u8], out: &[u8]) {
+    assert_only_words_differ(name, inp, out, b"C");
+}
+
+/// [`assert_only_words_differ`] for the rotary words (A, B, C).
+pub fn assert_only_rotary_words_differ(name: &str, inp: &[u8], out: &[u8]) {
+    assert_only_words_differ(name, inp, out, b"ABC");
+}
+
+/// Patch `bytes` and check the invariants of the method `opts.axes` selects. Returns the
+/// report and the output.
 pub fn check_patch(
+    name: &str,
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &PatchOptions,
+) -> (FileReport, Vec<u8>) {
+    match opts.axes {
+        PatchAxes::OnlyC => check_patch_only_c(name, bytes, machine, opts),
+        PatchAxes::Both => check_patch_both(name, bytes, machine, opts),
+    }
+}
+
+/// Per run, the analysis samples (`None` for a run not analysed).
+fn run_samples(lp: &LoadedProgram, machine: &Machine, cone: f64) -> Vec<Option<Vec<Sample>>> {
+    let opts = AnalysisOptions {
+        cone_deg: cone,
+        keep_samples: true,
+        ..AnalysisOptions::default()
+    };
+    lp.runs
+        .iter()
+        .map(|r| {
+            r.path
+                .as_ref()
+                .ok()
+                .map(|p| analyze_path(p, machine, &opts).unwrap().samples)
+        })
+        .collect()
+}
+
+/// The invariants of issue 8 for the default method (both rotary axes):
+/// - a program without zone comes out byte-identical; only rotary words differ;
+/// - every zone the report lists reaches feed on both rotary axes (on the written values,
+///   read back) and the file read back has no singular zone left;
+/// - nothing is worse: at every analysis sample of every run, the primary and C ratios are
+///   at least `min(before, 1)` (to `NOT_WORSE_REL`), and X Y Z (hence s and their ratios)
+///   are unchanged.
+pub fn check_patch_both(
+    name: &str,
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &PatchOptions,
+) -> (FileReport, Vec<u8>) {
+    let m = &machine.name;
+    let lp = load_bytes(bytes, name, machine);
+    let before = c_ratios_and_zones(&lp, machine, opts.cone_deg);
+    let (out, report) = patch_loaded(&lp, machine, opts);
+    if before.iter().all(|r| r.1 == 0) {
+        assert_eq!(out, bytes, "{name} on {m}: no zone, so byte-identical");
+    }
+    assert_only_rotary_words_differ(name, bytes, &out);
+    let lp2 = load_bytes(&out, name, machine);
+    let after = c_ratios_and_zones(&lp2, machine, opts.cone_deg);
+    let mut proven = 0;
+    for z in &report.zones {
+        if z.outcome != "reached" {
+            // Left below feed: only where no values at all can reach it (the LP proof).
+            assert!(
+                proven_unreachable(&lp, z, machine, opts),
+                "{name} on {m}: zone left below feed, yet reachable: {z:?}"
+            );
+            eprintln!(
+                "note: {name} on {m}: zone lines {:?} proven unreachable",
+                z.lines
+            );
+            proven += 1;
+            continue;
+        }
+        assert!(
+            z.after.c_ratio >= 1.0 - 1e-9 && z.after.primary_ratio >= 1.0 - 1e-9,
+            "{name} on {m}: both rotary axes must reach feed: {z:?}"
+        );
+    }
+    let left: usize = after.iter().map(|a| a.1).sum();
+    if proven == 0 {
+        assert_eq!(
+            left, 0,
+            "{name} on {m}: zones left after patching: {after:?}"
+        );
+    }
+    let (sb, sa) = (
+        run_samples(&lp, machine, opts.cone_deg),
+        run_samples(&lp2, machine, opts.cone_deg),
+    );
+    for (k, (b, a)) in sb.iter().zip(&sa).enumerate() {
+        let (Some(b), Some(a)) = (b, a) else { continue };
+        assert_eq!(
+            b.len(),
+            a.len(),
+            "{name} on {m}: run {}: samples moved",
+            k + 1
+        );
+        for (x, y) in b.iter().zip(a) {
+            assert_eq!(x.s_mm, y.s_mm);
+            for axis in 0..5 {
+                // "Not worse" to the patcher's resolution (0.01 % of the ratio).
+                let floor = x.axis_ratio[axis].min(1.0) * (1.0 - NOT_WORSE_REL) - 1e-12;
+                assert!(
+                    y.axis_ratio[axis] >= floor,
+                    "{name} on {m}: run {}, s = {:.3} mm: axis {axis} ratio {:.4} → {:.4}",
+                    k + 1,
+                    x.s_mm,
+                    x.axis_ratio[axis],
+                    y.axis_ratio[axis]
+                );
+            }
+        }
+    }
+    (report, out)
+}
+
+/// Whether the zone of report row `z` is proven unreachable: with every point of its run
+/// but the first (and the last, where `polepatch::end_pose` keeps it) free, no values
+/// written with `opts.max_decimals` decimals bring the zone's original singular zones to
+/// feed on both rotary axes ([`polepatch::patcher::reference::reachable`]).
+pub fn proven_unreachable(
+    lp: &LoadedProgram,
+    z: &polepatch::ZoneRow,
+    machine: &Machine,
+    opts: &PatchOptions,
+) -> bool {
+    let r = z.run - 1;
+    let Ok(path) = &lp.runs[r].path else {
+        return false;
+    };
+    let n = path.s_mm.len();
+    let a = analyze_path(
+        path,
+        machine,
+        &AnalysisOptions {
+            cone_deg: opts.cone_deg,
+            ..AnalysisOptions::default()
+        },
+    )
+    .unwrap();
+    let (l0, l1) = (z.lines[0], z.lines[1]);
+    let inside: Vec<_> = a
+        .zones
+        .iter()
+        .filter(|x| lp.line_of(r, x.first) <= l1 && lp.line_of(r, x.last) >= l0)
+        .collect();
+    if inside.is_empty() {
+        return false;
+    }
+    let zone = polepatch::patcher::Zone {
+        first: inside.iter().map(|x| x.first).min().unwrap(),
+        last: inside.iter().map(|x| x.last).max().unwrap(),
+        ..inside[0].clone()
+    };
+    let end = if polepatch::end_pose::end_pose_is_free(lp, r) {
+        n - 1
+    } else {
+        n - 2
+    };
+    let p: Vec<f64> = path.axes.iter().map(|q| q[Axis::Primary.index()]).collect();
+    let c: Vec<f64> = path.axes.iter().map(|q| q[Axis::C.index()]).collect();
+    let step = path.feed_mm_min / 60.0 * opts.tcy_s.unwrap_or(machine.tcy_s);
+    !polepatch::patcher::reference::reachable(
+        &path.s_mm,
+        &p,
+        &c,
+        1,
+        end,
+        polepatch::patcher::reference::zone_core(&zone, n),
+        machine,
+        path.feed_mm_min,
+        step,
+        opts.max_decimals,
+    )
+    .unwrap_or(true)
+}
+
+/// The invariants of issue 4 for the C-only method (`--only-c`). Returns the report.
+pub fn check_patch_only_c(
     name: &str,
     bytes: &[u8],
     machine: &Machine,
