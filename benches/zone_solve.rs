@@ -1,36 +1,27 @@
 //! Time to patch one singular zone (SPEC §6: ≤ 1 ms median): `patch_path` on whole runs
-//! whose zones are known, reported per run (divide by the zone count printed at start-up).
-//! Run:
+//! whose zones are known, with the default method (both rotary axes: re-selection or the
+//! joint SOCP) and with `--only-c` (G16's C-only method). Each benched run holds one zone;
+//! the figure includes detection, every solve, verification and the report figures. Run:
 //! `cargo bench -p polepatch-benches --bench zone_solve -- --warm-up-time 1 --measurement-time 5`
 //! Figures are written up in docs/performance-patcher.md.
 
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use polepatch::program::load_nc;
 use polepatch_kinematics::Machine;
-use polepatch_nc::{Dialect, modal, parse, primary_in_use, runs};
-use polepatch_patcher::{PatchOptions, Path, patch_path};
+use polepatch_patcher::{PatchAxes, PatchOptions, Path, patch_path};
 
-/// The runs of a fixture that have zones on `machine`, as the CLI builds them.
+/// The runs of a fixture that have zones on `machine`, as the pipeline builds them.
 fn zone_runs(file: &str, machine: &Machine) -> Vec<Path> {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let bytes = std::fs::read(root.join(file)).expect("fixture");
-    let prog = parse(bytes, Dialect::Auto).expect("parsable fixture");
-    let rs = runs(&prog);
-    let own = if machine.primary_letter() == 'A' {
-        modal::A
-    } else {
-        modal::B
-    };
-    let pi = primary_in_use(&rs, own);
+    let lp = load_nc(bytes, file, machine, None).expect("parsable fixture");
     let opts = PatchOptions::default();
-    rs.iter()
+    lp.runs
+        .into_iter()
         .filter_map(|r| {
-            let path = Path {
-                s_mm: r.s_mm.clone(),
-                axes: r.axes5(pi),
-                feed_mm_min: r.feed_mm_min?,
-            };
+            let path = r.path.ok()?;
             let res = patch_path(&path, machine, &opts).ok()?;
             (!res.zones.is_empty()).then_some(path)
         })
@@ -46,20 +37,28 @@ fn zone_solve(c: &mut Criterion) {
             "fixtures/generated/heidenhain-ac-swing-d0.5.I",
         ),
     ];
-    let opts = PatchOptions::default();
     let mut g = c.benchmark_group("patcher/zone_solve");
-    for mname in ["mikron-ucp710", "mikron-hsm600"] {
-        let m = Machine::builtin(mname).expect("built-in machine");
-        for (label, file) in cases {
-            for (k, path) in zone_runs(file, &m).into_iter().enumerate() {
-                let zones = patch_path(&path, &m, &opts).unwrap().zones.len();
-                eprintln!(
-                    "{label}/{mname}/run{k}: {zones} zone(s), {} points",
-                    path.s_mm.len()
-                );
-                g.bench_function(format!("{label}/{mname}/run{k}"), |b| {
-                    b.iter(|| patch_path(black_box(&path), &m, &opts).unwrap())
-                });
+    g.sample_size(10);
+    for (method, axes) in [("both", PatchAxes::Both), ("only-c", PatchAxes::OnlyC)] {
+        let opts = PatchOptions {
+            axes,
+            ..PatchOptions::default()
+        };
+        for mname in ["mikron-ucp710", "mikron-hsm600"] {
+            let m = Machine::builtin(mname).expect("built-in machine");
+            for (label, file) in cases {
+                for (k, path) in zone_runs(file, &m).into_iter().enumerate() {
+                    let res = patch_path(&path, &m, &opts).unwrap();
+                    eprintln!(
+                        "{method}/{label}/{mname}/run{k}: {} zone(s), {} points, {} solves",
+                        res.zones.len(),
+                        path.s_mm.len(),
+                        res.zones.iter().map(|z| z.qp.solves).sum::<u32>()
+                    );
+                    g.bench_function(format!("{method}/{label}/{mname}/run{k}"), |b| {
+                        b.iter(|| patch_path(black_box(&path), &m, &opts).unwrap())
+                    });
+                }
             }
         }
     }

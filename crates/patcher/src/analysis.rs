@@ -391,3 +391,160 @@ pub fn detect_zones(path: &Path, below: &[BelowFeed], cone_deg: f64) -> Vec<Zone
     }
     zones
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testutil::{machine, planted};
+
+    /// A straight line of X only, at any feed: every ratio is 1, the time is exactly L/F,
+    /// no zone.
+    #[test]
+    fn a_straight_line_runs_at_feed() {
+        let m = machine("mikron-ucp710");
+        let path = Path {
+            s_mm: (0..21).map(f64::from).collect(),
+            axes: (0..21)
+                .map(|i| [f64::from(i), 0.0, 0.0, 20.0, 30.0])
+                .collect(),
+            feed_mm_min: 3000.0,
+        };
+        let a = analyze_path(&path, &m, &AnalysisOptions::default()).unwrap();
+        assert_eq!(a.min.ratio, 1.0);
+        assert!((a.time_s - a.ideal_time_s).abs() < 1e-12, "{a:?}");
+        assert!((a.ideal_time_s - 20.0 / 50.0).abs() < 1e-12);
+        assert!(a.zones.is_empty());
+        assert_eq!(a.step_mm, 50.0 * m.tcy_s);
+    }
+
+    /// Planted constant slowdown: C turning at twice V/F everywhere halves the feed, so the
+    /// estimated time is exactly 2·L/F and C's velocity limits (no zone: the primary axis
+    /// is far from the pole).
+    #[test]
+    fn time_estimate_of_a_planted_slowdown() {
+        let m = machine("mikron-ucp710");
+        let feed = 1000.0;
+        let v = m.limit(Axis::C).v / (feed / 60.0); // V/F, °/mm
+        let path = Path {
+            s_mm: (0..41).map(|i| 0.5 * f64::from(i)).collect(),
+            axes: (0..41)
+                .map(|i| {
+                    let s = 0.5 * f64::from(i);
+                    [s, 0.0, 0.0, 30.0, 2.0 * v * s]
+                })
+                .collect(),
+            feed_mm_min: feed,
+        };
+        let a = analyze_path(&path, &m, &AnalysisOptions::default()).unwrap();
+        assert!((a.min.ratio - 0.5).abs() < 1e-12, "{:?}", a.min);
+        assert_eq!(
+            (a.min.axis, a.min.kind),
+            (Some(Axis::C), LimitKind::Velocity)
+        );
+        assert!((a.time_s - 2.0 * a.ideal_time_s).abs() < 1e-9, "{a:?}");
+        assert!(a.zones.is_empty(), "P = 30° is outside the cone");
+        assert!((a.peak_speed[Axis::C.index()] - 2.0 * m.limit(Axis::C).v).abs() < 1e-9);
+    }
+
+    /// A domain-rule flip is an A-flip zone whose singular point is the last point before
+    /// the sign change; the continuous branch of the same pass is a C-swing zone whose
+    /// singular point is the point of least |P|; both need a point within the cone.
+    #[test]
+    fn zone_kinds_and_singular_points() {
+        let m = machine("mikron-ucp710");
+        let flip = planted(241, 0.5, 1.0, true, 1000.0);
+        let a = analyze_path(&flip, &m, &AnalysisOptions::default()).unwrap();
+        assert_eq!(a.zones.len(), 1);
+        let z = &a.zones[0];
+        assert_eq!(z.kind, ZoneKind::AFlip);
+        let p = |i: usize| flip.axes[i][Axis::Primary.index()];
+        assert!(p(z.singular) * p(z.singular + 1) < 0.0, "{z:?}");
+        assert!((z.min_abs_primary_deg - 1.0).abs() < 0.01, "{z:?}");
+        assert!(z.first < z.singular && z.singular < z.last && z.c_ratio_min < 1.0);
+
+        let swing = planted(241, 0.5, 1.0, false, 1000.0);
+        let a = analyze_path(&swing, &m, &AnalysisOptions::default()).unwrap();
+        assert_eq!(a.zones.len(), 1);
+        let z = &a.zones[0];
+        assert_eq!(z.kind, ZoneKind::CSwing);
+        let least = (z.first..=z.last)
+            .min_by(|&i, &j| swing.axes[i][3].abs().total_cmp(&swing.axes[j][3].abs()))
+            .unwrap();
+        assert_eq!(z.singular, least);
+
+        // The same swing with a cone of 0.5°: C still crawls, but no point is in the cone.
+        let narrow = AnalysisOptions {
+            cone_deg: 0.5,
+            ..AnalysisOptions::default()
+        };
+        let a = analyze_path(&swing, &m, &narrow).unwrap();
+        assert!(a.zones.is_empty());
+        assert!(a.axis_min[Axis::C.index()].0 < 1.0);
+    }
+
+    /// Stretches of C below feed that touch merge into one zone; `detect_zones` on planted
+    /// stretches.
+    #[test]
+    fn touching_stretches_merge() {
+        let path = planted(41, 1.0, 1.0, false, 1000.0);
+        let below = [
+            BelowFeed {
+                first_span: 10,
+                last_span: 14,
+                min_ratio: 0.5,
+            },
+            BelowFeed {
+                first_span: 15,
+                last_span: 22,
+                min_ratio: 0.2,
+            },
+            BelowFeed {
+                first_span: 30,
+                last_span: 31,
+                min_ratio: 0.9,
+            },
+        ];
+        let zones = detect_zones(&path, &below, 50.0);
+        assert_eq!(zones.len(), 2, "{zones:?}");
+        assert_eq!((zones[0].first, zones[0].last), (10, 23));
+        assert_eq!(zones[0].c_ratio_min, 0.2);
+        assert_eq!((zones[1].first, zones[1].last), (30, 32));
+        // With a 0.1° cone neither has a point in it.
+        assert!(detect_zones(&path, &below, 0.1).is_empty());
+    }
+
+    /// Bad paths are errors, never a panic or a silent result.
+    #[test]
+    fn bad_paths_are_errors() {
+        let m = machine("mikron-ucp710");
+        let ok = planted(5, 1.0, 1.0, false, 1000.0);
+        let mut bad = ok.clone();
+        bad.s_mm[2] = bad.s_mm[1];
+        assert!(matches!(
+            analyze_path(&bad, &m, &AnalysisOptions::default()),
+            Err(PathError::NotIncreasing { index: 2, .. })
+        ));
+        let mut bad = ok.clone();
+        bad.axes[3][4] = f64::INFINITY;
+        assert!(matches!(
+            analyze_path(&bad, &m, &AnalysisOptions::default()),
+            Err(PathError::NotFinite {
+                index: 3,
+                what: "C",
+                ..
+            })
+        ));
+        let mut bad = ok.clone();
+        bad.feed_mm_min = 0.0;
+        assert!(analyze_path(&bad, &m, &AnalysisOptions::default()).is_err());
+        let one = Path {
+            s_mm: vec![0.0],
+            axes: vec![[0.0; 5]],
+            feed_mm_min: 1000.0,
+        };
+        assert_eq!(
+            analyze_path(&one, &m, &AnalysisOptions::default()),
+            Err(PathError::TooShort(1))
+        );
+    }
+}

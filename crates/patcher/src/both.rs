@@ -50,6 +50,10 @@ pub const MARGIN_LADDER: [f64; 3] = [1.0, 0.25, 0.0];
 /// patch (clipped to the run); after the last, the whole run is tried.
 pub const WIDENING_POINTS: [usize; 5] = [4, 10, 22, 46, 94];
 
+/// |P| below which a point counts as on the pole when C's continuity is judged, degrees
+/// (C does not orient the tool there).
+pub const POLE_DEG: f64 = 1e-6;
+
 /// Solves each start gets when several are screened at a level; the best then goes on
 /// (warm) for the rest of [`crate::joint::SCP_MAX_SOLVES`].
 pub const SCREEN_SOLVES: usize = 2;
@@ -298,8 +302,10 @@ impl Ctx<'_> {
         if p[k + 1..].iter().any(|&v| !(lo..=hi).contains(&-v)) {
             return None;
         }
-        // C after the switch, moved by ±180°, nearest to C before it.
-        let d = wrap_deg(c[k + 1] + 180.0 - c[k]) - (c[k + 1] + 180.0 - c[k]);
+        // C after the switch, moved by ±180°, nearest to C before it — before it on a
+        // point off the pole (on the pole C does not orient the tool and may be anything).
+        let r = (0..=k).rev().find(|&i| p[i].abs() > POLE_DEG).unwrap_or(k);
+        let d = wrap_deg(c[k + 1] + 180.0 - c[r]) - (c[k + 1] + 180.0 - c[r]);
         let shift = 180.0 + d;
         let shift = if shift > 180.0 + 1e-9 {
             shift - 360.0
@@ -690,5 +696,173 @@ impl Ctx<'_> {
             Some(ck) => Some((ck, true)),
             None => best.map(|b| (b, false)),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::Sample;
+    use crate::testutil::{machine, planted, sing_path};
+    use crate::verify::NOT_WORSE_REL;
+
+    fn samples(path: &Path, m: &Machine) -> Vec<Sample> {
+        let opts = AnalysisOptions {
+            keep_samples: true,
+            ..AnalysisOptions::default()
+        };
+        analyze_path(path, m, &opts).unwrap().samples
+    }
+
+    /// The path with the result's values.
+    fn written(path: &Path, res: &PatchResult) -> Path {
+        let mut out = path.clone();
+        for (q, (p, c)) in out.axes.iter_mut().zip(res.p_deg.iter().zip(&res.c_deg)) {
+            q[3] = *p;
+            q[4] = *c;
+        }
+        out
+    }
+
+    /// The invariants of the default method: X Y Z unchanged and the changed flags right;
+    /// at every analysis sample no axis ratio falls below `min(before, 1)` (to
+    /// NOT_WORSE_REL); every zone reaches feed on both rotary axes; the result read back
+    /// has no zone left. Returns the largest orientation change.
+    fn check_both(path: &Path, m: &Machine, res: &PatchResult, what: &str) -> f64 {
+        let after = written(path, res);
+        for (i, (a, b)) in path.axes.iter().zip(&after.axes).enumerate() {
+            assert_eq!(a[..3], b[..3], "{what}: X Y Z moved at {i}");
+            assert_eq!(res.p_changed[i], a[3] != b[3], "{what}");
+            assert_eq!(res.c_changed[i], a[4] != b[4], "{what}");
+        }
+        assert!(
+            !res.p_changed[0] && !res.c_changed[0],
+            "{what}: the first point moved"
+        );
+        for (x, y) in samples(path, m).iter().zip(&samples(&after, m)) {
+            for k in 0..5 {
+                let floor = x.axis_ratio[k].min(1.0) * (1.0 - NOT_WORSE_REL) - 1e-12;
+                assert!(
+                    y.axis_ratio[k] >= floor,
+                    "{what}: axis {k} at s = {:.3}: {} → {}",
+                    x.s_mm,
+                    x.axis_ratio[k],
+                    y.axis_ratio[k]
+                );
+            }
+        }
+        for z in &res.zones {
+            assert_eq!(z.outcome, Outcome::Reached, "{what}: {z:#?}");
+            assert!(z.after.c_ratio >= 1.0 - 1e-9 && z.after.primary_ratio >= 1.0 - 1e-9);
+        }
+        let a = analyze_path(&after, m, &AnalysisOptions::default()).unwrap();
+        assert!(a.zones.is_empty(), "{what}: zones left {:?}", a.zones);
+        (0..path.s_mm.len())
+            .map(|i| {
+                let o = forward(m, path.axes[i][3], path.axes[i][4]);
+                angle_between_deg(o, forward(m, res.p_deg[i], res.c_deg[i]))
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// Issue 8's planted check: a domain-rule flip 4° from the pole on the UCP710 (F1000,
+    /// 0.5 mm spacing) reaches feed on both axes by re-selection alone, every point's tool
+    /// axis unchanged (< 0.01°).
+    #[test]
+    fn domain_rule_flip_at_4_degrees_is_reselected() {
+        let m = machine("mikron-ucp710");
+        let path = planted(241, 0.5, 4.0, true, 1000.0);
+        let before = analyze_path(&path, &m, &AnalysisOptions::default()).unwrap();
+        assert_eq!(before.zones.len(), 1, "the planted zone");
+        assert!(
+            before.axis_min[Axis::Primary.index()].0 < 0.5,
+            "A crawls before"
+        );
+        let res = patch_both(&path, &m, &PatchOptions::default()).unwrap();
+        assert_eq!(res.zones.len(), 1);
+        let z = &res.zones[0];
+        assert_eq!(z.method, Method::Reselect, "{z:#?}");
+        assert!(z.reselected_points > 100, "{z:#?}");
+        let dev = check_both(&path, &m, &res, "flip 4°");
+        assert!(dev < 0.01, "largest deviation {dev}°");
+        assert!(z.max_deviation_deg < 0.01);
+        // Every primary value past the switch has the other sign, on one branch.
+        assert!(res.p_deg.iter().all(|&p| p >= 0.0));
+    }
+
+    /// Flips and swings 0 … 4° from the pole, both machines: both rotary axes reach feed,
+    /// nothing gets worse, and the orientation changes by no more than going through the
+    /// pole costs (about the distance to it), to SPEC §6's 1.25×.
+    #[test]
+    fn planted_passes_reach_feed_on_both_axes() {
+        let opts = PatchOptions::default();
+        let mut zones = 0;
+        for (mname, feed) in [("mikron-hsm600", 3000.0), ("mikron-ucp710", 1000.0)] {
+            let m = machine(mname);
+            for flip in [false, true] {
+                for d in [0.0, 0.01, 0.5, 2.0, 4.0] {
+                    let path = planted(241, 0.5, d, flip, feed);
+                    let res = patch_both(&path, &m, &opts).unwrap();
+                    zones += res.zones.len();
+                    let what = format!("{mname} F{feed} flip={flip} d={d}");
+                    let dev = check_both(&path, &m, &res, &what);
+                    assert!(dev <= 1.25 * d + 0.01, "{what}: {dev}°");
+                }
+            }
+        }
+        assert!(zones >= 16, "{zones}");
+    }
+
+    /// C17's `%SING` on the UCP710: A and C both reach feed, the tool passes (within
+    /// rounding) through the pole, about 1° from the programmed axes (C-only: 3.35°).
+    #[test]
+    fn sing_reaches_feed_on_both_axes() {
+        let m = machine("mikron-ucp710");
+        let path = sing_path();
+        let res = patch_both(&path, &m, &PatchOptions::default()).unwrap();
+        let dev = check_both(&path, &m, &res, "SING");
+        assert!(dev < 1.01, "{dev}°");
+        let sign_changes = res.p_deg.windows(2).filter(|w| w[0] * w[1] < 0.0).count();
+        assert_eq!(sign_changes, 1, "A passes through zero once");
+    }
+
+    /// A machine whose primary range forbids the other branch ([0°, 120°]): nothing is ever
+    /// written outside it, and the zones are still patched on the programmed side.
+    #[test]
+    fn primary_range_forbids_the_other_branch() {
+        let mut m = machine("mikron-ucp710");
+        m.primary_range_deg = (0.0, 120.0);
+        for d in [0.01, 0.5, 2.0] {
+            let path = planted(241, 0.5, d, false, 1000.0);
+            let res = patch_both(&path, &m, &PatchOptions::default()).unwrap();
+            assert!(
+                res.p_deg.iter().all(|&p| (0.0..=120.0).contains(&p)),
+                "d={d}: a primary value left the range"
+            );
+            assert!(!res.zones.is_empty(), "d={d}");
+            check_both(&path, &m, &res, &format!("range [0, 120], d={d}"));
+        }
+    }
+
+    /// Degenerate inputs: three points across the pole, and a point exactly on the pole.
+    #[test]
+    fn tiny_paths_and_the_exact_pole_do_not_panic() {
+        let m = machine("mikron-ucp710");
+        let three = Path {
+            s_mm: vec![0.0, 1.0, 2.0],
+            axes: vec![
+                [0.0, 0.0, 0.0, 1.0, 0.0],
+                [1.0, 0.0, 0.0, 0.0, 90.0],
+                [2.0, 0.0, 0.0, -1.0, 180.0],
+            ],
+            feed_mm_min: 2000.0,
+        };
+        let res = patch_both(&three, &m, &PatchOptions::default()).unwrap();
+        assert_eq!(res.c_deg.len(), 3);
+        assert!(!res.p_changed[0] && !res.c_changed[0]);
+        let mut pole = planted(81, 1.0, 0.0, false, 2000.0);
+        pole.axes[40][3] = 0.0;
+        let res = patch_both(&pole, &m, &PatchOptions::default()).unwrap();
+        check_both(&pole, &m, &res, "exact pole");
     }
 }

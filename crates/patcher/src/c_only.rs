@@ -484,3 +484,163 @@ impl Ctx<'_> {
         None
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::direct::deviation_bound_sampled;
+    use crate::limits::CLimits;
+    use crate::testutil::{machine, planted, sing_path};
+
+    const DIRECT_ONLY: Methods = Methods {
+        g16: false,
+        direct: true,
+    };
+
+    /// The invariants of the C-only method on a patched path: only C changes (and
+    /// `c_changed` says where), C never gets worse, every zone in the cone reaches feed on
+    /// C, and the path read back has no zone left.
+    fn check_invariants(path: &Path, m: &Machine, res: &PatchResult, opts: &PatchOptions) {
+        let before = analyze_path(path, m, &AnalysisOptions::default()).unwrap();
+        let mut after_path = path.clone();
+        for (q, c) in after_path.axes.iter_mut().zip(&res.c_deg) {
+            q[4] = *c;
+        }
+        for (i, (a, b)) in path.axes.iter().zip(&after_path.axes).enumerate() {
+            assert_eq!(a[..4], b[..4]);
+            assert_eq!(res.c_changed[i], a[4] != b[4]);
+        }
+        assert!(!res.p_changed.iter().any(|&c| c), "C-only never moves P");
+        let after = analyze_path(&after_path, m, &AnalysisOptions::default()).unwrap();
+        assert!(
+            after.axis_min[4].0 >= before.axis_min[4].0 - 1e-9,
+            "C ratio got worse: {} -> {}",
+            before.axis_min[4].0,
+            after.axis_min[4].0
+        );
+        for z in &res.zones {
+            if z.min_abs_primary_deg <= opts.cone_deg {
+                assert_eq!(z.outcome, Outcome::Reached, "zone not reached: {z:#?}");
+                assert!(z.after.c_ratio >= 1.0 - 1e-9, "{z:#?}");
+            }
+        }
+        assert!(after.zones.is_empty(), "zones left: {:?}", after.zones);
+    }
+
+    /// Planted flips and swings at 0.01–4° from the pole, two spacings, both machines: the
+    /// direct QP alone reaches feed on C; its deviation stays within SPEC §6's 1.25× of the
+    /// C-only LP bound over the points it moved.
+    #[test]
+    fn planted_passes_reach_feed() {
+        let opts = PatchOptions::default();
+        for (mname, feed) in [("mikron-hsm600", 3000.0), ("mikron-ucp710", 1000.0)] {
+            let m = machine(mname);
+            let lim0 = CLimits::new(&m, feed, 0.0);
+            let step = feed / 60.0 * m.tcy_s;
+            for flip in [false, true] {
+                for d in [0.01, 0.5, 2.0, 4.0] {
+                    for spacing in [1.0, 0.5] {
+                        let n = (120.0 / spacing) as usize + 1;
+                        let path = planted(n, spacing, d, flip, feed);
+                        let res = patch_c_only(&path, &m, &opts, DIRECT_ONLY).unwrap();
+                        check_invariants(&path, &m, &res, &opts);
+                        let p: Vec<f64> = path.axes.iter().map(|q| q[3]).collect();
+                        let c: Vec<f64> = path.axes.iter().map(|q| q[4]).collect();
+                        for z in &res.zones {
+                            // The bound over the points this patch moved (zone ∪ patch).
+                            let (bound, _) = deviation_bound_sampled(
+                                &path.s_mm, &p, &c, z.first, z.last, &lim0, step,
+                            )
+                            .unwrap();
+                            assert!(
+                                z.max_deviation_deg <= 1.25 * bound + 1e-3,
+                                "{mname} flip={flip} d={d} h={spacing}: {} against {bound}",
+                                z.max_deviation_deg
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The same planted passes with both formulations (G16 first, direct as fallback).
+    #[test]
+    fn planted_passes_reach_feed_with_g16() {
+        let opts = PatchOptions {
+            axes: crate::options::PatchAxes::OnlyC,
+            ..PatchOptions::default()
+        };
+        let mut zones = 0;
+        for (mname, feed) in [("mikron-hsm600", 2000.0), ("mikron-ucp710", 2000.0)] {
+            let m = machine(mname);
+            for flip in [false, true] {
+                for d in [0.01, 0.5, 2.0, 4.0] {
+                    let path = planted(121, 1.0, d, flip, feed);
+                    let res = crate::patch_path(&path, &m, &opts).unwrap();
+                    zones += res.zones.len();
+                    assert!(
+                        res.zones
+                            .iter()
+                            .all(|z| matches!(z.method, Method::G16Patch | Method::Direct)),
+                        "{:?}",
+                        res.zones
+                    );
+                    check_invariants(&path, &m, &res, &opts);
+                }
+            }
+        }
+        assert!(zones >= 12, "{zones} zones");
+    }
+
+    #[test]
+    fn tiny_paths_and_the_exact_pole_do_not_panic() {
+        let m = machine("mikron-ucp710");
+        let three = Path {
+            s_mm: vec![0.0, 1.0, 2.0],
+            axes: vec![
+                [0.0, 0.0, 0.0, 1.0, 0.0],
+                [1.0, 0.0, 0.0, 0.0, 90.0],
+                [2.0, 0.0, 0.0, -1.0, 180.0],
+            ],
+            feed_mm_min: 2000.0,
+        };
+        let res = patch_c_only(&three, &m, &PatchOptions::default(), DIRECT_ONLY).unwrap();
+        assert_eq!(res.c_deg.len(), 3);
+        let mut pole = planted(81, 1.0, 0.0, false, 2000.0);
+        pole.axes[40][3] = 0.0;
+        let res = patch_c_only(&pole, &m, &PatchOptions::default(), DIRECT_ONLY).unwrap();
+        assert_eq!(res.c_deg.len(), 81);
+    }
+
+    /// C17's `%SING` on both machines: reached on C, the deviation between the C-only LP
+    /// bound and 1.25× it (G16's method keeps A, whose jerk then limits on the UCP710).
+    #[test]
+    fn c17_sing() {
+        let path = sing_path();
+        let opts = PatchOptions::default();
+        for mname in ["mikron-ucp710", "mikron-hsm600"] {
+            let m = machine(mname);
+            let res = patch_c_only(&path, &m, &opts, DIRECT_ONLY).unwrap();
+            assert_eq!(res.zones.len(), 1);
+            let p: Vec<f64> = path.axes.iter().map(|q| q[3]).collect();
+            let c: Vec<f64> = path.axes.iter().map(|q| q[4]).collect();
+            let z = &res.zones[0];
+            let step = 2000.0 / 60.0 * m.tcy_s;
+            let lim0 = CLimits::new(&m, 2000.0, 0.0);
+            let (bound, _) =
+                deviation_bound_sampled(&path.s_mm, &p, &c, z.first, z.last, &lim0, step).unwrap();
+            assert!(bound <= z.max_deviation_deg + 1e-6, "{mname}");
+            assert!(
+                z.max_deviation_deg <= 1.25 * bound,
+                "{mname}: {} vs {bound}",
+                z.max_deviation_deg
+            );
+            assert!(
+                z.after.time_s < z.before.time_s,
+                "{mname}: faster over the zone"
+            );
+            check_invariants(&path, &m, &res, &opts);
+        }
+    }
+}

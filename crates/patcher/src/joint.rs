@@ -281,7 +281,7 @@ pub fn solve_joint(pr: &JointProblem) -> Result<JointSolution, PatchFailure> {
             qp.add_le(&[(ic, 1.0)], dbar_c[k] + rho_c);
             qp.add_le(&[(ic, -1.0)], rho_c - dbar_c[k]);
         }
-        let x = match qp.solve_tight(&mut stats) {
+        let x = match qp.solve(&mut stats) {
             Ok(x) => x,
             Err(st) if dev.is_none() => {
                 // No feasible point near the base: widen the first trust region (the limits

@@ -20,6 +20,8 @@ mod qp;
 pub mod reference;
 pub mod report;
 pub mod spline;
+#[cfg(test)]
+mod testutil;
 pub mod verify;
 
 pub use analysis::{AnalysisOptions, RunAnalysis, Sample, Zone, ZoneKind, analyze_path};

@@ -220,157 +220,10 @@ pub(crate) fn zone_figures(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::c_only::{Methods, patch_c_only as patch_path_with};
-    use crate::direct::deviation_bound_sampled;
-    use crate::limits::CLimits;
-    use crate::options::round_written;
+    use crate::testutil::{machine, planted};
 
-    const DIRECT_ONLY: Methods = Methods {
-        g16: false,
-        direct: true,
-    };
-
-    fn machine(name: &str) -> Machine {
-        Machine::builtin(name).expect("built-in machine")
-    }
-
-    /// A straight pass s = X whose tool axis sweeps past the pole at angular distance
-    /// `d_deg`: tool axis ∝ (sin d, sin(τ(s)), 1), τ sweeping 0.4°/mm. `flip`: primary
-    /// and C by the domain rule (sign of j: A flips and C jumps ~180° where j crosses 0);
-    /// else the continuous branch A ≥ 0 (C swings ~180°).
-    fn planted(n: usize, spacing: f64, d_deg: f64, flip: bool, feed: f64) -> Path {
-        let mid = (n - 1) as f64 * spacing / 2.0;
-        let mut s_mm = Vec::new();
-        let mut axes = Vec::new();
-        let mut prev_c: Option<f64> = None;
-        for k in 0..n {
-            let s = k as f64 * spacing;
-            let v = [
-                d_deg.to_radians().sin(),
-                ((s - mid) * 0.4).to_radians().sin(),
-                1.0,
-            ];
-            let nv = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-            let (i, j, kk) = (v[0] / nv, v[1] / nv, v[2] / nv);
-            // i = sin C sin A, j = −cos C sin A, k = cos A.
-            let mut a = kk.clamp(-1.0, 1.0).acos().to_degrees();
-            let mut c = i.atan2(-j).to_degrees();
-            if flip && j > 0.0 {
-                a = -a;
-                c = (-i).atan2(j).to_degrees();
-            }
-            if let Some(pc) = prev_c
-                && !flip
-            {
-                while c - pc > 180.0 {
-                    c -= 360.0;
-                }
-                while c - pc < -180.0 {
-                    c += 360.0;
-                }
-            }
-            let c = round_written(c, 3);
-            prev_c = Some(c);
-            s_mm.push(s);
-            axes.push([s, 0.0, 0.0, round_written(a, 3), c]);
-        }
-        Path {
-            s_mm,
-            axes,
-            feed_mm_min: feed,
-        }
-    }
-
-    /// Checks the invariants of a patched path and returns a summary line.
-    fn check_invariants(path: &Path, m: &Machine, res: &PatchResult, opts: &PatchOptions) {
-        let before = analyze_path(path, m, &AnalysisOptions::default()).unwrap();
-        let mut after_path = path.clone();
-        for (q, c) in after_path.axes.iter_mut().zip(&res.c_deg) {
-            q[4] = *c;
-        }
-        // Only C changes, and `changed` says where.
-        for (i, (a, b)) in path.axes.iter().zip(&after_path.axes).enumerate() {
-            assert_eq!(a[..4], b[..4]);
-            assert_eq!(res.c_changed[i], a[4] != b[4]);
-        }
-        let after = analyze_path(&after_path, m, &AnalysisOptions::default()).unwrap();
-        // Never worse on C.
-        assert!(
-            after.axis_min[4].0 >= before.axis_min[4].0 - 1e-9,
-            "C ratio got worse: {} -> {}",
-            before.axis_min[4].0,
-            after.axis_min[4].0
-        );
-        for z in &res.zones {
-            if z.min_abs_primary_deg <= opts.cone_deg {
-                assert_eq!(z.outcome, Outcome::Reached, "zone not reached: {z:#?}");
-                assert!(z.after.c_ratio >= 1.0 - 1e-9, "{z:#?}");
-            }
-        }
-        // C reaches feed everywhere the zones were.
-        assert!(after.zones.is_empty(), "zones left: {:?}", after.zones);
-    }
-
-    #[test]
-    fn planted_passes_reach_feed() {
-        let opts = PatchOptions::default();
-        for (mname, feed) in [("mikron-hsm600", 3000.0), ("mikron-ucp710", 1000.0)] {
-            let m = machine(mname);
-            for flip in [false, true] {
-                for d in [0.01, 0.5, 2.0, 4.0] {
-                    for spacing in [1.0, 0.5] {
-                        let n = (120.0 / spacing) as usize + 1;
-                        let path = planted(n, spacing, d, flip, feed);
-                        let res = patch_path_with(&path, &m, &opts, DIRECT_ONLY).unwrap();
-                        for z in &res.zones {
-                            eprintln!(
-                                "{mname} F{feed} flip={flip} d={d} h={spacing}: {:?} {:?} \
-                                 c {:.3}->{:.3} len {:.1} pts {} dev {:.3} dec {} t {:.3}s/{}",
-                                z.kind,
-                                z.outcome,
-                                z.before.c_ratio,
-                                z.after.c_ratio,
-                                z.patch_length_mm,
-                                z.points_modified,
-                                z.max_deviation_deg,
-                                z.decimals,
-                                z.qp.solve_time_s,
-                                z.qp.solves
-                            );
-                        }
-                        check_invariants(&path, &m, &res, &opts);
-                    }
-                }
-            }
-        }
-    }
-
-    /// The same planted passes through [`patch_path`] (G16 first, direct as fallback).
-    #[test]
-    fn planted_passes_reach_feed_with_g16() {
-        let opts = PatchOptions {
-            axes: PatchAxes::OnlyC,
-            ..PatchOptions::default()
-        };
-        for (mname, feed) in [("mikron-hsm600", 2000.0), ("mikron-ucp710", 2000.0)] {
-            let m = machine(mname);
-            for flip in [false, true] {
-                for d in [0.01, 0.5, 2.0, 4.0] {
-                    let path = planted(121, 1.0, d, flip, feed);
-                    let res = patch_path(&path, &m, &opts).unwrap();
-                    for z in &res.zones {
-                        eprintln!(
-                            "g16+direct {mname} F{feed} flip={flip} d={d}: {:?} {:?} {:?} \
-                             len {:.1} dev {:.3}",
-                            z.kind, z.outcome, z.method, z.patch_length_mm, z.max_deviation_deg
-                        );
-                    }
-                    check_invariants(&path, &m, &res, &opts);
-                }
-            }
-        }
-    }
-
+    /// No point within the cone: nothing changes, with either method, and no spline work
+    /// is needed (no zone reported).
     #[test]
     fn no_point_in_cone_is_unchanged() {
         let m = machine("mikron-hsm600");
@@ -378,101 +231,31 @@ mod tests {
         for q in &mut path.axes {
             q[3] = q[3].abs().max(6.0);
         }
-        let res = patch_path(&path, &m, &PatchOptions::default()).unwrap();
-        assert!(res.zones.is_empty());
-        assert!(!res.any_change());
-        let c: Vec<f64> = path.axes.iter().map(|q| q[4]).collect();
-        assert_eq!(res.c_deg, c);
-    }
-
-    #[test]
-    fn tiny_paths_and_the_exact_pole_do_not_panic() {
-        let m = machine("mikron-ucp710");
-        let three = Path {
-            s_mm: vec![0.0, 1.0, 2.0],
-            axes: vec![
-                [0.0, 0.0, 0.0, 1.0, 0.0],
-                [1.0, 0.0, 0.0, 0.0, 90.0],
-                [2.0, 0.0, 0.0, -1.0, 180.0],
-            ],
-            feed_mm_min: 2000.0,
-        };
-        let res = patch_path_with(&three, &m, &PatchOptions::default(), DIRECT_ONLY).unwrap();
-        assert_eq!(res.c_deg.len(), 3);
-        let mut pole = planted(81, 1.0, 0.0, false, 2000.0);
-        pole.axes[40][3] = 0.0;
-        let res = patch_path_with(&pole, &m, &PatchOptions::default(), DIRECT_ONLY).unwrap();
-        assert_eq!(res.c_deg.len(), 81);
-    }
-
-    /// The C17 `%SING` program (N110..N620), s = X, on both built-in machines.
-    #[test]
-    fn c17_sing() {
-        let text = std::fs::read_to_string(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../fixtures/c17/SING.I"
-        ))
-        .unwrap();
-        let mut axes = Vec::new();
-        for line in text.lines() {
-            let nnum: usize = match line.strip_prefix('N').and_then(|r| r.split(' ').next()) {
-                Some(v) => v.parse().unwrap_or(0),
-                None => continue,
+        for axes in [PatchAxes::Both, PatchAxes::OnlyC] {
+            let opts = PatchOptions {
+                axes,
+                ..PatchOptions::default()
             };
-            if !(110..=610).contains(&nnum) {
-                continue;
-            }
-            let word = |l: char| -> f64 {
-                line.split(' ')
-                    .find_map(|w| w.strip_prefix(l))
-                    .unwrap()
-                    .parse()
-                    .unwrap()
-            };
-            axes.push([word('X'), 0.0, -8.0, word('A'), word('C')]);
-        }
-        assert_eq!(axes.len(), 51);
-        let path = Path {
-            s_mm: axes.iter().map(|q| q[0]).collect(),
-            axes,
-            feed_mm_min: 2000.0,
-        };
-        let opts = PatchOptions::default();
-        for mname in ["mikron-ucp710", "mikron-hsm600"] {
-            let m = machine(mname);
-            let res = patch_path_with(&path, &m, &opts, DIRECT_ONLY).unwrap();
-            assert!(!res.zones.is_empty());
-            let p: Vec<f64> = path.axes.iter().map(|q| q[3]).collect();
+            let res = patch_path(&path, &m, &opts).unwrap();
+            assert!(res.zones.is_empty());
+            assert!(!res.any_change());
             let c: Vec<f64> = path.axes.iter().map(|q| q[4]).collect();
-            for z in &res.zones {
-                let step = 2000.0 / 60.0 * m.tcy_s;
-                let lim0 = CLimits::new(&m, 2000.0, 0.0);
-                let (bound, _) =
-                    deviation_bound_sampled(&path.s_mm, &p, &c, z.first, z.last, &lim0, step)
-                        .unwrap();
-                eprintln!(
-                    "SING {mname}: {:?} {:?} c {:.3}->{:.3} pts {}..{} len {:.1} mod {} \
-                     dev {:.3} bound {:.3} dec {} qp {:.4}s/{} time {:.3}->{:.3} ideal {:.3}",
-                    z.kind,
-                    z.outcome,
-                    z.before.c_ratio,
-                    z.after.c_ratio,
-                    z.first,
-                    z.last,
-                    z.patch_length_mm,
-                    z.points_modified,
-                    z.max_deviation_deg,
-                    bound,
-                    z.decimals,
-                    z.qp.solve_time_s,
-                    z.qp.solves,
-                    z.before.time_s,
-                    z.after.time_s,
-                    z.ideal_time_s
-                );
-                assert!(bound <= z.max_deviation_deg + 1e-6);
-            }
-            check_invariants(&path, &m, &res, &opts);
+            assert_eq!(res.c_deg, c);
+            assert!(report_unpatched(&path, &m, &opts).unwrap().is_empty());
         }
+    }
+
+    /// A zone reported without patching: unchanged, same figures before and after.
+    #[test]
+    fn report_unpatched_reports_the_zone_as_it_is() {
+        let m = machine("mikron-ucp710");
+        let path = planted(241, 0.5, 0.5, false, 1000.0);
+        let z = report_unpatched(&path, &m, &PatchOptions::default()).unwrap();
+        assert_eq!(z.len(), 1);
+        assert_eq!(z[0].outcome, Outcome::Unchanged);
+        assert_eq!(z[0].method, Method::None);
+        assert_eq!(z[0].before, z[0].after);
+        assert!(z[0].before.c_ratio < 1.0);
+        assert_eq!((z[0].points_modified, z[0].max_deviation_deg), (0, 0.0));
     }
 }

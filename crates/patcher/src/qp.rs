@@ -24,12 +24,6 @@ pub(crate) fn settings() -> DefaultSettings<f64> {
     }
 }
 
-/// Feasibility and gap tolerance of the joint solves ([`QpBuilder::solve_tight`]): the
-/// model's third derivative is `6·(m_k + m_{k+1} − 2σ_k)/h²`, so a residual ε on the slope
-/// equalities becomes ≈ 12ε/h² on q''' — at 0.25 mm spacing clarabel's default 1e-8 leaves
-/// errors of 1e-5 where "not worse" is judged to 1 ppm.
-pub(crate) const TIGHT_TOL: f64 = 1e-10;
-
 /// Add `other` into `acc` (sums; status of the latest).
 pub(crate) fn add_stats(acc: &mut QpStats, other: &QpStats) {
     acc.iterations += other.iterations;
@@ -150,19 +144,6 @@ impl QpBuilder {
     /// `Solved` or `AlmostSolved`, otherwise its status.
     pub(crate) fn solve(&self, stats: &mut QpStats) -> Result<Vec<f64>, QpStatus> {
         self.solve_with(stats, settings())
-    }
-
-    /// [`QpBuilder::solve`] with gap and feasibility tolerances [`TIGHT_TOL`].
-    pub(crate) fn solve_tight(&self, stats: &mut QpStats) -> Result<Vec<f64>, QpStatus> {
-        self.solve_with(
-            stats,
-            DefaultSettings {
-                tol_feas: TIGHT_TOL,
-                tol_gap_abs: TIGHT_TOL,
-                tol_gap_rel: TIGHT_TOL,
-                ..settings()
-            },
-        )
     }
 
     fn solve_with(

@@ -202,7 +202,12 @@ pub fn zone_reference(
     let flipped = |after: usize| -> (Vec<f64>, Vec<f64>) {
         let (mut p, mut c) = (p_deg.to_vec(), c_deg.to_vec());
         if after + 1 < n {
-            let shift = unwrap_near_deg(c_deg[after + 1] + 180.0, c_deg[after]) - c_deg[after + 1];
+            // Continuous with the last point off the pole (on it C does not orient the tool).
+            let r = (0..=after)
+                .rev()
+                .find(|&i| p_deg[i].abs() > crate::both::POLE_DEG)
+                .unwrap_or(after);
+            let shift = unwrap_near_deg(c_deg[after + 1] + 180.0, c_deg[r]) - c_deg[after + 1];
             for i in after + 1..n {
                 p[i] = -p_deg[i];
                 c[i] = c_deg[i] + shift;

@@ -29,8 +29,8 @@ const WINDOW_GUARD_SPANS: usize = 10;
 /// of itself (0.01 %, a feed difference no controller resolves). It absorbs round-off, the
 /// solvers' own tolerance (clarabel's feasibility tolerance is relative to the problem's
 /// norms: with C changes of 100° the slope equalities hold to ~1e-7, which q''' multiplies
-/// by 6/h²) and what a change propagates, through the spline's decay, beyond the window a
-/// solver constrains.
+/// by 6/h²; measured: 3.6e-6 on q''' at 0.25 mm spacing) and what a change propagates,
+/// through the spline's decay, beyond the window a solver constrains.
 pub const NOT_WORSE_REL: f64 = 1e-4;
 
 /// One axis of a change: its values along the whole path before and after (degrees or
