@@ -1,5 +1,6 @@
-//! SPEC §6 accuracy study: the max orientation deviation of polepatch's patch against the
-//! best possible for C-only changes, per run with zones.
+//! SPEC §6 accuracy study of the C-only method (`--only-c`): the max orientation deviation
+//! of its patch against the best possible for C-only changes, per run with zones. (The
+//! default method, both rotary axes, is measured by `polepatch bench`.)
 //!
 //! ```text
 //! cargo run --release -p polepatch-patcher --example deviation_ratio [FILES…]
@@ -40,7 +41,10 @@ fn main() {
     } else {
         args
     };
-    let opts = PatchOptions::default();
+    let opts = PatchOptions {
+        axes: polepatch_patcher::PatchAxes::OnlyC,
+        ..PatchOptions::default()
+    };
     println!(
         "| file | machine | run pts | zones | outcome | ours ° | bound ° | ratio | solves | ms/zone |"
     );
