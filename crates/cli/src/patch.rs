@@ -255,13 +255,21 @@ fn print_summary(reports: &[&FileReport]) {
             rep.zones.iter().map(|z| z.points_modified).sum::<usize>(),
             rep.words_changed,
         );
-        if let (Some(written), Some(file)) = (rep.written_c_decimals, rep.file_c_decimals)
-            && written > file
-        {
-            println!(
-                "  note: C written with {} decimals (the file uses {}) so that Equation 6 holds on the written values",
-                written, file
-            );
+        for (letter, written, file) in [
+            ("C", rep.written_c_decimals, rep.file_c_decimals),
+            (
+                "primary",
+                rep.written_primary_decimals,
+                rep.file_primary_decimals,
+            ),
+        ] {
+            if let (Some(written), Some(file)) = (written, file)
+                && written > file
+            {
+                println!(
+                    "  note: {letter} written with {written} decimals (the file uses {file}) so that Equation 6 holds on the written values"
+                );
+            }
         }
     }
 }

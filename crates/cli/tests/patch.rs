@@ -198,3 +198,33 @@ fn zigzag_program_with_many_zones() {
         }
     }
 }
+
+/// Issue 8: a generated HSM600 pass at F4000 with 3-decimal rotary words reached feed only
+/// with `--max-decimals 6` (the old default, 4, left it "improved"). With the defaults it
+/// reaches feed on both axes, written with more decimals, and the report says how many.
+#[test]
+fn f4000_on_the_hsm600_with_three_decimals_reaches_feed_by_default() {
+    let m = polepatch::kinematics::Machine::builtin("mikron-hsm600").unwrap();
+    for (spacing_mm, d) in [(0.25, 1.0), (0.5, 0.5)] {
+        let pass = Pass {
+            pole_distance_deg: d,
+            spacing_mm,
+            feed_mm_min: 4000.0,
+            b_axis: true,
+            rotary_decimals: 3,
+            ..Pass::default()
+        };
+        let text = program(&pass, Dialect::Fanuc, "F4K");
+        let (rep, _) = check_patch("f4000", text.as_bytes(), &m, &PatchOptions::default());
+        assert!(!rep.zones.is_empty());
+        assert!(rep.zones.iter().all(|z| z.outcome == "reached"), "{rep:?}");
+        assert_eq!(rep.file_c_decimals, Some(3));
+        let written = rep.written_c_decimals.unwrap();
+        assert!((4..=6).contains(&written), "{rep:?}");
+        assert!(
+            rep.zones
+                .iter()
+                .all(|z| z.decimals <= 6 && z.primary_decimals <= 6)
+        );
+    }
+}

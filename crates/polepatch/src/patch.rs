@@ -280,6 +280,10 @@ pub struct FileReport {
     /// Decimal places written for changed C words (more than the file's when its
     /// precision could not hold Equation 6).
     pub written_c_decimals: Option<usize>,
+    /// Decimal places of the file's primary-axis words (`None` as for C).
+    pub file_primary_decimals: Option<usize>,
+    /// Decimal places written for changed primary-axis words.
+    pub written_primary_decimals: Option<usize>,
     /// Runs left as they are (no TCPM, G91, no feed, invalid values), with why.
     pub untouched_runs: Vec<UntouchedRun>,
     /// Notes for the user.
@@ -319,6 +323,8 @@ pub fn patch_program(
         words_changed: 0,
         file_c_decimals: None,
         written_c_decimals: None,
+        file_primary_decimals: None,
+        written_primary_decimals: None,
         untouched_runs: Vec::new(),
         warnings: lp.warnings.clone(),
         zones: Vec::new(),
@@ -358,6 +364,7 @@ pub fn patch_program(
     };
     let mut edits: Vec<Edit> = Vec::new();
     let mut written_c = c_style.decimals;
+    let mut written_p = p_style.decimals;
     for (r, rp) in lp.runs.iter().enumerate() {
         let path = match &rp.path {
             Ok(p) => p,
@@ -461,6 +468,8 @@ pub fn patch_program(
                 }
                 if letter == b'C' {
                     written_c = written_c.max(decimals);
+                } else {
+                    written_p = written_p.max(decimals);
                 }
                 edits.push(Edit {
                     block: rp.run.blocks[k],
@@ -497,6 +506,8 @@ pub fn patch_program(
     report.words_changed = edits.len();
     report.file_c_decimals = Some(c_style.decimals);
     report.written_c_decimals = Some(written_c);
+    report.file_primary_decimals = Some(p_style.decimals);
+    report.written_primary_decimals = Some(written_p);
     (edits, report)
 }
 
