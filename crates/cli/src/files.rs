@@ -68,12 +68,30 @@ pub fn patch_file(
     Ok(report)
 }
 
-/// Whether two paths name the same existing file.
+/// Whether two paths name the same existing file: the same path once `.`, `..` and
+/// symbolic links are resolved, or (on Unix) the same device and inode, which also
+/// catches a case-insensitive file system's other spelling.
 pub fn same_file(a: &FsPath, b: &FsPath) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
+    if let (Ok(x), Ok(y)) = (a.canonicalize(), b.canonicalize())
+        && x == y
+    {
+        return true;
+    }
+    same_inode(a, b)
+}
+
+#[cfg(unix)]
+fn same_inode(a: &FsPath, b: &FsPath) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (std::fs::metadata(a), std::fs::metadata(b)) {
+        (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
         _ => false,
     }
+}
+
+#[cfg(not(unix))]
+fn same_inode(_: &FsPath, _: &FsPath) -> bool {
+    false
 }
 
 /// Write `bytes` to `path` through a temporary file in the same folder and a rename.

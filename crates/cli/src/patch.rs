@@ -82,11 +82,25 @@ fn expand(inputs: &[PathBuf]) -> Result<Vec<(PathBuf, PathBuf)>> {
 pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
     let opts = options(&args)?;
     let machine = machine(&args.machine)?;
+    for (flag, path) in [("--report", &args.report), ("--csv", &args.csv)] {
+        if let Some(path) = path {
+            for input in &args.inputs {
+                if input.is_file() && polepatch_cli::files::same_file(input, path) {
+                    bail!(
+                        "{flag} {} is the input file; polepatch never modifies its input",
+                        path.display()
+                    );
+                }
+            }
+        }
+    }
+    let mut names: Vec<PathBuf> = Vec::new();
     let reports: Vec<Result<FileReport, JobError>> = match (&args.output, &args.out_dir) {
         (Some(output), None) => {
             if args.inputs.len() != 1 || args.inputs[0].is_dir() {
                 bail!("-o/--output takes one input file; use --out-dir for several or a folder");
             }
+            names.push(args.inputs[0].clone());
             vec![patch_file(
                 &args.inputs[0],
                 output,
@@ -100,6 +114,7 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
             if files.is_empty() {
                 bail!("no input files");
             }
+            names = files.iter().map(|(input, _)| input.clone()).collect();
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(args.jobs.unwrap_or(0))
                 .build()
@@ -150,7 +165,9 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
             }
         }
     }
-    print_summary(&ok);
+    if failed < reports.len() {
+        print_summary(&names, &reports);
+    }
     for rep in &ok {
         for w in &rep.warnings {
             eprintln!("polepatch: warning: {w}");
@@ -184,6 +201,13 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
         );
     }
     if failed > 0 {
+        if reports.len() > 1 {
+            eprintln!(
+                "polepatch: {failed} of {} files failed (nothing written for them); the other {} were written",
+                reports.len(),
+                reports.len() - failed
+            );
+        }
         return Ok(ExitCode::from(1));
     }
     if args.strict && below > 0 {
@@ -208,12 +232,24 @@ fn csv_rows(reports: &[&FileReport]) -> Result<Vec<u8>> {
     Ok(w.into_inner()?)
 }
 
-fn print_summary(reports: &[&FileReport]) {
+/// One line per input file, in input order; a file that failed says so (its error is
+/// printed on standard error).
+fn print_summary(inputs: &[PathBuf], reports: &[Result<FileReport, JobError>]) {
     println!(
         "{:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8} {:>6} {:>8}",
         "file", "zones", "reached", "C ratio", "overall", "time s", "dev °", "points", "words"
     );
-    for rep in reports {
+    for (input, r) in inputs.iter().zip(reports) {
+        let rep = match r {
+            Ok(rep) => rep,
+            Err(_) => {
+                let name = input.file_name().map_or(input.display().to_string(), |n| {
+                    n.to_string_lossy().into_owned()
+                });
+                println!("{name:<40} failed, not written (see the error above)");
+                continue;
+            }
+        };
         let reached = rep.zones.iter().filter(|z| z.outcome == "reached").count();
         let min =
             |f: &dyn Fn(&ZoneRow) -> f64| rep.zones.iter().map(f).fold(f64::INFINITY, f64::min);

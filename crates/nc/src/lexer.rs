@@ -15,8 +15,10 @@
 //! - anything else up to the next blank, letter, `;` or `(` is an unknown token.
 //!
 //! Errors: a malformed or non-finite number on an address word, a value that is an
-//! expression on an axis word (X Y Z A B C F), and a letter that needs a number but has
-//! none (`X`, `X+`).
+//! expression on an axis word (X Y Z A B C F), an axis value in exponent notation
+//! (`X1e999`: a plain decimal or `X1 E999`? polepatch does not guess), a letter that needs
+//! a number but has none (`X`, `X+`), and an ASCII control byte (NUL, ESC, DEL…) outside
+//! a comment.
 
 use std::ops::Range;
 
@@ -93,6 +95,26 @@ pub const NUMBER_LETTERS: &[u8] = b"XYZABCFGMNTS";
 
 fn is_blank(b: u8) -> bool {
     matches!(b, b' ' | b'\t' | b'\r' | 0x0b | 0x0c)
+}
+
+/// An ASCII control byte that is not a blank (NUL, ESC, DEL, …): a damaged or binary
+/// file. Outside comments it is an error, not something to skip.
+fn is_control(b: u8) -> bool {
+    (b < 0x20 && !is_blank(b)) || b == 0x7f
+}
+
+/// The error for a control byte: its code and, for NUL, its name.
+fn control_message(b: u8) -> String {
+    let name = match b {
+        0 => " (NUL)",
+        0x1a => " (SUB, end-of-file mark)",
+        0x1b => " (ESC)",
+        0x7f => " (DEL)",
+        _ => "",
+    };
+    format!(
+        "control byte 0x{b:02X}{name} in the program text; the file is damaged or not an NC program"
+    )
 }
 
 fn is_axis(letter: u8) -> bool {
@@ -282,6 +304,30 @@ impl<'a> Lexer<'a> {
         let eq = q < self.end && b[q] == b'=';
         let ns = if eq { q + 1 } else { q };
         let (ds, e, fast) = self.scan_number(ns);
+        if e < self.end && is_control(b[e]) {
+            return self.err(e, control_message(b[e]));
+        }
+        if is_axis(letter) && e > ds && e + 1 < self.end && matches!(b[e], b'e' | b'E') {
+            let k = if matches!(b[e + 1], b'+' | b'-') {
+                e + 2
+            } else {
+                e + 1
+            };
+            if k < self.end && b[k].is_ascii_digit() {
+                let mut x = k;
+                while x < self.end && b[x].is_ascii_digit() {
+                    x += 1;
+                }
+                return self.err(
+                    p,
+                    format!(
+                        "{l} value '{}' is in exponent notation (or an E word follows without a blank); \
+                         NC programs use plain decimals and polepatch will not guess which is meant",
+                        self.text(ns..x)
+                    ),
+                );
+            }
+        }
         let followed_by_expr = e < self.end
             && matches!(
                 b[e],
@@ -412,6 +458,9 @@ impl Iterator for Lexer<'_> {
         }
         let p = self.pos;
         let c = b[p];
+        if is_control(c) {
+            return self.err(p, control_message(c));
+        }
         match c {
             b'A'..=b'Z' | b'a'..=b'z' => {
                 let next = if p + 1 < self.end { b[p + 1] } else { b' ' };
@@ -639,5 +688,43 @@ mod tests {
         assert_eq!(lex_err("G1 X+ Y1").message, "X value '+' is not a number");
         let huge = format!("X{}", "9".repeat(400));
         assert!(lex_err(&huge).message.ends_with("is not a finite number"));
+    }
+
+    #[test]
+    fn exponent_notation_on_an_axis_is_refused_with_its_column() {
+        let e = lex_err("N360 X1e999 Y+0");
+        assert_eq!(e.at, 5);
+        assert!(
+            e.message
+                .starts_with("X value '1e999' is in exponent notation")
+        );
+        assert!(lex_err("G1 C1.5E-3").message.contains("'1.5E-3'"));
+        // A letter E after a number with a blank is an ordinary word; `E` alone is not
+        // an exponent.
+        assert!(
+            Lexer::new(b"G1 X1 E999", 0..10).all(|t| t.is_ok()),
+            "X1 E999 is two words"
+        );
+        assert!(Lexer::new(b"G1 X1E", 0..6).all(|t| t.is_ok()));
+    }
+
+    #[test]
+    fn control_bytes_are_errors_outside_comments() {
+        let line = b"N370 X+26 C+\x00211.506 *";
+        let e = Lexer::new(line, 0..line.len())
+            .find_map(|t| t.err())
+            .expect("an error");
+        assert_eq!(e.at, 12);
+        assert!(e.message.contains("0x00 (NUL)"), "{}", e.message);
+        let line = b"G1 X1\x00 Y2";
+        let e = Lexer::new(line, 0..line.len())
+            .find_map(|t| t.err())
+            .expect("an error");
+        assert_eq!(e.at, 5);
+        let line = b"\x1bG1 X1";
+        assert!(Lexer::new(line, 0..line.len()).any(|t| t.is_err()));
+        // Inside a comment the bytes are the user's: passed through.
+        let line = b"G1 X1 (a\x00b) ; c\x07";
+        assert!(Lexer::new(line, 0..line.len()).all(|t| t.is_ok()));
     }
 }

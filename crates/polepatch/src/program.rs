@@ -95,6 +95,37 @@ pub fn load_nc(
     )
 }
 
+/// Why a program has no run of G1 motion to analyse: the first G1 block that could not
+/// start one, and the reason, or plainly [`Error::NoRuns`] when there is no G1 move.
+fn why_no_runs(program: &Program, name: &str) -> Error {
+    for (i, block) in program.blocks.iter().enumerate() {
+        if !block.is_move {
+            continue;
+        }
+        let st = program.state(i);
+        if st.motion != polepatch_nc::Motion::Linear {
+            continue;
+        }
+        let what = if st.incremental {
+            "incremental mode (G91) is not supported: polepatch reads absolute programs (G90), \
+             because a rotary value changed in incremental mode would shift every later position"
+        } else if st.pos[..3].iter().any(Option::is_none) {
+            "G1 moves from a position the program does not state (after G28/G53/G92 or a datum \
+             change, or before X Y Z are all programmed): nothing can be analysed without it"
+        } else {
+            continue;
+        };
+        return Error::Unsupported {
+            path: name.to_string(),
+            line: block.line,
+            what: what.to_string(),
+        };
+    }
+    Error::NoRuns {
+        path: name.to_string(),
+    }
+}
+
 /// Group a parsed program into runs and build each run's path for `machine`.
 /// `feed_fallback_mm_min` is used for runs with no F in force.
 pub fn load(
@@ -105,9 +136,7 @@ pub fn load(
 ) -> Result<LoadedProgram, Error> {
     let runs = polepatch_nc::runs(&program);
     if runs.is_empty() {
-        return Err(Error::NoRuns {
-            path: name.to_string(),
-        });
+        return Err(why_no_runs(&program, name));
     }
     let letter = |i: usize| if i == modal::A { b'A' } else { b'B' };
     let own = if machine.primary_letter() == 'A' {
