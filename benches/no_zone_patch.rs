@@ -1,6 +1,7 @@
 //! The whole no-zone path of `polepatch patch` minus the file system: `polepatch::patch_nc`
-//! (parse → runs and paths → `patch_path` per run → write), and the analysis alone from a
-//! parsed program (`program::load` → `patch_program`). Run:
+//! (since issue 10 §2 the streaming scan `far::far_from_pole` that proves no point is in
+//! the cone, then a copy), and the full path's analysis alone from a parsed program
+//! (`program::load` → `patch_program`). Run:
 //! `cargo bench -p polepatch-benches --bench no_zone_patch -- --warm-up-time 1 --measurement-time 5`
 //! Figures are written up in docs/performance-nc.md.
 

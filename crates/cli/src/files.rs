@@ -2,7 +2,7 @@
 
 use polepatch::kinematics::Machine;
 use polepatch::program::load_nc;
-use polepatch::{Error, FileReport, patch_loaded};
+use polepatch::{Error, FileReport, patch_program};
 use polepatch_patcher::PatchOptions;
 use std::io::Write;
 use std::path::Path as FsPath;
@@ -58,12 +58,44 @@ pub fn patch_file(
     if same_file(input, output) {
         return Err(JobError::Overwrite { path: name });
     }
-    let lp = load_nc(read(input)?, &name, machine, feed_fallback_mm_min)?;
-    let (bytes, mut report) = patch_loaded(&lp, machine, opts);
-    write_atomic_like(output, &bytes, Some(input)).map_err(|source| JobError::Write {
+    let bytes = read(input)?;
+    let write_err = |source| JobError::Write {
         path: output.display().to_string(),
         source,
-    })?;
+    };
+    // No run point within the cone: the output is the input, proven by a streaming read
+    // (memory: the file once).
+    let whole = polepatch::PatchOptions {
+        patch: opts.clone(),
+        feed_fallback_mm_min,
+        name: name.clone(),
+    };
+    // The copy is written while the scan runs (it is the output when the scan proves the
+    // program far from the pole; otherwise it is deleted).
+    let (far, staged) = std::thread::scope(|sc| {
+        let copy = sc.spawn(|| stage(output, &bytes, Some(input)));
+        let far = polepatch::far::far_from_pole(&bytes, machine, &whole);
+        (far, copy.join())
+    });
+    if let Some(mut report) = far? {
+        let staged = staged.unwrap_or_else(|p| std::panic::resume_unwind(p));
+        staged
+            .map_err(write_err)?
+            .persist(output)
+            .map_err(|e| write_err(e.error))?;
+        report.output = Some(output.display().to_string());
+        return Ok(report);
+    }
+    drop(staged);
+    let lp = load_nc(bytes, &name, machine, feed_fallback_mm_min)?;
+    let (edits, mut report) = patch_program(&lp, machine, opts);
+    if edits.is_empty() {
+        write_atomic_like(output, &lp.program.bytes, Some(input)).map_err(write_err)?;
+    } else {
+        let bytes = polepatch::nc::write(&lp.program, &edits);
+        drop(lp);
+        write_atomic_like(output, &bytes, Some(input)).map_err(write_err)?;
+    }
     report.output = Some(output.display().to_string());
     Ok(report)
 }
@@ -102,6 +134,20 @@ pub fn write_atomic_like(
     bytes: &[u8],
     like: Option<&FsPath>,
 ) -> std::io::Result<()> {
+    stage(path, bytes, like)?
+        .persist(path)
+        .map_err(|e| e.error)?;
+    Ok(())
+}
+
+/// The first half of [`write_atomic_like`]: `bytes` written and synced to a temporary
+/// file beside `path`, with the permissions it will have. `persist(path)` puts it in
+/// place; dropping it deletes it.
+pub fn stage(
+    path: &FsPath,
+    bytes: &[u8],
+    like: Option<&FsPath>,
+) -> std::io::Result<tempfile::NamedTempFile> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => FsPath::new("."),
@@ -116,8 +162,7 @@ pub fn write_atomic_like(
     if let Some(perms) = perms.or_else(default_permissions) {
         tmp.as_file().set_permissions(perms)?;
     }
-    tmp.persist(path).map_err(|e| e.error)?;
-    Ok(())
+    Ok(tmp)
 }
 
 /// [`write_atomic_like`] without a model file (reports, CSV).

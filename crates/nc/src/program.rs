@@ -137,14 +137,7 @@ impl Program {
 /// [`crate::modal`] for how the modal state follows the blocks.
 pub fn parse(bytes: Vec<u8>, dialect: Dialect) -> Result<Program, ParseError> {
     if u32::try_from(bytes.len()).is_err() {
-        return Err(ParseError::at(
-            1,
-            1,
-            format!(
-                "the file has {} bytes; polepatch reads programs of at most 4 GiB",
-                bytes.len()
-            ),
-        ));
+        return Err(too_big(bytes.len()));
     }
     let dialect = match dialect {
         Dialect::Auto => detect(&bytes),
@@ -158,11 +151,42 @@ pub fn parse(bytes: Vec<u8>, dialect: Dialect) -> Result<Program, ParseError> {
     let mut interp = Interpreter::new(dialect);
     let mut last = interp.modal;
     states.push(PackedModal::pack(&last));
+    for (span, line) in lines(&bytes) {
+        let mut block = interp.block(&bytes, span, line, &mut words)?;
+        if interp.modal != last {
+            last = interp.modal;
+            states.push(PackedModal::pack(&last));
+        }
+        // At most one state per block plus the initial one, so at most 2^32 - 1.
+        block.state = (states.len() - 1) as u32;
+        blocks.push(block);
+    }
+    Ok(Program {
+        bytes,
+        blocks,
+        words,
+        dialect,
+        states,
+    })
+}
+
+/// The lines of `bytes` with their 1-based numbers: split at `\n`, a `\r` before it
+/// belongs to the line ending; a final line without a newline is a line, a final empty
+/// segment after the last newline is not.
+fn lines(bytes: &[u8]) -> impl Iterator<Item = (Range<usize>, usize)> + '_ {
+    lines_from(bytes, 0)
+}
+
+/// [`lines`] from byte `start` (a line start), numbered from 1 there.
+fn lines_from(bytes: &[u8], start: usize) -> impl Iterator<Item = (Range<usize>, usize)> + '_ {
     let n = bytes.len();
-    let mut start = 0;
-    let mut line = 1;
-    while start < n {
-        let (end, next) = match find_newline(&bytes, start) {
+    let mut start = start;
+    let mut line = 0;
+    std::iter::from_fn(move || {
+        if start >= n {
+            return None;
+        }
+        let (end, next) = match find_newline(bytes, start) {
             Some(nl) => (
                 if nl > start && bytes[nl - 1] == b'\r' {
                     nl - 1
@@ -173,24 +197,137 @@ pub fn parse(bytes: Vec<u8>, dialect: Dialect) -> Result<Program, ParseError> {
             ),
             None => (n, n),
         };
-        let mut block = interp.block(&bytes, start..end, line, &mut words)?;
-        if interp.modal != last {
-            last = interp.modal;
-            states.push(PackedModal::pack(&last));
-        }
-        // At most one state per block plus the initial one, so at most 2^32 - 1.
-        block.state = (states.len() - 1) as u32;
-        blocks.push(block);
+        let span = start..end;
         start = next;
         line += 1;
-    }
-    Ok(Program {
-        bytes,
-        blocks,
-        words,
-        dialect,
-        states,
+        Some((span, line))
     })
+}
+
+/// Read `bytes` block by block without building a [`Program`]: `visit` gets each block
+/// (its [`Block::words`] index the slice it is given), its words and the modal state after
+/// it, in file order, and may stop the scan early with `ControlFlow::Break`. Memory is one
+/// block's words. Same rules and the same errors, in the same order, as [`parse`] (which
+/// reads the whole file and so also reports an error after a point where `visit` stopped).
+///
+/// Returns the dialect used (`Dialect::Auto` is detected as in [`parse`]).
+pub fn scan(
+    bytes: &[u8],
+    dialect: Dialect,
+    visit: impl FnMut(&Block, &[Word], &Modal) -> std::ops::ControlFlow<()>,
+) -> Result<Dialect, ParseError> {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
+    scan_with(bytes, dialect, threads, visit)
+}
+
+/// [`scan`] on `threads` threads.
+fn scan_with(
+    bytes: &[u8],
+    dialect: Dialect,
+    threads: usize,
+    mut visit: impl FnMut(&Block, &[Word], &Modal) -> std::ops::ControlFlow<()>,
+) -> Result<Dialect, ParseError> {
+    if u32::try_from(bytes.len()).is_err() {
+        return Err(too_big(bytes.len()));
+    }
+    let dialect = match dialect {
+        Dialect::Auto => detect(bytes),
+        d => d,
+    };
+    let mut interp = Interpreter::new(dialect);
+    if threads <= 1 || bytes.len() < SCAN_WINDOW_BYTES {
+        let mut words = Vec::with_capacity(32);
+        for (span, line) in lines(bytes) {
+            words.clear();
+            let block = interp.block(bytes, span, line, &mut words)?;
+            if visit(&block, &words, &interp.modal).is_break() {
+                break;
+            }
+        }
+        return Ok(dialect);
+    }
+    // Windows of about SCAN_WINDOW_BYTES, each cut at newlines into one part per thread;
+    // the parts are lexed side by side (lexing needs only the dialect), then applied to
+    // the modal state in file order. Memory: one window's words and line summaries.
+    let mut line_offset = 0usize;
+    let mut from = 0usize;
+    let mut parts: Vec<LexedPart> = (0..threads).map(|_| LexedPart::default()).collect();
+    while from < bytes.len() {
+        let to = cut_after(bytes, from + SCAN_WINDOW_BYTES);
+        let mut cuts = vec![from];
+        for k in 1..threads {
+            let c = cut_after(bytes, from + (to - from) * k / threads).min(to);
+            cuts.push(c.max(*cuts.last().unwrap_or(&from)));
+        }
+        cuts.push(to);
+        let interp_ref = &interp;
+        std::thread::scope(|sc| {
+            let (first, rest) = parts.split_at_mut(1);
+            let handles: Vec<_> = cuts
+                .windows(2)
+                .skip(1)
+                .zip(rest.iter_mut())
+                .map(|(w, part)| {
+                    let (a, b) = (w[0], w[1]);
+                    sc.spawn(move || interp_ref.lex_part(bytes, a..b, part))
+                })
+                .collect();
+            interp_ref.lex_part(bytes, cuts[0]..cuts[1], &mut first[0]);
+            for h in handles {
+                h.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
+            }
+        });
+        for part in &mut parts {
+            for (k, (span, scan, words)) in part.lines.drain(..).enumerate() {
+                let line = line_offset + k + 1;
+                let ws = &part.words[words];
+                let block = interp.apply(scan, line, span, 0..ws.len());
+                if visit(&block, ws, &interp.modal).is_break() {
+                    return Ok(dialect);
+                }
+            }
+            line_offset += part.line_count;
+            if let Some(mut e) = part.error.take() {
+                e.line += line_offset - part.line_count;
+                return Err(e);
+            }
+        }
+        from = to;
+    }
+    Ok(dialect)
+}
+
+/// Size of the windows [`scan`] lexes on several threads at a time, bytes: large enough
+/// that starting threads costs nothing, small enough that a window's words stay a small
+/// part of any program worth doing this for.
+const SCAN_WINDOW_BYTES: usize = 1 << 20;
+
+/// One part of a window, lexed: per line (its span, what it says, its words' range in
+/// `words`), up to the first error, which is kept with its line counted within the part.
+/// Reused from window to window.
+#[derive(Default)]
+struct LexedPart {
+    lines: Vec<(Range<usize>, Scan, Range<usize>)>,
+    words: Vec<Word>,
+    /// Lines in the part (all of them, also past an error).
+    line_count: usize,
+    error: Option<ParseError>,
+}
+
+/// The offset just past the newline at or after `at` (the end of `bytes` if none).
+fn cut_after(bytes: &[u8], at: usize) -> usize {
+    if at >= bytes.len() {
+        return bytes.len();
+    }
+    find_newline(bytes, at).map_or(bytes.len(), |nl| nl + 1)
+}
+
+fn too_big(len: usize) -> ParseError {
+    ParseError::at(
+        1,
+        1,
+        format!("the file has {len} bytes; polepatch reads programs of at most 4 GiB"),
+    )
 }
 
 /// Offset of the first `\n` at or after `from`, eight bytes at a time.
@@ -392,6 +529,41 @@ impl Interpreter {
         words: &mut Vec<Word>,
     ) -> Result<Block, ParseError> {
         let first_word = words.len();
+        let s = self.lex(bytes, span.clone(), line, words)?;
+        Ok(self.apply(s, line, span, first_word..words.len()))
+    }
+
+    /// Lex the lines of `range` (which starts at a line start and ends after a newline or
+    /// at the end of the file), numbering them from 1 within the part.
+    fn lex_part(&self, bytes: &[u8], range: Range<usize>, part: &mut LexedPart) {
+        let sub = &bytes[..range.end];
+        part.lines.clear();
+        part.words.clear();
+        part.line_count = 0;
+        part.error = None;
+        for (span, _) in lines_from(sub, range.start) {
+            part.line_count += 1;
+            if part.error.is_some() {
+                continue;
+            }
+            let first = part.words.len();
+            match self.lex(bytes, span.clone(), part.line_count, &mut part.words) {
+                Ok(scan) => part.lines.push((span, scan, first..part.words.len())),
+                Err(e) => part.error = Some(e),
+            }
+        }
+    }
+
+    /// What a line says (its words appended to `words`), before the modal state: this
+    /// depends on the dialect only, so lines can be lexed in any order
+    /// ([`scan`] does it on several threads).
+    fn lex(
+        &self,
+        bytes: &[u8],
+        span: Range<usize>,
+        line: usize,
+        words: &mut Vec<Word>,
+    ) -> Result<Scan, ParseError> {
         let mut s = Scan::default();
         for token in Lexer::new(bytes, span.clone()) {
             let token =
@@ -445,7 +617,7 @@ impl Interpreter {
                 Token::Comment { .. } | Token::BlockEnd { .. } | Token::Other { .. } => {}
             }
         }
-        Ok(self.apply(s, line, span, first_word..words.len()))
+        Ok(s)
     }
 
     /// Update the modal state; the block's `state` index is set by the caller.
@@ -695,5 +867,81 @@ mod tests {
         )
         .unwrap();
         assert_eq!(prog.state(1).pos[Y], Some(2.0));
+    }
+
+    /// A program of about `mb` MB with a comment line, modal changes and feed changes.
+    fn big(mb: usize) -> Vec<u8> {
+        let mut t = b"%BIG G71 *\nN10 G90 *\nN30 M128 *\n".to_vec();
+        let mut k = 0u64;
+        while t.len() < mb << 20 {
+            let line = match k % 997 {
+                0 => "; a comment (with words X1 Y2)\n".to_string(),
+                1 => format!("N{k} G01 X+1 Y+2 Z-8 A+10 C+20 F{} *\n", 1000 + k % 7),
+                2 => "\r\n".to_string(),
+                _ => format!(
+                    "N{k} X{:+.3} Y{:+.3} A{:+.3} C{:+.3} *\n",
+                    k as f64 * 0.01,
+                    (k as f64 * 0.001).sin(),
+                    (k % 40) as f64 - 20.0,
+                    (k * 7 % 720) as f64 - 360.0
+                ),
+            };
+            t.extend_from_slice(line.as_bytes());
+            k += 1;
+        }
+        t
+    }
+
+    /// What `scan_with` visits, as (line, span, words, state, is_move, breaks_run).
+    type Visited = Vec<(usize, Range<usize>, Vec<Word>, Modal, bool, bool)>;
+
+    fn scanned(bytes: &[u8], threads: usize) -> Result<Visited, ParseError> {
+        let mut v = Vec::new();
+        scan_with(bytes, Dialect::Auto, threads, |b, w, m| {
+            v.push((b.line, b.span(), w.to_vec(), *m, b.is_move, b.breaks_run));
+            std::ops::ControlFlow::Continue(())
+        })?;
+        Ok(v)
+    }
+
+    #[test]
+    fn scan_on_threads_sees_what_parse_sees() {
+        let bytes = big(9);
+        let prog = parse(bytes.clone(), Dialect::Auto).unwrap();
+        let expected: Visited = (0..prog.blocks.len())
+            .map(|i| {
+                let b = &prog.blocks[i];
+                (
+                    b.line,
+                    b.span(),
+                    prog.block_words(i).to_vec(),
+                    prog.state(i),
+                    b.is_move,
+                    b.breaks_run,
+                )
+            })
+            .collect();
+        for threads in [1, 2, 3] {
+            let got = scanned(&bytes, threads).unwrap();
+            assert_eq!(got.len(), expected.len(), "{threads} threads");
+            assert!(got == expected, "{threads} threads");
+        }
+    }
+
+    #[test]
+    fn scan_on_threads_gives_parses_first_error() {
+        let mut bytes = big(9);
+        // Two errors in different windows: the first in file order is reported.
+        for (at, bad) in [(7usize << 20, &b"X1..2"[..]), (5 << 20, b"C12e5")] {
+            let nl = find_newline(&bytes, at).unwrap() + 1;
+            bytes.splice(nl..nl, bad.iter().copied().chain(*b"\n"));
+        }
+        let e = parse(bytes.clone(), Dialect::Auto).unwrap_err();
+        assert!(e.message.contains("exponent"), "{}", e.message);
+        for threads in [1, 2, 3] {
+            let got = scanned(&bytes, threads).unwrap_err();
+            assert_eq!((got.line, got.column), (e.line, e.column), "{threads}");
+            assert_eq!(got.message, e.message);
+        }
     }
 }

@@ -1,7 +1,7 @@
 //! Runs of G1 motion with cumulative tool-tip path length s.
 
 use crate::modal::{Modal, X, Y, Z};
-use crate::program::Program;
+use crate::program::{Block, Program};
 
 /// Why a run ended (for reports).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -67,25 +67,7 @@ pub const ZERO_LENGTH_MM: f64 = 1e-9;
 /// Other blocks (comments, S, coolant, an F alone) are skipped.
 pub fn runs(program: &Program) -> Vec<Run> {
     let mut out = Vec::new();
-    let mut cur: Option<Run> = None;
-    let mut prev = Modal::default();
-    let mut last_pos: Option<usize> = None;
-    let finish = |cur: &mut Option<Run>, why: RunBreak, out: &mut Vec<Run>| {
-        if let Some(mut r) = cur.take() {
-            if r.len() >= 2 {
-                r.ended_by = why;
-                out.push(r);
-            }
-        }
-    };
-    let start = |block: usize, st: &Modal| Run {
-        blocks: vec![block],
-        s_mm: vec![0.0],
-        pos: vec![st.pos],
-        feed_mm_min: st.feed_mm_min,
-        tcpm: st.tcpm,
-        ended_by: RunBreak::End,
-    };
+    let mut builder = RunBuilder::default();
     let mut cur_state = Modal::default();
     for (i, b) in program.blocks.iter().enumerate() {
         if b.state_index()
@@ -96,32 +78,72 @@ pub fn runs(program: &Program) -> Vec<Run> {
         {
             cur_state = program.state(i);
         }
-        let st = &cur_state;
+        builder.push(i, b, &cur_state, &mut |r| out.push(r));
+    }
+    builder.finish(&mut |r| out.push(r));
+    out
+}
+
+/// The run-finding walk of [`runs`], one block at a time, for callers that read a
+/// program as a stream ([`crate::program::scan`]) and want each run as it ends instead of
+/// a [`Program`] and all runs at once.
+#[derive(Debug, Clone, Default)]
+pub struct RunBuilder {
+    cur: Option<Run>,
+    prev: Modal,
+    last_pos: Option<usize>,
+}
+
+impl RunBuilder {
+    fn finish_run(&mut self, why: RunBreak, emit: &mut impl FnMut(Run)) {
+        if let Some(mut r) = self.cur.take()
+            && r.len() >= 2
+        {
+            r.ended_by = why;
+            emit(r);
+        }
+    }
+
+    fn start(block: usize, st: &Modal) -> Run {
+        Run {
+            blocks: vec![block],
+            s_mm: vec![0.0],
+            pos: vec![st.pos],
+            feed_mm_min: st.feed_mm_min,
+            tcpm: st.tcpm,
+            ended_by: RunBreak::End,
+        }
+    }
+
+    /// Take block `i` (`b`, with `st` the modal state after it); `emit` gets the run it
+    /// ends, if any.
+    pub fn push(&mut self, i: usize, b: &Block, st: &Modal, emit: &mut impl FnMut(Run)) {
         if b.breaks_run {
-            finish(&mut cur, RunBreak::Block, &mut out);
+            self.finish_run(RunBreak::Block, emit);
         } else if b.is_move {
-            match (xyz(&prev.pos), xyz(&st.pos)) {
+            match (xyz(&self.prev.pos), xyz(&st.pos)) {
                 (Some(p0), Some(p1)) => {
                     let d = ((p1[0] - p0[0]).powi(2)
                         + (p1[1] - p0[1]).powi(2)
                         + (p1[2] - p0[2]).powi(2))
                     .sqrt();
                     if d <= ZERO_LENGTH_MM {
-                        finish(&mut cur, RunBreak::ZeroLength, &mut out);
-                        cur = Some(start(i, st));
+                        self.finish_run(RunBreak::ZeroLength, emit);
+                        self.cur = Some(Self::start(i, st));
                     } else {
-                        if let Some(r) = &mut cur {
-                            if r.feed_mm_min != st.feed_mm_min || r.tcpm != st.tcpm {
-                                if r.len() == 1 {
-                                    r.feed_mm_min = st.feed_mm_min;
-                                    r.tcpm = st.tcpm;
-                                } else {
-                                    finish(&mut cur, RunBreak::FeedChange, &mut out);
-                                }
+                        if let Some(r) = &mut self.cur
+                            && (r.feed_mm_min != st.feed_mm_min || r.tcpm != st.tcpm)
+                        {
+                            if r.len() == 1 {
+                                r.feed_mm_min = st.feed_mm_min;
+                                r.tcpm = st.tcpm;
+                            } else {
+                                self.finish_run(RunBreak::FeedChange, emit);
                             }
                         }
-                        let r = cur.get_or_insert_with(|| {
-                            let mut r = start(last_pos.unwrap_or(i), &prev);
+                        let (last_pos, prev) = (self.last_pos, &self.prev);
+                        let r = self.cur.get_or_insert_with(|| {
+                            let mut r = Self::start(last_pos.unwrap_or(i), prev);
                             r.feed_mm_min = st.feed_mm_min;
                             r.tcpm = st.tcpm;
                             r
@@ -133,18 +155,21 @@ pub fn runs(program: &Program) -> Vec<Run> {
                     }
                 }
                 _ => {
-                    finish(&mut cur, RunBreak::Block, &mut out);
-                    cur = Some(start(i, st));
+                    self.finish_run(RunBreak::Block, emit);
+                    self.cur = Some(Self::start(i, st));
                 }
             }
         }
-        if b.is_move || st.pos != prev.pos {
-            last_pos = Some(i);
+        if b.is_move || st.pos != self.prev.pos {
+            self.last_pos = Some(i);
         }
-        prev = *st;
+        self.prev = *st;
     }
-    finish(&mut cur, RunBreak::End, &mut out);
-    out
+
+    /// The end of the program: `emit` gets the run in progress, if any.
+    pub fn finish(&mut self, emit: &mut impl FnMut(Run)) {
+        self.finish_run(RunBreak::End, emit);
+    }
 }
 
 fn xyz(pos: &[Option<f64>; 6]) -> Option<[f64; 3]> {

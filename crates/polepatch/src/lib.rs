@@ -25,6 +25,7 @@ pub use polepatch_patcher as patcher;
 
 pub mod end_pose;
 pub mod error;
+pub mod far;
 pub mod patch;
 pub mod program;
 pub mod report;
@@ -90,6 +91,9 @@ pub fn patch_nc(
     machine: &Machine,
     opts: &PatchOptions,
 ) -> Result<(Vec<u8>, FileReport), Error> {
+    if let Some(report) = far::far_from_pole(bytes, machine, opts)? {
+        return Ok((bytes.to_vec(), report));
+    }
     let lp = program::load_nc(
         bytes.to_vec(),
         &opts.name,

@@ -379,6 +379,11 @@ pub fn patch_program(
                 continue;
             }
         };
+        // A zone needs a point in the cone (`detect_zones`): a run with none has nothing to
+        // patch or report, and its analysis is skipped.
+        if !path.axes.iter().any(|q| q[pi].abs() <= opts.cone_deg) {
+            continue;
+        }
         let incremental = rp
             .run
             .blocks

@@ -126,6 +126,27 @@ fn why_no_runs(program: &Program, name: &str) -> Error {
     }
 }
 
+fn tilt_letter(idx: usize) -> u8 {
+    if idx == modal::A { b'A' } else { b'B' }
+}
+
+/// The warning when the program's tilting letter (`p_idx`, `modal::A` or `modal::B`) is
+/// not the machine's.
+pub(crate) fn primary_mismatch_warning(
+    name: &str,
+    machine: &Machine,
+    p_idx: usize,
+) -> Option<String> {
+    let used = tilt_letter(p_idx) as char;
+    let own = machine.primary_letter();
+    (used != own).then(|| {
+        format!(
+            "{name}: the program uses {used} but machine {} has {own}: {own}'s limits are applied to {used}",
+            machine.name
+        )
+    })
+}
+
 /// Group a parsed program into runs and build each run's path for `machine`.
 /// `feed_fallback_mm_min` is used for runs with no F in force.
 pub fn load(
@@ -138,25 +159,16 @@ pub fn load(
     if runs.is_empty() {
         return Err(why_no_runs(&program, name));
     }
-    let letter = |i: usize| if i == modal::A { b'A' } else { b'B' };
     let own = if machine.primary_letter() == 'A' {
         modal::A
     } else {
         modal::B
     };
     let p_idx = polepatch_nc::primary_in_use(&runs, own);
-    let primary_letter = letter(p_idx);
-    let mut warnings = Vec::new();
-    if p_idx != own {
-        warnings.push(format!(
-            "{name}: the program uses {} but machine {} has {}: {}'s limits are applied to {}",
-            primary_letter as char,
-            machine.name,
-            letter(own) as char,
-            letter(own) as char,
-            primary_letter as char
-        ));
-    }
+    let primary_letter = tilt_letter(p_idx);
+    let warnings: Vec<String> = primary_mismatch_warning(name, machine, p_idx)
+        .into_iter()
+        .collect();
     let has = |idx: usize| runs.iter().any(|r| r.uses(idx));
     if !has(p_idx) && !has(modal::C) {
         return Err(Error::NoRotary {

@@ -1,0 +1,124 @@
+//! The no-zone fast path: prove from a streaming read that no run comes within the
+//! singular cone, without building the program.
+//!
+//! A zone needs a CL point with |primary| ≤ the cone (`patcher::detect_zones`), so a
+//! program none of whose run points is that close has no zone, and [`crate::patch_nc`]
+//! returns it unchanged. [`far_from_pole`] decides that with [`polepatch_nc::scan`] and
+//! [`polepatch_nc::RunBuilder`] — the same reading and the same runs as the full path,
+//! one block and one run at a time — so memory is the input plus one run, and it stops
+//! at the first run that comes near the pole (the full path then takes over).
+//!
+//! It answers only when the answer is the full path's exactly: whenever the report would
+//! have more than the file name, the machine and a warning — a run without a feed, no
+//! run at all, no rotary words — it says "not decided" and the full path runs (and gives
+//! the error or the report).
+
+use crate::patch::FileReport;
+use crate::program::primary_mismatch_warning;
+use polepatch_kinematics::Machine;
+use polepatch_nc::modal::{A, B, C};
+use polepatch_nc::{Dialect, RunBuilder, scan};
+use std::ops::ControlFlow;
+
+/// What the scan found, run by run.
+#[derive(Debug, Default)]
+struct Seen {
+    runs: usize,
+    /// Some run point has a value for X Y Z A B C (index as `Modal::pos`).
+    uses: [bool; 6],
+    /// Least |A| and |B| over all run points, a missing value read as 0 (as the full path
+    /// reads it).
+    min_abs_a_deg: f64,
+    min_abs_b_deg: f64,
+    /// A run with no feed in force (and no fallback): the full path reports it.
+    feedless: bool,
+}
+
+/// The report of a program that is proven to have no run point within `opts.cone_deg`
+/// of the pole (no zone: the output is the input), or `None` when that is not proven and
+/// the full path must run. Errors are the input's syntax errors, as [`crate::patch_nc`]
+/// gives them.
+pub fn far_from_pole(
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &crate::PatchOptions,
+) -> Result<Option<FileReport>, crate::Error> {
+    let cone_deg = opts.patch.cone_deg;
+    let fallback = opts.feed_fallback_mm_min;
+    let mut seen = Seen {
+        min_abs_a_deg: f64::INFINITY,
+        min_abs_b_deg: f64::INFINITY,
+        ..Seen::default()
+    };
+    let mut builder = RunBuilder::default();
+    let mut near = false;
+    let take = |run: polepatch_nc::Run, seen: &mut Seen| {
+        seen.runs += 1;
+        if run.feed_mm_min.or(fallback).is_none() {
+            seen.feedless = true;
+        }
+        for p in &run.pos {
+            for (u, v) in seen.uses.iter_mut().zip(p) {
+                *u |= v.is_some();
+            }
+            seen.min_abs_a_deg = seen.min_abs_a_deg.min(p[A].unwrap_or(0.0).abs());
+            seen.min_abs_b_deg = seen.min_abs_b_deg.min(p[B].unwrap_or(0.0).abs());
+        }
+    };
+    let mut i = 0usize;
+    scan(bytes, Dialect::Auto, |block, _, st| {
+        builder.push(i, block, st, &mut |run| take(run, &mut seen));
+        i += 1;
+        // Whichever tilting letter turns out to be the primary, a point is in the cone.
+        near = seen.feedless || (seen.min_abs_a_deg <= cone_deg && seen.min_abs_b_deg <= cone_deg);
+        if near {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    })
+    .map_err(|e| crate::Error::Parse(e.with_path(&opts.name)))?;
+    if near {
+        return Ok(None);
+    }
+    builder.finish(&mut |run| take(run, &mut seen));
+    let own = if machine.primary_letter() == 'A' {
+        A
+    } else {
+        B
+    };
+    let other = if own == A { B } else { A };
+    // `polepatch_nc::primary_in_use`, on the flags.
+    let p_idx = if !seen.uses[own] && seen.uses[other] {
+        other
+    } else {
+        own
+    };
+    let min_abs = if p_idx == A {
+        seen.min_abs_a_deg
+    } else {
+        seen.min_abs_b_deg
+    };
+    if seen.runs == 0
+        || seen.feedless
+        || (!seen.uses[p_idx] && !seen.uses[C])
+        || min_abs <= cone_deg
+    {
+        return Ok(None);
+    }
+    Ok(Some(FileReport {
+        file: opts.name.clone(),
+        output: None,
+        machine: machine.name.clone(),
+        words_changed: 0,
+        file_c_decimals: None,
+        written_c_decimals: None,
+        file_primary_decimals: None,
+        written_primary_decimals: None,
+        untouched_runs: Vec::new(),
+        warnings: primary_mismatch_warning(&opts.name, machine, p_idx)
+            .into_iter()
+            .collect(),
+        zones: Vec::new(),
+    }))
+}
