@@ -3,7 +3,6 @@
 use polepatch::kinematics::Machine;
 use polepatch::program::load_nc;
 use polepatch::{Error, FileReport, patch_program};
-use polepatch_patcher::PatchOptions;
 use std::io::Write;
 use std::path::Path as FsPath;
 
@@ -51,8 +50,7 @@ pub fn patch_file(
     input: &FsPath,
     output: &FsPath,
     machine: &Machine,
-    opts: &PatchOptions,
-    feed_fallback_mm_min: Option<f64>,
+    opts: &polepatch::PatchOptions,
 ) -> Result<FileReport, JobError> {
     let name = input.display().to_string();
     if same_file(input, output) {
@@ -66,9 +64,8 @@ pub fn patch_file(
     // No run point within the cone: the output is the input, proven by a streaming read
     // (memory: the file once).
     let whole = polepatch::PatchOptions {
-        patch: opts.clone(),
-        feed_fallback_mm_min,
         name: name.clone(),
+        ..opts.clone()
     };
     // The copy is written while the scan runs (it is the output when the scan proves the
     // program far from the pole; otherwise it is deleted).
@@ -87,8 +84,9 @@ pub fn patch_file(
         return Ok(report);
     }
     drop(staged);
-    let lp = load_nc(bytes, &name, machine, feed_fallback_mm_min)?;
-    let (edits, mut report) = patch_program(&lp, machine, opts);
+    let mut lp = load_nc(bytes, &name, machine, opts.feed_fallback_mm_min)?;
+    lp.work_offset_mm = opts.work_offset_mm;
+    let (edits, mut report) = patch_program(&lp, machine, &opts.patch);
     if edits.is_empty() {
         write_atomic_like(output, &lp.program.bytes, Some(input)).map_err(write_err)?;
     } else {

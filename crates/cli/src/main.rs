@@ -91,6 +91,11 @@ pub(crate) struct PatchArgs {
     /// Worker threads for batches (default: all cores).
     #[arg(long)]
     pub(crate) jobs: Option<usize>,
+    /// Work offset X,Y,Z (mm, machine coordinates of the program's zero) for a machine
+    /// with a kinematic chain, where the program only names it (G54); default: the
+    /// program's datum shift (Heidenhain G54 X Y Z).
+    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z")]
+    pub(crate) work_offset: Option<[f64; 3]>,
 }
 
 #[derive(clap::Args)]
@@ -113,6 +118,24 @@ struct AnalyzeArgs {
     /// Print one JSON document instead of the table.
     #[arg(long)]
     json: bool,
+    /// Work offset X,Y,Z (mm) for a machine with a kinematic chain (see `patch`).
+    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z")]
+    work_offset: Option<[f64; 3]>,
+}
+
+/// `X,Y,Z` as three finite numbers.
+pub(crate) fn parse_xyz(text: &str) -> Result<[f64; 3], String> {
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|t| t.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("'{text}': {e}; expected X,Y,Z in mm, e.g. -30.5,-4.3,38"))?;
+    match v[..] {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok([x, y, z]),
+        _ => Err(format!(
+            "'{text}': expected three finite numbers X,Y,Z in mm, e.g. -30.5,-4.3,38"
+        )),
+    }
 }
 
 fn main() -> ExitCode {
@@ -153,7 +176,8 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
     check_positive("--cone", Some(args.cone))?;
     let machine = machine(&args.machine)?;
     let name = args.file.display().to_string();
-    let lp = load_nc(files::read(&args.file)?, &name, &machine, args.feed)?;
+    let mut lp = load_nc(files::read(&args.file)?, &name, &machine, args.feed)?;
+    lp.work_offset_mm = args.work_offset;
     let opts = AnalysisOptions {
         cone_deg: args.cone,
         tcy_s: args.tcy_ms.map(|ms| ms / 1000.0),
@@ -244,6 +268,21 @@ fn print_analysis(report: &AnalyzeReport, primary_letter: u8) {
             })
             .collect();
         println!("  min ratio per axis: {}", ratios.join(", "));
+        if let Some(m) = &r.machine_frame {
+            let xyz = |map: &std::collections::BTreeMap<String, f64>| {
+                ["X", "Y", "Z"]
+                    .map(|l| format!("{l} {:.3}", map[l]))
+                    .join(", ")
+            };
+            println!(
+                "  machine frame (chain, datum X{:+.3} Y{:+.3} Z{:+.3}): peak speed at F {} m/min; min ratio {}",
+                m.datum_mm[0],
+                m.datum_mm[1],
+                m.datum_mm[2],
+                xyz(&m.peak_speed),
+                xyz(&m.axis_min_ratio)
+            );
+        }
         if f.zones.is_empty() {
             println!("  no singular zone");
         }

@@ -80,7 +80,12 @@ fn expand(inputs: &[PathBuf]) -> Result<Vec<(PathBuf, PathBuf)>> {
 }
 
 pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
-    let opts = options(&args)?;
+    let opts = polepatch::PatchOptions {
+        patch: options(&args)?,
+        feed_fallback_mm_min: args.feed,
+        work_offset_mm: args.work_offset,
+        ..polepatch::PatchOptions::default()
+    };
     let machine = machine(&args.machine)?;
     for (flag, path) in [("--report", &args.report), ("--csv", &args.csv)] {
         if let Some(path) = path {
@@ -101,13 +106,7 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
                 bail!("-o/--output takes one input file; use --out-dir for several or a folder");
             }
             names.push(args.inputs[0].clone());
-            vec![patch_file(
-                &args.inputs[0],
-                output,
-                &machine,
-                &opts,
-                args.feed,
-            )]
+            vec![patch_file(&args.inputs[0], output, &machine, &opts)]
         }
         (None, Some(dir)) => {
             let files = expand(&args.inputs)?;
@@ -142,7 +141,7 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
                                 source,
                             })?;
                         }
-                        let r = patch_file(input, &output, &machine, &opts, args.feed);
+                        let r = patch_file(input, &output, &machine, &opts);
                         bar.inc(1);
                         r
                     })

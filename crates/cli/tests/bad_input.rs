@@ -5,8 +5,8 @@
 
 mod common;
 use common::root;
+use polepatch::PatchOptions;
 use polepatch::kinematics::Machine;
-use polepatch::patcher::PatchOptions;
 use polepatch_cli::files::{JobError, patch_file};
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
@@ -282,9 +282,8 @@ fn check_patch_file(dir: &Path, bytes: &[u8], machine: &Machine) -> Result<(), T
     let output = dir.join("out.I");
     std::fs::write(&input, bytes).unwrap();
     let _ = std::fs::remove_file(&output);
-    let r = std::panic::catch_unwind(|| {
-        patch_file(&input, &output, machine, &PatchOptions::default(), None)
-    });
+    let r =
+        std::panic::catch_unwind(|| patch_file(&input, &output, machine, &PatchOptions::default()));
     let r = r.map_err(|_| TestCaseError::fail("panic"))?;
     prop_assert_eq!(std::fs::read(&input).unwrap(), bytes);
     match r {
@@ -364,5 +363,21 @@ fn every_truncation_of_a_small_program_is_handled() {
     for n in (0..=bytes.len()).step_by(step) {
         check_patch_file(&dir, &bytes[..n], &machine)
             .unwrap_or_else(|e| panic!("truncated at {n}: {e}"));
+    }
+}
+
+#[test]
+fn a_malformed_work_offset_is_refused_with_the_expected_form() {
+    for bad in ["1,2", "a,b,c", "1,2,inf"] {
+        let (code, _, err) = polepatch(&[
+            "analyze",
+            "fixtures/c17/SING.I",
+            "--machine",
+            "mikron-ucp710",
+            "--work-offset",
+            bad,
+        ]);
+        assert_ne!(code, 0, "{bad}");
+        assert!(err.contains("X,Y,Z"), "{bad}: {err}");
     }
 }

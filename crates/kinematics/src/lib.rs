@@ -18,6 +18,7 @@
 //! G16 eq. 1 is `sp = sc = +1` with A (`i = sin C sin A, j = −cos C sin A, k = cos A`);
 //! C17 eq. 2 is `sp = sc = −1` (`i = sin C sin A, j = cos C sin A, k = cos A`).
 
+pub mod chain;
 pub mod feed;
 pub mod forward;
 pub mod inverse;
@@ -27,6 +28,7 @@ pub mod tolerances;
 #[cfg(test)]
 mod testutil;
 
+pub use chain::Chain;
 pub use feed::{AxisBound, FeedBound, LimitKind, axis_feed_bound, axis_feed_ratio, feed_bound};
 pub use forward::{angle_between_deg, forward, forward_jacobian};
 pub use inverse::{

@@ -71,6 +71,9 @@ pub struct Machine {
     pub tcy_s: f64,
     /// Limits per axis in [`Axis`] order, internal units.
     pub limits: [AxisLimits; 5],
+    /// Where the rotary axes sit in the machine frame (`[chain]`, optional): needed to
+    /// patch programs without TCPM and to analyse the linear axes in the machine frame.
+    pub chain: Option<crate::chain::Chain>,
 }
 
 /// Errors of machine loading.
@@ -138,6 +141,9 @@ impl Machine {
     /// v_rpm = 20.0
     /// a_rev_s2 = 0.83
     /// j_rev_s3 = 50.0
+    /// [chain]                          # optional: where the rotary axes sit (mm, machine frame)
+    /// primary_axis_point_mm = [0.0, 0.0, -150.0]   # a point on the primary axis line
+    /// c_axis_point_mm = [0.0, 0.0, -100.0]         # a point on the C axis at primary = 0
     /// ```
     ///
     /// Limits are converted once to internal units: m/min → mm/s ×1000/60, m/s² → mm/s²
@@ -214,6 +220,7 @@ struct MachineFile {
     z: LinearFile,
     primary: PrimaryFile,
     c: CFile,
+    chain: Option<crate::chain::Chain>,
 }
 
 /// `[x]`, `[y]`, `[z]`.
@@ -326,6 +333,13 @@ impl MachineFile {
                 rotary_limits("primary", p.v_rpm, p.a_rev_s2, p.j_rev_s3)?,
                 rotary_limits("c", c.v_rpm, c.a_rev_s2, c.j_rev_s3)?,
             ],
+            chain: match self.chain {
+                Some(ch) => {
+                    ch.validate()?;
+                    Some(ch)
+                }
+                None => None,
+            },
         })
     }
 }

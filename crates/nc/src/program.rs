@@ -98,6 +98,10 @@ pub struct Program {
     pub words: Vec<Word>,
     /// Dialect used.
     pub dialect: Dialect,
+    /// Datum shifts that state their values (Heidenhain ISO `G54 X… Y… Z…`), in file order:
+    /// the block and the new datum's X Y Z (mm; a missing axis is 0). A work-offset
+    /// selection that only names a register (Fanuc/Sinumerik `G54`) is not here.
+    pub datum_shifts: Vec<(usize, [f64; 3])>,
     /// Modal states, one per change: block `b`'s state is `states[blocks[b].state]`.
     states: Vec<PackedModal>,
 }
@@ -159,6 +163,9 @@ pub fn parse(bytes: Vec<u8>, dialect: Dialect) -> Result<Program, ParseError> {
         }
         // At most one state per block plus the initial one, so at most 2^32 - 1.
         block.state = (states.len() - 1) as u32;
+        if let Some(d) = interp.stated_datum.take() {
+            interp.datum_shifts.push((blocks.len(), d));
+        }
         blocks.push(block);
     }
     Ok(Program {
@@ -166,6 +173,7 @@ pub fn parse(bytes: Vec<u8>, dialect: Dialect) -> Result<Program, ParseError> {
         blocks,
         words,
         dialect,
+        datum_shifts: interp.datum_shifts,
         states,
     })
 }
@@ -417,6 +425,8 @@ struct Scan {
     feed_mode: Option<FeedMode>,
     /// Axis words define a datum/frame (Heidenhain G54, G92, G10, G52, TRANS…): not a move.
     datum_shift: bool,
+    /// Heidenhain ISO `G54`: the block's X Y Z are the new datum.
+    stated_datum: bool,
     /// Work offset selection (Fanuc/Sinumerik G54…G59, G500): positions re-based.
     work_offset: bool,
     /// Reference / machine-coordinate move (G28, G30, G53, SUPA).
@@ -432,6 +442,10 @@ struct Interpreter {
     dialect: Dialect,
     modal: Modal,
     feed_mode: FeedMode,
+    /// The datum the last block stated (Heidenhain `G54 X Y Z`), taken by `parse`.
+    stated_datum: Option<[f64; 3]>,
+    /// All stated datums (see [`Program::datum_shifts`]).
+    datum_shifts: Vec<(usize, [f64; 3])>,
 }
 
 impl Interpreter {
@@ -440,6 +454,8 @@ impl Interpreter {
             dialect,
             modal: Modal::default(),
             feed_mode: FeedMode::PerMinute,
+            stated_datum: None,
+            datum_shifts: Vec::new(),
         }
     }
 
@@ -463,7 +479,11 @@ impl Interpreter {
                 s.feed_mode = Some(FeedMode::Other);
                 s.breaks = true;
             }
-            Some(530 | 540) if heidenhain => s.datum_shift = true,
+            Some(540) if heidenhain => {
+                s.datum_shift = true;
+                s.stated_datum = true;
+            }
+            Some(530) if heidenhain => s.datum_shift = true,
             Some(540..=590 | 5000 | 5050..=5990) => s.work_offset = true,
             Some(920 | 100 | 520 | 500 | 510 | 680 | 681 | 690) => s.datum_shift = true,
             Some(530 | 280 | 300) => s.reference = true,
@@ -645,6 +665,10 @@ impl Interpreter {
             }
         }
         let scale = if m.inch { 25.4 } else { 1.0 };
+        if s.stated_datum {
+            let v = |i: usize| s.axes[i].unwrap_or(0.0) * scale;
+            self.stated_datum = Some([v(X), v(Y), v(Z)]);
+        }
         if let Some(f) = s.feed {
             m.feed_mm_min = (self.feed_mode == FeedMode::PerMinute).then_some(f * scale);
         }
@@ -943,5 +967,18 @@ mod tests {
             assert_eq!((got.line, got.column), (e.line, e.column), "{threads}");
             assert_eq!(got.message, e.message);
         }
+    }
+
+    #[test]
+    fn heidenhain_datum_shifts_are_kept_with_their_values() {
+        let prog = p(
+            "%P G71 *\nN10 G54 X-30.489 Y-7.1 Z+38.054 *\nN20 G01 X1 Y2 Z3 F100 *\nN30 G54 X+5 *\n",
+        );
+        assert_eq!(
+            prog.datum_shifts,
+            vec![(1, [-30.489, -7.1, 38.054]), (3, [5.0, 0.0, 0.0])]
+        );
+        // A Fanuc work-offset selection names a register only: no values.
+        assert!(p("G54\nG1 X1 Y2 Z3 F100\n").datum_shifts.is_empty());
     }
 }

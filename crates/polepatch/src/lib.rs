@@ -26,6 +26,7 @@ pub use polepatch_patcher as patcher;
 pub mod end_pose;
 pub mod error;
 pub mod far;
+pub mod machine_frame;
 pub mod patch;
 pub mod program;
 pub mod report;
@@ -48,6 +49,9 @@ pub struct PatchOptions {
     pub feed_fallback_mm_min: Option<f64>,
     /// Name of the input in messages and in the report (`file`). Default `"input"`.
     pub name: String,
+    /// Work offset (machine coordinates of the program's zero, mm) for a machine with a
+    /// kinematic chain. Default `None`: the program's own datum (Heidenhain `G54 X Y Z`).
+    pub work_offset_mm: Option<[f64; 3]>,
 }
 
 impl Default for PatchOptions {
@@ -56,6 +60,7 @@ impl Default for PatchOptions {
             patch: patcher::PatchOptions::default(),
             feed_fallback_mm_min: None,
             name: "input".to_string(),
+            work_offset_mm: None,
         }
     }
 }
@@ -69,6 +74,8 @@ pub struct AnalyzeOptions {
     pub feed_fallback_mm_min: Option<f64>,
     /// Name of the input in messages and in the report. Default `"input"`.
     pub name: String,
+    /// Work offset for a machine with a kinematic chain (as [`PatchOptions::work_offset_mm`]).
+    pub work_offset_mm: Option<[f64; 3]>,
 }
 
 impl Default for AnalyzeOptions {
@@ -77,6 +84,7 @@ impl Default for AnalyzeOptions {
             analysis: AnalysisOptions::default(),
             feed_fallback_mm_min: None,
             name: "input".to_string(),
+            work_offset_mm: None,
         }
     }
 }
@@ -94,12 +102,13 @@ pub fn patch_nc(
     if let Some(report) = far::far_from_pole(bytes, machine, opts)? {
         return Ok((bytes.to_vec(), report));
     }
-    let lp = program::load_nc(
+    let mut lp = program::load_nc(
         bytes.to_vec(),
         &opts.name,
         machine,
         opts.feed_fallback_mm_min,
     )?;
+    lp.work_offset_mm = opts.work_offset_mm;
     Ok(patch_loaded(&lp, machine, &opts.patch))
 }
 
@@ -110,11 +119,12 @@ pub fn analyze_nc(
     machine: &Machine,
     opts: &AnalyzeOptions,
 ) -> Result<AnalyzeReport, Error> {
-    let lp = program::load_nc(
+    let mut lp = program::load_nc(
         bytes.to_vec(),
         &opts.name,
         machine,
         opts.feed_fallback_mm_min,
     )?;
+    lp.work_offset_mm = opts.work_offset_mm;
     Ok(report::analyze_program(&lp, machine, &opts.analysis))
 }

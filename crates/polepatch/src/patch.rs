@@ -12,6 +12,7 @@
 //! every later position. Both appear in [`FileReport::untouched_runs`] when they hold a
 //! singular zone.
 
+use crate::machine_frame;
 use crate::program::{LoadedProgram, RunProblem};
 use crate::report::{axis_letter, limit_name, zone_kind_name};
 use polepatch_kinematics::Machine;
@@ -246,6 +247,9 @@ pub enum UntouchedReason {
     NoFeed,
     /// The run's values could not be analysed (a path error).
     Invalid,
+    /// With the machine's kinematic chain: the patch would make a linear axis worse in the
+    /// machine frame, or could not be written through the chain.
+    MachineFrame,
 }
 
 /// A run left byte-identical, and why.
@@ -362,6 +366,9 @@ pub fn patch_program(
             .max(p_style.decimals),
         ..opts.clone()
     };
+    let xyz_decimals = NumberStyle::of(program, b'X')
+        .decimals
+        .max(machine_frame::MIN_XYZ_DECIMALS);
     let mut edits: Vec<Edit> = Vec::new();
     let mut written_c = c_style.decimals;
     let mut written_p = p_style.decimals;
@@ -390,12 +397,26 @@ pub fn patch_program(
             .iter()
             .skip(1)
             .any(|&b| program.state(b).incremental);
-        let leave = if !rp.run.tcpm {
+        let chain = machine
+            .chain
+            .as_ref()
+            .and_then(|ch| machine_frame::run_datum(lp, r, lp.work_offset_mm).map(|d| (ch, d)));
+        let inch = rp.run.blocks.iter().any(|&b| program.state(b).inch);
+        let leave = if !rp.run.tcpm && (chain.is_none() || inch || incremental) {
             Some((
                 UntouchedReason::NoTcpm,
-                "no TCPM active (M128, TRAORI or G43.4) — X Y Z are machine coordinates; \
-                 changing rotary words alone would move the part under the tool, so the run is \
-                 left as it is (give the machine's kinematic chain to patch it)",
+                if machine.chain.is_none() {
+                    "no TCPM active (M128, TRAORI or G43.4) — X Y Z are machine coordinates; \
+                     changing rotary words alone would move the part under the tool, so the run is \
+                     left as it is (give the machine's kinematic chain to patch it)"
+                } else if chain.is_none() {
+                    "no TCPM active and the work offset is unknown (the program states no datum \
+                     with values): X Y Z cannot be recomputed, so the run is left as it is \
+                     (give --work-offset X,Y,Z)"
+                } else {
+                    "no TCPM active, in inch or incremental mode: X Y Z are not recomputed there, \
+                     so the run is left as it is"
+                },
             ))
         } else if incremental {
             Some((
@@ -433,10 +454,23 @@ pub fn patch_program(
             continue;
         }
         let run_opts = PatchOptions {
-            keep_last_point: !crate::end_pose::end_pose_is_free(lp, r),
+            // Without TCPM the moves after the run are in machine coordinates: the last
+            // point keeps its values (X Y Z included).
+            keep_last_point: !rp.run.tcpm || !crate::end_pose::end_pose_is_free(lp, r),
             ..opts.clone()
         };
-        let result = match patch_path(path, machine, &run_opts) {
+        // Without TCPM (and with a chain) the patcher works on the part-frame path.
+        let part_path = match (rp.run.tcpm, chain) {
+            (false, Some((ch, d))) => Some(machine_frame::part_frame_path(ch, machine, d, path)),
+            _ => None,
+        };
+        let work_path = part_path.as_ref().unwrap_or(path);
+        let patched = if part_path.is_some() {
+            machine_frame::patch_part_frame(work_path, machine, &run_opts)
+        } else {
+            patch_path(work_path, machine, &run_opts)
+        };
+        let result = match patched {
             Ok(res) => res,
             Err(e) => {
                 report.untouched_runs.push(untouched(
@@ -449,9 +483,41 @@ pub fn patch_program(
                 continue;
             }
         };
+        let first_row = report.zones.len();
         report
             .zones
             .extend(result.zones.iter().map(|z| ZoneRow::new(lp, r, z)));
+        let mut run_edits: Vec<Edit> = Vec::new();
+        if let Some((ch, d)) = chain {
+            match through_chain(
+                lp,
+                r,
+                path,
+                work_path,
+                &result,
+                machine,
+                ch,
+                d,
+                &opts,
+                xyz_decimals,
+            ) {
+                Ok(xyz) => run_edits = xyz,
+                Err(why) => {
+                    for row in &mut report.zones[first_row..] {
+                        row.outcome = "unchanged";
+                    }
+                    report.untouched_runs.push(untouched(
+                        lp,
+                        r,
+                        UntouchedReason::MachineFrame,
+                        result.zones.len(),
+                        why,
+                    ));
+                    continue;
+                }
+            }
+        }
+        edits.append(&mut run_edits);
         let letters = [
             (
                 lp.primary_letter,
@@ -514,6 +580,108 @@ pub fn patch_program(
     report.file_primary_decimals = Some(p_style.decimals);
     report.written_primary_decimals = Some(written_p);
     (edits, report)
+}
+
+/// With a kinematic chain: for a run without TCPM, the X Y Z edits that keep the part-frame
+/// tool tip of every changed point (from the written rotary values, checked within
+/// [`machine_frame::TIP_TOLERANCE_MM`]); for every run, the machine-frame check (no axis's
+/// lowest Equation-6 ratio worse than `min(before, 1)`). `Err` says why the run must keep
+/// its original values.
+#[allow(clippy::too_many_arguments)]
+fn through_chain(
+    lp: &LoadedProgram,
+    r: usize,
+    path: &polepatch_patcher::Path,
+    work_path: &polepatch_patcher::Path,
+    result: &polepatch_patcher::PatchResult,
+    machine: &Machine,
+    chain: &polepatch_kinematics::Chain,
+    datum_mm: [f64; 3],
+    opts: &PatchOptions,
+    xyz_decimals: usize,
+) -> Result<Vec<Edit>, String> {
+    let rp = &lp.runs[r];
+    let tcpm = rp.run.tcpm;
+    let n = path.axes.len();
+    let changed = |k: usize| result.p_changed[k] || result.c_changed[k];
+    if !(0..n).any(changed) {
+        return Ok(Vec::new());
+    }
+    let mut after: Vec<[f64; 5]> = path.axes.clone();
+    let mut edits = Vec::new();
+    for (k, point) in after.iter_mut().enumerate() {
+        point[3] = result.p_deg[k];
+        point[4] = result.c_deg[k];
+        if tcpm || !changed(k) {
+            continue;
+        }
+        let tip = [
+            work_path.axes[k][0],
+            work_path.axes[k][1],
+            work_path.axes[k][2],
+        ];
+        let (p, c) = (result.p_deg[k], result.c_deg[k]);
+        let exact = chain.program_xyz(machine, datum_mm, p, c, tip);
+        let mut written = exact;
+        let mut ok = false;
+        for decimals in xyz_decimals..=xyz_decimals.max(6) {
+            written = exact.map(|v| machine_frame::round_to(v, decimals));
+            let back = chain.part_tip(machine, datum_mm, p, c, written);
+            let err = (0..3).map(|i| (back[i] - tip[i]).abs()).fold(0.0, f64::max);
+            if err <= machine_frame::TIP_TOLERANCE_MM {
+                ok = true;
+                for (i, letter) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
+                    if written[i] != path.axes[k][i] {
+                        edits.push(Edit {
+                            block: rp.run.blocks[k],
+                            letter,
+                            value: written[i],
+                            decimals,
+                        });
+                    }
+                }
+                break;
+            }
+        }
+        if !ok {
+            return Err(format!(
+                "the tool tip at line {} cannot be kept within {} mm through the kinematic chain",
+                lp.line_of(r, k),
+                machine_frame::TIP_TOLERANCE_MM
+            ));
+        }
+        point[..3].copy_from_slice(&written);
+    }
+    let aopts = polepatch_patcher::AnalysisOptions {
+        cone_deg: opts.cone_deg,
+        tcy_s: opts.tcy_s,
+        keep_samples: false,
+    };
+    let frame = |values: &[[f64; 5]]| {
+        machine_frame::machine_frame_path(
+            chain,
+            machine,
+            datum_mm,
+            tcpm,
+            values,
+            &path.s_mm,
+            path.feed_mm_min,
+        )
+    };
+    let before = machine_frame::axis_min_ratios(&frame(&path.axes), machine, &aopts)
+        .map_err(|e| format!("machine-frame analysis failed before the patch: {e}"))?;
+    let after_r = machine_frame::axis_min_ratios(&frame(&after), machine, &aopts)
+        .map_err(|e| format!("machine-frame analysis failed after the patch: {e}"))?;
+    if let Some(axis) = machine_frame::worse_axis(&before, &after_r) {
+        let l = axis_letter(axis, lp.primary_letter);
+        return Err(format!(
+            "the patch would slow {l} in the machine frame (its lowest ratio {:.3} → {:.3}; \
+             the linear axes follow the table near the pole), so the run keeps its values",
+            before[axis.index()],
+            after_r[axis.index()]
+        ));
+    }
+    Ok(edits)
 }
 
 fn problem_reason(p: &RunProblem) -> UntouchedReason {

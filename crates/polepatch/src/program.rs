@@ -45,6 +45,10 @@ pub struct LoadedProgram {
     pub runs: Vec<RunPath>,
     /// Things the user should know (e.g. primary-letter substitution).
     pub warnings: Vec<String>,
+    /// Work offset given by the caller (machine coordinates of the program's zero, mm),
+    /// used with a machine's kinematic chain; `None`: from the program
+    /// ([`crate::machine_frame::run_datum`]).
+    pub work_offset_mm: Option<[f64; 3]>,
 }
 
 impl LoadedProgram {
@@ -197,5 +201,6 @@ pub fn load(
         primary_letter,
         runs,
         warnings,
+        work_offset_mm: None,
     })
 }

@@ -106,6 +106,23 @@ pub struct RunReport {
     /// The figures (absent when `error` is set).
     #[serde(flatten)]
     pub figures: Option<RunFigures>,
+    /// With the machine's kinematic chain and a known work offset: the linear axes in
+    /// the machine frame (what the controller moves).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub machine_frame: Option<MachineFrameFigures>,
+}
+
+/// Equation 6 on the machine-frame X Y Z of a run ([`crate::machine_frame`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct MachineFrameFigures {
+    /// Work offset used (machine coordinates of the program's zero), mm.
+    pub datum_mm: [f64; 3],
+    /// Peak speed of X Y Z at the programmed feed, m/min.
+    pub peak_speed: BTreeMap<String, f64>,
+    /// Lowest ratio of X Y Z.
+    pub axis_min_ratio: BTreeMap<String, f64>,
+    /// Binding limit of X Y Z at their lowest ratio.
+    pub axis_limit: BTreeMap<String, &'static str>,
 }
 
 /// The whole analysis document.
@@ -164,6 +181,45 @@ pub fn run_figures(lp: &LoadedProgram, r: usize, a: &RunAnalysis) -> RunFigures 
     }
 }
 
+/// The machine-frame figures of run `r`, when the machine has a chain and the work offset
+/// is known.
+fn machine_frame_figures(
+    lp: &LoadedProgram,
+    r: usize,
+    path: &polepatch_patcher::Path,
+    machine: &Machine,
+    opts: &AnalysisOptions,
+) -> Option<MachineFrameFigures> {
+    let chain = machine.chain.as_ref()?;
+    let datum_mm = crate::machine_frame::run_datum(lp, r, lp.work_offset_mm)?;
+    let mp = crate::machine_frame::machine_frame_path(
+        chain,
+        machine,
+        datum_mm,
+        lp.runs[r].run.tcpm,
+        &path.axes,
+        &path.s_mm,
+        path.feed_mm_min,
+    );
+    let a = analyze_path(&mp, machine, opts).ok()?;
+    let mut f = MachineFrameFigures {
+        datum_mm,
+        peak_speed: BTreeMap::new(),
+        axis_min_ratio: BTreeMap::new(),
+        axis_limit: BTreeMap::new(),
+    };
+    for axis in [Axis::X, Axis::Y, Axis::Z] {
+        let l = axis_letter(axis, lp.primary_letter);
+        f.peak_speed
+            .insert(l.clone(), machine_units(axis, a.peak_speed[axis.index()]));
+        f.axis_min_ratio
+            .insert(l.clone(), a.axis_min[axis.index()].0);
+        f.axis_limit
+            .insert(l, limit_name(a.axis_min[axis.index()].1));
+    }
+    Some(f)
+}
+
 /// Analyse every run of a loaded program.
 pub fn analyze_program(
     lp: &LoadedProgram,
@@ -184,11 +240,15 @@ pub fn analyze_program(
                 feed_mm_min: rp.path.as_ref().ok().map(|p| p.feed_mm_min),
                 error: None,
                 figures: None,
+                machine_frame: None,
             };
             match &rp.path {
                 Err(problem) => rep.error = Some(problem.to_string()),
                 Ok(path) => match analyze_path(path, machine, opts) {
-                    Ok(a) => rep.figures = Some(run_figures(lp, r, &a)),
+                    Ok(a) => {
+                        rep.figures = Some(run_figures(lp, r, &a));
+                        rep.machine_frame = machine_frame_figures(lp, r, path, machine, opts);
+                    }
                     Err(e) => rep.error = Some(e.to_string()),
                 },
             }

@@ -1,0 +1,210 @@
+//! The machine frame: what the linear axes must do, from the machine's kinematic chain
+//! ([`polepatch_kinematics::Chain`]) and the work offset.
+//!
+//! Two uses, both only when the machine description has a `[chain]`:
+//!
+//! - **Runs without TCPM** (X Y Z are machine coordinates minus the work offset) can be
+//!   patched: the tool tip in the part frame is computed for every point (C17 eq. 1), the
+//!   patcher changes the rotary values on that part-frame path exactly as for a TCPM run,
+//!   and X Y Z are recomputed for every changed point from the *written* (rounded) rotary
+//!   values, then rounded with at least [`MIN_XYZ_DECIMALS`] decimals, so the part-frame
+//!   tool tip of the written block is within [`TIP_TOLERANCE_MM`] of the original.
+//! - **Every run with a chain** is checked in the machine frame after the patch: Equation 6
+//!   on the machine-frame X Y Z (C17 eq. 6: near the pole the linear axes follow the
+//!   table), before and after; a run whose patch would make any axis's lowest ratio worse
+//!   than `min(before, 1)` keeps its original values, and the report says why.
+//!
+//! # The path parameter s
+//! Equation 6 needs the path the programmed feed refers to. With TCPM the controller
+//! moves the tool tip along the part at F: s is the part-frame tool-tip length (the
+//! run's s). Without TCPM the controller interpolates X Y Z at F: s is the length of the
+//! program's X Y Z path (also the run's s as read). The machine-frame check uses those.
+//! The patcher, for a run without TCPM, works on the part-frame path (s = part-frame tool
+//! tip length, the cutting path the CAM system planned), which is what its orientation
+//! deviation and continuity are about; the machine-frame check then decides on the
+//! program as the controller will run it.
+//!
+//! # The work offset
+//! [`run_datum`]: the caller's (`--work-offset`), else the last Heidenhain datum shift
+//! with values (`G54 X… Y… Z…`) before the run, else unknown (the run is left as it is,
+//! with a message asking for `--work-offset`).
+
+use crate::program::LoadedProgram;
+use polepatch_kinematics::{Axis, Chain, Machine};
+use polepatch_patcher::{AnalysisOptions, Path, analyze_path};
+
+/// The part-frame tool tip of a rewritten block without TCPM must be within this of the
+/// original, mm (issue 10: "to the file's precision", 1 µm).
+pub const TIP_TOLERANCE_MM: f64 = 1e-3;
+
+/// Fewest decimals written for X Y Z recomputed through the chain: rounding to 3 decimals
+/// moves a point by at most 0.0005·√3 ≈ 0.00087 mm < [`TIP_TOLERANCE_MM`].
+pub const MIN_XYZ_DECIMALS: usize = 3;
+
+/// A machine-frame ratio may be this much below `min(before, 1)` (relative) and still
+/// count as not worse: the analysis's own resolution.
+pub const NOT_WORSE_REL: f64 = 1e-4;
+
+/// The work offset (machine coordinates of the program's zero, mm) for run `r`: `given`
+/// if set, else the last datum shift with values before the run, else `None`.
+pub fn run_datum(lp: &LoadedProgram, r: usize, given: Option<[f64; 3]>) -> Option<[f64; 3]> {
+    if given.is_some() {
+        return given;
+    }
+    let first = lp.runs[r].run.blocks[0];
+    lp.program
+        .datum_shifts
+        .iter()
+        .rev()
+        .find(|(b, _)| *b <= first)
+        .map(|(_, d)| *d)
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+fn cumulative(points: &[[f64; 3]]) -> Vec<f64> {
+    let mut s = Vec::with_capacity(points.len());
+    let mut acc = 0.0;
+    for (k, p) in points.iter().enumerate() {
+        if k > 0 {
+            acc += dist(points[k - 1], *p);
+        }
+        s.push(acc);
+    }
+    s
+}
+
+/// A run without TCPM as a part-frame path: the tool tip of every point through the
+/// chain, s its length.
+pub fn part_frame_path(chain: &Chain, machine: &Machine, datum_mm: [f64; 3], path: &Path) -> Path {
+    let tips: Vec<[f64; 3]> = path
+        .axes
+        .iter()
+        .map(|q| chain.part_tip(machine, datum_mm, q[3], q[4], [q[0], q[1], q[2]]))
+        .collect();
+    Path {
+        s_mm: cumulative(&tips),
+        axes: tips
+            .iter()
+            .zip(&path.axes)
+            .map(|(t, q)| [t[0], t[1], t[2], q[3], q[4]])
+            .collect(),
+        feed_mm_min: path.feed_mm_min,
+    }
+}
+
+/// The program's values `[X, Y, Z, P, C]` per point as the machine runs them: X Y Z in
+/// the machine frame (minus the datum) and s as the controller's feed refers to it
+/// (module docs).
+pub fn machine_frame_path(
+    chain: &Chain,
+    machine: &Machine,
+    datum_mm: [f64; 3],
+    tcpm: bool,
+    program_values: &[[f64; 5]],
+    tcpm_s_mm: &[f64],
+    feed_mm_min: f64,
+) -> Path {
+    let axes: Vec<[f64; 5]> = program_values
+        .iter()
+        .map(|q| {
+            if tcpm {
+                let x = chain.program_xyz(machine, datum_mm, q[3], q[4], [q[0], q[1], q[2]]);
+                [x[0], x[1], x[2], q[3], q[4]]
+            } else {
+                *q
+            }
+        })
+        .collect();
+    let s_mm = if tcpm {
+        tcpm_s_mm.to_vec()
+    } else {
+        let xyz: Vec<[f64; 3]> = axes.iter().map(|q| [q[0], q[1], q[2]]).collect();
+        cumulative(&xyz)
+    };
+    Path {
+        s_mm,
+        axes,
+        feed_mm_min,
+    }
+}
+
+/// Lowest Equation-6 ratio per axis ([`Axis`] order) of a machine-frame path.
+pub fn axis_min_ratios(
+    path: &Path,
+    machine: &Machine,
+    opts: &AnalysisOptions,
+) -> Result<[f64; 5], String> {
+    let a = analyze_path(path, machine, opts).map_err(|e| e.to_string())?;
+    Ok(std::array::from_fn(|i| a.axis_min[i].0))
+}
+
+/// The first axis whose lowest ratio `after` is worse than `min(before, 1)`, if any.
+pub fn worse_axis(before: &[f64; 5], after: &[f64; 5]) -> Option<Axis> {
+    Axis::ALL.into_iter().find(|a| {
+        let i = a.index();
+        after[i] < before[i].min(1.0) * (1.0 - NOT_WORSE_REL)
+    })
+}
+
+/// Round to `decimals`.
+pub fn round_to(v: f64, decimals: usize) -> f64 {
+    let k = 10f64.powi(decimals as i32);
+    (v * k).round() / k
+}
+
+/// A part-frame segment shorter than this is a rotary repositioning about the tool tip
+/// (mm): without TCPM the program's X Y Z move with it, so the run goes on; in the part
+/// frame the tool tip stands still, and the patcher treats the pieces either side as
+/// separate paths (as a TCPM program's zero-length block splits its runs).
+pub const PART_ZERO_LENGTH_MM: f64 = TIP_TOLERANCE_MM;
+
+/// [`polepatch_patcher::patch_path`] on a part-frame path that may stand still at places:
+/// each stretch between [`PART_ZERO_LENGTH_MM`] segments is patched on its own, its last
+/// point kept unless it ends the path (then `opts.keep_last_point` decides), and the
+/// results are put back together with zone indices of the whole path.
+pub fn patch_part_frame(
+    path: &Path,
+    machine: &Machine,
+    opts: &polepatch_patcher::PatchOptions,
+) -> Result<polepatch_patcher::PatchResult, polepatch_patcher::PathError> {
+    use polepatch_patcher::{PatchOptions, PatchResult, patch_path};
+    let n = path.s_mm.len();
+    let mut out = PatchResult::unchanged(path, opts);
+    let mut a = 0;
+    while a + 1 < n {
+        let mut b = a;
+        while b + 1 < n && path.s_mm[b + 1] - path.s_mm[b] > PART_ZERO_LENGTH_MM {
+            b += 1;
+        }
+        if b > a {
+            let sub = Path {
+                s_mm: path.s_mm[a..=b].iter().map(|s| s - path.s_mm[a]).collect(),
+                axes: path.axes[a..=b].to_vec(),
+                feed_mm_min: path.feed_mm_min,
+            };
+            let sub_opts = PatchOptions {
+                keep_last_point: opts.keep_last_point || b + 1 < n,
+                ..opts.clone()
+            };
+            let r = patch_path(&sub, machine, &sub_opts)?;
+            for k in 0..=b - a {
+                out.p_deg[a + k] = r.p_deg[k];
+                out.p_changed[a + k] = r.p_changed[k];
+                out.c_deg[a + k] = r.c_deg[k];
+                out.c_changed[a + k] = r.c_changed[k];
+            }
+            out.p_decimals = out.p_decimals.max(r.p_decimals);
+            out.c_decimals = out.c_decimals.max(r.c_decimals);
+            out.zones.extend(r.zones.into_iter().map(|mut z| {
+                z.first += a;
+                z.last += a;
+                z
+            }));
+        }
+        a = b + 1;
+    }
+    Ok(out)
+}

@@ -1,0 +1,227 @@
+//! Issue 10 §1 with a kinematic chain: a program without TCPM is patched by changing X Y Z
+//! with the rotary values (the part-frame tool tip unchanged within 1 µm at every point),
+//! and TCPM programs are analysed and checked in the machine frame.
+
+use polepatch::kinematics::{Chain, Machine};
+use polepatch::machine_frame::TIP_TOLERANCE_MM;
+use polepatch::nc::{Edit, modal};
+use polepatch::program::load_nc;
+use polepatch::{AnalyzeOptions, PatchOptions, UntouchedReason, analyze_nc, patch_nc};
+use std::path::PathBuf;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn sing() -> Vec<u8> {
+    std::fs::read(root().join("fixtures/c17/SING.I")).unwrap()
+}
+
+/// The documented example chain of the UCP710 (crates/kinematics/machines).
+fn example_machine() -> Machine {
+    let path = root().join("crates/kinematics/machines/mikron-ucp710-example-chain.toml");
+    Machine::load(path.to_str().unwrap()).unwrap()
+}
+
+/// SING's datum (`N60 G54 Y-7.1 Z+38.054`).
+const SING_DATUM: [f64; 3] = [-30.489, -7.1, 38.054];
+
+/// `%SING` as a post without TCPM writes it for `machine`'s chain: every point of its TCPM
+/// run with X Y Z through the chain (3 decimals), `M128` removed. Returns the program and, per block,
+/// the part-frame tool tip it was made from.
+fn sing_without_tcpm(machine: &Machine) -> (Vec<u8>, Vec<Option<[f64; 3]>>) {
+    let chain = machine.chain.unwrap();
+    let lp = load_nc(sing(), "SING.I", machine, None).unwrap();
+    let program = &lp.program;
+    let mut edits = Vec::new();
+    let mut tips = vec![None; program.blocks.len()];
+    for rp in lp.runs.iter().filter(|rp| rp.run.tcpm) {
+        for &b in &rp.run.blocks {
+            let st = program.state(b);
+            let v = |i: usize| st.pos[i].unwrap_or(0.0);
+            let tip = [v(modal::X), v(modal::Y), v(modal::Z)];
+            tips[b] = Some(tip);
+            let x = chain.program_xyz(machine, SING_DATUM, v(modal::A), v(modal::C), tip);
+            for (i, letter) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
+                let value = (x[i] * 1000.0).round() / 1000.0;
+                if program.word(b, letter).is_some() && value != tip[i] {
+                    edits.push(Edit {
+                        block: b,
+                        letter,
+                        value,
+                        decimals: 3,
+                    });
+                }
+            }
+        }
+    }
+    edits.sort_by_key(|e| (e.block, e.letter));
+    let text = String::from_utf8(polepatch::nc::write(program, &edits)).unwrap();
+    assert!(text.contains("N65 M128 *\n"));
+    (text.replace("N65 M128 *\n", "").into_bytes(), {
+        // One line fewer: block indices after line 11 shift by one.
+        let mut t = tips;
+        t.remove(10);
+        t
+    })
+}
+
+#[test]
+fn without_tcpm_x_y_z_change_with_the_rotary_axes_and_the_tool_tip_stays() {
+    let machine = example_machine();
+    let chain = machine.chain.unwrap();
+    let (input, tips) = sing_without_tcpm(&machine);
+    let opts = PatchOptions {
+        name: "SING_noM128.I".into(),
+        ..PatchOptions::default()
+    };
+    let (out, report) = patch_nc(&input, &machine, &opts).unwrap();
+    assert!(
+        report.untouched_runs.is_empty(),
+        "{:?}",
+        report.untouched_runs
+    );
+    assert_eq!(report.zones.len(), 1);
+    assert_eq!(report.zones[0].outcome, "reached", "{:?}", report.zones[0]);
+    // X Y Z and C change together, block by block.
+    let before = load_nc(input.clone(), "in", &machine, None).unwrap();
+    let after = load_nc(out.clone(), "out", &machine, None).unwrap();
+    let (bp, ap) = (&before.program, &after.program);
+    assert_eq!(bp.blocks.len(), ap.blocks.len());
+    let mut c_changed = 0;
+    let mut xyz_with_c = 0;
+    let mut worst_mm: f64 = 0.0;
+    for (b, tip) in tips.iter().enumerate() {
+        let (s0, s1) = (bp.state(b), ap.state(b));
+        if s0.pos[modal::C] != s1.pos[modal::C] || s0.pos[modal::A] != s1.pos[modal::A] {
+            c_changed += 1;
+            if s0.pos[..3] != s1.pos[..3] {
+                xyz_with_c += 1;
+            }
+        }
+        // The part-frame tool tip of every point of the converted run, on the written
+        // values, against the input's.
+        if let Some(orig) = tip {
+            let tip_of = |st: &polepatch::nc::Modal| {
+                let v = |i: usize| st.pos[i].unwrap();
+                chain.part_tip(
+                    &machine,
+                    SING_DATUM,
+                    v(modal::A),
+                    v(modal::C),
+                    [v(modal::X), v(modal::Y), v(modal::Z)],
+                )
+            };
+            let (t0, t1) = (tip_of(&s0), tip_of(&s1));
+            let err = (0..3).map(|i| (t1[i] - t0[i]).abs()).fold(0.0, f64::max);
+            worst_mm = worst_mm.max(err);
+            // And the input is SING's part path (to its 3 written decimals).
+            let conv = (0..3).map(|i| (t0[i] - orig[i]).abs()).fold(0.0, f64::max);
+            assert!(conv <= 2e-3, "line {}: {conv}", ap.blocks[b].line);
+        }
+    }
+    assert!(c_changed >= 10, "{c_changed} blocks changed");
+    // A pose change too small to move the tip by the last written digit keeps its X Y Z
+    // (the tip check below covers it).
+    assert!(
+        xyz_with_c * 10 >= c_changed * 9,
+        "{xyz_with_c} of {c_changed} changed poses have new X Y Z"
+    );
+    assert!(worst_mm <= TIP_TOLERANCE_MM, "tool tip moved {worst_mm} mm");
+    // Only X Y Z A C words differ.
+    let (a, b) = (
+        String::from_utf8_lossy(&input),
+        String::from_utf8_lossy(&out),
+    );
+    for (la, lb) in a.lines().zip(b.lines()) {
+        let strip = |l: &str| {
+            l.split_whitespace()
+                .filter(|w| !w.starts_with(['X', 'Y', 'Z', 'A', 'C']))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        assert_eq!(strip(la), strip(lb));
+    }
+}
+
+#[test]
+fn without_tcpm_and_without_a_work_offset_the_run_is_left() {
+    // The chain is known but the program states no datum (G54 line removed).
+    let machine = example_machine();
+    let (input, _) = sing_without_tcpm(&machine);
+    let text = String::from_utf8(input).unwrap();
+    let text = text.replace("N60 G54 X-30.489 Y-7.1 Z+38.054 *\n", "");
+    let (out, report) = patch_nc(text.as_bytes(), &machine, &PatchOptions::default()).unwrap();
+    assert_eq!(out, text.as_bytes());
+    assert_eq!(report.untouched_runs[0].reason, UntouchedReason::NoTcpm);
+    assert!(
+        report.untouched_runs[0].message.contains("--work-offset"),
+        "{}",
+        report.untouched_runs[0].message
+    );
+    // Given on the command line, the run is patched.
+    let opts = PatchOptions {
+        work_offset_mm: Some(SING_DATUM),
+        ..PatchOptions::default()
+    };
+    let (out, report) = patch_nc(text.as_bytes(), &machine, &opts).unwrap();
+    assert_ne!(out, text.as_bytes());
+    assert_eq!(report.zones[0].outcome, "reached");
+}
+
+/// The issue's set-up: the part 50 mm off the C axis at the zone (the C axis put at
+/// machine X = −55.489, Y = −7.1 for SING's datum, so the tool point X25 Y0 of the zone is
+/// 50 mm from it). C needs 192 rpm there; the linear axes then follow the table at about
+/// 2π·50 mm·192/min ≈ 60 m/min (C17 eq. 6).
+#[test]
+fn analyze_reports_machine_frame_linear_axes_that_follow_c() {
+    let mut machine = Machine::builtin("mikron-ucp710").unwrap();
+    machine.chain = Some(Chain {
+        primary_axis_point_mm: [0.0, 0.0, -50.0],
+        c_axis_point_mm: [-55.489, -7.1, 0.0],
+    });
+    let report = analyze_nc(&sing(), &machine, &AnalyzeOptions::default()).unwrap();
+    let run = &report.runs[0];
+    let f = run.figures.as_ref().unwrap();
+    assert!(
+        (f.peak_speed["C"] - 192.4).abs() < 1.0,
+        "{}",
+        f.peak_speed["C"]
+    );
+    let m = run.machine_frame.as_ref().expect("machine-frame figures");
+    assert_eq!(m.datum_mm, SING_DATUM);
+    let xy = m.peak_speed["X"].max(m.peak_speed["Y"]);
+    assert!((55.0..65.0).contains(&xy), "{:?}", m.peak_speed);
+    assert!(m.axis_min_ratio["Y"] < 0.3, "{:?}", m.axis_min_ratio);
+    // Without a chain there are no machine-frame figures.
+    let plain = analyze_nc(
+        &sing(),
+        &Machine::builtin("mikron-ucp710").unwrap(),
+        &AnalyzeOptions::default(),
+    )
+    .unwrap();
+    assert!(plain.runs[0].machine_frame.is_none());
+    // The TCPM patch frees C and, with it, the machine-frame X and Y: accepted.
+    let (out, rep) = patch_nc(&sing(), &machine, &PatchOptions::default()).unwrap();
+    assert_eq!(rep.zones[0].outcome, "reached");
+    let after = analyze_nc(&out, &machine, &AnalyzeOptions::default()).unwrap();
+    let ma = after.runs[0].machine_frame.as_ref().unwrap();
+    assert!(ma.axis_min_ratio["Y"] > 0.7, "{:?}", ma.axis_min_ratio);
+}
+
+/// SING with its M128 deleted (X Y Z stay part coordinates, read now as machine
+/// coordinates): with the example chain the patch would slow Y in the machine frame, so
+/// the run keeps every value and the report says why.
+#[test]
+fn a_patch_that_slows_a_linear_axis_in_the_machine_frame_is_not_written() {
+    let machine = example_machine();
+    let text = String::from_utf8(sing())
+        .unwrap()
+        .replace("N65 M128 *\n", "");
+    let (out, report) = patch_nc(text.as_bytes(), &machine, &PatchOptions::default()).unwrap();
+    assert_eq!(out, text.as_bytes());
+    let u = &report.untouched_runs[0];
+    assert_eq!(u.reason, UntouchedReason::MachineFrame);
+    assert!(u.message.contains("in the machine frame"), "{}", u.message);
+    assert_eq!(report.zones[0].outcome, "unchanged");
+}
