@@ -27,6 +27,9 @@ enum Command {
     Analyze(AnalyzeArgs),
     /// Rewrite the C words near the pole so that C reaches the programmed feed.
     Patch(PatchArgs),
+    /// Tilt the workpiece on a jig (C17's avoidance): given angles, or the smallest tilt
+    /// that makes the program reach feed on both rotary axes.
+    Reorient(reorient_cmd::ReorientArgs),
     /// Quality suite: analyze and patch every program × machine, compare the deviation
     /// with the best possible for C-only changes, and print one table.
     Bench(bench_cmd::BenchArgs),
@@ -144,6 +147,7 @@ fn main() -> ExitCode {
         Command::Analyze(args) => analyze(args),
         Command::Patch(args) => patch::run(args),
         Command::Bench(args) => bench_cmd::run(args),
+        Command::Reorient(args) => reorient_cmd::run(args),
     };
     match result {
         Ok(code) => code,
@@ -156,6 +160,7 @@ fn main() -> ExitCode {
 
 mod bench_cmd;
 mod patch;
+mod reorient_cmd;
 
 pub(crate) fn machine(name: &str) -> Result<Machine> {
     Ok(Machine::load(name)?)

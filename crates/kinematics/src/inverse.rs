@@ -145,10 +145,21 @@ pub fn domain_rule_index(machine: &Machine, o_wp: [f64; 3]) -> usize {
 /// C's own range (`c_range_deg`) is not checked here. A zero or non-finite tool axis gives
 /// a NaN point, and the next point continues from the last finite one.
 pub fn inverse_path(machine: &Machine, o_wp: &[[f64; 3]], rule: BranchRule) -> Vec<IkSolution> {
+    inverse_path_from(machine, o_wp, rule, None)
+}
+
+/// [`inverse_path`] continuing from `start` (the joint values before the first tool axis):
+/// the first point is chosen and C unwrapped as if `start` were the previous point.
+pub fn inverse_path_from(
+    machine: &Machine,
+    o_wp: &[[f64; 3]],
+    rule: BranchRule,
+    start: Option<IkSolution>,
+) -> Vec<IkSolution> {
     let (p_lo, p_hi) = machine.primary_range_deg;
     let in_range = |s: &IkSolution| p_lo <= s.p_deg && s.p_deg <= p_hi;
     let mut out = Vec::with_capacity(o_wp.len());
-    let mut prev: Option<IkSolution> = None;
+    let mut prev: Option<IkSolution> = start.filter(|s| s.p_deg.is_finite() && s.c_deg.is_finite());
     for &o in o_wp {
         let held_c = prev.map_or(0.0, |p| p.c_deg);
         let solutions = inverse(machine, o);

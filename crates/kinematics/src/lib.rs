@@ -23,6 +23,7 @@ pub mod feed;
 pub mod forward;
 pub mod inverse;
 pub mod machine;
+pub mod reorient;
 pub mod tolerances;
 
 #[cfg(test)]
@@ -32,6 +33,8 @@ pub use chain::Chain;
 pub use feed::{AxisBound, FeedBound, LimitKind, axis_feed_bound, axis_feed_ratio, feed_bound};
 pub use forward::{angle_between_deg, forward, forward_jacobian};
 pub use inverse::{
-    BranchRule, IkSolution, domain_rule_index, inverse, inverse_path, unwrap_near_deg, wrap_deg,
+    BranchRule, IkSolution, domain_rule_index, inverse, inverse_path, inverse_path_from,
+    unwrap_near_deg, wrap_deg,
 };
 pub use machine::{Axis, AxisLimits, Machine, MachineError, PrimaryAxis};
+pub use reorient::JigRotation;

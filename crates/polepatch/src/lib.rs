@@ -29,6 +29,7 @@ pub mod far;
 pub mod machine_frame;
 pub mod patch;
 pub mod program;
+pub mod reorient;
 pub mod report;
 
 pub use error::Error;
