@@ -244,3 +244,55 @@ fn no_tcpm_is_never_patched() {
     let (code, _, err) = polepatch(&strict);
     assert_eq!(code, 2, "{err}");
 }
+
+/// Issue 11: the CLI writes what the library (`polepatch::patch_nc`, also behind the C
+/// ABI) returns, bytes and report, on the C17 and dialect fixtures × both machines.
+#[test]
+fn the_cli_writes_what_the_library_returns() {
+    let dir = temp_dir("same");
+    for file in [
+        "fixtures/c17/SING.I",
+        "fixtures/c17/NON_SING.I",
+        "fixtures/dialects/fanuc.nc",
+        "fixtures/dialects/sinumerik.mpf",
+        "fixtures/dialects/heidenhain_latin1.I",
+    ] {
+        for machine in ["mikron-ucp710", "mikron-hsm600"] {
+            let out = dir.join("out");
+            let report = dir.join("report.json");
+            let (code, _, err) = polepatch(&[
+                "patch",
+                file,
+                "-o",
+                out.to_str().unwrap(),
+                "--machine",
+                machine,
+                "--report",
+                report.to_str().unwrap(),
+            ]);
+            assert_eq!(code, 0, "{file} {machine}: {err}");
+            let opts = polepatch::PatchOptions {
+                name: file.into(),
+                ..polepatch::PatchOptions::default()
+            };
+            let m = polepatch::kinematics::Machine::builtin(machine).unwrap();
+            let (want, want_report) =
+                polepatch::patch_nc(&std::fs::read(root().join(file)).unwrap(), &m, &opts).unwrap();
+            assert_eq!(std::fs::read(&out).unwrap(), want, "{file} {machine}");
+            let strip = |mut v: serde_json::Value| {
+                v.as_object_mut().unwrap().remove("output");
+                for z in v["zones"].as_array_mut().unwrap() {
+                    z.as_object_mut().unwrap().remove("solve_time_ms");
+                }
+                v
+            };
+            let got: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+            assert_eq!(
+                strip(got),
+                strip(serde_json::to_value(&want_report).unwrap()),
+                "{file} {machine}"
+            );
+        }
+    }
+}

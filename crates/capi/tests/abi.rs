@@ -1,0 +1,347 @@
+//! The C ABI called from Rust through the rlib: the same bytes and report as the library
+//! on every fixture × both machines, joints from CL points, joint-array patching, and the
+//! refusals (status and message, never a crash).
+
+use polepatch::kinematics::{BranchRule, Machine, forward, inverse_path};
+use polepatch::patcher::{Path, patch_path};
+use polepatch_capi::*;
+use std::ffi::{CStr, CString};
+use std::path::PathBuf;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn fixtures() -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![root().join("fixtures")];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if matches!(
+                p.extension().and_then(|x| x.to_str()),
+                Some("I" | "nc" | "mpf")
+            ) {
+                out.push(p);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+fn last_error() -> String {
+    unsafe { CStr::from_ptr(pp_last_error()) }
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn machine(name: &str) -> *mut PpMachine {
+    let name = CString::new(name).unwrap();
+    let mut m = std::ptr::null_mut();
+    assert_eq!(
+        unsafe { pp_machine_builtin(name.as_ptr(), &mut m) },
+        PpStatus::PpOk
+    );
+    m
+}
+
+fn without_timing(json: &[u8]) -> serde_json::Value {
+    let mut v: serde_json::Value = serde_json::from_slice(json).unwrap();
+    for z in v["zones"].as_array_mut().unwrap() {
+        z.as_object_mut().unwrap().remove("solve_time_ms");
+    }
+    v
+}
+
+fn take(b: &mut PpBuffer) -> Vec<u8> {
+    let v = if b.data.is_null() {
+        Vec::new()
+    } else {
+        unsafe { std::slice::from_raw_parts(b.data, b.len) }.to_vec()
+    };
+    unsafe { pp_buffer_free(b) };
+    assert!(b.data.is_null() && b.len == 0);
+    v
+}
+
+/// Every fixture, on the two machines in turn (each machine sees half the fixtures, every
+/// dialect and kind on both).
+#[test]
+fn patch_nc_through_the_abi_is_the_library_on_every_fixture() {
+    let mut n = 0;
+    for (turn, name) in ["mikron-ucp710", "mikron-hsm600"].into_iter().enumerate() {
+        let m = machine(name);
+        let rust_machine = Machine::builtin(name).unwrap();
+        for path in fixtures().into_iter().skip(turn).step_by(2) {
+            let bytes = std::fs::read(&path).unwrap();
+            let label = path.display().to_string();
+            let c_label = CString::new(label.clone()).unwrap();
+            let mut opts = pp_options_default();
+            opts.name = c_label.as_ptr();
+            let (mut out, mut report) = (
+                PpBuffer {
+                    data: std::ptr::null_mut(),
+                    len: 0,
+                },
+                PpBuffer {
+                    data: std::ptr::null_mut(),
+                    len: 0,
+                },
+            );
+            let status = unsafe {
+                pp_patch_nc(m, bytes.as_ptr(), bytes.len(), &opts, &mut out, &mut report)
+            };
+            let lib_opts = polepatch::PatchOptions {
+                name: label.clone(),
+                ..polepatch::PatchOptions::default()
+            };
+            match polepatch::patch_nc(&bytes, &rust_machine, &lib_opts) {
+                Ok((want, want_report)) => {
+                    assert_eq!(status, PpStatus::PpOk, "{label}: {}", last_error());
+                    assert_eq!(take(&mut out), want, "{label} on {name}");
+                    let want_json = serde_json::to_vec_pretty(&want_report).unwrap();
+                    assert_eq!(
+                        without_timing(&take(&mut report)),
+                        without_timing(&want_json)
+                    );
+                }
+                Err(e) => {
+                    assert_eq!(status, PpStatus::PpBadInput, "{label}");
+                    assert_eq!(last_error(), e.to_string());
+                }
+            }
+            n += 1;
+        }
+        unsafe { pp_machine_free(m) };
+    }
+    assert!(n >= 100, "{n}");
+}
+
+#[test]
+fn cl_to_joints_inverts_forward_kinematics() {
+    let m = machine("mikron-ucp710");
+    let rust_machine = Machine::builtin("mikron-ucp710").unwrap();
+    let joints_in = [(14.825, 137.259), (1.0, 180.0), (0.5, -170.0), (-3.0, 12.0)];
+    let mut cl = Vec::new();
+    for (k, &(p, c)) in joints_in.iter().enumerate() {
+        let o = forward(&rust_machine, p, c);
+        // Not normalised on purpose: the ABI normalises.
+        cl.extend_from_slice(&[k as f64, 0.0, -8.0, 2.0 * o[0], 2.0 * o[1], 2.0 * o[2]]);
+    }
+    let mut out = vec![0.0; 5 * joints_in.len()];
+    let status = unsafe {
+        pp_cl_to_joints(
+            m,
+            cl.as_ptr(),
+            joints_in.len(),
+            PpBranchRule::PpBranchNearest as i32,
+            out.as_mut_ptr(),
+        )
+    };
+    assert_eq!(status, PpStatus::PpOk, "{}", last_error());
+    let axes: Vec<[f64; 3]> = joints_in
+        .iter()
+        .map(|&(p, c)| forward(&rust_machine, p, c))
+        .collect();
+    let want = inverse_path(&rust_machine, &axes, BranchRule::Nearest);
+    for (k, w) in want.iter().enumerate() {
+        assert_eq!(&out[5 * k..5 * k + 3], &cl[6 * k..6 * k + 3]);
+        assert!((out[5 * k + 3] - w.p_deg).abs() < 1e-9 && (out[5 * k + 4] - w.c_deg).abs() < 1e-9);
+        let o = forward(&rust_machine, out[5 * k + 3], out[5 * k + 4]);
+        assert!((0..3).all(|i| (o[i] - axes[k][i]).abs() < 1e-12));
+    }
+    unsafe { pp_machine_free(m) };
+}
+
+#[test]
+fn patch_joints_is_the_patcher_on_the_arrays() {
+    // SING's long TCPM run, as a CAM plugin would hold it.
+    let rust_machine = Machine::builtin("mikron-ucp710").unwrap();
+    let lp = polepatch::program::load_nc(
+        std::fs::read(root().join("fixtures/c17/SING.I")).unwrap(),
+        "SING.I",
+        &rust_machine,
+        None,
+    )
+    .unwrap();
+    let path = lp.runs[0].path.as_ref().unwrap();
+    let flat: Vec<f64> = path.axes.iter().flatten().copied().collect();
+    let n = path.axes.len();
+    let m = machine("mikron-ucp710");
+    let mut out = vec![0.0; 5 * n];
+    let mut zones = [PpZone {
+        first: 0,
+        last: 0,
+        outcome: PpOutcome::PpUnchanged,
+        c_ratio_before: 0.0,
+        c_ratio_after: 0.0,
+        overall_ratio_before: 0.0,
+        overall_ratio_after: 0.0,
+        max_deviation_deg: 0.0,
+        points_modified: 0,
+    }; 4];
+    let mut count = 0usize;
+    let status = unsafe {
+        pp_patch_joints(
+            m,
+            flat.as_ptr(),
+            n,
+            path.feed_mm_min,
+            std::ptr::null(),
+            out.as_mut_ptr(),
+            zones.as_mut_ptr(),
+            zones.len(),
+            &mut count,
+        )
+    };
+    assert_eq!(status, PpStatus::PpOk, "{}", last_error());
+    assert_eq!(count, 1);
+    assert_eq!(zones[0].outcome, PpOutcome::PpReached);
+    assert!(zones[0].c_ratio_before < 0.2 && zones[0].c_ratio_after >= 1.0);
+    // The same as the patcher with the options the ABI documents.
+    let mut popts = polepatch::patcher::PatchOptions::default();
+    popts.c_decimals = popts.max_decimals;
+    popts.p_decimals = popts.max_decimals;
+    popts.keep_last_point = true;
+    let own = Path {
+        s_mm: path.s_mm.clone(),
+        axes: path.axes.clone(),
+        feed_mm_min: path.feed_mm_min,
+    };
+    let r = patch_path(&own, &rust_machine, &popts).unwrap();
+    for k in 0..n {
+        assert_eq!(out[5 * k + 3], r.p_deg[k]);
+        assert_eq!(out[5 * k + 4], r.c_deg[k]);
+    }
+    assert_eq!(out[5 * (n - 1) + 4], path.axes[n - 1][4], "last point kept");
+    unsafe { pp_machine_free(m) };
+}
+
+#[test]
+fn refusals_give_a_status_and_a_message() {
+    let m = machine("mikron-ucp710");
+    let mut out = PpBuffer {
+        data: std::ptr::null_mut(),
+        len: 0,
+    };
+    let text = b"G1 X0 Y0 Z0 A1 C0 F1000\nX1 C1..5\n";
+    let cases: Vec<(&str, PpStatus, PpStatus)> = vec![
+        (
+            "syntax",
+            unsafe {
+                pp_patch_nc(
+                    m,
+                    text.as_ptr(),
+                    text.len(),
+                    std::ptr::null(),
+                    &mut out,
+                    std::ptr::null_mut(),
+                )
+            },
+            PpStatus::PpBadInput,
+        ),
+        (
+            "null machine",
+            unsafe {
+                pp_patch_nc(
+                    std::ptr::null(),
+                    text.as_ptr(),
+                    text.len(),
+                    std::ptr::null(),
+                    &mut out,
+                    std::ptr::null_mut(),
+                )
+            },
+            PpStatus::PpBadMachine,
+        ),
+        (
+            "huge length",
+            unsafe {
+                pp_patch_nc(
+                    m,
+                    text.as_ptr(),
+                    usize::MAX,
+                    std::ptr::null(),
+                    &mut out,
+                    std::ptr::null_mut(),
+                )
+            },
+            PpStatus::PpBadInput,
+        ),
+        (
+            "bad toml",
+            unsafe {
+                let t = CString::new("[x]\nv_m_min = -1").unwrap();
+                let mut mm = std::ptr::null_mut();
+                pp_machine_from_toml(t.as_ptr(), &mut mm)
+            },
+            PpStatus::PpBadMachine,
+        ),
+        (
+            "null out machine",
+            unsafe {
+                let t = CString::new("mikron-ucp710").unwrap();
+                pp_machine_builtin(t.as_ptr(), std::ptr::null_mut())
+            },
+            PpStatus::PpBadInput,
+        ),
+        (
+            "one point",
+            unsafe {
+                let mut c = 0usize;
+                pp_patch_joints(
+                    m,
+                    [0.0; 5].as_ptr(),
+                    1,
+                    1000.0,
+                    std::ptr::null(),
+                    [0.0; 5].as_mut_ptr(),
+                    std::ptr::null_mut(),
+                    0,
+                    &mut c,
+                )
+            },
+            PpStatus::PpBadInput,
+        ),
+        (
+            "standing still",
+            unsafe {
+                let pts = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 2.0, 90.0];
+                let mut o = [0.0; 10];
+                let mut c = 0usize;
+                pp_patch_joints(
+                    m,
+                    pts.as_ptr(),
+                    2,
+                    1000.0,
+                    std::ptr::null(),
+                    o.as_mut_ptr(),
+                    std::ptr::null_mut(),
+                    0,
+                    &mut c,
+                )
+            },
+            PpStatus::PpBadInput,
+        ),
+    ];
+    for (what, got, want) in cases {
+        assert_eq!(got, want, "{what}: {}", last_error());
+        assert!(!last_error().is_empty(), "{what}: no message");
+    }
+    // A success clears the message.
+    let mut m2 = std::ptr::null_mut();
+    let t = CString::new("mikron-hsm600").unwrap();
+    assert_eq!(
+        unsafe { pp_machine_builtin(t.as_ptr(), &mut m2) },
+        PpStatus::PpOk
+    );
+    assert_eq!(last_error(), "");
+    unsafe {
+        pp_machine_free(m2);
+        pp_machine_free(m);
+        pp_buffer_free(std::ptr::null_mut());
+    }
+}

@@ -1,0 +1,134 @@
+//! Proof that the C ABI links: `tests/c/patch_file.c` is compiled with the system C
+//! compiler against the static library and `include/polepatch.h`, run on
+//! `fixtures/c17/SING.I`, and must write byte for byte what `polepatch::patch_nc` (the
+//! CLI's pipeline) writes, with the same report. A Python `ctypes` example does the same
+//! when `python3` is present. Skipped, with a message, where no C compiler exists.
+
+use polepatch::kinematics::Machine;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// The folder with `libpolepatch_capi.a` / `.so`: the profile folder of this test binary.
+fn lib_dir() -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    exe.parent().unwrap().parent().unwrap().to_path_buf()
+}
+
+fn have(tool: &str) -> bool {
+    Command::new(tool)
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+fn expected(name: &str, machine: &str) -> (Vec<u8>, String) {
+    let m = Machine::builtin(machine).unwrap();
+    let opts = polepatch::PatchOptions {
+        name: name.into(),
+        ..polepatch::PatchOptions::default()
+    };
+    let (out, report) =
+        polepatch::patch_nc(&std::fs::read(root().join(name)).unwrap(), &m, &opts).unwrap();
+    (out, serde_json::to_string_pretty(&report).unwrap())
+}
+
+/// The report without `solve_time_ms` (a measured time, different on every run).
+fn without_timing(json: &str) -> serde_json::Value {
+    let mut v: serde_json::Value = serde_json::from_str(json).unwrap();
+    for z in v["zones"].as_array_mut().unwrap() {
+        z.as_object_mut().unwrap().remove("solve_time_ms");
+    }
+    v
+}
+
+fn temp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("polepatch-capi-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn compile(dir: &Path) -> Option<PathBuf> {
+    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    if !have(&cc) {
+        eprintln!(
+            "SKIPPED: no C compiler ('{cc}') on this machine; the C ABI was not linked from C"
+        );
+        return None;
+    }
+    let exe = dir.join("patch_file");
+    let manifest = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let status = Command::new(&cc)
+        .args(["-std=c11", "-Wall", "-Wextra", "-Werror", "-o"])
+        .arg(&exe)
+        .arg(manifest.join("tests/c/patch_file.c"))
+        .arg("-I")
+        .arg(manifest.join("include"))
+        .arg(lib_dir().join("libpolepatch_capi.a"))
+        .args(["-lpthread", "-ldl", "-lm"])
+        .status()
+        .expect("the C compiler runs");
+    assert!(status.success(), "compiling tests/c/patch_file.c failed");
+    Some(exe)
+}
+
+#[test]
+fn a_c_program_patches_sing_byte_for_byte() {
+    let dir = temp("c");
+    let Some(exe) = compile(&dir) else { return };
+    let name = "fixtures/c17/SING.I";
+    for machine in ["mikron-ucp710", "mikron-hsm600"] {
+        let (out, report) = (dir.join("out.I"), dir.join("report.json"));
+        let run = Command::new(&exe)
+            .arg(machine)
+            .arg(root().join(name))
+            .args([&out, &report])
+            .arg(name)
+            .output()
+            .unwrap();
+        assert!(
+            run.status.success(),
+            "{}{}",
+            String::from_utf8_lossy(&run.stdout),
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let (want, want_report) = expected(name, machine);
+        assert_eq!(std::fs::read(&out).unwrap(), want, "{machine}");
+        assert_eq!(
+            without_timing(&std::fs::read_to_string(&report).unwrap()),
+            without_timing(&want_report)
+        );
+    }
+}
+
+#[test]
+fn the_python_ctypes_example_patches_sing_byte_for_byte() {
+    if !have("python3") {
+        eprintln!("SKIPPED: python3 is not installed; the ctypes example was not run");
+        return;
+    }
+    let lib = lib_dir().join("libpolepatch_capi.so");
+    let dir = temp("py");
+    let out = dir.join("out.I");
+    let name = "fixtures/c17/SING.I";
+    let run = Command::new("python3")
+        .arg(root().join("examples/python/patch_nc.py"))
+        .arg(&lib)
+        .arg("mikron-ucp710")
+        .arg(root().join(name))
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&run.stdout),
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let (want, _) = expected(name, "mikron-ucp710");
+    assert_eq!(std::fs::read(&out).unwrap(), want);
+}
