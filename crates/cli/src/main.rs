@@ -27,6 +27,9 @@ enum Command {
     Analyze(AnalyzeArgs),
     /// Rewrite the C words near the pole so that C reaches the programmed feed.
     Patch(PatchArgs),
+    /// Post a CL file (APT or CSV x,y,z,i,j,k) as a TCPM program for a machine, with pole
+    /// handling (the same patch as `patch`, unless --no-patch).
+    Post(post_cmd::PostArgs),
     /// Tilt the workpiece on a jig (C17's avoidance): given angles, or the smallest tilt
     /// that makes the program reach feed on both rotary axes.
     Reorient(reorient_cmd::ReorientArgs),
@@ -148,6 +151,7 @@ fn main() -> ExitCode {
         Command::Patch(args) => patch::run(args),
         Command::Bench(args) => bench_cmd::run(args),
         Command::Reorient(args) => reorient_cmd::run(args),
+        Command::Post(args) => post_cmd::run(args),
     };
     match result {
         Ok(code) => code,
@@ -160,6 +164,7 @@ fn main() -> ExitCode {
 
 mod bench_cmd;
 mod patch;
+mod post_cmd;
 mod reorient_cmd;
 
 pub(crate) fn machine(name: &str) -> Result<Machine> {

@@ -9,6 +9,7 @@
 //! Units: linear values and s in mm (inch programs, G20/G70, are converted on read),
 //! feed in mm/min, rotary values in degrees as written.
 
+pub mod emit;
 pub mod error;
 pub mod lexer;
 pub mod modal;

@@ -44,6 +44,14 @@ pub enum Error {
         /// What is not supported and why.
         what: String,
     },
+    /// A bad record in a CL file, with line and column.
+    #[error("{path}:{record}")]
+    Cl {
+        /// File.
+        path: String,
+        /// The record's error (line, column, message).
+        record: polepatch_cl::ClError,
+    },
     /// Bad options (a value out of range), named.
     #[error("{0}")]
     Options(String),

@@ -19,6 +19,7 @@
 //! binary (`polepatch-cli`) and the C ABI (`polepatch-capi`) are thin layers over it.
 
 pub use polepatch_bspline as bspline;
+pub use polepatch_cl as cl;
 pub use polepatch_kinematics as kinematics;
 pub use polepatch_nc as nc;
 pub use polepatch_patcher as patcher;
@@ -28,6 +29,7 @@ pub mod error;
 pub mod far;
 pub mod machine_frame;
 pub mod patch;
+pub mod post;
 pub mod program;
 pub mod reorient;
 pub mod report;

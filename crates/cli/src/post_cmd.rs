@@ -1,0 +1,123 @@
+//! `polepatch post`: CL file → joints → TCPM NC program (patched unless `--no-patch`).
+
+use crate::{check_positive, machine};
+use anyhow::{Context, Result, bail};
+use polepatch::kinematics::BranchRule;
+use polepatch::nc::Dialect;
+use polepatch::post::{PostOptions, post_cl, read_cl};
+use polepatch_cli::files::{read, same_file, write_atomic, write_atomic_like};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum DialectArg {
+    Heidenhain,
+    Sinumerik,
+    Fanuc,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum BranchArg {
+    /// Nearest to the previous point (continuous).
+    Nearest,
+    /// G16 Table 1's domain rule (P flips sign near the pole).
+    Domain,
+    /// Always P ≥ 0.
+    Positive,
+    /// Always P ≤ 0.
+    Negative,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct PostArgs {
+    /// CL file: APT CLDATA (GOTO/x,y,z,i,j,k …) or CSV x,y,z,i,j,k[,f].
+    cl: PathBuf,
+    /// Machine: a built-in name or a TOML file.
+    #[arg(long, short)]
+    machine: String,
+    /// Dialect to write.
+    #[arg(long, value_enum)]
+    dialect: DialectArg,
+    /// Output NC program.
+    #[arg(long, short)]
+    output: PathBuf,
+    /// Write the joints as the inverse kinematics gives them (no patch).
+    #[arg(long)]
+    no_patch: bool,
+    /// IK branch rule.
+    #[arg(long, value_enum, default_value = "nearest")]
+    branch: BranchArg,
+    /// Write the patch report as JSON here.
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// Feed in mm/min for points without one.
+    #[arg(long)]
+    feed: Option<f64>,
+    /// Decimals of the rotary words.
+    #[arg(long, default_value_t = 3)]
+    rotary_decimals: usize,
+}
+
+pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
+    check_positive("--feed", args.feed)?;
+    if args.rotary_decimals > 9 {
+        bail!(
+            "--rotary-decimals must be at most 9, got {}",
+            args.rotary_decimals
+        );
+    }
+    let machine = machine(&args.machine)?;
+    let name = args.cl.display().to_string();
+    if same_file(&args.cl, &args.output) {
+        bail!("{name}: the output would overwrite the input; polepatch never modifies its input");
+    }
+    let cl = read_cl(&read(&args.cl)?, &name)?;
+    let opts = PostOptions {
+        dialect: match args.dialect {
+            DialectArg::Heidenhain => Dialect::Heidenhain,
+            DialectArg::Sinumerik => Dialect::Sinumerik,
+            DialectArg::Fanuc => Dialect::Fanuc,
+        },
+        branch: match args.branch {
+            BranchArg::Nearest => BranchRule::Nearest,
+            BranchArg::Domain => BranchRule::DomainRule,
+            BranchArg::Positive => BranchRule::PreferPositive,
+            BranchArg::Negative => BranchRule::PreferNegative,
+        },
+        patch: !args.no_patch,
+        patch_options: polepatch::PatchOptions {
+            name: name.clone(),
+            feed_fallback_mm_min: args.feed,
+            ..polepatch::PatchOptions::default()
+        },
+        rotary_decimals: args.rotary_decimals,
+        linear_decimals: 3,
+    };
+    let (bytes, report) = post_cl(&cl, &machine, &opts)?;
+    write_atomic_like(&args.output, &bytes, None)
+        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    for n in &cl.notes {
+        eprintln!("polepatch: note: {name}: {n}");
+    }
+    let points = cl.points.len();
+    match &report {
+        Some(r) => {
+            let reached = r.zones.iter().filter(|z| z.outcome == "reached").count();
+            println!(
+                "{name} → {}: {points} points, {} zone(s), {reached} reach feed, {} words patched",
+                args.output.display(),
+                r.zones.len(),
+                r.words_changed
+            );
+            if let Some(path) = &args.report {
+                write_atomic(path, serde_json::to_string_pretty(r)?.as_bytes())
+                    .with_context(|| format!("cannot write {}", path.display()))?;
+            }
+        }
+        None => println!(
+            "{name} → {}: {points} points, not patched (--no-patch)",
+            args.output.display()
+        ),
+    }
+    Ok(ExitCode::SUCCESS)
+}

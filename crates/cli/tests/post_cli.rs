@@ -1,0 +1,102 @@
+//! `polepatch post` as a user runs it.
+
+mod common;
+use common::root;
+use std::process::Command;
+
+fn polepatch(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_polepatch"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn the_bundled_cl_example_posts_and_patches_in_every_dialect() {
+    let dir = std::env::temp_dir().join(format!("polepatch-post-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for (dialect, ext) in [("heidenhain", "I"), ("sinumerik", "mpf"), ("fanuc", "nc")] {
+        let out = dir.join(format!("sing.{ext}"));
+        let report = dir.join(format!("{dialect}.json"));
+        let (code, stdout, err) = polepatch(&[
+            "post",
+            "fixtures/cl/SING.apt",
+            "--machine",
+            "mikron-ucp710",
+            "--dialect",
+            dialect,
+            "--branch",
+            "positive",
+            "-o",
+            out.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{err}");
+        assert!(stdout.contains("1 zone(s), 1 reach feed"), "{stdout}");
+        // The posted program is a program `patch` and `analyze` read like any other.
+        let (code, stdout, err) = polepatch(&[
+            "analyze",
+            out.to_str().unwrap(),
+            "--machine",
+            "mikron-ucp710",
+        ]);
+        assert_eq!(code, 0, "{err}");
+        assert!(stdout.contains("no singular zone"), "{stdout}");
+    }
+}
+
+#[test]
+fn bad_records_are_refused_with_line_and_column_and_nothing_written() {
+    let dir = std::env::temp_dir().join(format!("polepatch-post-bad-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let cl = dir.join("bad.apt");
+    std::fs::write(
+        &cl,
+        "MULTAX/ON\nFEDRAT/1000,MMPM\nGOTO/1,2,3,0,0,1\nGOTO/1,2,3.5.1,0,0,1\n",
+    )
+    .unwrap();
+    let out = dir.join("out.I");
+    let (code, _, err) = polepatch(&[
+        "post",
+        cl.to_str().unwrap(),
+        "--machine",
+        "mikron-ucp710",
+        "--dialect",
+        "heidenhain",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("bad.apt:4:10: z '3.5.1' is not a number"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    // No feed for a cutting move: the line, and the way out.
+    std::fs::write(&cl, "1,2,3,0,0,1\n2,2,3,0,0,1\n").unwrap();
+    let (code, _, err) = polepatch(&[
+        "post",
+        cl.to_str().unwrap(),
+        "--machine",
+        "mikron-ucp710",
+        "--dialect",
+        "fanuc",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("bad.apt:1:") && err.contains("--feed"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}

@@ -1,0 +1,32 @@
+//! Write C17's `%SING` as a CL file (APT), the bundled example of `polepatch post`:
+//! `cargo run -p polepatch --example sing_to_cl > fixtures/cl/SING.apt`.
+//! The cutter locations are the tool tip and tool axis of every move under TCPM, from the
+//! UCP710's forward kinematics.
+
+use polepatch::cl::{ClPoint, to_apt};
+use polepatch::kinematics::{Machine, forward};
+use polepatch::nc::{Motion, modal};
+use polepatch::program::load_nc;
+
+fn main() {
+    let machine = Machine::builtin("mikron-ucp710").expect("built-in");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let bytes = std::fs::read(root.join("fixtures/c17/SING.I")).expect("SING.I");
+    let lp = load_nc(bytes, "SING.I", &machine, None).expect("loads");
+    let p = &lp.program;
+    let points: Vec<ClPoint> = (0..p.blocks.len())
+        .filter(|&b| p.blocks[b].is_move && p.state(b).tcpm)
+        .filter_map(|b| {
+            let st = p.state(b);
+            let v = |i: usize| st.pos[i];
+            Some(ClPoint {
+                pos_mm: [v(modal::X)?, v(modal::Y)?, v(modal::Z)?],
+                axis: forward(&machine, v(modal::A)?, v(modal::C)?),
+                feed_mm_min: st.feed_mm_min,
+                rapid: st.motion == Motion::Rapid,
+                line: p.blocks[b].line,
+            })
+        })
+        .collect();
+    print!("{}", to_apt(&points, "SING", 7));
+}
