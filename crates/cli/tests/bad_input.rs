@@ -4,33 +4,12 @@
 //! the input is at fault.
 
 mod common;
-use common::root;
+use common::{polepatch, root, temp_dir};
 use polepatch::PatchOptions;
 use polepatch::kinematics::Machine;
 use polepatch_cli::files::{JobError, patch_file};
 use proptest::prelude::*;
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn polepatch(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_polepatch"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("polepatch-bad-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use std::path::Path;
 
 fn sing() -> String {
     std::fs::read_to_string(root().join("fixtures/c17/SING.I")).unwrap()

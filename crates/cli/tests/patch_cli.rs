@@ -1,30 +1,8 @@
 //! `polepatch patch` as a user runs it: one file, a folder batch, --strict, refusals.
 
 mod common;
-use common::{assert_only_rotary_words_differ, root};
+use common::{assert_only_rotary_words_differ, polepatch, root, temp_dir};
 use polepatch_fixturegen::{Dialect, Pass, program};
-use std::path::PathBuf;
-use std::process::Command;
-
-fn polepatch(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_polepatch"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("polepatch-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 #[test]
 fn one_file_with_report() {

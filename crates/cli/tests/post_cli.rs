@@ -1,27 +1,11 @@
 //! `polepatch post` as a user runs it.
 
 mod common;
-use common::root;
-use std::process::Command;
-
-fn polepatch(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_polepatch"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use common::{polepatch, temp_dir};
 
 #[test]
 fn the_bundled_cl_example_posts_and_patches_in_every_dialect() {
-    let dir = std::env::temp_dir().join(format!("polepatch-post-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("post");
     for (dialect, ext) in [("heidenhain", "I"), ("sinumerik", "mpf"), ("fanuc", "nc")] {
         let out = dir.join(format!("sing.{ext}"));
         let report = dir.join(format!("{dialect}.json"));
@@ -55,9 +39,7 @@ fn the_bundled_cl_example_posts_and_patches_in_every_dialect() {
 
 #[test]
 fn bad_records_are_refused_with_line_and_column_and_nothing_written() {
-    let dir = std::env::temp_dir().join(format!("polepatch-post-bad-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("post-bad");
     let cl = dir.join("bad.apt");
     std::fs::write(
         &cl,

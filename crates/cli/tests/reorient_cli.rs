@@ -1,27 +1,11 @@
 //! `polepatch reorient` as a user runs it.
 
 mod common;
-use common::root;
-use std::process::Command;
-
-fn polepatch(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_polepatch"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use common::{polepatch, root, temp_dir};
 
 #[test]
 fn given_angles_write_the_program_report_and_plot() {
-    let dir = std::env::temp_dir().join(format!("polepatch-reorient-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("reorient");
     let out = dir.join("NON_SING.ours.I");
     let plot = dir.join("sphere.svg");
     let (code, stdout, err) = polepatch(&[
@@ -56,9 +40,7 @@ fn given_angles_write_the_program_report_and_plot() {
 
 #[test]
 fn leaving_the_range_is_refused_with_the_line_and_nothing_written() {
-    let dir = std::env::temp_dir().join(format!("polepatch-reorient-r-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("reorient-r");
     let toml =
         std::fs::read_to_string(root().join("crates/kinematics/machines/mikron-ucp710.toml"))
             .unwrap()

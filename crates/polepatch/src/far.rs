@@ -106,19 +106,11 @@ pub fn far_from_pole(
     {
         return Ok(None);
     }
-    Ok(Some(FileReport {
-        file: opts.name.clone(),
-        output: None,
-        machine: machine.name.clone(),
-        words_changed: 0,
-        file_c_decimals: None,
-        written_c_decimals: None,
-        file_primary_decimals: None,
-        written_primary_decimals: None,
-        untouched_runs: Vec::new(),
-        warnings: primary_mismatch_warning(&opts.name, machine, p_idx)
+    Ok(Some(FileReport::unchanged(
+        &opts.name,
+        machine,
+        primary_mismatch_warning(&opts.name, machine, p_idx)
             .into_iter()
             .collect(),
-        zones: Vec::new(),
-    }))
+    )))
 }

@@ -297,6 +297,22 @@ pub struct FileReport {
 }
 
 impl FileReport {
+    /// The report of a file left as it is: no zone, no word changed.
+    pub fn unchanged(file: &str, machine: &Machine, warnings: Vec<String>) -> FileReport {
+        FileReport {
+            file: file.to_string(),
+            output: None,
+            machine: machine.name.clone(),
+            words_changed: 0,
+            file_c_decimals: None,
+            written_c_decimals: None,
+            file_primary_decimals: None,
+            written_primary_decimals: None,
+            untouched_runs: Vec::new(),
+            warnings,
+            zones: Vec::new(),
+        }
+    }
     /// Zones that stay below feed (including those of untouched runs).
     pub fn zones_below_feed(&self) -> usize {
         self.zones.iter().filter(|z| z.outcome != "reached").count()
@@ -320,19 +336,7 @@ pub fn patch_program(
     opts: &PatchOptions,
 ) -> (Vec<Edit>, FileReport) {
     let program = &lp.program;
-    let mut report = FileReport {
-        file: lp.name.clone(),
-        output: None,
-        machine: machine.name.clone(),
-        words_changed: 0,
-        file_c_decimals: None,
-        written_c_decimals: None,
-        file_primary_decimals: None,
-        written_primary_decimals: None,
-        untouched_runs: Vec::new(),
-        warnings: lp.warnings.clone(),
-        zones: Vec::new(),
-    };
+    let mut report = FileReport::unchanged(&lp.name, machine, lp.warnings.clone());
     // The file's number style is only needed when some run comes near the pole; reading
     // it costs a pass over every word, so a program without such a run skips it.
     let pi = polepatch_kinematics::Axis::Primary.index();

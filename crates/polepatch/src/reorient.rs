@@ -362,22 +362,20 @@ pub fn reorient_nc(
     let opts = analysis_options(cone_deg);
     let before = program_figures(&lp, machine, &opts);
     let (out, after, words, untouched) = apply(&lp, machine, tilt, &opts)?;
-    Ok((
-        out,
-        ReorientReport {
-            file: name.to_string(),
-            machine: machine.name.clone(),
-            theta_x_deg: tilt.theta_x_deg,
-            theta_z_deg: tilt.theta_z_deg,
-            pivot_mm: tilt.pivot_mm,
-            before,
-            after,
-            words_changed: words,
-            untouched_lines: untouched,
-            alternatives: Vec::new(),
-            objective: "given angles".into(),
-        },
-    ))
+    let report = ReorientReport {
+        file: name.to_string(),
+        machine: machine.name.clone(),
+        theta_x_deg: tilt.theta_x_deg,
+        theta_z_deg: tilt.theta_z_deg,
+        pivot_mm: tilt.pivot_mm,
+        before,
+        after,
+        words_changed: words,
+        untouched_lines: untouched,
+        alternatives: Vec::new(),
+        objective: "given angles".into(),
+    };
+    Ok((out, report))
 }
 
 /// Reorient and analyse the result: (bytes, figures after, words changed, untouched lines).
@@ -496,22 +494,22 @@ pub fn search(
             ),
         });
     };
-    Ok((
-        out,
-        ReorientReport {
-            file: name.to_string(),
-            machine: machine.name.clone(),
-            theta_x_deg: tilt.theta_x_deg,
-            theta_z_deg: tilt.theta_z_deg,
-            pivot_mm,
-            before,
-            after,
-            words_changed: words,
-            untouched_lines: untouched,
-            alternatives,
-            objective: "smallest |θx| reaching feed on both rotary axes; then shortest time; then largest pole distance".into(),
-        },
-    ))
+    let report = ReorientReport {
+        file: name.to_string(),
+        machine: machine.name.clone(),
+        theta_x_deg: tilt.theta_x_deg,
+        theta_z_deg: tilt.theta_z_deg,
+        pivot_mm,
+        before,
+        after,
+        words_changed: words,
+        untouched_lines: untouched,
+        alternatives,
+        objective: "smallest |θx| reaching feed on both rotary axes; then shortest time; then \
+                    largest pole distance"
+            .into(),
+    };
+    Ok((out, report))
 }
 
 /// The tool orientations under TCPM in the part frame (for the sphere plot).
