@@ -102,6 +102,10 @@ pub struct Program {
     /// the block and the new datum's X Y Z (mm; a missing axis is 0). A work-offset
     /// selection that only names a register (Fanuc/Sinumerik `G54`) is not here.
     pub datum_shifts: Vec<(usize, [f64; 3])>,
+    /// Blocks that change the coordinate frame without stating it: a work-offset selection
+    /// by name (Fanuc/Sinumerik `G54`…`G59`, `G500`…) or a shift/rotation whose values
+    /// polepatch does not follow (`G92`, `G52`, `G10`, `TRANS`, `ROT`, …), in file order.
+    pub frame_changes: Vec<usize>,
     /// Modal states, one per change: block `b`'s state is `states[blocks[b].state]`.
     states: Vec<PackedModal>,
 }
@@ -166,6 +170,9 @@ pub fn parse(bytes: Vec<u8>, dialect: Dialect) -> Result<Program, ParseError> {
         if let Some(d) = interp.stated_datum.take() {
             interp.datum_shifts.push((blocks.len(), d));
         }
+        if std::mem::take(&mut interp.frame_changed) {
+            interp.frame_changes.push(blocks.len());
+        }
         blocks.push(block);
     }
     Ok(Program {
@@ -174,6 +181,7 @@ pub fn parse(bytes: Vec<u8>, dialect: Dialect) -> Result<Program, ParseError> {
         words,
         dialect,
         datum_shifts: interp.datum_shifts,
+        frame_changes: interp.frame_changes,
         states,
     })
 }
@@ -446,6 +454,10 @@ struct Interpreter {
     stated_datum: Option<[f64; 3]>,
     /// All stated datums (see [`Program::datum_shifts`]).
     datum_shifts: Vec<(usize, [f64; 3])>,
+    /// The last block changed the frame without stating it, taken by `parse`.
+    frame_changed: bool,
+    /// See [`Program::frame_changes`].
+    frame_changes: Vec<usize>,
 }
 
 impl Interpreter {
@@ -456,6 +468,8 @@ impl Interpreter {
             feed_mode: FeedMode::PerMinute,
             stated_datum: None,
             datum_shifts: Vec::new(),
+            frame_changed: false,
+            frame_changes: Vec::new(),
         }
     }
 
@@ -668,6 +682,8 @@ impl Interpreter {
         if s.stated_datum {
             let v = |i: usize| s.axes[i].unwrap_or(0.0) * scale;
             self.stated_datum = Some([v(X), v(Y), v(Z)]);
+        } else if s.datum_shift || s.work_offset {
+            self.frame_changed = true;
         }
         if let Some(f) = s.feed {
             m.feed_mm_min = (self.feed_mode == FeedMode::PerMinute).then_some(f * scale);
@@ -978,7 +994,10 @@ mod tests {
             prog.datum_shifts,
             vec![(1, [-30.489, -7.1, 38.054]), (3, [5.0, 0.0, 0.0])]
         );
-        // A Fanuc work-offset selection names a register only: no values.
-        assert!(p("G54\nG1 X1 Y2 Z3 F100\n").datum_shifts.is_empty());
+        assert!(prog.frame_changes.is_empty());
+        // A Fanuc work-offset selection names a register only: no values, a frame change.
+        let fanuc = p("G54\nG1 X1 Y2 Z3 F100\nG92 X0\n");
+        assert!(fanuc.datum_shifts.is_empty());
+        assert_eq!(fanuc.frame_changes, vec![0, 2]);
     }
 }

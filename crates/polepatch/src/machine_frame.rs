@@ -25,9 +25,11 @@
 //! program as the controller will run it.
 //!
 //! # The work offset
-//! [`run_datum`]: the caller's (`--work-offset`), else the last Heidenhain datum shift
-//! with values (`G54 X… Y… Z…`) before the run, else unknown (the run is left as it is,
-//! with a message asking for `--work-offset`).
+//! [`run_datum`]: the last Heidenhain datum shift with values (`G54 X… Y… Z…`) before the
+//! run when no other frame change came after it; else the caller's (`--work-offset`) when
+//! the program changes its frame at most once before the run (it only names `G54`); else
+//! unknown — the run is left as it is, with a message asking for `--work-offset`, and no
+//! machine-frame check is made.
 
 use crate::program::LoadedProgram;
 use polepatch_kinematics::{Axis, Chain, Machine};
@@ -45,19 +47,28 @@ pub const MIN_XYZ_DECIMALS: usize = 3;
 /// count as not worse: the analysis's own resolution.
 pub const NOT_WORSE_REL: f64 = 1e-4;
 
-/// The work offset (machine coordinates of the program's zero, mm) for run `r`: `given`
-/// if set, else the last datum shift with values before the run, else `None`.
+/// The work offset (machine coordinates of the program's zero, mm) for run `r`, or `None`
+/// when it is not known for certain:
+///
+/// - the last frame change before the run states its values (Heidenhain `G54 X Y Z`):
+///   those values;
+/// - else, when the program changes its frame at most once before the run (a named work
+///   offset such as Fanuc `G54`, or nothing at all): `given` (`--work-offset`);
+/// - else (the frame changed more than once, or by a shift polepatch does not follow —
+///   `G92`, `TRANS`, … — after the last stated datum): unknown.
 pub fn run_datum(lp: &LoadedProgram, r: usize, given: Option<[f64; 3]>) -> Option<[f64; 3]> {
-    if given.is_some() {
-        return given;
-    }
     let first = lp.runs[r].run.blocks[0];
-    lp.program
-        .datum_shifts
-        .iter()
-        .rev()
-        .find(|(b, _)| *b <= first)
-        .map(|(_, d)| *d)
+    let p = &lp.program;
+    let stated = p.datum_shifts.iter().rev().find(|(b, _)| *b <= first);
+    let other = p.frame_changes.iter().rev().find(|&&b| b <= first);
+    match (stated, other) {
+        (Some((sb, d)), o) if o.is_none_or(|ob| ob < sb) => Some(*d),
+        _ => {
+            let changes = p.datum_shifts.iter().filter(|(b, _)| *b <= first).count()
+                + p.frame_changes.iter().filter(|&&b| b <= first).count();
+            if changes <= 1 { given } else { None }
+        }
+    }
 }
 
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {

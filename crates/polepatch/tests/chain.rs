@@ -225,3 +225,29 @@ fn a_patch_that_slows_a_linear_axis_in_the_machine_frame_is_not_written() {
     assert!(u.message.contains("in the machine frame"), "{}", u.message);
     assert_eq!(report.zones[0].outcome, "unchanged");
 }
+
+/// The work offset is taken only where it is known for certain.
+#[test]
+fn the_work_offset_is_known_or_the_run_is_left() {
+    use polepatch::machine_frame::run_datum;
+    let m = Machine::builtin("mikron-ucp710").unwrap();
+    let given = Some([10.0, 20.0, 30.0]);
+    let datum = |text: &str, given: Option<[f64; 3]>| {
+        let lp = load_nc(text.as_bytes().to_vec(), "t", &m, None).unwrap();
+        run_datum(&lp, lp.runs.len() - 1, given)
+    };
+    let run = "G1 X0 Y0 Z0 A30 C0 F1000\nX1 C10\nX2 C20\n";
+    // Fanuc names G54 once: the command line's value.
+    assert_eq!(datum(&format!("G54\n{run}"), given), given);
+    assert_eq!(datum(&format!("G54\n{run}"), None), None);
+    // No frame named at all: the command line's value too.
+    assert_eq!(datum(run, given), given);
+    // A G92 (or a second offset) after it: not followed, unknown even with a value.
+    assert_eq!(datum(&format!("G54\nG92 X0 Y0 Z0\n{run}"), given), None);
+    assert_eq!(datum(&format!("G54\n{run}G55\n{run}"), given), None);
+    // Heidenhain states its datum: that one.
+    let h =
+        "%P G71 *\nN1 G54 X1 Y2 Z3 *\nN2 G01 X0 Y0 Z0 A30 C0 F1000 *\nN3 X1 C10 *\nN4 X2 C20 *\n";
+    assert_eq!(datum(h, None), Some([1.0, 2.0, 3.0]));
+    assert_eq!(datum(h, given), Some([1.0, 2.0, 3.0]));
+}
