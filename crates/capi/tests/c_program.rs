@@ -12,10 +12,35 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-/// The folder with `libpolepatch_capi.a` / `.so`: the profile folder of this test binary.
+/// The folder with `libpolepatch_capi.a` / `.so`, built for this test: `cargo test` builds
+/// the library only as an rlib, so the C artefacts are built here, once per test process,
+/// with the cargo that runs the tests, in the same target folder and the `test` profile
+/// (cargo has released its lock while tests run, and the dependencies are already built
+/// for that profile: only this crate is compiled and linked).
 fn lib_dir() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    exe.parent().unwrap().parent().unwrap().to_path_buf()
+    static DIR: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| {
+        let exe = std::env::current_exe().unwrap();
+        // target/<profile>/deps/<test> → target
+        let target = exe.ancestors().nth(3).unwrap().to_path_buf();
+        let status = Command::new(env!("CARGO"))
+            .args([
+                "build",
+                "--quiet",
+                "--profile",
+                "test",
+                "-p",
+                "polepatch-capi",
+            ])
+            .arg("--target-dir")
+            .arg(&target)
+            .current_dir(root())
+            .status()
+            .expect("cargo runs");
+        assert!(status.success(), "building the C library failed");
+        target.join("debug")
+    })
+    .clone()
 }
 
 fn have(tool: &str) -> bool {

@@ -599,7 +599,8 @@ mod tests {
                 match inverse(m, o) {
                     None => prop_assert!(x.hypot(y) < POLE_SIN_TOL * n),
                     Some(sols) => for s in sols {
-                        prop_assert!(dist(forward(m, s.p_deg, s.c_deg), o) < 1e-15);
+                        // A few ulps of a unit vector: degrees ↔ radians round twice.
+                        prop_assert!(dist(forward(m, s.p_deg, s.c_deg), o) < 4e-15);
                     },
                 }
             }

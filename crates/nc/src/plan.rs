@@ -128,7 +128,7 @@ mod tests {
         let out = String::from_utf8(write(&p, &edits)).unwrap();
         assert_eq!(
             out,
-            "G20 G1 X0 Y0 Z0 A1 C10 F10\n(NOTE)\nX1.500 A-2.000 C20\nM8\nY2 X1.0 A2.0\n"
+            "G20 G1 X0 Y0 Z0 A1 C10 F10\n(NOTE)\nX1.500 A-2.000 C20\nM8\nX1.0 Y2 A2.0\n"
         );
     }
 }

@@ -6,8 +6,9 @@ use crate::style::NumberStyle;
 
 /// Set word `letter` of block `block` to `value`, written with `decimals` places in the
 /// file's style for that letter ([`crate::NumberStyle::of`]). A block without the word gets
-/// one inserted after its last axis word that precedes the letter in X Y Z A B C order
-/// (else after the last word before the block end), separated as the file separates words.
+/// one inserted after its last axis word that precedes the letter in X Y Z A B C order,
+/// else before its first axis word, else after the last word before the block end,
+/// separated as the file separates words.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Edit {
     /// Block index.
@@ -70,10 +71,26 @@ pub fn write(program: &Program, edits: &[Edit]) -> Vec<u8> {
             continue;
         }
         let words = program.block_words(e.block);
-        let anchor = words
+        let preceding = words
             .iter()
-            .rposition(|w| rank(w.letter) < own_rank && own_rank < AXES.len())
-            .or_else(|| words.len().checked_sub(1));
+            .rposition(|w| rank(w.letter) < own_rank && own_rank < AXES.len());
+        // No axis word before it in X Y Z A B C order, but one after it (`Z… C…` getting an
+        // X): the new word goes right before that one, so the axes stay in order.
+        if preceding.is_none()
+            && own_rank < AXES.len()
+            && let Some(next) = words.iter().find(|w| rank(w.letter) < AXES.len())
+        {
+            let mut text = Vec::with_capacity(number.len() + 3);
+            text.push(letter);
+            if style.equals {
+                text.push(b'=');
+            }
+            text.extend_from_slice(number.as_bytes());
+            text.extend_from_slice(default_gap.get_or_insert_with(|| file_gap(program)));
+            splices.push((next.span().start, next.span().start, own_rank, text));
+            continue;
+        }
+        let anchor = preceding.or_else(|| words.len().checked_sub(1));
         let mut text = Vec::with_capacity(number.len() + 3);
         let at = match anchor {
             Some(a) => {
@@ -213,6 +230,35 @@ mod tests {
             edit("G1 X1.5 Y2.5 F100\n", &ab),
             "G1 X1.5 Y2.5 A2.0 C1.0 F100\n",
             "fixed one decimal"
+        );
+    }
+
+    /// An axis letter earlier than every axis word of the block goes before the first of
+    /// them (`X Y` into `G1 Z… C… F…`), not after F.
+    #[test]
+    fn inserts_keep_axis_order_when_nothing_precedes() {
+        let xy = [
+            Edit {
+                block: 0,
+                letter: b'Y',
+                value: -2.076,
+                decimals: 3,
+            },
+            Edit {
+                block: 0,
+                letter: b'X',
+                value: -5.105,
+                decimals: 3,
+            },
+        ];
+        assert_eq!(
+            edit("N70 G1 Z-1.497 C45.631 F800.\n", &xy),
+            "N70 G1 X-5.105 Y-2.076 Z-1.497 C45.631 F800.\n"
+        );
+        assert_eq!(
+            edit("G1X1.Z2.\n", &xy[..1]),
+            "G1X1.Y-2.076Z2.\n",
+            "after X, before Z, no gap in a tight file"
         );
     }
 
