@@ -82,3 +82,18 @@ fn bad_records_are_refused_with_line_and_column_and_nothing_written() {
     );
     assert!(!out.exists());
 }
+
+#[test]
+fn a_cl_file_given_to_patch_is_named_as_such() {
+    let dir = temp_dir("cl-to-patch");
+    let (code, _, err) = polepatch(&[
+        "patch",
+        "fixtures/cl/SING.apt",
+        "-o",
+        dir.join("x.I").to_str().unwrap(),
+        "--machine",
+        "mikron-ucp710",
+    ]);
+    assert_eq!(code, 1);
+    assert!(err.contains("SING.apt:5: this is a CL file"), "{err}");
+}

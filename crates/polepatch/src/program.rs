@@ -125,6 +125,20 @@ fn why_no_runs(program: &Program, name: &str) -> Error {
             what: what.to_string(),
         };
     }
+    // A CL file handed to `patch`: say what it is.
+    if let Some(k) = program.blocks.iter().position(|b| {
+        let line = &program.bytes[b.span()];
+        let t = line.trim_ascii_start();
+        t.len() >= 5 && t[..5].eq_ignore_ascii_case(b"GOTO/")
+    }) {
+        return Error::Unsupported {
+            path: name.to_string(),
+            line: program.blocks[k].line,
+            what: "this is a CL file (APT GOTO/ records), not an NC program: post it with \
+                   `polepatch post`"
+                .to_string(),
+        };
+    }
     Error::NoRuns {
         path: name.to_string(),
     }
