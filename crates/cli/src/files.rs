@@ -1,8 +1,7 @@
 //! Files: read an NC program, patch it through the library, write the output safely.
 
 use polepatch::kinematics::Machine;
-use polepatch::program::load_nc;
-use polepatch::{Error, FileReport, patch_program};
+use polepatch::{Error, FileReport};
 use std::io::Write;
 use std::path::Path as FsPath;
 
@@ -84,16 +83,21 @@ pub fn patch_file(
         return Ok(report);
     }
     drop(staged);
-    let mut lp = load_nc(bytes, &name, machine, opts.feed_fallback_mm_min)?;
-    lp.work_offset_mm = opts.work_offset_mm;
-    let (edits, mut report) = patch_program(&lp, machine, &opts.patch);
-    if edits.is_empty() {
-        write_atomic_like(output, &lp.program.bytes, Some(input)).map_err(write_err)?;
-    } else {
-        let bytes = polepatch::nc::write(&lp.program, &edits);
-        drop(lp);
-        write_atomic_like(output, &bytes, Some(input)).map_err(write_err)?;
-    }
+    // Near the pole: the output is written as the stretches near the pole are patched
+    // (memory: the input and those stretches), to a temporary file renamed on success.
+    let mut tmp = temp_beside(output).map_err(write_err)?;
+    let mut report = {
+        let mut w = std::io::BufWriter::with_capacity(1 << 20, tmp.as_file_mut());
+        let report = polepatch::stream::patch_nc_to(&bytes, machine, &whole, &mut w);
+        let report = match report {
+            Err(Error::Output(e)) => return Err(write_err(e)),
+            r => r?,
+        };
+        w.flush().map_err(write_err)?;
+        report
+    };
+    finish_staged(&mut tmp, output, Some(input)).map_err(write_err)?;
+    tmp.persist(output).map_err(|e| write_err(e.error))?;
     report.output = Some(output.display().to_string());
     Ok(report)
 }
@@ -146,21 +150,37 @@ pub fn stage(
     bytes: &[u8],
     like: Option<&FsPath>,
 ) -> std::io::Result<tempfile::NamedTempFile> {
+    let mut tmp = temp_beside(path)?;
+    tmp.write_all(bytes)?;
+    finish_staged(&mut tmp, path, like)?;
+    Ok(tmp)
+}
+
+/// An empty temporary file in `path`'s folder (deleted when dropped).
+fn temp_beside(path: &FsPath) -> std::io::Result<tempfile::NamedTempFile> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => FsPath::new("."),
     };
+    tempfile::NamedTempFile::new_in(dir)
+}
+
+/// Sync a written temporary file and give it the permissions the file at `path` has,
+/// else those of `like`, else rw-r--r--.
+fn finish_staged(
+    tmp: &mut tempfile::NamedTempFile,
+    path: &FsPath,
+    like: Option<&FsPath>,
+) -> std::io::Result<()> {
     let perms = std::fs::metadata(path)
         .or_else(|e| like.map_or(Err(e), std::fs::metadata))
         .map(|m| m.permissions())
         .ok();
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
-    tmp.write_all(bytes)?;
     tmp.as_file().sync_all()?;
     if let Some(perms) = perms.or_else(default_permissions) {
         tmp.as_file().set_permissions(perms)?;
     }
-    Ok(tmp)
+    Ok(())
 }
 
 /// [`write_atomic_like`] without a model file (reports, CSV).

@@ -22,7 +22,9 @@ pub mod writer;
 pub use error::ParseError;
 pub use modal::{Modal, Motion};
 pub use plan::restore_modal;
-pub use program::{Block, Dialect, Program, Word, parse, scan};
+pub use program::{
+    Block, Dialect, Program, ProgramBuilder, Scanned, Word, parse, scan, scan_blocks,
+};
 pub use run::{Run, RunBreak, RunBuilder, primary_in_use, runs};
-pub use style::NumberStyle;
-pub use writer::{Edit, write};
+pub use style::{FileStyle, NumberStyle, StyleEvidence};
+pub use writer::{Edit, write, write_styled};

@@ -119,12 +119,13 @@ impl Program {
     pub fn state(&self, block: usize) -> Modal {
         self.states[self.blocks[block].state as usize].unpack()
     }
-    /// The modal state in force before `block` (the state after the previous block, or the
-    /// power-on default for the first).
+    /// The modal state in force before `block` (the state after the previous block; for
+    /// the first, the power-on default, or for a stretch of a file built with
+    /// [`ProgramBuilder`] the state it starts from).
     pub fn state_before(&self, block: usize) -> Modal {
         block
             .checked_sub(1)
-            .map_or_else(Modal::default, |b| self.state(b))
+            .map_or_else(|| self.states[0].unpack(), |b| self.state(b))
     }
     /// The word with `letter` in a block, if any (the last one if repeated).
     pub fn word(&self, block: usize, letter: u8) -> Option<&Word> {
@@ -230,18 +231,42 @@ fn lines_from(bytes: &[u8], start: usize) -> impl Iterator<Item = (Range<usize>,
 pub fn scan(
     bytes: &[u8],
     dialect: Dialect,
-    visit: impl FnMut(&Block, &[Word], &Modal) -> std::ops::ControlFlow<()>,
+    mut visit: impl FnMut(&Block, &[Word], &Modal) -> std::ops::ControlFlow<()>,
+) -> Result<Dialect, ParseError> {
+    scan_blocks(bytes, dialect, |s| visit(s.block, s.words, s.state))
+}
+
+/// One block as [`scan_blocks`] gives it.
+#[derive(Debug, Clone, Copy)]
+pub struct Scanned<'a> {
+    /// The block; its [`Block::words`] index `words`.
+    pub block: &'a Block,
+    /// The block's words (offsets into the whole file).
+    pub words: &'a [Word],
+    /// The modal state after the block.
+    pub state: &'a Modal,
+    /// The datum the block states, as it goes into [`Program::datum_shifts`].
+    pub stated_datum: Option<[f64; 3]>,
+    /// The block changes the frame without stating it, as [`Program::frame_changes`].
+    pub frame_changed: bool,
+}
+
+/// [`scan`], with what the block does to the coordinate frame.
+pub fn scan_blocks(
+    bytes: &[u8],
+    dialect: Dialect,
+    visit: impl FnMut(Scanned<'_>) -> std::ops::ControlFlow<()>,
 ) -> Result<Dialect, ParseError> {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
     scan_with(bytes, dialect, threads, visit)
 }
 
-/// [`scan`] on `threads` threads.
+/// [`scan_blocks`] on `threads` threads.
 fn scan_with(
     bytes: &[u8],
     dialect: Dialect,
     threads: usize,
-    mut visit: impl FnMut(&Block, &[Word], &Modal) -> std::ops::ControlFlow<()>,
+    mut visit: impl FnMut(Scanned<'_>) -> std::ops::ControlFlow<()>,
 ) -> Result<Dialect, ParseError> {
     if u32::try_from(bytes.len()).is_err() {
         return Err(too_big(bytes.len()));
@@ -251,12 +276,21 @@ fn scan_with(
         d => d,
     };
     let mut interp = Interpreter::new(dialect);
+    let mut give = |interp: &mut Interpreter, block: &Block, words: &[Word]| {
+        visit(Scanned {
+            block,
+            words,
+            state: &interp.modal,
+            stated_datum: interp.stated_datum.take(),
+            frame_changed: std::mem::take(&mut interp.frame_changed),
+        })
+    };
     if threads <= 1 || bytes.len() < SCAN_WINDOW_BYTES {
         let mut words = Vec::with_capacity(32);
         for (span, line) in lines(bytes) {
             words.clear();
             let block = interp.block(bytes, span, line, &mut words)?;
-            if visit(&block, &words, &interp.modal).is_break() {
+            if give(&mut interp, &block, &words).is_break() {
                 break;
             }
         }
@@ -298,7 +332,7 @@ fn scan_with(
                 let line = line_offset + k + 1;
                 let ws = &part.words[words];
                 let block = interp.apply(scan, line, span, 0..ws.len());
-                if visit(&block, ws, &interp.modal).is_break() {
+                if give(&mut interp, &block, ws).is_break() {
                     return Ok(dialect);
                 }
             }
@@ -311,6 +345,110 @@ fn scan_with(
         from = to;
     }
     Ok(dialect)
+}
+
+/// A [`Program`] for a stretch of a larger file, built from the blocks [`scan_blocks`]
+/// gives (consecutive ones): block indices count from the stretch's first block, byte
+/// offsets from its first byte, line numbers and modal states are the file's. The
+/// stretch's [`Program::datum_shifts`] and [`Program::frame_changes`] are its own.
+#[derive(Debug)]
+pub struct ProgramBuilder {
+    base: usize,
+    blocks: Vec<Block>,
+    words: Vec<Word>,
+    states: Vec<PackedModal>,
+    last: Modal,
+    datum_shifts: Vec<(usize, [f64; 3])>,
+    frame_changes: Vec<usize>,
+}
+
+impl ProgramBuilder {
+    /// A stretch that starts with a block at byte `base` of the file, in modal state
+    /// `before` (the state after the block before it).
+    pub fn new(base: usize, before: &Modal) -> Self {
+        ProgramBuilder {
+            base,
+            blocks: Vec::new(),
+            words: Vec::new(),
+            states: vec![PackedModal::pack(before)],
+            last: *before,
+            datum_shifts: Vec::new(),
+            frame_changes: Vec::new(),
+        }
+    }
+
+    /// Byte offset of the stretch in the file.
+    pub fn base(&self) -> usize {
+        self.base
+    }
+
+    /// Blocks taken so far.
+    pub fn len(&self) -> usize {
+        self.blocks.len()
+    }
+
+    /// Whether no block was taken yet.
+    pub fn is_empty(&self) -> bool {
+        self.blocks.is_empty()
+    }
+
+    /// Take the next block of the file.
+    ///
+    /// # Panics
+    /// If the block starts before the stretch.
+    pub fn push(&mut self, s: &Scanned<'_>) {
+        let base = u32::try_from(self.base).unwrap_or(u32::MAX);
+        assert!(s.block.start >= base, "block before the stretch");
+        if *s.state != self.last {
+            self.last = *s.state;
+            self.states.push(PackedModal::pack(s.state));
+        }
+        let first = self.words.len();
+        self.words
+            .extend(s.words[s.block.words()].iter().map(|w| Word {
+                start: w.start - base,
+                value_start: w.value_start - base,
+                end: w.end - base,
+                ..w.clone()
+            }));
+        if let Some(d) = s.stated_datum {
+            self.datum_shifts.push((self.blocks.len(), d));
+        }
+        if s.frame_changed {
+            self.frame_changes.push(self.blocks.len());
+        }
+        self.blocks.push(Block {
+            start: s.block.start - base,
+            end: s.block.end - base,
+            words_start: first as u32,
+            words_end: self.words.len() as u32,
+            state: (self.states.len() - 1) as u32,
+            ..s.block.clone()
+        });
+    }
+
+    /// The program of the stretch: `bytes` are the file's bytes from the stretch's first
+    /// byte (at least up to the end of its last block).
+    ///
+    /// # Panics
+    /// If `bytes` is shorter than the blocks taken.
+    pub fn finish(self, bytes: Vec<u8>, dialect: Dialect) -> Program {
+        if let Some(b) = self.blocks.last() {
+            assert!(
+                b.end as usize <= bytes.len(),
+                "bytes shorter than the blocks"
+            );
+        }
+        Program {
+            bytes,
+            blocks: self.blocks,
+            words: self.words,
+            dialect,
+            datum_shifts: self.datum_shifts,
+            frame_changes: self.frame_changes,
+            states: self.states,
+        }
+    }
 }
 
 /// Size of the windows [`scan`] lexes on several threads at a time, bytes: large enough
@@ -918,6 +1056,8 @@ mod tests {
                 0 => "; a comment (with words X1 Y2)\n".to_string(),
                 1 => format!("N{k} G01 X+1 Y+2 Z-8 A+10 C+20 F{} *\n", 1000 + k % 7),
                 2 => "\r\n".to_string(),
+                3 => format!("N{k} G54 X+{} Y+2 Z+0 *\n", k % 5),
+                4 => format!("N{k} G92 X+0 *\n"),
                 _ => format!(
                     "N{k} X{:+.3} Y{:+.3} A{:+.3} C{:+.3} *\n",
                     k as f64 * 0.01,
@@ -932,13 +1072,33 @@ mod tests {
         t
     }
 
-    /// What `scan_with` visits, as (line, span, words, state, is_move, breaks_run).
-    type Visited = Vec<(usize, Range<usize>, Vec<Word>, Modal, bool, bool)>;
+    /// What `scan_with` visits, as (line, span, words, state, is_move, breaks_run,
+    /// stated datum, frame changed).
+    type Visited = Vec<(
+        usize,
+        Range<usize>,
+        Vec<Word>,
+        Modal,
+        bool,
+        bool,
+        Option<[f64; 3]>,
+        bool,
+    )>;
 
     fn scanned(bytes: &[u8], threads: usize) -> Result<Visited, ParseError> {
         let mut v = Vec::new();
-        scan_with(bytes, Dialect::Auto, threads, |b, w, m| {
-            v.push((b.line, b.span(), w.to_vec(), *m, b.is_move, b.breaks_run));
+        scan_with(bytes, Dialect::Auto, threads, |s| {
+            let b = s.block;
+            v.push((
+                b.line,
+                b.span(),
+                s.words.to_vec(),
+                *s.state,
+                b.is_move,
+                b.breaks_run,
+                s.stated_datum,
+                s.frame_changed,
+            ));
             std::ops::ControlFlow::Continue(())
         })?;
         Ok(v)
@@ -958,6 +1118,11 @@ mod tests {
                     prog.state(i),
                     b.is_move,
                     b.breaks_run,
+                    prog.datum_shifts
+                        .iter()
+                        .find(|(k, _)| *k == i)
+                        .map(|(_, d)| *d),
+                    prog.frame_changes.contains(&i),
                 )
             })
             .collect();
@@ -966,6 +1131,55 @@ mod tests {
             assert_eq!(got.len(), expected.len(), "{threads} threads");
             assert!(got == expected, "{threads} threads");
         }
+    }
+
+    /// A stretch built from scanned blocks is the whole program's, re-based: the same
+    /// lines, words, states (before its first block too), frame changes and bytes.
+    #[test]
+    fn program_builder_gives_the_stretch_of_the_whole_program() {
+        let bytes = big(2);
+        let prog = parse(bytes.clone(), Dialect::Auto).unwrap();
+        let n = prog.blocks.len();
+        for (from, to) in [(0, 10), (1, 2), (5, 3000), (n - 50, n), (990, 1010)] {
+            let base = prog.blocks[from].span().start;
+            let mut builder = ProgramBuilder::new(base, &prog.state_before(from));
+            let mut i = 0;
+            scan_with(&bytes, Dialect::Auto, 2, |s| {
+                if (from..to).contains(&i) {
+                    builder.push(&s);
+                }
+                i += 1;
+                std::ops::ControlFlow::Continue(())
+            })
+            .unwrap();
+            let end = prog.blocks[to - 1].span().end;
+            let sub = builder.finish(bytes[base..end].to_vec(), prog.dialect);
+            assert_eq!(sub.blocks.len(), to - from);
+            assert_eq!(sub.state_before(0), prog.state_before(from));
+            for k in 0..to - from {
+                let (a, b) = (&sub.blocks[k], &prog.blocks[from + k]);
+                assert_eq!(a.line, b.line);
+                assert_eq!(&sub.bytes[a.span()], &bytes[b.span()]);
+                assert_eq!(sub.state(k), prog.state(from + k));
+                let (wa, wb) = (sub.block_words(k), prog.block_words(from + k));
+                assert_eq!(wa.len(), wb.len());
+                for (x, y) in wa.iter().zip(wb) {
+                    assert_eq!(&sub.bytes[x.value_span()], &bytes[y.value_span()]);
+                    assert_eq!((x.letter, x.value), (y.letter, y.value));
+                }
+            }
+            let local = |v: &[usize]| -> Vec<usize> {
+                v.iter()
+                    .filter(|&&b| (from..to).contains(&b))
+                    .map(|b| b - from)
+                    .collect()
+            };
+            assert_eq!(sub.frame_changes, local(&prog.frame_changes));
+            let shifts: Vec<usize> = prog.datum_shifts.iter().map(|d| d.0).collect();
+            let sub_shifts: Vec<usize> = sub.datum_shifts.iter().map(|d| d.0).collect();
+            assert_eq!(sub_shifts, local(&shifts));
+        }
+        assert!(!prog.frame_changes.is_empty() && !prog.datum_shifts.is_empty());
     }
 
     #[test]

@@ -166,6 +166,15 @@ impl RunBuilder {
         self.prev = *st;
     }
 
+    /// The last block of the run in progress, when it has two points or more (it will be
+    /// given to `emit` when a later block ends it, or by [`RunBuilder::finish`]).
+    pub fn open_run_last_block(&self) -> Option<usize> {
+        self.cur
+            .as_ref()
+            .filter(|r| r.len() >= 2)
+            .and_then(|r| r.blocks.last().copied())
+    }
+
     /// The end of the program: `emit` gets the run in progress, if any.
     pub fn finish(&mut self, emit: &mut impl FnMut(Run)) {
         self.finish_run(RunBreak::End, emit);

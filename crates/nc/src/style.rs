@@ -2,7 +2,7 @@
 
 use crate::lexer::parse_number;
 use crate::modal::AXES;
-use crate::program::Program;
+use crate::program::{Program, Word};
 
 /// How numbers of one address letter are written in a file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -43,50 +43,60 @@ struct Evidence {
 }
 
 impl Evidence {
-    fn collect(program: &Program, pick: impl Fn(u8) -> bool) -> Evidence {
-        let mut e = Evidence {
+    fn empty() -> Evidence {
+        Evidence {
             min_decimals: usize::MAX,
             ..Evidence::default()
-        };
+        }
+    }
+
+    fn collect(program: &Program, pick: impl Fn(u8) -> bool) -> Evidence {
+        let mut e = Evidence::empty();
         let bytes = &program.bytes[..];
         for w in program.words.iter().filter(|w| pick(w.letter)) {
-            let text = &bytes[w.value_span()];
-            e.words += 1;
-            if w.value_start > w.start + 1 {
-                e.equals += 1;
-            }
-            let (sign, body) = match text.first() {
-                Some(b'+') => (Some(b'+'), &text[1..]),
-                Some(b'-') => (Some(b'-'), &text[1..]),
-                _ => (None, text),
-            };
-            match sign {
-                Some(b'+') => e.plus += 1,
-                None => e.unsigned += 1,
-                _ => {}
-            }
-            let (decimals, has_point) = match body.iter().position(|&b| b == b'.') {
-                Some(k) => (body.len() - k - 1, true),
-                None => (0, false),
-            };
-            e.max_decimals = e.max_decimals.max(decimals);
-            e.min_decimals = e.min_decimals.min(decimals);
-            if decimals > 0 && body.last() == Some(&b'0') {
-                e.trailing_zero += 1;
-            }
-            if decimals == 0 {
-                if has_point {
-                    e.point += 1;
-                } else {
-                    e.no_point += 1;
-                }
-            } else if body.first() == Some(&b'.') {
-                e.no_zero += 1;
-            } else if body.first() == Some(&b'0') && body.get(1) == Some(&b'.') {
-                e.zero += 1;
-            }
+            e.add(bytes, w);
         }
         e
+    }
+
+    /// Count word `w` (its offsets index `bytes`).
+    fn add(&mut self, bytes: &[u8], w: &Word) {
+        let e = self;
+        let text = &bytes[w.value_span()];
+        e.words += 1;
+        if w.value_start > w.start + 1 {
+            e.equals += 1;
+        }
+        let (sign, body) = match text.first() {
+            Some(b'+') => (Some(b'+'), &text[1..]),
+            Some(b'-') => (Some(b'-'), &text[1..]),
+            _ => (None, text),
+        };
+        match sign {
+            Some(b'+') => e.plus += 1,
+            None => e.unsigned += 1,
+            _ => {}
+        }
+        let (decimals, has_point) = match body.iter().position(|&b| b == b'.') {
+            Some(k) => (body.len() - k - 1, true),
+            None => (0, false),
+        };
+        e.max_decimals = e.max_decimals.max(decimals);
+        e.min_decimals = e.min_decimals.min(decimals);
+        if decimals > 0 && body.last() == Some(&b'0') {
+            e.trailing_zero += 1;
+        }
+        if decimals == 0 {
+            if has_point {
+                e.point += 1;
+            } else {
+                e.no_point += 1;
+            }
+        } else if body.first() == Some(&b'.') {
+            e.no_zero += 1;
+        } else if body.first() == Some(&b'0') && body.get(1) == Some(&b'.') {
+            e.zero += 1;
+        }
     }
 }
 
@@ -123,21 +133,25 @@ impl NumberStyle {
         let letter = letter.to_ascii_uppercase();
         let own = Evidence::collect(program, |l| l == letter);
         let axes = Evidence::collect(program, |l| AXES.contains(&l));
-        let main = if own.words > 0 { &own } else { &axes };
+        NumberStyle::from_evidence(&own, &axes)
+    }
+
+    fn from_evidence(own: &Evidence, axes: &Evidence) -> NumberStyle {
+        let main = if own.words > 0 { own } else { axes };
         let plus = if main.plus + main.unsigned > 0 {
             main
         } else {
-            &axes
+            axes
         };
         let point = if main.point + main.no_point > 0 {
             main
         } else {
-            &axes
+            axes
         };
         let zero = if main.zero + main.no_zero > 0 {
             main
         } else {
-            &axes
+            axes
         };
         NumberStyle {
             plus_sign: plus.plus > 0,
@@ -191,6 +205,84 @@ impl NumberStyle {
     /// finite).
     pub fn rounded(&self, value: f64, decimals: usize) -> f64 {
         parse_number(self.render(value, decimals).as_bytes()).unwrap_or(f64::NAN)
+    }
+}
+
+/// How a whole file writes its axis words (X Y Z A B C, each as [`NumberStyle::of`]) and
+/// separates words: what [`crate::write_styled`] needs to write edits into any stretch
+/// of the file the file's way.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FileStyle {
+    /// Styles of X Y Z A B C, in [`AXES`] order.
+    pub axes: [NumberStyle; 6],
+    /// The usual gap between two words of a block: a space, unless most words follow
+    /// each other directly (`G1X10.Y5.`).
+    pub gap: &'static [u8],
+}
+
+impl FileStyle {
+    /// The style of `program`'s axis words.
+    pub fn of(program: &Program) -> FileStyle {
+        let mut ev = StyleEvidence::default();
+        for b in &program.blocks {
+            ev.add_block(&program.bytes, &program.words[b.words()]);
+        }
+        ev.style()
+    }
+
+    /// The style of axis `letter` (X Y Z A B C), `None` for another letter.
+    pub fn letter(&self, letter: u8) -> Option<NumberStyle> {
+        let l = letter.to_ascii_uppercase();
+        AXES.iter().position(|&a| a == l).map(|i| self.axes[i])
+    }
+}
+
+/// [`FileStyle`] evidence gathered block by block, for callers that read a file as a
+/// stream ([`crate::scan`]): the same figures as [`FileStyle::of`] on the whole program.
+pub struct StyleEvidence {
+    letters: [Evidence; 6],
+    any_axis: Evidence,
+    spaced: usize,
+    tight: usize,
+}
+
+impl Default for StyleEvidence {
+    fn default() -> Self {
+        StyleEvidence {
+            letters: std::array::from_fn(|_| Evidence::empty()),
+            any_axis: Evidence::empty(),
+            spaced: 0,
+            tight: 0,
+        }
+    }
+}
+
+impl StyleEvidence {
+    /// Count the words of one block (their offsets index `bytes`).
+    pub fn add_block(&mut self, bytes: &[u8], words: &[Word]) {
+        for w in words {
+            if let Some(i) = AXES.iter().position(|&a| a == w.letter) {
+                self.letters[i].add(bytes, w);
+                self.any_axis.add(bytes, w);
+            }
+        }
+        for pair in words.windows(2) {
+            if pair[0].end == pair[1].start {
+                self.tight += 1;
+            } else {
+                self.spaced += 1;
+            }
+        }
+    }
+
+    /// The file's style from what was counted.
+    pub fn style(&self) -> FileStyle {
+        FileStyle {
+            axes: std::array::from_fn(|i| {
+                NumberStyle::from_evidence(&self.letters[i], &self.any_axis)
+            }),
+            gap: if self.tight > self.spaced { b"" } else { b" " },
+        }
     }
 }
 
@@ -277,6 +369,30 @@ mod tests {
                 f
             };
             assert_eq!(st.render(v, 3), expected, "{v}");
+        }
+    }
+
+    /// The file style gathered block by block is each letter's [`NumberStyle::of`], and the
+    /// gap the file uses.
+    #[test]
+    fn file_style_is_each_letters_style() {
+        for src in [
+            "N1 G01 X+0 C+126.28 *\nN2 C+148.494 *\nN3 C+180 *\n",
+            "G1 X10. Y-.5 C12.5\nC180.\nC-.25\n",
+            "N10 G1 X=10.000 A=2.500 C=30.000\n",
+            "N1 G01 X+1.5 Y+0 A+2.25 *\n",
+            "G1X1.Y2.Z3.B-.5\nX2.\n",
+            "(no words at all)\n",
+        ] {
+            let p = parse(src.as_bytes().to_vec(), Dialect::Auto).unwrap();
+            let f = FileStyle::of(&p);
+            for (i, &l) in AXES.iter().enumerate() {
+                assert_eq!(f.axes[i], NumberStyle::of(&p, l), "{src} {}", l as char);
+                assert_eq!(f.letter(l), Some(f.axes[i]));
+            }
+            assert_eq!(f.letter(b'F'), None);
+            let tight = src.starts_with("G1X1.");
+            assert_eq!(f.gap, if tight { &b""[..] } else { &b" "[..] }, "{src}");
         }
     }
 }

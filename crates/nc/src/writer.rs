@@ -2,7 +2,7 @@
 
 use crate::modal::AXES;
 use crate::program::Program;
-use crate::style::NumberStyle;
+use crate::style::{FileStyle, NumberStyle};
 
 /// Set word `letter` of block `block` to `value`, written with `decimals` places in the
 /// file's style for that letter ([`crate::NumberStyle::of`]). A block without the word gets
@@ -33,6 +33,19 @@ pub struct Edit {
 /// # Panics
 /// If an edit names a block that does not exist.
 pub fn write(program: &Program, edits: &[Edit]) -> Vec<u8> {
+    if edits.is_empty() {
+        return program.bytes.clone();
+    }
+    write_styled(program, edits, &FileStyle::of(program))
+}
+
+/// [`write`] with the file's style given: `program` may be a stretch of a larger file
+/// ([`crate::ProgramBuilder`]) whose own words are too few to show the file's style.
+/// Letters other than X Y Z A B C are written in `program`'s style for them.
+///
+/// # Panics
+/// If an edit names a block that does not exist.
+pub fn write_styled(program: &Program, edits: &[Edit], file: &FileStyle) -> Vec<u8> {
     let bytes = &program.bytes;
     if edits.is_empty() {
         return bytes.clone();
@@ -40,7 +53,6 @@ pub fn write(program: &Program, edits: &[Edit]) -> Vec<u8> {
     let mut order: Vec<usize> = (0..edits.len()).collect();
     order.sort_by_key(|&i| (edits[i].block, edits[i].letter.to_ascii_uppercase()));
     let mut styles: [Option<NumberStyle>; 26] = [None; 26];
-    let mut default_gap: Option<&'static [u8]> = None;
     // (start, end, rank, replacement)
     let mut splices: Vec<(usize, usize, usize, Vec<u8>)> = Vec::with_capacity(edits.len());
     for (k, &i) in order.iter().enumerate() {
@@ -57,8 +69,11 @@ pub fn write(program: &Program, edits: &[Edit]) -> Vec<u8> {
             e.block,
             program.blocks.len()
         );
-        let style = *styles[usize::from(letter.wrapping_sub(b'A')).min(25)]
-            .get_or_insert_with(|| NumberStyle::of(program, letter));
+        let style =
+            *styles[usize::from(letter.wrapping_sub(b'A')).min(25)].get_or_insert_with(|| {
+                file.letter(letter)
+                    .unwrap_or_else(|| NumberStyle::of(program, letter))
+            });
         let number = style.render(e.value, e.decimals);
         let own_rank = rank(letter);
         if let Some(w) = program.word(e.block, letter) {
@@ -86,7 +101,7 @@ pub fn write(program: &Program, edits: &[Edit]) -> Vec<u8> {
                 text.push(b'=');
             }
             text.extend_from_slice(number.as_bytes());
-            text.extend_from_slice(default_gap.get_or_insert_with(|| file_gap(program)));
+            text.extend_from_slice(file.gap);
             splices.push((next.span().start, next.span().start, own_rank, text));
             continue;
         }
@@ -103,9 +118,7 @@ pub fn write(program: &Program, edits: &[Edit]) -> Vec<u8> {
                 let blank = |g: &&[u8]| g.iter().all(|&b| b == b' ' || b == b'\t');
                 match gap_before.filter(blank).or(gap_after.filter(blank)) {
                     Some(g) => text.extend_from_slice(g),
-                    None => {
-                        text.extend_from_slice(default_gap.get_or_insert_with(|| file_gap(program)))
-                    }
+                    None => text.extend_from_slice(file.gap),
                 }
                 words[a].span().end
             }
@@ -137,23 +150,6 @@ pub fn write(program: &Program, edits: &[Edit]) -> Vec<u8> {
 /// Position of `letter` in X Y Z A B C order; other letters come after.
 fn rank(letter: u8) -> usize {
     AXES.iter().position(|&l| l == letter).unwrap_or(AXES.len())
-}
-
-/// The usual gap between two words of a block in this file: a space, unless most words
-/// follow each other directly (`G1X10.Y5.`).
-fn file_gap(program: &Program) -> &'static [u8] {
-    let (mut spaced, mut tight) = (0usize, 0usize);
-    for b in &program.blocks {
-        let ws = &program.words[b.words()];
-        for pair in ws.windows(2) {
-            if pair[0].end == pair[1].start {
-                tight += 1;
-            } else {
-                spaced += 1;
-            }
-        }
-    }
-    if tight > spaced { b"" } else { b" " }
 }
 
 #[cfg(test)]

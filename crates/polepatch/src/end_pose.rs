@@ -27,53 +27,88 @@
 
 use crate::program::LoadedProgram;
 use polepatch_nc::modal::{C, X, Y};
+use polepatch_nc::{Modal, Word};
 
 /// Whether the moves after run `r` of `lp` are independent of the pose its last point is
 /// in (module docs).
 pub fn end_pose_is_free(lp: &LoadedProgram, r: usize) -> bool {
+    if let Some(w) = &lp.window {
+        return w.end_free[r];
+    }
     let program = &lp.program;
     let run = &lp.runs[r].run;
     let Some(&last) = run.blocks.last() else {
         return false;
     };
-    let primary = lp.primary_letter;
-    let p_idx = lp.primary_index();
     let mut prev = program.state(last);
     for b in last + 1..program.blocks.len() {
         let st = program.state(b);
-        let has = |l: u8| program.word(b, l).is_some();
-        let m_code = |v: f64| {
-            program
-                .block_words(b)
-                .iter()
-                .any(|w| w.letter == b'M' && w.value == v)
+        let after = After {
+            words: program.block_words(b),
+            is_move: program.blocks[b].is_move,
+            state: &st,
+            before: &prev,
         };
-        if has(b'T') || m_code(6.0) || m_code(2.0) || m_code(30.0) {
-            return true;
-        }
-        if st.incremental {
-            return false;
-        }
-        let (has_p, has_c) = (has(primary), has(b'C'));
-        let linear_moves = st.pos[..3] != prev.pos[..3];
-        if program.blocks[b].is_move {
-            if has_p && has_c {
-                return !linear_moves;
-            }
-            if has_p || has_c {
-                return false;
-            }
-            let xy_moves = st.pos[X] != prev.pos[X] || st.pos[Y] != prev.pos[Y];
-            if !st.tcpm && xy_moves {
-                return false;
-            }
-        } else if st.pos[p_idx] != prev.pos[p_idx] || st.pos[C] != prev.pos[C] {
-            // A non-move that names a rotary axis (a datum shift on it): be safe.
-            return false;
+        if let Some(free) = after.verdict(lp.primary_letter) {
+            return free;
         }
         prev = st;
     }
     true
+}
+
+/// One block after a run's last point, for [`After::verdict`].
+#[derive(Debug, Clone, Copy)]
+pub struct After<'a> {
+    /// Its words.
+    pub words: &'a [Word],
+    /// It moves ([`polepatch_nc::Block::is_move`]).
+    pub is_move: bool,
+    /// The modal state after it.
+    pub state: &'a Modal,
+    /// The modal state before it.
+    pub before: &'a Modal,
+}
+
+impl After<'_> {
+    /// What this block says about the pose of the last point before it, for a program
+    /// whose tilting letter is `primary` (`b'A'` or `b'B'`): `Some(true)` free,
+    /// `Some(false)` fixed, `None` the next block decides (module docs). The answer for a
+    /// run is that of the first block after it that decides, free at the end of the file.
+    pub fn verdict(&self, primary: u8) -> Option<bool> {
+        let has = |l: u8| self.words.iter().any(|w| w.letter == l);
+        let m_code = |v: f64| self.words.iter().any(|w| w.letter == b'M' && w.value == v);
+        if has(b'T') || m_code(6.0) || m_code(2.0) || m_code(30.0) {
+            return Some(true);
+        }
+        let (st, prev) = (self.state, self.before);
+        if st.incremental {
+            return Some(false);
+        }
+        let p_idx = if primary == b'A' {
+            polepatch_nc::modal::A
+        } else {
+            polepatch_nc::modal::B
+        };
+        let (has_p, has_c) = (has(primary), has(b'C'));
+        let linear_moves = st.pos[..3] != prev.pos[..3];
+        if self.is_move {
+            if has_p && has_c {
+                return Some(!linear_moves);
+            }
+            if has_p || has_c {
+                return Some(false);
+            }
+            let xy_moves = st.pos[X] != prev.pos[X] || st.pos[Y] != prev.pos[Y];
+            if !st.tcpm && xy_moves {
+                return Some(false);
+            }
+        } else if st.pos[p_idx] != prev.pos[p_idx] || st.pos[C] != prev.pos[C] {
+            // A non-move that names a rotary axis (a datum shift on it): be safe.
+            return Some(false);
+        }
+        None
+    }
 }
 
 #[cfg(test)]

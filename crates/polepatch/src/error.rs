@@ -52,6 +52,10 @@ pub enum Error {
         /// The record's error (line, column, message).
         record: polepatch_cl::ClError,
     },
+    /// The output could not be written (to the writer given to
+    /// [`crate::stream::patch_nc_to`]).
+    #[error("cannot write the output: {0}")]
+    Output(std::io::Error),
     /// Bad options (a value out of range), named.
     #[error("{0}")]
     Options(String),

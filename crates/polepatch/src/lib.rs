@@ -10,9 +10,10 @@
 //! # let _ = output;
 //! ```
 //!
-//! [`patch_nc`] and [`analyze_nc`] are the entry points for NC programs held in memory;
-//! [`program::load_nc`] + [`patch::patch_loaded`] the same in two steps for callers that
-//! want the parsed program too (the quality suite). CAM plugins that hold CL points rather
+//! [`patch_nc`] and [`analyze_nc`] are the entry points for NC programs held in memory
+//! ([`stream::patch_nc_to`] writes the output to a writer as it goes, parsing in full only
+//! the stretches near the pole); [`program::load_nc`] + [`patch::patch_loaded`] the same
+//! on the whole parsed program, for callers that want it (the quality suite). CAM plugins that hold CL points rather
 //! than a file use the patcher directly on a [`patcher::Path`].
 //!
 //! This crate does no file I/O and depends on no command-line crate: the `polepatch`
@@ -33,6 +34,7 @@ pub mod post;
 pub mod program;
 pub mod reorient;
 pub mod report;
+pub mod stream;
 
 pub use error::Error;
 pub use patch::{FileReport, UntouchedReason, UntouchedRun, ZoneRow, patch_loaded, patch_program};
@@ -105,14 +107,9 @@ pub fn patch_nc(
     if let Some(report) = far::far_from_pole(bytes, machine, opts)? {
         return Ok((bytes.to_vec(), report));
     }
-    let mut lp = program::load_nc(
-        bytes.to_vec(),
-        &opts.name,
-        machine,
-        opts.feed_fallback_mm_min,
-    )?;
-    lp.work_offset_mm = opts.work_offset_mm;
-    Ok(patch_loaded(&lp, machine, &opts.patch))
+    let mut out = Vec::with_capacity(bytes.len());
+    let report = stream::patch_nc_to(bytes, machine, opts, &mut out)?;
+    Ok((out, report))
 }
 
 /// Equation 6 along every run of an NC program held in memory (what `polepatch analyze`

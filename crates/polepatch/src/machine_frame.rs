@@ -57,15 +57,34 @@ pub const NOT_WORSE_REL: f64 = 1e-4;
 /// - else (the frame changed more than once, or by a shift polepatch does not follow —
 ///   `G92`, `TRANS`, … — after the last stated datum): unknown.
 pub fn run_datum(lp: &LoadedProgram, r: usize, given: Option<[f64; 3]>) -> Option<[f64; 3]> {
-    let first = lp.runs[r].run.blocks[0];
+    if let Some(w) = &lp.window {
+        return w.datum_mm[r];
+    }
     let p = &lp.program;
-    let stated = p.datum_shifts.iter().rev().find(|(b, _)| *b <= first);
-    let other = p.frame_changes.iter().rev().find(|&&b| b <= first);
+    datum_at(
+        &p.datum_shifts,
+        &p.frame_changes,
+        lp.runs[r].run.blocks[0],
+        given,
+    )
+}
+
+/// [`run_datum`] for a run whose first block is `first`, from the program's stated datum
+/// shifts and other frame changes (block indices in file order, as in
+/// [`polepatch_nc::Program`]).
+pub fn datum_at(
+    datum_shifts: &[(usize, [f64; 3])],
+    frame_changes: &[usize],
+    first: usize,
+    given: Option<[f64; 3]>,
+) -> Option<[f64; 3]> {
+    let stated = datum_shifts.iter().rev().find(|(b, _)| *b <= first);
+    let other = frame_changes.iter().rev().find(|&&b| b <= first);
     match (stated, other) {
         (Some((sb, d)), o) if o.is_none_or(|ob| ob < sb) => Some(*d),
         _ => {
-            let changes = p.datum_shifts.iter().filter(|(b, _)| *b <= first).count()
-                + p.frame_changes.iter().filter(|&&b| b <= first).count();
+            let changes = datum_shifts.iter().filter(|(b, _)| *b <= first).count()
+                + frame_changes.iter().filter(|&&b| b <= first).count();
             if changes <= 1 { given } else { None }
         }
     }

@@ -209,7 +209,7 @@ impl ZoneRow {
         let pl = lp.primary_letter;
         ZoneRow {
             file: lp.name.clone(),
-            run: run + 1,
+            run: lp.run_number(run),
             lines: [lp.line_of(run, z.first), lp.line_of(run, z.last)],
             kind: zone_kind_name(z.kind),
             min_abs_primary_deg: z.min_abs_primary_deg,
@@ -359,8 +359,14 @@ pub fn patch_program(
         }
         return (Vec::new(), report);
     }
-    let c_style = NumberStyle::of(program, b'C');
-    let p_style = NumberStyle::of(program, lp.primary_letter);
+    let file_style = lp.file_style();
+    let style_of = |l: u8| {
+        file_style
+            .letter(l)
+            .unwrap_or_else(|| NumberStyle::of(program, l))
+    };
+    let c_style = style_of(b'C');
+    let p_style = style_of(lp.primary_letter);
     let opts = PatchOptions {
         c_decimals: c_style.decimals,
         p_decimals: p_style.decimals,
@@ -370,9 +376,7 @@ pub fn patch_program(
             .max(p_style.decimals),
         ..opts.clone()
     };
-    let xyz_decimals = NumberStyle::of(program, b'X')
-        .decimals
-        .max(machine_frame::MIN_XYZ_DECIMALS);
+    let xyz_decimals = style_of(b'X').decimals.max(machine_frame::MIN_XYZ_DECIMALS);
     let mut edits: Vec<Edit> = Vec::new();
     let mut written_c = c_style.decimals;
     let mut written_p = p_style.decimals;
@@ -702,7 +706,7 @@ fn untouched(
     message: String,
 ) -> UntouchedRun {
     UntouchedRun {
-        run: r + 1,
+        run: lp.run_number(r),
         lines: lp.lines_of_run(r),
         reason,
         zones,
@@ -721,7 +725,7 @@ pub fn patch_loaded(
     let bytes = if edits.is_empty() {
         lp.program.bytes.clone()
     } else {
-        polepatch_nc::write(&lp.program, &edits)
+        polepatch_nc::write_styled(&lp.program, &edits, &lp.file_style())
     };
     (bytes, report)
 }

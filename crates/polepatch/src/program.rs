@@ -2,7 +2,7 @@
 
 use crate::error::Error;
 use polepatch_kinematics::Machine;
-use polepatch_nc::{Dialect, Program, Run, modal};
+use polepatch_nc::{Dialect, FileStyle, Program, Run, modal};
 use polepatch_patcher::Path;
 
 /// Why one run cannot be analysed (the others still can).
@@ -49,6 +49,25 @@ pub struct LoadedProgram {
     /// used with a machine's kinematic chain; `None`: from the program
     /// ([`crate::machine_frame::run_datum`]).
     pub work_offset_mm: Option<[f64; 3]>,
+    /// When `program` is a stretch of a larger file ([`crate::stream`]): what the rest
+    /// of the file says about it. `None` for a whole program.
+    pub window: Option<Window>,
+}
+
+/// What a stretch of a file ([`LoadedProgram::window`]) needs from the rest of the file,
+/// per run of the stretch where it is per run.
+#[derive(Debug, Clone)]
+pub struct Window {
+    /// Number (from 0) in the whole file of the stretch's first run.
+    pub first_run: usize,
+    /// The whole file's number style.
+    pub style: FileStyle,
+    /// Whether the run's end pose is free ([`crate::end_pose`]), decided on the blocks
+    /// after it in the whole file.
+    pub end_free: Vec<bool>,
+    /// The run's work offset ([`crate::machine_frame::run_datum`]) from the whole file's
+    /// frame changes.
+    pub datum_mm: Vec<Option<[f64; 3]>>,
 }
 
 impl LoadedProgram {
@@ -62,6 +81,17 @@ impl LoadedProgram {
             self.line_of(r, 0),
             self.line_of(r, self.runs[r].run.len() - 1),
         ]
+    }
+    /// Number of run `r` in the file, from 1 (as reports give it).
+    pub fn run_number(&self, r: usize) -> usize {
+        r + 1 + self.window.as_ref().map_or(0, |w| w.first_run)
+    }
+    /// The file's number style (of the whole file, also for a stretch).
+    pub fn file_style(&self) -> FileStyle {
+        match &self.window {
+            Some(w) => w.style,
+            None => FileStyle::of(&self.program),
+        }
     }
     /// Index of the primary letter in [`polepatch_nc::Modal::pos`].
     pub fn primary_index(&self) -> usize {
@@ -165,6 +195,21 @@ pub(crate) fn primary_mismatch_warning(
     })
 }
 
+/// A run with its path for the patcher: axes X Y Z, the tilting letter at `p_idx`
+/// (`modal::A` or `modal::B`) and C; the run's feed, else `feed_fallback_mm_min`.
+pub(crate) fn run_path(run: Run, p_idx: usize, feed_fallback_mm_min: Option<f64>) -> RunPath {
+    let path = run
+        .feed_mm_min
+        .or(feed_fallback_mm_min)
+        .ok_or(RunProblem::NoFeed)
+        .map(|feed| Path {
+            s_mm: run.s_mm.clone(),
+            axes: run.axes5(p_idx),
+            feed_mm_min: feed,
+        });
+    RunPath { run, path }
+}
+
 /// Group a parsed program into runs and build each run's path for `machine`.
 /// `feed_fallback_mm_min` is used for runs with no F in force.
 pub fn load(
@@ -196,18 +241,7 @@ pub fn load(
     }
     let runs = runs
         .into_iter()
-        .map(|run| {
-            let path = run
-                .feed_mm_min
-                .or(feed_fallback_mm_min)
-                .ok_or(RunProblem::NoFeed)
-                .map(|feed| Path {
-                    s_mm: run.s_mm.clone(),
-                    axes: run.axes5(p_idx),
-                    feed_mm_min: feed,
-                });
-            RunPath { run, path }
-        })
+        .map(|run| run_path(run, p_idx, feed_fallback_mm_min))
         .collect();
     Ok(LoadedProgram {
         name: name.to_string(),
@@ -216,5 +250,6 @@ pub fn load(
         runs,
         warnings,
         work_offset_mm: None,
+        window: None,
     })
 }

@@ -233,7 +233,7 @@ pub fn analyze_program(
         .map(|(r, rp)| {
             let n = rp.run.len();
             let mut rep = RunReport {
-                run: r + 1,
+                run: lp.run_number(r),
                 lines: [lp.line_of(r, 0), lp.line_of(r, n - 1)],
                 points: n,
                 length_mm: rp.run.length_mm(),

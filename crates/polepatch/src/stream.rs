@@ -1,0 +1,439 @@
+//! Patching a program a stretch at a time: memory is the input plus the runs near the
+//! pole, not the whole parsed program.
+//!
+//! A parsed program costs about ten times its bytes (words, blocks, modal states, run
+//! positions). Only runs that come within the cone can hold a zone, and a patch changes
+//! words of its own run only; so [`patch_nc_to`] reads the program twice as a stream
+//! ([`polepatch_nc::scan_blocks`]) and parses in full only the stretches that hold such
+//! runs:
+//!
+//! 1. **Survey.** The runs ([`polepatch_nc::RunBuilder`], the same walk as the whole-program
+//!    path), each with its first and last block, whether a point is within the cone for
+//!    either tilting letter, whether it has a feed; which letters the runs use (the
+//!    tilting letter in use, [`polepatch_nc::primary_in_use`]); the file's number style
+//!    ([`polepatch_nc::StyleEvidence`]); the frame changes (for the work offset,
+//!    [`crate::machine_frame::datum_at`]); and for every run whether its end pose is free
+//!    ([`crate::end_pose::After::verdict`], decided by the first block after the run that
+//!    decides, for both tilting letters since the one in use is known only at the end).
+//! 2. **Stretches.** A run near the pole (or without a feed, which the report lists) is
+//!    a stretch from its first block (point 0) to its last; runs that share a block
+//!    (a feed change splits a path into two runs with a common point) are one stretch.
+//! 3. **Patch.** The second read builds each stretch as a program of its own
+//!    ([`polepatch_nc::ProgramBuilder`]: the file's lines, states and bytes), with the
+//!    runs exactly as the first read found them, and hands it to
+//!    [`crate::patch::patch_program`] with what the rest of the file says
+//!    ([`crate::program::Window`]: run numbers, number style, end poses, work offsets).
+//!    Bytes between stretches are copied; each stretch is written as
+//!    [`polepatch_nc::write_styled`] renders it.
+//!
+//! The output and the report are those of the whole-program path
+//! ([`crate::program::load_nc`] + [`crate::patch::patch_loaded`]) — tested on every
+//! fixture, both machines, and programs built to cross stretch boundaries. Programs the
+//! whole-program path rejects (no runs, no rotary words) are handed to it for its error.
+//!
+//! Memory: the input, the output writer's buffer, one record per run (first and last
+//! block, flags: ~48 B), and the stretches in hand (usually one). A single run near the
+//! pole is parsed whole, so one giant run costs ~10× its own bytes.
+
+use crate::end_pose::After;
+use crate::error::Error;
+use crate::patch::{FileReport, patch_loaded, patch_program};
+use crate::program::{LoadedProgram, RunPath, Window, load_nc, primary_mismatch_warning, run_path};
+use polepatch_kinematics::Machine;
+use polepatch_nc::modal::{A, B, C};
+use polepatch_nc::{
+    Dialect, FileStyle, Modal, ProgramBuilder, Run, RunBuilder, Scanned, StyleEvidence, scan_blocks,
+};
+use std::collections::VecDeque;
+use std::io::Write;
+use std::ops::ControlFlow;
+
+/// Index of a tilting letter in the per-letter arrays: 0 for A, 1 for B.
+const LETTERS: [u8; 2] = [b'A', b'B'];
+
+/// What the survey keeps of one run.
+#[derive(Debug, Clone)]
+struct RunRec {
+    first_block: usize,
+    last_block: usize,
+    /// Some point is within the cone if A (index 0) or B (index 1) is the tilting axis
+    /// (a value never programmed reads as 0, as [`Run::axes5`] reads it).
+    near: [bool; 2],
+    /// No feed in force and no fallback.
+    feedless: bool,
+    /// End pose free, per tilting letter; `None` until a later block decides.
+    end_free: [Option<bool>; 2],
+    /// Work offset for this run ([`crate::machine_frame::datum_at`]).
+    datum_mm: Option<[f64; 3]>,
+}
+
+/// The first read's findings.
+struct Survey {
+    dialect: Dialect,
+    runs: Vec<RunRec>,
+    /// Some run point has a value for X Y Z A B C.
+    uses: [bool; 6],
+    style: FileStyle,
+}
+
+/// The first read in progress.
+struct Surveying {
+    cone_deg: f64,
+    fallback: Option<f64>,
+    work_offset_mm: Option<[f64; 3]>,
+    runs: Vec<RunRec>,
+    uses: [bool; 6],
+    datum_shifts: Vec<(usize, [f64; 3])>,
+    frame_changes: Vec<usize>,
+    /// Runs given out whose end pose is not decided yet, per letter.
+    pending: [Vec<usize>; 2],
+    /// The first deciding block's verdict after the open run's last block, per letter.
+    first_after: [Option<bool>; 2],
+}
+
+impl Surveying {
+    /// Keep what matters of a run the run walk gives out.
+    fn take(&mut self, run: Run) {
+        let mut near = [false; 2];
+        for p in &run.pos {
+            for (u, v) in self.uses.iter_mut().zip(p) {
+                *u |= v.is_some();
+            }
+            for (l, idx) in [A, B].into_iter().enumerate() {
+                near[l] |= p[idx].unwrap_or(0.0).abs() <= self.cone_deg;
+            }
+        }
+        let first_block = run.blocks[0];
+        let r = self.runs.len();
+        for (l, decided) in self.first_after.iter().enumerate() {
+            if decided.is_none() {
+                self.pending[l].push(r);
+            }
+        }
+        self.runs.push(RunRec {
+            first_block,
+            last_block: *run.blocks.last().unwrap_or(&first_block),
+            near,
+            feedless: run.feed_mm_min.or(self.fallback).is_none(),
+            end_free: self.first_after,
+            datum_mm: crate::machine_frame::datum_at(
+                &self.datum_shifts,
+                &self.frame_changes,
+                first_block,
+                self.work_offset_mm,
+            ),
+        });
+    }
+
+    /// A block's verdict on the end pose of the runs before it, per letter.
+    fn decide(&mut self, verdict: [Option<bool>; 2]) {
+        for (l, v) in verdict.into_iter().enumerate() {
+            if let Some(free) = v {
+                for r in self.pending[l].drain(..) {
+                    self.runs[r].end_free[l] = Some(free);
+                }
+                self.first_after[l].get_or_insert(free);
+            }
+        }
+    }
+}
+
+/// The first read (module docs, step 1).
+fn survey(bytes: &[u8], opts: &crate::PatchOptions) -> Result<Survey, Error> {
+    let mut sv = Surveying {
+        cone_deg: opts.patch.cone_deg,
+        fallback: opts.feed_fallback_mm_min,
+        work_offset_mm: opts.work_offset_mm,
+        runs: Vec::new(),
+        uses: [false; 6],
+        datum_shifts: Vec::new(),
+        frame_changes: Vec::new(),
+        pending: [Vec::new(), Vec::new()],
+        first_after: [None, None],
+    };
+    let mut style = StyleEvidence::default();
+    let mut builder = RunBuilder::default();
+    let mut prev = Modal::default();
+    let mut i = 0usize;
+    let dialect = scan_blocks(bytes, Dialect::Auto, |s: Scanned<'_>| {
+        style.add_block(bytes, s.words);
+        if let Some(d) = s.stated_datum {
+            sv.datum_shifts.push((i, d));
+        }
+        if s.frame_changed {
+            sv.frame_changes.push(i);
+        }
+        let after = After {
+            words: s.words,
+            is_move: s.block.is_move,
+            state: s.state,
+            before: &prev,
+        };
+        sv.decide(LETTERS.map(|l| after.verdict(l)));
+        builder.push(i, s.block, s.state, &mut |run| sv.take(run));
+        // Deciding blocks count from the open run's last block on: when this block
+        // extended it, or no run is open, the verdicts seen so far are spent.
+        if builder.open_run_last_block().is_none_or(|last| last == i) {
+            sv.first_after = [None, None];
+        }
+        prev = *s.state;
+        i += 1;
+        ControlFlow::Continue(())
+    })
+    .map_err(|e| Error::Parse(e.with_path(&opts.name)))?;
+    builder.finish(&mut |run| sv.take(run));
+    // Nothing after them decides: the end of the file leaves the pose free.
+    for rec in &mut sv.runs {
+        for f in &mut rec.end_free {
+            f.get_or_insert(true);
+        }
+    }
+    Ok(Survey {
+        dialect,
+        runs: sv.runs,
+        uses: sv.uses,
+        style: style.style(),
+    })
+}
+
+/// A stretch to parse in full: blocks `first_block..=last_block`, runs `runs` (numbers in
+/// the file, from 0).
+#[derive(Debug, Clone)]
+struct Stretch {
+    first_block: usize,
+    last_block: usize,
+    runs: std::ops::Range<usize>,
+}
+
+/// The stretches (module docs, step 2) for the tilting letter `l` (0 A, 1 B).
+fn stretches(runs: &[RunRec], l: usize) -> Vec<Stretch> {
+    let mut out: Vec<Stretch> = Vec::new();
+    for (r, rec) in runs.iter().enumerate() {
+        if !(rec.near[l] || rec.feedless) {
+            continue;
+        }
+        match out.last_mut() {
+            Some(s) if s.runs.end == r && rec.first_block <= s.last_block => {
+                s.last_block = s.last_block.max(rec.last_block);
+                s.runs.end = r + 1;
+            }
+            _ => out.push(Stretch {
+                first_block: rec.first_block,
+                last_block: rec.last_block,
+                runs: r..r + 1,
+            }),
+        }
+    }
+    out
+}
+
+/// A stretch being read in the second pass.
+struct InHand {
+    stretch: Stretch,
+    program: ProgramBuilder,
+    /// Byte just past the stretch's last line (its line ending included).
+    end_byte: Option<usize>,
+    runs: Vec<Run>,
+}
+
+/// The byte just past the line ending after `at` (the end of `bytes` if none).
+fn line_end_after(bytes: &[u8], at: usize) -> usize {
+    bytes[at..]
+        .iter()
+        .position(|&b| b == b'\n')
+        .map_or(bytes.len(), |k| at + k + 1)
+}
+
+/// Patch an NC program held in memory, writing the output to `out` as it goes (module
+/// docs): the same output and report as [`crate::patch_nc`], with memory for the input
+/// and the stretches near the pole only. On an error nothing more is written to `out`;
+/// what was written before it must be discarded by the caller.
+pub fn patch_nc_to(
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &crate::PatchOptions,
+    out: &mut dyn Write,
+) -> Result<FileReport, Error> {
+    let sv = survey(bytes, opts)?;
+    let own = if machine.primary_letter() == 'A' {
+        A
+    } else {
+        B
+    };
+    let other = if own == A { B } else { A };
+    let p_idx = if !sv.uses[own] && sv.uses[other] {
+        other
+    } else {
+        own
+    };
+    if sv.runs.is_empty() || (!sv.uses[p_idx] && !sv.uses[C]) {
+        // The whole-program path names what is wrong (no runs and why, no rotary words).
+        let mut lp = load_nc(
+            bytes.to_vec(),
+            &opts.name,
+            machine,
+            opts.feed_fallback_mm_min,
+        )?;
+        lp.work_offset_mm = opts.work_offset_mm;
+        let (output, report) = patch_loaded(&lp, machine, &opts.patch);
+        out.write_all(&output).map_err(Error::Output)?;
+        return Ok(report);
+    }
+    let l = usize::from(p_idx == B);
+    let mut report = FileReport::unchanged(
+        &opts.name,
+        machine,
+        primary_mismatch_warning(&opts.name, machine, p_idx)
+            .into_iter()
+            .collect(),
+    );
+    let todo = stretches(&sv.runs, l);
+    if todo.is_empty() {
+        out.write_all(bytes).map_err(Error::Output)?;
+        return Ok(report);
+    }
+    let mut next = 0usize; // next stretch to start
+    let mut building: Option<InHand> = None;
+    let mut done: VecDeque<InHand> = VecDeque::new();
+    let mut copied_to = 0usize;
+    let mut failure: Option<Error> = None;
+    let mut builder = RunBuilder::default();
+    let mut run_no = 0usize;
+    let mut prev = Modal::default();
+    let mut i = 0usize;
+    let mut finish = |hand: InHand, copied_to: &mut usize, report: &mut FileReport| {
+        let (output, part, replaced) = patch_stretch(bytes, hand, &sv, l, machine, opts);
+        out.write_all(&bytes[*copied_to..replaced.start])?;
+        out.write_all(&output)?;
+        *copied_to = replaced.end;
+        merge(report, part);
+        Ok::<(), std::io::Error>(())
+    };
+    let give_run = |run: Run,
+                    run_no: &mut usize,
+                    building: &mut Option<InHand>,
+                    done: &mut VecDeque<InHand>| {
+        let r = *run_no;
+        *run_no += 1;
+        let hand = done
+            .iter_mut()
+            .chain(building.iter_mut())
+            .find(|h| h.stretch.runs.contains(&r));
+        if let Some(h) = hand {
+            h.runs.push(run);
+        }
+    };
+    scan_blocks(bytes, sv.dialect, |s: Scanned<'_>| {
+        if building.is_none()
+            && let Some(st) = todo.get(next)
+            && st.first_block == i
+        {
+            building = Some(InHand {
+                stretch: st.clone(),
+                program: ProgramBuilder::new(s.block.span().start, &prev),
+                end_byte: None,
+                runs: Vec::new(),
+            });
+            next += 1;
+        }
+        if let Some(h) = &mut building {
+            h.program.push(&s);
+            if h.stretch.last_block == i {
+                h.end_byte = Some(line_end_after(bytes, s.block.span().end));
+                done.extend(building.take());
+            }
+        }
+        builder.push(i, s.block, s.state, &mut |run| {
+            give_run(run, &mut run_no, &mut building, &mut done)
+        });
+        while done
+            .front()
+            .is_some_and(|h| h.runs.len() == h.stretch.runs.len())
+        {
+            if let Some(h) = done.pop_front()
+                && let Err(e) = finish(h, &mut copied_to, &mut report)
+            {
+                failure = Some(Error::Output(e));
+                return ControlFlow::Break(());
+            }
+        }
+        prev = *s.state;
+        i += 1;
+        ControlFlow::Continue(())
+    })
+    .map_err(|e| Error::Parse(e.with_path(&opts.name)))?;
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    builder.finish(&mut |run| give_run(run, &mut run_no, &mut building, &mut done));
+    while let Some(h) = done.pop_front() {
+        finish(h, &mut copied_to, &mut report).map_err(Error::Output)?;
+    }
+    out.write_all(&bytes[copied_to..]).map_err(Error::Output)?;
+    Ok(report)
+}
+
+/// Patch one stretch: its output bytes, its part of the report, and the bytes of the file
+/// it replaces.
+fn patch_stretch(
+    bytes: &[u8],
+    hand: InHand,
+    sv: &Survey,
+    l: usize,
+    machine: &Machine,
+    opts: &crate::PatchOptions,
+) -> (Vec<u8>, FileReport, std::ops::Range<usize>) {
+    let base = hand.program.base();
+    let end = hand.end_byte.unwrap_or(bytes.len());
+    let program = hand.program.finish(bytes[base..end].to_vec(), sv.dialect);
+    let first = hand.stretch.first_block;
+    let p_idx = if l == 0 { A } else { B };
+    let runs: Vec<RunPath> = hand
+        .runs
+        .into_iter()
+        .map(|mut run| {
+            for b in &mut run.blocks {
+                *b -= first;
+            }
+            run_path(run, p_idx, opts.feed_fallback_mm_min)
+        })
+        .collect();
+    let recs = &sv.runs[hand.stretch.runs.clone()];
+    let lp = LoadedProgram {
+        name: opts.name.clone(),
+        program,
+        primary_letter: LETTERS[l],
+        runs,
+        warnings: Vec::new(),
+        work_offset_mm: opts.work_offset_mm,
+        window: Some(Window {
+            first_run: hand.stretch.runs.start,
+            style: sv.style,
+            end_free: recs.iter().map(|r| r.end_free[l].unwrap_or(true)).collect(),
+            datum_mm: recs.iter().map(|r| r.datum_mm).collect(),
+        }),
+    };
+    let (edits, part) = patch_program(&lp, machine, &opts.patch);
+    let output = if edits.is_empty() {
+        lp.program.bytes
+    } else {
+        polepatch_nc::write_styled(&lp.program, &edits, &sv.style)
+    };
+    (output, part, base..end)
+}
+
+/// Add a stretch's report to the file's.
+fn merge(report: &mut FileReport, part: FileReport) {
+    report.words_changed += part.words_changed;
+    if part.file_c_decimals.is_some() {
+        report.file_c_decimals = part.file_c_decimals;
+        report.file_primary_decimals = part.file_primary_decimals;
+    }
+    report.written_c_decimals = report.written_c_decimals.max(part.written_c_decimals);
+    report.written_primary_decimals = report
+        .written_primary_decimals
+        .max(part.written_primary_decimals);
+    report.untouched_runs.extend(part.untouched_runs);
+    report.warnings.extend(part.warnings);
+    report.zones.extend(part.zones);
+}

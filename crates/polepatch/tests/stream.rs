@@ -1,0 +1,210 @@
+//! The stretch-at-a-time pipeline (`stream::patch_nc_to`, behind `patch_nc`) gives the
+//! whole-program path's output and report (`load_nc` + `patch_loaded`): on fixtures, both
+//! machines, and programs built so that runs, stretches, feed changes, end poses, frame
+//! changes and feedless runs meet at stretch boundaries.
+
+use polepatch::kinematics::Machine;
+use polepatch::program::load_nc;
+use polepatch::stream::patch_nc_to;
+use polepatch::{FileReport, PatchOptions, patch_loaded};
+use std::path::PathBuf;
+
+/// The report as text with the solver's timing (which differs run to run) zeroed.
+fn comparable(r: &FileReport) -> String {
+    let mut r = r.clone();
+    for z in &mut r.zones {
+        z.solve_time_ms = 0.0;
+    }
+    format!("{r:?}")
+}
+
+/// Both paths on `bytes`; panics with `what` where they differ. Returns the report.
+fn same(bytes: &[u8], machine: &Machine, opts: &PatchOptions, what: &str) -> FileReport {
+    let full = load_nc(
+        bytes.to_vec(),
+        &opts.name,
+        machine,
+        opts.feed_fallback_mm_min,
+    )
+    .map(|mut lp| {
+        lp.work_offset_mm = opts.work_offset_mm;
+        patch_loaded(&lp, machine, &opts.patch)
+    });
+    let mut out = Vec::new();
+    let streamed = patch_nc_to(bytes, machine, opts, &mut out);
+    match (full, streamed) {
+        (Ok((full_out, full_rep)), Ok(rep)) => {
+            assert!(full_out == out, "{what}: outputs differ");
+            assert_eq!(
+                comparable(&rep),
+                comparable(&full_rep),
+                "{what}: reports differ"
+            );
+            rep
+        }
+        (Err(a), Err(b)) => {
+            assert_eq!(a.to_string(), b.to_string(), "{what}");
+            FileReport::unchanged(&opts.name, machine, Vec::new())
+        }
+        (a, b) => panic!("{what}: {:?} vs {:?}", a.err(), b.err()),
+    }
+}
+
+fn fixture(rel: &str) -> Vec<u8> {
+    std::fs::read(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../../fixtures")
+            .join(rel),
+    )
+    .unwrap()
+}
+
+fn machines() -> [Machine; 2] {
+    ["mikron-ucp710", "mikron-hsm600"].map(|m| Machine::builtin(m).unwrap())
+}
+
+/// The C17 and dialect fixtures, and a generated one of each dialect, axis pair and kind
+/// at two distances from the pole.
+#[test]
+fn fixtures_give_the_whole_program_answer() {
+    let mut files: Vec<String> = [
+        "c17/SING.I",
+        "c17/NON_SING.I",
+        "dialects/fanuc.nc",
+        "dialects/heidenhain_latin1.I",
+        "dialects/sinumerik.mpf",
+    ]
+    .map(String::from)
+    .to_vec();
+    for (dialect, ext) in [("heidenhain", "I"), ("sinumerik", "mpf"), ("fanuc", "nc")] {
+        for pair in ["ac", "bc"] {
+            for kind in ["flip", "swing"] {
+                for d in ["0.1", "2"] {
+                    files.push(format!("generated/{dialect}-{pair}-{kind}-d{d}.{ext}"));
+                }
+            }
+        }
+    }
+    let mut zones = 0;
+    for f in &files {
+        let bytes = fixture(f);
+        for machine in machines() {
+            for cone_deg in [0.05, 5.0] {
+                let mut opts = PatchOptions {
+                    name: f.clone(),
+                    ..PatchOptions::default()
+                };
+                opts.patch.cone_deg = cone_deg;
+                let rep = same(
+                    &bytes,
+                    &machine,
+                    &opts,
+                    &format!("{f} {} {cone_deg}", machine.name),
+                );
+                zones += rep.zones.len();
+            }
+        }
+    }
+    assert!(zones >= 40, "{zones} zones");
+}
+
+/// Several programs one after the other in one file (stretches with far runs between
+/// them, run numbers counted across), C17's SING with its feed changed halfway (two runs
+/// sharing a point, one stretch), a run without feed far from the pole (reported), a
+/// tool change right after a run (end pose free) and a rotary move with a linear one
+/// right after another (end pose fixed).
+#[test]
+fn programs_built_across_stretch_boundaries() {
+    let sing = String::from_utf8(fixture("c17/SING.I")).unwrap();
+    let non = String::from_utf8(fixture("c17/NON_SING.I")).unwrap();
+    let body = |s: &str| -> String {
+        s.lines()
+            .filter(|l| !l.starts_with('%') && !l.contains("M30") && !l.contains("M00"))
+            .map(|l| format!("{l}\n"))
+            .collect()
+    };
+    // SING with a feed change in the middle of its zone.
+    let split: String = body(&sing)
+        .lines()
+        .map(|l| {
+            if l.starts_with("N400 ") {
+                format!("{} F2500 *\n", l.trim_end_matches('*').trim_end())
+            } else {
+                format!("{l}\n")
+            }
+        })
+        .collect();
+    assert_ne!(split, body(&sing), "the feed change went in");
+    let far_feedless = "N1 G01 X+0 Y+0 Z+50 A+40 C+0 *\nN2 X+10 A+41 C+5 *\n";
+    let fixed_after = "N3 G01 X+5 Y+5 Z+20 A+10 C+10 *\n";
+    // The feedless run comes first, before any F.
+    let text = format!(
+        "%ALL G71 *\n{}{}{}T7 M6 *\n{}{}{}N5 M129 *\nN999 M30 *\n",
+        far_feedless,
+        body(&sing),
+        body(&non),
+        split,
+        fixed_after,
+        body(&sing),
+    );
+    let bytes = text.into_bytes();
+    for machine in machines() {
+        let opts = PatchOptions {
+            name: "all.I".into(),
+            ..PatchOptions::default()
+        };
+        let rep = same(&bytes, &machine, &opts, &machine.name);
+        assert!(
+            rep.zones.len() >= 3,
+            "{}: {} zones",
+            machine.name,
+            rep.zones.len()
+        );
+        assert!(rep.zones.iter().map(|z| z.run).max() > Some(3));
+        assert_eq!(rep.untouched_runs.len(), 1, "the feedless run");
+        assert_eq!(rep.untouched_runs[0].run, 1);
+        // With a fallback feed the last run has one.
+        let opts = PatchOptions {
+            feed_fallback_mm_min: Some(1500.0),
+            ..opts
+        };
+        same(
+            &bytes,
+            &machine,
+            &opts,
+            &format!("{} fallback", machine.name),
+        );
+    }
+}
+
+/// With a kinematic chain: SING without M128 (machine coordinates; its stated datum), the
+/// same after a G92 (work offset unknown), and with `--work-offset` on a program that
+/// names nothing.
+#[test]
+fn chain_runs_get_their_work_offset_from_the_whole_file() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let path = root.join("crates/kinematics/machines/mikron-ucp710-example-chain.toml");
+    let machine = Machine::load(path.to_str().unwrap()).unwrap();
+    let sing = String::from_utf8(fixture("c17/SING.I")).unwrap();
+    let no_tcpm = sing.replace("N65 M128 *\n", "");
+    let g92 = no_tcpm.replace("N65 ", "N64 G92 X+0 *\nN65 ");
+    let tcpm_after_g92 = sing.replace("N65 M128 *\n", "N64 G92 X+0 *\nN65 M128 *\n");
+    for (what, text, offset) in [
+        ("SING", sing.clone(), None),
+        ("no M128", no_tcpm.clone(), None),
+        ("no M128, G92", g92, Some([1.0, 2.0, 3.0])),
+        ("M128 after G92", tcpm_after_g92, Some([1.0, 2.0, 3.0])),
+        (
+            "no M128, offset",
+            no_tcpm.replace("N60 G54", "N60 G55"),
+            Some([-30.0, -7.0, 38.0]),
+        ),
+    ] {
+        let opts = PatchOptions {
+            name: what.into(),
+            work_offset_mm: offset,
+            ..PatchOptions::default()
+        };
+        same(text.as_bytes(), &machine, &opts, what);
+    }
+}
