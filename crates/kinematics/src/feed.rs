@@ -62,10 +62,16 @@ pub fn axis_feed_bound(limits: &AxisLimits, d: [f64; 3]) -> AxisBound {
         feed_mm_s = a;
         kind = LimitKind::Acceleration;
     }
-    let j = term(limits.j, d[2]).cbrt();
-    if j < feed_mm_s {
-        feed_mm_s = j;
-        kind = LimitKind::Jerk;
+    // The cube root (a slow libm call, the bulk of an analysis) only where it can bind:
+    // cbrt(t) < f implies t < f³ (the margin covers the rounding of f³), so the result
+    // is the same as always taking it.
+    let tj = term(limits.j, d[2]);
+    if tj < feed_mm_s * feed_mm_s * feed_mm_s * (1.0 + 1e-9) {
+        let j = tj.cbrt();
+        if j < feed_mm_s {
+            feed_mm_s = j;
+            kind = LimitKind::Jerk;
+        }
     }
     AxisBound { feed_mm_s, kind }
 }
@@ -127,6 +133,56 @@ mod tests {
         a: 400.0,
         j: 8000.0,
     };
+
+    /// Taking the cube root only where it can bind gives the bound of always taking it,
+    /// bit for bit: on a sweep of derivatives over 24 decades (each term binding in turn,
+    /// and ties between the jerk and the other terms), zero, infinite and NaN ones.
+    #[test]
+    fn skipping_the_cube_root_changes_nothing() {
+        let reference = |l: &AxisLimits, d: [f64; 3]| {
+            let mut f = term(l.v, d[0]);
+            let mut kind = LimitKind::Velocity;
+            let a = term(l.a, d[1]).sqrt();
+            if a < f {
+                f = a;
+                kind = LimitKind::Acceleration;
+            }
+            let j = term(l.j, d[2]).cbrt();
+            if j < f {
+                f = j;
+                kind = LimitKind::Jerk;
+            }
+            AxisBound { feed_mm_s: f, kind }
+        };
+        let mut values = vec![0.0, -0.0, f64::INFINITY, f64::NAN, f64::MIN_POSITIVE];
+        let mut x = 1e-12;
+        while x < 1e12 {
+            values.extend([x, -x, x * (1.0 + 1e-15)]);
+            x *= 1.37;
+        }
+        // Exact ties: q_sss such that cbrt(J/q_sss) equals the velocity bound 100/q_s.
+        for qs in [1.0, 3.0, 7.5] {
+            let f: f64 = LIM.v / qs;
+            values.push(LIM.j / (f * f * f));
+        }
+        let mut n = 0;
+        for (k, &a) in values.iter().enumerate() {
+            for &b in values.iter().skip(k % 7).step_by(7) {
+                for &c in &values {
+                    let d = [a, b, c];
+                    let got = axis_feed_bound(&LIM, d);
+                    let want = reference(&LIM, d);
+                    assert!(
+                        got.kind == want.kind
+                            && (got.feed_mm_s.to_bits() == want.feed_mm_s.to_bits()),
+                        "{d:?}: {got:?} vs {want:?}"
+                    );
+                    n += 1;
+                }
+            }
+        }
+        assert!(n > 100_000, "{n}");
+    }
 
     #[test]
     fn velocity_binds() {

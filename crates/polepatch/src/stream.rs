@@ -31,9 +31,12 @@
 //! fixture, both machines, and programs built to cross stretch boundaries. Programs the
 //! whole-program path rejects (no runs, no rotary words) are handed to it for its error.
 //!
+//! Stretches are patched on all cores in batches of about 1/16 of the file (256 KiB to
+//! 4 MiB), then written in file order.
+//!
 //! Memory: the input, the output writer's buffer, one record per run (first and last
-//! block, flags: ~48 B), and the stretches in hand (usually one). A single run near the
-//! pole is parsed whole, so one giant run costs ~10× its own bytes.
+//! block, flags: ~64 B), and the batch of stretches in hand. A single run near the pole
+//! is parsed whole, so one giant run costs ~10× its own bytes.
 
 use crate::end_pose::After;
 use crate::error::Error;
@@ -47,6 +50,14 @@ use polepatch_nc::{
 use std::collections::VecDeque;
 use std::io::Write;
 use std::ops::ControlFlow;
+
+/// Stretches are patched in batches of about this part of the file's bytes (so that the
+/// batch's parsed programs, ~10× their bytes, stay within the file's size) …
+const BATCH_FRACTION: usize = 64;
+/// … but at least this many bytes (small files: one batch) …
+const BATCH_MIN_BYTES: usize = 64 << 10;
+/// … and at most this many.
+const BATCH_MAX_BYTES: usize = 256 << 10;
 
 /// Index of a tilting letter in the per-letter arrays: 0 for A, 1 for B.
 const LETTERS: [u8; 2] = [b'A', b'B'];
@@ -301,12 +312,22 @@ pub fn patch_nc_to(
     let mut run_no = 0usize;
     let mut prev = Modal::default();
     let mut i = 0usize;
-    let mut finish = |hand: InHand, copied_to: &mut usize, report: &mut FileReport| {
-        let (output, part, replaced) = patch_stretch(bytes, hand, &sv, l, machine, opts);
-        out.write_all(&bytes[*copied_to..replaced.start])?;
-        out.write_all(&output)?;
-        *copied_to = replaced.end;
-        merge(report, part);
+    // Complete stretches are patched in batches on all cores, then written in file order.
+    let mut ready: Vec<InHand> = Vec::new();
+    let mut ready_bytes = 0usize;
+    let batch_bytes = (bytes.len() / BATCH_FRACTION).clamp(BATCH_MIN_BYTES, BATCH_MAX_BYTES);
+    let mut flush = |ready: &mut Vec<InHand>, copied_to: &mut usize, report: &mut FileReport| {
+        use rayon::prelude::*;
+        let parts: Vec<_> = std::mem::take(ready)
+            .into_par_iter()
+            .map(|hand| patch_stretch(bytes, hand, &sv, l, machine, opts))
+            .collect();
+        for (output, part, replaced) in parts {
+            out.write_all(&bytes[*copied_to..replaced.start])?;
+            out.write_all(&output)?;
+            *copied_to = replaced.end;
+            merge(report, part);
+        }
         Ok::<(), std::io::Error>(())
     };
     let give_run = |run: Run,
@@ -350,9 +371,14 @@ pub fn patch_nc_to(
             .front()
             .is_some_and(|h| h.runs.len() == h.stretch.runs.len())
         {
-            if let Some(h) = done.pop_front()
-                && let Err(e) = finish(h, &mut copied_to, &mut report)
-            {
+            if let Some(h) = done.pop_front() {
+                ready_bytes += h.end_byte.unwrap_or(bytes.len()) - h.program.base();
+                ready.push(h);
+            }
+        }
+        if ready_bytes >= batch_bytes {
+            ready_bytes = 0;
+            if let Err(e) = flush(&mut ready, &mut copied_to, &mut report) {
                 failure = Some(Error::Output(e));
                 return ControlFlow::Break(());
             }
@@ -366,9 +392,8 @@ pub fn patch_nc_to(
         return Err(e);
     }
     builder.finish(&mut |run| give_run(run, &mut run_no, &mut building, &mut done));
-    while let Some(h) = done.pop_front() {
-        finish(h, &mut copied_to, &mut report).map_err(Error::Output)?;
-    }
+    ready.extend(done);
+    flush(&mut ready, &mut copied_to, &mut report).map_err(Error::Output)?;
     out.write_all(&bytes[copied_to..]).map_err(Error::Output)?;
     Ok(report)
 }
