@@ -454,7 +454,7 @@ impl ProgramBuilder {
 /// Size of the windows [`scan`] lexes on several threads at a time, bytes: large enough
 /// that starting threads costs nothing, small enough that a window's words stay a small
 /// part of any program worth doing this for.
-const SCAN_WINDOW_BYTES: usize = 1 << 20;
+const SCAN_WINDOW_BYTES: usize = 256 << 10;
 
 /// One part of a window, lexed: per line (its span, what it says, its words' range in
 /// `words`), up to the first error, which is kept with its line counted within the part.

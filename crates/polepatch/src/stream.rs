@@ -31,8 +31,8 @@
 //! fixture, both machines, and programs built to cross stretch boundaries. Programs the
 //! whole-program path rejects (no runs, no rotary words) are handed to it for its error.
 //!
-//! Stretches are patched on all cores in batches of about 1/16 of the file (256 KiB to
-//! 4 MiB), then written in file order.
+//! Stretches are patched on all cores in batches of about 1/256 of the file (16 KiB to
+//! 256 KiB of it), then written in file order.
 //!
 //! Memory: the input, the output writer's buffer, one record per run (first and last
 //! block, flags: ~64 B), and the batch of stretches in hand. A single run near the pole
@@ -52,10 +52,10 @@ use std::io::Write;
 use std::ops::ControlFlow;
 
 /// Stretches are patched in batches of about this part of the file's bytes (so that the
-/// batch's parsed programs, ~10× their bytes, stay within the file's size) …
-const BATCH_FRACTION: usize = 64;
+/// batch's parsed programs, ~10× their bytes, stay a small part of the file's size) …
+const BATCH_FRACTION: usize = 256;
 /// … but at least this many bytes (small files: one batch) …
-const BATCH_MIN_BYTES: usize = 64 << 10;
+const BATCH_MIN_BYTES: usize = 16 << 10;
 /// … and at most this many.
 const BATCH_MAX_BYTES: usize = 256 << 10;
 
