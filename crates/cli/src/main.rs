@@ -4,8 +4,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use polepatch::kinematics::{Axis, Machine};
 use polepatch::patcher::AnalysisOptions;
-use polepatch::program::load_nc;
-use polepatch::report::{AnalyzeReport, analyze_program, axis_letter};
+use polepatch::report::{AnalyzeReport, axis_letter};
 use polepatch_cli::files;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -186,21 +185,24 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
     check_positive("--cone", Some(args.cone))?;
     let machine = machine(&args.machine)?;
     let name = args.file.display().to_string();
-    let mut lp = load_nc(files::read(&args.file)?, &name, &machine, args.feed)?;
-    lp.work_offset_mm = args.work_offset;
-    let opts = AnalysisOptions {
-        cone_deg: args.cone,
-        tcy_s: args.tcy_ms.map(|ms| ms / 1000.0),
-        keep_samples: false,
+    let opts = polepatch::AnalyzeOptions {
+        analysis: AnalysisOptions {
+            cone_deg: args.cone,
+            tcy_s: args.tcy_ms.map(|ms| ms / 1000.0),
+            keep_samples: false,
+        },
+        feed_fallback_mm_min: args.feed,
+        name: name.clone(),
+        work_offset_mm: args.work_offset,
     };
-    let report = analyze_program(&lp, &machine, &opts);
+    let report = polepatch::analyze_nc(&files::read(&args.file)?, &machine, &opts)?;
     if args.json {
         println!(
             "{}",
             serde_json::to_string_pretty(&report).context("writing JSON")?
         );
     } else {
-        print_analysis(&report, lp.primary_letter);
+        print_analysis(&report, report.primary.as_bytes()[0]);
     }
     for w in &report.warnings {
         eprintln!("polepatch: warning: {w}");

@@ -119,12 +119,5 @@ pub fn analyze_nc(
     machine: &Machine,
     opts: &AnalyzeOptions,
 ) -> Result<AnalyzeReport, Error> {
-    let mut lp = program::load_nc(
-        bytes.to_vec(),
-        &opts.name,
-        machine,
-        opts.feed_fallback_mm_min,
-    )?;
-    lp.work_offset_mm = opts.work_offset_mm;
-    Ok(report::analyze_program(&lp, machine, &opts.analysis))
+    stream::analyze_nc_stretches(bytes, machine, opts)
 }

@@ -134,6 +134,8 @@ pub struct AnalyzeReport {
     pub machine: String,
     /// Singular cone used, degrees.
     pub cone_deg: f64,
+    /// The tilting letter the program uses as the primary axis (`A` or `B`).
+    pub primary: String,
     /// Notes for the user.
     pub warnings: Vec<String>,
     /// Runs in file order.
@@ -259,6 +261,7 @@ pub fn analyze_program(
         file: lp.name.clone(),
         machine: machine.name.clone(),
         cone_deg: opts.cone_deg,
+        primary: (lp.primary_letter as char).to_string(),
         warnings: lp.warnings.clone(),
         runs,
     }

@@ -16,8 +16,11 @@
 //!    ([`crate::end_pose::After::verdict`], decided by the first block after the run that
 //!    decides, for both tilting letters since the one in use is known only at the end).
 //! 2. **Stretches.** A run near the pole (or without a feed, which the report lists) is
-//!    a stretch from its first block (point 0) to its last; runs that share a block
-//!    (a feed change splits a path into two runs with a common point) are one stretch.
+//!    a stretch from its first block (point 0) to its last. Two runs may share a block (a
+//!    feed change splits a path into two runs with a common point): the block is then in
+//!    both stretches, and written with the first (the whole-program path builds every
+//!    run's path from the original values too, and never changes a run's first point, so
+//!    the second stretch has it unchanged — checked when writing).
 //! 3. **Patch.** The second read builds each stretch as a program of its own
 //!    ([`polepatch_nc::ProgramBuilder`]: the file's lines, states and bytes), with the
 //!    runs exactly as the first read found them, and hands it to
@@ -42,6 +45,7 @@ use crate::end_pose::After;
 use crate::error::Error;
 use crate::patch::{FileReport, patch_loaded, patch_program};
 use crate::program::{LoadedProgram, RunPath, Window, load_nc, primary_mismatch_warning, run_path};
+use crate::report::AnalyzeReport;
 use polepatch_kinematics::Machine;
 use polepatch_nc::modal::{A, B, C};
 use polepatch_nc::{
@@ -149,11 +153,19 @@ impl Surveying {
     }
 }
 
+/// What both reads need to know of the caller's options.
+struct Reading<'a> {
+    name: &'a str,
+    cone_deg: f64,
+    fallback: Option<f64>,
+    work_offset_mm: Option<[f64; 3]>,
+}
+
 /// The first read (module docs, step 1).
-fn survey(bytes: &[u8], opts: &crate::PatchOptions) -> Result<Survey, Error> {
+fn survey(bytes: &[u8], opts: &Reading<'_>) -> Result<Survey, Error> {
     let mut sv = Surveying {
-        cone_deg: opts.patch.cone_deg,
-        fallback: opts.feed_fallback_mm_min,
+        cone_deg: opts.cone_deg,
+        fallback: opts.fallback,
         work_offset_mm: opts.work_offset_mm,
         runs: Vec::new(),
         uses: [false; 6],
@@ -191,7 +203,7 @@ fn survey(bytes: &[u8], opts: &crate::PatchOptions) -> Result<Survey, Error> {
         i += 1;
         ControlFlow::Continue(())
     })
-    .map_err(|e| Error::Parse(e.with_path(&opts.name)))?;
+    .map_err(|e| Error::Parse(e.with_path(opts.name)))?;
     builder.finish(&mut |run| sv.take(run));
     // Nothing after them decides: the end of the file leaves the pose free.
     for rec in &mut sv.runs {
@@ -216,26 +228,17 @@ struct Stretch {
     runs: std::ops::Range<usize>,
 }
 
-/// The stretches (module docs, step 2) for the tilting letter `l` (0 A, 1 B).
-fn stretches(runs: &[RunRec], l: usize) -> Vec<Stretch> {
-    let mut out: Vec<Stretch> = Vec::new();
-    for (r, rec) in runs.iter().enumerate() {
-        if !(rec.near[l] || rec.feedless) {
-            continue;
-        }
-        match out.last_mut() {
-            Some(s) if s.runs.end == r && rec.first_block <= s.last_block => {
-                s.last_block = s.last_block.max(rec.last_block);
-                s.runs.end = r + 1;
-            }
-            _ => out.push(Stretch {
-                first_block: rec.first_block,
-                last_block: rec.last_block,
-                runs: r..r + 1,
-            }),
-        }
-    }
-    out
+/// The stretches (module docs, step 2): one per run `wanted` picks.
+fn stretches(runs: &[RunRec], wanted: impl Fn(&RunRec) -> bool) -> Vec<Stretch> {
+    runs.iter()
+        .enumerate()
+        .filter(|(_, rec)| wanted(rec))
+        .map(|(r, rec)| Stretch {
+            first_block: rec.first_block,
+            last_block: rec.last_block,
+            runs: r..r + 1,
+        })
+        .collect()
 }
 
 /// A stretch being read in the second pass.
@@ -255,6 +258,22 @@ fn line_end_after(bytes: &[u8], at: usize) -> usize {
         .map_or(bytes.len(), |k| at + k + 1)
 }
 
+/// The tilting letter in use (`modal::A` or `modal::B`), as
+/// [`polepatch_nc::primary_in_use`] picks it from the runs' letters.
+fn tilting_index(sv: &Survey, machine: &Machine) -> usize {
+    let own = if machine.primary_letter() == 'A' {
+        A
+    } else {
+        B
+    };
+    let other = if own == A { B } else { A };
+    if !sv.uses[own] && sv.uses[other] {
+        other
+    } else {
+        own
+    }
+}
+
 /// Patch an NC program held in memory, writing the output to `out` as it goes (module
 /// docs): the same output and report as [`crate::patch_nc`], with memory for the input
 /// and the stretches near the pole only. On an error nothing more is written to `out`;
@@ -265,18 +284,14 @@ pub fn patch_nc_to(
     opts: &crate::PatchOptions,
     out: &mut dyn Write,
 ) -> Result<FileReport, Error> {
-    let sv = survey(bytes, opts)?;
-    let own = if machine.primary_letter() == 'A' {
-        A
-    } else {
-        B
+    let rd = Reading {
+        name: &opts.name,
+        cone_deg: opts.patch.cone_deg,
+        fallback: opts.feed_fallback_mm_min,
+        work_offset_mm: opts.work_offset_mm,
     };
-    let other = if own == A { B } else { A };
-    let p_idx = if !sv.uses[own] && sv.uses[other] {
-        other
-    } else {
-        own
-    };
+    let sv = survey(bytes, &rd)?;
+    let p_idx = tilting_index(&sv, machine);
     if sv.runs.is_empty() || (!sv.uses[p_idx] && !sv.uses[C]) {
         // The whole-program path names what is wrong (no runs and why, no rotary words).
         let mut lp = load_nc(
@@ -298,35 +313,130 @@ pub fn patch_nc_to(
             .into_iter()
             .collect(),
     );
-    let todo = stretches(&sv.runs, l);
-    if todo.is_empty() {
-        out.write_all(bytes).map_err(Error::Output)?;
-        return Ok(report);
+    let todo = stretches(&sv.runs, |rec| rec.near[l] || rec.feedless);
+    let mut copied_to = 0usize;
+    each_stretch(
+        bytes,
+        &sv,
+        &todo,
+        l,
+        &rd,
+        |lp| {
+            let (edits, part) = patch_program(&lp, machine, &opts.patch);
+            let output = if edits.is_empty() {
+                lp.program.bytes
+            } else {
+                polepatch_nc::write_styled(&lp.program, &edits, &sv.style)
+            };
+            (output, part)
+        },
+        |(output, part), replaced| {
+            // A stretch that starts at the block the previous one ended at: that block was
+            // written with the previous stretch (a run never changes its first point).
+            let shared = copied_to.saturating_sub(replaced.start);
+            assert!(
+                output.get(..shared) == bytes.get(replaced.start..replaced.start + shared),
+                "a run changed its first point (line shared with the run before it)"
+            );
+            out.write_all(&bytes[copied_to.min(replaced.start)..replaced.start])?;
+            out.write_all(&output[shared..])?;
+            copied_to = replaced.end;
+            merge(&mut report, part);
+            Ok(())
+        },
+    )?;
+    out.write_all(&bytes[copied_to..]).map_err(Error::Output)?;
+    Ok(report)
+}
+
+/// Equation 6 along every run of an NC program held in memory, a stretch at a time
+/// (module docs; every run is a stretch): the report of [`crate::analyze_nc`] on the
+/// whole program, with memory for the input, one record per run and the runs in hand.
+pub fn analyze_nc_stretches(
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &crate::AnalyzeOptions,
+) -> Result<AnalyzeReport, Error> {
+    let rd = Reading {
+        name: &opts.name,
+        cone_deg: opts.analysis.cone_deg,
+        fallback: opts.feed_fallback_mm_min,
+        work_offset_mm: opts.work_offset_mm,
+    };
+    let sv = survey(bytes, &rd)?;
+    let p_idx = tilting_index(&sv, machine);
+    if sv.runs.is_empty() || (!sv.uses[p_idx] && !sv.uses[C]) {
+        let mut lp = load_nc(
+            bytes.to_vec(),
+            &opts.name,
+            machine,
+            opts.feed_fallback_mm_min,
+        )?;
+        lp.work_offset_mm = opts.work_offset_mm;
+        return Ok(crate::report::analyze_program(&lp, machine, &opts.analysis));
     }
+    let l = usize::from(p_idx == B);
+    let mut report = AnalyzeReport {
+        file: opts.name.clone(),
+        machine: machine.name.clone(),
+        cone_deg: opts.analysis.cone_deg,
+        primary: (LETTERS[l] as char).to_string(),
+        warnings: primary_mismatch_warning(&opts.name, machine, p_idx)
+            .into_iter()
+            .collect(),
+        runs: Vec::with_capacity(sv.runs.len()),
+    };
+    let todo = stretches(&sv.runs, |_| true);
+    each_stretch(
+        bytes,
+        &sv,
+        &todo,
+        l,
+        &rd,
+        |lp| crate::report::analyze_program(&lp, machine, &opts.analysis).runs,
+        |runs, _| {
+            report.runs.extend(runs);
+            Ok(())
+        },
+    )?;
+    Ok(report)
+}
+
+/// The second read (module docs, step 3): each stretch of `todo` built as a program with
+/// its runs and what the rest of the file says, handed to `work` — in batches on all
+/// cores — and the results to `sink` in file order, with the bytes of the file the
+/// stretch covers.
+fn each_stretch<T: Send>(
+    bytes: &[u8],
+    sv: &Survey,
+    todo: &[Stretch],
+    l: usize,
+    rd: &Reading<'_>,
+    work: impl Fn(LoadedProgram) -> T + Sync,
+    mut sink: impl FnMut(T, std::ops::Range<usize>) -> std::io::Result<()>,
+) -> Result<(), Error> {
     let mut next = 0usize; // next stretch to start
     let mut building: Option<InHand> = None;
     let mut done: VecDeque<InHand> = VecDeque::new();
-    let mut copied_to = 0usize;
     let mut failure: Option<Error> = None;
     let mut builder = RunBuilder::default();
     let mut run_no = 0usize;
     let mut prev = Modal::default();
     let mut i = 0usize;
-    // Complete stretches are patched in batches on all cores, then written in file order.
     let mut ready: Vec<InHand> = Vec::new();
     let mut ready_bytes = 0usize;
     let batch_bytes = (bytes.len() / BATCH_FRACTION).clamp(BATCH_MIN_BYTES, BATCH_MAX_BYTES);
-    let mut flush = |ready: &mut Vec<InHand>, copied_to: &mut usize, report: &mut FileReport| {
+    let mut flush = |ready: &mut Vec<InHand>| {
         use rayon::prelude::*;
         let parts: Vec<_> = std::mem::take(ready)
             .into_par_iter()
-            .map(|hand| patch_stretch(bytes, hand, &sv, l, machine, opts))
+            .map(|hand| {
+                let replaced = hand.program.base()..hand.end_byte.unwrap_or(bytes.len());
+                (work(loaded(bytes, hand, sv, l, rd)), replaced)
+            })
             .collect();
-        for (output, part, replaced) in parts {
-            out.write_all(&bytes[*copied_to..replaced.start])?;
-            out.write_all(&output)?;
-            *copied_to = replaced.end;
-            merge(report, part);
+        for (part, replaced) in parts {
+            sink(part, replaced)?;
         }
         Ok::<(), std::io::Error>(())
     };
@@ -345,24 +455,28 @@ pub fn patch_nc_to(
         }
     };
     scan_blocks(bytes, sv.dialect, |s: Scanned<'_>| {
-        if building.is_none()
-            && let Some(st) = todo.get(next)
-            && st.first_block == i
-        {
-            building = Some(InHand {
-                stretch: st.clone(),
-                program: ProgramBuilder::new(s.block.span().start, &prev),
-                end_byte: None,
-                runs: Vec::new(),
-            });
-            next += 1;
-        }
         if let Some(h) = &mut building {
             h.program.push(&s);
             if h.stretch.last_block == i {
                 h.end_byte = Some(line_end_after(bytes, s.block.span().end));
                 done.extend(building.take());
             }
+        }
+        // The next stretch may start at the block this one ended at (two runs sharing a
+        // point): that block is then in both.
+        if building.is_none()
+            && let Some(st) = todo.get(next)
+            && st.first_block == i
+        {
+            let mut program = ProgramBuilder::new(s.block.span().start, &prev);
+            program.push(&s);
+            building = Some(InHand {
+                stretch: st.clone(),
+                program,
+                end_byte: None,
+                runs: Vec::new(),
+            });
+            next += 1;
         }
         builder.push(i, s.block, s.state, &mut |run| {
             give_run(run, &mut run_no, &mut building, &mut done)
@@ -378,7 +492,7 @@ pub fn patch_nc_to(
         }
         if ready_bytes >= batch_bytes {
             ready_bytes = 0;
-            if let Err(e) = flush(&mut ready, &mut copied_to, &mut report) {
+            if let Err(e) = flush(&mut ready) {
                 failure = Some(Error::Output(e));
                 return ControlFlow::Break(());
             }
@@ -387,27 +501,18 @@ pub fn patch_nc_to(
         i += 1;
         ControlFlow::Continue(())
     })
-    .map_err(|e| Error::Parse(e.with_path(&opts.name)))?;
+    .map_err(|e| Error::Parse(e.with_path(rd.name)))?;
     if let Some(e) = failure {
         return Err(e);
     }
     builder.finish(&mut |run| give_run(run, &mut run_no, &mut building, &mut done));
     ready.extend(done);
-    flush(&mut ready, &mut copied_to, &mut report).map_err(Error::Output)?;
-    out.write_all(&bytes[copied_to..]).map_err(Error::Output)?;
-    Ok(report)
+    flush(&mut ready).map_err(Error::Output)
 }
 
-/// Patch one stretch: its output bytes, its part of the report, and the bytes of the file
-/// it replaces.
-fn patch_stretch(
-    bytes: &[u8],
-    hand: InHand,
-    sv: &Survey,
-    l: usize,
-    machine: &Machine,
-    opts: &crate::PatchOptions,
-) -> (Vec<u8>, FileReport, std::ops::Range<usize>) {
+/// A stretch as a loaded program: its blocks, its runs (block indices re-based) with their
+/// paths, and what the rest of the file says about it.
+fn loaded(bytes: &[u8], hand: InHand, sv: &Survey, l: usize, rd: &Reading<'_>) -> LoadedProgram {
     let base = hand.program.base();
     let end = hand.end_byte.unwrap_or(bytes.len());
     let program = hand.program.finish(bytes[base..end].to_vec(), sv.dialect);
@@ -420,31 +525,24 @@ fn patch_stretch(
             for b in &mut run.blocks {
                 *b -= first;
             }
-            run_path(run, p_idx, opts.feed_fallback_mm_min)
+            run_path(run, p_idx, rd.fallback)
         })
         .collect();
     let recs = &sv.runs[hand.stretch.runs.clone()];
-    let lp = LoadedProgram {
-        name: opts.name.clone(),
+    LoadedProgram {
+        name: rd.name.to_string(),
         program,
         primary_letter: LETTERS[l],
         runs,
         warnings: Vec::new(),
-        work_offset_mm: opts.work_offset_mm,
+        work_offset_mm: rd.work_offset_mm,
         window: Some(Window {
             first_run: hand.stretch.runs.start,
             style: sv.style,
             end_free: recs.iter().map(|r| r.end_free[l].unwrap_or(true)).collect(),
             datum_mm: recs.iter().map(|r| r.datum_mm).collect(),
         }),
-    };
-    let (edits, part) = patch_program(&lp, machine, &opts.patch);
-    let output = if edits.is_empty() {
-        lp.program.bytes
-    } else {
-        polepatch_nc::write_styled(&lp.program, &edits, &sv.style)
-    };
-    (output, part, base..end)
+    }
 }
 
 /// Add a stretch's report to the file's.

@@ -1,12 +1,15 @@
-//! The stretch-at-a-time pipeline (`stream::patch_nc_to`, behind `patch_nc`) gives the
-//! whole-program path's output and report (`load_nc` + `patch_loaded`): on fixtures, both
+//! The stretch-at-a-time pipeline (`stream::patch_nc_to` behind `patch_nc`,
+//! `stream::analyze_nc_stretches` behind `analyze_nc`) gives the whole-program path's
+//! output and reports (`load_nc` + `patch_loaded` / `analyze_program`): on fixtures, both
 //! machines, and programs built so that runs, stretches, feed changes, end poses, frame
 //! changes and feedless runs meet at stretch boundaries.
 
 use polepatch::kinematics::Machine;
+use polepatch::patcher::AnalysisOptions;
 use polepatch::program::load_nc;
-use polepatch::stream::patch_nc_to;
-use polepatch::{FileReport, PatchOptions, patch_loaded};
+use polepatch::report::analyze_program;
+use polepatch::stream::{analyze_nc_stretches, patch_nc_to};
+use polepatch::{AnalyzeOptions, FileReport, PatchOptions, patch_loaded};
 use std::path::PathBuf;
 
 /// The report as text with the solver's timing (which differs run to run) zeroed.
@@ -18,7 +21,37 @@ fn comparable(r: &FileReport) -> String {
     format!("{r:?}")
 }
 
-/// Both paths on `bytes`; panics with `what` where they differ. Returns the report.
+/// `analyze` both ways (every run a stretch, and the whole program); panics with `what`
+/// where they differ.
+fn same_analysis(bytes: &[u8], machine: &Machine, opts: &PatchOptions, what: &str) {
+    let aopts = AnalyzeOptions {
+        analysis: AnalysisOptions {
+            cone_deg: opts.patch.cone_deg,
+            ..AnalysisOptions::default()
+        },
+        feed_fallback_mm_min: opts.feed_fallback_mm_min,
+        name: opts.name.clone(),
+        work_offset_mm: opts.work_offset_mm,
+    };
+    let full = load_nc(
+        bytes.to_vec(),
+        &opts.name,
+        machine,
+        opts.feed_fallback_mm_min,
+    )
+    .map(|mut lp| {
+        lp.work_offset_mm = opts.work_offset_mm;
+        analyze_program(&lp, machine, &aopts.analysis)
+    });
+    match (full, analyze_nc_stretches(bytes, machine, &aopts)) {
+        (Ok(a), Ok(b)) => assert_eq!(format!("{a:?}"), format!("{b:?}"), "{what}: analyze"),
+        (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string(), "{what}: analyze"),
+        (a, b) => panic!("{what}: analyze {:?} vs {:?}", a.err(), b.err()),
+    }
+}
+
+/// Both paths on `bytes`, `patch` and `analyze`; panics with `what` where they differ.
+/// Returns the patch report.
 fn same(bytes: &[u8], machine: &Machine, opts: &PatchOptions, what: &str) -> FileReport {
     let full = load_nc(
         bytes.to_vec(),
@@ -30,6 +63,7 @@ fn same(bytes: &[u8], machine: &Machine, opts: &PatchOptions, what: &str) -> Fil
         lp.work_offset_mm = opts.work_offset_mm;
         patch_loaded(&lp, machine, &opts.patch)
     });
+    same_analysis(bytes, machine, opts, what);
     let mut out = Vec::new();
     let streamed = patch_nc_to(bytes, machine, opts, &mut out);
     match (full, streamed) {
