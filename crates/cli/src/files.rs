@@ -9,23 +9,23 @@ use std::path::Path as FsPath;
 #[derive(Debug, thiserror::Error)]
 pub enum JobError {
     /// The file could not be read.
-    #[error("cannot read {path}: {source}")]
+    #[error("cannot read {path}: {cause}")]
     Read {
         /// File.
         path: String,
-        /// Cause.
-        source: std::io::Error,
+        /// Cause (in the message, not a `source()`: error chains would print it twice).
+        cause: std::io::Error,
     },
     /// Bad input.
     #[error(transparent)]
     Input(#[from] Error),
     /// The output could not be written.
-    #[error("cannot write {path}: {source}")]
+    #[error("cannot write {path}: {cause}")]
     Write {
         /// Output path.
         path: String,
-        /// Cause.
-        source: std::io::Error,
+        /// Cause (in the message, not a `source()`: error chains would print it twice).
+        cause: std::io::Error,
     },
     /// Output and input are the same file.
     #[error("{path}: the output would overwrite the input; polepatch never modifies its input")]
@@ -37,9 +37,9 @@ pub enum JobError {
 
 /// Read a file's bytes.
 pub fn read(path: &FsPath) -> Result<Vec<u8>, JobError> {
-    std::fs::read(path).map_err(|source| JobError::Read {
+    std::fs::read(path).map_err(|cause| JobError::Read {
         path: path.display().to_string(),
-        source,
+        cause,
     })
 }
 
@@ -56,9 +56,9 @@ pub fn patch_file(
         return Err(JobError::Overwrite { path: name });
     }
     let bytes = read(input)?;
-    let write_err = |source| JobError::Write {
+    let write_err = |cause| JobError::Write {
         path: output.display().to_string(),
-        source,
+        cause,
     };
     // No run point within the cone: the output is the input, proven by a streaming read
     // (memory: the file once).

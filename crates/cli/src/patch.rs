@@ -136,9 +136,9 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
                     .map(|(input, rel)| {
                         let output = dir.join(rel);
                         if let Some(parent) = output.parent() {
-                            std::fs::create_dir_all(parent).map_err(|source| JobError::Write {
+                            std::fs::create_dir_all(parent).map_err(|cause| JobError::Write {
                                 path: parent.display().to_string(),
-                                source,
+                                cause,
                             })?;
                         }
                         let r = patch_file(input, &output, &machine, &opts);

@@ -123,6 +123,10 @@ fn fails_with(args: &[&str], needle: &str) {
         err.contains(needle),
         "for {args:?} expected '{needle}' in: {err}"
     );
+    assert!(
+        err.matches("(os error").count() <= 1,
+        "the OS error is said once: {err}"
+    );
 }
 
 #[test]
