@@ -5,7 +5,9 @@ use clap::{Parser, Subcommand};
 use polepatch::kinematics::{Axis, Machine};
 use polepatch::patcher::AnalysisOptions;
 use polepatch::report::{AnalyzeReport, axis_letter};
+use polepatch::stream::Piece;
 use polepatch_cli::files;
+use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -195,19 +197,62 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
         name: name.clone(),
         work_offset_mm: args.work_offset,
     };
-    let report = polepatch::analyze_nc(&files::read(&args.file)?, &machine, &opts)?;
-    if args.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&report).context("writing JSON")?
-        );
-    } else {
-        print_analysis(&report, report.primary.as_bytes()[0]);
+    let bytes = files::read(&args.file)?;
+    // The report is printed as each run is analysed (a program of many runs has a report
+    // larger than itself): the header first, then the runs in file order.
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    let mut head: Option<AnalyzeReport> = None;
+    let mut failed: Vec<polepatch::report::RunReport> = Vec::new();
+    let mut runs = 0usize;
+    let json = args.json;
+    polepatch::stream::analyze_nc_each(&bytes, &machine, &opts, &mut |piece| match piece {
+        Piece::Head(h) => {
+            head = Some(h.clone());
+            if json {
+                // `to_string_pretty` of the whole report, written in pieces.
+                let text = serde_json::to_string_pretty(h)?;
+                let open = text.strip_suffix("[]\n}").unwrap_or(&text);
+                write!(out, "{open}[")
+            } else {
+                writeln!(
+                    out,
+                    "{} on {} (singular cone {}°)",
+                    h.file, h.machine, h.cone_deg
+                )
+            }
+        }
+        Piece::Run(r) => {
+            if json {
+                let text = serde_json::to_string_pretty(&r)?;
+                let sep = if runs == 0 { "\n" } else { ",\n" };
+                let indented: Vec<String> = text.lines().map(|l| format!("    {l}")).collect();
+                write!(out, "{sep}{}", indented.join("\n"))?;
+            } else {
+                let primary = head.as_ref().map_or(b'A', |h| h.primary.as_bytes()[0]);
+                print_run(&mut out, &r, primary)?;
+            }
+            runs += 1;
+            if r.error.is_some() {
+                failed.push(*r);
+            }
+            Ok(())
+        }
+    })?;
+    if json {
+        if runs == 0 {
+            writeln!(out, "]\n}}")?;
+        } else {
+            writeln!(out, "\n  ]\n}}")?;
+        }
     }
+    out.flush().context("writing the report")?;
+    drop(out);
+    let Some(report) = head else {
+        anyhow::bail!("no report");
+    };
     for w in &report.warnings {
         eprintln!("polepatch: warning: {w}");
     }
-    let failed: Vec<_> = report.runs.iter().filter(|r| r.error.is_some()).collect();
     for r in &failed {
         eprintln!(
             "polepatch: error: {}: run {} (lines {}–{}): {}",
@@ -225,25 +270,28 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
     })
 }
 
-fn print_analysis(report: &AnalyzeReport, primary_letter: u8) {
-    println!(
-        "{} on {} (singular cone {}°)",
-        report.file, report.machine, report.cone_deg
-    );
-    for r in &report.runs {
+/// One run of `analyze`'s table.
+fn print_run(
+    out: &mut impl Write,
+    r: &polepatch::report::RunReport,
+    primary_letter: u8,
+) -> std::io::Result<()> {
+    {
         let feed = r
             .feed_mm_min
             .map_or("no F".to_string(), |f| format!("F{f}"));
-        println!(
+        writeln!(
+            out,
             "\nrun {}: lines {}–{}, {} points, {:.3} mm at {}",
             r.run, r.lines[0], r.lines[1], r.points, r.length_mm, feed
-        );
+        )?;
         let Some(f) = &r.figures else {
-            println!("  not analysed: {}", r.error.as_deref().unwrap_or(""));
-            continue;
+            writeln!(out, "  not analysed: {}", r.error.as_deref().unwrap_or(""))?;
+            return Ok(());
         };
         match &f.limiting_axis {
-            Some(axis) => println!(
+            Some(axis) => writeln!(
+                out,
                 "  min feed ratio {:.3}: {} {} limit at line {} (s = {:.3} mm)",
                 f.min_ratio,
                 axis,
@@ -255,14 +303,15 @@ fn print_analysis(report: &AnalyzeReport, primary_letter: u8) {
                 f.min_at_line,
                 f.min_at_s_mm
             ),
-            None => println!("  reaches the programmed feed everywhere"),
-        }
-        println!(
+            None => writeln!(out, "  reaches the programmed feed everywhere"),
+        }?;
+        writeln!(
+            out,
             "  estimated time {:.3} s against L/F {:.3} s ({:+.1} %)",
             f.time_s,
             f.ideal_time_s,
             100.0 * (f.time_s / f.ideal_time_s - 1.0)
-        );
+        )?;
         let peaks: Vec<String> = Axis::ALL
             .iter()
             .map(|&a| {
@@ -271,7 +320,7 @@ fn print_analysis(report: &AnalyzeReport, primary_letter: u8) {
                 format!("{l} {:.3} {unit}", f.peak_speed[&l])
             })
             .collect();
-        println!("  peak speed at F: {}", peaks.join(", "));
+        writeln!(out, "  peak speed at F: {}", peaks.join(", "))?;
         let ratios: Vec<String> = Axis::ALL
             .iter()
             .map(|&a| {
@@ -279,27 +328,29 @@ fn print_analysis(report: &AnalyzeReport, primary_letter: u8) {
                 format!("{l} {:.3} ({})", f.axis_min_ratio[&l], f.axis_limit[&l])
             })
             .collect();
-        println!("  min ratio per axis: {}", ratios.join(", "));
+        writeln!(out, "  min ratio per axis: {}", ratios.join(", "))?;
         if let Some(m) = &r.machine_frame {
             let xyz = |map: &std::collections::BTreeMap<String, f64>| {
                 ["X", "Y", "Z"]
                     .map(|l| format!("{l} {:.3}", map[l]))
                     .join(", ")
             };
-            println!(
+            writeln!(
+                out,
                 "  machine frame (chain, datum X{:+.3} Y{:+.3} Z{:+.3}): peak speed at F {} m/min; min ratio {}",
                 m.datum_mm[0],
                 m.datum_mm[1],
                 m.datum_mm[2],
                 xyz(&m.peak_speed),
                 xyz(&m.axis_min_ratio)
-            );
+            )?;
         }
         if f.zones.is_empty() {
-            println!("  no singular zone");
+            writeln!(out, "  no singular zone")?;
         }
         for z in &f.zones {
-            println!(
+            writeln!(
+                out,
                 "  singular zone lines {}–{} ({}), min |{}| {:.3}° at line {}, C ratio {:.3}",
                 z.lines[0],
                 z.lines[1],
@@ -308,7 +359,8 @@ fn print_analysis(report: &AnalyzeReport, primary_letter: u8) {
                 z.min_abs_primary_deg,
                 z.singular_line,
                 z.c_ratio_min
-            );
+            )?;
         }
     }
+    Ok(())
 }

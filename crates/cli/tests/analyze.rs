@@ -229,3 +229,43 @@ fn bad_input_gets_a_clear_message_and_nonzero_exit() {
         "--feed must be a positive number",
     );
 }
+
+/// `analyze` prints its report as runs are analysed: the JSON is the library's report,
+/// pretty-printed, byte for byte; the table has one block per run, in order; a run
+/// without a feed is listed and makes the exit code 1.
+#[test]
+fn the_printed_report_is_the_librarys() {
+    use polepatch::kinematics::Machine;
+    let machine = Machine::builtin("mikron-ucp710").unwrap();
+    let feedless = temp_file(
+        "feedless.I",
+        b"%P G71 *\nN1 M128 *\nN2 G01 X+0 Y+0 Z+0 A+10 C+0 *\nN3 X+1 A+9 C+5 *\nN4 X+2 A+8 C+10 F1000 *\nN5 X+3 A+7 C+15 *\nN6 X+4 A+6 C+20 *\n",
+    );
+    for (file, code) in [
+        ("fixtures/c17/SING.I".to_string(), 0),
+        ("fixtures/dialects/fanuc.nc".to_string(), 0),
+        (feedless.display().to_string(), 1),
+    ] {
+        let opts = polepatch::AnalyzeOptions {
+            name: file.clone(),
+            ..polepatch::AnalyzeOptions::default()
+        };
+        let bytes = std::fs::read(root().join(&file)).unwrap();
+        let report = polepatch::analyze_nc(&bytes, &machine, &opts).unwrap();
+        let (c, out, err) = polepatch(&["analyze", &file, "--machine", "mikron-ucp710", "--json"]);
+        assert_eq!(c, code, "{file}: {err}");
+        assert_eq!(
+            out,
+            format!("{}\n", serde_json::to_string_pretty(&report).unwrap()),
+            "{file}"
+        );
+        let (c, table, _) = polepatch(&["analyze", &file, "--machine", "mikron-ucp710"]);
+        assert_eq!(c, code);
+        let runs: Vec<usize> = table
+            .lines()
+            .filter_map(|l| l.strip_prefix("run "))
+            .map(|l| l.split(':').next().unwrap().parse().unwrap())
+            .collect();
+        assert_eq!(runs, (1..=report.runs.len()).collect::<Vec<_>>(), "{file}");
+    }
+}

@@ -45,7 +45,7 @@ use crate::end_pose::After;
 use crate::error::Error;
 use crate::patch::{FileReport, patch_loaded, patch_program};
 use crate::program::{LoadedProgram, RunPath, Window, load_nc, primary_mismatch_warning, run_path};
-use crate::report::AnalyzeReport;
+use crate::report::{AnalyzeReport, RunReport};
 use polepatch_kinematics::Machine;
 use polepatch_nc::modal::{A, B, C};
 use polepatch_nc::{
@@ -351,12 +351,44 @@ pub fn patch_nc_to(
 
 /// Equation 6 along every run of an NC program held in memory, a stretch at a time
 /// (module docs; every run is a stretch): the report of [`crate::analyze_nc`] on the
-/// whole program, with memory for the input, one record per run and the runs in hand.
+/// whole program, with memory for the input, one record per run and the report.
 pub fn analyze_nc_stretches(
     bytes: &[u8],
     machine: &Machine,
     opts: &crate::AnalyzeOptions,
 ) -> Result<AnalyzeReport, Error> {
+    let mut report = None;
+    let mut runs = Vec::new();
+    analyze_nc_each(bytes, machine, opts, &mut |piece| {
+        match piece {
+            Piece::Head(head) => report = Some(head.clone()),
+            Piece::Run(run) => runs.push(*run),
+        }
+        Ok(())
+    })?;
+    let mut report = report.ok_or_else(|| Error::Options("no report".to_string()))?;
+    report.runs = runs;
+    Ok(report)
+}
+
+/// A piece of the analysis report, as [`analyze_nc_each`] hands it out.
+#[derive(Debug)]
+pub enum Piece<'a> {
+    /// The report without its runs (file, machine, cone, primary letter, warnings): first.
+    Head(&'a AnalyzeReport),
+    /// One run's report, in file order.
+    Run(Box<RunReport>),
+}
+
+/// [`analyze_nc_stretches`] handing out the report as it is made, so that it need not be
+/// kept: `each` gets the head ([`Piece::Head`]), then every run's report in file order.
+/// An error of `each` stops the reading ([`Error::Output`]).
+pub fn analyze_nc_each(
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &crate::AnalyzeOptions,
+    each: &mut dyn FnMut(Piece<'_>) -> std::io::Result<()>,
+) -> Result<(), Error> {
     let rd = Reading {
         name: &opts.name,
         cone_deg: opts.analysis.cone_deg,
@@ -366,6 +398,7 @@ pub fn analyze_nc_stretches(
     let sv = survey(bytes, &rd)?;
     let p_idx = tilting_index(&sv, machine);
     if sv.runs.is_empty() || (!sv.uses[p_idx] && !sv.uses[C]) {
+        // The whole-program path names what is wrong (no runs and why, no rotary words).
         let mut lp = load_nc(
             bytes.to_vec(),
             &opts.name,
@@ -373,10 +406,16 @@ pub fn analyze_nc_stretches(
             opts.feed_fallback_mm_min,
         )?;
         lp.work_offset_mm = opts.work_offset_mm;
-        return Ok(crate::report::analyze_program(&lp, machine, &opts.analysis));
+        let mut report = crate::report::analyze_program(&lp, machine, &opts.analysis);
+        let runs = std::mem::take(&mut report.runs);
+        each(Piece::Head(&report)).map_err(Error::Output)?;
+        for run in runs {
+            each(Piece::Run(Box::new(run))).map_err(Error::Output)?;
+        }
+        return Ok(());
     }
     let l = usize::from(p_idx == B);
-    let mut report = AnalyzeReport {
+    each(Piece::Head(&AnalyzeReport {
         file: opts.name.clone(),
         machine: machine.name.clone(),
         cone_deg: opts.analysis.cone_deg,
@@ -384,8 +423,9 @@ pub fn analyze_nc_stretches(
         warnings: primary_mismatch_warning(&opts.name, machine, p_idx)
             .into_iter()
             .collect(),
-        runs: Vec::with_capacity(sv.runs.len()),
-    };
+        runs: Vec::new(),
+    }))
+    .map_err(Error::Output)?;
     let todo = stretches(&sv.runs, |_| true);
     each_stretch(
         bytes,
@@ -395,11 +435,10 @@ pub fn analyze_nc_stretches(
         &rd,
         |lp| crate::report::analyze_program(&lp, machine, &opts.analysis).runs,
         |runs, _| {
-            report.runs.extend(runs);
-            Ok(())
+            runs.into_iter()
+                .try_for_each(|r| each(Piece::Run(Box::new(r))))
         },
-    )?;
-    Ok(report)
+    )
 }
 
 /// The second read (module docs, step 3): each stretch of `todo` built as a program with
