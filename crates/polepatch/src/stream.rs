@@ -274,6 +274,29 @@ fn tilting_index(sv: &Survey, machine: &Machine) -> usize {
     }
 }
 
+/// After the first read: the whole-program path for a program it must reject (no runs and
+/// why, no rotary words — it names what is wrong), or the survey and the tilting letter
+/// (0 A, 1 B) for the stretches.
+enum Begun {
+    Whole(Box<LoadedProgram>),
+    Stretches { sv: Survey, l: usize, p_idx: usize },
+}
+
+fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Error> {
+    let sv = survey(bytes, rd)?;
+    let p_idx = tilting_index(&sv, machine);
+    if sv.runs.is_empty() || (!sv.uses[p_idx] && !sv.uses[C]) {
+        let mut lp = load_nc(bytes.to_vec(), rd.name, machine, rd.fallback)?;
+        lp.work_offset_mm = rd.work_offset_mm;
+        return Ok(Begun::Whole(Box::new(lp)));
+    }
+    Ok(Begun::Stretches {
+        sv,
+        l: usize::from(p_idx == B),
+        p_idx,
+    })
+}
+
 /// Patch an NC program held in memory, writing the output to `out` as it goes (module
 /// docs): the same output and report as [`crate::patch_nc`], with memory for the input
 /// and the stretches near the pole only. On an error nothing more is written to `out`;
@@ -290,22 +313,14 @@ pub fn patch_nc_to(
         fallback: opts.feed_fallback_mm_min,
         work_offset_mm: opts.work_offset_mm,
     };
-    let sv = survey(bytes, &rd)?;
-    let p_idx = tilting_index(&sv, machine);
-    if sv.runs.is_empty() || (!sv.uses[p_idx] && !sv.uses[C]) {
-        // The whole-program path names what is wrong (no runs and why, no rotary words).
-        let mut lp = load_nc(
-            bytes.to_vec(),
-            &opts.name,
-            machine,
-            opts.feed_fallback_mm_min,
-        )?;
-        lp.work_offset_mm = opts.work_offset_mm;
-        let (output, report) = patch_loaded(&lp, machine, &opts.patch);
-        out.write_all(&output).map_err(Error::Output)?;
-        return Ok(report);
-    }
-    let l = usize::from(p_idx == B);
+    let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
+        Begun::Whole(lp) => {
+            let (output, report) = patch_loaded(&lp, machine, &opts.patch);
+            out.write_all(&output).map_err(Error::Output)?;
+            return Ok(report);
+        }
+        Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx),
+    };
     let mut report = FileReport::unchanged(
         &opts.name,
         machine,
@@ -395,26 +410,18 @@ pub fn analyze_nc_each(
         fallback: opts.feed_fallback_mm_min,
         work_offset_mm: opts.work_offset_mm,
     };
-    let sv = survey(bytes, &rd)?;
-    let p_idx = tilting_index(&sv, machine);
-    if sv.runs.is_empty() || (!sv.uses[p_idx] && !sv.uses[C]) {
-        // The whole-program path names what is wrong (no runs and why, no rotary words).
-        let mut lp = load_nc(
-            bytes.to_vec(),
-            &opts.name,
-            machine,
-            opts.feed_fallback_mm_min,
-        )?;
-        lp.work_offset_mm = opts.work_offset_mm;
-        let mut report = crate::report::analyze_program(&lp, machine, &opts.analysis);
-        let runs = std::mem::take(&mut report.runs);
-        each(Piece::Head(&report)).map_err(Error::Output)?;
-        for run in runs {
-            each(Piece::Run(Box::new(run))).map_err(Error::Output)?;
+    let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
+        Begun::Whole(lp) => {
+            let mut report = crate::report::analyze_program(&lp, machine, &opts.analysis);
+            let runs = std::mem::take(&mut report.runs);
+            each(Piece::Head(&report)).map_err(Error::Output)?;
+            for run in runs {
+                each(Piece::Run(Box::new(run))).map_err(Error::Output)?;
+            }
+            return Ok(());
         }
-        return Ok(());
-    }
-    let l = usize::from(p_idx == B);
+        Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx),
+    };
     each(Piece::Head(&AnalyzeReport {
         file: opts.name.clone(),
         machine: machine.name.clone(),

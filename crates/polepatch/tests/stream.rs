@@ -21,6 +21,22 @@ fn comparable(r: &FileReport) -> String {
     format!("{r:?}")
 }
 
+/// The whole program, loaded.
+fn whole(
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &PatchOptions,
+) -> Result<polepatch::program::LoadedProgram, polepatch::Error> {
+    let mut lp = load_nc(
+        bytes.to_vec(),
+        &opts.name,
+        machine,
+        opts.feed_fallback_mm_min,
+    )?;
+    lp.work_offset_mm = opts.work_offset_mm;
+    Ok(lp)
+}
+
 /// `analyze` both ways (every run a stretch, and the whole program); panics with `what`
 /// where they differ.
 fn same_analysis(bytes: &[u8], machine: &Machine, opts: &PatchOptions, what: &str) {
@@ -33,16 +49,7 @@ fn same_analysis(bytes: &[u8], machine: &Machine, opts: &PatchOptions, what: &st
         name: opts.name.clone(),
         work_offset_mm: opts.work_offset_mm,
     };
-    let full = load_nc(
-        bytes.to_vec(),
-        &opts.name,
-        machine,
-        opts.feed_fallback_mm_min,
-    )
-    .map(|mut lp| {
-        lp.work_offset_mm = opts.work_offset_mm;
-        analyze_program(&lp, machine, &aopts.analysis)
-    });
+    let full = whole(bytes, machine, opts).map(|lp| analyze_program(&lp, machine, &aopts.analysis));
     match (full, analyze_nc_stretches(bytes, machine, &aopts)) {
         (Ok(a), Ok(b)) => assert_eq!(format!("{a:?}"), format!("{b:?}"), "{what}: analyze"),
         (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string(), "{what}: analyze"),
@@ -53,16 +60,7 @@ fn same_analysis(bytes: &[u8], machine: &Machine, opts: &PatchOptions, what: &st
 /// Both paths on `bytes`, `patch` and `analyze`; panics with `what` where they differ.
 /// Returns the patch report.
 fn same(bytes: &[u8], machine: &Machine, opts: &PatchOptions, what: &str) -> FileReport {
-    let full = load_nc(
-        bytes.to_vec(),
-        &opts.name,
-        machine,
-        opts.feed_fallback_mm_min,
-    )
-    .map(|mut lp| {
-        lp.work_offset_mm = opts.work_offset_mm;
-        patch_loaded(&lp, machine, &opts.patch)
-    });
+    let full = whole(bytes, machine, opts).map(|lp| patch_loaded(&lp, machine, &opts.patch));
     same_analysis(bytes, machine, opts, what);
     let mut out = Vec::new();
     let streamed = patch_nc_to(bytes, machine, opts, &mut out);
