@@ -13,23 +13,7 @@ fn root() -> PathBuf {
 }
 
 fn fixtures() -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    let mut stack = vec![root().join("fixtures")];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if matches!(
-                p.extension().and_then(|x| x.to_str()),
-                Some("I" | "nc" | "mpf")
-            ) {
-                out.push(p);
-            }
-        }
-    }
-    out.sort();
-    out
+    polepatch_fixturegen::nc_files(&root().join("fixtures"))
 }
 
 fn last_error() -> String {

@@ -357,3 +357,28 @@ pub fn zigzag_program(
     line(format!("%{name} G71"));
     out
 }
+
+/// Every NC program under `dir` (recursively, by extension: `.I` `.H` `.mpf` `.MPF` `.nc`
+/// `.NC` `.ngc` `.tap`), sorted — the fixture list the test suites share.
+///
+/// # Panics
+/// If a folder under `dir` cannot be read.
+pub fn nc_files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).expect("read a fixture folder") {
+            let p = e.expect("read a fixture folder entry").path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if matches!(
+                p.extension().and_then(|x| x.to_str()),
+                Some("I" | "H" | "mpf" | "MPF" | "nc" | "NC" | "ngc" | "tap")
+            ) {
+                out.push(p);
+            }
+        }
+    }
+    out.sort();
+    out
+}

@@ -9,24 +9,9 @@ use polepatch::{PatchOptions, patch_loaded};
 use std::path::PathBuf;
 
 fn fixtures() -> Vec<PathBuf> {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures");
-    let mut out = Vec::new();
-    let mut stack = vec![root];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if matches!(
-                p.extension().and_then(|x| x.to_str()),
-                Some("I" | "nc" | "mpf")
-            ) {
-                out.push(p);
-            }
-        }
-    }
-    out.sort();
-    out
+    polepatch_fixturegen::nc_files(
+        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures"),
+    )
 }
 
 #[test]

@@ -38,23 +38,7 @@ pub fn root() -> PathBuf {
 
 /// Every NC fixture under fixtures/ (recursively), sorted.
 pub fn fixtures() -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    let mut stack = vec![root().join("fixtures")];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if matches!(
-                p.extension().and_then(|x| x.to_str()),
-                Some("I" | "H" | "mpf" | "MPF" | "nc" | "NC" | "ngc" | "tap")
-            ) {
-                out.push(p);
-            }
-        }
-    }
-    out.sort();
-    out
+    polepatch_fixturegen::nc_files(&root().join("fixtures"))
 }
 
 pub fn load_bytes(bytes: &[u8], name: &str, machine: &Machine) -> LoadedProgram {
