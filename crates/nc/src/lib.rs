@@ -25,6 +25,6 @@ pub use plan::restore_modal;
 pub use program::{
     Block, Dialect, Program, ProgramBuilder, Scanned, Word, parse, scan, scan_blocks,
 };
-pub use run::{Run, RunBreak, RunBuilder, primary_in_use, runs};
+pub use run::{Run, RunBreak, RunBuilder, primary_in_use, primary_of, runs};
 pub use style::{FileStyle, NumberStyle, StyleEvidence};
 pub use writer::{Edit, write, write_styled};

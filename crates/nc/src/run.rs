@@ -209,10 +209,19 @@ impl Run {
 /// The tilting axis the runs use: `preferred` (`modal::A` or `modal::B`, the machine's),
 /// unless the runs never program it but do program the other tilting letter.
 pub fn primary_in_use(runs: &[Run], preferred: usize) -> usize {
+    let mut uses = [false; 6];
+    for (i, u) in uses.iter_mut().enumerate() {
+        *u = runs.iter().any(|r| r.uses(i));
+    }
+    primary_of(&uses, preferred)
+}
+
+/// [`primary_in_use`] from which of X Y Z A B C the runs use (index as
+/// [`crate::Modal::pos`]), for callers that read runs one at a time.
+pub fn primary_of(uses: &[bool; 6], preferred: usize) -> usize {
     use crate::modal::{A, B};
     let other = if preferred == A { B } else { A };
-    let has = |i: usize| runs.iter().any(|r| r.uses(i));
-    if !has(preferred) && has(other) {
+    if !uses[preferred] && uses[other] {
         other
     } else {
         preferred

@@ -87,13 +87,7 @@ pub fn far_from_pole(
     } else {
         B
     };
-    let other = if own == A { B } else { A };
-    // `polepatch_nc::primary_in_use`, on the flags.
-    let p_idx = if !seen.uses[own] && seen.uses[other] {
-        other
-    } else {
-        own
-    };
+    let p_idx = polepatch_nc::primary_of(&seen.uses, own);
     let min_abs = if p_idx == A {
         seen.min_abs_a_deg
     } else {

@@ -37,9 +37,13 @@
 //! Stretches are patched on all cores in batches of about 1/256 of the file (16 KiB to
 //! 256 KiB of it), then written in file order.
 //!
+//! [`analyze_nc_each`] reads the same way with every run a stretch, and hands each run's
+//! report out as it is made (a program of many runs has a report larger than itself).
+//!
 //! Memory: the input, the output writer's buffer, one record per run (first and last
-//! block, flags: ~64 B), and the batch of stretches in hand. A single run near the pole
-//! is parsed whole, so one giant run costs ~10× its own bytes.
+//! block, flags: ~64 B), and the batch of stretches in hand. A single run is parsed whole,
+//! so one giant run costs ~10× its own bytes; runs that share a block are not joined, so a
+//! program of many runs is bounded by its longest run.
 
 use crate::end_pose::After;
 use crate::error::Error;
@@ -266,12 +270,7 @@ fn tilting_index(sv: &Survey, machine: &Machine) -> usize {
     } else {
         B
     };
-    let other = if own == A { B } else { A };
-    if !sv.uses[own] && sv.uses[other] {
-        other
-    } else {
-        own
-    }
+    polepatch_nc::primary_of(&sv.uses, own)
 }
 
 /// After the first read: the whole-program path for a program it must reject (no runs and
