@@ -43,6 +43,16 @@ fn lib_dir() -> PathBuf {
     .clone()
 }
 
+/// Asserts that a program ran successfully, showing its output when not.
+fn succeeded(run: &std::process::Output) {
+    assert!(
+        run.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&run.stdout),
+        String::from_utf8_lossy(&run.stderr)
+    );
+}
+
 fn have(tool: &str) -> bool {
     Command::new(tool)
         .arg("--version")
@@ -115,12 +125,7 @@ fn a_c_program_patches_sing_byte_for_byte() {
             .arg(name)
             .output()
             .unwrap();
-        assert!(
-            run.status.success(),
-            "{}{}",
-            String::from_utf8_lossy(&run.stdout),
-            String::from_utf8_lossy(&run.stderr)
-        );
+        succeeded(&run);
         let (want, want_report) = expected(name, machine);
         assert_eq!(std::fs::read(&out).unwrap(), want, "{machine}");
         assert_eq!(
@@ -148,12 +153,7 @@ fn the_python_ctypes_example_patches_sing_byte_for_byte() {
         .arg(&out)
         .output()
         .unwrap();
-    assert!(
-        run.status.success(),
-        "{}{}",
-        String::from_utf8_lossy(&run.stdout),
-        String::from_utf8_lossy(&run.stderr)
-    );
+    succeeded(&run);
     let (want, _) = expected(name, "mikron-ucp710");
     assert_eq!(std::fs::read(&out).unwrap(), want);
 }

@@ -3,6 +3,20 @@
 mod common;
 use common::{polepatch, temp_dir};
 
+/// `polepatch post CL --machine mikron-ucp710 --dialect D -o OUT`.
+fn post(cl: &std::path::Path, dialect: &str, out: &std::path::Path) -> (i32, String, String) {
+    polepatch(&[
+        "post",
+        cl.to_str().unwrap(),
+        "--machine",
+        "mikron-ucp710",
+        "--dialect",
+        dialect,
+        "-o",
+        out.to_str().unwrap(),
+    ])
+}
+
 #[test]
 fn the_bundled_cl_example_posts_and_patches_in_every_dialect() {
     let dir = temp_dir("post");
@@ -47,16 +61,7 @@ fn bad_records_are_refused_with_line_and_column_and_nothing_written() {
     )
     .unwrap();
     let out = dir.join("out.I");
-    let (code, _, err) = polepatch(&[
-        "post",
-        cl.to_str().unwrap(),
-        "--machine",
-        "mikron-ucp710",
-        "--dialect",
-        "heidenhain",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let (code, _, err) = post(&cl, "heidenhain", &out);
     assert_eq!(code, 1);
     assert!(
         err.contains("bad.apt:4:10: z '3.5.1' is not a number"),
@@ -65,16 +70,7 @@ fn bad_records_are_refused_with_line_and_column_and_nothing_written() {
     assert!(!out.exists());
     // No feed for a cutting move: the line, and the way out.
     std::fs::write(&cl, "1,2,3,0,0,1\n2,2,3,0,0,1\n").unwrap();
-    let (code, _, err) = polepatch(&[
-        "post",
-        cl.to_str().unwrap(),
-        "--machine",
-        "mikron-ucp710",
-        "--dialect",
-        "fanuc",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let (code, _, err) = post(&cl, "fanuc", &out);
     assert_eq!(code, 1);
     assert!(
         err.contains("bad.apt:1:") && err.contains("--feed"),

@@ -15,8 +15,8 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-/// (x y z p c, line) of every move under TCPM with known values.
-fn tcpm_moves(lp: &LoadedProgram) -> Vec<[f64; 5]> {
+/// Every move under TCPM with known values: its block and state, with X Y Z P C.
+fn tcpm_blocks(lp: &LoadedProgram) -> Vec<(usize, polepatch::nc::Modal, [f64; 5])> {
     let p = &lp.program;
     let pi = lp.primary_index();
     (0..p.blocks.len())
@@ -27,35 +27,32 @@ fn tcpm_moves(lp: &LoadedProgram) -> Vec<[f64; 5]> {
                 return None;
             }
             let v = |i: usize| st.pos[i];
-            Some([
+            let q = [
                 v(modal::X)?,
                 v(modal::Y)?,
                 v(modal::Z)?,
                 v(pi)?,
                 v(modal::C)?,
-            ])
+            ];
+            Some((b, st, q))
         })
         .collect()
 }
 
+/// X Y Z P C of every move under TCPM with known values.
+fn tcpm_moves(lp: &LoadedProgram) -> Vec<[f64; 5]> {
+    tcpm_blocks(lp).into_iter().map(|(_, _, q)| q).collect()
+}
+
 fn cl_points(lp: &LoadedProgram, machine: &Machine) -> Vec<ClPoint> {
-    let p = &lp.program;
-    let pi = lp.primary_index();
-    (0..p.blocks.len())
-        .filter(|&b| p.blocks[b].is_move)
-        .filter_map(|b| {
-            let st = p.state(b);
-            if !st.tcpm {
-                return None;
-            }
-            let v = |i: usize| st.pos[i];
-            Some(ClPoint {
-                pos_mm: [v(modal::X)?, v(modal::Y)?, v(modal::Z)?],
-                axis: forward(machine, v(pi)?, v(modal::C)?),
-                feed_mm_min: st.feed_mm_min,
-                rapid: st.motion == Motion::Rapid,
-                line: p.blocks[b].line,
-            })
+    tcpm_blocks(lp)
+        .into_iter()
+        .map(|(b, st, q)| ClPoint {
+            pos_mm: [q[0], q[1], q[2]],
+            axis: forward(machine, q[3], q[4]),
+            feed_mm_min: st.feed_mm_min,
+            rapid: st.motion == Motion::Rapid,
+            line: lp.program.blocks[b].line,
         })
         .collect()
 }
