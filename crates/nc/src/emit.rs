@@ -56,7 +56,8 @@ fn style(dialect: Dialect) -> NumberStyle {
             leading_zero: true,
             equals: false,
         },
-        Dialect::Heidenhain | Dialect::Auto => NumberStyle {
+        // The post writes Heidenhain ISO for either Heidenhain dialect.
+        Dialect::Heidenhain | Dialect::Conversational | Dialect::Auto => NumberStyle {
             plus_sign: true,
             decimals: 3,
             strip_trailing_zeros: true,
@@ -115,7 +116,7 @@ pub fn emit(points: &[EmitPoint], o: &EmitOptions) -> Vec<u8> {
     let mut out = String::new();
     let mut n = 0u64;
     match o.dialect {
-        Dialect::Heidenhain | Dialect::Auto => {
+        Dialect::Heidenhain | Dialect::Conversational | Dialect::Auto => {
             let mut block = |s: &str, out: &mut String| {
                 n += 10;
                 out.push_str(&format!("N{n} {s} *\n"));
@@ -211,7 +212,7 @@ mod tests {
             assert_eq!(prog.dialect, dialect, "{}", String::from_utf8_lossy(&bytes));
             let r = runs(&prog);
             assert_eq!(r.len(), 1, "{}", String::from_utf8_lossy(&bytes));
-            assert!(r[0].tcpm);
+            assert!(r[0].tcpm.is_on());
             assert_eq!(r[0].feed_mm_min, Some(2000.0));
             let last = r[0].pos.last().unwrap();
             assert_eq!(last[modal::A], Some(-0.5));

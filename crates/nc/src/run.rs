@@ -1,6 +1,7 @@
 //! Runs of G1 motion with cumulative tool-tip path length s.
 
 use crate::modal::{Modal, X, Y, Z};
+
 use crate::program::{Block, Program};
 
 /// Why a run ended (for reports).
@@ -30,8 +31,9 @@ pub struct Run {
     pub pos: Vec<[Option<f64>; 6]>,
     /// Programmed feed, mm/min (`None` if no F is in force).
     pub feed_mm_min: Option<f64>,
-    /// TCPM state during the run.
-    pub tcpm: bool,
+    /// TCPM state during the run (only [`crate::Tcpm::On`] allows changing rotary words
+    /// alone).
+    pub tcpm: crate::Tcpm,
     /// Why the run ended.
     pub ended_by: RunBreak,
 }

@@ -16,7 +16,7 @@ use crate::machine_frame;
 use crate::program::{LoadedProgram, RunProblem};
 use crate::report::{axis_letter, limit_name, zone_kind_name};
 use polepatch_kinematics::Machine;
-use polepatch_nc::{Edit, NumberStyle};
+use polepatch_nc::{Edit, NumberStyle, Tcpm};
 use polepatch_patcher::{
     Method, Outcome, PatchOptions, QpStatus, ZoneFigures, ZoneReport, patch_path, report_unpatched,
 };
@@ -250,6 +250,9 @@ pub enum UntouchedReason {
     /// With the machine's kinematic chain: the patch would make a linear axis worse in the
     /// machine frame, or could not be written through the chain.
     MachineFrame,
+    /// TCPM is switched by a block that block delete (`/`) may skip: X Y Z may be machine
+    /// coordinates.
+    TcpmUncertain,
 }
 
 /// A run left byte-identical, and why.
@@ -321,7 +324,12 @@ impl FileReport {
     pub fn runs_left_without_tcpm(&self) -> usize {
         self.untouched_runs
             .iter()
-            .filter(|u| u.reason == UntouchedReason::NoTcpm && u.zones > 0)
+            .filter(|u| {
+                matches!(
+                    u.reason,
+                    UntouchedReason::NoTcpm | UntouchedReason::TcpmUncertain
+                ) && u.zones > 0
+            })
             .count()
     }
 }
@@ -410,7 +418,14 @@ pub fn patch_program(
             .as_ref()
             .and_then(|ch| machine_frame::run_datum(lp, r, lp.work_offset_mm).map(|d| (ch, d)));
         let inch = rp.run.blocks.iter().any(|&b| program.state(b).inch);
-        let leave = if !rp.run.tcpm && (chain.is_none() || inch || incremental) {
+        let leave = if rp.run.tcpm == Tcpm::Uncertain {
+            Some((
+                UntouchedReason::TcpmUncertain,
+                "TCPM is switched by a block that block delete (`/`) may skip: whether X Y Z are \
+                 part or machine coordinates depends on the block-delete switch, so the run is \
+                 left as it is",
+            ))
+        } else if !rp.run.tcpm.is_on() && (chain.is_none() || inch || incremental) {
             Some((
                 UntouchedReason::NoTcpm,
                 if machine.chain.is_none() {
@@ -464,12 +479,14 @@ pub fn patch_program(
         let run_opts = PatchOptions {
             // Without TCPM the moves after the run are in machine coordinates: the last
             // point keeps its values (X Y Z included).
-            keep_last_point: !rp.run.tcpm || !crate::end_pose::end_pose_is_free(lp, r),
+            keep_last_point: !rp.run.tcpm.is_on() || !crate::end_pose::end_pose_is_free(lp, r),
             ..opts.clone()
         };
         // Without TCPM (and with a chain) the patcher works on the part-frame path.
         let part_path = match (rp.run.tcpm, chain) {
-            (false, Some((ch, d))) => Some(machine_frame::part_frame_path(ch, machine, d, path)),
+            (Tcpm::Off, Some((ch, d))) => {
+                Some(machine_frame::part_frame_path(ch, machine, d, path))
+            }
             _ => None,
         };
         let work_path = part_path.as_ref().unwrap_or(path);
@@ -609,7 +626,7 @@ fn through_chain(
     xyz_decimals: usize,
 ) -> Result<Vec<Edit>, String> {
     let rp = &lp.runs[r];
-    let tcpm = rp.run.tcpm;
+    let tcpm = rp.run.tcpm.is_on();
     let n = path.axes.len();
     let changed = |k: usize| result.p_changed[k] || result.c_changed[k];
     if !(0..n).any(changed) {

@@ -198,7 +198,7 @@ fn machine_frame_figures(
         chain,
         machine,
         datum_mm,
-        lp.runs[r].run.tcpm,
+        lp.runs[r].run.tcpm.is_on(),
         &path.axes,
         &path.s_mm,
         path.feed_mm_min,

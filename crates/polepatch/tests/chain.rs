@@ -35,7 +35,7 @@ fn sing_without_tcpm(machine: &Machine) -> (Vec<u8>, Vec<Option<[f64; 3]>>) {
     let program = &lp.program;
     let mut edits = Vec::new();
     let mut tips = vec![None; program.blocks.len()];
-    for rp in lp.runs.iter().filter(|rp| rp.run.tcpm) {
+    for rp in lp.runs.iter().filter(|rp| rp.run.tcpm.is_on()) {
         for &b in &rp.run.blocks {
             let st = program.state(b);
             let v = |i: usize| st.pos[i].unwrap_or(0.0);

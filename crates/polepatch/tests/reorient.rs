@@ -19,7 +19,9 @@ fn rotary_words(bytes: &[u8], machine: &Machine) -> Vec<(usize, f64, f64)> {
     let lp = load_nc(bytes.to_vec(), "x", machine, None).unwrap();
     let p = &lp.program;
     (0..p.blocks.len())
-        .filter(|&b| p.state(b).tcpm && p.word(b, b'A').is_some() && p.word(b, b'C').is_some())
+        .filter(|&b| {
+            p.state(b).tcpm.is_on() && p.word(b, b'A').is_some() && p.word(b, b'C').is_some()
+        })
         .map(|b| {
             let st = p.state(b);
             (
@@ -116,7 +118,7 @@ fn reorientation_and_back_returns_the_words() {
     let (mut compared, mut same_branch) = (0, 0);
     for blk in 0..a.program.blocks.len() {
         let (sa, sb) = (a.program.state(blk), b.program.state(blk));
-        if !(a.program.blocks[blk].is_move && sa.tcpm) {
+        if !(a.program.blocks[blk].is_move && sa.tcpm.is_on()) {
             continue;
         }
         for i in [modal::X, modal::Y, modal::Z] {

@@ -134,3 +134,83 @@ fn incremental_runs_are_left_alone() {
     );
     assert!(report.untouched_runs[0].message.contains("G91"));
 }
+
+fn generated(name: &str) -> String {
+    std::fs::read_to_string(format!(
+        "{}/../../fixtures/generated/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap()
+}
+
+/// Issue 19 §1: codes that end or replace TCPM in each controller's modal groups — Fanuc
+/// `G43`/`G44` (group 8) after `G43.4`, Sinumerik `TRANSMIT`/`TRACYL` after `TRAORI` —
+/// leave the run after them in machine coordinates: untouched, byte for byte, reported.
+#[test]
+fn codes_that_replace_tcpm_leave_the_run_alone() {
+    let fanuc = generated("fanuc-ac-flip-d0.5.nc");
+    let sin = generated("sinumerik-ac-flip-d0.5.mpf");
+    let cases = [
+        (
+            "G43 after G43.4",
+            fanuc.replace("G43.4 H1\n", "G43.4 H1\nG43 H1\n"),
+        ),
+        (
+            "G44 after G43.4",
+            fanuc.replace("G43.4 H1\n", "G43.4 H1\nG44 H1\n"),
+        ),
+        (
+            "TRANSMIT after TRAORI",
+            sin.replace("TRAORI\r\n", "TRAORI\r\nTRANSMIT\r\n"),
+        ),
+        (
+            "TRACYL after TRAORI",
+            sin.replace("TRAORI\r\n", "TRAORI\r\nTRACYL(40)\r\n"),
+        ),
+    ];
+    for name in Machine::builtin_names() {
+        let m = Machine::builtin(name).unwrap();
+        for (label, text) in &cases {
+            assert!(
+                text != &fanuc && text != &sin,
+                "{label}: the case was built"
+            );
+            let (out, report) = patch_nc(text.as_bytes(), &m, &PatchOptions::default()).unwrap();
+            assert!(
+                out == text.as_bytes(),
+                "{label} on {name}: no byte may change"
+            );
+            assert!(report.runs_left_without_tcpm() >= 1, "{label}: {report:#?}");
+            assert!(
+                report.zones_below_feed() >= 1,
+                "{label}: --strict must exit 2"
+            );
+        }
+    }
+}
+
+/// Issue 19 §1: a TCPM switch in a block that block delete may skip leaves the state
+/// uncertain: the run is left as it is and reported with its own reason.
+#[test]
+fn a_skippable_tcpm_block_is_uncertain_and_left_alone() {
+    let m = Machine::builtin("mikron-ucp710").unwrap();
+    let heid = String::from_utf8(sing())
+        .unwrap()
+        .replace("N65 M128 *", "/N65 M128 *");
+    let fanuc = generated("fanuc-ac-flip-d0.5.nc").replace("G43.4 H1\n", "/N50 G43.4 H1\n");
+    let sin = generated("sinumerik-ac-flip-d0.5.mpf").replace("TRAORI\r\n", "/N6 TRAORI\r\n");
+    for (label, text) in [("heidenhain", heid), ("fanuc", fanuc), ("sinumerik", sin)] {
+        assert!(text.contains("/N"), "{label}: the case was built");
+        let (out, report) = patch_nc(text.as_bytes(), &m, &PatchOptions::default()).unwrap();
+        assert!(out == text.as_bytes(), "{label}: no byte may change");
+        assert!(
+            report
+                .untouched_runs
+                .iter()
+                .any(|u| u.reason == UntouchedReason::TcpmUncertain && u.zones >= 1),
+            "{label}: {:#?}",
+            report.untouched_runs
+        );
+        assert!(report.zones_below_feed() >= 1, "{label}");
+    }
+}
