@@ -17,7 +17,7 @@ use crate::patch::FileReport;
 use crate::program::primary_mismatch_warning;
 use polepatch_kinematics::Machine;
 use polepatch_nc::modal::{A, B, C};
-use polepatch_nc::{Dialect, RunBuilder, scan};
+use polepatch_nc::{RunBuilder, scan_blocks_with};
 use std::ops::ControlFlow;
 
 /// What the scan found, run by run.
@@ -54,7 +54,10 @@ pub fn far_from_pole(
     let mut near = false;
     let take = |run: polepatch_nc::Run, seen: &mut Seen| {
         seen.runs += 1;
-        if run.feed_mm_min.or(fallback).is_none() {
+        if [A, B]
+            .into_iter()
+            .any(|p| crate::program::run_check(&run, p, fallback, 0).is_err())
+        {
             seen.feedless = true;
         }
         for p in &run.pos {
@@ -66,7 +69,13 @@ pub fn far_from_pole(
         }
     };
     let mut i = 0usize;
-    scan(bytes, Dialect::Auto, |block, _, st| {
+    let read = crate::program::read_options(machine)?;
+    let mut notes = crate::notes::Notes::new();
+    let mut prev = polepatch_nc::modal::initial(&read.controller);
+    scan_blocks_with(bytes, &read, |s| {
+        let (block, st) = (s.block, s.state);
+        notes.push(block, s.words, &prev, st);
+        prev = *st;
         builder.push(i, block, st, &mut |run| take(run, &mut seen));
         i += 1;
         // Whichever tilting letter turns out to be the primary, a point is in the cone.
@@ -100,11 +109,15 @@ pub fn far_from_pole(
     {
         return Ok(None);
     }
-    Ok(Some(FileReport::unchanged(
+    let mut report = FileReport::unchanged(
         &opts.name,
         machine,
         primary_mismatch_warning(&opts.name, machine, p_idx)
             .into_iter()
             .collect(),
-    )))
+    );
+    let (not_analysed, warnings) = notes.finish(p_idx, cone_deg, &opts.name);
+    report.not_analysed = not_analysed;
+    report.warnings.extend(warnings);
+    Ok(Some(report))
 }

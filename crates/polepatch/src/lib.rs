@@ -29,6 +29,7 @@ pub mod end_pose;
 pub mod error;
 pub mod far;
 pub mod machine_frame;
+pub mod notes;
 pub mod patch;
 pub mod post;
 pub mod program;

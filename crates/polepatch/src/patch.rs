@@ -103,6 +103,18 @@ pub struct ZoneRow {
     pub primary_decimals: usize,
     /// 360° multiple added to C after the zone.
     pub c_offset_deg: f64,
+    /// Feed mode of the run: `G94` (feed per minute) or `G93` (inverse time: each block
+    /// keeps its time, F words untouched).
+    pub feed_mode: &'static str,
+}
+
+/// Report name of a feed mode: `G94`, `G93` or `G95`.
+pub fn feed_mode_name(m: polepatch_nc::FeedMode) -> &'static str {
+    match m {
+        polepatch_nc::FeedMode::PerMinute => "G94",
+        polepatch_nc::FeedMode::InverseTime => "G93",
+        polepatch_nc::FeedMode::PerRevolution => "G95",
+    }
 }
 
 /// Report name of an outcome.
@@ -127,7 +139,7 @@ fn method_name(m: Method) -> &'static str {
 
 impl ZoneRow {
     /// CSV column names of [`ZoneRow::csv_fields`] (the row's fields after `file`).
-    pub const CSV_COLUMNS: [&'static str; 31] = [
+    pub const CSV_COLUMNS: [&'static str; 32] = [
         "run",
         "first_line",
         "last_line",
@@ -159,6 +171,7 @@ impl ZoneRow {
         "decimals",
         "primary_decimals",
         "c_offset_deg",
+        "feed_mode",
     ];
 
     /// The row as CSV fields, in [`ZoneRow::CSV_COLUMNS`] order.
@@ -202,6 +215,7 @@ impl ZoneRow {
             self.decimals.to_string(),
             self.primary_decimals.to_string(),
             format!("{}", self.c_offset_deg),
+            self.feed_mode.to_string(),
         ]
     }
 
@@ -231,6 +245,7 @@ impl ZoneRow {
             decimals: z.decimals,
             primary_decimals: z.p_decimals,
             c_offset_deg: z.c_offset_deg,
+            feed_mode: feed_mode_name(lp.runs[run].run.feed_mode),
         }
     }
 }
@@ -253,6 +268,12 @@ pub enum UntouchedReason {
     /// TCPM is switched by a block that block delete (`/`) may skip: X Y Z may be machine
     /// coordinates.
     TcpmUncertain,
+    /// The feed is below [`crate::program::MIN_FEED_MM_MIN`].
+    FeedTooLow,
+    /// Inverse-time feed (G93) whose blocks have different feeds.
+    InverseTimeVarying,
+    /// A rotary axis moves while its value at some point is unknown.
+    UnknownRotary,
 }
 
 /// A run left byte-identical, and why.
@@ -293,6 +314,9 @@ pub struct FileReport {
     pub written_primary_decimals: Option<usize>,
     /// Runs left as they are (no TCPM, G91, no feed, invalid values), with why.
     pub untouched_runs: Vec<UntouchedRun>,
+    /// Lines carried through without analysis (expressions, arcs and skippable blocks near
+    /// the pole, …; [`crate::notes`]).
+    pub not_analysed: Vec<crate::notes::NotAnalysed>,
     /// Notes for the user.
     pub warnings: Vec<String>,
     /// One row per zone.
@@ -312,9 +336,30 @@ impl FileReport {
             file_primary_decimals: None,
             written_primary_decimals: None,
             untouched_runs: Vec::new(),
+            not_analysed: Vec::new(),
             warnings,
             zones: Vec::new(),
         }
+    }
+    /// What `--strict` counts as a failure: zones that stay below feed (those of untouched
+    /// runs included), runs that could not be analysed (no feed, a feed too low, G93 with
+    /// differing feeds, invalid values) and lines carried through without analysis.
+    pub fn strict_failures(&self) -> usize {
+        let unanalysed_runs = self
+            .untouched_runs
+            .iter()
+            .filter(|u| {
+                matches!(
+                    u.reason,
+                    UntouchedReason::NoFeed
+                        | UntouchedReason::FeedTooLow
+                        | UntouchedReason::InverseTimeVarying
+                        | UntouchedReason::UnknownRotary
+                        | UntouchedReason::Invalid
+                )
+            })
+            .count();
+        self.zones_below_feed() + unanalysed_runs + self.not_analysed.len()
     }
     /// Zones that stay below feed (including those of untouched runs).
     pub fn zones_below_feed(&self) -> usize {
@@ -345,6 +390,9 @@ pub fn patch_program(
 ) -> (Vec<Edit>, FileReport) {
     let program = &lp.program;
     let mut report = FileReport::unchanged(&lp.name, machine, lp.warnings.clone());
+    let (not_analysed, warnings) = lp.notes.finish(lp.primary_index(), opts.cone_deg, &lp.name);
+    report.not_analysed = not_analysed;
+    report.warnings.extend(warnings);
     // The file's number style is only needed when some run comes near the pole; reading
     // it costs a pass over every word, so a program without such a run skips it.
     let pi = polepatch_kinematics::Axis::Primary.index();
@@ -712,6 +760,9 @@ fn through_chain(
 fn problem_reason(p: &RunProblem) -> UntouchedReason {
     match p {
         RunProblem::NoFeed => UntouchedReason::NoFeed,
+        RunProblem::FeedTooLow { .. } => UntouchedReason::FeedTooLow,
+        RunProblem::InverseTimeVarying { .. } => UntouchedReason::InverseTimeVarying,
+        RunProblem::UnknownRotary { .. } => UntouchedReason::UnknownRotary,
     }
 }
 
