@@ -287,7 +287,11 @@ fn tilting_index(sv: &Survey, machine: &Machine) -> usize {
 /// (0 A, 1 B) for the stretches.
 enum Begun {
     Whole(Box<LoadedProgram>),
-    Stretches { sv: Survey, l: usize, p_idx: usize },
+    Stretches {
+        sv: Box<Survey>,
+        l: usize,
+        p_idx: usize,
+    },
 }
 
 fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Error> {
@@ -299,7 +303,7 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
         return Ok(Begun::Whole(Box::new(lp)));
     }
     Ok(Begun::Stretches {
-        sv,
+        sv: Box::new(sv),
         l: usize::from(p_idx == B),
         p_idx,
     })
