@@ -103,6 +103,12 @@ pub(crate) struct PatchArgs {
     /// program's datum shift (Heidenhain G54 X Y Z).
     #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z")]
     pub(crate) work_offset: Option<[f64; 3]>,
+    /// With a kinematic chain, for runs without TCPM: how far the tool tip may leave the
+    /// programmed line between two points of a rewritten block, mm (the controller
+    /// interpolates every axis linearly there); a run that would exceed it — and its
+    /// original block — keeps its values.
+    #[arg(long, value_name = "MM", default_value_t = polepatch::machine_frame::CHORD_TOLERANCE_MM)]
+    pub(crate) chord_tolerance: f64,
 }
 
 #[derive(clap::Args)]

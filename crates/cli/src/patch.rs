@@ -80,10 +80,12 @@ fn expand(inputs: &[PathBuf]) -> Result<Vec<(PathBuf, PathBuf)>> {
 }
 
 pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
+    check_positive("--chord-tolerance", Some(args.chord_tolerance))?;
     let opts = polepatch::PatchOptions {
         patch: options(&args)?,
         feed_fallback_mm_min: args.feed,
         work_offset_mm: args.work_offset,
+        chord_tolerance_mm: args.chord_tolerance,
         ..polepatch::PatchOptions::default()
     };
     let machine = machine(&args.machine)?;

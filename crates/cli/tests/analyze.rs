@@ -198,6 +198,7 @@ fn bad_input_gets_a_clear_message_and_nonzero_exit() {
         ],
         ":2:",
     );
+    // A run without a feed is listed, not an error (issue 20 §7); --strict makes it one.
     let no_f = temp_file("nof.nc", b"G1 X0 Y0 Z0 A1 C0\nX1 C1\nX2 C2\nX3 C3\n");
     fails_with(
         &[
@@ -205,6 +206,7 @@ fn bad_input_gets_a_clear_message_and_nonzero_exit() {
             no_f.to_str().unwrap(),
             "--machine",
             "mikron-ucp710",
+            "--strict",
         ],
         "no feed (F)",
     );

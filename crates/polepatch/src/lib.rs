@@ -58,6 +58,11 @@ pub struct PatchOptions {
     /// Work offset (machine coordinates of the program's zero, mm) for a machine with a
     /// kinematic chain. Default `None`: the program's own datum (Heidenhain `G54 X Y Z`).
     pub work_offset_mm: Option<[f64; 3]>,
+    /// With a kinematic chain, for runs without TCPM: how far the tool tip may leave the
+    /// programmed line between two points when the rewritten block's axes are
+    /// interpolated linearly, mm (never more than the original block did, either).
+    /// Default [`machine_frame::CHORD_TOLERANCE_MM`] (0.005 mm).
+    pub chord_tolerance_mm: f64,
 }
 
 impl Default for PatchOptions {
@@ -67,6 +72,7 @@ impl Default for PatchOptions {
             feed_fallback_mm_min: None,
             name: "input".to_string(),
             work_offset_mm: None,
+            chord_tolerance_mm: machine_frame::CHORD_TOLERANCE_MM,
         }
     }
 }

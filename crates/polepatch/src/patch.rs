@@ -573,6 +573,7 @@ pub fn patch_program(
                 d,
                 &opts,
                 xyz_decimals,
+                lp.chord_tolerance_mm,
             ) {
                 Ok(xyz) => run_edits = xyz,
                 Err(why) => {
@@ -672,6 +673,7 @@ fn through_chain(
     datum_mm: [f64; 3],
     opts: &PatchOptions,
     xyz_decimals: usize,
+    chord_tolerance_mm: f64,
 ) -> Result<Vec<Edit>, String> {
     let rp = &lp.runs[r];
     let tcpm = rp.run.tcpm.is_on();
@@ -724,6 +726,40 @@ fn through_chain(
             ));
         }
         point[..3].copy_from_slice(&written);
+    }
+    if !tcpm {
+        // Between the points (issue 19 §2): the tool tip under linear interpolation of the
+        // written values may not leave the programmed line by more than the tolerance, nor
+        // by more than the original block did.
+        for k in 1..n {
+            if !(changed(k - 1) || changed(k)) {
+                continue;
+            }
+            let tip = |i: usize| {
+                [
+                    work_path.axes[i][0],
+                    work_path.axes[i][1],
+                    work_path.axes[i][2],
+                ]
+            };
+            let tips = [tip(k - 1), tip(k)];
+            let err = |from: &[f64; 5], to: &[f64; 5]| {
+                machine_frame::chord_error_mm(chain, machine, datum_mm, from, to, tips)
+            };
+            let new = err(&after[k - 1], &after[k]);
+            let old = err(&path.axes[k - 1], &path.axes[k]);
+            // The endpoints themselves may move by the tip tolerance (rounding).
+            if new > chord_tolerance_mm.max(old) + machine_frame::TIP_TOLERANCE_MM {
+                return Err(format!(
+                    "between lines {} and {} the tool tip would leave the programmed line by \
+                     {new:.3} mm with the axes interpolated linearly (without TCPM; the original \
+                     block: {old:.3} mm, chord tolerance {chord_tolerance_mm} mm), so the run \
+                     keeps its values",
+                    lp.line_of(r, k - 1),
+                    lp.line_of(r, k)
+                ));
+            }
+        }
     }
     let aopts = polepatch_patcher::AnalysisOptions {
         cone_deg: opts.cone_deg,

@@ -120,6 +120,9 @@ pub struct LoadedProgram {
     /// used with a machine's kinematic chain; `None`: from the program
     /// ([`crate::machine_frame::run_datum`]).
     pub work_offset_mm: Option<[f64; 3]>,
+    /// Chord tolerance for runs patched through the kinematic chain, mm (default
+    /// [`crate::machine_frame::CHORD_TOLERANCE_MM`]; see [`crate::PatchOptions`]).
+    pub chord_tolerance_mm: f64,
     /// When `program` is a stretch of a larger file ([`crate::stream`]): what the rest
     /// of the file says about it. `None` for a whole program.
     pub window: Option<Window>,
@@ -415,6 +418,7 @@ pub fn load(
         runs,
         warnings,
         work_offset_mm: None,
+        chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
         window: None,
         notes,
     })

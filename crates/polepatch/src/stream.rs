@@ -169,6 +169,8 @@ struct Reading<'a> {
     work_offset_mm: Option<[f64; 3]>,
     /// How the machine's programs are read.
     read: polepatch_nc::ReadOptions,
+    /// Chord tolerance for the chain path, mm.
+    chord_tolerance_mm: f64,
 }
 
 /// The first read (module docs, step 1).
@@ -300,6 +302,7 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
     if sv.runs.is_empty() || (!sv.uses[p_idx] && !sv.uses[C]) {
         let mut lp = load_nc(bytes.to_vec(), rd.name, machine, rd.fallback)?;
         lp.work_offset_mm = rd.work_offset_mm;
+        lp.chord_tolerance_mm = rd.chord_tolerance_mm;
         return Ok(Begun::Whole(Box::new(lp)));
     }
     Ok(Begun::Stretches {
@@ -325,6 +328,7 @@ pub fn patch_nc_to(
         fallback: opts.feed_fallback_mm_min,
         work_offset_mm: opts.work_offset_mm,
         read: crate::program::read_options(machine)?,
+        chord_tolerance_mm: opts.chord_tolerance_mm,
     };
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
         Begun::Whole(lp) => {
@@ -426,6 +430,7 @@ pub fn analyze_nc_each(
         fallback: opts.feed_fallback_mm_min,
         work_offset_mm: opts.work_offset_mm,
         read: crate::program::read_options(machine)?,
+        chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
     };
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
         Begun::Whole(lp) => {
@@ -607,6 +612,7 @@ fn loaded(bytes: &[u8], hand: InHand, sv: &Survey, l: usize, rd: &Reading<'_>) -
         runs,
         warnings: Vec::new(),
         work_offset_mm: rd.work_offset_mm,
+        chord_tolerance_mm: rd.chord_tolerance_mm,
         window: Some(Window {
             first_run: hand.stretch.runs.start,
             style: sv.style,
