@@ -83,7 +83,9 @@ fn incremental_programs_are_told_what_is_not_supported() {
         err.contains("incremental mode (G91) is not supported"),
         "{err}"
     );
-    assert!(err.contains("g91.I:4:"), "{err}");
+    // The error names the G91 line, and the first move in it (issue 19 §6).
+    assert!(err.contains("g91.I:2:"), "{err}");
+    assert!(err.contains("the first move in it is at line 4"), "{err}");
 }
 
 #[test]

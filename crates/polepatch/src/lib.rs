@@ -104,6 +104,11 @@ impl Default for AnalyzeOptions {
 /// Patch an NC program held in memory: the rewritten bytes (identical to `bytes` except
 /// the rotary words that had to change) and the report.
 ///
+/// Programs of up to 4 GiB are read (the reader's byte offsets are 32-bit); memory is about
+/// twice the input for a program far from the pole, plus about ten times each run near it
+/// (docs/performance-nc.md). Where memory cannot be had the call returns
+/// [`Error::OutOfMemory`] (or a parse error naming it) instead of aborting the process.
+///
 /// Bad input (syntax errors with line and column, an empty program, no G1 motion, no
 /// rotary words) is an [`Error`]; a zone that cannot reach feed is a status in the report.
 pub fn patch_nc(
@@ -111,10 +116,18 @@ pub fn patch_nc(
     machine: &Machine,
     opts: &PatchOptions,
 ) -> Result<(Vec<u8>, FileReport), Error> {
+    // The output is about the input's size: a host that cannot give it gets an error,
+    // not an abort (the reader reserves its own tables the same way).
+    let mut out = Vec::new();
+    out.try_reserve(bytes.len())
+        .map_err(|_| Error::OutOfMemory {
+            what: "the output",
+            bytes: bytes.len(),
+        })?;
     if let Some(report) = far::far_from_pole(bytes, machine, opts)? {
-        return Ok((bytes.to_vec(), report));
+        out.extend_from_slice(bytes);
+        return Ok((out, report));
     }
-    let mut out = Vec::with_capacity(bytes.len());
     let report = stream::patch_nc_to(bytes, machine, opts, &mut out)?;
     Ok((out, report))
 }

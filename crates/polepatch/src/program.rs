@@ -219,10 +219,24 @@ fn why_no_runs(program: &Program, name: &str) -> Error {
         if st.motion != polepatch_nc::Motion::Linear {
             continue;
         }
-        let what = if st.incremental {
-            "incremental mode (G91) is not supported: polepatch reads absolute programs (G90), \
-             because a rotary value changed in incremental mode would shift every later position"
-        } else if st.pos[..3].iter().any(Option::is_none) {
+        if st.incremental {
+            // The error is where G91 was programmed (the move only follows it).
+            let set = (0..=i)
+                .rev()
+                .find(|&b| !program.state_before(b).incremental && program.state(b).incremental)
+                .unwrap_or(i);
+            return Error::Unsupported {
+                path: name.to_string(),
+                line: program.blocks[set].line,
+                what: format!(
+                    "incremental mode (G91) is not supported: polepatch reads absolute programs \
+                     (G90), because a rotary value changed in incremental mode would shift every \
+                     later position (the first move in it is at line {})",
+                    block.line
+                ),
+            };
+        }
+        let what = if st.pos[..3].iter().any(Option::is_none) {
             "G1 moves from a position the program does not state (after G28/G53/G92 or a datum \
              change, or before X Y Z are all programmed): nothing can be analysed without it"
         } else {

@@ -214,3 +214,48 @@ fn a_skippable_tcpm_block_is_uncertain_and_left_alone() {
         assert!(report.zones_below_feed() >= 1, "{label}");
     }
 }
+
+/// Issue 19 §5: an arc or a block that block delete may skip, inside a zone, is not
+/// analysed: the report lists it (so `--strict` exits 2), whatever the runs either side
+/// report.
+#[test]
+fn arcs_and_skippable_blocks_inside_a_zone_are_listed() {
+    let m = Machine::builtin("mikron-ucp710").unwrap();
+    let flip = generated("heidenhain-ac-flip-d0.5.I");
+    let cases = [
+        (
+            "arc",
+            flip.replace(
+                "N540 X+24.5 Y+0 Z-5 A+0.591 C+58.315 *",
+                "N540 G02 X+24.5 Y+0 I+24.25 J+0.25 A+0.591 C+58.315 *\nN545 G01 *",
+            ),
+            polepatch::notes::SkipReason::ArcNearPole,
+        ),
+        (
+            "skippable",
+            flip.replace(
+                "N540 X+24.5 Y+0 Z-5 A+0.591 C+58.315 *",
+                "/N540 X+24.5 Y+0 Z-5 A+0.591 C+58.315 *",
+            ),
+            polepatch::notes::SkipReason::SkippableNearPole,
+        ),
+    ];
+    for (label, text, reason) in cases {
+        assert!(text != flip, "{label}: the case was built");
+        let (_, report) = patch_nc(text.as_bytes(), &m, &PatchOptions::default()).unwrap();
+        let listed: Vec<_> = report
+            .not_analysed
+            .iter()
+            .filter(|n| n.reason == reason)
+            .collect();
+        assert_eq!(listed.len(), 1, "{label}: {:?}", report.not_analysed);
+        assert!(listed[0].lines[0] >= 50, "{label}: {:?}", listed[0]);
+        assert!(report.strict_failures() >= 1, "{label}");
+        // Far from the pole the same blocks are not listed.
+        let far = generated("heidenhain-ac-flip-d20.I");
+        let far_text = far.replacen(" X+2 Y+0 Z-5", " G02 X+2 Y+0 I+1 J+0 Z-5", 1);
+        assert!(far_text != far);
+        let (_, report) = patch_nc(far_text.as_bytes(), &m, &PatchOptions::default()).unwrap();
+        assert!(report.not_analysed.is_empty(), "{:?}", report.not_analysed);
+    }
+}
