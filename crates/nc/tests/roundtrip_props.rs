@@ -156,8 +156,11 @@ enum Form {
     FanucSpaced,
 }
 
-/// One random move: the form, and per axis X Y Z A C a value (some absent), with decimals.
-fn valid_program() -> impl Strategy<Value = (Form, Vec<Vec<Option<(f64, usize)>>>)> {
+/// A block's values per axis X Y Z A C (some absent), each with its decimals.
+type Block = Vec<Option<(f64, usize)>>;
+
+/// Random moves: the form, and the blocks.
+fn valid_program() -> impl Strategy<Value = (Form, Vec<Block>)> {
     let form = prop_oneof![
         Just(Form::HeidenhainIso),
         Just(Form::Conversational),
