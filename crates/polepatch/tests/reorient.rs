@@ -206,3 +206,25 @@ fn search_on_sing_finds_a_small_tilt() {
         report.alternatives.len()
     );
 }
+
+/// Issue 19 §1: `reorient` reads TCPM as the controller does — after `G43` (which replaces
+/// `G43.4`) or a skippable `M128`, no move is under TCPM, so nothing is rewritten.
+#[test]
+fn reorient_follows_the_tcpm_state() {
+    let m = Machine::builtin("mikron-ucp710").unwrap();
+    let tilt = Tilt {
+        theta_x_deg: 10.0,
+        theta_z_deg: 0.0,
+        pivot_mm: [0.0; 3],
+    };
+    let fanuc = String::from_utf8(read("fixtures/generated/fanuc-ac-flip-d0.5.nc")).unwrap();
+    let sing = String::from_utf8(read("fixtures/c17/SING.I")).unwrap();
+    for (label, text) in [
+        ("G43 after G43.4", fanuc.replace("G43.4 H1\n", "G43.4 H1\nG43 H1\n")),
+        ("/M128", sing.replace("N65 M128 *", "/N65 M128 *")),
+    ] {
+        assert!(text != fanuc && text != sing, "{label}");
+        let e = reorient_nc(text.as_bytes(), &m, &tilt, "t", 5.0).unwrap_err();
+        assert!(e.to_string().contains("no move with TCPM on"), "{label}: {e}");
+    }
+}
