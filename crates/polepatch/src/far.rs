@@ -30,8 +30,9 @@ struct Seen {
     /// reads it).
     min_abs_a_deg: f64,
     min_abs_b_deg: f64,
-    /// A run with no feed in force (and no fallback): the full path reports it.
-    feedless: bool,
+    /// A run that cannot be analysed (no feed, …: [`crate::program::run_check`]) if A
+    /// (index 0) or B (index 1) is the tilting letter: the full path reports it.
+    feedless: [bool; 2],
 }
 
 /// The report of a program that is proven to have no run point within `opts.cone_deg`
@@ -54,11 +55,8 @@ pub fn far_from_pole(
     let mut near = false;
     let take = |run: polepatch_nc::Run, seen: &mut Seen| {
         seen.runs += 1;
-        if [A, B]
-            .into_iter()
-            .any(|p| crate::program::run_check(&run, p, fallback, 0).is_err())
-        {
-            seen.feedless = true;
+        for (l, p) in [A, B].into_iter().enumerate() {
+            seen.feedless[l] |= crate::program::run_check(&run, p, fallback, 0).is_err();
         }
         for p in &run.pos {
             for (u, v) in seen.uses.iter_mut().zip(p) {
@@ -79,7 +77,8 @@ pub fn far_from_pole(
         builder.push(i, block, st, &mut |run| take(run, &mut seen));
         i += 1;
         // Whichever tilting letter turns out to be the primary, a point is in the cone.
-        near = seen.feedless || (seen.min_abs_a_deg <= cone_deg && seen.min_abs_b_deg <= cone_deg);
+        near = (seen.feedless[0] || seen.min_abs_a_deg <= cone_deg)
+            && (seen.feedless[1] || seen.min_abs_b_deg <= cone_deg);
         if near {
             ControlFlow::Break(())
         } else {
@@ -103,7 +102,7 @@ pub fn far_from_pole(
         seen.min_abs_b_deg
     };
     if seen.runs == 0
-        || seen.feedless
+        || seen.feedless[usize::from(p_idx == B)]
         || (!seen.uses[p_idx] && !seen.uses[C])
         || min_abs <= cone_deg
     {
