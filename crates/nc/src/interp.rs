@@ -61,6 +61,38 @@ pub(crate) struct Interpreter {
     pub(crate) frame_changed: bool,
 }
 
+/// Identifiers of program flow: LinuxCNC O-word statements (`o100 call`, `o<x> if`, …) and
+/// Sinumerik jumps, loops and calls.
+const FLOW: &[&[u8]] = &[
+    b"CALL",
+    b"SUB",
+    b"ENDSUB",
+    b"RETURN",
+    b"IF",
+    b"ELSE",
+    b"ELSEIF",
+    b"ENDIF",
+    b"WHILE",
+    b"ENDWHILE",
+    b"DO",
+    b"REPEAT",
+    b"ENDREPEAT",
+    b"BREAK",
+    b"CONTINUE",
+    b"GOTO",
+    b"GOTOF",
+    b"GOTOB",
+    b"GOTOC",
+    b"LOOP",
+    b"ENDLOOP",
+    b"FOR",
+    b"ENDFOR",
+    b"UNTIL",
+    b"RET",
+    b"PCALL",
+    b"MCALL",
+];
+
 /// Bit of axis index `i` in [`Scan::axes_expr`].
 fn bit(i: usize) -> u8 {
     1 << i
@@ -174,6 +206,11 @@ impl Interpreter {
             s.datum_shift = true;
         } else if is(b"SUPA") {
             s.reference = true;
+        } else if FLOW.iter().any(|n| is(n)) {
+            // Program flow (jumps, loops, calls): the blocks after it may not follow the
+            // ones before it, so positions are unknown after it.
+            s.unknown_after = true;
+            s.breaks = true;
         } else {
             s.breaks = true;
         }
@@ -285,6 +322,10 @@ impl Interpreter {
                         s.axes_expr |= bit(i);
                     } else if letter == b'F' {
                         s.feed_expr = true;
+                    } else if letter == b'O' {
+                        // `o<name> call`, `o<name> sub`: LinuxCNC program flow.
+                        s.unknown_after = true;
+                        s.breaks = true;
                     } else if !matches!(letter, b'R' | b'S') {
                         s.breaks = true;
                     }
@@ -311,6 +352,9 @@ impl Interpreter {
                         s.flags.set(Flags::UNCLOSED_COMMENT);
                     }
                 }
+                // A parameter outside an axis word (an assignment `#<a> = 5`, `#1=#2+1`):
+                // no motion, but the line is not a plain move either.
+                Token::Param { .. } => s.breaks = true,
                 Token::BlockEnd { .. } | Token::Other { .. } => {}
             }
         }

@@ -16,6 +16,7 @@
 //! - a letter followed by a letter or `_` starts an identifier (`TRAORI`, `CYCLE800(…)`,
 //!   `MSG("…")`), which takes a following `(…)`/`[…]` and `=expression` along;
 //! - `/` with optional level digits is the block-delete marker;
+//! - `#` starts a parameter (`#12`, `#<name>`, `#[expr]`);
 //! - anything else up to the next blank, letter, `;` or `(` is an unknown token.
 //!
 //! Errors: a malformed or non-finite number on an address word, an axis value in exponent
@@ -69,6 +70,11 @@ pub enum Token {
     /// `%` and the rest of the line.
     Percent {
         /// From `%` to the end of the line.
+        span: Range<usize>,
+    },
+    /// A parameter reference or assignment target: `#12`, `#<name>`, `#[expr]`.
+    Param {
+        /// The reference.
         span: Range<usize>,
     },
     /// `/` block-delete marker with optional level digits.
@@ -573,6 +579,26 @@ impl Iterator for Lexer<'_> {
                 }
                 self.pos = (i + 1).min(self.end);
                 Some(Ok(Token::Other { span: p..self.pos }))
+            }
+            b'#' => {
+                // A parameter: `#12`, `#<name>`, `#[expr]` (LinuxCNC, Fanuc macro B).
+                let mut i = p + 1;
+                match b.get(i).filter(|_| i < self.end) {
+                    Some(b'<') => {
+                        while i < self.end && b[i] != b'>' {
+                            i += 1;
+                        }
+                        i = (i + 1).min(self.end);
+                    }
+                    Some(b'[') => i = self.skip_group(i),
+                    _ => {
+                        while i < self.end && b[i].is_ascii_digit() {
+                            i += 1;
+                        }
+                    }
+                }
+                self.pos = i;
+                Some(Ok(Token::Param { span: p..i }))
             }
             _ => {
                 let mut i = p + 1;

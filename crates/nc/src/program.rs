@@ -1115,4 +1115,20 @@ mod tests {
         assert_eq!(prog.state(4).inverse_time_per_min, None);
         assert!(prog.blocks[3].breaks_run);
     }
+
+    /// LinuxCNC parameters and O-word flow (as its 5-axis demos write them): parameter
+    /// assignments are not moves; a call, a subroutine or a loop leaves positions unknown.
+    #[test]
+    fn linuxcnc_parameters_and_o_words() {
+        let prog = p(
+            "(LCNC)\n#<zmax> = #1 (=10)\n#<n> = 5\nG0 X0 Y0 Z0 A0 C0\nG1 F#<frate> Z2\no<helix> call [1][2]\no100 call\nG1 X1 F100\n",
+        );
+        assert!(!prog.blocks[1].is_move && prog.blocks[1].breaks_run);
+        assert!(prog.blocks[4].flags.has(Flags::NOT_ANALYSABLE));
+        assert_eq!(prog.state(5).pos[X], None, "o<helix> call");
+        assert_eq!(prog.state(3).pos[X], Some(0.0));
+        let mut q = prog.state(3);
+        q.pos = prog.state(6).pos;
+        assert_eq!(q.pos[X], None, "o100 call");
+    }
 }

@@ -219,6 +219,16 @@ fn why_no_runs(program: &Program, name: &str) -> Error {
         if st.motion != polepatch_nc::Motion::Linear {
             continue;
         }
+        if block.flags.has(polepatch_nc::Flags::NOT_ANALYSABLE) {
+            return Error::Unsupported {
+                path: name.to_string(),
+                line: block.line,
+                what: "no G1 run can be analysed: the G1 moves' axis or feed words are \
+                       expressions or variables (as here), which polepatch carries through but \
+                       cannot evaluate"
+                    .to_string(),
+            };
+        }
         if st.incremental {
             // The error is where G91 was programmed (the move only follows it).
             let set = (0..=i)

@@ -220,11 +220,17 @@ fn reorient_follows_the_tcpm_state() {
     let fanuc = String::from_utf8(read("fixtures/generated/fanuc-ac-flip-d0.5.nc")).unwrap();
     let sing = String::from_utf8(read("fixtures/c17/SING.I")).unwrap();
     for (label, text) in [
-        ("G43 after G43.4", fanuc.replace("G43.4 H1\n", "G43.4 H1\nG43 H1\n")),
+        (
+            "G43 after G43.4",
+            fanuc.replace("G43.4 H1\n", "G43.4 H1\nG43 H1\n"),
+        ),
         ("/M128", sing.replace("N65 M128 *", "/N65 M128 *")),
     ] {
         assert!(text != fanuc && text != sing, "{label}");
         let e = reorient_nc(text.as_bytes(), &m, &tilt, "t", 5.0).unwrap_err();
-        assert!(e.to_string().contains("no move with TCPM on"), "{label}: {e}");
+        assert!(
+            e.to_string().contains("no move with TCPM on"),
+            "{label}: {e}"
+        );
     }
 }
