@@ -67,7 +67,8 @@ pub struct ZoneRow {
     pub min_abs_primary_deg: f64,
     /// Before patching.
     pub before: FiguresRow,
-    /// After patching, on the values as written.
+    /// After patching, on the values as written (the `before` figures when the patch was
+    /// not written).
     pub after: FiguresRow,
     /// L/F over the zone, s.
     pub ideal_time_s: f64,
@@ -103,6 +104,24 @@ pub struct ZoneRow {
     pub primary_decimals: usize,
     /// 360° multiple added to C after the zone.
     pub c_offset_deg: f64,
+}
+
+impl ZoneRow {
+    /// The row of a zone whose patch was found but not written (the run keeps its values,
+    /// [`UntouchedRun`] says why): outcome `unchanged`, the figures after are the figures
+    /// before, nothing deviates or moves. The method and solver figures stay: they say what
+    /// was tried.
+    pub fn not_written(&mut self) {
+        self.outcome = "unchanged";
+        self.after = self.before.clone();
+        self.max_deviation_deg = 0.0;
+        self.points_modified = 0;
+        self.primary_points_modified = 0;
+        self.branch_reselected = false;
+        self.reselected_points = 0;
+        self.patch_length_mm = 0.0;
+        self.c_offset_deg = 0.0;
+    }
 }
 
 /// Report name of an outcome.
@@ -263,6 +282,10 @@ pub struct UntouchedRun {
     pub reason: UntouchedReason,
     /// Singular zones the run holds (reported in [`FileReport::zones`] as `unchanged`).
     pub zones: usize,
+    /// A point of the run is within the singular cone, or its primary value is not stated:
+    /// the run may hold a zone. With `zones` = 0 such a run was not analysed (no feed,
+    /// invalid values), so whether it reaches feed is unknown ([`FileReport::runs_not_analysed`]).
+    pub near_pole: bool,
     /// The message for people.
     pub message: String,
 }
@@ -317,6 +340,14 @@ impl FileReport {
     pub fn zones_below_feed(&self) -> usize {
         self.zones.iter().filter(|z| z.outcome != "reached").count()
     }
+    /// Runs that may hold a zone (a point within the cone) but could not be analysed (no
+    /// feed, invalid values): whether they reach feed is unknown.
+    pub fn runs_not_analysed(&self) -> usize {
+        self.untouched_runs
+            .iter()
+            .filter(|u| u.near_pole && u.zones == 0)
+            .count()
+    }
     /// Runs left because no TCPM is active although they hold a singular zone.
     pub fn runs_left_without_tcpm(&self) -> usize {
         self.untouched_runs
@@ -354,6 +385,7 @@ pub fn patch_program(
                     problem_reason(problem),
                     0,
                     problem.to_string(),
+                    opts.cone_deg,
                 ));
             }
         }
@@ -390,6 +422,7 @@ pub fn patch_program(
                     problem_reason(problem),
                     0,
                     problem.to_string(),
+                    opts.cone_deg,
                 ));
                 continue;
             }
@@ -448,6 +481,7 @@ pub fn patch_program(
                             reason,
                             zones.len(),
                             message.to_string(),
+                            opts.cone_deg,
                         ));
                     }
                 }
@@ -457,6 +491,7 @@ pub fn patch_program(
                     UntouchedReason::Invalid,
                     0,
                     e.to_string(),
+                    opts.cone_deg,
                 )),
             }
             continue;
@@ -487,6 +522,7 @@ pub fn patch_program(
                     UntouchedReason::Invalid,
                     0,
                     e.to_string(),
+                    opts.cone_deg,
                 ));
                 continue;
             }
@@ -512,7 +548,7 @@ pub fn patch_program(
                 Ok(xyz) => run_edits = xyz,
                 Err(why) => {
                     for row in &mut report.zones[first_row..] {
-                        row.outcome = "unchanged";
+                        row.not_written();
                     }
                     report.untouched_runs.push(untouched(
                         lp,
@@ -520,6 +556,7 @@ pub fn patch_program(
                         UntouchedReason::MachineFrame,
                         result.zones.len(),
                         why,
+                        opts.cone_deg,
                     ));
                     continue;
                 }
@@ -704,12 +741,19 @@ fn untouched(
     reason: UntouchedReason,
     zones: usize,
     message: String,
+    cone_deg: f64,
 ) -> UntouchedRun {
+    let pi = lp.primary_index();
     UntouchedRun {
         run: lp.run_number(r),
         lines: lp.lines_of_run(r),
         reason,
         zones,
+        near_pole: lp.runs[r]
+            .run
+            .pos
+            .iter()
+            .any(|p| p[pi].is_none_or(|v| v.abs() <= cone_deg)),
         message,
     }
 }
