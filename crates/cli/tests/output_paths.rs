@@ -176,6 +176,13 @@ fn a_batch_with_two_inputs_of_one_file_name_is_refused_before_writing() {
     let mut args = vec!["patch", "a/x.I", "b/x.I", "--out-dir", "o"];
     args.extend(m());
     refused(&dir, &args, &["o/x.I (from a/x.I)", "o/x.I (from b/x.I)"]);
+    // An output that the batch also reads as an input (o/x.I, given second).
+    std::fs::create_dir_all(dir.join("o")).unwrap();
+    std::fs::write(dir.join("o/x.I"), non_sing()).unwrap();
+    let mut args = vec!["patch", "a/x.I", "o/x.I", "--out-dir", "o"];
+    args.extend(m());
+    refused(&dir, &args, &["o/x.I (from a/x.I)", "the input o/x.I"]);
+    std::fs::remove_dir_all(dir.join("o")).unwrap();
     // The folders given instead: each output under its folder's name.
     let mut args = vec!["patch", "a", "b", "--out-dir", "o"];
     args.extend(m());
@@ -471,4 +478,34 @@ fn a_refused_plan_of_bench_writes_nothing() {
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("are the same file"), "{err}");
     assert!(!dir.join("b.json").exists());
+}
+
+/// Plots of two programs with one file stem (in different folders) would share a name.
+#[test]
+fn bench_plots_of_one_name_are_refused_before_writing() {
+    let dir = temp_dir("op-plots");
+    for d in ["a", "b"] {
+        std::fs::create_dir_all(dir.join(d)).unwrap();
+        std::fs::write(dir.join(d).join("SING.I"), sing()).unwrap();
+    }
+    let args = [
+        "bench",
+        "a",
+        "b",
+        "--machine",
+        "mikron-ucp710",
+        "--no-bound",
+        "--plots",
+        "plots",
+        "--json",
+        "b.json",
+    ];
+    refused(
+        &dir,
+        &args,
+        &[
+            "the plot plots/SING-mikron-ucp710-run1-zone1.svg",
+            "are the same file",
+        ],
+    );
 }
