@@ -8,7 +8,7 @@ use polepatch::patcher::PatchOptions;
 use polepatch_cli::bench::{
     BenchOptions, BenchReport, BenchStrategy, BenchZone, RATIO_TARGET, plot,
 };
-use polepatch_cli::files::write_atomic;
+use polepatch_cli::outputs::{Input, Output, Target, plan};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -95,7 +95,7 @@ fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
 
 pub(crate) fn run(args: BenchArgs) -> Result<ExitCode> {
     check_positive("--feed", args.feed)?;
-    check_positive("--tcy-ms", args.tcy_ms)?;
+    crate::check_tcy_ms(args.tcy_ms)?;
     check_positive("--cone", Some(args.cone))?;
     if !(0.0..0.5).contains(&args.margin) {
         bail!("--margin must be in [0, 0.5), got {}", args.margin);
@@ -115,6 +115,20 @@ pub(crate) fn run(args: BenchArgs) -> Result<ExitCode> {
     if files.is_empty() {
         bail!("no input files");
     }
+    let mut inputs: Vec<Input> = files.iter().map(|f| Input::new("the input", f)).collect();
+    for m in &args.machine {
+        inputs.extend(crate::patch::machine_input(m));
+    }
+    let mut outputs = Vec::new();
+    if let Some(path) = &args.json {
+        outputs.push(Output::new("--json", path));
+    }
+    if let Some(path) = &args.csv {
+        outputs.push(Output::new("--csv", path));
+    }
+    // Checked now (before the suite runs), and again with the plots once their names are
+    // known (before anything is written).
+    plan(&inputs, outputs.clone())?;
     let machines: Vec<Machine> = if args.machine.is_empty() {
         Machine::builtin_names()
             .iter()
@@ -165,18 +179,41 @@ pub(crate) fn run(args: BenchArgs) -> Result<ExitCode> {
     for e in &report.errors {
         eprintln!("polepatch: error: {} on {}: {}", e.file, e.machine, e.error);
     }
-    if let Some(path) = &args.json {
+    let plots = match &args.plots {
+        Some(dir) => plot_files(&report, dir, args.plot_only.as_deref()),
+        None => Vec::new(),
+    };
+    let n_files = outputs.len();
+    outputs.extend(
+        plots
+            .iter()
+            .map(|(path, _)| Output::new("the plot", path.clone())),
+    );
+    let targets = plan(&inputs, outputs)?;
+    let write = |target: &Target, bytes: &[u8]| {
+        target
+            .write(bytes, None)
+            .with_context(|| format!("cannot write {}", target.path.display()))
+    };
+    let mut files_out = targets[..n_files].iter();
+    if args.json.is_some() {
         let doc = serde_json::to_string_pretty(&report)?;
-        write_atomic(path, doc.as_bytes())
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        write(files_out.next().expect("planned"), doc.as_bytes())?;
     }
-    if let Some(path) = &args.csv {
-        write_atomic(path, &csv_rows(&report)?)
-            .with_context(|| format!("cannot write {}", path.display()))?;
+    if args.csv.is_some() {
+        write(files_out.next().expect("planned"), &csv_rows(&report)?)?;
     }
     if let Some(dir) = &args.plots {
-        let n = write_plots(&report, dir, args.plot_only.as_deref())?;
-        eprintln!("polepatch: {n} plot(s) written to {}", dir.display());
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        for ((_, p), target) in plots.iter().zip(&targets[n_files..]) {
+            let svg = plot::render_svg(p).map_err(anyhow::Error::msg)?;
+            write(target, svg.as_bytes())?;
+        }
+        eprintln!(
+            "polepatch: {} plot(s) written to {}",
+            plots.len(),
+            dir.display()
+        );
     }
     Ok(if report.errors.is_empty() {
         ExitCode::SUCCESS
@@ -392,10 +429,14 @@ fn csv_rows(report: &BenchReport) -> Result<Vec<u8>> {
 }
 
 /// One SVG per zone with plot data: `<file-stem>-<machine>-run<r>-zone<k>.svg`, k counting
-/// the zones of the run from 1; with `only`, just the files whose name contains it.
-fn write_plots(report: &BenchReport, dir: &Path, only: Option<&str>) -> Result<usize> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let mut n = 0;
+/// the zones of the run from 1; with `only`, just the files whose name contains it. The
+/// paths and the plots, to be checked by the output policy and then written.
+fn plot_files<'a>(
+    report: &'a BenchReport,
+    dir: &Path,
+    only: Option<&str>,
+) -> Vec<(PathBuf, &'a plot::ZonePlot)> {
+    let mut out = Vec::new();
     for case in &report.cases {
         if only.is_some_and(|o| !short_name(&case.file).contains(o)) {
             continue;
@@ -412,7 +453,6 @@ fn write_plots(report: &BenchReport, dir: &Path, only: Option<&str>) -> Result<u
             }
             k += 1;
             let Some(p) = &z.plot else { continue };
-            let svg = plot::render_svg(p).map_err(anyhow::Error::msg)?;
             let suffix = match case.strategy {
                 BenchStrategy::Polepatch => String::new(),
                 s => format!("-{}", s.name()),
@@ -421,10 +461,8 @@ fn write_plots(report: &BenchReport, dir: &Path, only: Option<&str>) -> Result<u
                 "{stem}-{}-run{}-zone{k}{suffix}.svg",
                 case.machine, z.row.run
             ));
-            write_atomic(&path, svg.as_bytes())
-                .with_context(|| format!("cannot write {}", path.display()))?;
-            n += 1;
+            out.push((path, p));
         }
     }
-    Ok(n)
+    out
 }

@@ -1,5 +1,7 @@
-//! Files: read an NC program, patch it through the library, write the output safely.
+//! Files: read an NC program, patch it through the library, write the output by the
+//! output policy ([`crate::outputs`]).
 
+use crate::outputs::{self, Input, Output, PathError, Target};
 use polepatch::kinematics::Machine;
 use polepatch::{Error, FileReport};
 use std::io::Write;
@@ -27,12 +29,9 @@ pub enum JobError {
         /// Cause (in the message, not a `source()`: error chains would print it twice).
         cause: std::io::Error,
     },
-    /// Output and input are the same file.
-    #[error("{path}: the output would overwrite the input; polepatch never modifies its input")]
-    Overwrite {
-        /// Path.
-        path: String,
-    },
+    /// The output path is refused by the output policy ([`crate::outputs`]).
+    #[error(transparent)]
+    Path(#[from] PathError),
 }
 
 /// Read a file's bytes.
@@ -43,158 +42,51 @@ pub fn read(path: &FsPath) -> Result<Vec<u8>, JobError> {
     })
 }
 
-/// Read, patch and write one file. The output is written to a temporary file beside it and
-/// renamed on success: nothing half-written, the input never touched.
+/// Read, patch and write one file to `output` (checked against the input by the output
+/// policy, [`crate::outputs`]).
 pub fn patch_file(
     input: &FsPath,
     output: &FsPath,
     machine: &Machine,
     opts: &polepatch::PatchOptions,
 ) -> Result<FileReport, JobError> {
+    let targets = outputs::plan(
+        &[Input::new("the input", input)],
+        vec![Output::new("-o", output)],
+    )?;
+    patch_to(input, &targets[0], machine, opts)
+}
+
+/// Read one file, patch it through [`polepatch::patch_nc_to`] and write the output to a
+/// checked target ([`outputs::plan`]): a temporary file renamed on success (nothing
+/// half-written, the input never touched), or a device or FIFO written through.
+pub fn patch_to(
+    input: &FsPath,
+    target: &Target,
+    machine: &Machine,
+    opts: &polepatch::PatchOptions,
+) -> Result<FileReport, JobError> {
     let name = input.display().to_string();
-    if same_file(input, output) {
-        return Err(JobError::Overwrite { path: name });
-    }
     let bytes = read(input)?;
     let write_err = |cause| JobError::Write {
-        path: output.display().to_string(),
+        path: target.path.display().to_string(),
         cause,
     };
-    // No run point within the cone: the output is the input, proven by a streaming read
-    // (memory: the file once).
-    let whole = polepatch::PatchOptions {
-        name: name.clone(),
+    let opts = polepatch::PatchOptions {
+        name,
         ..opts.clone()
     };
-    // The copy is written while the scan runs (it is the output when the scan proves the
-    // program far from the pole; otherwise it is deleted).
-    let (far, staged) = std::thread::scope(|sc| {
-        let copy = sc.spawn(|| stage(output, &bytes, Some(input)));
-        let far = polepatch::far::far_from_pole(&bytes, machine, &whole);
-        (far, copy.join())
-    });
-    if let Some(mut report) = far? {
-        let staged = staged.unwrap_or_else(|p| std::panic::resume_unwind(p));
-        staged
-            .map_err(write_err)?
-            .persist(output)
-            .map_err(|e| write_err(e.error))?;
-        report.output = Some(output.display().to_string());
-        return Ok(report);
-    }
-    drop(staged);
-    // Near the pole: the output is written as the stretches near the pole are patched
-    // (memory: the input and those stretches), to a temporary file renamed on success.
-    let mut tmp = temp_beside(output).map_err(write_err)?;
+    let mut sink = target.create(Some(input)).map_err(write_err)?;
     let mut report = {
-        let mut w = std::io::BufWriter::with_capacity(1 << 20, tmp.as_file_mut());
-        let report = polepatch::stream::patch_nc_to(&bytes, machine, &whole, &mut w);
-        let report = match report {
+        let mut w = std::io::BufWriter::with_capacity(1 << 20, &mut sink);
+        let report = match polepatch::patch_nc_to(&bytes, machine, &opts, &mut w) {
             Err(Error::Output(e)) => return Err(write_err(e)),
             r => r?,
         };
         w.flush().map_err(write_err)?;
         report
     };
-    finish_staged(&mut tmp, output, Some(input)).map_err(write_err)?;
-    tmp.persist(output).map_err(|e| write_err(e.error))?;
-    report.output = Some(output.display().to_string());
+    sink.commit().map_err(write_err)?;
+    report.output = Some(target.path.display().to_string());
     Ok(report)
-}
-
-/// Whether two paths name the same existing file: the same path once `.`, `..` and
-/// symbolic links are resolved, or (on Unix) the same device and inode, which also
-/// catches a case-insensitive file system's other spelling.
-pub fn same_file(a: &FsPath, b: &FsPath) -> bool {
-    if let (Ok(x), Ok(y)) = (a.canonicalize(), b.canonicalize())
-        && x == y
-    {
-        return true;
-    }
-    same_inode(a, b)
-}
-
-#[cfg(unix)]
-fn same_inode(a: &FsPath, b: &FsPath) -> bool {
-    use std::os::unix::fs::MetadataExt;
-    match (std::fs::metadata(a), std::fs::metadata(b)) {
-        (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
-        _ => false,
-    }
-}
-
-#[cfg(not(unix))]
-fn same_inode(_: &FsPath, _: &FsPath) -> bool {
-    false
-}
-
-/// Write `bytes` to `path` through a temporary file in the same folder and a rename.
-/// The file gets the permissions of the file it replaces, else those of `like` (the
-/// input), else rw-r--r-- — not the temporary file's owner-only mode.
-pub fn write_atomic_like(
-    path: &FsPath,
-    bytes: &[u8],
-    like: Option<&FsPath>,
-) -> std::io::Result<()> {
-    stage(path, bytes, like)?
-        .persist(path)
-        .map_err(|e| e.error)?;
-    Ok(())
-}
-
-/// The first half of [`write_atomic_like`]: `bytes` written and synced to a temporary
-/// file beside `path`, with the permissions it will have. `persist(path)` puts it in
-/// place; dropping it deletes it.
-pub fn stage(
-    path: &FsPath,
-    bytes: &[u8],
-    like: Option<&FsPath>,
-) -> std::io::Result<tempfile::NamedTempFile> {
-    let mut tmp = temp_beside(path)?;
-    tmp.write_all(bytes)?;
-    finish_staged(&mut tmp, path, like)?;
-    Ok(tmp)
-}
-
-/// An empty temporary file in `path`'s folder (deleted when dropped).
-fn temp_beside(path: &FsPath) -> std::io::Result<tempfile::NamedTempFile> {
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => FsPath::new("."),
-    };
-    tempfile::NamedTempFile::new_in(dir)
-}
-
-/// Sync a written temporary file and give it the permissions the file at `path` has,
-/// else those of `like`, else rw-r--r--.
-fn finish_staged(
-    tmp: &mut tempfile::NamedTempFile,
-    path: &FsPath,
-    like: Option<&FsPath>,
-) -> std::io::Result<()> {
-    let perms = std::fs::metadata(path)
-        .or_else(|e| like.map_or(Err(e), std::fs::metadata))
-        .map(|m| m.permissions())
-        .ok();
-    tmp.as_file().sync_all()?;
-    if let Some(perms) = perms.or_else(default_permissions) {
-        tmp.as_file().set_permissions(perms)?;
-    }
-    Ok(())
-}
-
-/// [`write_atomic_like`] without a model file (reports, CSV).
-pub fn write_atomic(path: &FsPath, bytes: &[u8]) -> std::io::Result<()> {
-    write_atomic_like(path, bytes, None)
-}
-
-#[cfg(unix)]
-fn default_permissions() -> Option<std::fs::Permissions> {
-    use std::os::unix::fs::PermissionsExt;
-    Some(std::fs::Permissions::from_mode(0o644))
-}
-
-#[cfg(not(unix))]
-fn default_permissions() -> Option<std::fs::Permissions> {
-    None
 }

@@ -60,7 +60,8 @@ pub(crate) struct PatchArgs {
     /// Write the per-zone rows of every file as CSV to this file.
     #[arg(long)]
     pub(crate) csv: Option<PathBuf>,
-    /// Exit with status 2 if any zone stays below feed.
+    /// Exit with status 2 if any zone stays below feed, or a run near the pole could not
+    /// be analysed (no feed, invalid values).
     #[arg(long)]
     pub(crate) strict: bool,
     /// Feed in mm/min for runs with no F in force.
@@ -156,6 +157,7 @@ pub(crate) fn parse_xyz(text: &str) -> Result<[f64; 3], String> {
 }
 
 fn main() -> ExitCode {
+    polepatch_cli::outputs::remove_temporaries_on_signal();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Analyze(args) => analyze(args),
@@ -167,10 +169,26 @@ fn main() -> ExitCode {
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("polepatch: error: {e:#}");
+            eprintln!("polepatch: error: {}", message(&e));
             ExitCode::from(1)
         }
     }
+}
+
+/// An error and its causes, `: `-separated, each cause once: a cause whose text the message
+/// already holds (an error that quotes its source) is not repeated.
+fn message(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let part = cause.to_string();
+        if !text.contains(&part) {
+            if !text.is_empty() {
+                text.push_str(": ");
+            }
+            text.push_str(&part);
+        }
+    }
+    text
 }
 
 mod bench_cmd;
@@ -180,6 +198,14 @@ mod reorient_cmd;
 
 pub(crate) fn machine(name: &str) -> Result<Machine> {
     Ok(Machine::load(name)?)
+}
+
+/// `--tcy-ms` within the range a machine file accepts (`kinematics::machine::TCY_MS_RANGE`).
+pub(crate) fn check_tcy_ms(v: Option<f64>) -> Result<()> {
+    if let Some(v) = v {
+        polepatch::kinematics::machine::check_tcy_ms("--tcy-ms", v).map_err(anyhow::Error::msg)?;
+    }
+    Ok(())
 }
 
 pub(crate) fn check_positive(name: &str, v: Option<f64>) -> Result<()> {
@@ -193,7 +219,7 @@ pub(crate) fn check_positive(name: &str, v: Option<f64>) -> Result<()> {
 
 fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
     check_positive("--feed", args.feed)?;
-    check_positive("--tcy-ms", args.tcy_ms)?;
+    check_tcy_ms(args.tcy_ms)?;
     check_positive("--cone", Some(args.cone))?;
     let machine = machine(&args.machine)?;
     let name = args.file.display().to_string();

@@ -5,7 +5,8 @@ use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use polepatch::patcher::{PatchAxes, PatchOptions};
 use polepatch::{FileReport, ZoneRow};
-use polepatch_cli::files::{JobError, patch_file, write_atomic};
+use polepatch_cli::files::{JobError, patch_to};
+use polepatch_cli::outputs::{Input, Output, plan};
 use rayon::prelude::*;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -14,7 +15,7 @@ use std::process::ExitCode;
 fn options(args: &PatchArgs) -> Result<PatchOptions> {
     check_positive("--cone", Some(args.cone))?;
     check_positive("--max-deviation", args.max_deviation)?;
-    check_positive("--tcy-ms", args.tcy_ms)?;
+    crate::check_tcy_ms(args.tcy_ms)?;
     check_positive("--feed", args.feed)?;
     check_positive("--max-patch-length", args.max_patch_length)?;
     if !(0.0..0.5).contains(&args.margin) {
@@ -44,29 +45,54 @@ fn options(args: &PatchArgs) -> Result<PatchOptions> {
     })
 }
 
-/// Files named on the command line; folders expand to the files in them (recursively,
-/// skipping hidden entries), each with its path relative to the folder's parent.
-fn expand(inputs: &[PathBuf]) -> Result<Vec<(PathBuf, PathBuf)>> {
+/// Files named on the command line, each with its path under `--out-dir`: a file given
+/// keeps its file name; a folder given expands to the regular files in it (recursively,
+/// skipping hidden entries, FIFOs and devices, not following links to folders), each under the folder's own name
+/// (its real name, so `.` and `..` too) followed by its path inside the folder. The
+/// relative paths are made of names only: they cannot leave `--out-dir`. The folder
+/// `skip` (`--out-dir`, when it lies inside an input folder) is not expanded: the outputs of
+/// an earlier run are not inputs.
+fn expand(inputs: &[PathBuf], skip: Option<&Path>) -> Result<Vec<(PathBuf, PathBuf)>> {
+    let skip = skip.and_then(|d| d.canonicalize().ok());
     let mut out = Vec::new();
     for input in inputs {
         if input.is_dir() {
-            let base = input.parent().unwrap_or(Path::new(""));
-            let mut stack = vec![input.clone()];
-            while let Some(dir) = stack.pop() {
-                let mut entries: Vec<_> = std::fs::read_dir(&dir)
+            let real = input
+                .canonicalize()
+                .with_context(|| format!("cannot read folder {}", input.display()))?;
+            let top = PathBuf::from(real.file_name().unwrap_or_default());
+            let mut stack = vec![(input.clone(), top)];
+            while let Some((dir, rel_dir)) = stack.pop() {
+                let mut entries: Vec<(PathBuf, bool)> = Vec::new();
+                for e in std::fs::read_dir(&dir)
                     .with_context(|| format!("cannot read folder {}", dir.display()))?
-                    .filter_map(|e| e.ok().map(|e| e.path()))
-                    .filter(|p| {
-                        !p.file_name()
-                            .is_some_and(|n| n.to_string_lossy().starts_with('.'))
-                    })
-                    .collect();
+                {
+                    let e = e.with_context(|| format!("cannot read folder {}", dir.display()))?;
+                    if e.file_name().to_string_lossy().starts_with('.') {
+                        continue;
+                    }
+                    let kind = e.file_type()?;
+                    // A link to a folder is not followed (a loop would never end).
+                    let is_dir = kind.is_dir();
+                    if kind.is_symlink() && e.path().is_dir() {
+                        continue;
+                    }
+                    if is_dir && skip.is_some() && e.path().canonicalize().ok() == skip {
+                        continue;
+                    }
+                    // Only regular files (or links to them) are programs: a FIFO or a
+                    // device in a folder would block or never end.
+                    if !is_dir && !e.path().is_file() {
+                        continue;
+                    }
+                    entries.push((e.path(), is_dir));
+                }
                 entries.sort();
-                for p in entries {
-                    if p.is_dir() {
-                        stack.push(p);
+                for (p, is_dir) in entries {
+                    let rel = rel_dir.join(p.file_name().unwrap_or_default());
+                    if is_dir {
+                        stack.push((p, rel));
                     } else {
-                        let rel = p.strip_prefix(base).unwrap_or(&p).to_path_buf();
                         out.push((p, rel));
                     }
                 }
@@ -79,6 +105,16 @@ fn expand(inputs: &[PathBuf]) -> Result<Vec<(PathBuf, PathBuf)>> {
     Ok(out)
 }
 
+/// The files a command reads besides its programs: the machine file, when `--machine`
+/// names one rather than a built-in.
+pub(crate) fn machine_input(name: &str) -> Vec<Input> {
+    if polepatch::kinematics::Machine::builtin(name).is_some() {
+        Vec::new()
+    } else {
+        vec![Input::new("the machine file", name)]
+    }
+}
+
 pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
     check_positive("--chord-tolerance", Some(args.chord_tolerance))?;
     let opts = polepatch::PatchOptions {
@@ -89,71 +125,78 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
         ..polepatch::PatchOptions::default()
     };
     let machine = machine(&args.machine)?;
-    for (flag, path) in [("--report", &args.report), ("--csv", &args.csv)] {
-        if let Some(path) = path {
-            for input in &args.inputs {
-                if input.is_file() && polepatch_cli::files::same_file(input, path) {
-                    bail!(
-                        "{flag} {} is the input file; polepatch never modifies its input",
-                        path.display()
-                    );
-                }
-            }
-        }
-    }
-    let mut names: Vec<PathBuf> = Vec::new();
-    let reports: Vec<Result<FileReport, JobError>> = match (&args.output, &args.out_dir) {
-        (Some(output), None) => {
+    // Every file this command reads and writes, checked together before anything is
+    // written (crate::outputs, docs/output-paths.md).
+    let files: Vec<(PathBuf, PathBuf)> = match (&args.output, &args.out_dir) {
+        (Some(_), None) => {
             if args.inputs.len() != 1 || args.inputs[0].is_dir() {
                 bail!("-o/--output takes one input file; use --out-dir for several or a folder");
             }
-            names.push(args.inputs[0].clone());
-            vec![patch_file(&args.inputs[0], output, &machine, &opts)]
+            vec![(args.inputs[0].clone(), PathBuf::new())]
         }
         (None, Some(dir)) => {
-            let files = expand(&args.inputs)?;
+            let files = expand(&args.inputs, Some(dir))?;
             if files.is_empty() {
                 bail!("no input files");
             }
-            names = files.iter().map(|(input, _)| input.clone()).collect();
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(args.jobs.unwrap_or(0))
-                .build()
-                .context("starting worker threads")?;
-            let bar = if std::io::stderr().is_terminal() && files.len() > 1 {
-                let b = ProgressBar::new(files.len() as u64);
-                b.set_style(
-                    ProgressStyle::with_template(
-                        "{bar:40} {pos}/{len} files {elapsed_precise} {msg}",
-                    )
-                    .expect("valid template"),
-                );
-                b
-            } else {
-                ProgressBar::hidden()
-            };
-            let out = pool.install(|| {
-                files
-                    .par_iter()
-                    .map(|(input, rel)| {
-                        let output = dir.join(rel);
-                        if let Some(parent) = output.parent() {
-                            std::fs::create_dir_all(parent).map_err(|cause| JobError::Write {
-                                path: parent.display().to_string(),
-                                cause,
-                            })?;
-                        }
-                        let r = patch_file(input, &output, &machine, &opts);
-                        bar.inc(1);
-                        r
-                    })
-                    .collect()
-            });
-            bar.finish_and_clear();
-            out
+            files
         }
         _ => bail!("give either -o OUTPUT (one input) or --out-dir DIR"),
     };
+    let mut inputs: Vec<Input> = files
+        .iter()
+        .map(|(input, _)| Input::new("the input", input))
+        .collect();
+    inputs.extend(machine_input(&args.machine));
+    let mut planned: Vec<Output> = Vec::new();
+    for (input, rel) in &files {
+        planned.push(match (&args.output, &args.out_dir) {
+            (Some(o), _) => Output::new("-o", o),
+            (_, Some(dir)) => Output::under(input, dir, rel)?,
+            _ => unreachable!("checked above"),
+        });
+    }
+    for (flag, path) in [("--report", &args.report), ("--csv", &args.csv)] {
+        if let Some(path) = path {
+            planned.push(Output::new(flag, path));
+        }
+    }
+    let targets = plan(&inputs, planned)?;
+    let names: Vec<PathBuf> = files.iter().map(|(input, _)| input.clone()).collect();
+    let reports: Vec<Result<FileReport, JobError>> = if files.len() == 1 && args.output.is_some() {
+        vec![patch_to(&files[0].0, &targets[0], &machine, &opts)]
+    } else {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(args.jobs.unwrap_or(0))
+            .build()
+            .context("starting worker threads")?;
+        let bar = if std::io::stderr().is_terminal() && files.len() > 1 {
+            let b = ProgressBar::new(files.len() as u64);
+            b.set_style(
+                ProgressStyle::with_template("{bar:40} {pos}/{len} files {elapsed_precise} {msg}")
+                    .expect("valid template"),
+            );
+            b
+        } else {
+            ProgressBar::hidden()
+        };
+        let out = pool.install(|| {
+            files
+                .par_iter()
+                .zip(&targets[..files.len()])
+                .map(|((input, _), target)| {
+                    let r = patch_to(input, target, &machine, &opts);
+                    bar.inc(1);
+                    r
+                })
+                .collect()
+        });
+        bar.finish_and_clear();
+        out
+    };
+    let mut extra = targets[files.len()..].iter();
+    let report_target = args.report.as_ref().and_then(|_| extra.next());
+    let csv_target = args.csv.as_ref().and_then(|_| extra.next());
 
     let mut ok: Vec<&FileReport> = Vec::new();
     let mut failed = 0;
@@ -186,18 +229,20 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
             );
         }
     }
-    if let Some(path) = &args.report {
+    if let Some(target) = report_target {
         let doc = if ok.len() == 1 && args.output.is_some() {
             serde_json::to_string_pretty(ok[0])?
         } else {
             serde_json::to_string_pretty(&ok)?
         };
-        write_atomic(path, doc.as_bytes())
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        target
+            .write(doc.as_bytes(), None)
+            .with_context(|| format!("cannot write {}", target.path.display()))?;
     }
-    if let Some(path) = &args.csv {
-        write_atomic(path, &csv_rows(&ok)?)
-            .with_context(|| format!("cannot write {}", path.display()))?;
+    if let Some(target) = csv_target {
+        target
+            .write(&csv_rows(&ok)?, None)
+            .with_context(|| format!("cannot write {}", target.path.display()))?;
     }
     let below: usize = ok.iter().map(|r| r.zones_below_feed()).sum();
     let unanalysed: usize = ok
@@ -222,10 +267,15 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
         return Ok(ExitCode::from(1));
     }
     if args.strict && below + unanalysed > 0 {
-        eprintln!(
-            "polepatch: {below} zone(s) stay below feed, {unanalysed} run(s) or line range(s) \
-             not analysed (--strict)"
-        );
+        if below > 0 {
+            eprintln!("polepatch: {below} zone(s) stay below feed (--strict)");
+        }
+        if unanalysed > 0 {
+            eprintln!(
+                "polepatch: {unanalysed} run(s) near the pole or line range(s) could not be \
+                 analysed (see the warnings above): whether they reach feed is unknown (--strict)"
+            );
+        }
         return Ok(ExitCode::from(2));
     }
     Ok(ExitCode::SUCCESS)

@@ -5,7 +5,8 @@ use anyhow::{Context, Result, bail};
 use polepatch::kinematics::BranchRule;
 use polepatch::nc::Dialect;
 use polepatch::post::{PostOptions, post_cl, read_cl};
-use polepatch_cli::files::{read, same_file, write_atomic, write_atomic_like};
+use polepatch_cli::files::read;
+use polepatch_cli::outputs::{Input, Output, plan};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -68,9 +69,13 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
     }
     let machine = machine(&args.machine)?;
     let name = args.cl.display().to_string();
-    if same_file(&args.cl, &args.output) {
-        bail!("{name}: the output would overwrite the input; polepatch never modifies its input");
+    let mut inputs = vec![Input::new("the CL input", &args.cl)];
+    inputs.extend(crate::patch::machine_input(&args.machine));
+    let mut outputs = vec![Output::new("-o", &args.output)];
+    if let Some(path) = &args.report {
+        outputs.push(Output::new("--report", path));
     }
+    let targets = plan(&inputs, outputs)?;
     let cl = read_cl(&read(&args.cl)?, &name)?;
     let opts = PostOptions {
         dialect: match args.dialect {
@@ -94,7 +99,8 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
         linear_decimals: 3,
     };
     let (bytes, report) = post_cl(&cl, &machine, &opts)?;
-    write_atomic_like(&args.output, &bytes, None)
+    targets[0]
+        .write(&bytes, None)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
     for n in &cl.notes {
         eprintln!("polepatch: note: {name}: {n}");
@@ -109,9 +115,10 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
                 r.zones.len(),
                 r.words_changed
             );
-            if let Some(path) = &args.report {
-                write_atomic(path, serde_json::to_string_pretty(r)?.as_bytes())
-                    .with_context(|| format!("cannot write {}", path.display()))?;
+            if let Some(target) = targets.get(1) {
+                target
+                    .write(serde_json::to_string_pretty(r)?.as_bytes(), None)
+                    .with_context(|| format!("cannot write {}", target.path.display()))?;
             }
         }
         None => println!(

@@ -5,7 +5,8 @@ use anyhow::{Context, Result, bail};
 use plotters::prelude::*;
 use polepatch::program::load_nc;
 use polepatch::reorient::{ReorientReport, Tilt, pole_after, reorient_nc, search, tool_axes};
-use polepatch_cli::files::{read, same_file, write_atomic_like};
+use polepatch_cli::files::read;
+use polepatch_cli::outputs::{Input, Output, plan};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -51,11 +52,21 @@ pub(crate) fn run(args: ReorientArgs) -> Result<ExitCode> {
     }
     let machine = machine(&args.machine)?;
     let name = args.file.display().to_string();
-    if let Some(out) = &args.output
-        && same_file(&args.file, out)
-    {
-        bail!("{name}: the output would overwrite the input; polepatch never modifies its input");
+    let mut inputs = vec![Input::new("the input", &args.file)];
+    inputs.extend(crate::patch::machine_input(&args.machine));
+    let mut outputs = Vec::new();
+    if let Some(path) = &args.output {
+        outputs.push(Output::new("-o", path));
     }
+    if let Some(path) = &args.plot {
+        outputs.push(Output::new("--plot", path));
+    }
+    let targets = plan(&inputs, outputs)?;
+    let mut targets = targets.iter();
+    let (out_target, plot_target) = (
+        args.output.as_ref().and_then(|_| targets.next()),
+        args.plot.as_ref().and_then(|_| targets.next()),
+    );
     let bytes = read(&args.file)?;
     let pivot = args.pivot.unwrap_or([0.0; 3]);
     let (out, report) = match (args.theta_x, args.theta_z) {
@@ -69,11 +80,13 @@ pub(crate) fn run(args: ReorientArgs) -> Result<ExitCode> {
         }
         _ => search(&bytes, &machine, pivot, &name, args.cone)?,
     };
-    if let Some(path) = &args.output {
-        write_atomic_like(path, &out, Some(&args.file))
-            .with_context(|| format!("cannot write {}", path.display()))?;
+    if let Some(target) = out_target {
+        target
+            .write(&out, Some(&args.file))
+            .with_context(|| format!("cannot write {}", target.path.display()))?;
     }
-    if let Some(path) = &args.plot {
+    if let Some(target) = plot_target {
+        let path = &target.path;
         let lp = load_nc(bytes, &name, &machine, None)?;
         let axes = tool_axes(&lp, &machine);
         let tilt = Tilt {
@@ -83,7 +96,8 @@ pub(crate) fn run(args: ReorientArgs) -> Result<ExitCode> {
         };
         let svg = sphere_svg(&axes, pole_after(&tilt), &report, args.cone)
             .map_err(|e| anyhow::anyhow!("drawing {}: {e}", path.display()))?;
-        write_atomic_like(path, svg.as_bytes(), None)
+        target
+            .write(svg.as_bytes(), None)
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     if args.json {

@@ -164,7 +164,10 @@ fn refusals() {
         "mikron-ucp710",
     ]);
     assert_eq!(code, 1);
-    assert!(err.contains("would overwrite the input"), "{err}");
+    assert!(
+        err.contains("polepatch never writes over a file it reads"),
+        "{err}"
+    );
     assert_eq!(std::fs::read(&input).unwrap(), before);
     // A syntax error: no output file at all.
     let bad = dir.join("bad.nc");

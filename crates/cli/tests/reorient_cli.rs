@@ -80,7 +80,10 @@ fn leaving_the_range_is_refused_with_the_line_and_nothing_written() {
         "fixtures/c17/SING.I",
     ]);
     assert_eq!(code, 1);
-    assert!(err.contains("would overwrite the input"), "{err}");
+    assert!(
+        err.contains("polepatch never writes over a file it reads"),
+        "{err}"
+    );
     // One angle alone is a usage error.
     let (code, _, _) = polepatch(&[
         "reorient",

@@ -109,12 +109,12 @@ pub enum MachineError {
         builtins: String,
     },
     /// File could not be read.
-    #[error("cannot read machine file {path}: {source}")]
+    #[error("cannot read machine file {path}: {cause}")]
     Io {
         /// Path.
         path: String,
-        /// Cause.
-        source: std::io::Error,
+        /// Cause (in the message, not a `source()`: an error chain would print it twice).
+        cause: std::io::Error,
     },
     /// TOML is malformed or a field is invalid.
     #[error("machine file {path}: {message}")]
@@ -171,6 +171,10 @@ impl Machine {
     /// tcpm_always = false              # true: kinematics always TCP
     /// ```
     ///
+    /// Every limit must lie within [`LIMIT_MIN`, `LIMIT_MAX`] = 0.001 to 10⁶ in the file's
+    /// units, `tcy_ms` within [`TCY_MS_RANGE`] = 0.1 to 100 ms, a `range_deg` must have
+    /// exactly two values and a chain point exactly three (an error names the field).
+    ///
     /// Limits are converted once to internal units: m/min → mm/s ×1000/60, m/s² → mm/s²
     /// ×1000, m/s³ → mm/s³ ×1000, rpm → °/s ×6, rev/s² → °/s² ×360, rev/s³ → °/s³ ×360.
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Machine, MachineError> {
@@ -183,7 +187,9 @@ impl Machine {
     }
     /// A built-in name or a path to a TOML file.
     ///
-    /// Built-in names win over files of the same name in the working directory.
+    /// Built-in names win over files of the same name in the working directory. At most
+    /// [`MAX_MACHINE_FILE_BYTES`] are read (a device such as `/dev/zero` or a FIFO is read
+    /// up to that bound, never without limit); a longer file is an error.
     pub fn load(name_or_path: &str) -> Result<Machine, MachineError> {
         if let Some(m) = Machine::builtin(name_or_path) {
             return Ok(m);
@@ -195,9 +201,9 @@ impl Machine {
                 builtins: Machine::builtin_names().join(", "),
             });
         }
-        let text = std::fs::read_to_string(path).map_err(|source| MachineError::Io {
+        let text = read_bounded(path).map_err(|cause| MachineError::Io {
             path: name_or_path.to_string(),
-            source,
+            cause,
         })?;
         Machine::from_toml_str(&text, name_or_path)
     }
@@ -223,6 +229,67 @@ fn builtin_toml(name: &str) -> Option<&'static str> {
     }
 }
 
+/// Largest machine file read, bytes (1 MiB; a machine description is under 2 KB). A longer
+/// file, or a device that never ends (`/dev/zero`), is refused rather than read whole.
+pub const MAX_MACHINE_FILE_BYTES: u64 = 1 << 20;
+
+/// Smallest kinematic limit accepted, in the file's units (m/min, m/s², m/s³, rpm, rev/s²,
+/// rev/s³). The slowest axis of a real machine is orders of magnitude above it; a value
+/// below is a unit mistake, and would make every time estimate astronomically long.
+pub const LIMIT_MIN: f64 = 1e-3;
+/// Largest kinematic limit accepted, in the file's units (the fastest real axes are below
+/// 10⁴ in every one of them).
+pub const LIMIT_MAX: f64 = 1e6;
+/// Range of the interpolation cycle time `tcy_ms` accepted, milliseconds: controllers
+/// interpolate every 0.1 ms (the fastest) to a few ms; 100 ms is a generous bound, and the
+/// analysis samples every F·Tcy, so a Tcy far below 0.1 ms only multiplies the work.
+pub const TCY_MS_RANGE: (f64, f64) = (0.1, 100.0);
+
+/// The whole file at `path`, as text, reading at most [`MAX_MACHINE_FILE_BYTES`] + 1
+/// bytes: more is an error, as is text that is not UTF-8.
+fn read_bounded(path: &std::path::Path) -> std::io::Result<String> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(MAX_MACHINE_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MAX_MACHINE_FILE_BYTES {
+        return Err(std::io::Error::other(format!(
+            "longer than {MAX_MACHINE_FILE_BYTES} bytes (a machine description is a short TOML \
+             file); is it the right file?"
+        )));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "not UTF-8 text (byte {} is not valid); a machine file is TOML",
+                e.utf8_error().valid_up_to() + 1
+            ),
+        )
+    })
+}
+
+/// A number for a message: the shortest form that reads back as the value (`1e-300`, not
+/// three hundred digits), without a trailing `.0`.
+fn num(v: f64) -> String {
+    let text = format!("{v:?}");
+    text.strip_suffix(".0").map_or(text.clone(), str::to_string)
+}
+
+/// `tcy_ms` within [`TCY_MS_RANGE`]; `name` is the field or option named in the error.
+pub fn check_tcy_ms(name: &str, tcy_ms: f64) -> Result<f64, String> {
+    let (lo, hi) = TCY_MS_RANGE;
+    if tcy_ms.is_finite() && (lo..=hi).contains(&tcy_ms) {
+        Ok(tcy_ms)
+    } else {
+        Err(format!(
+            "{name} must be a cycle time from {lo} to {hi} ms, got {}",
+            num(tcy_ms)
+        ))
+    }
+}
+
 /// mm/s per m/min.
 const MM_S_PER_M_MIN: f64 = 1000.0 / 60.0;
 /// mm per m (for m/s² and m/s³).
@@ -245,9 +312,42 @@ struct MachineFile {
     z: LinearFile,
     primary: PrimaryFile,
     c: CFile,
-    chain: Option<crate::chain::Chain>,
+    chain: Option<ChainFile>,
     #[serde(default)]
     controller: Controller,
+}
+
+/// `[chain]` as written: arrays of any length, checked for three values each (a fixed-size
+/// array would be filled from the first three values and the rest ignored).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ChainFile {
+    primary_axis_point_mm: Vec<f64>,
+    c_axis_point_mm: Vec<f64>,
+}
+
+impl ChainFile {
+    fn into_chain(self) -> Result<crate::chain::Chain, String> {
+        let chain = crate::chain::Chain {
+            primary_axis_point_mm: exactly(
+                "chain.primary_axis_point_mm",
+                &self.primary_axis_point_mm,
+            )?,
+            c_axis_point_mm: exactly("chain.c_axis_point_mm", &self.c_axis_point_mm)?,
+        };
+        chain.validate()?;
+        Ok(chain)
+    }
+}
+
+/// The `N` values of an array field, or an error naming it when it has another length.
+fn exactly<const N: usize>(field: &str, values: &[f64]) -> Result<[f64; N], String> {
+    values.try_into().map_err(|_| {
+        format!(
+            "{field} must have {N} values, got {}: {values:?}",
+            values.len()
+        )
+    })
 }
 
 /// `[x]`, `[y]`, `[z]`.
@@ -265,7 +365,7 @@ struct LinearFile {
 struct PrimaryFile {
     letter: PrimaryAxis,
     sense: f64,
-    range_deg: [f64; 2],
+    range_deg: Vec<f64>,
     v_rpm: f64,
     a_rev_s2: f64,
     j_rev_s3: f64,
@@ -276,19 +376,31 @@ struct PrimaryFile {
 #[serde(deny_unknown_fields)]
 struct CFile {
     sense: f64,
-    range_deg: Option<[f64; 2]>,
+    range_deg: Option<Vec<f64>>,
     v_rpm: f64,
     a_rev_s2: f64,
     j_rev_s3: f64,
 }
 
-/// A limit must be positive and finite; `field` is its dotted TOML name.
+/// A limit must be positive, finite and within [`LIMIT_MIN`, `LIMIT_MAX`] (file units);
+/// `field` is its dotted TOML name.
 fn positive(field: &str, value: f64) -> Result<f64, String> {
-    if value.is_finite() && value > 0.0 {
-        Ok(value)
-    } else {
-        Err(format!("{field} must be positive and finite, got {value}"))
+    if !(value.is_finite() && value > 0.0) {
+        return Err(format!(
+            "{field} must be positive and finite, got {}",
+            num(value)
+        ));
     }
+    if !(LIMIT_MIN..=LIMIT_MAX).contains(&value) {
+        return Err(format!(
+            "{field} = {} is outside the accepted range {} to {} (in the file's units; a \
+             unit mistake?)",
+            num(value),
+            num(LIMIT_MIN),
+            num(LIMIT_MAX)
+        ));
+    }
+    Ok(value)
 }
 
 /// A sense must be exactly +1 or −1.
@@ -296,18 +408,26 @@ fn sense(field: &str, value: f64) -> Result<f64, String> {
     if value == 1.0 || value == -1.0 {
         Ok(value)
     } else {
-        Err(format!("{field} must be +1 or -1, got {value}"))
+        Err(format!("{field} must be +1 or -1, got {}", num(value)))
     }
 }
 
-/// A range must be finite with min < max.
-fn range(field: &str, r: [f64; 2]) -> Result<(f64, f64), String> {
-    let [lo, hi] = r;
+/// A range must be two finite values with min < max.
+fn range(field: &str, r: &[f64]) -> Result<(f64, f64), String> {
+    let [lo, hi] = exactly(field, r)?;
     if !(lo.is_finite() && hi.is_finite()) {
-        return Err(format!("{field} must be finite, got [{lo}, {hi}]"));
+        return Err(format!(
+            "{field} must be finite, got [{}, {}]",
+            num(lo),
+            num(hi)
+        ));
     }
     if lo >= hi {
-        return Err(format!("{field}: min must be below max, got [{lo}, {hi}]"));
+        return Err(format!(
+            "{field}: min must be below max, got [{}, {}]",
+            num(lo),
+            num(hi)
+        ));
     }
     Ok((lo, hi))
 }
@@ -339,10 +459,7 @@ fn rotary_limits(
 impl MachineFile {
     /// Validate and convert to internal units; the error names the field.
     fn into_machine(self) -> Result<Machine, String> {
-        let tcy_ms = self.tcy_ms.unwrap_or(1.0);
-        if !(tcy_ms.is_finite() && tcy_ms > 0.0) {
-            return Err(format!("tcy_ms must be positive and finite, got {tcy_ms}"));
-        }
+        let tcy_ms = check_tcy_ms("tcy_ms", self.tcy_ms.unwrap_or(1.0))?;
         let p = &self.primary;
         let c = &self.c;
         Ok(Machine {
@@ -350,8 +467,12 @@ impl MachineFile {
             primary: p.letter,
             primary_sense: sense("primary.sense", p.sense)?,
             c_sense: sense("c.sense", c.sense)?,
-            primary_range_deg: range("primary.range_deg", p.range_deg)?,
-            c_range_deg: c.range_deg.map(|r| range("c.range_deg", r)).transpose()?,
+            primary_range_deg: range("primary.range_deg", &p.range_deg)?,
+            c_range_deg: c
+                .range_deg
+                .as_deref()
+                .map(|r| range("c.range_deg", r))
+                .transpose()?,
             tcy_s: tcy_ms / 1000.0,
             limits: [
                 self.x.limits("x")?,
@@ -360,13 +481,7 @@ impl MachineFile {
                 rotary_limits("primary", p.v_rpm, p.a_rev_s2, p.j_rev_s3)?,
                 rotary_limits("c", c.v_rpm, c.a_rev_s2, c.j_rev_s3)?,
             ],
-            chain: match self.chain {
-                Some(ch) => {
-                    ch.validate()?;
-                    Some(ch)
-                }
-                None => None,
-            },
+            chain: self.chain.map(ChainFile::into_chain).transpose()?,
             controller: {
                 for (field, codes) in [
                     ("controller.tcpm_on", &self.controller.tcpm_on),
@@ -579,12 +694,54 @@ j_rev_s3 = 1
             (
                 "tcy_ms = 2.0",
                 "tcy_ms = 0.0",
-                "tcy_ms must be positive and finite, got 0",
+                "tcy_ms must be a cycle time from 0.1 to 100 ms, got 0",
             ),
             (
                 "tcy_ms = 2.0",
                 "tcy_ms = -1.0",
-                "tcy_ms must be positive and finite, got -1",
+                "tcy_ms must be a cycle time from 0.1 to 100 ms, got -1",
+            ),
+            (
+                "tcy_ms = 2.0",
+                "tcy_ms = 1e-300",
+                "tcy_ms must be a cycle time from 0.1 to 100 ms, got 1e-300",
+            ),
+            (
+                "tcy_ms = 2.0",
+                "tcy_ms = 1000",
+                "tcy_ms must be a cycle time from 0.1 to 100 ms, got 1000",
+            ),
+            // Issue 19: v_rpm = 1e-300 made a 300-digit time estimate.
+            (
+                "v_rpm = 10",
+                "v_rpm = 1e-300",
+                "primary.v_rpm = 1e-300 is outside the accepted range 0.001 to 1000000",
+            ),
+            (
+                "[x]\nv_m_min = 60\na_m_s2 = 1",
+                "[x]\nv_m_min = 60\na_m_s2 = 1e300",
+                "x.a_m_s2 = 1e300 is outside the accepted range",
+            ),
+            (
+                "360.0]\nv_rpm = 10\na_rev_s2 = 1\nj_rev_s3 = 1",
+                "360.0]\nv_rpm = 10\na_rev_s2 = 1\nj_rev_s3 = 0.0001",
+                "c.j_rev_s3 = 0.0001 is outside the accepted range",
+            ),
+            // Issue 19: a third value was silently dropped.
+            (
+                "range_deg = [-30, 110]",
+                "range_deg = [-30, 110, 5]",
+                "primary.range_deg must have 2 values, got 3: [-30.0, 110.0, 5.0]",
+            ),
+            (
+                "range_deg = [-30, 110]",
+                "range_deg = [-30]",
+                "primary.range_deg must have 2 values, got 1",
+            ),
+            (
+                "range_deg = [-360.0, 360.0]",
+                "range_deg = [-360.0, 360.0, 0.0]",
+                "c.range_deg must have 2 values, got 3",
             ),
             (
                 "j_rev_s3 = 1\n[c]",
@@ -604,6 +761,84 @@ j_rev_s3 = 1
                 "edit {to:?}: message {msg:?} lacks {want:?}"
             );
         }
+    }
+
+    #[test]
+    fn limits_at_the_bounds_are_accepted() {
+        let text = GOOD
+            .replace("v_rpm = 10", "v_rpm = 0.001")
+            .replace("[x]\nv_m_min = 60", "[x]\nv_m_min = 1000000")
+            .replace("tcy_ms = 2.0", "tcy_ms = 0.1");
+        let m = Machine::from_toml_str(&text, "t").unwrap();
+        assert!(close(m.limit(Axis::Primary).v, 0.006));
+        assert!(close(m.tcy_s, 0.0001));
+        let text = GOOD.replace("tcy_ms = 2.0", "tcy_ms = 100");
+        assert!(close(
+            Machine::from_toml_str(&text, "t").unwrap().tcy_s,
+            0.1
+        ));
+    }
+
+    #[test]
+    fn chain_points_need_exactly_three_values() {
+        let chain = "[chain]\nprimary_axis_point_mm = [0.0, 0.0, -150.0]\nc_axis_point_mm = [0.0, 0.0, -100.0]\n";
+        let m = Machine::from_toml_str(&format!("{GOOD}{chain}"), "t").unwrap();
+        assert_eq!(m.chain.unwrap().c_axis_point_mm, [0.0, 0.0, -100.0]);
+        let four = chain.replace("[0.0, 0.0, -100.0]", "[0.0, 0.0, -100.0, 7.0]");
+        let msg = invalid_message(&format!("{GOOD}{four}"));
+        assert!(
+            msg.contains("chain.c_axis_point_mm must have 3 values, got 4"),
+            "{msg}"
+        );
+        let two = chain.replace("[0.0, 0.0, -150.0]", "[0.0, -150.0]");
+        let msg = invalid_message(&format!("{GOOD}{two}"));
+        assert!(
+            msg.contains("chain.primary_axis_point_mm must have 3 values, got 2"),
+            "{msg}"
+        );
+    }
+
+    /// Issue 19: `--machine /dev/zero` was read without limit.
+    #[cfg(unix)]
+    #[test]
+    fn an_endless_or_huge_machine_file_is_refused_after_a_bounded_read() {
+        let msg = Machine::load("/dev/zero").unwrap_err().to_string();
+        assert!(
+            msg.contains("/dev/zero") && msg.contains("longer than 1048576 bytes"),
+            "{msg}"
+        );
+        let dir = std::env::temp_dir().join(format!("polepatch-kin-big-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let big = dir.join("big.toml");
+        // A valid machine padded with a comment past the bound.
+        let mut text = GOOD.to_string();
+        text.push('#');
+        text.push_str(&"x".repeat(MAX_MACHINE_FILE_BYTES as usize));
+        std::fs::write(&big, &text).unwrap();
+        let msg = Machine::load(big.to_str().unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("longer than"), "{msg}");
+        // Exactly at the bound it is read.
+        text.truncate(MAX_MACHINE_FILE_BYTES as usize);
+        std::fs::write(&big, &text).unwrap();
+        assert_eq!(
+            Machine::load(big.to_str().unwrap()).unwrap().name,
+            "test-bc"
+        );
+        std::fs::write(&big, b"name = \"\xff\"\n").unwrap();
+        let msg = Machine::load(big.to_str().unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("not UTF-8"), "{msg}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn an_io_error_is_printed_once_in_an_error_chain() {
+        let dir = std::env::temp_dir();
+        let err = Machine::load(dir.to_str().unwrap()).unwrap_err();
+        assert!(std::error::Error::source(&err).is_none(), "{err:?}");
     }
 
     #[test]

@@ -9,8 +9,9 @@ use polepatch_nc::ParseError;
 /// and column where the input is at fault.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
-    /// Syntax error with line and column.
-    #[error("{0}")]
+    /// Syntax error with line and column. Transparent: its message is the parse error's,
+    /// and it is not also given as a `source()` (an error chain would print it twice).
+    #[error(transparent)]
     Parse(#[from] ParseError),
     /// Nothing but whitespace.
     #[error("{path}: empty program")]
@@ -53,7 +54,7 @@ pub enum Error {
         record: polepatch_cl::ClError,
     },
     /// The output could not be written (to the writer given to
-    /// [`crate::stream::patch_nc_to`]).
+    /// [`crate::patch_nc_to`]).
     #[error("cannot write the output: {0}")]
     Output(std::io::Error),
     /// Bad options (a value out of range), named.

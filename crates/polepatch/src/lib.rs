@@ -11,8 +11,8 @@
 //! ```
 //!
 //! [`patch_nc`] and [`analyze_nc`] are the entry points for NC programs held in memory
-//! ([`stream::patch_nc_to`] writes the output to a writer as it goes, parsing in full only
-//! the stretches near the pole); [`program::load_nc`] + [`patch::patch_loaded`] the same
+//! ([`patch_nc_to`] writes the output to a writer as it goes, parsing in full only the
+//! stretches near the pole); [`program::load_nc`] + [`patch::patch_loaded`] the same
 //! on the whole parsed program, for callers that want it (the quality suite). CAM plugins that hold CL points rather
 //! than a file use the patcher directly on a [`patcher::Path`].
 //!
@@ -102,7 +102,7 @@ impl Default for AnalyzeOptions {
 }
 
 /// Patch an NC program held in memory: the rewritten bytes (identical to `bytes` except
-/// the rotary words that had to change) and the report.
+/// the rotary words that had to change) and the report. [`patch_nc_to`] into a `Vec`.
 ///
 /// Programs of up to 4 GiB are read (the reader's byte offsets are 32-bit); memory is about
 /// twice the input for a program far from the pole, plus about ten times each run near it
@@ -124,12 +124,31 @@ pub fn patch_nc(
             what: "the output",
             bytes: bytes.len(),
         })?;
-    if let Some(report) = far::far_from_pole(bytes, machine, opts)? {
-        out.extend_from_slice(bytes);
-        return Ok((out, report));
-    }
-    let report = stream::patch_nc_to(bytes, machine, opts, &mut out)?;
+    let report = patch_nc_to(bytes, machine, opts, &mut out)?;
     Ok((out, report))
+}
+
+/// Patch an NC program held in memory, writing the output to `out`: the one entry every
+/// caller goes through (the CLI's file jobs, [`patch_nc`], hence the C ABI and `post`).
+///
+/// 1. [`far::far_from_pole`]: a streaming scan on all cores; a program with no run point
+///    within the cone has no zone, and its output is its input, written in one piece.
+/// 2. Otherwise [`stream::patch_nc_to`]: the stretches near the pole are parsed, patched
+///    and written in file order, everything between them copied.
+///
+/// On an error nothing more is written; what was written before it must be discarded by
+/// the caller (the CLI writes to a temporary file). A failed write is [`Error::Output`].
+pub fn patch_nc_to(
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &PatchOptions,
+    out: &mut dyn std::io::Write,
+) -> Result<FileReport, Error> {
+    if let Some(report) = far::far_from_pole(bytes, machine, opts)? {
+        out.write_all(bytes).map_err(Error::Output)?;
+        return Ok(report);
+    }
+    stream::patch_nc_to(bytes, machine, opts, out)
 }
 
 /// Equation 6 along every run of an NC program held in memory (what `polepatch analyze`

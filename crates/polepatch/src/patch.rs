@@ -67,7 +67,8 @@ pub struct ZoneRow {
     pub min_abs_primary_deg: f64,
     /// Before patching.
     pub before: FiguresRow,
-    /// After patching, on the values as written.
+    /// After patching, on the values as written (the `before` figures when the patch was
+    /// not written).
     pub after: FiguresRow,
     /// L/F over the zone, s.
     pub ideal_time_s: f64,
@@ -114,6 +115,24 @@ pub fn feed_mode_name(m: polepatch_nc::FeedMode) -> &'static str {
         polepatch_nc::FeedMode::PerMinute => "G94",
         polepatch_nc::FeedMode::InverseTime => "G93",
         polepatch_nc::FeedMode::PerRevolution => "G95",
+    }
+}
+
+impl ZoneRow {
+    /// The row of a zone whose patch was found but not written (the run keeps its values,
+    /// [`UntouchedRun`] says why): outcome `unchanged`, the figures after are the figures
+    /// before, nothing deviates or moves. The method and solver figures stay: they say what
+    /// was tried.
+    pub fn not_written(&mut self) {
+        self.outcome = "unchanged";
+        self.after = self.before.clone();
+        self.max_deviation_deg = 0.0;
+        self.points_modified = 0;
+        self.primary_points_modified = 0;
+        self.branch_reselected = false;
+        self.reselected_points = 0;
+        self.patch_length_mm = 0.0;
+        self.c_offset_deg = 0.0;
     }
 }
 
@@ -287,6 +306,10 @@ pub struct UntouchedRun {
     pub reason: UntouchedReason,
     /// Singular zones the run holds (reported in [`FileReport::zones`] as `unchanged`).
     pub zones: usize,
+    /// A point of the run is within the singular cone, or its primary value is not stated:
+    /// the run may hold a zone. With `zones` = 0 such a run was not analysed (no feed,
+    /// invalid values), so whether it reaches feed is unknown ([`FileReport::runs_not_analysed`]).
+    pub near_pole: bool,
     /// The message for people.
     pub message: String,
 }
@@ -341,29 +364,24 @@ impl FileReport {
             zones: Vec::new(),
         }
     }
-    /// What `--strict` counts as a failure: zones that stay below feed (those of untouched
-    /// runs included), runs that could not be analysed (no feed, a feed too low, G93 with
-    /// differing feeds, invalid values) and lines carried through without analysis.
-    pub fn strict_failures(&self) -> usize {
-        let unanalysed_runs = self
-            .untouched_runs
-            .iter()
-            .filter(|u| {
-                matches!(
-                    u.reason,
-                    UntouchedReason::NoFeed
-                        | UntouchedReason::FeedTooLow
-                        | UntouchedReason::InverseTimeVarying
-                        | UntouchedReason::UnknownRotary
-                        | UntouchedReason::Invalid
-                )
-            })
-            .count();
-        self.zones_below_feed() + unanalysed_runs + self.not_analysed.len()
-    }
     /// Zones that stay below feed (including those of untouched runs).
     pub fn zones_below_feed(&self) -> usize {
         self.zones.iter().filter(|z| z.outcome != "reached").count()
+    }
+    /// What `--strict` counts as a failure: zones that stay below feed (those of untouched
+    /// runs included), runs near the pole that could not be analysed (no feed, a feed too
+    /// low, G93 with differing feeds, an unknown rotary value, invalid values:
+    /// [`FileReport::runs_not_analysed`]) and lines carried through without analysis.
+    pub fn strict_failures(&self) -> usize {
+        self.zones_below_feed() + self.runs_not_analysed() + self.not_analysed.len()
+    }
+    /// Runs that may hold a zone (a point within the cone) but could not be analysed (no
+    /// feed, invalid values): whether they reach feed is unknown.
+    pub fn runs_not_analysed(&self) -> usize {
+        self.untouched_runs
+            .iter()
+            .filter(|u| u.near_pole && u.zones == 0)
+            .count()
     }
     /// Runs left because no TCPM is active although they hold a singular zone.
     pub fn runs_left_without_tcpm(&self) -> usize {
@@ -410,6 +428,7 @@ pub fn patch_program(
                     problem_reason(problem),
                     0,
                     problem.to_string(),
+                    opts.cone_deg,
                 ));
             }
         }
@@ -446,6 +465,7 @@ pub fn patch_program(
                     problem_reason(problem),
                     0,
                     problem.to_string(),
+                    opts.cone_deg,
                 ));
                 continue;
             }
@@ -511,6 +531,7 @@ pub fn patch_program(
                             reason,
                             zones.len(),
                             message.to_string(),
+                            opts.cone_deg,
                         ));
                     }
                 }
@@ -520,6 +541,7 @@ pub fn patch_program(
                     UntouchedReason::Invalid,
                     0,
                     e.to_string(),
+                    opts.cone_deg,
                 )),
             }
             continue;
@@ -552,6 +574,7 @@ pub fn patch_program(
                     UntouchedReason::Invalid,
                     0,
                     e.to_string(),
+                    opts.cone_deg,
                 ));
                 continue;
             }
@@ -578,7 +601,7 @@ pub fn patch_program(
                 Ok(xyz) => run_edits = xyz,
                 Err(why) => {
                     for row in &mut report.zones[first_row..] {
-                        row.outcome = "unchanged";
+                        row.not_written();
                     }
                     report.untouched_runs.push(untouched(
                         lp,
@@ -586,6 +609,7 @@ pub fn patch_program(
                         UntouchedReason::MachineFrame,
                         result.zones.len(),
                         why,
+                        opts.cone_deg,
                     ));
                     continue;
                 }
@@ -808,12 +832,19 @@ fn untouched(
     reason: UntouchedReason,
     zones: usize,
     message: String,
+    cone_deg: f64,
 ) -> UntouchedRun {
+    let pi = lp.primary_index();
     UntouchedRun {
         run: lp.run_number(r),
         lines: lp.lines_of_run(r),
         reason,
         zones,
+        near_pole: lp.runs[r]
+            .run
+            .pos
+            .iter()
+            .any(|p| p[pi].is_none_or(|v| v.abs() <= cone_deg)),
         message,
     }
 }

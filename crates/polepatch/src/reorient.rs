@@ -4,14 +4,18 @@
 //! # Given angles ([`reorient_nc`])
 //! For every move with TCPM on, the tool orientation `O_W = forward(P, C)` is rotated,
 //! `Ō_W = R_x(θx)·R_z(θz)·O_W` (C17 eq. 7, [`polepatch_kinematics::JigRotation`]), and the
-//! new primary and C come from the inverse kinematics, branch nearest to the previous
-//! point (continuous, C unwrapped; the first move continues from its own original
-//! values), inside the primary range; the tool tip is rotated the
-//! same way about the pivot (default: the program's origin). Words are written in the
+//! new primary and C come from the inverse kinematics, inside the primary range. Branch:
+//! for |θx| below [`BRANCH_KEEP_DEG`] every move keeps the program's own branch (its side
+//! of the pole), so θ = 0 changes nothing (byte for byte) and a tiny tilt keeps every
+//! branch; from it on, the branch nearest to the previous move (continuous, C unwrapped;
+//! the first move continues from its own original values). The tool tip is rotated
+//! the same way about the pivot (default: the program's origin). Words are written in the
 //! file's style with at least [`MIN_DECIMALS`] decimals; a block that relied on a modal
 //! value gets a word only where its new value differs from what it now inherits.
 //!
 //! Explicit rules:
+//! - |θx| ≤ [`MAX_THETA_X_DEG`] (90°) and |θz| ≤ [`MAX_THETA_Z_DEG`] (360°), finite;
+//!   other angles are refused ([`Error::Options`]);
 //! - blocks with TCPM off are machine-coordinate moves (approach, retract, home): left as
 //!   they are, and the report lists their lines — check them against the jig;
 //! - a program with no move under TCPM is refused (nothing could be reoriented safely);
@@ -36,8 +40,9 @@
 use crate::error::Error;
 use crate::program::{LoadedProgram, load_nc};
 use crate::report::{AnalyzeReport, analyze_program};
+use polepatch_kinematics::inverse::unwrap_near_deg;
 use polepatch_kinematics::{
-    BranchRule, IkSolution, JigRotation, Machine, forward, inverse_path_from,
+    BranchRule, IkSolution, JigRotation, Machine, forward, inverse, inverse_path_from,
 };
 use polepatch_nc::modal::{C, X, Y, Z};
 use polepatch_nc::{Edit, Motion, NumberStyle};
@@ -45,6 +50,17 @@ use polepatch_patcher::AnalysisOptions;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
+/// Below this |θx|, degrees, every reoriented move keeps the program's IK branch (its side
+/// of the pole); from it on, the branch is continued from move to move (`continue_branch`).
+/// A tilt of less than 1° moves no tool axis by more than 1°: the program is still where it
+/// was relative to the pole, flips and all; a larger tilt is meant to take the path away
+/// from the pole, where continuity is what keeps C from swinging.
+pub const BRANCH_KEEP_DEG: f64 = 1.0;
+/// Largest |θx| accepted, degrees: a jig tilts the part at most onto its side; beyond,
+/// the tool would reach the faces the program cuts from below.
+pub const MAX_THETA_X_DEG: f64 = 90.0;
+/// Largest |θz| accepted, degrees (one turn either way; a larger value is a typing error).
+pub const MAX_THETA_Z_DEG: f64 = 360.0;
 /// Fewest decimals written for reoriented values (the file's if more).
 pub const MIN_DECIMALS: usize = 3;
 /// Search: step of |θx| levels, degrees.
@@ -212,13 +228,14 @@ pub fn reorient_edits(
         .iter()
         .map(|(_, q)| rot.apply(forward(machine, q[3], q[4])))
         .collect();
-    // Continuous from the first move's own values: the branch nearest to the program's, C
-    // unwrapped near it (a reorientation and its inverse return the original words).
-    let start = IkSolution {
-        p_deg: moves[0].1[3],
-        c_deg: moves[0].1[4],
-    };
-    let ik = inverse_path_from(machine, &axes, BranchRule::Nearest, Some(start));
+    let originals: Vec<IkSolution> = moves
+        .iter()
+        .map(|(_, q)| IkSolution {
+            p_deg: q[3],
+            c_deg: q[4],
+        })
+        .collect();
+    let ik = continue_branch(machine, &axes, &originals, tilt);
     let (lo, hi) = machine.primary_range_deg;
     let letters = [b'X', b'Y', b'Z', lp.primary_letter, b'C'];
     let decimals: Vec<usize> = letters
@@ -297,6 +314,76 @@ pub fn reorient_edits(
     Ok((edits, untouched))
 }
 
+/// The joint values of the reoriented moves: `axes` are the new tool axes, `originals`
+/// the program's own values of the same moves.
+///
+/// - |θx| < [`BRANCH_KEEP_DEG`]: every move keeps the program's branch, the solution whose
+///   primary has the sign of the program's own value there, C unwrapped near the
+///   program's C turned with the table (`C + sc·θz`). Such a tilt moves no tool axis by
+///   more than θx, so a move keeps its side of the pole unless it was that close to it;
+///   for θx = 0 the result is exactly `(P, C + sc·θz)` at every move: θ = 0 changes
+///   nothing, and the program's own branch changes (a domain-rule flip) stay where they
+///   are. On the pole (C does not change the tool axis) a move whose program axis is on
+///   the pole too keeps its C turned with the table; any other keeps the previous C.
+/// - Otherwise [`inverse_path_from`] the first move's own values, branch
+///   [`BranchRule::Nearest`]: each move takes the solution nearest to the move before it,
+///   so a tilted path that no longer passes the pole is continuous, whatever flips the
+///   program made near the pole.
+///
+/// In both, a solution outside the primary range gives way to the other one.
+fn continue_branch(
+    machine: &Machine,
+    axes: &[[f64; 3]],
+    originals: &[IkSolution],
+    tilt: &Tilt,
+) -> Vec<IkSolution> {
+    if tilt.theta_x_deg.abs() >= BRANCH_KEEP_DEG {
+        return inverse_path_from(
+            machine,
+            axes,
+            BranchRule::Nearest,
+            originals.first().copied(),
+        );
+    }
+    let (lo, hi) = machine.primary_range_deg;
+    let in_range = |s: &IkSolution| lo <= s.p_deg && s.p_deg <= hi;
+    let mut out: Vec<IkSolution> = Vec::with_capacity(axes.len());
+    for (&o, orig) in axes.iter().zip(originals) {
+        let turned_c = orig.c_deg + machine.c_sense * tilt.theta_z_deg;
+        let Some(mut cands) = inverse(machine, o) else {
+            let orig_on_pole = inverse(machine, forward(machine, orig.p_deg, orig.c_deg)).is_none();
+            let c_deg = match out.last() {
+                Some(p) if !orig_on_pole && p.c_deg.is_finite() => p.c_deg,
+                _ => turned_c,
+            };
+            let p_deg = match (o[2] < 0.0, orig.p_deg < 0.0) {
+                (false, _) => 0.0,
+                (true, false) => 180.0,
+                (true, true) => -180.0,
+            };
+            out.push(IkSolution { p_deg, c_deg });
+            continue;
+        };
+        for s in &mut cands {
+            s.c_deg = unwrap_near_deg(s.c_deg, turned_c);
+        }
+        // The program's side of the pole (cands[0] has P > 0, cands[1] P < 0); a program
+        // value on the pole: the solution nearest to its C.
+        let pick = if orig.p_deg != 0.0 {
+            usize::from(orig.p_deg < 0.0)
+        } else {
+            usize::from((cands[1].c_deg - turned_c).abs() < (cands[0].c_deg - turned_c).abs())
+        };
+        let pick = if !in_range(&cands[pick]) && in_range(&cands[1 - pick]) {
+            1 - pick
+        } else {
+            pick
+        };
+        out.push(cands[pick]);
+    }
+    out
+}
+
 /// A feasible candidate of the search: the tilt, the program, its figures, the words
 /// changed and the untouched lines.
 type Candidate = (Tilt, Vec<u8>, ProgramFigures, usize, Vec<usize>);
@@ -358,6 +445,7 @@ pub fn reorient_nc(
     name: &str,
     cone_deg: f64,
 ) -> Result<(Vec<u8>, ReorientReport), Error> {
+    check_tilt(tilt)?;
     let lp = load_nc(bytes.to_vec(), name, machine, None)?;
     let opts = analysis_options(cone_deg);
     let before = program_figures(&lp, machine, &opts);
@@ -376,6 +464,27 @@ pub fn reorient_nc(
         objective: "given angles".into(),
     };
     Ok((out, report))
+}
+
+/// The angles of a tilt within the accepted ranges (module docs).
+pub fn check_tilt(tilt: &Tilt) -> Result<(), Error> {
+    for (name, v, max) in [
+        ("θx", tilt.theta_x_deg, MAX_THETA_X_DEG),
+        ("θz", tilt.theta_z_deg, MAX_THETA_Z_DEG),
+    ] {
+        if !(v.is_finite() && v.abs() <= max) {
+            return Err(Error::Options(format!(
+                "{name} = {v:?}° is outside the accepted range −{max}° to {max}°"
+            )));
+        }
+    }
+    if tilt.pivot_mm.iter().any(|v| !v.is_finite()) {
+        return Err(Error::Options(format!(
+            "the pivot {:?} mm must be finite",
+            tilt.pivot_mm
+        )));
+    }
+    Ok(())
 }
 
 /// Reorient and analyse the result: (bytes, figures after, words changed, untouched lines).

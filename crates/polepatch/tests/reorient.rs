@@ -234,3 +234,152 @@ fn reorient_follows_the_tcpm_state() {
         );
     }
 }
+
+/// The machine a fixture is written for: B programs on the HSM600, A on the UCP710.
+fn machine_for(bytes: &[u8]) -> Machine {
+    let text = String::from_utf8_lossy(bytes);
+    let b = text.lines().any(|l| {
+        l.split(|c: char| c.is_whitespace()).any(|w| {
+            w.starts_with('B')
+                && w[1..].starts_with(|c: char| c.is_ascii_digit() || c == '-' || c == '+')
+        })
+    });
+    Machine::builtin(if b { "mikron-hsm600" } else { "mikron-ucp710" }).unwrap()
+}
+
+/// Issue 19: θ = 0, 0 rewrote `%SING` onto the other IK branch (the first move is on the
+/// pole, and the nearest solution from there is the other branch). No tilt changes
+/// nothing, byte for byte, on every fixture; a pure turn θz adds sc·θz to every C and
+/// keeps every primary value.
+#[test]
+fn no_tilt_changes_nothing_and_a_pure_turn_only_turns_c() {
+    let mut checked = 0;
+    for path in polepatch_fixturegen::nc_files(&root().join("fixtures")) {
+        let bytes = std::fs::read(&path).unwrap();
+        let m = machine_for(&bytes);
+        let name = path.display().to_string();
+        let zero = Tilt {
+            theta_x_deg: 0.0,
+            theta_z_deg: 0.0,
+            pivot_mm: [0.0; 3],
+        };
+        let Ok((out, report)) = reorient_nc(&bytes, &m, &zero, &name, 5.0) else {
+            continue; // a program without TCPM moves: refused, tested elsewhere
+        };
+        assert_eq!(report.words_changed, 0, "{name}");
+        assert!(out == bytes, "{name}: θ = 0 changed the program");
+        let turn = Tilt {
+            theta_z_deg: 77.0,
+            ..zero
+        };
+        let (out, _) = reorient_nc(&bytes, &m, &turn, &name, 5.0).unwrap();
+        let (before, after) = (rotary_words_of(&bytes, &m), rotary_words_of(&out, &m));
+        assert_eq!(before.len(), after.len(), "{name}");
+        for (b, a) in before.iter().zip(&after) {
+            assert!(
+                (b.1 - a.1).abs() < 2e-3,
+                "{name} line {}: P {} → {}",
+                b.0,
+                b.1,
+                a.1
+            );
+            assert!(
+                mod360(a.2 - b.2 - m.c_sense * 77.0) < 2e-3,
+                "{name} line {}: C {} → {}",
+                b.0,
+                b.2,
+                a.2
+            );
+        }
+        checked += 1;
+    }
+    assert!(checked >= 40, "only {checked} fixtures checked");
+}
+
+/// A tilt below `BRANCH_KEEP_DEG` keeps every move on the program's side of the pole (the
+/// sign of its primary value), on `%SING` whose first move is on the pole and on the
+/// domain-rule programs that flip the primary near it.
+#[test]
+fn a_tiny_tilt_keeps_every_branch() {
+    for p in [
+        "fixtures/c17/SING.I",
+        "fixtures/generated/fanuc-ac-flip-d0.5.nc",
+        "fixtures/generated/heidenhain-bc-flip-d2.I",
+        "fixtures/generated/sinumerik-ac-swing-d0.1.mpf",
+    ] {
+        let bytes = read(p);
+        let m = machine_for(&bytes);
+        for (tx, tz) in [(1e-6, 0.0), (0.01, 0.0), (-0.3, 25.0), (0.9, -140.0)] {
+            let tilt = Tilt {
+                theta_x_deg: tx,
+                theta_z_deg: tz,
+                pivot_mm: [0.0; 3],
+            };
+            let (out, _) = reorient_nc(&bytes, &m, &tilt, p, 5.0).unwrap();
+            let (before, after) = (rotary_words_of(&bytes, &m), rotary_words_of(&out, &m));
+            for (b, a) in before.iter().zip(&after) {
+                if b.1.abs() > tx.abs() + 1e-3 {
+                    assert_eq!(
+                        b.1 < 0.0,
+                        a.1 < 0.0,
+                        "{p} θ {tx},{tz} line {}: primary {} → {}",
+                        b.0,
+                        b.1,
+                        a.1
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Issue 19: θx = 1e9 was accepted. Tilts are finite, |θx| ≤ 90°, |θz| ≤ 360°.
+#[test]
+fn out_of_range_tilts_are_refused() {
+    let bytes = read("fixtures/c17/SING.I");
+    let m = c17_machine(1.0);
+    for (tx, tz) in [
+        (1e9, 0.0),
+        (90.5, 0.0),
+        (-91.0, 0.0),
+        (0.0, 361.0),
+        (0.0, -1e300),
+        (f64::NAN, 0.0),
+    ] {
+        let tilt = Tilt {
+            theta_x_deg: tx,
+            theta_z_deg: tz,
+            pivot_mm: [0.0; 3],
+        };
+        let e = reorient_nc(&bytes, &m, &tilt, "SING.I", 5.0).unwrap_err();
+        assert!(
+            matches!(e, polepatch::Error::Options(_))
+                && e.to_string().contains("outside the accepted range"),
+            "{tx}, {tz}: {e}"
+        );
+    }
+    for (tx, tz) in [(90.0, 0.0), (-10.0, 360.0)] {
+        let tilt = Tilt {
+            theta_x_deg: tx,
+            theta_z_deg: tz,
+            pivot_mm: [0.0; 3],
+        };
+        if let Err(polepatch::Error::Options(e)) = reorient_nc(&bytes, &m, &tilt, "SING.I", 5.0) {
+            panic!("{tx}, {tz}: {e}");
+        }
+    }
+}
+
+/// (line, P, C) of every move under TCPM, from the modal state (whichever tilting letter).
+fn rotary_words_of(bytes: &[u8], machine: &Machine) -> Vec<(usize, f64, f64)> {
+    let lp = load_nc(bytes.to_vec(), "x", machine, None).unwrap();
+    let p = &lp.program;
+    let pi = lp.primary_index();
+    (0..p.blocks.len())
+        .filter(|&b| p.blocks[b].is_move && p.state(b).tcpm.is_on())
+        .filter_map(|b| {
+            let st = p.state(b);
+            Some((p.blocks[b].line, st.pos[pi]?, st.pos[modal::C]?))
+        })
+        .collect()
+}

@@ -24,6 +24,20 @@ pub fn polepatch(args: &[&str]) -> (i32, String, String) {
     )
 }
 
+/// Run the `polepatch` binary in `dir`: (exit code, stdout, stderr).
+pub fn polepatch_in(dir: &Path, args: &[&str]) -> (i32, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_polepatch"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
 /// A fresh, empty temporary folder for this test process.
 pub fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("polepatch-test-{name}-{}", std::process::id()));
