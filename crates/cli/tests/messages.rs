@@ -57,7 +57,8 @@ fn an_error_is_printed_once() {
 }
 
 /// SING without its M128 on the machine with the example chain: the patch is found but
-/// would slow Y in the machine frame, so it is not written. The summary and the report
+/// would leave the programmed line between points (or slow Y in the machine frame), so it
+/// is not written. The summary and the report
 /// showed the patch's "after" figures (ratio 1.000, 50 points, 0.54°) for a file left as
 /// it was.
 #[test]
@@ -79,7 +80,11 @@ fn the_summary_shows_no_after_figures_for_a_patch_not_written() {
         ],
     );
     assert_eq!(code, 0, "{err}");
-    assert!(err.contains("in the machine frame"), "{err}");
+    // Not written because of the machine frame, or (first) the chord check between points.
+    assert!(
+        err.contains("in the machine frame") || err.contains("leave the programmed line"),
+        "{err}"
+    );
     assert_eq!(
         std::fs::read(dir.join("out.I")).unwrap(),
         std::fs::read(dir.join("nom128.I")).unwrap()
@@ -212,10 +217,7 @@ fn strict_fails_when_a_run_near_the_pole_could_not_be_analysed() {
     };
     let (code, _, err) = polepatch_in(&dir, &args("nof.I"));
     assert_eq!(code, 2, "{err}");
-    assert!(
-        err.contains("run(s) near the pole could not be analysed"),
-        "{err}"
-    );
+    assert!(err.contains("could not be analysed"), "{err}");
     // Without --strict: written unchanged, exit 0, with the warning.
     let (code, _, err) = polepatch_in(
         &dir,

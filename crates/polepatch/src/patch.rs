@@ -289,8 +289,6 @@ pub enum UntouchedReason {
     TcpmUncertain,
     /// The feed is below [`crate::program::MIN_FEED_MM_MIN`].
     FeedTooLow,
-    /// Inverse-time feed (G93) whose blocks have different feeds.
-    InverseTimeVarying,
     /// A rotary axis moves while its value at some point is unknown.
     UnknownRotary,
 }
@@ -821,7 +819,6 @@ fn problem_reason(p: &RunProblem) -> UntouchedReason {
     match p {
         RunProblem::NoFeed => UntouchedReason::NoFeed,
         RunProblem::FeedTooLow { .. } => UntouchedReason::FeedTooLow,
-        RunProblem::InverseTimeVarying { .. } => UntouchedReason::InverseTimeVarying,
         RunProblem::UnknownRotary { .. } => UntouchedReason::UnknownRotary,
     }
 }

@@ -23,11 +23,6 @@ pub enum RunProblem {
         /// The letter.
         letter: char,
     },
-    /// Inverse-time feed (G93) whose blocks have different feeds: not analysed yet.
-    InverseTimeVarying {
-        /// Lowest and highest block feed, mm/min.
-        range_mm_min: [f64; 2],
-    },
 }
 
 /// The lowest feed polepatch analyses, mm/min. Equation 6 itself has no lower limit, but a
@@ -35,11 +30,6 @@ pub enum RunProblem {
 /// and its time estimate is meaningless; such a run is reported with its line and left as
 /// it is.
 pub const MIN_FEED_MM_MIN: f64 = 1.0;
-
-/// Relative spread of the block feeds of a G93 run below which the run is analysed at one
-/// feed (the mean): inverse-time F words rounded to 3–4 significant digits by a post that
-/// computed them from one programmed feed differ by about this much.
-pub const INVERSE_TIME_FEED_SPREAD: f64 = 2e-3;
 
 impl std::fmt::Display for RunProblem {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -56,14 +46,6 @@ impl std::fmt::Display for RunProblem {
                 f,
                 "the rotary axes move in this run but {letter} is unknown at some of its points \
                  (after an expression, a datum change or a call); the run is left as it is"
-            ),
-            RunProblem::InverseTimeVarying { range_mm_min } => write!(
-                f,
-                "inverse-time feed (G93) with block feeds from {:.1} to {:.1} mm/min; runs whose \
-                 blocks differ by more than {}% are not analysed yet, so the run is left as it is",
-                range_mm_min[0],
-                range_mm_min[1],
-                INVERSE_TIME_FEED_SPREAD * 100.0
             ),
         }
     }
@@ -307,11 +289,39 @@ pub(crate) fn run_path(
     first_line: usize,
 ) -> RunPath {
     let path = run_check(&run, p_idx, feed_fallback_mm_min, first_line).map(|feed| Path {
-        s_mm: run.s_mm.clone(),
+        s_mm: if run.block_feed_mm_min.is_empty() {
+            run.s_mm.clone()
+        } else {
+            inverse_time_parameter(&run, feed)
+        },
         axes: run.axes5(p_idx),
         feed_mm_min: feed,
     });
     RunPath { run, path }
+}
+
+/// The path parameter of an inverse-time (G93) run whose blocks have different feeds,
+/// at its reference feed `f_ref` ([`inverse_time_feed`]): block k of tool-tip length L_k
+/// and feed F_k (its time L_k/F_k) spans u_k − u_{k−1} = L_k·f_ref/F_k, so that moving
+/// along u at f_ref takes every block its programmed time.
+///
+/// This is Equation 6 at each block's own feed: on a block, q_u = q_s·F_k/f_ref, so the
+/// bound V/|q_u| on u̇ is (f_ref/F_k)·V/|q_s| and the ratio u̇/f_ref = ṡ/F_k — and likewise
+/// for A and J (q_uu = q_ss·(F_k/f_ref)², q_uuu = q_sss·(F_k/f_ref)³). The analysis
+/// spline is the interpolant over u (the same points, knots spaced by block time); when
+/// every block has the same feed, u = s and the run is analysed exactly as in G94.
+fn inverse_time_parameter(run: &Run, f_ref: f64) -> Vec<f64> {
+    let feeds = &run.block_feed_mm_min;
+    if feeds.iter().all(|&f| f == feeds[0]) {
+        return run.s_mm.clone();
+    }
+    let mut u = Vec::with_capacity(run.s_mm.len());
+    u.push(0.0);
+    for (k, f) in feeds.iter().enumerate() {
+        let l = run.s_mm[k + 1] - run.s_mm[k];
+        u.push(u[k] + l * f_ref / f);
+    }
+    u
 }
 
 /// Whether a run can be analysed with the tilting letter at `p_idx` (`modal::A` or
@@ -362,7 +372,7 @@ fn run_feed(
             .or(feed_fallback_mm_min)
             .ok_or(RunProblem::NoFeed)?
     } else {
-        inverse_time_feed(&run.block_feed_mm_min)?
+        inverse_time_feed(run)
     };
     if feed < MIN_FEED_MM_MIN {
         return Err(RunProblem::FeedTooLow {
@@ -373,21 +383,23 @@ fn run_feed(
     Ok(feed)
 }
 
-/// The feed of a G93 run whose block feeds agree within [`INVERSE_TIME_FEED_SPREAD`]: their
-/// mean weighted by nothing (each block's own feed is within the spread of it).
-fn inverse_time_feed(block_feed_mm_min: &[f64]) -> Result<f64, RunProblem> {
-    let lo = block_feed_mm_min
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
-    let hi = block_feed_mm_min.iter().copied().fold(0.0, f64::max);
-    if hi - lo <= INVERSE_TIME_FEED_SPREAD * hi {
-        Ok(block_feed_mm_min.iter().sum::<f64>() / block_feed_mm_min.len() as f64)
-    } else {
-        Err(RunProblem::InverseTimeVarying {
-            range_mm_min: [lo, hi],
-        })
+/// The reference feed of a G93 run: its length over its programmed time (Σ L_k / Σ
+/// L_k/F_k, mm/min), or the block feed when they are all equal; a block slower than
+/// [`MIN_FEED_MM_MIN`] makes the run too slow to analyse.
+fn inverse_time_feed(run: &Run) -> f64 {
+    let feeds = &run.block_feed_mm_min;
+    if feeds.iter().all(|&f| f == feeds[0]) {
+        return feeds[0];
     }
+    if feeds.iter().any(|&f| f < MIN_FEED_MM_MIN) {
+        return feeds.iter().copied().fold(f64::INFINITY, f64::min);
+    }
+    let time: f64 = feeds
+        .iter()
+        .enumerate()
+        .map(|(k, f)| (run.s_mm[k + 1] - run.s_mm[k]) / f)
+        .sum();
+    run.length_mm() / time
 }
 
 /// Group a parsed program into runs and build each run's path for `machine`.
