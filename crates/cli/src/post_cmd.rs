@@ -2,9 +2,10 @@
 
 use crate::{check_positive, machine};
 use anyhow::{Context, Result, bail};
+use polepatch::cl::{ParseOptions, Units};
 use polepatch::kinematics::BranchRule;
 use polepatch::nc::Dialect;
-use polepatch::post::{PostOptions, post_cl, read_cl};
+use polepatch::post::{ARC_TOLERANCE_MM, PostOptions, post_cl, read_cl_with};
 use polepatch_cli::files::{read, same_file, write_atomic, write_atomic_like};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -14,6 +15,14 @@ enum DialectArg {
     Heidenhain,
     Sinumerik,
     Fanuc,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum UnitsArg {
+    /// Millimetres (G21, G71, G71).
+    Mm,
+    /// Inches (G20, G700; not for Heidenhain).
+    Inch,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -56,6 +65,20 @@ pub(crate) struct PostArgs {
     /// Decimals of the rotary words.
     #[arg(long, default_value_t = 3)]
     rotary_decimals: usize,
+    /// Units of the program written (default: the CL file's).
+    #[arg(long, value_enum)]
+    units: Option<UnitsArg>,
+    /// Write every arc as chords (default: G2/G3 where the arc lies in a principal plane
+    /// with a fixed tool axis).
+    #[arg(long)]
+    linearize: bool,
+    /// Chordal tolerance of arcs written as chords, mm.
+    #[arg(long, default_value_t = ARC_TOLERANCE_MM)]
+    arc_tolerance: f64,
+    /// Skip every APT record with this major word (e.g. THREAD) instead of refusing the
+    /// file; repeat for several. Only records polepatch would refuse can be skipped.
+    #[arg(long, value_name = "RECORD")]
+    ignore: Vec<String>,
 }
 
 pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
@@ -71,7 +94,13 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
     if same_file(&args.cl, &args.output) {
         bail!("{name}: the output would overwrite the input; polepatch never modifies its input");
     }
-    let cl = read_cl(&read(&args.cl)?, &name)?;
+    let parse = ParseOptions {
+        ignore: args.ignore.clone(),
+    };
+    if let Err(m) = parse.check() {
+        bail!("{m}");
+    }
+    let cl = read_cl_with(&read(&args.cl)?, &name, &parse)?;
     let opts = PostOptions {
         dialect: match args.dialect {
             DialectArg::Heidenhain => Dialect::Heidenhain,
@@ -92,6 +121,12 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
         },
         rotary_decimals: args.rotary_decimals,
         linear_decimals: 3,
+        units: args.units.map(|u| match u {
+            UnitsArg::Mm => Units::Mm,
+            UnitsArg::Inch => Units::Inch,
+        }),
+        linearize: args.linearize,
+        arc_tolerance_mm: args.arc_tolerance,
     };
     let (bytes, report) = post_cl(&cl, &machine, &opts)?;
     write_atomic_like(&args.output, &bytes, None)
@@ -99,7 +134,20 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
     for n in &cl.notes {
         eprintln!("polepatch: note: {name}: {n}");
     }
-    let points = cl.points.len();
+    // Every record kind read, once, with its count (and what was skipped on request).
+    if !cl.records.is_empty() {
+        let list = cl
+            .records
+            .iter()
+            .map(|(w, n)| match cl.skipped.get(w) {
+                Some(_) => format!("{w} {n} (skipped, --ignore)"),
+                None => format!("{w} {n}"),
+            })
+            .collect::<Vec<_>>()
+            .join(", ");
+        eprintln!("polepatch: note: {name}: records read: {list}");
+    }
+    let points = cl.point_count();
     match &report {
         Some(r) => {
             let reached = r.zones.iter().filter(|z| z.outcome == "reached").count();
