@@ -246,6 +246,7 @@ impl Reader<'_> {
             feed_mm_min: self.feed,
             kind,
             line: at.line,
+            column: at.column,
         }));
         self.rapid_next = false;
     }

@@ -246,8 +246,9 @@ impl Arc {
         slerp(self.start_axis, end_axis, t)
     }
 
-    /// Distance from `p` to the arc's circle (planar arcs) or helix, mm: the helix height
-    /// is taken at `p`'s own angle about the axis.
+    /// Distance from `p` to the arc (mm): to the point of the arc at `p`'s own angle about
+    /// the axis (the helix height taken there), or to an end of the arc when `p`'s angle is
+    /// outside the sweep. An upper bound of the true distance, exact on the arc.
     pub fn distance_mm(&self, p: [f64; 3]) -> f64 {
         let v = sub(p, self.center_mm);
         let ax = dot(v, self.normal);
@@ -258,16 +259,16 @@ impl Arc {
         if phi < 0.0 {
             phi += std::f64::consts::TAU;
         }
-        // Among the turns, the one whose height is nearest.
-        let mut best = f64::INFINITY;
+        let mut best = norm(sub(p, self.start_mm)).min(norm(sub(p, self.point_at(1.0))));
         let turns = (self.sweep_rad / std::f64::consts::TAU).ceil() as i64;
-        for k in -1..=turns {
+        for k in 0..=turns {
             let ang = phi + k as f64 * std::f64::consts::TAU;
-            let t = (ang / self.sweep_rad).clamp(0.0, 1.0);
-            let h = ax - t * self.lead_mm;
-            best = best.min(h.abs());
+            if ang <= self.sweep_rad {
+                let h = ax - ang / self.sweep_rad * self.lead_mm;
+                best = best.min(radial.hypot(h));
+            }
         }
-        radial.hypot(best)
+        best
     }
 }
 
@@ -317,6 +318,25 @@ mod tests {
         assert!((b.sweep_rad - 2.0 * std::f64::consts::TAU).abs() < 1e-12);
         assert_eq!(b.lead_mm, -2.0);
         assert!(Arc::new([0.0; 3], Z, 5.0, s, [0.0, 5.0, 0.0], Some(180.0), Z).is_err());
+    }
+
+    /// The distance is to the arc, not to its whole circle: the other side is far.
+    #[test]
+    fn distance_is_to_the_arc() {
+        let a = Arc::new(
+            [0.0; 3],
+            Z,
+            10.0,
+            [10.0, 0.0, 0.0],
+            [0.0, 10.0, 0.0],
+            None,
+            Z,
+        )
+        .unwrap();
+        assert!(a.distance_mm([0.0, 10.0, 0.0]) < 1e-12);
+        assert!((a.distance_mm([0.0, 11.0, 0.5]) - 1.25f64.sqrt()).abs() < 1e-12);
+        // (0, −10) is on the circle, not on the quarter: nearest the start.
+        assert!((a.distance_mm([0.0, -10.0, 0.0]) - 200f64.sqrt()).abs() < 1e-12);
     }
 
     #[test]

@@ -73,13 +73,10 @@ pub fn parse_csv(text: &str) -> Result<ClProgram, ClError> {
             }
             feed = Some(v[6]);
         }
-        prog.items.push(ClItem::Move(ClPoint::straight(
-            [v[0], v[1], v[2]],
-            axis,
-            feed,
-            false,
-            line,
-        )));
+        prog.items.push(ClItem::Move(ClPoint {
+            column: col0,
+            ..ClPoint::straight([v[0], v[1], v[2]], axis, feed, false, line)
+        }));
     }
     if prog.items.is_empty() {
         return Err(err(1, 1, "no cutter location in the file"));

@@ -54,10 +54,12 @@ pub struct ClPoint {
     pub kind: MoveKind,
     /// 1-based line of the record in the file.
     pub line: usize,
+    /// 1-based byte column of the record (its major word; a CSV line's first field).
+    pub column: usize,
 }
 
 impl ClPoint {
-    /// A straight feed move (`rapid` false) or a rapid move.
+    /// A straight feed move (`rapid` false) or a rapid move, at column 1 of `line`.
     pub fn straight(
         pos_mm: [f64; 3],
         axis: [f64; 3],
@@ -75,6 +77,7 @@ impl ClPoint {
                 MoveKind::Linear
             },
             line,
+            column: 1,
         }
     }
 

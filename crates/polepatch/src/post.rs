@@ -7,8 +7,8 @@
 //!
 //! - straight and rapid moves: X Y Z and the joints of the tool axis, under TCPM;
 //! - arcs: `G2`/`G3` when the arc lies in a principal plane (within `arc_tolerance_mm`)
-//!   with a fixed tool axis and a sweep of at most one turn (Heidenhain: the XY plane
-//!   only); otherwise, or with `linearize`, chords within `arc_tolerance_mm` of the true
+//!   with a fixed tool axis and a sweep of at most one turn (a helix along the plane's
+//!   normal included; Heidenhain: the XY plane only, no helix); otherwise, or with `linearize`, chords within `arc_tolerance_mm` of the true
 //!   arc (the tool axis turned along the arc by great-circle interpolation), which the pole
 //!   analysis and patch then see like any other points;
 //! - holes of canned cycles and moves under cutter compensation: with the tool along +Z
@@ -149,21 +149,19 @@ impl Poster<'_> {
         &self.opts.patch_options.name
     }
 
-    fn unsupported(&self, line: usize, what: String) -> Error {
-        Error::Unsupported {
-            path: self.name().to_string(),
-            line,
-            what,
-        }
+    /// An error at CL point `p`'s record.
+    fn at_point(&self, p: &ClPoint, what: String) -> Error {
+        cl_error(self.name(), p.line, p.column, what)
     }
 
-    /// The joints of tool axis `axis` at CL line `line`, continuing from the last point.
-    fn joints(&mut self, axis: [f64; 3], line: usize) -> Result<IkSolution, Error> {
+    /// The joints of tool axis `axis` for the move of CL point `src`, continuing from the
+    /// last point.
+    fn joints(&mut self, axis: [f64; 3], src: &ClPoint) -> Result<IkSolution, Error> {
         let s = inverse_path_from(self.machine, &[axis], self.opts.branch, self.prev)[0];
         let (lo, hi) = self.machine.primary_range_deg;
         if !(lo <= s.p_deg && s.p_deg <= hi) {
-            return Err(self.unsupported(
-                line,
+            return Err(self.at_point(
+                src,
                 format!(
                     "the tool axis ({:.6}, {:.6}, {:.6}) needs {}{:.3}, outside the machine's range [{lo}, {hi}] on either IK branch",
                     axis[0],
@@ -238,8 +236,8 @@ impl Poster<'_> {
         p.feed_mm_min
             .or(self.opts.patch_options.feed_fallback_mm_min)
             .ok_or_else(|| {
-                self.unsupported(
-                    p.line,
+                self.at_point(
+                    p,
                     "no feed for this move (no FEDRAT before it, no f column): give --feed".into(),
                 )
             })
@@ -252,23 +250,23 @@ impl Poster<'_> {
             .or_else(|| self.comp_cancel_pending.clone())
     }
 
-    /// A straight move to `pos` with tool axis `axis`.
+    /// A straight move to `pos` with tool axis `axis`, for the move of CL point `src`.
     fn straight(
         &mut self,
         pos: [f64; 3],
         axis: [f64; 3],
         feed: Option<f64>,
         rapid: bool,
-        line: usize,
+        src: &ClPoint,
     ) -> Result<(), Error> {
         let (p_deg, c_deg, tcpm) = match self.vertical_reason() {
             Some(why) => {
-                self.check_vertical(axis, line, &why)?;
+                self.check_vertical(axis, src.line, &why)?;
                 self.enter_vertical();
                 (0.0, 0.0, false)
             }
             None => {
-                let s = self.joints(axis, line)?;
+                let s = self.joints(axis, src)?;
                 self.frame = Frame::Tcpm;
                 (s.p_deg, s.c_deg, true)
             }
@@ -294,9 +292,11 @@ impl Poster<'_> {
         let fixed_axis = (0..3).all(|i| (p.axis[i] - a.start_axis[i]).abs() <= SAME_AXIS_TOL);
         let one_turn = a.sweep_rad <= std::f64::consts::TAU * (1.0 + 1e-12);
         let heidenhain = matches!(self.opts.dialect, Dialect::Heidenhain | Dialect::Auto);
+        // Heidenhain's circle in ISO programs: the XY plane, no helix (its helix is a polar
+        // block polepatch does not write).
         let plane = a
             .principal_plane(tol)
-            .filter(|pl| !heidenhain || *pl == Plane::Xy);
+            .filter(|pl| !heidenhain || (*pl == Plane::Xy && a.lead_mm.abs() <= tol));
         if let Some(why) = &self.comp_cancel_pending {
             return Err(cl_error(
                 self.name(),
@@ -338,7 +338,7 @@ impl Poster<'_> {
                     ));
                 }
                 let Some(start) = self.pos else {
-                    return Err(self.unsupported(p.line, "an arc with no point before it".into()));
+                    return Err(self.at_point(p, "an arc with no point before it".into()));
                 };
                 let tcpm = match self.vertical_reason() {
                     Some(why) => {
@@ -350,7 +350,7 @@ impl Poster<'_> {
                         // The orientation does not change along the arc: the joints are
                         // the start's (restated in place if the IK names them otherwise,
                         // e.g. after a vertical section).
-                        let s = self.joints(p.axis, p.line)?;
+                        let s = self.joints(p.axis, p)?;
                         if self.rotary != Some((s.p_deg, s.c_deg)) {
                             self.items.push(Item::Move(EmitPoint {
                                 xyz_mm: start,
@@ -393,14 +393,14 @@ impl Poster<'_> {
                         p.axis
                     } else {
                         a.axis_at(t, p.axis).ok_or_else(|| {
-                            self.unsupported(
-                                p.line,
+                            self.at_point(
+                                p,
                                 "the tool axis turns by 180° along the arc: no unique way to turn it"
                                     .into(),
                             )
                         })?
                     };
-                    self.straight(q, axis, Some(feed), false, p.line)?;
+                    self.straight(q, axis, Some(feed), false, p)?;
                 }
                 Ok(())
             }
@@ -467,9 +467,9 @@ impl Poster<'_> {
             ClItem::Move(p) => match &p.kind {
                 MoveKind::Linear => {
                     let f = self.feed(p)?;
-                    self.straight(p.pos_mm, p.axis, Some(f), false, p.line)
+                    self.straight(p.pos_mm, p.axis, Some(f), false, p)
                 }
-                MoveKind::Rapid => self.straight(p.pos_mm, p.axis, None, true, p.line),
+                MoveKind::Rapid => self.straight(p.pos_mm, p.axis, None, true, p),
                 MoveKind::Arc(a) => self.arc(p, a),
                 MoveKind::Hole(c) => self.hole(p, c),
             },
@@ -662,7 +662,7 @@ pub fn post_cl(
         machine.name, opts.patch_options.name
     )];
     for (w, n) in &cl.skipped {
-        comments.push(format!("{w} records skipped (--ignore {w}): {n}"));
+        comments.push(format!("{w} records skipped by --ignore {w}: {n}"));
     }
     let bytes = emit(
         &items,
