@@ -7,7 +7,9 @@
 //!   `CYCLE`, `LOADTL`/`LOAD/TOOL`, `SPINDL`, `COOLNT`, `CUTCOM`, `DELAY`, `STOP`, `OPSTOP`,
 //!   `TLAXIS`, `UNITS`/`UNIT`, `PARTNO`/`PPRINT`/`TPRINT` (comments);
 //! - read, no effect on the motion (counted): [`PASSIVE`];
-//! - `MSYS`/`CSYS` with the identity frame (counted); any other frame is refused;
+//! - `CSYS/[R|t]` (CAMWorks): the values that follow are given in that frame and are
+//!   converted to the part frame (world = R·v + t, 3-value GOTOs along its Z);
+//!   `TRNTYP/WORLD,0,0,0` read; `MSYS` with the identity frame (counted), any other refused;
 //! - every other record stops the read with its line, column and name, unless the caller
 //!   skips it by name ([`crate::ParseOptions::ignore`]).
 //!
@@ -43,6 +45,10 @@ pub const PASSIVE: &[&str] = &[
     "CLRSRF",
     "DISPLY",
     "REWIND",
+    "SEQNO",
+    // CAMWorks: tool geometry for its simulation.
+    "CSI_SET_FLUTE_LENGTH",
+    "CSI_SET_EXTENSION_LENGTH",
 ];
 
 /// Records polepatch posts (they cannot be skipped with `--ignore`).
@@ -141,7 +147,8 @@ fn records(text: &str) -> Result<Vec<Record>, ClError> {
 struct PendingCircle {
     center: [f64; 3],
     normal: [f64; 3],
-    radius_mm: f64,
+    /// `None`: CAMWorks' `CIRCLE/xc,yc,zc,i,j,k`, the radius is the start point's.
+    radius_mm: Option<f64>,
     /// `MOVARC`'s `ANGLE`, degrees.
     angle_deg: Option<f64>,
     at: At,
@@ -160,12 +167,17 @@ struct Reader<'o> {
     pos: Option<[f64; 3]>,
     /// Tool axis of the last move (an arc's start axis).
     last_axis: [f64; 3],
+    /// The frame the values are given in (`CSYS`): rows of R and t (mm), world = R·v + t;
+    /// `None`: the part frame itself.
+    frame: Option<([[f64; 3]; 3], [f64; 3])>,
     from: Option<([f64; 3], [f64; 3])>,
     /// `CIRCLE`/`MOVARC` waiting for its `GOTO`.
     circle: Option<PendingCircle>,
     /// The last cycle defined, and whether it is on.
     cycle: Option<Cycle>,
     cycle_on: bool,
+    /// `CYCLE/INIT` (CAMWorks) waiting for the cycle it prepares.
+    cycle_init: Option<At>,
     spindle_rpm: Option<f64>,
     spindle_dir: Option<SpindleDir>,
     /// `CUTCOM/ON` waiting for its side.
@@ -211,6 +223,31 @@ impl Reader<'_> {
         if self.inch { MM_PER_INCH } else { 1.0 }
     }
 
+    /// A direction given in the current frame, in the part frame.
+    fn dir(&self, v: [f64; 3]) -> [f64; 3] {
+        match &self.frame {
+            None => v,
+            Some((r, _)) => [0, 1, 2].map(|i| crate::arcs::dot(r[i], v)),
+        }
+    }
+
+    /// A position given in the current frame (mm), in the part frame, in range.
+    fn position(&self, v: [f64; 3], at: At, what: &str) -> Result<[f64; 3], ClError> {
+        let Some((_, t)) = &self.frame else {
+            return Ok(v);
+        };
+        let w = crate::arcs::add(self.dir(v), *t);
+        for (i, x) in w.into_iter().enumerate() {
+            coordinate(
+                x,
+                at,
+                &format!("{what} (in the part frame, {})", ["x", "y", "z"][i]),
+                &format!("{x}"),
+            )?;
+        }
+        Ok(w)
+    }
+
     /// x y z [i j k] of a GOTO-like record: a point in mm and the tool axis (the last one
     /// when only x y z).
     fn point(&mut self, word: &str, f: &[(&str, At)], at: At) -> Result<[f64; 3], ClError> {
@@ -229,9 +266,10 @@ impl Reader<'_> {
             }
         }
         if f.len() == 6 {
-            self.axis = unit_axis([v[3], v[4], v[5]], f[3].1.line, f[3].1.column)?;
+            let a = unit_axis([v[3], v[4], v[5]], f[3].1.line, f[3].1.column)?;
+            self.axis = self.dir(a);
         }
-        Ok([v[0], v[1], v[2]])
+        self.position([v[0], v[1], v[2]], f[0].1, word)
     }
 
     fn push_move(&mut self, pos: [f64; 3], kind: MoveKind, at: At) {
@@ -321,6 +359,12 @@ impl Reader<'_> {
         match word.as_str() {
             "GOTO" => {
                 self.check_cutcom()?;
+                if let Some(init) = self.cycle_init {
+                    return Err(e(
+                        init,
+                        "CYCLE/INIT without a cycle before the next GOTO (is it a hole or a move?): refused",
+                    ));
+                }
                 let p = self.point("GOTO", &f, at0)?;
                 let kind = if let Some(PendingCircle {
                     center: c,
@@ -339,6 +383,12 @@ impl Reader<'_> {
                             "CIRCLE after a hole or at the start: its start point is unknown",
                         ));
                     };
+                    // Without a stated radius: the start point's distance from the axis.
+                    let r = r.unwrap_or_else(|| {
+                        let a = crate::arcs::sub(start, c);
+                        let ax = crate::arcs::dot(a, n);
+                        crate::arcs::norm(crate::arcs::sub(a, crate::arcs::scale(n, ax)))
+                    });
                     MoveKind::Arc(
                         Arc::new(c, n, r, start, p, angle, self.last_axis)
                             .map_err(|m| e(cat, format!("CIRCLE: {m}")))?,
@@ -397,7 +447,7 @@ impl Reader<'_> {
                         for (i, &(t, a)) in f.iter().enumerate() {
                             d[i] = number(t, a, ["dx", "dy", "dz"][i])? * self.scale();
                         }
-                        d
+                        self.dir(d)
                     }
                     n => {
                         return Err(e(
@@ -454,7 +504,8 @@ impl Reader<'_> {
                 for (i, &(t, a)) in f.iter().enumerate() {
                     v[i] = number(t, a, ["i", "j", "k"][i])?;
                 }
-                self.axis = unit_axis(v, f[0].1.line, f[0].1.column)?;
+                let a = unit_axis(v, f[0].1.line, f[0].1.column)?;
+                self.axis = self.dir(a);
             }
             "CIRCLE" | "MOVARC" => self.circle(&word, &f, at0)?,
             "CYCLE" => {
@@ -462,6 +513,7 @@ impl Reader<'_> {
                     scale: self.scale(),
                     feed_mm_min: self.feed,
                     spindle_rpm: self.spindle_rpm,
+                    uniform_peck: self.opts.uniform_peck,
                 };
                 match parse_cycle(&f, at0, &ctx, &number)? {
                     CycleRecord::Define(c) => {
@@ -484,14 +536,23 @@ impl Reader<'_> {
                         }
                         self.cycle = Some(c);
                         self.cycle_on = true;
+                        self.cycle_init = None;
                     }
                     CycleRecord::On => {
                         if self.cycle.is_none() {
                             return Err(e(at0, "CYCLE/ON without a cycle defined before it"));
                         }
                         self.cycle_on = true;
+                        self.cycle_init = None;
                     }
-                    CycleRecord::Off => self.cycle_on = false,
+                    CycleRecord::Off => {
+                        self.cycle_on = false;
+                        self.cycle_init = None;
+                    }
+                    CycleRecord::Init => {
+                        self.cycle_on = false;
+                        self.cycle_init = Some(at0);
+                    }
                 }
             }
             "LOADTL" | "LOAD" => self.loadtl(&word, &f, at0)?,
@@ -560,24 +621,36 @@ impl Reader<'_> {
                     .push(format!("line {}: {word} {text}", at0.line));
                 self.prog.items.push(ClItem::Comment(text));
             }
-            "MSYS" | "CSYS" => {
+            "TRNTYP" => {
+                // CAMWorks: TRNTYP/WORLD,0,0,0 (no transformation) is read; any other is not.
+                let identity = matches!(f.first(), Some((w, _)) if w.eq_ignore_ascii_case("WORLD"))
+                    && f.len() == 4
+                    && f[1..]
+                        .iter()
+                        .all(|&(t, _)| t.parse::<f64>().is_ok_and(|v| v == 0.0));
+                if !identity {
+                    return Err(e(
+                        at0,
+                        "TRNTYP other than WORLD,0,0,0 is not posted (it moves the part frame); give --ignore TRNTYP only if the frame is set on the machine",
+                    ));
+                }
+            }
+            "CSYS" => self.csys(&f, at0)?,
+            "MSYS" => {
+                // NX writes its GOTOs in the machine coordinate system (MCS) and MSYS says
+                // where that is in the model: only the identity is read (else the program
+                // zero is not the part frame the post assumes).
                 let mut v = Vec::with_capacity(f.len());
                 for &(t, a) in &f {
-                    v.push(number(t, a, word.as_str())?);
+                    v.push(number(t, a, "MSYS")?);
                 }
-                let identity: &[f64] = match v.len() {
-                    9 => &[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0],
-                    12 => &[1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0],
-                    _ => &[],
-                };
-                let is_identity = identity.len() == v.len()
-                    && v.iter().zip(identity).all(|(a, b)| (a - b).abs() <= 1e-9);
+                let identity = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+                let is_identity =
+                    v.len() == 9 && v.iter().zip(identity).all(|(a, b)| (a - b).abs() <= 1e-9);
                 if !is_identity {
                     return Err(e(
                         at0,
-                        format!(
-                            "{word} other than the identity frame is not posted (it moves the part frame; post the CL in the machine's part frame); give --ignore {word} only if the frame is set on the machine"
-                        ),
+                        "MSYS other than the identity frame is not posted (the program zero would not be the part frame); give --ignore MSYS only if the frame is set on the machine",
                     ));
                 }
             }
@@ -591,6 +664,48 @@ impl Reader<'_> {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// `CSYS/r11,r12,r13,t1, r21,r22,r23,t2, r31,r32,r33,t3` (CAMWorks): the values that
+    /// follow are in this frame, world = R·v + t; the tool axis of 3-value GOTOs is its Z.
+    /// R must be a rotation (orthonormal, right-handed, within 1e-4).
+    fn csys(&mut self, f: &[(&str, At)], at: At) -> Result<(), ClError> {
+        if f.len() != 12 {
+            return Err(e(
+                f.first().map_or(at, |x| x.1),
+                format!(
+                    "CSYS needs 12 values (a 3×4 matrix [R|t], by rows); got {}",
+                    f.len()
+                ),
+            ));
+        }
+        let mut v = [0.0; 12];
+        for (i, &(t, a)) in f.iter().enumerate() {
+            v[i] = number(t, a, "CSYS value")?;
+        }
+        let r = [[v[0], v[1], v[2]], [v[4], v[5], v[6]], [v[8], v[9], v[10]]];
+        let t = [3, 7, 11].map(|i| v[i] * self.scale());
+        let det = crate::arcs::dot(r[0], crate::arcs::cross(r[1], r[2]));
+        let orthonormal = (0..3).all(|i| {
+            (0..3).all(|j| {
+                let want = if i == j { 1.0 } else { 0.0 };
+                (crate::arcs::dot(r[i], r[j]) - want).abs() <= 1e-4
+            })
+        });
+        if !orthonormal || det <= 0.0 {
+            return Err(e(
+                at,
+                "CSYS: the matrix is not a rotation (orthonormal, right-handed): refused",
+            ));
+        }
+        for (i, x) in t.into_iter().enumerate() {
+            coordinate(x, f[[3, 7, 11][i]].1, "CSYS origin", f[[3, 7, 11][i]].0)?;
+        }
+        let identity = t == [0.0; 3]
+            && (0..3).all(|i| (0..3).all(|j| r[i][j] == if i == j { 1.0 } else { 0.0 }));
+        self.frame = (!identity).then_some((r, t));
+        self.axis = self.dir([0.0, 0.0, 1.0]);
         Ok(())
     }
 
@@ -641,10 +756,12 @@ impl Reader<'_> {
         if self.circle.is_some() {
             return Err(e(at, format!("{word} after a CIRCLE that had no GOTO")));
         }
-        if f.len() < 7 {
+        // CAMWorks writes CIRCLE/xc,yc,zc,i,j,k (the radius is the start point's).
+        let with_radius = f.len() >= 7;
+        if f.len() < 6 || (word == "MOVARC" && !with_radius) {
             return Err(e(
                 f.first().map_or(at, |x| x.1),
-                format!("{word} needs xc,yc,zc,i,j,k,r; got {} values", f.len()),
+                format!("{word} needs xc,yc,zc,i,j,k[,r]; got {} values", f.len()),
             ));
         }
         let mut v = [0.0; 7];
@@ -655,9 +772,10 @@ impl Reader<'_> {
                 v[i] = coordinate(v[i] * self.scale(), a, what, t)?;
             }
         }
-        let n = unit_axis([v[3], v[4], v[5]], f[3].1.line, f[3].1.column)?;
+        let n = self.dir(unit_axis([v[3], v[4], v[5]], f[3].1.line, f[3].1.column)?);
+        let center = self.position([v[0], v[1], v[2]], f[0].1, word)?;
         let mut angle = None;
-        let rest = &f[7..];
+        let rest = &f[f.len().min(7)..];
         if word == "MOVARC" {
             match rest {
                 [(k, _), (t, a)] if k.eq_ignore_ascii_case("ANGLE") => {
@@ -675,9 +793,9 @@ impl Reader<'_> {
             }
         }
         self.circle = Some(PendingCircle {
-            center: [v[0], v[1], v[2]],
+            center,
             normal: n,
-            radius_mm: v[6],
+            radius_mm: with_radius.then_some(v[6]),
             angle_deg: angle,
             at,
         });
@@ -895,10 +1013,12 @@ pub fn parse_apt(text: &str, opts: &ParseOptions) -> Result<ClProgram, ClError> 
         axis: [0.0, 0.0, 1.0],
         pos: None,
         last_axis: [0.0, 0.0, 1.0],
+        frame: None,
         from: None,
         circle: None,
         cycle: None,
         cycle_on: false,
+        cycle_init: None,
         spindle_rpm: None,
         spindle_dir: None,
         cutcom_on: None,
@@ -1234,6 +1354,7 @@ mod tests {
         );
         let opts = ParseOptions {
             ignore: vec!["thread".into()],
+            ..ParseOptions::default()
         };
         let p = parse_with(text.as_bytes(), &opts).unwrap();
         assert_eq!(p.point_count(), 2);
@@ -1256,6 +1377,7 @@ mod tests {
             b"GOTO/0,0,0\n",
             &ParseOptions {
                 ignore: vec!["GOTO".into()],
+                ..ParseOptions::default()
             },
         )
         .unwrap_err();
@@ -1264,6 +1386,114 @@ mod tests {
         assert!(parse(b"MSYS/0,0,0,1,0,0,0,1,0\nGOTO/0,0,0\n").is_ok());
         let e = parse(b"MSYS/10,0,0,1,0,0,0,1,0\nGOTO/0,0,0\n").unwrap_err();
         assert!(e.message.contains("MSYS other than the identity"), "{e}");
+    }
+
+    /// CAMWorks' CSYS: the values after it are in that frame (world = R·v + t, by rows),
+    /// 3-value GOTOs along its Z; TRNTYP/WORLD,0,0,0 is no transformation.
+    #[test]
+    fn csys_frames_are_converted_to_the_part_frame() {
+        // A frame turned 90° about Z and moved by (10, 20, 0); then one tilted 10° about X.
+        let s10 = 10f64.to_radians().sin();
+        let c10 = 10f64.to_radians().cos();
+        let text = format!(
+            "UNIT/MM\nTRNTYP/WORLD,0,0,0\nCSYS/0,-1.,0,10.,1.,0,0,20.,0,0,1.,0\nFEDRAT/100\n\
+             GOTO/1.,0,0\nCIRCLE/0,0,0,0,0,1.\nGOTO/0,1.,0\nGODLTA/1.,0,0\n\
+             CSYS/1.,0,0,0,0,{c10},{ms10},0,0,{s10},{c10},0\nGOTO/0,0,5.\n",
+            ms10 = -s10
+        );
+        let p = parse(text.as_bytes()).unwrap();
+        let pts: Vec<_> = p.points().collect();
+        let close = |a: [f64; 3], b: [f64; 3]| (0..3).all(|i| (a[i] - b[i]).abs() < 1e-12);
+        assert!(
+            close(pts[0].pos_mm, [10.0, 21.0, 0.0]),
+            "{:?}",
+            pts[0].pos_mm
+        );
+        assert_eq!(pts[0].axis, [0.0, 0.0, 1.0]);
+        // The arc's centre is the frame's origin; local (0,1) is world (9, 20).
+        let MoveKind::Arc(a) = &pts[1].kind else {
+            panic!()
+        };
+        assert!(close(a.center_mm, [10.0, 20.0, 0.0]) && close(pts[1].pos_mm, [9.0, 20.0, 0.0]));
+        assert!((a.sweep_rad - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        assert!(
+            close(pts[2].pos_mm, [9.0, 21.0, 0.0]),
+            "GODLTA turned with the frame"
+        );
+        // The tilted frame: the tool along its Z, (0, −sin 10°, cos 10°), the point too.
+        assert!(close(pts[3].axis, [0.0, -s10, c10]), "{:?}", pts[3].axis);
+        assert!(close(pts[3].pos_mm, [0.0, -5.0 * s10, 5.0 * c10]));
+        for (text, what) in [
+            (
+                "CSYS/1,0,0,0,0,2,0,0,0,0,1,0\nGOTO/0,0,0\n",
+                "not a rotation",
+            ),
+            (
+                "CSYS/1,0,0,0,0,1,0,0,0,0,-1,0\nGOTO/0,0,0\n",
+                "not a rotation",
+            ),
+            ("CSYS/1,0,0,0\nGOTO/0,0,0\n", "12 values"),
+            (
+                "TRNTYP/LOCAL,0,0,0\nGOTO/0,0,0\n",
+                "TRNTYP other than WORLD",
+            ),
+        ] {
+            let e = parse(text.as_bytes()).unwrap_err();
+            assert!(e.message.contains(what), "{text}: {e}");
+        }
+    }
+
+    /// CAMWorks' forms: CIRCLE without a radius (the start point's), CYCLE/INIT before a
+    /// cycle, 1STPECK/SUBPECK (read when equal), RAPID/ with a slash.
+    #[test]
+    fn camworks_forms() {
+        let p = parse(
+            b"UNIT/MM\nRAPID/\nGOTO/0,0,10\nFEDRAT/100,MMPM\nGOTO/-1.2,0,0\nCIRCLE/0,0,0,0,0,1.\nGOTO/0,-1.2,0\n\
+              CYCLE/INIT\nCYCLE/DEEP2,FEDTO,10.,1STPECK,2.,SUBPECK,2.,MMPM,50.,RAPTO,3.\nGOTO/5,5,0\nCYCLE/OFF\n",
+        )
+        .unwrap();
+        let pts: Vec<_> = p.points().collect();
+        assert!(pts[0].is_rapid());
+        let MoveKind::Arc(a) = &pts[2].kind else {
+            panic!()
+        };
+        assert!((a.radius_mm - 1.2).abs() < 1e-12);
+        // From 180° to 270° counter-clockwise: a quarter.
+        assert!((a.sweep_rad - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        let MoveKind::Hole(c) = &pts[3].kind else {
+            panic!()
+        };
+        assert_eq!(c.peck_mm, Some(2.0));
+        for (text, at, what) in [
+            (
+                "FEDRAT/9\nCYCLE/INIT\nGOTO/0,0,0\n",
+                (2, 1),
+                "CYCLE/INIT without a cycle",
+            ),
+            (
+                "CYCLE/DEEP2,FEDTO,9,1STPECK,5.,SUBPECK,2.,MMPM,9,RAPTO,3\nGOTO/0,0,0\n",
+                (1, 21),
+                "1STPECK 5",
+            ),
+        ] {
+            let e = parse(text.as_bytes()).unwrap_err();
+            assert_eq!((e.line, e.column), at, "{text}: {e}");
+            assert!(e.message.contains(what), "{text}: {e}");
+        }
+        // On request, the smaller peck throughout.
+        let opts = ParseOptions {
+            uniform_peck: true,
+            ..ParseOptions::default()
+        };
+        let p = parse_with(
+            b"CYCLE/DEEP2,FEDTO,9,1STPECK,5.,SUBPECK,2.,MMPM,9,RAPTO,3\nGOTO/0,0,0\n",
+            &opts,
+        )
+        .unwrap();
+        let MoveKind::Hole(c) = &p.points().next().unwrap().kind else {
+            panic!()
+        };
+        assert_eq!(c.peck_mm, Some(2.0));
     }
 
     #[test]

@@ -6,11 +6,14 @@
 //! ```text
 //! CYCLE/mode, FEDTO,d, MMPM|IPM,f | MMPR|IPR,f, RAPTO,r [,RTRCTO,t] [,DWELL,s] [,STEP,p | INCR,p]
 //! CYCLE/ON      the last cycle again          CYCLE/OFF     no cycle
+//! CYCLE/INIT    (CAMWorks) no cycle until the next definition; a GOTO before it is refused
 //! ```
 //!
 //! - `d` depth below the top along the tool axis (> 0), `r` the clearance above the top
 //!   where the feed starts (≥ 0, required), `t` where the tool returns (above the top;
-//!   default r), `s` dwell at the bottom in seconds, `p` the peck;
+//!   default r), `s` dwell at the bottom in seconds, `p` the peck (CAMWorks'
+//!   `1STPECK,p1,SUBPECK,p2`: read when p1 = p2; otherwise refused, or with
+//!   [`crate::ParseOptions::uniform_peck`] the smaller of the two throughout);
 //! - the feed: the record's (per-revolution values times the spindle speed in force), else
 //!   the `FEDRAT` in force, else the record is refused;
 //! - modes: `DRILL`; `DEEP`, `DEEP2` (peck drilling, full retract: `STEP` required);
@@ -77,6 +80,8 @@ pub enum CycleRecord {
     On,
     /// `CYCLE/OFF`.
     Off,
+    /// `CYCLE/INIT` (CAMWorks, before each cycle): no cycle until the next definition.
+    Init,
 }
 
 /// The state a cycle record is read in.
@@ -87,6 +92,8 @@ pub(crate) struct CycleContext {
     pub feed_mm_min: Option<f64>,
     /// The spindle speed in force, rpm (per-revolution feeds).
     pub spindle_rpm: Option<f64>,
+    /// [`crate::ParseOptions::uniform_peck`].
+    pub uniform_peck: bool,
 }
 
 /// Read the fields of a `CYCLE` record: `(text, where)` per comma-separated field.
@@ -103,7 +110,7 @@ pub(crate) fn parse_cycle(
     };
     let mode = first.trim().to_ascii_uppercase();
     let kind = match mode.as_str() {
-        "OFF" | "ON" if fields.len() > 1 => {
+        "OFF" | "ON" | "INIT" if fields.len() > 1 => {
             return Err(e(
                 fields[1].1,
                 format!("CYCLE/{mode} takes no values, got '{}'", fields[1].0.trim()),
@@ -111,6 +118,7 @@ pub(crate) fn parse_cycle(
         }
         "OFF" => return Ok(CycleRecord::Off),
         "ON" => return Ok(CycleRecord::On),
+        "INIT" => return Ok(CycleRecord::Init),
         "DRILL" => CycleKind::Drill,
         "DEEP" | "DEEP2" => CycleKind::Deep,
         "BRKCHP" => CycleKind::ChipBreak,
@@ -132,6 +140,8 @@ pub(crate) fn parse_cycle(
     let mut retract = None;
     let mut dwell = 0.0;
     let mut peck = None;
+    let mut first_peck: Option<(f64, At)> = None;
+    let mut sub_peck = None;
     let mut k = 1;
     // The value after keyword `fields[k]`.
     let value = |k: usize, what: &str| -> Result<f64, crate::ClError> {
@@ -197,6 +207,16 @@ pub(crate) fn parse_cycle(
             "STEP" | "INCR" => {
                 peck = Some(positive(value(k, "STEP (peck)")?, "STEP (peck)", true)? * ctx.scale)
             }
+            // CAMWorks: the first peck and the following ones.
+            "1STPECK" => {
+                first_peck = Some((
+                    positive(value(k, "1STPECK")?, "1STPECK", true)? * ctx.scale,
+                    a,
+                ))
+            }
+            "SUBPECK" => {
+                sub_peck = Some(positive(value(k, "SUBPECK")?, "SUBPECK", true)? * ctx.scale)
+            }
             "" => return Err(e(a, format!("CYCLE/{mode}: an empty field"))),
             _ if t.trim().parse::<f64>().is_ok() => {
                 return Err(e(
@@ -219,6 +239,20 @@ pub(crate) fn parse_cycle(
         // A value that follows its keyword: the next field must be a keyword again
         // (a second value, e.g. STEP,p1,p2 or DWELL,s1,s2, is refused there).
         k += 2;
+    }
+    match (first_peck, sub_peck) {
+        (Some((f, _)), Some(s)) if f == s => peck = peck.or(Some(f)),
+        (Some((f, _)), Some(s)) if ctx.uniform_peck => peck = peck.or(Some(f.min(s))),
+        (Some((f, fa)), Some(s)) => {
+            return Err(e(
+                fa,
+                format!(
+                    "CYCLE/{mode}: a first peck (1STPECK {f}) other than the following ones (SUBPECK {s}) is not posted (the dialects' peck cycles take one peck); give --uniform-peck to drill with the smaller one throughout"
+                ),
+            ));
+        }
+        (Some((f, _)), None) | (None, Some(f)) => peck = peck.or(Some(f)),
+        (None, None) => {}
     }
     let depth_mm = depth.ok_or_else(|| {
         e(

@@ -73,6 +73,10 @@ pub struct ParseOptions {
     /// is counted in [`ClProgram::skipped`] instead of stopping the read. Records polepatch
     /// posts ([`apt::POSTED`]) cannot be skipped ([`ParseOptions::check`]). Default none.
     pub ignore: Vec<String>,
+    /// Peck cycles whose first peck differs from the following ones (CAMWorks'
+    /// `1STPECK,p1,SUBPECK,p2`) are drilled with the smaller peck throughout instead of
+    /// being refused (the dialects' peck cycles take one peck). Default `false`.
+    pub uniform_peck: bool,
 }
 
 impl ParseOptions {

@@ -79,6 +79,10 @@ pub(crate) struct PostArgs {
     /// file; repeat for several. Only records polepatch would refuse can be skipped.
     #[arg(long, value_name = "RECORD")]
     ignore: Vec<String>,
+    /// Drill peck cycles whose first peck differs from the following ones (CAMWorks'
+    /// 1STPECK/SUBPECK) with the smaller peck throughout (default: refused).
+    #[arg(long)]
+    uniform_peck: bool,
 }
 
 pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
@@ -96,6 +100,7 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
     }
     let parse = ParseOptions {
         ignore: args.ignore.clone(),
+        uniform_peck: args.uniform_peck,
     };
     if let Err(m) = parse.check() {
         bail!("{m}");
@@ -162,8 +167,21 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
                     .with_context(|| format!("cannot write {}", path.display()))?;
             }
         }
-        None => println!(
+        None if args.report.is_some() => {
+            eprintln!(
+                "polepatch: note: {name}: no patch report written (the program was not patched)"
+            );
+            println!(
+                "{name} → {}: {points} points, not patched",
+                args.output.display()
+            );
+        }
+        None if args.no_patch => println!(
             "{name} → {}: {points} points, not patched (--no-patch)",
+            args.output.display()
+        ),
+        None => println!(
+            "{name} → {}: {points} points, no G1 run to patch (holes and rapids only)",
             args.output.display()
         ),
     }

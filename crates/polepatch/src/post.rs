@@ -635,7 +635,9 @@ pub fn post_items(
     Ok(p.items)
 }
 
-/// Post a CL program for `machine`: the NC bytes and, when patched, the patch report.
+/// Post a CL program for `machine`: the NC bytes and, when patched, the patch report
+/// (`None` with `patch: false`, or when the program has no G1 run for the patch to look at:
+/// holes and rapids only).
 pub fn post_cl(
     cl: &ClProgram,
     machine: &Machine,
@@ -679,6 +681,10 @@ pub fn post_cl(
     if !opts.patch {
         return Ok((bytes, None));
     }
-    let (out, report) = crate::patch_nc(&bytes, machine, &opts.patch_options)?;
-    Ok((out, Some(report)))
+    match crate::patch_nc(&bytes, machine, &opts.patch_options) {
+        Ok((out, report)) => Ok((out, Some(report))),
+        // A program of holes and rapids only: nothing for the patch to look at.
+        Err(Error::NoRuns { .. }) => Ok((bytes, None)),
+        Err(e) => Err(e),
+    }
 }

@@ -100,71 +100,76 @@ fn cycles(text: &str, dialect: Dialect) -> Vec<[f64; 4]> {
     out
 }
 
+/// Every hole of `cl` is one canned cycle of `text` at its position and depth (x, y,
+/// bottom, feed start within the last written digit), in order, and there is no feed move
+/// between two cycle calls of one tool. Returns the number of holes.
+fn check_holes(cl: &ClProgram, text: &str, dialect: Dialect, what: &str) -> usize {
+    let holes: Vec<[f64; 4]> = cl
+        .points()
+        .filter_map(|p| match &p.kind {
+            MoveKind::Hole(c) => Some([
+                p.pos_mm[0],
+                p.pos_mm[1],
+                p.pos_mm[2] - c.depth_mm,
+                p.pos_mm[2] + c.clearance_mm,
+            ]),
+            _ => None,
+        })
+        .collect();
+    let got = cycles(text, dialect);
+    assert_eq!(got.len(), holes.len(), "{what} {dialect:?}\n{text}");
+    // Within the last written digit (inch: 0.0001 in).
+    let tol = if text.contains("G20") || text.contains("G700") {
+        0.0013
+    } else {
+        0.0006
+    };
+    for (g, h) in got.iter().zip(&holes) {
+        for i in 0..4 {
+            assert!(
+                (g[i] - h[i]).abs() <= tol,
+                "{what} {dialect:?}: {g:?} vs {h:?}\n{text}"
+            );
+        }
+    }
+    // Between two cycle calls of one tool: rapids, cycle lines and parameters only, never
+    // a feed move.
+    let lines: Vec<&str> = text.lines().collect();
+    let calls: Vec<usize> = lines
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.starts_with("G98 G") || l.starts_with("CYCLE8") || l.contains(" G79 "))
+        .map(|(i, _)| i)
+        .collect();
+    for w in calls.windows(2) {
+        let between = &lines[w[0] + 1..w[1]];
+        if between.iter().any(|l| l.contains("M6") || l.contains(" T")) {
+            continue;
+        }
+        for l in between {
+            let feed_move = ["G01", "G1 ", "G02", "G03", "G2 ", "G3 "]
+                .iter()
+                .any(|g| l.contains(g));
+            assert!(
+                !feed_move,
+                "{what} {dialect:?}: '{l}' between holes\n{text}"
+            );
+        }
+    }
+    got.len()
+}
+
 /// Issue 16 check 1: every hole becomes one canned cycle at its position and depth, and
-/// there is no feed move between the holes of a cycle.
+/// there is no feed move between holes.
 #[test]
 fn every_hole_is_one_canned_cycle_at_its_position_and_depth() {
     let mut checked = 0;
     for name in FIXTURES {
         let cl = parse(&fixture(name)).unwrap();
-        let holes: Vec<[f64; 4]> = cl
-            .points()
-            .filter_map(|p| match &p.kind {
-                MoveKind::Hole(c) => Some([
-                    p.pos_mm[0],
-                    p.pos_mm[1],
-                    p.pos_mm[2] - c.depth_mm,
-                    p.pos_mm[2] + c.clearance_mm,
-                ]),
-                _ => None,
-            })
-            .collect();
         for dialect in DIALECTS {
             for patch in [false, true] {
                 let text = post(&cl, dialect, patch, |_| {});
-                let got = cycles(&text, dialect);
-                assert_eq!(got.len(), holes.len(), "{name} {dialect:?}\n{text}");
-                // Within the last written digit (inch: 0.0001 in).
-                let tol = if text.contains("G20") || text.contains("G700") {
-                    0.0013
-                } else {
-                    0.0006
-                };
-                for (g, h) in got.iter().zip(&holes) {
-                    for i in 0..4 {
-                        assert!(
-                            (g[i] - h[i]).abs() <= tol,
-                            "{name} {dialect:?}: {g:?} vs {h:?}\n{text}"
-                        );
-                    }
-                }
-                // Between two cycle calls of one tool: rapids, cycle lines and parameters
-                // only, never a feed move.
-                let lines: Vec<&str> = text.lines().collect();
-                let calls: Vec<usize> = lines
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, l)| {
-                        l.starts_with("G98 G") || l.starts_with("CYCLE8") || l.contains(" G79 ")
-                    })
-                    .map(|(i, _)| i)
-                    .collect();
-                for w in calls.windows(2) {
-                    let between = &lines[w[0] + 1..w[1]];
-                    if between.iter().any(|l| l.contains("M6") || l.contains(" T")) {
-                        continue;
-                    }
-                    for l in between {
-                        let feed_move = ["G01", "G1 ", "G02", "G03", "G2 ", "G3 "]
-                            .iter()
-                            .any(|g| l.contains(g));
-                        assert!(
-                            !feed_move,
-                            "{name} {dialect:?}: '{l}' between holes\n{text}"
-                        );
-                    }
-                }
-                checked += got.len();
+                checked += check_holes(&cl, &text, dialect, name);
             }
         }
     }
@@ -277,7 +282,9 @@ fn pieces(text: &str) -> Vec<Piece> {
         let Some(p) = (|| Some([st.pos[modal::X]?, st.pos[modal::Y]?, st.pos[modal::Z]?]))() else {
             continue;
         };
-        if let Some(s) = prev {
+        // The first move: a piece from where the machine was (taken as its own end).
+        let s = prev.unwrap_or(p);
+        {
             match st.motion {
                 Motion::ArcCw | Motion::ArcCcw => {
                     let center = if heidenhain {
@@ -333,8 +340,10 @@ fn arc_errors(cl: &ClProgram, text: &str) -> Vec<(Arc, f64, usize)> {
             // A move the path starts with (no piece ends before it).
             assert!(
                 prev_end.is_none() || next == 0,
-                "CL line {} not found",
-                p.line
+                "CL line {} ({:?}) not found after piece {next} ending {:?}",
+                p.line,
+                p.pos_mm,
+                path.get(next.wrapping_sub(1)).map(Piece::end)
             );
             continue;
         };
@@ -573,6 +582,79 @@ fn what_is_not_posted_is_refused_naming_the_record() {
         let e = refused(text);
         assert!(e.contains(want), "{text}\n→ {e}\nwanted {want}");
     }
+}
+
+/// The same checks on CL files from elsewhere (real CAM output is not committed):
+/// `POLEPATCH_REAL_CL=DIR [POLEPATCH_REAL_CL_IGNORE=INSERT,…] [POLEPATCH_REAL_CL_UNIFORM_PECK=1]
+/// cargo test -p polepatch --test post_cam real_cl_files -- --nocapture` posts every file of
+/// DIR in the three dialects; a file is either refused (the reason is printed) or every hole
+/// and arc passes the checks above. Skipped (with a message) without the variable.
+#[test]
+fn real_cl_files() {
+    let Ok(dir) = std::env::var("POLEPATCH_REAL_CL") else {
+        eprintln!("real_cl_files: skipped (set POLEPATCH_REAL_CL to a folder of CL files)");
+        return;
+    };
+    let opts = polepatch::cl::ParseOptions {
+        ignore: std::env::var("POLEPATCH_REAL_CL_IGNORE")
+            .map(|v| v.split(',').map(str::to_string).collect())
+            .unwrap_or_default(),
+        uniform_peck: std::env::var("POLEPATCH_REAL_CL_UNIFORM_PECK").is_ok(),
+    };
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file())
+        .collect();
+    files.sort();
+    let (mut posted, mut refused, mut holes, mut arcs) = (0, 0, 0, 0);
+    for f in files {
+        let name = f.file_name().unwrap().to_string_lossy().into_owned();
+        let cl = match polepatch::cl::parse_with(&std::fs::read(&f).unwrap(), &opts) {
+            Ok(cl) => cl,
+            Err(e) => {
+                eprintln!("{name}: refused: {e}");
+                refused += 1;
+                continue;
+            }
+        };
+        let mut ok = true;
+        for dialect in DIALECTS {
+            let o = PostOptions {
+                dialect,
+                units: (dialect == Dialect::Heidenhain).then_some(Units::Mm),
+                ..PostOptions::default()
+            };
+            match post_cl(&cl, &ucp710(), &o) {
+                Err(e) => {
+                    eprintln!("{name} {dialect:?}: refused: {e}");
+                    ok = false;
+                    break;
+                }
+                Ok((bytes, _)) => {
+                    let text = String::from_utf8(bytes).unwrap();
+                    holes += check_holes(&cl, &text, dialect, &name);
+                    let inch = text.contains("G20") || text.contains("G700");
+                    let rounding = 3f64.sqrt() * if inch { 0.00127 } else { 0.0005 };
+                    for (a, worst, _) in arc_errors(&cl, &text) {
+                        assert!(
+                            worst <= o.arc_tolerance_mm + rounding,
+                            "{name} {dialect:?}: {worst} mm from {a:?}"
+                        );
+                        arcs += 1;
+                    }
+                }
+            }
+        }
+        if ok {
+            posted += 1;
+        } else {
+            refused += 1;
+        }
+    }
+    eprintln!(
+        "real_cl_files: {posted} posted in 3 dialects ({holes} holes, {arcs} arcs checked), {refused} refused"
+    );
 }
 
 /// The tilted part of the NX file: the rotary axes go to P 0, C 0 under TCPM before a
