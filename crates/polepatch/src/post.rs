@@ -431,8 +431,20 @@ impl Poster<'_> {
                     c.mode
                 )));
             }
-            CycleKind::Deep => HoleKind::Deep(c.peck_mm.expect("read requires STEP")),
-            CycleKind::ChipBreak => HoleKind::ChipBreak(c.peck_mm.expect("read requires STEP")),
+            CycleKind::Deep | CycleKind::ChipBreak => {
+                // The reader requires STEP; a cycle built otherwise may lack it.
+                let Some(peck) = c.peck_mm.filter(|p| *p > 0.0) else {
+                    return Err(refuse(format!(
+                        "CYCLE/{} (peck drilling) without a positive peck",
+                        c.mode
+                    )));
+                };
+                if c.kind == CycleKind::Deep {
+                    HoleKind::Deep(peck)
+                } else {
+                    HoleKind::ChipBreak(peck)
+                }
+            }
             CycleKind::Tap => match self.spindle {
                 Some((rpm, dir)) if dir != SpindleDir::Off => HoleKind::Tap {
                     rpm,
@@ -497,12 +509,21 @@ impl Poster<'_> {
                 self.frame = Frame::Tcpm;
                 Ok(())
             }
-            ClItem::Spindle { rpm, dir, .. } => {
+            ClItem::Spindle { rpm, dir, at } => {
                 let s = match (dir, rpm) {
                     (SpindleDir::Off, _) => Spindle::Off,
                     (SpindleDir::Cw, Some(r)) => Spindle::Cw(*r),
                     (SpindleDir::Ccw, Some(r)) => Spindle::Ccw(*r),
-                    (_, None) => unreachable!("the reader gives a start its speed"),
+                    // The reader gives every start its speed; a program built otherwise
+                    // may not.
+                    (_, None) => {
+                        return Err(cl_error(
+                            self.name(),
+                            at.line,
+                            at.column,
+                            "SPINDL starts the spindle without a speed".into(),
+                        ));
+                    }
                 };
                 self.spindle = match (dir, rpm) {
                     (SpindleDir::Off, _) => None,
