@@ -42,7 +42,7 @@ fn no_zone(c: &mut Criterion) {
             )
         });
         // The analysis alone, from a parsed program: runs, paths, patch_path per run.
-        let parsed = parse_program(text.clone(), "bench").expect("parses");
+        let parsed = parse_program(text.clone(), "bench", &machine).expect("parses");
         g.bench_with_input(BenchmarkId::new("runs_and_patch", name), &parsed, |b, p| {
             b.iter_batched(
                 || p.clone(),

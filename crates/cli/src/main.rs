@@ -103,6 +103,12 @@ pub(crate) struct PatchArgs {
     /// program's datum shift (Heidenhain G54 X Y Z).
     #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z")]
     pub(crate) work_offset: Option<[f64; 3]>,
+    /// With a kinematic chain, for runs without TCPM: how far the tool tip may leave the
+    /// programmed line between two points of a rewritten block, mm (the controller
+    /// interpolates every axis linearly there); a run that would exceed it — and its
+    /// original block — keeps its values.
+    #[arg(long, value_name = "MM", default_value_t = polepatch::machine_frame::CHORD_TOLERANCE_MM)]
+    pub(crate) chord_tolerance: f64,
 }
 
 #[derive(clap::Args)]
@@ -128,6 +134,10 @@ struct AnalyzeArgs {
     /// Work offset X,Y,Z (mm) for a machine with a kinematic chain (see `patch`).
     #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z")]
     work_offset: Option<[f64; 3]>,
+    /// Exit with status 2 when a run or lines could not be analysed (no feed, expressions,
+    /// arcs or skippable blocks near the pole, …).
+    #[arg(long)]
+    strict: bool,
 }
 
 /// `X,Y,Z` as three finite numbers.
@@ -198,6 +208,7 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
         work_offset_mm: args.work_offset,
     };
     let bytes = files::read(&args.file)?;
+    let args_strict = args.strict;
     // The report is printed as each run is analysed (a program of many runs has a report
     // larger than itself): the header first, then the runs in file order.
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
@@ -255,7 +266,7 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
     }
     for r in &failed {
         eprintln!(
-            "polepatch: error: {}: run {} (lines {}–{}): {}",
+            "polepatch: {}: run {} (lines {}–{}) not analysed: {}",
             report.file,
             r.run,
             r.lines[0],
@@ -263,10 +274,17 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
             r.error.as_deref().unwrap_or("")
         );
     }
-    Ok(if failed.is_empty() {
-        ExitCode::SUCCESS
+    for n in &report.not_analysed {
+        eprintln!("polepatch: {}: not analysed: {}", report.file, n.message);
+    }
+    // The file was read: runs or lines that could not be analysed are listed, and fail
+    // only with --strict (as for `patch`).
+    let failures = failed.len() + report.not_analysed.len();
+    Ok(if args_strict && failures > 0 {
+        eprintln!("polepatch: {failures} run(s) or line range(s) not analysed (--strict)");
+        ExitCode::from(2)
     } else {
-        ExitCode::from(1)
+        ExitCode::SUCCESS
     })
 }
 

@@ -80,10 +80,12 @@ fn expand(inputs: &[PathBuf]) -> Result<Vec<(PathBuf, PathBuf)>> {
 }
 
 pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
+    check_positive("--chord-tolerance", Some(args.chord_tolerance))?;
     let opts = polepatch::PatchOptions {
         patch: options(&args)?,
         feed_fallback_mm_min: args.feed,
         work_offset_mm: args.work_offset,
+        chord_tolerance_mm: args.chord_tolerance,
         ..polepatch::PatchOptions::default()
     };
     let machine = machine(&args.machine)?;
@@ -177,6 +179,12 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
                 rep.file, u.run, u.lines[0], u.lines[1], u.message
             );
         }
+        for n in &rep.not_analysed {
+            eprintln!(
+                "polepatch: warning: {}: not analysed: {}",
+                rep.file, n.message
+            );
+        }
     }
     if let Some(path) = &args.report {
         let doc = if ok.len() == 1 && args.output.is_some() {
@@ -192,6 +200,10 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     let below: usize = ok.iter().map(|r| r.zones_below_feed()).sum();
+    let unanalysed: usize = ok
+        .iter()
+        .map(|r| r.strict_failures() - r.zones_below_feed())
+        .sum();
     let no_tcpm: usize = ok.iter().map(|r| r.runs_left_without_tcpm()).sum();
     if no_tcpm > 0 {
         eprintln!(
@@ -209,8 +221,11 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
         }
         return Ok(ExitCode::from(1));
     }
-    if args.strict && below > 0 {
-        eprintln!("polepatch: {below} zone(s) stay below feed (--strict)");
+    if args.strict && below + unanalysed > 0 {
+        eprintln!(
+            "polepatch: {below} zone(s) stay below feed, {unanalysed} run(s) or line range(s) \
+             not analysed (--strict)"
+        );
         return Ok(ExitCode::from(2));
     }
     Ok(ExitCode::SUCCESS)

@@ -198,6 +198,7 @@ fn bad_input_gets_a_clear_message_and_nonzero_exit() {
         ],
         ":2:",
     );
+    // A run without a feed is listed, not an error (issue 20 §7); --strict makes it one.
     let no_f = temp_file("nof.nc", b"G1 X0 Y0 Z0 A1 C0\nX1 C1\nX2 C2\nX3 C3\n");
     fails_with(
         &[
@@ -205,6 +206,7 @@ fn bad_input_gets_a_clear_message_and_nonzero_exit() {
             no_f.to_str().unwrap(),
             "--machine",
             "mikron-ucp710",
+            "--strict",
         ],
         "no feed (F)",
     );
@@ -232,7 +234,7 @@ fn bad_input_gets_a_clear_message_and_nonzero_exit() {
 
 /// `analyze` prints its report as runs are analysed: the JSON is the library's report,
 /// pretty-printed, byte for byte; the table has one block per run, in order; a run
-/// without a feed is listed and makes the exit code 1.
+/// without a feed is listed (exit 0: the file was read; `--strict` makes it 2).
 #[test]
 fn the_printed_report_is_the_librarys() {
     use polepatch::kinematics::Machine;
@@ -244,7 +246,7 @@ fn the_printed_report_is_the_librarys() {
     for (file, code) in [
         ("fixtures/c17/SING.I".to_string(), 0),
         ("fixtures/dialects/fanuc.nc".to_string(), 0),
-        (feedless.display().to_string(), 1),
+        (feedless.display().to_string(), 0),
     ] {
         let opts = polepatch::AnalyzeOptions {
             name: file.clone(),
@@ -267,5 +269,39 @@ fn the_printed_report_is_the_librarys() {
             .map(|l| l.split(':').next().unwrap().parse().unwrap())
             .collect();
         assert_eq!(runs, (1..=report.runs.len()).collect::<Vec<_>>(), "{file}");
+    }
+}
+
+/// Issue 20 §7 / 19 §5: `analyze` and `patch` agree on exit codes: 0 when the file was read
+/// (what could not be analysed is listed), 2 with `--strict`, for a run without a usable
+/// feed as for lines carried through (an expression).
+#[test]
+fn strict_fails_on_what_was_not_analysed() {
+    let feedless = temp_file(
+        "strict-feedless.I",
+        b"%P G71 *\nN1 M128 *\nN2 G01 X+0 Y+0 Z+0 A+1 C+0 *\nN3 X+1 A+0.5 C+50 *\nN4 X+2 A+0.2 C+120 *\n",
+    );
+    let expression = temp_file(
+        "strict-expression.nc",
+        b"(X)\nG43.4 H1\nG1 X0 Y0 Z0 A10 C0 F1000\nX1 A#<a>\nX2 A12 C5\nX3 A13 C6\n",
+    );
+    for file in [&feedless, &expression] {
+        let f = file.display().to_string();
+        for cmd in ["analyze", "patch"] {
+            let out = format!("{f}.out");
+            let mut args = vec![cmd, &f, "--machine", "mikron-ucp710"];
+            if cmd == "patch" {
+                args.extend(["-o", &out]);
+            }
+            let (c, _, err) = polepatch(&args);
+            assert_eq!(c, 0, "{cmd} {f}: {err}");
+            assert!(
+                err.contains("not analysed") || err.contains("no feed"),
+                "{cmd} {f}: {err}"
+            );
+            args.push("--strict");
+            let (c, _, err) = polepatch(&args);
+            assert_eq!(c, 2, "{cmd} {f} --strict: {err}");
+        }
     }
 }

@@ -296,6 +296,246 @@ pub fn program(p: &Pass, dialect: Dialect, name: &str) -> String {
     out
 }
 
+/// A program form shops run that is not one of [`Dialect`]'s ISO styles (issue 20): the
+/// same pass, written as each controller's users write it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShopForm {
+    /// Heidenhain conversational with `FUNCTION TCPM` / `FUNCTION RESET TCPM`.
+    ConversationalFunctionTcpm,
+    /// Heidenhain conversational with `M128` / `M129`.
+    ConversationalM128,
+    /// Fanuc/Haas with `G43.4` and inverse-time feed (`G93`, F = 1/min per block).
+    FanucInverseTime,
+    /// LinuxCNC: spaces inside words, `G93`, TCP switched by `M428`/`M429` (a machine file
+    /// names them: `[controller] tcpm_on = ["M428"]`).
+    LinuxCncInverseTime,
+    /// A machine whose kinematics are always TCP (`tcpm_always = true`): no TCPM code.
+    AlwaysTcp,
+    /// Fanuc with spaces between address and number (`X 6.302  A -71.841`).
+    SpacedWords,
+    /// Fanuc with a first run whose rotary words are variables (`A#101`), then the pass.
+    Variables,
+}
+
+impl ShopForm {
+    /// Every form.
+    pub const ALL: [ShopForm; 7] = [
+        ShopForm::ConversationalFunctionTcpm,
+        ShopForm::ConversationalM128,
+        ShopForm::FanucInverseTime,
+        ShopForm::LinuxCncInverseTime,
+        ShopForm::AlwaysTcp,
+        ShopForm::SpacedWords,
+        ShopForm::Variables,
+    ];
+    /// File stem and extension.
+    pub fn file_name(self, stem: &str) -> String {
+        match self {
+            ShopForm::ConversationalFunctionTcpm => format!("{stem}-conv-function-tcpm.H"),
+            ShopForm::ConversationalM128 => format!("{stem}-conv-m128.H"),
+            ShopForm::FanucInverseTime => format!("{stem}-fanuc-g93.nc"),
+            ShopForm::LinuxCncInverseTime => format!("{stem}-linuxcnc-g93-m428.ngc"),
+            ShopForm::AlwaysTcp => format!("{stem}-always-tcp.ngc"),
+            ShopForm::SpacedWords => format!("{stem}-spaced-words.nc"),
+            ShopForm::Variables => format!("{stem}-variables.nc"),
+        }
+    }
+}
+
+/// The pass of the shop-form fixtures: A-C, 0.5 mm spacing, F2000 (domain rule or
+/// continuous branch, `pole_distance_deg` from the pole).
+pub fn shop_pass(domain_rule: bool, pole_distance_deg: f64) -> Pass {
+    Pass {
+        pole_distance_deg,
+        domain_rule,
+        spacing_mm: 0.5,
+        ..Pass::default()
+    }
+}
+
+/// The program text of a pass in a shop form, named `name`. The pass's tool-tip path and
+/// joint values are those of [`program`]; under G93 each block's F is its length divided by
+/// the programmed feed's time, written with 3 decimals (1/min).
+pub fn shop_program(p: &Pass, form: ShopForm, name: &str) -> String {
+    let j = joints(p);
+    let pl = if p.b_axis { 'B' } else { 'A' };
+    let d = p.rotary_decimals;
+    let f = num(p.feed_mm_min, 0, false);
+    let mut out = String::new();
+    let mut line = |s: String| {
+        out.push_str(&s);
+        out.push('\n');
+    };
+    let block_f = |k: usize| {
+        let a = j[k - 1];
+        let b = j[k];
+        let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2)).sqrt();
+        format!("{:.3}", p.feed_mm_min / len)
+    };
+    match form {
+        ShopForm::ConversationalFunctionTcpm | ShopForm::ConversationalM128 => {
+            let fn_tcpm = form == ShopForm::ConversationalFunctionTcpm;
+            let mut n = 0;
+            let mut blk = |s: String, line: &mut dyn FnMut(String)| {
+                line(format!("{n} {s}"));
+                n += 1;
+            };
+            blk(format!("BEGIN PGM {name} MM"), &mut line);
+            blk("BLK FORM 0.1 Z  X-10  Y-20  Z-30".into(), &mut line);
+            blk(
+                format!(
+                    "BLK FORM 0.2  X+{}  Y+20  Z+0",
+                    num(p.length_mm + 10.0, 0, false)
+                ),
+                &mut line,
+            );
+            blk("TOOL CALL 1 Z S12000".into(), &mut line);
+            blk("L  Z+100 R0 FMAX M3".into(), &mut line);
+            blk(
+                if fn_tcpm {
+                    "FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS".into()
+                } else {
+                    "L  M128".into()
+                },
+                &mut line,
+            );
+            let q0 = j[0];
+            blk(
+                format!(
+                    "L  X{}  Y{}  {pl}{}  C{} R0 FMAX",
+                    num(q0[0], 3, true),
+                    num(q0[1], 3, true),
+                    num(q0[3], d, true),
+                    num(q0[4], d, true)
+                ),
+                &mut line,
+            );
+            blk(
+                format!("L  Z{} R0 FMAX M8", num(q0[2] + 5.0, 3, true)),
+                &mut line,
+            );
+            // The plunge at its own feed: the pass is a run of its own from its first point.
+            blk(format!("L  Z{} R0 F500", num(q0[2], 3, true)), &mut line);
+            blk("* - PASS".into(), &mut line);
+            for (k, q) in j.iter().enumerate().skip(1) {
+                let feed = if k == 1 {
+                    format!(" F{f}")
+                } else {
+                    String::new()
+                };
+                blk(
+                    format!(
+                        "L  X{}  Y{}  Z{}  {pl}{}  C{}{feed}",
+                        num(q[0], 3, true),
+                        num(q[1], 3, true),
+                        num(q[2], 3, true),
+                        num(q[3], d, true),
+                        num(q[4], d, true),
+                    ),
+                    &mut line,
+                );
+            }
+            blk("L  Z+100 R0 FMAX M9".into(), &mut line);
+            blk(
+                if fn_tcpm {
+                    "FUNCTION RESET TCPM".into()
+                } else {
+                    "L  M129".into()
+                },
+                &mut line,
+            );
+            blk("L  M30".into(), &mut line);
+            blk(format!("END PGM {name} MM"), &mut line);
+        }
+        ShopForm::FanucInverseTime
+        | ShopForm::LinuxCncInverseTime
+        | ShopForm::AlwaysTcp
+        | ShopForm::SpacedWords
+        | ShopForm::Variables => {
+            let linuxcnc = matches!(form, ShopForm::LinuxCncInverseTime | ShopForm::AlwaysTcp);
+            let g93 = matches!(
+                form,
+                ShopForm::FanucInverseTime | ShopForm::LinuxCncInverseTime
+            );
+            let spaced = matches!(form, ShopForm::LinuxCncInverseTime | ShopForm::SpacedWords);
+            let w = |l: char, v: String| {
+                if spaced {
+                    format!("{l} {v}")
+                } else {
+                    format!("{l}{v}")
+                }
+            };
+            if !linuxcnc {
+                line("%".into());
+                line("O1000".into());
+            }
+            line(format!("({name})"));
+            line("G90 G21 G94 G17".into());
+            line("T1 M6".into());
+            line("S12000 M3".into());
+            match form {
+                ShopForm::LinuxCncInverseTime => line("M428 (TCP KINEMATICS)".into()),
+                ShopForm::AlwaysTcp => {}
+                _ => line("G43.4 H1".into()),
+            }
+            let q0 = j[0];
+            if form == ShopForm::Variables {
+                // A first run whose rotary words are variables: carried through, listed.
+                line(format!("#101={}", num(q0[3] + 10.0, d, false)));
+                line(format!("#102={}", num(q0[4], d, false)));
+                line(format!("G0 X{} Y10. Z0. A#101 C#102", num(q0[0], 3, false)));
+                line(format!("G1 X{} Y10. Z-5. F{f}", num(q0[0] + 1.0, 3, false)));
+                line(format!("X{} A#101 C[#102+1.]", num(q0[0] + 2.0, 3, false)));
+                line(format!("X{} A#101 C[#102+2.]", num(q0[0] + 3.0, 3, false)));
+                line("G0 Z50.".into());
+            }
+            line(format!(
+                "G0 {} {} {} {}",
+                w('X', num(q0[0], 3, false)),
+                w('Y', num(q0[1], 3, false)),
+                w(pl, num(q0[3], d, false)),
+                w('C', num(q0[4], d, false))
+            ));
+            line(format!("G0 {}", w('Z', num(q0[2] + 5.0, 3, false))));
+            // The plunge at its own feed: the pass is a run of its own from its first point.
+            line(format!("G1 {} F500", w('Z', num(q0[2], 3, false))));
+            if g93 {
+                line("G93".into());
+            }
+            for (k, q) in j.iter().enumerate().skip(1) {
+                let mut s = format!(
+                    "{} {} {} {} {}",
+                    w('X', num(q[0], 3, false)),
+                    w('Y', num(q[1], 3, false)),
+                    w('Z', num(q[2], 3, false)),
+                    w(pl, num(q[3], d, false)),
+                    w('C', num(q[4], d, false))
+                );
+                if g93 {
+                    s.push_str(&format!(" F{}", block_f(k)));
+                } else if k == 1 {
+                    s.push_str(&format!(" F{f}"));
+                }
+                line(s);
+            }
+            if g93 {
+                line("G94".into());
+            }
+            line(format!("G0 {}", w('Z', "50.".into())));
+            match form {
+                ShopForm::LinuxCncInverseTime => line("M429 (IDENTITY KINEMATICS)".into()),
+                ShopForm::AlwaysTcp => {}
+                _ => line("G49".into()),
+            }
+            line(if linuxcnc { "M2".into() } else { "M30".into() });
+            if !linuxcnc {
+                line("%".into());
+            }
+        }
+    }
+    out
+}
+
 /// A zigzag finishing program in Heidenhain ISO: `passes` parallel passes (alternating
 /// direction, 2 mm apart in Y), each its own G1 run between rapid moves, the k-th passing
 /// at `pole_distances_deg[k % len]` from the pole — a program with many singular zones.

@@ -1,4 +1,5 @@
-//! `polepatch-fixturegen DIR`: writes the committed set of synthetic fixtures into DIR.
+//! `polepatch-fixturegen DIR [SHOP_DIR]`: writes the committed set of synthetic fixtures into
+//! DIR (and the shop forms of issue 20 into SHOP_DIR).
 
 use polepatch_fixturegen::{Dialect, Pass, program};
 use std::path::PathBuf;
@@ -42,5 +43,25 @@ fn main() -> std::io::Result<()> {
         }
     }
     eprintln!("wrote {count} programs to {}", dir.display());
+    // The shop forms (issue 20) of two passes: a flip at 0.5° and a swing at 1°, A-C.
+    if let Some(shop) = std::env::args().nth(2).map(PathBuf::from) {
+        std::fs::create_dir_all(&shop)?;
+        let mut count = 0;
+        for (stem, domain_rule, d) in [("ac-flip-d0.5", true, 0.5), ("ac-swing-d1", false, 1.0)] {
+            let pass = polepatch_fixturegen::shop_pass(domain_rule, d);
+            for form in polepatch_fixturegen::ShopForm::ALL {
+                let name = stem.to_uppercase().replace(['.', '-'], "_");
+                let text = polepatch_fixturegen::shop_program(&pass, form, &name);
+                std::fs::write(shop.join(form.file_name(stem)), text)?;
+                count += 1;
+            }
+            // Its G94 ISO twin, for the equality tests.
+            let name = stem.to_uppercase().replace(['.', '-'], "_");
+            let text = program(&pass, Dialect::Fanuc, &name);
+            std::fs::write(shop.join(format!("{stem}-fanuc-g94.nc")), text)?;
+            count += 1;
+        }
+        eprintln!("wrote {count} programs to {}", shop.display());
+    }
     Ok(())
 }

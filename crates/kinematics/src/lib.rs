@@ -36,5 +36,5 @@ pub use inverse::{
     BranchRule, IkSolution, domain_rule_index, inverse, inverse_path, inverse_path_from,
     unwrap_near_deg, wrap_deg,
 };
-pub use machine::{Axis, AxisLimits, Machine, MachineError, PrimaryAxis};
+pub use machine::{Axis, AxisLimits, Controller, Machine, MachineError, PrimaryAxis};
 pub use reorient::JigRotation;

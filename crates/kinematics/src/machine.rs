@@ -74,6 +74,27 @@ pub struct Machine {
     /// Where the rotary axes sit in the machine frame (`[chain]`, optional): needed to
     /// patch programs without TCPM and to analyse the linear axes in the machine frame.
     pub chain: Option<crate::chain::Chain>,
+    /// How the controller switches TCPM beyond its dialect's codes (`[controller]`,
+    /// optional).
+    pub controller: Controller,
+}
+
+/// `[controller]`: the machine's own TCPM codes, as NC words (`"M428"`, `"G43.4"`,
+/// `"TRAORI"`), added to the built-in codes of the program's dialect by the NC reader; or
+/// `tcpm_always = true` for kinematics that are always TCP (X Y Z are always tool-tip
+/// positions in the part frame).
+#[derive(Debug, Clone, Default, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Controller {
+    /// Codes that switch TCPM on. Default none.
+    #[serde(default)]
+    pub tcpm_on: Vec<String>,
+    /// Codes that end it. Default none.
+    #[serde(default)]
+    pub tcpm_off: Vec<String>,
+    /// Always TCP. Default false.
+    #[serde(default)]
+    pub tcpm_always: bool,
 }
 
 /// Errors of machine loading.
@@ -144,6 +165,10 @@ impl Machine {
     /// [chain]                          # optional: where the rotary axes sit (mm, machine frame)
     /// primary_axis_point_mm = [0.0, 0.0, -150.0]   # a point on the primary axis line
     /// c_axis_point_mm = [0.0, 0.0, -100.0]         # a point on the C axis at primary = 0
+    /// [controller]                     # optional: the machine's own TCPM codes
+    /// tcpm_on = ["M428"]               # added to the dialect's (M128, TRAORI, G43.4, …)
+    /// tcpm_off = ["M429", "M430"]
+    /// tcpm_always = false              # true: kinematics always TCP
     /// ```
     ///
     /// Limits are converted once to internal units: m/min → mm/s ×1000/60, m/s² → mm/s²
@@ -221,6 +246,8 @@ struct MachineFile {
     primary: PrimaryFile,
     c: CFile,
     chain: Option<crate::chain::Chain>,
+    #[serde(default)]
+    controller: Controller,
 }
 
 /// `[x]`, `[y]`, `[z]`.
@@ -339,6 +366,26 @@ impl MachineFile {
                     Some(ch)
                 }
                 None => None,
+            },
+            controller: {
+                for (field, codes) in [
+                    ("controller.tcpm_on", &self.controller.tcpm_on),
+                    ("controller.tcpm_off", &self.controller.tcpm_off),
+                ] {
+                    if let Some(bad) = codes.iter().find(|c| {
+                        c.trim().is_empty()
+                            || !c
+                                .trim()
+                                .bytes()
+                                .all(|b| b.is_ascii_alphanumeric() || b == b'.' || b == b'_')
+                    }) {
+                        return Err(format!(
+                            "{field}: '{bad}' is not an NC code (write a G or M code such as \
+                             \"M428\" or \"G43.4\", or a word such as \"TRAORI\")"
+                        ));
+                    }
+                }
+                self.controller
             },
         })
     }

@@ -223,7 +223,7 @@ fn style(dialect: Dialect) -> NumberStyle {
             leading_zero: true,
             equals: false,
         },
-        Dialect::Heidenhain | Dialect::Auto => NumberStyle {
+        Dialect::Heidenhain | Dialect::Conversational | Dialect::Auto => NumberStyle {
             plus_sign: true,
             decimals: 3,
             strip_trailing_zeros: true,
@@ -282,7 +282,10 @@ struct Writer<'o> {
 
 impl Writer<'_> {
     fn heidenhain(&self) -> bool {
-        matches!(self.o.dialect, Dialect::Heidenhain | Dialect::Auto)
+        matches!(
+            self.o.dialect,
+            Dialect::Heidenhain | Dialect::Conversational | Dialect::Auto
+        )
     }
 
     fn len(&self, mm: f64) -> String {
@@ -716,7 +719,7 @@ fn frame(body: &[String], o: &EmitOptions) -> Vec<u8> {
     let name = clean(&o.name);
     let mut out = String::new();
     match o.dialect {
-        Dialect::Heidenhain | Dialect::Auto => {
+        Dialect::Heidenhain | Dialect::Conversational | Dialect::Auto => {
             let units = if o.inch { "G70" } else { "G71" };
             let mut n = 0u64;
             out.push_str(&format!("%{name} {units} *\n"));
@@ -817,7 +820,7 @@ mod tests {
             assert_eq!(prog.dialect, dialect, "{}", String::from_utf8_lossy(&bytes));
             let r = runs(&prog);
             assert_eq!(r.len(), 1, "{}", String::from_utf8_lossy(&bytes));
-            assert!(r[0].tcpm);
+            assert!(r[0].tcpm.is_on());
             assert_eq!(r[0].feed_mm_min, Some(2000.0));
             let last = r[0].pos.last().unwrap();
             assert_eq!(last[modal::A], Some(-0.5));
@@ -929,7 +932,10 @@ mod tests {
                 assert_eq!(prog.dialect, dialect, "{text}");
                 let r = runs(&prog);
                 // The TCPM straight moves at feed: one run of the two cutting blocks.
-                let tcpm_runs: Vec<_> = r.iter().filter(|r| r.tcpm && r.pos.len() > 1).collect();
+                let tcpm_runs: Vec<_> = r
+                    .iter()
+                    .filter(|r| r.tcpm.is_on() && r.pos.len() > 1)
+                    .collect();
                 assert!(!tcpm_runs.is_empty(), "{text}");
                 let x = tcpm_runs[0].pos.last().unwrap()[modal::X].unwrap();
                 // Within half the last written digit (0.0001 inch = 0.00254 mm).

@@ -8,14 +8,19 @@
 //! - `*` ends the block (Heidenhain); it and the rest of the line pass through;
 //! - `%` starts a pass-through rest of line (`%NAME G71 *`, `N999999 %SING G71 *`);
 //! - a letter followed by a sign, digit or `.` is an address word (`C+148.494`, `X-.5`,
-//!   `G01`, `X10.`); followed by `=` it is a Sinumerik word (`X=12.5`);
+//!   `G01`, `X10.`); followed by `=` it is a Sinumerik word (`X=12.5`); blanks may stand
+//!   between the letter and its number and between a sign and its digits (`X  6.302`,
+//!   `Y -11.56`, `Z- 5`: RS274/NGC and Fanuc accept them), and belong to the word;
+//! - a letter whose value is not a plain number (`A#<a>`, `X=R1+2`, `X+Q5`, `F=FGREF(5)`)
+//!   is an [`Token::Assign`]: the reader marks such a block as not analysable;
 //! - a letter followed by a letter or `_` starts an identifier (`TRAORI`, `CYCLE800(…)`,
 //!   `MSG("…")`), which takes a following `(…)`/`[…]` and `=expression` along;
 //! - `/` with optional level digits is the block-delete marker;
+//! - `#` starts a parameter (`#12`, `#<name>`, `#[expr]`);
 //! - anything else up to the next blank, letter, `;` or `(` is an unknown token.
 //!
-//! Errors: a malformed or non-finite number on an address word, a value that is an
-//! expression on an axis word (X Y Z A B C F), an axis value in exponent notation
+//! Errors: a malformed or non-finite number on an address word, an axis value in exponent
+//! notation
 //! (`X1e999`: a plain decimal or `X1 E999`? polepatch does not guess), a letter that needs
 //! a number but has none (`X`, `X+`), and an ASCII control byte (NUL, ESC, DEL…) outside
 //! a comment.
@@ -65,6 +70,11 @@ pub enum Token {
     /// `%` and the rest of the line.
     Percent {
         /// From `%` to the end of the line.
+        span: Range<usize>,
+    },
+    /// A parameter reference or assignment target: `#12`, `#<name>`, `#[expr]`.
+    Param {
+        /// The reference.
         span: Range<usize>,
     },
     /// `/` block-delete marker with optional level digits.
@@ -129,6 +139,18 @@ fn is_non_finite_name(text: &[u8]) -> bool {
     t.eq_ignore_ascii_case(b"nan")
         || t.eq_ignore_ascii_case(b"inf")
         || t.eq_ignore_ascii_case(b"infinity")
+}
+
+/// Whether a value that is not a plain number reads as an expression or a variable: after
+/// an optional sign, a variable (`#1`, `#<name>`, `R1`, `Q5`, `$P_X`), a bracket (`[…]`,
+/// `(…)`), `<`, or a function name (`IC(5)`).
+fn is_expression_start(text: &[u8]) -> bool {
+    let t = match text.first() {
+        Some(b'+' | b'-') => &text[1..],
+        _ => text,
+    };
+    t.first()
+        .is_some_and(|&c| c.is_ascii_alphabetic() || matches!(c, b'#' | b'[' | b'(' | b'<' | b'$'))
 }
 
 /// Exact powers of ten representable in f64.
@@ -265,6 +287,14 @@ impl<'a> Lexer<'a> {
         let neg = e < self.end && b[e] == b'-';
         if e < self.end && matches!(b[e], b'+' | b'-') {
             e += 1;
+            // `Z- 5`: blanks between a sign and its digits.
+            let mut k = e;
+            while k < self.end && is_blank(b[k]) {
+                k += 1;
+            }
+            if k > e && k < self.end && (b[k].is_ascii_digit() || b[k] == b'.') {
+                e = k;
+            }
         }
         let digits_start = e;
         let mut mantissa: u64 = 0;
@@ -302,7 +332,24 @@ impl<'a> Lexer<'a> {
         let l = letter as char;
         let q = p + 1;
         let eq = q < self.end && b[q] == b'=';
-        let ns = if eq { q + 1 } else { q };
+        let mut ns = if eq { q + 1 } else { q };
+        // `X  6.302`, `Y -11.56`: blanks before a number belong to the word.
+        let mut k = ns;
+        while k < self.end && is_blank(b[k]) {
+            k += 1;
+        }
+        if k > ns
+            && k < self.end
+            && (b[k].is_ascii_digit()
+                || b[k] == b'.'
+                || (matches!(b[k], b'+' | b'-')
+                    && b[k + 1..self.end]
+                        .iter()
+                        .find(|&&c| !is_blank(c))
+                        .is_some_and(|c| c.is_ascii_digit() || *c == b'.')))
+        {
+            ns = k;
+        }
         let (ds, e, fast) = self.scan_number(ns);
         if e < self.end && is_control(b[e]) {
             return self.err(e, control_message(b[e]));
@@ -327,6 +374,24 @@ impl<'a> Lexer<'a> {
                     ),
                 );
             }
+        }
+        if is_axis(letter)
+            && e > ds
+            && e + 1 < self.end
+            && b[e] == b','
+            && b[e + 1].is_ascii_digit()
+        {
+            let mut x = e + 1;
+            while x < self.end && b[x].is_ascii_digit() {
+                x += 1;
+            }
+            return self.err(
+                p,
+                format!(
+                    "{l} value '{}' is not a number (a decimal comma? NC programs use a point)",
+                    self.text(ns..x)
+                ),
+            );
         }
         let followed_by_expr = e < self.end
             && matches!(
@@ -353,13 +418,14 @@ impl<'a> Lexer<'a> {
                         p,
                         format!("{l} value '{}' is not a finite number", self.text(ns..x)),
                     )
+                } else if is_expression_start(text) {
+                    // An expression or a variable: the reader marks the block.
+                    self.pos = x;
+                    Some(Ok(Token::Assign { letter, span: p..x }))
                 } else {
                     self.err(
                         p,
-                        format!(
-                            "{l} value '{}' is an expression; polepatch needs a plain number on axis words",
-                            self.text(ns..x)
-                        ),
+                        format!("{l} value '{}' is not a number", self.text(ns..x)),
                     )
                 };
             }
@@ -386,7 +452,15 @@ impl<'a> Lexer<'a> {
                 Token::Other { span: p..q }
             }));
         }
-        let value = match fast.or_else(|| parse_number(&b[ns..e])) {
+        let value = match fast.or_else(|| {
+            let text = &b[ns..e];
+            if text.iter().any(|&c| is_blank(c)) {
+                let plain: Vec<u8> = text.iter().copied().filter(|&c| !is_blank(c)).collect();
+                parse_number(&plain)
+            } else {
+                parse_number(text)
+            }
+        }) {
             Some(v) => v,
             None => {
                 return self.err(
@@ -505,6 +579,26 @@ impl Iterator for Lexer<'_> {
                 }
                 self.pos = (i + 1).min(self.end);
                 Some(Ok(Token::Other { span: p..self.pos }))
+            }
+            b'#' => {
+                // A parameter: `#12`, `#<name>`, `#[expr]` (LinuxCNC, Fanuc macro B).
+                let mut i = p + 1;
+                match b.get(i).filter(|_| i < self.end) {
+                    Some(b'<') => {
+                        while i < self.end && b[i] != b'>' {
+                            i += 1;
+                        }
+                        i = (i + 1).min(self.end);
+                    }
+                    Some(b'[') => i = self.skip_group(i),
+                    _ => {
+                        while i < self.end && b[i].is_ascii_digit() {
+                            i += 1;
+                        }
+                    }
+                }
+                self.pos = i;
+                Some(Ok(Token::Param { span: p..i }))
             }
             _ => {
                 let mut i = p + 1;
@@ -678,12 +772,25 @@ mod tests {
             lex_err("C=inf").message,
             "C value 'inf' is not a finite number"
         );
-        assert!(
-            lex_err("X=IC(5)")
-                .message
-                .contains("'IC(5)' is an expression")
+        // Expressions and variables are tokens the reader flags, not errors.
+        for text in [
+            "X=IC(5)",
+            "X[#1+2]",
+            "A#<a_angle>",
+            "X+Q5",
+            "F=FGREF(5000)",
+            "X=R1+2",
+        ] {
+            assert!(
+                matches!(lex(text)[0], Token::Assign { .. }),
+                "{text}: {:?}",
+                lex(text)
+            );
+        }
+        assert_eq!(
+            lex_err("X\u{fc}").message,
+            "X value '\u{fc}' is not a number"
         );
-        assert!(lex_err("X[#1+2]").message.contains("is an expression"));
         assert_eq!(lex_err("G1 X").message, "X word has no number");
         assert_eq!(lex_err("G1 X+ Y1").message, "X value '+' is not a number");
         let huge = format!("X{}", "9".repeat(400));

@@ -9,22 +9,29 @@
 //! Units: linear values and s in mm (inch programs, G20/G70, are converted on read),
 //! feed in mm/min, rotary values in degrees as written.
 
+pub mod conversational;
 pub mod emit;
 pub mod error;
+mod interp;
 pub mod lexer;
+pub mod lines;
 pub mod modal;
 pub mod plan;
 pub mod program;
 pub mod run;
 pub mod style;
+pub mod tcpm;
 pub mod writer;
 
 pub use error::ParseError;
-pub use modal::{Modal, Motion};
+pub use lines::LineEnds;
+pub use modal::{FeedMode, Modal, Motion, Tcpm};
 pub use plan::restore_modal;
 pub use program::{
-    Block, Dialect, Program, ProgramBuilder, Scanned, Word, parse, scan, scan_blocks,
+    Block, Dialect, Flags, Program, ProgramBuilder, Scanned, Word, parse, parse_with, scan,
+    scan_blocks, scan_blocks_with,
 };
 pub use run::{Run, RunBreak, RunBuilder, primary_in_use, primary_of, runs};
 pub use style::{FileStyle, NumberStyle, StyleEvidence};
+pub use tcpm::{Code, ControllerCodes, ReadOptions};
 pub use writer::{Edit, write, write_styled};

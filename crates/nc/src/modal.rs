@@ -5,9 +5,15 @@
 //! - `G90`/`G91` absolute/incremental (incremental from an unknown position stays
 //!   unknown); `G20`/`G21`, `G70`/`G71`, `G700`/`G710` inch/metric (also read from a `%NAME
 //!   G71` header): in inch mode X Y Z and F are multiplied by 25.4 on read;
-//! - TCPM: `M128`/`M129`, `TRAORI`/`TRAFOOF`, `G43.4`/`G43.5`/`G49`;
-//! - F in mm/min under `G94`; under `G93` (inverse time) or `G95` (per revolution) the
-//!   feed is `None`, and after returning to `G94` it is `None` until the next F;
+//! - TCPM: switched on and off by each dialect's codes and the machine's own
+//!   ([`crate::tcpm`]: `M128`/`FUNCTION TCPM`, `TRAORI`, `G43.4`/`G43.5`, `G234`; ended
+//!   by `M129`/`FUNCTION RESET TCPM`, `TRAFOOF`/`TRANSMIT`/`TRACYL`, `G49`/`G43`/`G44`,
+//!   the program's end); a switch in a block that block delete (`/`) may skip leaves the
+//!   state [`Tcpm::Uncertain`];
+//! - F in mm/min under `G94`; under `G93` (inverse time) F is the reciprocal of the
+//!   block's time in minutes, read per block ([`Modal::inverse_time_per_min`]); under
+//!   `G95` (per revolution) the feed is `None`; after a change of feed mode the feed is
+//!   `None` until the next F;
 //! - axis words X Y Z A B C set positions in moves (and in a block without any motion mode
 //!   yet, which is then not counted as a move);
 //! - datum shifts — Heidenhain `G54`/`G53` with or without axis words, `G92`, `G10`, `G52`,
@@ -43,6 +49,39 @@ pub enum Motion {
     ArcCcw,
 }
 
+/// Tool-centre-point management (TCPM, RTCP, TRAORI): whether X Y Z are tool-tip
+/// positions in the part frame (on) or machine-axis positions (off).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Tcpm {
+    /// Off: X Y Z are machine coordinates.
+    #[default]
+    Off,
+    /// On.
+    On,
+    /// Depends on whether block delete (`/`) skipped a block that switches it: treated
+    /// as off by every caller (never patched), and reported.
+    Uncertain,
+}
+
+impl Tcpm {
+    /// Whether TCPM is certainly on.
+    pub fn is_on(self) -> bool {
+        self == Tcpm::On
+    }
+}
+
+/// Feed interpretation (modal G group 5).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FeedMode {
+    /// G94: F is a feed per minute (mm/min, or inch/min in inch mode).
+    #[default]
+    PerMinute,
+    /// G93: F is the reciprocal of the block's time in minutes.
+    InverseTime,
+    /// G95: F is a feed per spindle revolution (not analysable: no time base).
+    PerRevolution,
+}
+
 /// Index of each axis in [`Modal::pos`].
 pub const X: usize = 0;
 /// Y index.
@@ -67,10 +106,15 @@ pub struct Modal {
     /// Positions X Y Z (mm) A B C (degrees), `None` until known (never programmed, or
     /// unknown after a datum shift / reference move).
     pub pos: [Option<f64>; 6],
-    /// Programmed feed, mm/min (`None` until an F word; also `None` under G93 inverse time).
+    /// Programmed feed, mm/min (`None` until an F word; also `None` under G93 and G95).
     pub feed_mm_min: Option<f64>,
-    /// Tool-centre-point management on (M128, TRAORI, G43.4/G43.5).
-    pub tcpm: bool,
+    /// Under G93: this block's F, the reciprocal of its time in minutes (1/min); `None` in
+    /// a block without F and under G94/G95. Not modal: each G93 move states its own.
+    pub inverse_time_per_min: Option<f64>,
+    /// Feed mode (G94, G93, G95).
+    pub feed_mode: FeedMode,
+    /// Tool-centre-point management.
+    pub tcpm: Tcpm,
     /// Incremental mode (G91).
     pub incremental: bool,
     /// Inch units (G20 / G70): values are converted to mm on read.
@@ -83,25 +127,44 @@ impl Default for Modal {
             motion: Motion::None,
             pos: [None; 6],
             feed_mm_min: None,
-            tcpm: false,
+            inverse_time_per_min: None,
+            feed_mode: FeedMode::PerMinute,
+            tcpm: Tcpm::Off,
             incremental: false,
             inch: false,
         }
     }
 }
 
-/// [`Modal`] as the program stores it: 64 bytes instead of 120 (one bit per known value
+/// The state before a program's first block on a machine with `controller`'s codes (TCPM
+/// on from the start where the kinematics are always TCP).
+pub fn initial(controller: &crate::tcpm::ControllerCodes) -> Modal {
+    Modal {
+        tcpm: if controller.always {
+            Tcpm::On
+        } else {
+            Tcpm::Off
+        },
+        ..Modal::default()
+    }
+}
+
+/// [`Modal`] as the program stores it: 64 bytes instead of 136 (one bit per known value
 /// instead of an `Option` tag on each), converted losslessly both ways.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct PackedModal {
     /// Positions; meaningful where bit `i` of `known` is set.
     pos: [f64; 6],
-    /// Feed, mm/min; meaningful where bit 6 of `known` is set.
-    feed_mm_min: f64,
-    /// Bits 0–5: `pos[i]` is known; bit 6: the feed is known.
+    /// Feed, mm/min (bit 6 of `known`), or the block's inverse-time F (bit 7): at most
+    /// one of them is known (G93 leaves the feed per minute unknown).
+    feed: f64,
+    /// Bits 0–5: `pos[i]` is known; bit 6: the feed is known; bit 7: the inverse-time F.
     known: u8,
-    /// Bits 0–2: motion (0 none … 4 G3); bit 3 TCPM; bit 4 incremental; bit 5 inch.
+    /// Bits 0–2: motion (0 none … 4 G3); bit 3 TCPM on; bit 4 incremental; bit 5 inch;
+    /// bit 6 TCPM uncertain.
     flags: u8,
+    /// Feed mode: 0 G94, 1 G93, 2 G95.
+    feed_mode: u8,
 }
 
 impl PackedModal {
@@ -114,8 +177,18 @@ impl PackedModal {
                 known |= 1 << i;
             }
         }
-        if m.feed_mm_min.is_some() {
+        debug_assert!(
+            m.feed_mm_min.is_none() || m.inverse_time_per_min.is_none(),
+            "a feed per minute and an inverse-time F at once"
+        );
+        let mut feed = 0.0;
+        if let Some(f) = m.feed_mm_min {
             known |= 1 << 6;
+            feed = f;
+        }
+        if let Some(f) = m.inverse_time_per_min {
+            known |= 1 << 7;
+            feed = f;
         }
         let motion = match m.motion {
             Motion::None => 0,
@@ -126,12 +199,18 @@ impl PackedModal {
         };
         PackedModal {
             pos,
-            feed_mm_min: m.feed_mm_min.unwrap_or(0.0),
+            feed,
             known,
             flags: motion
-                | u8::from(m.tcpm) << 3
+                | u8::from(m.tcpm == Tcpm::On) << 3
                 | u8::from(m.incremental) << 4
-                | u8::from(m.inch) << 5,
+                | u8::from(m.inch) << 5
+                | u8::from(m.tcpm == Tcpm::Uncertain) << 6,
+            feed_mode: match m.feed_mode {
+                FeedMode::PerMinute => 0,
+                FeedMode::InverseTime => 1,
+                FeedMode::PerRevolution => 2,
+            },
         }
     }
 
@@ -146,8 +225,20 @@ impl PackedModal {
                 _ => Motion::ArcCcw,
             },
             pos: std::array::from_fn(|i| bit(i as u32).then_some(self.pos[i])),
-            feed_mm_min: bit(6).then_some(self.feed_mm_min),
-            tcpm: self.flags & 8 != 0,
+            feed_mm_min: bit(6).then_some(self.feed),
+            inverse_time_per_min: bit(7).then_some(self.feed),
+            feed_mode: match self.feed_mode {
+                0 => FeedMode::PerMinute,
+                1 => FeedMode::InverseTime,
+                _ => FeedMode::PerRevolution,
+            },
+            tcpm: if self.flags & 8 != 0 {
+                Tcpm::On
+            } else if self.flags & 64 != 0 {
+                Tcpm::Uncertain
+            } else {
+                Tcpm::Off
+            },
             incremental: self.flags & 16 != 0,
             inch: self.flags & 32 != 0,
         }
@@ -177,7 +268,13 @@ mod tests {
             m.pos[k] = Some(-0.0);
             m.pos[5 - k] = Some(f64::MAX);
             m.feed_mm_min = (k % 2 == 0).then_some(1e-300 * k as f64);
-            m.tcpm = k % 2 == 1;
+            m.inverse_time_per_min = (k == 3).then_some(12.5);
+            m.feed_mode = [
+                FeedMode::PerMinute,
+                FeedMode::InverseTime,
+                FeedMode::PerRevolution,
+            ][k % 3];
+            m.tcpm = [Tcpm::Off, Tcpm::On, Tcpm::Uncertain][k % 3];
             m.incremental = k % 3 == 1;
             m.inch = k >= 3;
             let back = PackedModal::pack(&m).unpack();

@@ -1,24 +1,67 @@
-//! Parsed program: blocks, words with byte spans, modal state.
+//! Parsed program: blocks, words with byte spans, modal state — and the one reader that
+//! makes them ([`scan_blocks`], which every other way of reading is built on: [`scan`],
+//! [`parse`] through [`ProgramBuilder`], and the stretch reader of the library).
 
 use crate::{
     error::ParseError,
-    lexer::{Lexer, Token},
-    modal::{A, B, C, Modal, Motion, PackedModal, X, Y, Z},
+    interp::{Interpreter, Scan},
+    lines::LineEnds,
+    modal::{Modal, PackedModal},
+    tcpm::ReadOptions,
 };
 use std::ops::Range;
 
 /// Dialect of the file (detected, or forced by the caller).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Dialect {
-    /// Detect from the text (`*` block ends or `%NAME G71` → Heidenhain; `TRAORI`/`;`
-    /// comments → Sinumerik; `( )` comments / G43.4 → Fanuc). Reading rules are shared.
+    /// Detect from the text ([`detect`]).
+    #[default]
     Auto,
-    /// Heidenhain in ISO mode.
+    /// Heidenhain in ISO mode (`%NAME G71 *`, `N10 G01 X+1 *`).
     Heidenhain,
+    /// Heidenhain conversational (Klartext: `BEGIN PGM`, `L X+10 C+90 R0 F2000`); see
+    /// [`crate::conversational`].
+    Conversational,
     /// Siemens Sinumerik.
     Sinumerik,
-    /// Fanuc and Fanuc-like.
+    /// Fanuc and the ISO controllers like it (Haas, LinuxCNC, grblHAL, Mazak ISO, …).
     Fanuc,
+}
+
+/// What a block does beyond moving: a set of bits ([`Flags::has`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Flags(u16);
+
+impl Flags {
+    /// The block carries a block-delete marker (`/`): it may be skipped.
+    pub const SKIPPABLE: Flags = Flags(1);
+    /// An axis or feed word is an expression or a variable (`A#<a>`, `X=R1+2`, `X+Q5`):
+    /// the block cannot be analysed and its axes are unknown after it.
+    pub const NOT_ANALYSABLE: Flags = Flags(2);
+    /// A tool change (`T…`, `M6`, `TOOL CALL`).
+    pub const TOOL_CHANGE: Flags = Flags(4);
+    /// The program's end (`M2`, `M30`, `END PGM`).
+    pub const PROGRAM_END: Flags = Flags(8);
+    /// A circular or polar move (`G2`/`G3`, conversational `C`, `CR`, `CT`, `CP`, `LP`,
+    /// `APPR`, `DEP`): polepatch does not follow its path; it ends runs.
+    pub const ARC: Flags = Flags(16);
+    /// Conversational incremental axis words (`IX+5`): the block ends runs and is never
+    /// changed.
+    pub const INCREMENTAL_WORDS: Flags = Flags(32);
+    /// A `(` comment without its `)` hides what looks like axis words.
+    pub const UNCLOSED_COMMENT: Flags = Flags(64);
+    /// A conversational line polepatch does not model, which may move the machine: carried
+    /// through, positions unknown after it.
+    pub const NOT_MODELLED: Flags = Flags(128);
+
+    /// Whether every bit of `other` is set.
+    pub fn has(self, other: Flags) -> bool {
+        self.0 & other.0 == other.0
+    }
+    /// Set the bits of `other`.
+    pub fn set(&mut self, other: Flags) {
+        self.0 |= other.0;
+    }
 }
 
 /// One address word such as `C+148.494`, `X-.5`, `G01`, `X=10`.
@@ -58,17 +101,19 @@ impl Word {
 pub struct Block {
     /// 1-based line number.
     pub line: usize,
-    start: u32,
-    end: u32,
-    words_start: u32,
-    words_end: u32,
+    pub(crate) start: u32,
+    pub(crate) end: u32,
+    pub(crate) words_start: u32,
+    pub(crate) words_end: u32,
     /// Index of the modal state after this block in the program's state table.
-    state: u32,
+    pub(crate) state: u32,
     /// The block moves the tool tip or a rotary axis (a G0/G1/G2/G3 move with axis words,
     /// not a datum shift or other non-move use of axis letters).
     pub is_move: bool,
     /// Why this block ends any run of G1 motion (beyond being a non-G1 move), if it does.
     pub breaks_run: bool,
+    /// What else the block does.
+    pub flags: Flags,
 }
 
 impl Block {
@@ -108,6 +153,8 @@ pub struct Program {
     pub frame_changes: Vec<usize>,
     /// Modal states, one per change: block `b`'s state is `states[blocks[b].state]`.
     states: Vec<PackedModal>,
+    /// The file's line ending.
+    pub line_ends: LineEnds,
 }
 
 impl Program {
@@ -137,88 +184,38 @@ impl Program {
 }
 
 /// Parse `bytes`. Errors name line and column: malformed or non-finite numbers on address
-/// words, an axis word whose value is an expression, and the like. Unknown words and
-/// tokens are kept, not rejected.
+/// words, an axis word twice in a block, and the like. Unknown words and tokens are kept,
+/// not rejected; a block whose axis or feed words are expressions is kept and flagged
+/// ([`Flags::NOT_ANALYSABLE`]).
 ///
-/// Every line (split at `\n`; a `\r` before it belongs to the line ending) is one
-/// [`Block`]; a final line without a newline is a block too, a final empty segment after
-/// the last newline is not. See [`crate::lexer`] for the token rules and
-/// [`crate::modal`] for how the modal state follows the blocks.
+/// Every line (see [`crate::lines`]) is one [`Block`]. See [`crate::lexer`] for the token
+/// rules and [`crate::modal`] for how the modal state follows the blocks. This is
+/// [`scan_blocks`] collected by a [`ProgramBuilder`].
 pub fn parse(bytes: Vec<u8>, dialect: Dialect) -> Result<Program, ParseError> {
-    if u32::try_from(bytes.len()).is_err() {
-        return Err(too_big(bytes.len()));
-    }
-    let dialect = match dialect {
-        Dialect::Auto => detect(&bytes),
-        d => d,
-    };
+    parse_with(bytes, &ReadOptions::dialect(dialect))
+}
+
+/// [`parse`] with the machine's TCPM codes.
+pub fn parse_with(bytes: Vec<u8>, opts: &ReadOptions) -> Result<Program, ParseError> {
+    let mut builder = ProgramBuilder::new(0, &crate::modal::initial(&opts.controller));
     // Reserved from the size: lines of NC code are rarely shorter than 24 bytes or words
-    // than 6; untouched capacity costs address space only, a reallocation a copy.
-    let mut blocks = Vec::with_capacity(bytes.len() / 24 + 1);
-    let mut words = Vec::with_capacity(bytes.len() / 6 + 1);
-    let mut states = Vec::with_capacity(bytes.len() / 24 + 1);
-    let mut interp = Interpreter::new(dialect);
-    let mut last = interp.modal;
-    states.push(PackedModal::pack(&last));
-    for (span, line) in lines(&bytes) {
-        let mut block = interp.block(&bytes, span, line, &mut words)?;
-        if interp.modal != last {
-            last = interp.modal;
-            states.push(PackedModal::pack(&last));
-        }
-        // At most one state per block plus the initial one, so at most 2^32 - 1.
-        block.state = (states.len() - 1) as u32;
-        if let Some(d) = interp.stated_datum.take() {
-            interp.datum_shifts.push((blocks.len(), d));
-        }
-        if std::mem::take(&mut interp.frame_changed) {
-            interp.frame_changes.push(blocks.len());
-        }
-        blocks.push(block);
-    }
-    Ok(Program {
-        bytes,
-        blocks,
-        words,
-        dialect,
-        datum_shifts: interp.datum_shifts,
-        frame_changes: interp.frame_changes,
-        states,
-    })
-}
-
-/// The lines of `bytes` with their 1-based numbers: split at `\n`, a `\r` before it
-/// belongs to the line ending; a final line without a newline is a line, a final empty
-/// segment after the last newline is not.
-fn lines(bytes: &[u8]) -> impl Iterator<Item = (Range<usize>, usize)> + '_ {
-    lines_from(bytes, 0)
-}
-
-/// [`lines`] from byte `start` (a line start), numbered from 1 there.
-fn lines_from(bytes: &[u8], start: usize) -> impl Iterator<Item = (Range<usize>, usize)> + '_ {
-    let n = bytes.len();
-    let mut start = start;
-    let mut line = 0;
-    std::iter::from_fn(move || {
-        if start >= n {
-            return None;
-        }
-        let (end, next) = match find_newline(bytes, start) {
-            Some(nl) => (
-                if nl > start && bytes[nl - 1] == b'\r' {
-                    nl - 1
-                } else {
-                    nl
-                },
-                nl + 1,
+    // than 6; untouched capacity costs address space only, a reallocation a copy. A
+    // machine that cannot give the memory gets an error, not an abort.
+    builder.reserve(bytes.len()).map_err(|what| {
+        ParseError::at(
+            1,
+            1,
+            format!(
+                "not enough memory to read a program of {} bytes ({what})",
+                bytes.len()
             ),
-            None => (n, n),
-        };
-        let span = start..end;
-        start = next;
-        line += 1;
-        Some((span, line))
-    })
+        )
+    })?;
+    let dialect = scan_blocks_with(&bytes, opts, |s| {
+        builder.push(&s);
+        std::ops::ControlFlow::Continue(())
+    })?;
+    Ok(builder.finish(bytes, dialect))
 }
 
 /// Read `bytes` block by block without building a [`Program`]: `visit` gets each block
@@ -249,6 +246,8 @@ pub struct Scanned<'a> {
     pub stated_datum: Option<[f64; 3]>,
     /// The block changes the frame without stating it, as [`Program::frame_changes`].
     pub frame_changed: bool,
+    /// The file's line ending.
+    pub line_ends: LineEnds,
 }
 
 /// [`scan`], with what the block does to the coordinate frame.
@@ -257,25 +256,35 @@ pub fn scan_blocks(
     dialect: Dialect,
     visit: impl FnMut(Scanned<'_>) -> std::ops::ControlFlow<()>,
 ) -> Result<Dialect, ParseError> {
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
-    scan_with(bytes, dialect, threads, visit)
+    scan_blocks_with(bytes, &ReadOptions::dialect(dialect), visit)
 }
 
-/// [`scan_blocks`] on `threads` threads.
+/// [`scan_blocks`] with the machine's TCPM codes: the one reader.
+pub fn scan_blocks_with(
+    bytes: &[u8],
+    opts: &ReadOptions,
+    visit: impl FnMut(Scanned<'_>) -> std::ops::ControlFlow<()>,
+) -> Result<Dialect, ParseError> {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
+    scan_with(bytes, opts, threads, visit)
+}
+
+/// [`scan_blocks_with`] on `threads` threads.
 fn scan_with(
     bytes: &[u8],
-    dialect: Dialect,
+    opts: &ReadOptions,
     threads: usize,
     mut visit: impl FnMut(Scanned<'_>) -> std::ops::ControlFlow<()>,
 ) -> Result<Dialect, ParseError> {
     if u32::try_from(bytes.len()).is_err() {
         return Err(too_big(bytes.len()));
     }
-    let dialect = match dialect {
+    let dialect = match opts.dialect {
         Dialect::Auto => detect(bytes),
         d => d,
     };
-    let mut interp = Interpreter::new(dialect);
+    let ends = LineEnds::of(bytes);
+    let mut interp = Interpreter::new(opts, dialect);
     let mut give = |interp: &mut Interpreter, block: &Block, words: &[Word]| {
         visit(Scanned {
             block,
@@ -283,11 +292,12 @@ fn scan_with(
             state: &interp.modal,
             stated_datum: interp.stated_datum.take(),
             frame_changed: std::mem::take(&mut interp.frame_changed),
+            line_ends: ends,
         })
     };
     if threads <= 1 || bytes.len() < SCAN_WINDOW_BYTES {
         let mut words = Vec::with_capacity(32);
-        for (span, line) in lines(bytes) {
+        for (span, line) in ends.lines_from(bytes, 0) {
             words.clear();
             let block = interp.block(bytes, span, line, &mut words)?;
             if give(&mut interp, &block, &words).is_break() {
@@ -296,17 +306,19 @@ fn scan_with(
         }
         return Ok(dialect);
     }
-    // Windows of about SCAN_WINDOW_BYTES, each cut at newlines into one part per thread;
+    // Windows of about SCAN_WINDOW_BYTES, each cut at line ends into one part per thread;
     // the parts are lexed side by side (lexing needs only the dialect), then applied to
     // the modal state in file order. Memory: one window's words and line summaries.
     let mut line_offset = 0usize;
     let mut from = 0usize;
     let mut parts: Vec<LexedPart> = (0..threads).map(|_| LexedPart::default()).collect();
     while from < bytes.len() {
-        let to = cut_after(bytes, from + SCAN_WINDOW_BYTES);
+        let to = ends.cut_after(bytes, from + SCAN_WINDOW_BYTES);
         let mut cuts = vec![from];
         for k in 1..threads {
-            let c = cut_after(bytes, from + (to - from) * k / threads).min(to);
+            let c = ends
+                .cut_after(bytes, from + (to - from) * k / threads)
+                .min(to);
             cuts.push(c.max(*cuts.last().unwrap_or(&from)));
         }
         cuts.push(to);
@@ -319,10 +331,10 @@ fn scan_with(
                 .zip(rest.iter_mut())
                 .map(|(w, part)| {
                     let (a, b) = (w[0], w[1]);
-                    sc.spawn(move || interp_ref.lex_part(bytes, a..b, part))
+                    sc.spawn(move || part.lex(interp_ref, ends, bytes, a..b))
                 })
                 .collect();
-            interp_ref.lex_part(bytes, cuts[0]..cuts[1], &mut first[0]);
+            first[0].lex(interp_ref, ends, bytes, cuts[0]..cuts[1]);
             for h in handles {
                 h.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
             }
@@ -360,6 +372,7 @@ pub struct ProgramBuilder {
     last: Modal,
     datum_shifts: Vec<(usize, [f64; 3])>,
     frame_changes: Vec<usize>,
+    line_ends: LineEnds,
 }
 
 impl ProgramBuilder {
@@ -374,7 +387,21 @@ impl ProgramBuilder {
             last: *before,
             datum_shifts: Vec::new(),
             frame_changes: Vec::new(),
+            line_ends: LineEnds::Lf,
         }
+    }
+
+    /// Reserve room for a program of `bytes` bytes (lines of NC code are rarely shorter
+    /// than 24 bytes, words than 6): the error names what could not be allocated.
+    pub fn reserve(&mut self, bytes: usize) -> Result<(), &'static str> {
+        self.blocks
+            .try_reserve(bytes / 24 + 1)
+            .map_err(|_| "blocks")?;
+        self.words.try_reserve(bytes / 6 + 1).map_err(|_| "words")?;
+        self.states
+            .try_reserve(bytes / 24 + 1)
+            .map_err(|_| "modal states")?;
+        Ok(())
     }
 
     /// Byte offset of the stretch in the file.
@@ -417,6 +444,7 @@ impl ProgramBuilder {
         if s.frame_changed {
             self.frame_changes.push(self.blocks.len());
         }
+        self.line_ends = s.line_ends;
         self.blocks.push(Block {
             start: s.block.start - base,
             end: s.block.end - base,
@@ -447,6 +475,7 @@ impl ProgramBuilder {
             datum_shifts: self.datum_shifts,
             frame_changes: self.frame_changes,
             states: self.states,
+            line_ends: self.line_ends,
         }
     }
 }
@@ -468,12 +497,27 @@ struct LexedPart {
     error: Option<ParseError>,
 }
 
-/// The offset just past the newline at or after `at` (the end of `bytes` if none).
-fn cut_after(bytes: &[u8], at: usize) -> usize {
-    if at >= bytes.len() {
-        return bytes.len();
+impl LexedPart {
+    /// Lex the lines of `range` (which starts at a line start and ends after a line ending
+    /// or at the end of the file), numbering them from 1 within the part.
+    fn lex(&mut self, interp: &Interpreter, ends: LineEnds, bytes: &[u8], range: Range<usize>) {
+        let sub = &bytes[..range.end];
+        self.lines.clear();
+        self.words.clear();
+        self.line_count = 0;
+        self.error = None;
+        for (span, _) in ends.lines_from(sub, range.start) {
+            self.line_count += 1;
+            if self.error.is_some() {
+                continue;
+            }
+            let first = self.words.len();
+            match interp.lex(bytes, span.clone(), self.line_count, &mut self.words) {
+                Ok(scan) => self.lines.push((span, scan, first..self.words.len())),
+                Err(e) => self.error = Some(e),
+            }
+        }
     }
-    find_newline(bytes, at).map_or(bytes.len(), |nl| nl + 1)
 }
 
 fn too_big(len: usize) -> ParseError {
@@ -484,38 +528,32 @@ fn too_big(len: usize) -> ParseError {
     )
 }
 
-/// Offset of the first `\n` at or after `from`, eight bytes at a time.
-fn find_newline(bytes: &[u8], from: usize) -> Option<usize> {
-    const LO: u64 = 0x0101_0101_0101_0101;
-    const HI: u64 = 0x8080_8080_8080_8080;
-    const NL: u64 = LO * b'\n' as u64;
-    let mut i = from;
-    while let Some(chunk) = bytes.get(i..i + 8) {
-        let x = u64::from_le_bytes(chunk.try_into().unwrap_or([0; 8])) ^ NL;
-        // The lowest set bit marks the first zero byte of x, i.e. the first newline.
-        let t = x.wrapping_sub(LO) & !x & HI;
-        if t != 0 {
-            return Some(i + (t.trailing_zeros() / 8) as usize);
-        }
-        i += 8;
-    }
-    bytes
-        .get(i..)?
-        .iter()
-        .position(|&b| b == b'\n')
-        .map(|k| i + k)
-}
-
-/// Guess the dialect from the first 64 KiB: a `*` block end or a `%NAME G71` header →
-/// Heidenhain; `TRAORI`/`TRAFOOF` → Sinumerik; `( )` comments or `G43.4` → Fanuc; `;`
-/// comments → Sinumerik; else Fanuc.
+/// Guess the dialect from the first 64 KiB: a `BEGIN PGM` line → Heidenhain
+/// conversational; a `*` block end or a `%NAME G71` header → Heidenhain ISO;
+/// `TRAORI`/`TRAFOOF` → Sinumerik; `( )` comments or `G43.4` → Fanuc; `M128` or
+/// `FUNCTION TCPM` → Heidenhain ISO; `;` comments → Sinumerik; else Fanuc.
 pub fn detect(bytes: &[u8]) -> Dialect {
     let head = &bytes[..bytes.len().min(64 * 1024)];
     let contains = |needle: &[u8]| {
         head.windows(needle.len())
             .any(|w| w.eq_ignore_ascii_case(needle))
     };
-    for line in head.split(|&b| b == b'\n') {
+    let ends = LineEnds::of(head);
+    let lines = || ends.lines_from(head, 0).map(|(r, _)| &head[r]);
+    // Conversational: a `BEGIN PGM` line (after an optional block number).
+    if lines().any(|line| {
+        let t = line.trim_ascii_start();
+        let t = t[t.iter().take_while(|c| c.is_ascii_digit()).count()..].trim_ascii_start();
+        t.len() >= 9
+            && t[..5].eq_ignore_ascii_case(b"BEGIN")
+            && t[5..]
+                .trim_ascii_start()
+                .get(..3)
+                .is_some_and(|w| w.eq_ignore_ascii_case(b"PGM"))
+    }) {
+        return Dialect::Conversational;
+    }
+    for line in lines() {
         let code = match line.iter().position(|&b| b == b';') {
             Some(k) => &line[..k],
             None => line,
@@ -532,10 +570,18 @@ pub fn detect(bytes: &[u8]) -> Dialect {
             return Dialect::Heidenhain;
         }
     }
+    // M128 as a word (not M1280): Heidenhain's TCPM code.
+    let m128 = head.windows(5).enumerate().any(|(k, w)| {
+        w[..4].eq_ignore_ascii_case(b"M128")
+            && !w[4].is_ascii_digit()
+            && (k == 0 || !head[k - 1].is_ascii_alphanumeric())
+    }) || head.ends_with(b"M128");
     if contains(b"TRAORI") || contains(b"TRAFOOF") {
         Dialect::Sinumerik
     } else if head.contains(&b'(') || contains(b"G43.4") {
         Dialect::Fanuc
+    } else if m128 || contains(b"FUNCTION TCPM") {
+        Dialect::Heidenhain
     } else if head.contains(&b';') {
         Dialect::Sinumerik
     } else {
@@ -543,343 +589,11 @@ pub fn detect(bytes: &[u8]) -> Dialect {
     }
 }
 
-/// Feed interpretation (modal G group 5).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum FeedMode {
-    /// G94: F is a feed per minute.
-    PerMinute,
-    /// G93 inverse time or G95 feed per revolution: F is not a feed in mm/min.
-    Other,
-}
-
-/// `G`/`M` code number times ten (`G43.4` → 434, `M128` → 1280), if it is one.
-fn code10(v: f64) -> Option<i64> {
-    let t = v * 10.0;
-    let r = t.round();
-    ((t - r).abs() < 1e-6 && (0.0..1e9).contains(&r)).then_some(r as i64)
-}
-
-/// What one block says, collected before the modal state is updated.
-#[derive(Default)]
-struct Scan {
-    axes: [Option<f64>; 6],
-    feed: Option<f64>,
-    motion: Option<Motion>,
-    incremental: Option<bool>,
-    inch: Option<bool>,
-    tcpm: Option<bool>,
-    feed_mode: Option<FeedMode>,
-    /// Axis words define a datum/frame (Heidenhain G54, G92, G10, G52, TRANS…): not a move.
-    datum_shift: bool,
-    /// Heidenhain ISO `G54`: the block's X Y Z are the new datum.
-    stated_datum: bool,
-    /// Work offset selection (Fanuc/Sinumerik G54…G59, G500): positions re-based.
-    work_offset: bool,
-    /// Reference / machine-coordinate move (G28, G30, G53, SUPA).
-    reference: bool,
-    /// Axis words are arguments, not a move (G4 dwell, G65 macro call).
-    no_move: bool,
-    /// Positions are unknown afterwards (macro call).
-    unknown_after: bool,
-    breaks: bool,
-}
-
-struct Interpreter {
-    dialect: Dialect,
-    modal: Modal,
-    feed_mode: FeedMode,
-    /// The datum the last block stated (Heidenhain `G54 X Y Z`), taken by `parse`.
-    stated_datum: Option<[f64; 3]>,
-    /// All stated datums (see [`Program::datum_shifts`]).
-    datum_shifts: Vec<(usize, [f64; 3])>,
-    /// The last block changed the frame without stating it, taken by `parse`.
-    frame_changed: bool,
-    /// See [`Program::frame_changes`].
-    frame_changes: Vec<usize>,
-}
-
-impl Interpreter {
-    fn new(dialect: Dialect) -> Self {
-        Interpreter {
-            dialect,
-            modal: Modal::default(),
-            feed_mode: FeedMode::PerMinute,
-            stated_datum: None,
-            datum_shifts: Vec::new(),
-            frame_changed: false,
-            frame_changes: Vec::new(),
-        }
-    }
-
-    fn g(&self, code: Option<i64>, s: &mut Scan) {
-        let heidenhain = self.dialect == Dialect::Heidenhain;
-        match code {
-            Some(0) => s.motion = Some(Motion::Rapid),
-            Some(10) => s.motion = Some(Motion::Linear),
-            Some(20) => s.motion = Some(Motion::ArcCw),
-            Some(30) => s.motion = Some(Motion::ArcCcw),
-            // Plane, cutter compensation off, canned cycle off, path control modes.
-            Some(170 | 180 | 190 | 400 | 800 | 600 | 610 | 640 | 6410..=6450) => {}
-            Some(900) => s.incremental = Some(false),
-            Some(910) => s.incremental = Some(true),
-            Some(200 | 700 | 7000) => s.inch = Some(true),
-            Some(210 | 710 | 7100) => s.inch = Some(false),
-            Some(434 | 435) => s.tcpm = Some(true),
-            Some(490) => s.tcpm = Some(false),
-            Some(940) => s.feed_mode = Some(FeedMode::PerMinute),
-            Some(930 | 950) => {
-                s.feed_mode = Some(FeedMode::Other);
-                s.breaks = true;
-            }
-            Some(540) if heidenhain => {
-                s.datum_shift = true;
-                s.stated_datum = true;
-            }
-            Some(530) if heidenhain => s.datum_shift = true,
-            Some(540..=590 | 5000 | 5050..=5990) => s.work_offset = true,
-            Some(920 | 100 | 520 | 500 | 510 | 680 | 681 | 690) => s.datum_shift = true,
-            Some(530 | 280 | 300) => s.reference = true,
-            Some(40) => {
-                s.no_move = true;
-                s.breaks = true;
-            }
-            Some(650 | 660) => {
-                s.no_move = true;
-                s.unknown_after = true;
-                s.breaks = true;
-            }
-            _ => s.breaks = true,
-        }
-    }
-
-    fn m(code: Option<i64>, s: &mut Scan) {
-        match code {
-            // Spindle and coolant.
-            Some(30 | 40 | 50 | 70 | 80 | 90 | 130 | 140) => {}
-            Some(1280) => s.tcpm = Some(true),
-            Some(1290) => s.tcpm = Some(false),
-            // Stops, end of program, tool change, anything unknown.
-            _ => s.breaks = true,
-        }
-    }
-
-    fn ident(name: &[u8], s: &mut Scan) {
-        let is = |n: &[u8]| name.eq_ignore_ascii_case(n);
-        if is(b"TRAORI") {
-            s.tcpm = Some(true);
-        } else if is(b"TRAFOOF") {
-            s.tcpm = Some(false);
-        } else if is(b"MSG") {
-        } else if [
-            &b"TRANS"[..],
-            b"ATRANS",
-            b"CTRANS",
-            b"ROT",
-            b"AROT",
-            b"CROT",
-            b"SCALE",
-            b"ASCALE",
-            b"MIRROR",
-            b"AMIRROR",
-        ]
-        .iter()
-        .any(|n| is(n))
-        {
-            s.datum_shift = true;
-        } else if is(b"SUPA") {
-            s.reference = true;
-        } else {
-            s.breaks = true;
-        }
-    }
-
-    fn block(
-        &mut self,
-        bytes: &[u8],
-        span: Range<usize>,
-        line: usize,
-        words: &mut Vec<Word>,
-    ) -> Result<Block, ParseError> {
-        let first_word = words.len();
-        let s = self.lex(bytes, span.clone(), line, words)?;
-        Ok(self.apply(s, line, span, first_word..words.len()))
-    }
-
-    /// Lex the lines of `range` (which starts at a line start and ends after a newline or
-    /// at the end of the file), numbering them from 1 within the part.
-    fn lex_part(&self, bytes: &[u8], range: Range<usize>, part: &mut LexedPart) {
-        let sub = &bytes[..range.end];
-        part.lines.clear();
-        part.words.clear();
-        part.line_count = 0;
-        part.error = None;
-        for (span, _) in lines_from(sub, range.start) {
-            part.line_count += 1;
-            if part.error.is_some() {
-                continue;
-            }
-            let first = part.words.len();
-            match self.lex(bytes, span.clone(), part.line_count, &mut part.words) {
-                Ok(scan) => part.lines.push((span, scan, first..part.words.len())),
-                Err(e) => part.error = Some(e),
-            }
-        }
-    }
-
-    /// What a line says (its words appended to `words`), before the modal state: this
-    /// depends on the dialect only, so lines can be lexed in any order
-    /// ([`scan`] does it on several threads).
-    fn lex(
-        &self,
-        bytes: &[u8],
-        span: Range<usize>,
-        line: usize,
-        words: &mut Vec<Word>,
-    ) -> Result<Scan, ParseError> {
-        let mut s = Scan::default();
-        for token in Lexer::new(bytes, span.clone()) {
-            let token =
-                token.map_err(|e| ParseError::at(line, e.at - span.start + 1, e.message))?;
-            match token {
-                Token::Word {
-                    letter,
-                    span,
-                    value_span,
-                    value,
-                } => {
-                    match letter {
-                        b'X' => s.axes[X] = Some(value),
-                        b'Y' => s.axes[Y] = Some(value),
-                        b'Z' => s.axes[Z] = Some(value),
-                        b'A' => s.axes[A] = Some(value),
-                        b'B' => s.axes[B] = Some(value),
-                        b'C' => s.axes[C] = Some(value),
-                        b'F' => s.feed = Some(value),
-                        b'G' => self.g(code10(value), &mut s),
-                        b'M' => Self::m(code10(value), &mut s),
-                        b'N' | b'S' | b'I' | b'J' | b'K' | b'R' | b'O' => {}
-                        // T tool, D/H offsets, U V W axes, P Q L E parameters.
-                        _ => s.breaks = true,
-                    }
-                    // Offsets fit: `parse` rejects files of 4 GiB and more.
-                    words.push(Word {
-                        letter,
-                        start: span.start as u32,
-                        value_start: value_span.start as u32,
-                        end: span.end as u32,
-                        value,
-                    });
-                }
-                Token::Ident { name, .. } => Self::ident(&bytes[name], &mut s),
-                Token::Assign { letter, .. } => {
-                    if !matches!(letter, b'R' | b'S') {
-                        s.breaks = true;
-                    }
-                }
-                Token::Percent { span } => {
-                    for w in bytes[span].split(|b| b.is_ascii_whitespace()) {
-                        if w.eq_ignore_ascii_case(b"G70") {
-                            s.inch = Some(true);
-                        } else if w.eq_ignore_ascii_case(b"G71") {
-                            s.inch = Some(false);
-                        }
-                    }
-                }
-                Token::Slash { .. } => s.breaks = true,
-                Token::Comment { .. } | Token::BlockEnd { .. } | Token::Other { .. } => {}
-            }
-        }
-        Ok(s)
-    }
-
-    /// Update the modal state; the block's `state` index is set by the caller.
-    fn apply(&mut self, s: Scan, line: usize, span: Range<usize>, words: Range<usize>) -> Block {
-        let m = &mut self.modal;
-        let mut breaks = s.breaks;
-        if let Some(mo) = s.motion {
-            m.motion = mo;
-        }
-        if let Some(inc) = s.incremental {
-            m.incremental = inc;
-        }
-        if let Some(inch) = s.inch {
-            m.inch = inch;
-        }
-        if let Some(t) = s.tcpm {
-            m.tcpm = t;
-            breaks = true;
-        }
-        if let Some(fm) = s.feed_mode {
-            if fm != self.feed_mode {
-                self.feed_mode = fm;
-                m.feed_mm_min = None;
-                breaks = true;
-            }
-        }
-        let scale = if m.inch { 25.4 } else { 1.0 };
-        if s.stated_datum {
-            let v = |i: usize| s.axes[i].unwrap_or(0.0) * scale;
-            self.stated_datum = Some([v(X), v(Y), v(Z)]);
-        } else if s.datum_shift || s.work_offset {
-            self.frame_changed = true;
-        }
-        if let Some(f) = s.feed {
-            m.feed_mm_min = (self.feed_mode == FeedMode::PerMinute).then_some(f * scale);
-        }
-        let has_axes = s.axes.iter().any(Option::is_some);
-        let mut is_move = false;
-        if s.datum_shift || s.reference || s.unknown_after {
-            // Linear positions unknown afterwards; so are rotary axes named in the block.
-            for (i, p) in m.pos.iter_mut().enumerate() {
-                if i < A || s.axes[i].is_some() || s.unknown_after {
-                    *p = None;
-                }
-            }
-            is_move = s.reference && has_axes;
-            breaks = true;
-        } else if s.no_move {
-            breaks = true;
-        } else {
-            if s.work_offset {
-                m.pos[X] = None;
-                m.pos[Y] = None;
-                m.pos[Z] = None;
-                breaks = true;
-            }
-            for (i, v) in s.axes.iter().enumerate() {
-                if let Some(v) = *v {
-                    let v = if i < A { v * scale } else { v };
-                    m.pos[i] = if m.incremental {
-                        m.pos[i].map(|p| p + v)
-                    } else {
-                        Some(v)
-                    };
-                }
-            }
-            if has_axes {
-                is_move = m.motion != Motion::None;
-                if m.motion != Motion::Linear {
-                    breaks = true;
-                }
-            }
-        }
-        // Offsets fit: `parse` rejects files of 4 GiB and more.
-        Block {
-            line,
-            start: span.start as u32,
-            end: span.end as u32,
-            words_start: words.start as u32,
-            words_end: words.end as u32,
-            state: 0,
-            is_move,
-            breaks_run: breaks,
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::modal::{A, C, Motion, Tcpm, X, Y};
+    use crate::tcpm::{Code, ControllerCodes};
 
     fn p(s: &str) -> Program {
         parse(s.as_bytes().to_vec(), Dialect::Auto).unwrap()
@@ -899,15 +613,13 @@ mod tests {
     }
 
     #[test]
-    fn newline_search() {
-        let text = b"0123456789\nabcdefghijklmnopqrstuvwxyz\n\x8a\n";
-        for from in 0..text.len() + 2 {
-            let naive = text
-                .get(from..)
-                .and_then(|t| t.iter().position(|&b| b == b'\n'))
-                .map(|k| from + k);
-            assert_eq!(find_newline(text, from), naive, "{from}");
-        }
+    fn cr_alone_ends_lines() {
+        let prog = p("G1 X1 Y0 Z0 A0 F100\rX2\rX3\r");
+        assert_eq!(prog.blocks.len(), 3);
+        assert_eq!(prog.line_ends, LineEnds::Cr);
+        assert_eq!(prog.blocks[2].line, 3);
+        assert_eq!(prog.state(2).pos[X], Some(3.0));
+        assert_eq!(crate::runs(&prog).len(), 1);
     }
 
     #[test]
@@ -915,11 +627,19 @@ mod tests {
         assert_eq!(detect(b"%P G71 *\nN10 G90 *\n"), Dialect::Heidenhain);
         assert_eq!(detect(b"N10 TRAORI\nN20 G1 X1 ; cut\n"), Dialect::Sinumerik);
         assert_eq!(detect(b"%\nO1234 (PART)\nG43.4 H1\n%\n"), Dialect::Fanuc);
+        assert_eq!(
+            detect(b"0  BEGIN PGM P1 MM\n1  L X+0 R0 FMAX\n"),
+            Dialect::Conversational
+        );
+        assert_eq!(detect(b"BEGIN PGM P1 INCH\r"), Dialect::Conversational);
+        assert_eq!(detect(b"M128\nG1 X0 Y0\n"), Dialect::Heidenhain);
+        assert_eq!(detect(b"G1 X0 M1280\n"), Dialect::Fanuc);
     }
 
     #[test]
     fn modal_state() {
-        let prog = p("G21 G90 G1 X1 Y2 Z3 F100\nG91 X1 C10\nG90 G20 X1 F10\nG0 Z1\nM128\nG49\n");
+        let prog =
+            p("G21 G90 G1 X1 Y2 Z3 F100\nG91 X1 C10\nG90 G20 X1 F10\nG0 Z1\nG43.4 H1\nG49\n");
         let st: Vec<Modal> = (0..prog.blocks.len()).map(|b| prog.state(b)).collect();
         assert_eq!(st[0].feed_mm_min, Some(100.0));
         assert_eq!(st[1].pos[X], Some(2.0));
@@ -932,8 +652,8 @@ mod tests {
         assert!((st[2].feed_mm_min.unwrap() - 254.0).abs() < 1e-12);
         assert_eq!(st[3].motion, Motion::Rapid);
         assert!(prog.blocks[3].breaks_run && prog.blocks[3].is_move);
-        assert!(st[4].tcpm && prog.blocks[4].breaks_run);
-        assert!(!st[5].tcpm && prog.blocks[5].breaks_run);
+        assert!(st[4].tcpm.is_on() && prog.blocks[4].breaks_run);
+        assert!(st[5].tcpm == Tcpm::Off && prog.blocks[5].breaks_run);
         assert!(!prog.blocks[1].breaks_run && prog.blocks[1].is_move);
     }
 
@@ -1024,9 +744,13 @@ mod tests {
             e.to_string(),
             "line 2, col 5: C value '12..5' is not a number"
         );
-        let e = parse(b"N10 G1\r\nN20 X=IC(5) Y1\r\n".to_vec(), Dialect::Sinumerik).unwrap_err();
+        let e = parse(b"N10 G1\r\nN20 X12,5 Y1\r\n".to_vec(), Dialect::Sinumerik).unwrap_err();
         assert_eq!((e.line, e.column), (2, 5));
-        assert!(e.message.contains("needs a plain number"), "{}", e.message);
+        assert!(
+            e.message.contains("'12,5' is not a number"),
+            "{}",
+            e.message
+        );
     }
 
     #[test]
@@ -1087,7 +811,7 @@ mod tests {
 
     fn scanned(bytes: &[u8], threads: usize) -> Result<Visited, ParseError> {
         let mut v = Vec::new();
-        scan_with(bytes, Dialect::Auto, threads, |s| {
+        scan_with(bytes, &ReadOptions::default(), threads, |s| {
             let b = s.block;
             v.push((
                 b.line,
@@ -1144,7 +868,7 @@ mod tests {
             let base = prog.blocks[from].span().start;
             let mut builder = ProgramBuilder::new(base, &prog.state_before(from));
             let mut i = 0;
-            scan_with(&bytes, Dialect::Auto, 2, |s| {
+            scan_with(&bytes, &ReadOptions::default(), 2, |s| {
                 if (from..to).contains(&i) {
                     builder.push(&s);
                 }
@@ -1187,7 +911,7 @@ mod tests {
         let mut bytes = big(9);
         // Two errors in different windows: the first in file order is reported.
         for (at, bad) in [(7usize << 20, &b"X1..2"[..]), (5 << 20, b"C12e5")] {
-            let nl = find_newline(&bytes, at).unwrap() + 1;
+            let nl = crate::lines::find_byte(&bytes, at, b'\n').unwrap() + 1;
             bytes.splice(nl..nl, bad.iter().copied().chain(*b"\n"));
         }
         let e = parse(bytes.clone(), Dialect::Auto).unwrap_err();
@@ -1213,5 +937,198 @@ mod tests {
         let fanuc = p("G54\nG1 X1 Y2 Z3 F100\nG92 X0\n");
         assert!(fanuc.datum_shifts.is_empty());
         assert_eq!(fanuc.frame_changes, vec![0, 2]);
+    }
+
+    /// Each controller's codes end TCPM as its modal groups say (issue 19: G43/G44 after
+    /// G43.4, TRANSMIT/TRACYL after TRAORI, the program's end).
+    #[test]
+    fn tcpm_ends_as_controllers_define_it() {
+        let tcpm_after = |text: &str| {
+            let prog = p(text);
+            prog.state(prog.blocks.len() - 1).tcpm
+        };
+        for (on, off) in [
+            ("G43.4 H1", "G43 H1"),
+            ("G43.4 H1", "G44 H1"),
+            ("G43.4 H1", "G49"),
+            ("G43.5 H1", "G43 H2"),
+            ("G234 H1", "G49"),
+            ("G43.4 H1", "M30"),
+        ] {
+            let text = format!("(FANUC)\nG90 G1 X0 Y0 Z0 F100\n{on}\n");
+            assert_eq!(tcpm_after(&text), Tcpm::On, "{on}");
+            assert_eq!(
+                tcpm_after(&format!("{text}{off}\n")),
+                Tcpm::Off,
+                "{on} then {off}"
+            );
+        }
+        for off in ["TRAFOOF", "TRANSMIT", "TRACYL(40)", "TRAANG(45)", "M30"] {
+            let text = "N10 TRAORI ; 5 axes\n";
+            assert_eq!(tcpm_after(text), Tcpm::On);
+            assert_eq!(
+                tcpm_after(&format!("{text}N20 {off}\n")),
+                Tcpm::Off,
+                "{off}"
+            );
+        }
+        for (on, off) in [
+            ("N10 M128 *", "N20 M129 *"),
+            (
+                "N10 FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS *",
+                "N20 FUNCTION RESET TCPM *",
+            ),
+        ] {
+            let text = format!("%P G71 *\n{on}\n");
+            assert_eq!(tcpm_after(&text), Tcpm::On, "{on}");
+            assert_eq!(tcpm_after(&format!("{text}{off}\n")), Tcpm::Off, "{off}");
+        }
+        // G43 is paraxial compensation in Heidenhain ISO: it does not end M128.
+        assert_eq!(tcpm_after("%P G71 *\nN10 M128 *\nN20 G43 *\n"), Tcpm::On);
+        // M128 is Heidenhain's; G43.4 Fanuc's.
+        assert_eq!(tcpm_after("(F)\nM128\n"), Tcpm::Off);
+    }
+
+    /// A TCPM switch that block delete may skip leaves the state uncertain until a switch
+    /// that is always executed.
+    #[test]
+    fn a_skippable_switch_is_uncertain() {
+        let prog = p(
+            "%P G71 *\n/N65 M128 *\nN70 G01 X+1 Y+0 Z+0 A+1 C+0 F100 *\nN80 M129 *\nN90 M128 *\n/N95 M129 *\n",
+        );
+        assert_eq!(prog.state(1).tcpm, Tcpm::Uncertain);
+        assert_eq!(prog.state(2).tcpm, Tcpm::Uncertain);
+        assert!(prog.blocks[1].flags.has(Flags::SKIPPABLE));
+        assert_eq!(prog.state(3).tcpm, Tcpm::Off);
+        assert_eq!(prog.state(4).tcpm, Tcpm::On);
+        assert_eq!(prog.state(5).tcpm, Tcpm::Uncertain);
+        // A skippable switch to the state already in force changes nothing.
+        assert_eq!(p("(F)\n/N50 G49\n").state(1).tcpm, Tcpm::Off);
+        assert_eq!(p("(F)\n/N50 G43.4 H1\n").state(1).tcpm, Tcpm::Uncertain);
+        assert_eq!(p("N1 TRAORI\n/N6 TRAORI\n").state(1).tcpm, Tcpm::On);
+        assert_eq!(
+            p("N1 TRAFOOF ; x\n/N6 TRAORI\n").state(1).tcpm,
+            Tcpm::Uncertain
+        );
+    }
+
+    #[test]
+    fn the_machines_own_codes() {
+        let codes = ControllerCodes {
+            on: vec![Code::parse("M428").unwrap()],
+            off: vec![Code::parse("M429").unwrap()],
+            always: false,
+        };
+        let read = |text: &str, c: &ControllerCodes| {
+            let prog = parse_with(
+                text.as_bytes().to_vec(),
+                &ReadOptions {
+                    dialect: Dialect::Auto,
+                    controller: c.clone(),
+                },
+            )
+            .unwrap();
+            (0..prog.blocks.len())
+                .map(|b| prog.state(b).tcpm)
+                .collect::<Vec<_>>()
+        };
+        let text = "(LINUXCNC)\nM428\nG1 X0 Y0 Z0 A0 C0 F100\nM429\nM2\n";
+        assert_eq!(
+            read(text, &codes),
+            [Tcpm::Off, Tcpm::On, Tcpm::On, Tcpm::Off, Tcpm::Off]
+        );
+        assert_eq!(
+            read(text, &ControllerCodes::default()),
+            [Tcpm::Off; 5],
+            "M428 means nothing without the machine's word"
+        );
+        let always = ControllerCodes {
+            always: true,
+            ..ControllerCodes::default()
+        };
+        assert_eq!(
+            read(text, &always),
+            [Tcpm::On; 5],
+            "always TCP: nothing turns it off"
+        );
+    }
+
+    #[test]
+    fn spaces_inside_words() {
+        let prog = p("G1  X   6.302  Y -11.560  Z- 5  A -71.841 C 0.5 F 300\n");
+        let st = prog.state(0);
+        assert_eq!(st.pos[..3], [Some(6.302), Some(-11.56), Some(-5.0)]);
+        assert_eq!(st.pos[A], Some(-71.841));
+        assert_eq!(st.pos[C], Some(0.5));
+        assert_eq!(st.feed_mm_min, Some(300.0));
+        let a = prog.word(0, b'A').unwrap();
+        assert_eq!(&prog.bytes[a.span()], b"A -71.841");
+        assert_eq!(&prog.bytes[a.value_span()], b"-71.841");
+        // A letter with blanks and then no number is still an error.
+        assert!(parse(b"G1 X Y1\n".to_vec(), Dialect::Auto).is_err());
+    }
+
+    #[test]
+    fn a_word_twice_is_refused_with_its_column() {
+        let e = parse(
+            b"%P G71 *\nN10 G01 A+1 C+180 C+90 A+3 *\n".to_vec(),
+            Dialect::Auto,
+        )
+        .unwrap_err();
+        assert_eq!((e.line, e.column), (2, 19));
+        assert!(e.message.contains("C appears twice"), "{}", e.message);
+        assert!(e.message.contains("col 13"), "{}", e.message);
+    }
+
+    #[test]
+    fn expressions_flag_the_block_not_the_file() {
+        let prog = p("G1 X0 Y0 Z0 A1 C0 F100\nX1 A#<a_angle>\nX2 A2\nX=R1+2 Y1\nF=FGREF(5000)\n");
+        let b = &prog.blocks[1];
+        assert!(b.flags.has(Flags::NOT_ANALYSABLE) && b.breaks_run);
+        assert_eq!(prog.state(1).pos[A], None);
+        assert_eq!(prog.state(1).pos[X], Some(1.0));
+        assert!(prog.word(1, b'A').is_none(), "no number to rewrite");
+        assert_eq!(prog.state(2).pos[A], Some(2.0));
+        assert_eq!(prog.state(3).pos[X], None);
+        assert_eq!(prog.state(3).pos[Y], Some(1.0));
+        assert!(prog.blocks[4].flags.has(Flags::NOT_ANALYSABLE));
+        assert_eq!(prog.state(4).feed_mm_min, None);
+        assert_eq!(crate::write(&prog, &[]), prog.bytes);
+    }
+
+    #[test]
+    fn an_unclosed_comment_hiding_axis_words_is_flagged() {
+        let prog = p("G1 X0 Y0 Z0 F100\nX1 (TRIM Y2 C45\nX2 (NOTE\nX3 (OK) Y1\n");
+        assert!(prog.blocks[1].flags.has(Flags::UNCLOSED_COMMENT));
+        assert!(!prog.blocks[2].flags.has(Flags::UNCLOSED_COMMENT));
+        assert!(!prog.blocks[3].flags.has(Flags::UNCLOSED_COMMENT));
+    }
+
+    #[test]
+    fn inverse_time_feed() {
+        let prog = p("G93 G1 X0 Y0 Z0 A0 C0 F10\nX1 F20\nX2\nG94 F500\nX3\n");
+        assert_eq!(prog.state(0).inverse_time_per_min, Some(10.0));
+        assert_eq!(prog.state(0).feed_mm_min, None);
+        assert_eq!(prog.state(1).inverse_time_per_min, Some(20.0));
+        assert_eq!(prog.state(2).inverse_time_per_min, None, "not modal");
+        assert_eq!(prog.state(3).feed_mm_min, Some(500.0));
+        assert_eq!(prog.state(4).inverse_time_per_min, None);
+        assert!(prog.blocks[3].breaks_run);
+    }
+
+    /// LinuxCNC parameters and O-word flow (as its 5-axis demos write them): parameter
+    /// assignments are not moves; a call, a subroutine or a loop leaves positions unknown.
+    #[test]
+    fn linuxcnc_parameters_and_o_words() {
+        let prog = p(
+            "(LCNC)\n#<zmax> = #1 (=10)\n#<n> = 5\nG0 X0 Y0 Z0 A0 C0\nG1 F#<frate> Z2\no<helix> call [1][2]\no100 call\nG1 X1 F100\n",
+        );
+        assert!(!prog.blocks[1].is_move && prog.blocks[1].breaks_run);
+        assert!(prog.blocks[4].flags.has(Flags::NOT_ANALYSABLE));
+        assert_eq!(prog.state(5).pos[X], None, "o<helix> call");
+        assert_eq!(prog.state(3).pos[X], Some(0.0));
+        let mut q = prog.state(3);
+        q.pos = prog.state(6).pos;
+        assert_eq!(q.pos[X], None, "o100 call");
     }
 }

@@ -1,6 +1,7 @@
 //! Runs of G1 motion with cumulative tool-tip path length s.
 
 use crate::modal::{Modal, X, Y, Z};
+
 use crate::program::{Block, Program};
 
 /// Why a run ended (for reports).
@@ -28,10 +29,16 @@ pub struct Run {
     pub s_mm: Vec<f64>,
     /// Position of each point: X Y Z (mm), A B C (degrees), `None` where never programmed.
     pub pos: Vec<[Option<f64>; 6]>,
-    /// Programmed feed, mm/min (`None` if no F is in force).
+    /// Programmed feed, mm/min (`None` if no F is in force, and under G93 and G95).
     pub feed_mm_min: Option<f64>,
-    /// TCPM state during the run.
-    pub tcpm: bool,
+    /// Feed mode of the run (a change of feed mode ends runs).
+    pub feed_mode: crate::FeedMode,
+    /// Under G93 (inverse time): the feed of each block along the tool tip, mm/min — its
+    /// tool-tip length times its F (1/min) — for blocks `1..len()`; empty otherwise.
+    pub block_feed_mm_min: Vec<f64>,
+    /// TCPM state during the run (only [`crate::Tcpm::On`] allows changing rotary words
+    /// alone).
+    pub tcpm: crate::Tcpm,
     /// Why the run ended.
     pub ended_by: RunBreak,
 }
@@ -110,6 +117,8 @@ impl RunBuilder {
             s_mm: vec![0.0],
             pos: vec![st.pos],
             feed_mm_min: st.feed_mm_min,
+            feed_mode: st.feed_mode,
+            block_feed_mm_min: Vec::new(),
             tcpm: st.tcpm,
             ended_by: RunBreak::End,
         }
@@ -127,8 +136,14 @@ impl RunBuilder {
                         + (p1[1] - p0[1]).powi(2)
                         + (p1[2] - p0[2]).powi(2))
                     .sqrt();
+                    let inverse_time = st.feed_mode == crate::FeedMode::InverseTime;
                     if d <= ZERO_LENGTH_MM {
                         self.finish_run(RunBreak::ZeroLength, emit);
+                        self.cur = Some(Self::start(i, st));
+                    } else if inverse_time && st.inverse_time_per_min.is_none() {
+                        // A G93 move without F has no time (controllers alarm): it is not
+                        // part of any run.
+                        self.finish_run(RunBreak::Block, emit);
                         self.cur = Some(Self::start(i, st));
                     } else {
                         if let Some(r) = &mut self.cur
@@ -136,6 +151,7 @@ impl RunBuilder {
                         {
                             if r.len() == 1 {
                                 r.feed_mm_min = st.feed_mm_min;
+                                r.feed_mode = st.feed_mode;
                                 r.tcpm = st.tcpm;
                             } else {
                                 self.finish_run(RunBreak::FeedChange, emit);
@@ -145,6 +161,7 @@ impl RunBuilder {
                         let r = self.cur.get_or_insert_with(|| {
                             let mut r = Self::start(last_pos.unwrap_or(i), prev);
                             r.feed_mm_min = st.feed_mm_min;
+                            r.feed_mode = st.feed_mode;
                             r.tcpm = st.tcpm;
                             r
                         });
@@ -152,6 +169,9 @@ impl RunBuilder {
                         r.blocks.push(i);
                         r.s_mm.push(s);
                         r.pos.push(st.pos);
+                        if let Some(f) = st.inverse_time_per_min.filter(|_| inverse_time) {
+                            r.block_feed_mm_min.push(d * f);
+                        }
                     }
                 }
                 _ => {
@@ -274,6 +294,26 @@ mod tests {
         assert_eq!(r[1].feed_mm_min, Some(200.0));
         assert_eq!(r[2].blocks, vec![4, 5]);
         assert_eq!(r[2].feed_mm_min, Some(300.0));
+    }
+
+    /// Under G93 each block's feed is its length times its F; different feeds do not split
+    /// the run (its analysis takes each block at its own feed).
+    #[test]
+    fn inverse_time_runs_keep_each_blocks_feed() {
+        let (_, r) =
+            runs_of("G93 G1 X0 Y0 Z0 A1 F10\nX3 Y4 F200\nX6 Y8 F100\nX6 Y8 Z5 F20\nG94 F500\nX7\n");
+        assert_eq!(r.len(), 2);
+        assert_eq!(r[0].blocks, vec![0, 1, 2, 3]);
+        assert_eq!(r[0].feed_mm_min, None);
+        assert_eq!(r[0].feed_mode, crate::FeedMode::InverseTime);
+        assert_eq!(r[0].block_feed_mm_min, vec![1000.0, 500.0, 100.0]);
+        assert_eq!(r[1].feed_mm_min, Some(500.0));
+        assert!(r[1].block_feed_mm_min.is_empty());
+        // A G93 move without F belongs to no run.
+        let (_, r) = runs_of("G93 G1 X0 Y0 Z0 F10\nX1 F10\nX2\nX3 F10\nX4 F10\n");
+        assert_eq!(r.len(), 2);
+        assert_eq!(r[0].blocks, vec![0, 1]);
+        assert_eq!(r[1].blocks, vec![2, 3, 4]);
     }
 
     #[test]

@@ -64,7 +64,7 @@ impl Evidence {
         let e = self;
         let text = &bytes[w.value_span()];
         e.words += 1;
-        if w.value_start > w.start + 1 {
+        if bytes.get(w.start as usize + 1) == Some(&b'=') {
             e.equals += 1;
         }
         let (sign, body) = match text.first() {
@@ -218,6 +218,9 @@ pub struct FileStyle {
     /// The usual gap between two words of a block: a space, unless most words follow
     /// each other directly (`G1X10.Y5.`).
     pub gap: &'static [u8],
+    /// The gap between an axis letter and its number: none, unless most axis words have a
+    /// blank there (`X 6.302`, as some RS274/NGC posts write).
+    pub letter_gap: &'static [u8],
 }
 
 impl FileStyle {
@@ -244,6 +247,9 @@ pub struct StyleEvidence {
     any_axis: Evidence,
     spaced: usize,
     tight: usize,
+    /// Axis words with / without a blank between letter and number.
+    letter_spaced: usize,
+    letter_tight: usize,
 }
 
 impl Default for StyleEvidence {
@@ -253,6 +259,8 @@ impl Default for StyleEvidence {
             any_axis: Evidence::empty(),
             spaced: 0,
             tight: 0,
+            letter_spaced: 0,
+            letter_tight: 0,
         }
     }
 }
@@ -264,6 +272,14 @@ impl StyleEvidence {
             if let Some(i) = AXES.iter().position(|&a| a == w.letter) {
                 self.letters[i].add(bytes, w);
                 self.any_axis.add(bytes, w);
+                if bytes
+                    .get(w.start as usize + 1)
+                    .is_some_and(|&b| b == b' ' || b == b'\t')
+                {
+                    self.letter_spaced += 1;
+                } else {
+                    self.letter_tight += 1;
+                }
             }
         }
         for pair in words.windows(2) {
@@ -282,6 +298,11 @@ impl StyleEvidence {
                 NumberStyle::from_evidence(&self.letters[i], &self.any_axis)
             }),
             gap: if self.tight > self.spaced { b"" } else { b" " },
+            letter_gap: if self.letter_spaced > self.letter_tight {
+                b" "
+            } else {
+                b""
+            },
         }
     }
 }

@@ -100,6 +100,7 @@ pub fn write_styled(program: &Program, edits: &[Edit], file: &FileStyle) -> Vec<
             if style.equals {
                 text.push(b'=');
             }
+            text.extend_from_slice(file.letter_gap);
             text.extend_from_slice(number.as_bytes());
             text.extend_from_slice(file.gap);
             splices.push((next.span().start, next.span().start, own_rank, text));
@@ -128,6 +129,7 @@ pub fn write_styled(program: &Program, edits: &[Edit], file: &FileStyle) -> Vec<
         if style.equals {
             text.push(b'=');
         }
+        text.extend_from_slice(file.letter_gap);
         text.extend_from_slice(number.as_bytes());
         if anchor.is_none() && !program.blocks[e.block].span().is_empty() {
             text.push(b' ');

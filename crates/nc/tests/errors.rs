@@ -1,7 +1,7 @@
 //! Bad input: each error names the value, the 1-based line and the byte column of the
 //! word's letter.
 
-use polepatch_nc::{Dialect, ParseError, parse};
+use polepatch_nc::{Dialect, Flags, ParseError, parse};
 
 fn err(src: &[u8]) -> ParseError {
     parse(src.to_vec(), Dialect::Auto).expect_err("should be rejected")
@@ -32,17 +32,22 @@ fn non_finite_values() {
     );
 }
 
+/// An expression or a variable on an axis or feed word is not an error: the block is
+/// kept, flagged, and its run listed as not analysable by the library.
 #[test]
-fn expression_on_an_axis_word() {
-    let e = err(b"; sinumerik\r\nN10 TRAORI\r\nN20 G1 X=IC(5) Y0\r\n");
-    assert_eq!((e.line, e.column), (3, 8));
-    assert_eq!(
-        e.message,
-        "X value 'IC(5)' is an expression; polepatch needs a plain number on axis words"
-    );
-    let e = err(b"G1 F#100\n");
-    assert_eq!((e.line, e.column), (1, 4));
-    assert!(e.message.starts_with("F value '#100' is an expression"));
+fn expression_on_an_axis_word_flags_the_block() {
+    let p = parse(
+        b"; sinumerik\r\nN10 TRAORI\r\nN20 G1 X=IC(5) Y0\r\n".to_vec(),
+        Dialect::Auto,
+    )
+    .unwrap();
+    assert!(p.blocks[2].flags.has(Flags::NOT_ANALYSABLE));
+    let p = parse(b"G1 F#100\n".to_vec(), Dialect::Auto).unwrap();
+    assert!(p.blocks[0].flags.has(Flags::NOT_ANALYSABLE));
+    // Garbage is not an expression.
+    let e = err(b"G1 X1\nG1 C\xfc\n");
+    assert_eq!((e.line, e.column), (2, 4));
+    assert!(e.message.contains("is not a number"), "{}", e.message);
 }
 
 #[test]

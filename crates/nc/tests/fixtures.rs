@@ -80,7 +80,7 @@ fn sing_runs() {
     assert_eq!(ns(main), expect);
     assert_eq!(main.len(), 55);
     assert_eq!(main.feed_mm_min, Some(2000.0));
-    assert!(main.tcpm);
+    assert!(main.tcpm.is_on());
     assert_eq!(main.ended_by, RunBreak::Block);
     assert_eq!(
         main.pos[0],
@@ -104,7 +104,7 @@ fn sing_runs() {
     assert_eq!(main.pos[at25][modal::C], Some(180.0));
     assert!((main.length_mm() - 218.0).abs() < 1e-12);
     assert_eq!(ns(&r[1]), vec![620.0, 650.0]);
-    assert!(!r[1].tcpm);
+    assert!(!r[1].tcpm.is_on());
     assert_eq!(r[1].ended_by, RunBreak::ZeroLength);
     assert_eq!(ns(&r[2]), vec![660.0, 670.0]);
     assert_eq!(r[2].ended_by, RunBreak::Block);
@@ -167,7 +167,7 @@ fn sinumerik_fixture() {
     let run = &r[0];
     assert_eq!(run.len(), 10, "N7 (G0 start) then N10…N90");
     assert_eq!(p.word(run.blocks[0], b'N').unwrap().value, 7.0);
-    assert!(run.tcpm);
+    assert!(run.tcpm.is_on());
     assert_eq!(run.feed_mm_min, Some(1500.0));
     assert_eq!(
         run.pos[1],
@@ -208,7 +208,7 @@ fn fanuc_fixture_and_modal_omission() {
     let run = &r[0];
     assert_eq!(p.word(run.blocks[0], b'N').unwrap().value, 60.0);
     assert_eq!(run.len(), 10);
-    assert!(run.tcpm);
+    assert!(run.tcpm.is_on());
     assert_eq!(run.feed_mm_min, Some(800.0));
     let n90 = block_of(&p, 90.0);
     let n120 = block_of(&p, 120.0);
@@ -249,7 +249,7 @@ fn heidenhain_non_utf8_fixture() {
     let r = runs(&p);
     assert_eq!(r.len(), 1);
     assert_eq!(r[0].len(), 9, "N60 (G00 start) then N70…N140");
-    assert!(r[0].tcpm);
+    assert!(r[0].tcpm.is_on());
     let b = block_of(&p, 90.0);
     let out = write(
         &p,

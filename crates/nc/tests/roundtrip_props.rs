@@ -1,5 +1,6 @@
 //! Property tests: parsing never panics, a parsed program is written back byte for byte,
-//! and editing one C word changes only the bytes of its number.
+//! editing one C word changes only the bytes of its number, and random valid blocks in
+//! every dialect are read with the values they were written with.
 
 use polepatch_nc::{Dialect, Edit, NumberStyle, Program, parse, write};
 use proptest::prelude::*;
@@ -16,6 +17,8 @@ fn fixture_lines() -> Vec<Vec<u8>> {
         "dialects/sinumerik.mpf",
         "dialects/fanuc.nc",
         "dialects/heidenhain_latin1.I",
+        "shop/ac-flip-d0.5-linuxcnc-g93-m428.ngc",
+        "shop/ac-swing-d1-variables.nc",
     ] {
         let bytes = std::fs::read(dir.join(rel)).unwrap();
         lines.extend(bytes.split_inclusive(|&b| b == b'\n').map(<[u8]>::to_vec));
@@ -139,6 +142,84 @@ proptest! {
         for run in polepatch_nc::runs(&program) {
             prop_assert!(run.len() >= 2);
             prop_assert!(run.s_mm.windows(2).all(|w| w[1] > w[0]));
+        }
+    }
+}
+
+/// How a random block writes its words.
+#[derive(Debug, Clone, Copy)]
+enum Form {
+    HeidenhainIso,
+    Conversational,
+    Sinumerik,
+    Fanuc,
+    FanucSpaced,
+}
+
+/// A block's values per axis X Y Z A C (some absent), each with its decimals.
+type Block = Vec<Option<(f64, usize)>>;
+
+/// Random moves: the form, and the blocks.
+fn valid_program() -> impl Strategy<Value = (Form, Vec<Block>)> {
+    let form = prop_oneof![
+        Just(Form::HeidenhainIso),
+        Just(Form::Conversational),
+        Just(Form::Sinumerik),
+        Just(Form::Fanuc),
+        Just(Form::FanucSpaced),
+    ];
+    let value = prop::option::weighted(0.8, (-999.0f64..999.0, 0usize..5));
+    let block = prop::collection::vec(value, 5..=5);
+    (form, prop::collection::vec(block, 1..20))
+}
+
+fn render(form: Form, v: f64, decimals: usize) -> String {
+    let t = format!("{v:.decimals$}");
+    match form {
+        Form::HeidenhainIso | Form::Conversational if !t.starts_with('-') => format!("+{t}"),
+        _ => t,
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 500, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_valid_blocks_read_back_as_written((form, blocks) in valid_program()) {
+        let mut text = String::from(match form {
+            Form::HeidenhainIso => "%P G71 *\nN1 M128 *\n",
+            Form::Conversational => "0 BEGIN PGM P MM\n1 FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS\n",
+            Form::Sinumerik => "; p\nTRAORI\n",
+            Form::Fanuc | Form::FanucSpaced => "(P)\nG43.4 H1\n",
+        });
+        let mut want = Vec::new();
+        for (k, b) in blocks.iter().enumerate() {
+            let mut words = Vec::new();
+            for (i, letter) in ['X', 'Y', 'Z', 'A', 'C'].into_iter().enumerate() {
+                if let Some((v, d)) = b[i] {
+                    let n = render(form, v, d);
+                    words.push(match form {
+                        Form::Sinumerik if i >= 3 => format!("{letter}={n}"),
+                        Form::FanucSpaced => format!("{letter}  {n}"),
+                        _ => format!("{letter}{n}"),
+                    });
+                    want.push((k, letter as u8, n.parse::<f64>().unwrap()));
+                }
+            }
+            let body = words.join(" ");
+            text += &match form {
+                Form::HeidenhainIso => format!("N{} G01 {body} F1000 *\n", k + 2),
+                Form::Conversational => format!("{} L {body} R0 F1000\n", k + 2),
+                _ => format!("G1 {body} F1000\n"),
+            };
+        }
+        let bytes = text.into_bytes();
+        let program = parse(bytes.clone(), Dialect::Auto).map_err(|e| TestCaseError::fail(format!("{form:?}: {e}")))?;
+        prop_assert!(write(&program, &[]) == bytes);
+        for (k, letter, v) in want {
+            let w = program.word(k + 2, letter);
+            prop_assert!(w.is_some(), "{:?} block {} has no {}", form, k, letter as char);
+            prop_assert_eq!(w.unwrap().value, v);
         }
     }
 }

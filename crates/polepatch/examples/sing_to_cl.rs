@@ -15,7 +15,7 @@ fn main() {
     let lp = load_nc(bytes, "SING.I", &machine, None).expect("loads");
     let p = &lp.program;
     let points: Vec<ClPoint> = (0..p.blocks.len())
-        .filter(|&b| p.blocks[b].is_move && p.state(b).tcpm)
+        .filter(|&b| p.blocks[b].is_move && p.state(b).tcpm.is_on())
         .filter_map(|b| {
             let st = p.state(b);
             let v = |i: usize| st.pos[i];

@@ -100,7 +100,7 @@ impl After<'_> {
                 return Some(false);
             }
             let xy_moves = st.pos[X] != prev.pos[X] || st.pos[Y] != prev.pos[Y];
-            if !st.tcpm && xy_moves {
+            if !st.tcpm.is_on() && xy_moves {
                 return Some(false);
             }
         } else if st.pos[p_idx] != prev.pos[p_idx] || st.pos[C] != prev.pos[C] {

@@ -59,4 +59,12 @@ pub enum Error {
     /// Bad options (a value out of range), named.
     #[error("{0}")]
     Options(String),
+    /// Memory for `what` could not be allocated.
+    #[error("not enough memory for {what} of a program of {bytes} bytes")]
+    OutOfMemory {
+        /// What was being allocated.
+        what: &'static str,
+        /// Size of the input, bytes.
+        bytes: usize,
+    },
 }

@@ -17,7 +17,7 @@ use crate::patch::FileReport;
 use crate::program::primary_mismatch_warning;
 use polepatch_kinematics::Machine;
 use polepatch_nc::modal::{A, B, C};
-use polepatch_nc::{Dialect, RunBuilder, scan};
+use polepatch_nc::{RunBuilder, scan_blocks_with};
 use std::ops::ControlFlow;
 
 /// What the scan found, run by run.
@@ -30,8 +30,9 @@ struct Seen {
     /// reads it).
     min_abs_a_deg: f64,
     min_abs_b_deg: f64,
-    /// A run with no feed in force (and no fallback): the full path reports it.
-    feedless: bool,
+    /// A run that cannot be analysed (no feed, …: [`crate::program::run_check`]) if A
+    /// (index 0) or B (index 1) is the tilting letter: the full path reports it.
+    feedless: [bool; 2],
 }
 
 /// The report of a program that is proven to have no run point within `opts.cone_deg`
@@ -54,8 +55,8 @@ pub fn far_from_pole(
     let mut near = false;
     let take = |run: polepatch_nc::Run, seen: &mut Seen| {
         seen.runs += 1;
-        if run.feed_mm_min.or(fallback).is_none() {
-            seen.feedless = true;
+        for (l, p) in [A, B].into_iter().enumerate() {
+            seen.feedless[l] |= crate::program::run_check(&run, p, fallback, 0).is_err();
         }
         for p in &run.pos {
             for (u, v) in seen.uses.iter_mut().zip(p) {
@@ -66,11 +67,18 @@ pub fn far_from_pole(
         }
     };
     let mut i = 0usize;
-    scan(bytes, Dialect::Auto, |block, _, st| {
+    let read = crate::program::read_options(machine)?;
+    let mut notes = crate::notes::Notes::new();
+    let mut prev = polepatch_nc::modal::initial(&read.controller);
+    scan_blocks_with(bytes, &read, |s| {
+        let (block, st) = (s.block, s.state);
+        notes.push(block, s.words, &prev, st);
+        prev = *st;
         builder.push(i, block, st, &mut |run| take(run, &mut seen));
         i += 1;
         // Whichever tilting letter turns out to be the primary, a point is in the cone.
-        near = seen.feedless || (seen.min_abs_a_deg <= cone_deg && seen.min_abs_b_deg <= cone_deg);
+        near = (seen.feedless[0] || seen.min_abs_a_deg <= cone_deg)
+            && (seen.feedless[1] || seen.min_abs_b_deg <= cone_deg);
         if near {
             ControlFlow::Break(())
         } else {
@@ -94,17 +102,21 @@ pub fn far_from_pole(
         seen.min_abs_b_deg
     };
     if seen.runs == 0
-        || seen.feedless
+        || seen.feedless[usize::from(p_idx == B)]
         || (!seen.uses[p_idx] && !seen.uses[C])
         || min_abs <= cone_deg
     {
         return Ok(None);
     }
-    Ok(Some(FileReport::unchanged(
+    let mut report = FileReport::unchanged(
         &opts.name,
         machine,
         primary_mismatch_warning(&opts.name, machine, p_idx)
             .into_iter()
             .collect(),
-    )))
+    );
+    let (not_analysed, warnings) = notes.finish(p_idx, cone_deg, &opts.name);
+    report.not_analysed = not_analysed;
+    report.warnings.extend(warnings);
+    Ok(Some(report))
 }

@@ -29,6 +29,7 @@ pub mod end_pose;
 pub mod error;
 pub mod far;
 pub mod machine_frame;
+pub mod notes;
 pub mod patch;
 pub mod post;
 pub mod program;
@@ -57,6 +58,11 @@ pub struct PatchOptions {
     /// Work offset (machine coordinates of the program's zero, mm) for a machine with a
     /// kinematic chain. Default `None`: the program's own datum (Heidenhain `G54 X Y Z`).
     pub work_offset_mm: Option<[f64; 3]>,
+    /// With a kinematic chain, for runs without TCPM: how far the tool tip may leave the
+    /// programmed line between two points when the rewritten block's axes are
+    /// interpolated linearly, mm (never more than the original block did, either).
+    /// Default [`machine_frame::CHORD_TOLERANCE_MM`] (0.005 mm).
+    pub chord_tolerance_mm: f64,
 }
 
 impl Default for PatchOptions {
@@ -66,6 +72,7 @@ impl Default for PatchOptions {
             feed_fallback_mm_min: None,
             name: "input".to_string(),
             work_offset_mm: None,
+            chord_tolerance_mm: machine_frame::CHORD_TOLERANCE_MM,
         }
     }
 }
@@ -97,6 +104,11 @@ impl Default for AnalyzeOptions {
 /// Patch an NC program held in memory: the rewritten bytes (identical to `bytes` except
 /// the rotary words that had to change) and the report.
 ///
+/// Programs of up to 4 GiB are read (the reader's byte offsets are 32-bit); memory is about
+/// twice the input for a program far from the pole, plus about ten times each run near it
+/// (docs/performance-nc.md). Where memory cannot be had the call returns
+/// [`Error::OutOfMemory`] (or a parse error naming it) instead of aborting the process.
+///
 /// Bad input (syntax errors with line and column, an empty program, no G1 motion, no
 /// rotary words) is an [`Error`]; a zone that cannot reach feed is a status in the report.
 pub fn patch_nc(
@@ -104,10 +116,18 @@ pub fn patch_nc(
     machine: &Machine,
     opts: &PatchOptions,
 ) -> Result<(Vec<u8>, FileReport), Error> {
+    // The output is about the input's size: a host that cannot give it gets an error,
+    // not an abort (the reader reserves its own tables the same way).
+    let mut out = Vec::new();
+    out.try_reserve(bytes.len())
+        .map_err(|_| Error::OutOfMemory {
+            what: "the output",
+            bytes: bytes.len(),
+        })?;
     if let Some(report) = far::far_from_pole(bytes, machine, opts)? {
-        return Ok((bytes.to_vec(), report));
+        out.extend_from_slice(bytes);
+        return Ok((out, report));
     }
-    let mut out = Vec::with_capacity(bytes.len());
     let report = stream::patch_nc_to(bytes, machine, opts, &mut out)?;
     Ok((out, report))
 }

@@ -9,6 +9,12 @@
 //!   and X Y Z are recomputed for every changed point from the *written* (rounded) rotary
 //!   values, then rounded with at least [`MIN_XYZ_DECIMALS`] decimals, so the part-frame
 //!   tool tip of the written block is within [`TIP_TOLERANCE_MM`] of the original.
+//!   Between the points the controller interpolates every axis linearly (no TCPM), so the
+//!   tool tip leaves the programmed line by a chord error that grows with the rotary step:
+//!   every block whose values change is checked there ([`chord_error_mm`]), and a run
+//!   where one would leave the line by more than the chord tolerance
+//!   ([`CHORD_TOLERANCE_MM`] by default) — and by more than the original block did — keeps
+//!   its original values. (Inserting intermediate points instead is not done.)
 //! - **Every run with a chain** is checked in the machine frame after the patch: Equation 6
 //!   on the machine-frame X Y Z (C17 eq. 6: near the pole the linear axes follow the
 //!   table), before and after; a run whose patch would make any axis's lowest ratio worse
@@ -177,6 +183,49 @@ pub fn worse_axis(before: &[f64; 5], after: &[f64; 5]) -> Option<Axis> {
         let i = a.index();
         after[i] < before[i].min(1.0) * (1.0 - NOT_WORSE_REL)
     })
+}
+
+/// Default chord tolerance, mm: how far the part-frame tool tip of a block rewritten
+/// through the chain may leave the programmed line between its points (issue 19 §2).
+pub const CHORD_TOLERANCE_MM: f64 = 0.005;
+
+/// Samples per block for [`chord_error_mm`]. The tip's distance from the line is a smooth
+/// function of the interpolation parameter u that is 0 at both ends; for the rotary steps
+/// a rewritten block takes (tens of degrees at most) it is well within one sign change of
+/// its curvature over [0, 1], and sampling every 1/32 finds its maximum within about
+/// (1/64)²/2 of the maximum's curvature scale — under 0.02 % of it.
+pub const CHORD_SAMPLES: usize = 32;
+
+/// Largest distance of the part-frame tool tip from the programmed line `tips[0]`–`tips[1]`
+/// while a block without TCPM moves from program values `from` to `to` (`[X, Y, Z, P, C]`),
+/// every axis interpolated linearly as the controller does without TCPM: sampled at
+/// [`CHORD_SAMPLES`] steps, mm.
+pub fn chord_error_mm(
+    chain: &Chain,
+    machine: &Machine,
+    datum_mm: [f64; 3],
+    from: &[f64; 5],
+    to: &[f64; 5],
+    tips: [[f64; 3]; 2],
+) -> f64 {
+    let [a, b] = tips;
+    let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let len2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
+    let mut worst: f64 = 0.0;
+    for i in 1..CHORD_SAMPLES {
+        let u = i as f64 / CHORD_SAMPLES as f64;
+        let q: [f64; 5] = std::array::from_fn(|j| from[j] + u * (to[j] - from[j]));
+        let t = chain.part_tip(machine, datum_mm, q[3], q[4], [q[0], q[1], q[2]]);
+        let at = [t[0] - a[0], t[1] - a[1], t[2] - a[2]];
+        let w = if len2 > 0.0 {
+            ((at[0] * ab[0] + at[1] * ab[1] + at[2] * ab[2]) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let d = [at[0] - w * ab[0], at[1] - w * ab[1], at[2] - w * ab[2]];
+        worst = worst.max((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt());
+    }
+    worst
 }
 
 /// Round to `decimals`.

@@ -16,7 +16,7 @@ use crate::machine_frame;
 use crate::program::{LoadedProgram, RunProblem};
 use crate::report::{axis_letter, limit_name, zone_kind_name};
 use polepatch_kinematics::Machine;
-use polepatch_nc::{Edit, NumberStyle};
+use polepatch_nc::{Edit, NumberStyle, Tcpm};
 use polepatch_patcher::{
     Method, Outcome, PatchOptions, QpStatus, ZoneFigures, ZoneReport, patch_path, report_unpatched,
 };
@@ -103,6 +103,18 @@ pub struct ZoneRow {
     pub primary_decimals: usize,
     /// 360° multiple added to C after the zone.
     pub c_offset_deg: f64,
+    /// Feed mode of the run: `G94` (feed per minute) or `G93` (inverse time: each block
+    /// keeps its time, F words untouched).
+    pub feed_mode: &'static str,
+}
+
+/// Report name of a feed mode: `G94`, `G93` or `G95`.
+pub fn feed_mode_name(m: polepatch_nc::FeedMode) -> &'static str {
+    match m {
+        polepatch_nc::FeedMode::PerMinute => "G94",
+        polepatch_nc::FeedMode::InverseTime => "G93",
+        polepatch_nc::FeedMode::PerRevolution => "G95",
+    }
 }
 
 /// Report name of an outcome.
@@ -127,7 +139,7 @@ fn method_name(m: Method) -> &'static str {
 
 impl ZoneRow {
     /// CSV column names of [`ZoneRow::csv_fields`] (the row's fields after `file`).
-    pub const CSV_COLUMNS: [&'static str; 31] = [
+    pub const CSV_COLUMNS: [&'static str; 32] = [
         "run",
         "first_line",
         "last_line",
@@ -159,6 +171,7 @@ impl ZoneRow {
         "decimals",
         "primary_decimals",
         "c_offset_deg",
+        "feed_mode",
     ];
 
     /// The row as CSV fields, in [`ZoneRow::CSV_COLUMNS`] order.
@@ -202,6 +215,7 @@ impl ZoneRow {
             self.decimals.to_string(),
             self.primary_decimals.to_string(),
             format!("{}", self.c_offset_deg),
+            self.feed_mode.to_string(),
         ]
     }
 
@@ -231,6 +245,7 @@ impl ZoneRow {
             decimals: z.decimals,
             primary_decimals: z.p_decimals,
             c_offset_deg: z.c_offset_deg,
+            feed_mode: feed_mode_name(lp.runs[run].run.feed_mode),
         }
     }
 }
@@ -250,6 +265,15 @@ pub enum UntouchedReason {
     /// With the machine's kinematic chain: the patch would make a linear axis worse in the
     /// machine frame, or could not be written through the chain.
     MachineFrame,
+    /// TCPM is switched by a block that block delete (`/`) may skip: X Y Z may be machine
+    /// coordinates.
+    TcpmUncertain,
+    /// The feed is below [`crate::program::MIN_FEED_MM_MIN`].
+    FeedTooLow,
+    /// Inverse-time feed (G93) whose blocks have different feeds.
+    InverseTimeVarying,
+    /// A rotary axis moves while its value at some point is unknown.
+    UnknownRotary,
 }
 
 /// A run left byte-identical, and why.
@@ -290,6 +314,9 @@ pub struct FileReport {
     pub written_primary_decimals: Option<usize>,
     /// Runs left as they are (no TCPM, G91, no feed, invalid values), with why.
     pub untouched_runs: Vec<UntouchedRun>,
+    /// Lines carried through without analysis (expressions, arcs and skippable blocks near
+    /// the pole, …; [`crate::notes`]).
+    pub not_analysed: Vec<crate::notes::NotAnalysed>,
     /// Notes for the user.
     pub warnings: Vec<String>,
     /// One row per zone.
@@ -309,9 +336,30 @@ impl FileReport {
             file_primary_decimals: None,
             written_primary_decimals: None,
             untouched_runs: Vec::new(),
+            not_analysed: Vec::new(),
             warnings,
             zones: Vec::new(),
         }
+    }
+    /// What `--strict` counts as a failure: zones that stay below feed (those of untouched
+    /// runs included), runs that could not be analysed (no feed, a feed too low, G93 with
+    /// differing feeds, invalid values) and lines carried through without analysis.
+    pub fn strict_failures(&self) -> usize {
+        let unanalysed_runs = self
+            .untouched_runs
+            .iter()
+            .filter(|u| {
+                matches!(
+                    u.reason,
+                    UntouchedReason::NoFeed
+                        | UntouchedReason::FeedTooLow
+                        | UntouchedReason::InverseTimeVarying
+                        | UntouchedReason::UnknownRotary
+                        | UntouchedReason::Invalid
+                )
+            })
+            .count();
+        self.zones_below_feed() + unanalysed_runs + self.not_analysed.len()
     }
     /// Zones that stay below feed (including those of untouched runs).
     pub fn zones_below_feed(&self) -> usize {
@@ -321,7 +369,12 @@ impl FileReport {
     pub fn runs_left_without_tcpm(&self) -> usize {
         self.untouched_runs
             .iter()
-            .filter(|u| u.reason == UntouchedReason::NoTcpm && u.zones > 0)
+            .filter(|u| {
+                matches!(
+                    u.reason,
+                    UntouchedReason::NoTcpm | UntouchedReason::TcpmUncertain
+                ) && u.zones > 0
+            })
             .count()
     }
 }
@@ -337,6 +390,9 @@ pub fn patch_program(
 ) -> (Vec<Edit>, FileReport) {
     let program = &lp.program;
     let mut report = FileReport::unchanged(&lp.name, machine, lp.warnings.clone());
+    let (not_analysed, warnings) = lp.notes.finish(lp.primary_index(), opts.cone_deg, &lp.name);
+    report.not_analysed = not_analysed;
+    report.warnings.extend(warnings);
     // The file's number style is only needed when some run comes near the pole; reading
     // it costs a pass over every word, so a program without such a run skips it.
     let pi = polepatch_kinematics::Axis::Primary.index();
@@ -410,7 +466,14 @@ pub fn patch_program(
             .as_ref()
             .and_then(|ch| machine_frame::run_datum(lp, r, lp.work_offset_mm).map(|d| (ch, d)));
         let inch = rp.run.blocks.iter().any(|&b| program.state(b).inch);
-        let leave = if !rp.run.tcpm && (chain.is_none() || inch || incremental) {
+        let leave = if rp.run.tcpm == Tcpm::Uncertain {
+            Some((
+                UntouchedReason::TcpmUncertain,
+                "TCPM is switched by a block that block delete (`/`) may skip: whether X Y Z are \
+                 part or machine coordinates depends on the block-delete switch, so the run is \
+                 left as it is",
+            ))
+        } else if !rp.run.tcpm.is_on() && (chain.is_none() || inch || incremental) {
             Some((
                 UntouchedReason::NoTcpm,
                 if machine.chain.is_none() {
@@ -464,12 +527,14 @@ pub fn patch_program(
         let run_opts = PatchOptions {
             // Without TCPM the moves after the run are in machine coordinates: the last
             // point keeps its values (X Y Z included).
-            keep_last_point: !rp.run.tcpm || !crate::end_pose::end_pose_is_free(lp, r),
+            keep_last_point: !rp.run.tcpm.is_on() || !crate::end_pose::end_pose_is_free(lp, r),
             ..opts.clone()
         };
         // Without TCPM (and with a chain) the patcher works on the part-frame path.
         let part_path = match (rp.run.tcpm, chain) {
-            (false, Some((ch, d))) => Some(machine_frame::part_frame_path(ch, machine, d, path)),
+            (Tcpm::Off, Some((ch, d))) => {
+                Some(machine_frame::part_frame_path(ch, machine, d, path))
+            }
             _ => None,
         };
         let work_path = part_path.as_ref().unwrap_or(path);
@@ -508,6 +573,7 @@ pub fn patch_program(
                 d,
                 &opts,
                 xyz_decimals,
+                lp.chord_tolerance_mm,
             ) {
                 Ok(xyz) => run_edits = xyz,
                 Err(why) => {
@@ -607,9 +673,10 @@ fn through_chain(
     datum_mm: [f64; 3],
     opts: &PatchOptions,
     xyz_decimals: usize,
+    chord_tolerance_mm: f64,
 ) -> Result<Vec<Edit>, String> {
     let rp = &lp.runs[r];
-    let tcpm = rp.run.tcpm;
+    let tcpm = rp.run.tcpm.is_on();
     let n = path.axes.len();
     let changed = |k: usize| result.p_changed[k] || result.c_changed[k];
     if !(0..n).any(changed) {
@@ -660,6 +727,40 @@ fn through_chain(
         }
         point[..3].copy_from_slice(&written);
     }
+    if !tcpm {
+        // Between the points (issue 19 §2): the tool tip under linear interpolation of the
+        // written values may not leave the programmed line by more than the tolerance, nor
+        // by more than the original block did.
+        for k in 1..n {
+            if !(changed(k - 1) || changed(k)) {
+                continue;
+            }
+            let tip = |i: usize| {
+                [
+                    work_path.axes[i][0],
+                    work_path.axes[i][1],
+                    work_path.axes[i][2],
+                ]
+            };
+            let tips = [tip(k - 1), tip(k)];
+            let err = |from: &[f64; 5], to: &[f64; 5]| {
+                machine_frame::chord_error_mm(chain, machine, datum_mm, from, to, tips)
+            };
+            let new = err(&after[k - 1], &after[k]);
+            let old = err(&path.axes[k - 1], &path.axes[k]);
+            // The endpoints themselves may move by the tip tolerance (rounding).
+            if new > chord_tolerance_mm.max(old) + machine_frame::TIP_TOLERANCE_MM {
+                return Err(format!(
+                    "between lines {} and {} the tool tip would leave the programmed line by \
+                     {new:.3} mm with the axes interpolated linearly (without TCPM; the original \
+                     block: {old:.3} mm, chord tolerance {chord_tolerance_mm} mm), so the run \
+                     keeps its values",
+                    lp.line_of(r, k - 1),
+                    lp.line_of(r, k)
+                ));
+            }
+        }
+    }
     let aopts = polepatch_patcher::AnalysisOptions {
         cone_deg: opts.cone_deg,
         tcy_s: opts.tcy_s,
@@ -695,6 +796,9 @@ fn through_chain(
 fn problem_reason(p: &RunProblem) -> UntouchedReason {
     match p {
         RunProblem::NoFeed => UntouchedReason::NoFeed,
+        RunProblem::FeedTooLow { .. } => UntouchedReason::FeedTooLow,
+        RunProblem::InverseTimeVarying { .. } => UntouchedReason::InverseTimeVarying,
+        RunProblem::UnknownRotary { .. } => UntouchedReason::UnknownRotary,
     }
 }
 

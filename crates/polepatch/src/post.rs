@@ -291,7 +291,10 @@ impl Poster<'_> {
         let tol = self.opts.arc_tolerance_mm;
         let fixed_axis = (0..3).all(|i| (p.axis[i] - a.start_axis[i]).abs() <= SAME_AXIS_TOL);
         let one_turn = a.sweep_rad <= std::f64::consts::TAU * (1.0 + 1e-12);
-        let heidenhain = matches!(self.opts.dialect, Dialect::Heidenhain | Dialect::Auto);
+        let heidenhain = matches!(
+            self.opts.dialect,
+            Dialect::Heidenhain | Dialect::Conversational | Dialect::Auto
+        );
         // Heidenhain's circle in ISO programs: the XY plane, no helix (its helix is a polar
         // block polepatch does not write).
         let plane = a
@@ -665,7 +668,12 @@ pub fn post_cl(
     opts: &PostOptions,
 ) -> Result<(Vec<u8>, Option<FileReport>), Error> {
     let inch = opts.units.unwrap_or(cl.units) == Units::Inch;
-    if inch && matches!(opts.dialect, Dialect::Heidenhain | Dialect::Auto) {
+    if inch
+        && matches!(
+            opts.dialect,
+            Dialect::Heidenhain | Dialect::Conversational | Dialect::Auto
+        )
+    {
         return Err(Error::Options(
             "inch output for Heidenhain is not written: Heidenhain inch programs take F in 0.1 inch/min, which polepatch's reader does not read; post in mm (--units mm)"
                 .into(),

@@ -6,11 +6,40 @@ use polepatch_nc::{Dialect, FileStyle, Program, Run, modal};
 use polepatch_patcher::Path;
 
 /// Why one run cannot be analysed (the others still can).
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum RunProblem {
     /// No F in force and no fallback feed given.
     NoFeed,
+    /// The feed is below [`MIN_FEED_MM_MIN`] (at the run's first block's line).
+    FeedTooLow {
+        /// The feed, mm/min.
+        feed_mm_min: f64,
+        /// File line of the block with that feed.
+        line: usize,
+    },
+    /// A rotary axis moves in the run while its value at some point is unknown (after an
+    /// expression, a datum change or a call): reading it as anything would guess.
+    UnknownRotary {
+        /// The letter.
+        letter: char,
+    },
+    /// Inverse-time feed (G93) whose blocks have different feeds: not analysed yet.
+    InverseTimeVarying {
+        /// Lowest and highest block feed, mm/min.
+        range_mm_min: [f64; 2],
+    },
 }
+
+/// The lowest feed polepatch analyses, mm/min. Equation 6 itself has no lower limit, but a
+/// run at a feed below this (0.04 inch/min) is a typing error or a dwell written as a move,
+/// and its time estimate is meaningless; such a run is reported with its line and left as
+/// it is.
+pub const MIN_FEED_MM_MIN: f64 = 1.0;
+
+/// Relative spread of the block feeds of a G93 run below which the run is analysed at one
+/// feed (the mean): inverse-time F words rounded to 3–4 significant digits by a post that
+/// computed them from one programmed feed differ by about this much.
+pub const INVERSE_TIME_FEED_SPREAD: f64 = 2e-3;
 
 impl std::fmt::Display for RunProblem {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -18,8 +47,50 @@ impl std::fmt::Display for RunProblem {
             RunProblem::NoFeed => {
                 write!(f, "no feed (F) in force for this run; give one with --feed")
             }
+            RunProblem::FeedTooLow { feed_mm_min, line } => write!(
+                f,
+                "line {line}: feed F{feed_mm_min} mm/min is below polepatch's minimum of \
+                 {MIN_FEED_MM_MIN} mm/min; the run is left as it is"
+            ),
+            RunProblem::UnknownRotary { letter } => write!(
+                f,
+                "the rotary axes move in this run but {letter} is unknown at some of its points \
+                 (after an expression, a datum change or a call); the run is left as it is"
+            ),
+            RunProblem::InverseTimeVarying { range_mm_min } => write!(
+                f,
+                "inverse-time feed (G93) with block feeds from {:.1} to {:.1} mm/min; runs whose \
+                 blocks differ by more than {}% are not analysed yet, so the run is left as it is",
+                range_mm_min[0],
+                range_mm_min[1],
+                INVERSE_TIME_FEED_SPREAD * 100.0
+            ),
         }
     }
+}
+
+/// How to read programs for `machine`: the dialect detected, the machine's TCPM codes.
+pub fn read_options(machine: &Machine) -> Result<polepatch_nc::ReadOptions, Error> {
+    let codes = |field: &str, list: &[String]| {
+        list.iter()
+            .map(|c| {
+                polepatch_nc::Code::parse(c).map_err(|e| {
+                    Error::Options(format!(
+                        "machine {}: [controller] {field}: {e}",
+                        machine.name
+                    ))
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()
+    };
+    Ok(polepatch_nc::ReadOptions {
+        dialect: Dialect::Auto,
+        controller: polepatch_nc::ControllerCodes {
+            on: codes("tcpm_on", &machine.controller.tcpm_on)?,
+            off: codes("tcpm_off", &machine.controller.tcpm_off)?,
+            always: machine.controller.tcpm_always,
+        },
+    })
 }
 
 /// One run of the program with its path for the patcher.
@@ -49,9 +120,15 @@ pub struct LoadedProgram {
     /// used with a machine's kinematic chain; `None`: from the program
     /// ([`crate::machine_frame::run_datum`]).
     pub work_offset_mm: Option<[f64; 3]>,
+    /// Chord tolerance for runs patched through the kinematic chain, mm (default
+    /// [`crate::machine_frame::CHORD_TOLERANCE_MM`]; see [`crate::PatchOptions`]).
+    pub chord_tolerance_mm: f64,
     /// When `program` is a stretch of a larger file ([`crate::stream`]): what the rest
     /// of the file says about it. `None` for a whole program.
     pub window: Option<Window>,
+    /// What the reader carried through without analysing ([`crate::notes`]); empty for a
+    /// stretch (the stream lists it once for the file).
+    pub notes: crate::notes::Notes,
 }
 
 /// What a stretch of a file ([`LoadedProgram::window`]) needs from the rest of the file,
@@ -103,14 +180,16 @@ impl LoadedProgram {
     }
 }
 
-/// Parse `bytes` named `name` (for messages).
-pub fn parse_program(bytes: Vec<u8>, name: &str) -> Result<Program, Error> {
+/// Parse `bytes` named `name` (for messages) as the NC reader reads programs for
+/// `machine` ([`read_options`]).
+pub fn parse_program(bytes: Vec<u8>, name: &str, machine: &Machine) -> Result<Program, Error> {
     if bytes.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(Error::Empty {
             path: name.to_string(),
         });
     }
-    polepatch_nc::parse(bytes, Dialect::Auto).map_err(|e| Error::Parse(e.with_path(name)))
+    polepatch_nc::parse_with(bytes, &read_options(machine)?)
+        .map_err(|e| Error::Parse(e.with_path(name)))
 }
 
 /// Parse `bytes` and build each run's path for `machine`; `feed_fallback_mm_min` is used
@@ -122,7 +201,7 @@ pub fn load_nc(
     feed_fallback_mm_min: Option<f64>,
 ) -> Result<LoadedProgram, Error> {
     load(
-        parse_program(bytes, name)?,
+        parse_program(bytes, name, machine)?,
         name,
         machine,
         feed_fallback_mm_min,
@@ -140,10 +219,34 @@ fn why_no_runs(program: &Program, name: &str) -> Error {
         if st.motion != polepatch_nc::Motion::Linear {
             continue;
         }
-        let what = if st.incremental {
-            "incremental mode (G91) is not supported: polepatch reads absolute programs (G90), \
-             because a rotary value changed in incremental mode would shift every later position"
-        } else if st.pos[..3].iter().any(Option::is_none) {
+        if block.flags.has(polepatch_nc::Flags::NOT_ANALYSABLE) {
+            return Error::Unsupported {
+                path: name.to_string(),
+                line: block.line,
+                what: "no G1 run can be analysed: the G1 moves' axis or feed words are \
+                       expressions or variables (as here), which polepatch carries through but \
+                       cannot evaluate"
+                    .to_string(),
+            };
+        }
+        if st.incremental {
+            // The error is where G91 was programmed (the move only follows it).
+            let set = (0..=i)
+                .rev()
+                .find(|&b| !program.state_before(b).incremental && program.state(b).incremental)
+                .unwrap_or(i);
+            return Error::Unsupported {
+                path: name.to_string(),
+                line: program.blocks[set].line,
+                what: format!(
+                    "incremental mode (G91) is not supported: polepatch reads absolute programs \
+                     (G90), because a rotary value changed in incremental mode would shift every \
+                     later position (the first move in it is at line {})",
+                    block.line
+                ),
+            };
+        }
+        let what = if st.pos[..3].iter().any(Option::is_none) {
             "G1 moves from a position the program does not state (after G28/G53/G92 or a datum \
              change, or before X Y Z are all programmed): nothing can be analysed without it"
         } else {
@@ -197,17 +300,94 @@ pub(crate) fn primary_mismatch_warning(
 
 /// A run with its path for the patcher: axes X Y Z, the tilting letter at `p_idx`
 /// (`modal::A` or `modal::B`) and C; the run's feed, else `feed_fallback_mm_min`.
-pub(crate) fn run_path(run: Run, p_idx: usize, feed_fallback_mm_min: Option<f64>) -> RunPath {
-    let path = run
-        .feed_mm_min
-        .or(feed_fallback_mm_min)
-        .ok_or(RunProblem::NoFeed)
-        .map(|feed| Path {
-            s_mm: run.s_mm.clone(),
-            axes: run.axes5(p_idx),
-            feed_mm_min: feed,
-        });
+pub(crate) fn run_path(
+    run: Run,
+    p_idx: usize,
+    feed_fallback_mm_min: Option<f64>,
+    first_line: usize,
+) -> RunPath {
+    let path = run_check(&run, p_idx, feed_fallback_mm_min, first_line).map(|feed| Path {
+        s_mm: run.s_mm.clone(),
+        axes: run.axes5(p_idx),
+        feed_mm_min: feed,
+    });
     RunPath { run, path }
+}
+
+/// Whether a run can be analysed with the tilting letter at `p_idx` (`modal::A` or
+/// `modal::B`): its feed ([`run_feed`]), or why not — the one rule every read uses (the
+/// whole program, the stream survey, the no-zone fast path).
+pub(crate) fn run_check(
+    run: &Run,
+    p_idx: usize,
+    feed_fallback_mm_min: Option<f64>,
+    first_line: usize,
+) -> Result<f64, RunProblem> {
+    let feed = run_feed(run, feed_fallback_mm_min, first_line)?;
+    rotary_known(run, p_idx)?;
+    Ok(feed)
+}
+
+/// A run whose rotary axes (the tilting one at `p_idx`, and C) move may not have a point
+/// where one of them is unknown: [`Run::axes5`] reads an unknown value as 0, which is right
+/// only where the axis is not programmed at all in the run.
+fn rotary_known(run: &Run, p_idx: usize) -> Result<(), RunProblem> {
+    let moves = |i: usize| {
+        let mut known = run.pos.iter().filter_map(|p| p[i]);
+        known.next().is_some_and(|v0| known.any(|v| v != v0))
+    };
+    let rotary_moves = moves(p_idx) || moves(modal::C);
+    for (i, letter) in [
+        (p_idx, if p_idx == modal::A { 'A' } else { 'B' }),
+        (modal::C, 'C'),
+    ] {
+        let unknown = run.pos.iter().filter(|p| p[i].is_none()).count();
+        if unknown > 0 && (rotary_moves || unknown < run.pos.len()) {
+            return Err(RunProblem::UnknownRotary { letter });
+        }
+    }
+    Ok(())
+}
+
+/// The feed a run is analysed at, mm/min (its F; under G93 its blocks' common feed; the
+/// fallback where no F is in force), or why it has none; `first_line` is the line of its
+/// first point (for messages).
+fn run_feed(
+    run: &Run,
+    feed_fallback_mm_min: Option<f64>,
+    first_line: usize,
+) -> Result<f64, RunProblem> {
+    let feed = if run.block_feed_mm_min.is_empty() {
+        run.feed_mm_min
+            .or(feed_fallback_mm_min)
+            .ok_or(RunProblem::NoFeed)?
+    } else {
+        inverse_time_feed(&run.block_feed_mm_min)?
+    };
+    if feed < MIN_FEED_MM_MIN {
+        return Err(RunProblem::FeedTooLow {
+            feed_mm_min: feed,
+            line: first_line,
+        });
+    }
+    Ok(feed)
+}
+
+/// The feed of a G93 run whose block feeds agree within [`INVERSE_TIME_FEED_SPREAD`]: their
+/// mean weighted by nothing (each block's own feed is within the spread of it).
+fn inverse_time_feed(block_feed_mm_min: &[f64]) -> Result<f64, RunProblem> {
+    let lo = block_feed_mm_min
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let hi = block_feed_mm_min.iter().copied().fold(0.0, f64::max);
+    if hi - lo <= INVERSE_TIME_FEED_SPREAD * hi {
+        Ok(block_feed_mm_min.iter().sum::<f64>() / block_feed_mm_min.len() as f64)
+    } else {
+        Err(RunProblem::InverseTimeVarying {
+            range_mm_min: [lo, hi],
+        })
+    }
 }
 
 /// Group a parsed program into runs and build each run's path for `machine`.
@@ -232,6 +412,15 @@ pub fn load(
     let warnings: Vec<String> = primary_mismatch_warning(name, machine, p_idx)
         .into_iter()
         .collect();
+    let mut notes = crate::notes::Notes::new();
+    for b in 0..program.blocks.len() {
+        notes.push(
+            &program.blocks[b],
+            program.block_words(b),
+            &program.state_before(b),
+            &program.state(b),
+        );
+    }
     let has = |idx: usize| runs.iter().any(|r| r.uses(idx));
     if !has(p_idx) && !has(modal::C) {
         return Err(Error::NoRotary {
@@ -241,7 +430,10 @@ pub fn load(
     }
     let runs = runs
         .into_iter()
-        .map(|run| run_path(run, p_idx, feed_fallback_mm_min))
+        .map(|run| {
+            let line = program.blocks[run.blocks[0]].line;
+            run_path(run, p_idx, feed_fallback_mm_min, line)
+        })
         .collect();
     Ok(LoadedProgram {
         name: name.to_string(),
@@ -250,6 +442,8 @@ pub fn load(
         runs,
         warnings,
         work_offset_mm: None,
+        chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
         window: None,
+        notes,
     })
 }

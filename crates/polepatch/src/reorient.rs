@@ -162,7 +162,7 @@ pub fn reorient_edits(
             continue;
         }
         let st = program.state(b);
-        if !st.tcpm {
+        if !st.tcpm.is_on() {
             untouched.push(block.line);
             continue;
         }
@@ -333,7 +333,7 @@ pub fn program_figures(
     let pi = lp.primary_index();
     for (b, block) in lp.program.blocks.iter().enumerate() {
         let st = lp.program.state(b);
-        if block.is_move && st.tcpm {
+        if block.is_move && st.tcpm.is_on() {
             if let Some(p) = st.pos[pi] {
                 f.min_pole_distance_deg = f.min_pole_distance_deg.min(p.abs());
             }
@@ -519,7 +519,7 @@ pub fn tool_axes(lp: &LoadedProgram, machine: &Machine) -> Vec<[f64; 3]> {
         .filter(|&b| lp.program.blocks[b].is_move)
         .filter_map(|b| {
             let st = lp.program.state(b);
-            (st.tcpm)
+            (st.tcpm.is_on())
                 .then(|| Some(forward(machine, st.pos[pi]?, st.pos[C]?)))
                 .flatten()
         })

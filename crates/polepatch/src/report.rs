@@ -100,6 +100,9 @@ pub struct RunReport {
     pub length_mm: f64,
     /// Feed used, mm/min (`null` if none).
     pub feed_mm_min: Option<f64>,
+    /// Feed mode: `G94`, or `G93` (inverse time: the feed is each block's length over its
+    /// time).
+    pub feed_mode: &'static str,
     /// Why this run was not analysed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
@@ -138,8 +141,18 @@ pub struct AnalyzeReport {
     pub primary: String,
     /// Notes for the user.
     pub warnings: Vec<String>,
-    /// Runs in file order.
+    /// Lines carried through without analysis ([`crate::notes`]).
+    pub not_analysed: Vec<crate::notes::NotAnalysed>,
+    /// Runs in file order (last: the CLI prints the report as it goes).
     pub runs: Vec<RunReport>,
+}
+
+impl AnalyzeReport {
+    /// What `analyze --strict` counts as a failure: runs that could not be analysed and
+    /// lines carried through without analysis.
+    pub fn strict_failures(&self) -> usize {
+        self.runs.iter().filter(|r| r.error.is_some()).count() + self.not_analysed.len()
+    }
 }
 
 /// Summarise one analysed run.
@@ -198,7 +211,7 @@ fn machine_frame_figures(
         chain,
         machine,
         datum_mm,
-        lp.runs[r].run.tcpm,
+        lp.runs[r].run.tcpm.is_on(),
         &path.axes,
         &path.s_mm,
         path.feed_mm_min,
@@ -240,6 +253,7 @@ pub fn analyze_program(
                 points: n,
                 length_mm: rp.run.length_mm(),
                 feed_mm_min: rp.path.as_ref().ok().map(|p| p.feed_mm_min),
+                feed_mode: crate::patch::feed_mode_name(rp.run.feed_mode),
                 error: None,
                 figures: None,
                 machine_frame: None,
@@ -257,12 +271,15 @@ pub fn analyze_program(
             rep
         })
         .collect();
+    let (not_analysed, notes_warnings) =
+        lp.notes.finish(lp.primary_index(), opts.cone_deg, &lp.name);
     AnalyzeReport {
         file: lp.name.clone(),
         machine: machine.name.clone(),
         cone_deg: opts.cone_deg,
         primary: (lp.primary_letter as char).to_string(),
-        warnings: lp.warnings.clone(),
+        warnings: lp.warnings.iter().cloned().chain(notes_warnings).collect(),
+        not_analysed,
         runs,
     }
 }

@@ -53,7 +53,7 @@ use crate::report::{AnalyzeReport, RunReport};
 use polepatch_kinematics::Machine;
 use polepatch_nc::modal::{A, B, C};
 use polepatch_nc::{
-    Dialect, FileStyle, Modal, ProgramBuilder, Run, RunBuilder, Scanned, StyleEvidence, scan_blocks,
+    Dialect, FileStyle, ProgramBuilder, Run, RunBuilder, Scanned, StyleEvidence, scan_blocks_with,
 };
 use std::collections::VecDeque;
 use std::io::Write;
@@ -78,8 +78,10 @@ struct RunRec {
     /// Some point is within the cone if A (index 0) or B (index 1) is the tilting axis
     /// (a value never programmed reads as 0, as [`Run::axes5`] reads it).
     near: [bool; 2],
-    /// No feed in force and no fallback.
-    feedless: bool,
+    /// The run cannot be analysed if A (index 0) or B (index 1) is the tilting letter (no
+    /// feed, a feed too low, G93 with differing block feeds, an unknown rotary value:
+    /// [`crate::program::run_check`]): the report lists it.
+    feedless: [bool; 2],
     /// End pose free, per tilting letter; `None` until a later block decides.
     end_free: [Option<bool>; 2],
     /// Work offset for this run ([`crate::machine_frame::datum_at`]).
@@ -93,6 +95,8 @@ struct Survey {
     /// Some run point has a value for X Y Z A B C.
     uses: [bool; 6],
     style: FileStyle,
+    /// What the reader carried through without analysing.
+    notes: crate::notes::Notes,
 }
 
 /// The first read in progress.
@@ -133,7 +137,7 @@ impl Surveying {
             first_block,
             last_block: *run.blocks.last().unwrap_or(&first_block),
             near,
-            feedless: run.feed_mm_min.or(self.fallback).is_none(),
+            feedless: [A, B].map(|p| crate::program::run_check(&run, p, self.fallback, 0).is_err()),
             end_free: self.first_after,
             datum_mm: crate::machine_frame::datum_at(
                 &self.datum_shifts,
@@ -163,6 +167,10 @@ struct Reading<'a> {
     cone_deg: f64,
     fallback: Option<f64>,
     work_offset_mm: Option<[f64; 3]>,
+    /// How the machine's programs are read.
+    read: polepatch_nc::ReadOptions,
+    /// Chord tolerance for the chain path, mm.
+    chord_tolerance_mm: f64,
 }
 
 /// The first read (module docs, step 1).
@@ -179,11 +187,13 @@ fn survey(bytes: &[u8], opts: &Reading<'_>) -> Result<Survey, Error> {
         first_after: [None, None],
     };
     let mut style = StyleEvidence::default();
+    let mut notes = crate::notes::Notes::new();
     let mut builder = RunBuilder::default();
-    let mut prev = Modal::default();
+    let mut prev = polepatch_nc::modal::initial(&opts.read.controller);
     let mut i = 0usize;
-    let dialect = scan_blocks(bytes, Dialect::Auto, |s: Scanned<'_>| {
+    let dialect = scan_blocks_with(bytes, &opts.read, |s: Scanned<'_>| {
         style.add_block(bytes, s.words);
+        notes.push(s.block, s.words, &prev, s.state);
         if let Some(d) = s.stated_datum {
             sv.datum_shifts.push((i, d));
         }
@@ -220,6 +230,7 @@ fn survey(bytes: &[u8], opts: &Reading<'_>) -> Result<Survey, Error> {
         runs: sv.runs,
         uses: sv.uses,
         style: style.style(),
+        notes,
     })
 }
 
@@ -278,7 +289,11 @@ fn tilting_index(sv: &Survey, machine: &Machine) -> usize {
 /// (0 A, 1 B) for the stretches.
 enum Begun {
     Whole(Box<LoadedProgram>),
-    Stretches { sv: Survey, l: usize, p_idx: usize },
+    Stretches {
+        sv: Box<Survey>,
+        l: usize,
+        p_idx: usize,
+    },
 }
 
 fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Error> {
@@ -287,10 +302,11 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
     if sv.runs.is_empty() || (!sv.uses[p_idx] && !sv.uses[C]) {
         let mut lp = load_nc(bytes.to_vec(), rd.name, machine, rd.fallback)?;
         lp.work_offset_mm = rd.work_offset_mm;
+        lp.chord_tolerance_mm = rd.chord_tolerance_mm;
         return Ok(Begun::Whole(Box::new(lp)));
     }
     Ok(Begun::Stretches {
-        sv,
+        sv: Box::new(sv),
         l: usize::from(p_idx == B),
         p_idx,
     })
@@ -311,6 +327,8 @@ pub fn patch_nc_to(
         cone_deg: opts.patch.cone_deg,
         fallback: opts.feed_fallback_mm_min,
         work_offset_mm: opts.work_offset_mm,
+        read: crate::program::read_options(machine)?,
+        chord_tolerance_mm: opts.chord_tolerance_mm,
     };
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
         Begun::Whole(lp) => {
@@ -327,7 +345,10 @@ pub fn patch_nc_to(
             .into_iter()
             .collect(),
     );
-    let todo = stretches(&sv.runs, |rec| rec.near[l] || rec.feedless);
+    let (not_analysed, warnings) = sv.notes.finish(p_idx, rd.cone_deg, &opts.name);
+    report.not_analysed = not_analysed;
+    report.warnings.extend(warnings);
+    let todo = stretches(&sv.runs, |rec| rec.near[l] || rec.feedless[l]);
     let mut copied_to = 0usize;
     each_stretch(
         bytes,
@@ -408,6 +429,8 @@ pub fn analyze_nc_each(
         cone_deg: opts.analysis.cone_deg,
         fallback: opts.feed_fallback_mm_min,
         work_offset_mm: opts.work_offset_mm,
+        read: crate::program::read_options(machine)?,
+        chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
     };
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
         Begun::Whole(lp) => {
@@ -421,6 +444,7 @@ pub fn analyze_nc_each(
         }
         Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx),
     };
+    let (not_analysed, notes_warnings) = sv.notes.finish(p_idx, rd.cone_deg, &opts.name);
     each(Piece::Head(&AnalyzeReport {
         file: opts.name.clone(),
         machine: machine.name.clone(),
@@ -428,7 +452,9 @@ pub fn analyze_nc_each(
         primary: (LETTERS[l] as char).to_string(),
         warnings: primary_mismatch_warning(&opts.name, machine, p_idx)
             .into_iter()
+            .chain(notes_warnings)
             .collect(),
+        not_analysed,
         runs: Vec::new(),
     }))
     .map_err(Error::Output)?;
@@ -466,7 +492,7 @@ fn each_stretch<T: Send>(
     let mut failure: Option<Error> = None;
     let mut builder = RunBuilder::default();
     let mut run_no = 0usize;
-    let mut prev = Modal::default();
+    let mut prev = polepatch_nc::modal::initial(&rd.read.controller);
     let mut i = 0usize;
     let mut ready: Vec<InHand> = Vec::new();
     let mut ready_bytes = 0usize;
@@ -499,7 +525,11 @@ fn each_stretch<T: Send>(
             h.runs.push(run);
         }
     };
-    scan_blocks(bytes, sv.dialect, |s: Scanned<'_>| {
+    let read = polepatch_nc::ReadOptions {
+        dialect: sv.dialect,
+        ..rd.read.clone()
+    };
+    scan_blocks_with(bytes, &read, |s: Scanned<'_>| {
         if let Some(h) = &mut building {
             h.program.push(&s);
             if h.stretch.last_block == i {
@@ -570,7 +600,8 @@ fn loaded(bytes: &[u8], hand: InHand, sv: &Survey, l: usize, rd: &Reading<'_>) -
             for b in &mut run.blocks {
                 *b -= first;
             }
-            run_path(run, p_idx, rd.fallback)
+            let line = program.blocks[run.blocks[0]].line;
+            run_path(run, p_idx, rd.fallback, line)
         })
         .collect();
     let recs = &sv.runs[hand.stretch.runs.clone()];
@@ -581,12 +612,14 @@ fn loaded(bytes: &[u8], hand: InHand, sv: &Survey, l: usize, rd: &Reading<'_>) -
         runs,
         warnings: Vec::new(),
         work_offset_mm: rd.work_offset_mm,
+        chord_tolerance_mm: rd.chord_tolerance_mm,
         window: Some(Window {
             first_run: hand.stretch.runs.start,
             style: sv.style,
             end_free: recs.iter().map(|r| r.end_free[l].unwrap_or(true)).collect(),
             datum_mm: recs.iter().map(|r| r.datum_mm).collect(),
         }),
+        notes: crate::notes::Notes::new(),
     }
 }
 

@@ -35,7 +35,7 @@ fn sing_without_tcpm(machine: &Machine) -> (Vec<u8>, Vec<Option<[f64; 3]>>) {
     let program = &lp.program;
     let mut edits = Vec::new();
     let mut tips = vec![None; program.blocks.len()];
-    for rp in lp.runs.iter().filter(|rp| rp.run.tcpm) {
+    for rp in lp.runs.iter().filter(|rp| rp.run.tcpm.is_on()) {
         for &b in &rp.run.blocks {
             let st = program.state(b);
             let v = |i: usize| st.pos[i].unwrap_or(0.0);
@@ -66,6 +66,153 @@ fn sing_without_tcpm(machine: &Machine) -> (Vec<u8>, Vec<Option<[f64; 3]>>) {
     })
 }
 
+/// The largest chord error (mm) of the written program's blocks in `run_lines` — the
+/// part-frame tool tip under linear interpolation of every axis, from the programmed line
+/// between the part-frame tips at the points — and, per block, whether it is within
+/// `max(tolerance, the input block's) + 1 µm`.
+fn chord_errors(
+    machine: &Machine,
+    datum: [f64; 3],
+    input: &[u8],
+    output: &[u8],
+    tolerance_mm: f64,
+) -> (f64, usize) {
+    use polepatch::machine_frame::chord_error_mm;
+    let chain = machine.chain.unwrap();
+    let a = load_nc(input.to_vec(), "in", machine, None).unwrap();
+    let b = load_nc(output.to_vec(), "out", machine, None).unwrap();
+    assert_eq!(a.runs.len(), b.runs.len());
+    let mut worst: f64 = 0.0;
+    let mut checked = 0;
+    for (ra, rb) in a.runs.iter().zip(&b.runs) {
+        if ra.run.tcpm.is_on() {
+            continue;
+        }
+        let p = a.primary_index();
+        let (qa, qb) = (ra.run.axes5(p), rb.run.axes5(p));
+        let tip = |q: &[f64; 5]| chain.part_tip(machine, datum, q[3], q[4], [q[0], q[1], q[2]]);
+        for k in 1..qa.len() {
+            if qa[k] == qb[k] && qa[k - 1] == qb[k - 1] {
+                continue;
+            }
+            let tips = [tip(&qa[k - 1]), tip(&qa[k])];
+            let old = chord_error_mm(&chain, machine, datum, &qa[k - 1], &qa[k], tips);
+            let new = chord_error_mm(&chain, machine, datum, &qb[k - 1], &qb[k], tips);
+            assert!(
+                new <= tolerance_mm.max(old) + TIP_TOLERANCE_MM,
+                "line {}: {new} mm (input {old} mm, tolerance {tolerance_mm})",
+                b.line_of(0, 0)
+            );
+            worst = worst.max(new);
+            checked += 1;
+        }
+    }
+    (worst, checked)
+}
+
+/// Issue 19 §2: without TCPM the controller interpolates every axis linearly between the
+/// points; rewritten with the chain, two of SING's long blocks would turn C by 10° and take
+/// the tool tip 0.78 mm off the programmed line (the original: 0.13 mm at most). With the
+/// default chord tolerance the run keeps its values and the report names the block.
+#[test]
+fn without_tcpm_a_rewrite_that_leaves_the_line_between_points_is_not_written() {
+    let machine = example_machine();
+    let (input, _) = sing_without_tcpm(&machine);
+    let (out, report) = patch_nc(&input, &machine, &PatchOptions::default()).unwrap();
+    assert!(out == input, "nothing written");
+    let u = &report.untouched_runs[0];
+    assert_eq!(u.reason, UntouchedReason::MachineFrame);
+    assert!(
+        u.message.contains("leave the programmed line by 0.7"),
+        "{}",
+        u.message
+    );
+    assert!(
+        u.message.contains("chord tolerance 0.005 mm"),
+        "{}",
+        u.message
+    );
+    assert_eq!(report.zones[0].outcome, "unchanged");
+}
+
+/// The generated near-pole passes (short blocks) written without TCPM for the example
+/// chain: patched through the chain with the default chord tolerance, and on the written
+/// values every changed block keeps the tool tip within it between the points.
+#[test]
+fn without_tcpm_every_changed_block_stays_within_the_chord_tolerance() {
+    let machine = example_machine();
+    let datum = [-30.0, -7.0, 40.0];
+    let mut patched = 0;
+    for name in [
+        "heidenhain-ac-flip-d0.5.I",
+        "heidenhain-ac-swing-d0.5.I",
+        "heidenhain-ac-flip-d2.I",
+        "heidenhain-ac-swing-d0.I",
+    ] {
+        let tcpm = std::fs::read(root().join("fixtures/generated").join(name)).unwrap();
+        let input = machine_coordinates(&machine, &tcpm, datum);
+        let opts = PatchOptions {
+            work_offset_mm: Some(datum),
+            ..PatchOptions::default()
+        };
+        let (out, report) = patch_nc(&input, &machine, &opts).unwrap();
+        let (worst, checked) = chord_errors(
+            &machine,
+            datum,
+            &input,
+            &out,
+            polepatch::machine_frame::CHORD_TOLERANCE_MM,
+        );
+        if out != input {
+            patched += 1;
+            assert!(checked > 0, "{name}");
+        }
+        eprintln!(
+            "{name}: {checked} changed blocks, worst chord {worst:.4} mm; {:?}",
+            report.untouched_runs
+        );
+    }
+    assert!(patched >= 1, "the chain path is exercised");
+}
+
+/// A TCPM program written without TCPM for `machine`'s chain and work offset `datum`:
+/// every point of its TCPM runs with X Y Z through the chain (3 decimals), the M128 line
+/// removed.
+fn machine_coordinates(machine: &Machine, tcpm_program: &[u8], datum: [f64; 3]) -> Vec<u8> {
+    let chain = machine.chain.unwrap();
+    let lp = load_nc(tcpm_program.to_vec(), "tcpm", machine, None).unwrap();
+    let program = &lp.program;
+    let mut edits = Vec::new();
+    for rp in lp.runs.iter().filter(|rp| rp.run.tcpm.is_on()) {
+        for &b in &rp.run.blocks {
+            let st = program.state(b);
+            let v = |i: usize| st.pos[i].unwrap_or(0.0);
+            let tip = [v(modal::X), v(modal::Y), v(modal::Z)];
+            let x = chain.program_xyz(machine, datum, v(lp.primary_index()), v(modal::C), tip);
+            for (i, letter) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
+                let value = (x[i] * 1000.0).round() / 1000.0;
+                if value != tip[i] {
+                    edits.push(Edit {
+                        block: b,
+                        letter,
+                        value,
+                        decimals: 3,
+                    });
+                }
+            }
+        }
+    }
+    edits.sort_by_key(|e| (e.block, e.letter));
+    let text = String::from_utf8(polepatch::nc::write(program, &edits)).unwrap();
+    let without: Vec<&str> = text
+        .split_inclusive('\n')
+        .filter(|l| !l.contains("M128"))
+        .collect();
+    without.concat().into_bytes()
+}
+
+/// With a chord tolerance that admits SING's long blocks, the chain path writes X Y Z with
+/// the rotary values and the tool tip stays at every point.
 #[test]
 fn without_tcpm_x_y_z_change_with_the_rotary_axes_and_the_tool_tip_stays() {
     let machine = example_machine();
@@ -73,6 +220,7 @@ fn without_tcpm_x_y_z_change_with_the_rotary_axes_and_the_tool_tip_stays() {
     let (input, tips) = sing_without_tcpm(&machine);
     let opts = PatchOptions {
         name: "SING_noM128.I".into(),
+        chord_tolerance_mm: 1.0,
         ..PatchOptions::default()
     };
     let (out, report) = patch_nc(&input, &machine, &opts).unwrap();
@@ -128,6 +276,12 @@ fn without_tcpm_x_y_z_change_with_the_rotary_axes_and_the_tool_tip_stays() {
         "{xyz_with_c} of {c_changed} changed poses have new X Y Z"
     );
     assert!(worst_mm <= TIP_TOLERANCE_MM, "tool tip moved {worst_mm} mm");
+    // Between the points: within the tolerance given (or the input block's).
+    let (worst, checked) = chord_errors(&machine, SING_DATUM, &input, &out, 1.0);
+    assert!(
+        checked >= 10 && worst > 0.5,
+        "{checked} blocks, worst {worst} mm"
+    );
     // Only X Y Z A C words differ.
     let (a, b) = (
         String::from_utf8_lossy(&input),
@@ -159,9 +313,11 @@ fn without_tcpm_and_without_a_work_offset_the_run_is_left() {
         "{}",
         report.untouched_runs[0].message
     );
-    // Given on the command line, the run is patched.
+    // Given on the command line, the run is patched (with a chord tolerance that admits
+    // SING's long blocks).
     let opts = PatchOptions {
         work_offset_mm: Some(SING_DATUM),
+        chord_tolerance_mm: 1.0,
         ..PatchOptions::default()
     };
     let (out, report) = patch_nc(text.as_bytes(), &machine, &opts).unwrap();
@@ -218,7 +374,12 @@ fn a_patch_that_slows_a_linear_axis_in_the_machine_frame_is_not_written() {
     let text = String::from_utf8(sing())
         .unwrap()
         .replace("N65 M128 *\n", "");
-    let (out, report) = patch_nc(text.as_bytes(), &machine, &PatchOptions::default()).unwrap();
+    // The chord check would stop it first; without it, the machine-frame check does.
+    let opts = PatchOptions {
+        chord_tolerance_mm: f64::INFINITY,
+        ..PatchOptions::default()
+    };
+    let (out, report) = patch_nc(text.as_bytes(), &machine, &opts).unwrap();
     assert_eq!(out, text.as_bytes());
     let u = &report.untouched_runs[0];
     assert_eq!(u.reason, UntouchedReason::MachineFrame);

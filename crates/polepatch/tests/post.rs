@@ -23,7 +23,7 @@ fn tcpm_blocks(lp: &LoadedProgram) -> Vec<(usize, polepatch::nc::Modal, [f64; 5]
         .filter(|&b| p.blocks[b].is_move)
         .filter_map(|b| {
             let st = p.state(b);
-            if !st.tcpm {
+            if !st.tcpm.is_on() {
                 return None;
             }
             let v = |i: usize| st.pos[i];

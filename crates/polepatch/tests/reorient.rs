@@ -19,7 +19,9 @@ fn rotary_words(bytes: &[u8], machine: &Machine) -> Vec<(usize, f64, f64)> {
     let lp = load_nc(bytes.to_vec(), "x", machine, None).unwrap();
     let p = &lp.program;
     (0..p.blocks.len())
-        .filter(|&b| p.state(b).tcpm && p.word(b, b'A').is_some() && p.word(b, b'C').is_some())
+        .filter(|&b| {
+            p.state(b).tcpm.is_on() && p.word(b, b'A').is_some() && p.word(b, b'C').is_some()
+        })
         .map(|b| {
             let st = p.state(b);
             (
@@ -116,7 +118,7 @@ fn reorientation_and_back_returns_the_words() {
     let (mut compared, mut same_branch) = (0, 0);
     for blk in 0..a.program.blocks.len() {
         let (sa, sb) = (a.program.state(blk), b.program.state(blk));
-        if !(a.program.blocks[blk].is_move && sa.tcpm) {
+        if !(a.program.blocks[blk].is_move && sa.tcpm.is_on()) {
             continue;
         }
         for i in [modal::X, modal::Y, modal::Z] {
@@ -203,4 +205,32 @@ fn search_on_sing_finds_a_small_tilt() {
         report.after.peak_speed["C"],
         report.alternatives.len()
     );
+}
+
+/// Issue 19 §1: `reorient` reads TCPM as the controller does — after `G43` (which replaces
+/// `G43.4`) or a skippable `M128`, no move is under TCPM, so nothing is rewritten.
+#[test]
+fn reorient_follows_the_tcpm_state() {
+    let m = Machine::builtin("mikron-ucp710").unwrap();
+    let tilt = Tilt {
+        theta_x_deg: 10.0,
+        theta_z_deg: 0.0,
+        pivot_mm: [0.0; 3],
+    };
+    let fanuc = String::from_utf8(read("fixtures/generated/fanuc-ac-flip-d0.5.nc")).unwrap();
+    let sing = String::from_utf8(read("fixtures/c17/SING.I")).unwrap();
+    for (label, text) in [
+        (
+            "G43 after G43.4",
+            fanuc.replace("G43.4 H1\n", "G43.4 H1\nG43 H1\n"),
+        ),
+        ("/M128", sing.replace("N65 M128 *", "/N65 M128 *")),
+    ] {
+        assert!(text != fanuc && text != sing, "{label}");
+        let e = reorient_nc(text.as_bytes(), &m, &tilt, "t", 5.0).unwrap_err();
+        assert!(
+            e.to_string().contains("no move with TCPM on"),
+            "{label}: {e}"
+        );
+    }
 }

@@ -134,3 +134,128 @@ fn incremental_runs_are_left_alone() {
     );
     assert!(report.untouched_runs[0].message.contains("G91"));
 }
+
+fn generated(name: &str) -> String {
+    std::fs::read_to_string(format!(
+        "{}/../../fixtures/generated/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap()
+}
+
+/// Issue 19 §1: codes that end or replace TCPM in each controller's modal groups — Fanuc
+/// `G43`/`G44` (group 8) after `G43.4`, Sinumerik `TRANSMIT`/`TRACYL` after `TRAORI` —
+/// leave the run after them in machine coordinates: untouched, byte for byte, reported.
+#[test]
+fn codes_that_replace_tcpm_leave_the_run_alone() {
+    let fanuc = generated("fanuc-ac-flip-d0.5.nc");
+    let sin = generated("sinumerik-ac-flip-d0.5.mpf");
+    let cases = [
+        (
+            "G43 after G43.4",
+            fanuc.replace("G43.4 H1\n", "G43.4 H1\nG43 H1\n"),
+        ),
+        (
+            "G44 after G43.4",
+            fanuc.replace("G43.4 H1\n", "G43.4 H1\nG44 H1\n"),
+        ),
+        (
+            "TRANSMIT after TRAORI",
+            sin.replace("TRAORI\r\n", "TRAORI\r\nTRANSMIT\r\n"),
+        ),
+        (
+            "TRACYL after TRAORI",
+            sin.replace("TRAORI\r\n", "TRAORI\r\nTRACYL(40)\r\n"),
+        ),
+    ];
+    for name in Machine::builtin_names() {
+        let m = Machine::builtin(name).unwrap();
+        for (label, text) in &cases {
+            assert!(
+                text != &fanuc && text != &sin,
+                "{label}: the case was built"
+            );
+            let (out, report) = patch_nc(text.as_bytes(), &m, &PatchOptions::default()).unwrap();
+            assert!(
+                out == text.as_bytes(),
+                "{label} on {name}: no byte may change"
+            );
+            assert!(report.runs_left_without_tcpm() >= 1, "{label}: {report:#?}");
+            assert!(
+                report.zones_below_feed() >= 1,
+                "{label}: --strict must exit 2"
+            );
+        }
+    }
+}
+
+/// Issue 19 §1: a TCPM switch in a block that block delete may skip leaves the state
+/// uncertain: the run is left as it is and reported with its own reason.
+#[test]
+fn a_skippable_tcpm_block_is_uncertain_and_left_alone() {
+    let m = Machine::builtin("mikron-ucp710").unwrap();
+    let heid = String::from_utf8(sing())
+        .unwrap()
+        .replace("N65 M128 *", "/N65 M128 *");
+    let fanuc = generated("fanuc-ac-flip-d0.5.nc").replace("G43.4 H1\n", "/N50 G43.4 H1\n");
+    let sin = generated("sinumerik-ac-flip-d0.5.mpf").replace("TRAORI\r\n", "/N6 TRAORI\r\n");
+    for (label, text) in [("heidenhain", heid), ("fanuc", fanuc), ("sinumerik", sin)] {
+        assert!(text.contains("/N"), "{label}: the case was built");
+        let (out, report) = patch_nc(text.as_bytes(), &m, &PatchOptions::default()).unwrap();
+        assert!(out == text.as_bytes(), "{label}: no byte may change");
+        assert!(
+            report
+                .untouched_runs
+                .iter()
+                .any(|u| u.reason == UntouchedReason::TcpmUncertain && u.zones >= 1),
+            "{label}: {:#?}",
+            report.untouched_runs
+        );
+        assert!(report.zones_below_feed() >= 1, "{label}");
+    }
+}
+
+/// Issue 19 §5: an arc or a block that block delete may skip, inside a zone, is not
+/// analysed: the report lists it (so `--strict` exits 2), whatever the runs either side
+/// report.
+#[test]
+fn arcs_and_skippable_blocks_inside_a_zone_are_listed() {
+    let m = Machine::builtin("mikron-ucp710").unwrap();
+    let flip = generated("heidenhain-ac-flip-d0.5.I");
+    let cases = [
+        (
+            "arc",
+            flip.replace(
+                "N540 X+24.5 Y+0 Z-5 A+0.591 C+58.315 *",
+                "N540 G02 X+24.5 Y+0 I+24.25 J+0.25 A+0.591 C+58.315 *\nN545 G01 *",
+            ),
+            polepatch::notes::SkipReason::ArcNearPole,
+        ),
+        (
+            "skippable",
+            flip.replace(
+                "N540 X+24.5 Y+0 Z-5 A+0.591 C+58.315 *",
+                "/N540 X+24.5 Y+0 Z-5 A+0.591 C+58.315 *",
+            ),
+            polepatch::notes::SkipReason::SkippableNearPole,
+        ),
+    ];
+    for (label, text, reason) in cases {
+        assert!(text != flip, "{label}: the case was built");
+        let (_, report) = patch_nc(text.as_bytes(), &m, &PatchOptions::default()).unwrap();
+        let listed: Vec<_> = report
+            .not_analysed
+            .iter()
+            .filter(|n| n.reason == reason)
+            .collect();
+        assert_eq!(listed.len(), 1, "{label}: {:?}", report.not_analysed);
+        assert!(listed[0].lines[0] >= 50, "{label}: {:?}", listed[0]);
+        assert!(report.strict_failures() >= 1, "{label}");
+        // Far from the pole the same blocks are not listed.
+        let far = generated("heidenhain-ac-flip-d20.I");
+        let far_text = far.replacen(" X+2 Y+0 Z-5", " G02 X+2 Y+0 I+1 J+0 Z-5", 1);
+        assert!(far_text != far);
+        let (_, report) = patch_nc(far_text.as_bytes(), &m, &PatchOptions::default()).unwrap();
+        assert!(report.not_analysed.is_empty(), "{:?}", report.not_analysed);
+    }
+}

@@ -1,0 +1,506 @@
+//! Heidenhain conversational (Klartext) lines: what each says ([`lex`]).
+//!
+//! A line is an optional block number (digits, no `N`), a keyword and its words:
+//!
+//! | line | read as |
+//! |---|---|
+//! | `BEGIN PGM NAME MM` / `INCH` | program start; INCH: lengths ×25.4, F in 1/10 inch/min ×2.54 |
+//! | `END PGM NAME` | program end (TCPM off) |
+//! | `L X+10 Y-5 Z+0 A+0 C+90 R0 F2000 M3` | linear move; `FMAX` a rapid for this block only; `FAUTO`, `FU`, `FZ` no feed per minute; `IX+5` incremental for this block (the block is never changed and ends runs); `RL`/`RR`/`R+`/`R-` radius compensation ends runs |
+//! | `C`, `CR`, `CT` (arcs), `CP`, `LP` (polar), `APPR`, `DEP` | moves polepatch does not follow: they end runs (`LP`, `CP`, `APPR`, `DEP` leave X Y Z unknown) |
+//! | `CC X+25 Y+25` | circle centre: not a move |
+//! | `RND`, `CHF` | a corner rounded or chamfered: ends runs |
+//! | `LN …` | 3D-compensated line with normal vectors: a move that ends runs |
+//! | `TOOL CALL 5 Z S12000` | tool change; `TOOL DEF`: ends runs |
+//! | `BLK FORM 0.1 Z X+0 Y+0 Z-40` | blank definition: not a move |
+//! | `CYCL DEF 7.x` (datum shift), `247` (datum setting), `8`, `10`, `11`, `19`, `26` | frame changes (positions unknown after) |
+//! | `CYCL DEF` (other), `CYCL CALL`, `M99` | cycle definition ends runs; a cycle call moves the tool (positions unknown after) |
+//! | `LBL n`, `CALL LBL n`, `CALL PGM` | a label may be reached by a jump, a call runs other blocks: positions unknown after |
+//! | `FN 0..8`, `Q1 = …` | parameter arithmetic: ends runs; `FN 9..12` (jumps): positions unknown after |
+//! | `FUNCTION TCPM …`, `FUNCTION RESET TCPM`, `M128`, `M129` | TCPM on / off |
+//! | `PLANE …` | tilted working plane: a frame change (positions unknown after) |
+//! | `STOP`, `TCH PROBE`, anything else | ends runs; lines polepatch does not model leave positions unknown and are flagged |
+//! | `* - text`, `; text` | comments |
+//!
+//! An axis word whose value is a Q parameter (`X+Q1`, `C-QR5`) marks the block not
+//! analysable (positions unknown after it), never the file.
+
+use crate::error::ParseError;
+use crate::interp::{Interpreter, Scan, function};
+use crate::lexer::parse_number;
+use crate::modal::{A, AXES, B, C, Motion};
+use crate::program::{Flags, Word};
+use crate::tcpm::code10;
+use std::ops::Range;
+
+fn axis_index(letter: u8) -> Option<usize> {
+    AXES.iter().position(|&l| l == letter)
+}
+
+fn is_blank(b: u8) -> bool {
+    matches!(b, b' ' | b'\t' | b'\r' | 0x0b | 0x0c)
+}
+
+/// The blank-separated tokens of `bytes[range]` up to a `;` comment, as absolute ranges.
+fn tokens(bytes: &[u8], range: Range<usize>) -> Vec<Range<usize>> {
+    let mut out = Vec::new();
+    let mut i = range.start;
+    while i < range.end {
+        while i < range.end && is_blank(bytes[i]) {
+            i += 1;
+        }
+        if i >= range.end || bytes[i] == b';' {
+            break;
+        }
+        let start = i;
+        while i < range.end && !is_blank(bytes[i]) && bytes[i] != b';' {
+            i += 1;
+        }
+        out.push(start..i);
+    }
+    out
+}
+
+/// A keyword of the line, upper case.
+fn upper(bytes: &[u8], r: &Range<usize>) -> Vec<u8> {
+    bytes[r.clone()].to_ascii_uppercase()
+}
+
+/// The words of a move or M-code line (`L`, `C`, `CC`, …): `toks` after the keyword.
+struct Words<'a> {
+    bytes: &'a [u8],
+    line: usize,
+    line_start: usize,
+}
+
+impl Words<'_> {
+    fn err(&self, at: usize, message: String) -> ParseError {
+        ParseError::at(self.line, at - self.line_start + 1, message)
+    }
+
+    /// Read the words of `toks` into `s` and `words`.
+    fn read(
+        &self,
+        interp: &Interpreter,
+        toks: &[Range<usize>],
+        s: &mut Scan,
+        words: &mut Vec<Word>,
+    ) -> Result<(), ParseError> {
+        let b = self.bytes;
+        let mut seen = [false; 7];
+        for t in toks {
+            let text = &b[t.clone()];
+            let letters = text.iter().take_while(|c| c.is_ascii_alphabetic()).count();
+            let name = text[..letters].to_ascii_uppercase();
+            let value = t.start + letters..t.end;
+            let value_text = &b[value.clone()];
+            // An axis word, possibly incremental (`IX+5`).
+            let (incremental, axis) = match name.as_slice() {
+                [l] => (false, axis_index(*l)),
+                [b'I', l] => (true, axis_index(*l)),
+                _ => (false, None),
+            };
+            if let Some(i) = axis {
+                let letter = AXES[i];
+                let at = t.start + usize::from(incremental);
+                if std::mem::replace(&mut seen[i], true) {
+                    return Err(self.err(
+                        at,
+                        format!(
+                            "{} appears twice in this block; the control rejects such a block",
+                            letter as char
+                        ),
+                    ));
+                }
+                if value_text.is_empty() {
+                    return Err(self.err(at, format!("{} word has no number", letter as char)));
+                }
+                match parse_number(value_text) {
+                    Some(v) if v.is_finite() => {
+                        s.axes[i] = Some(v);
+                        if incremental {
+                            s.axes_incremental |= 1 << i;
+                        }
+                        words.push(Word {
+                            letter,
+                            start: at as u32,
+                            value_start: value.start as u32,
+                            end: value.end as u32,
+                            value: v,
+                        });
+                    }
+                    _ if value_text.iter().any(|c| c.eq_ignore_ascii_case(&b'Q')) => {
+                        s.axes_expr |= 1 << i;
+                    }
+                    _ => {
+                        return Err(self.err(
+                            at,
+                            format!(
+                                "{} value '{}' is not a number",
+                                letter as char,
+                                String::from_utf8_lossy(value_text)
+                            ),
+                        ));
+                    }
+                }
+                continue;
+            }
+            match name.as_slice() {
+                b"F" => {
+                    if std::mem::replace(&mut seen[6], true) {
+                        return Err(self.err(t.start, "F appears twice in this block".into()));
+                    }
+                    match parse_number(value_text) {
+                        Some(v) if v.is_finite() => {
+                            s.feed = Some(v);
+                            words.push(Word {
+                                letter: b'F',
+                                start: t.start as u32,
+                                value_start: value.start as u32,
+                                end: value.end as u32,
+                                value: v,
+                            });
+                        }
+                        _ if value_text.iter().any(|c| c.eq_ignore_ascii_case(&b'Q')) => {
+                            s.feed_expr = true;
+                        }
+                        _ => {
+                            return Err(self.err(
+                                t.start,
+                                format!(
+                                    "F value '{}' is not a number",
+                                    String::from_utf8_lossy(value_text)
+                                ),
+                            ));
+                        }
+                    }
+                }
+                b"FMAX" => s.rapid_once = true,
+                b"FAUTO" | b"FU" | b"FZ" => s.feed_unknown = true,
+                b"M" => {
+                    let v = parse_number(value_text)
+                        .filter(|v| v.is_finite())
+                        .ok_or_else(|| {
+                            self.err(
+                                t.start,
+                                format!(
+                                    "M value '{}' is not a number",
+                                    String::from_utf8_lossy(value_text)
+                                ),
+                            )
+                        })?;
+                    words.push(Word {
+                        letter: b'M',
+                        start: t.start as u32,
+                        value_start: value.start as u32,
+                        end: value.end as u32,
+                        value: v,
+                    });
+                    match code10(v) {
+                        // Machine coordinates for this block; retract along the tool axis;
+                        // cycle call: positions unknown after.
+                        Some(910 | 920 | 1400 | 990 | 890) => {
+                            s.unknown_after = true;
+                            s.breaks = true;
+                        }
+                        c => interp.m(c, s),
+                    }
+                }
+                // Radius compensation: R0 none, RL/RR/R+/R- on (ends runs).
+                b"R" if value_text == b"0" => {}
+                b"RL" | b"RR" | b"R" => s.breaks = true,
+                // Arc direction, arc radius, polar coordinates, approach lengths…: read by
+                // the arc and polar moves, which end runs anyway.
+                _ => s.breaks = true,
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What a conversational line says (module docs), its words appended to `words`.
+pub(crate) fn lex(
+    interp: &Interpreter,
+    bytes: &[u8],
+    span: Range<usize>,
+    line: usize,
+    words: &mut Vec<Word>,
+) -> Result<Scan, ParseError> {
+    let mut s = Scan::default();
+    for (k, &c) in bytes[span.clone()].iter().enumerate() {
+        if (c < 0x20 && !is_blank(c)) || c == 0x7f {
+            // Inside a comment the bytes are the user's.
+            let before = &bytes[span.start..span.start + k];
+            if !before.contains(&b';') && before.trim_ascii_start().first() != Some(&b'*') {
+                return Err(ParseError::at(
+                    line,
+                    k + 1,
+                    format!(
+                        "control byte 0x{c:02X} in the program text; the file is damaged or not \
+                         an NC program"
+                    ),
+                ));
+            }
+        }
+    }
+    let mut toks = tokens(bytes, span.clone());
+    // Block number.
+    if toks
+        .first()
+        .is_some_and(|t| bytes[t.clone()].iter().all(u8::is_ascii_digit))
+    {
+        toks.remove(0);
+    }
+    let Some(first) = toks.first().cloned() else {
+        return Ok(s);
+    };
+    let key = upper(bytes, &first);
+    let rest = &toks[1..];
+    let w = Words {
+        bytes,
+        line,
+        line_start: span.start,
+    };
+    let second = rest.first().map(|t| upper(bytes, t)).unwrap_or_default();
+    match key.as_slice() {
+        k if k.first() == Some(&b'*') => {}
+        b"BEGIN" => {
+            if let Some(unit) = rest.last() {
+                let u = upper(bytes, unit);
+                if u == b"INCH" {
+                    s.inch = Some(true);
+                } else if u == b"MM" {
+                    s.inch = Some(false);
+                }
+            }
+            s.breaks = true;
+        }
+        b"END" => {
+            s.flags.set(Flags::PROGRAM_END);
+            interp.m(Some(300), &mut s);
+        }
+        b"L" => {
+            s.motion = Some(Motion::Linear);
+            w.read(interp, rest, &mut s, words)?;
+        }
+        b"LN" => {
+            s.motion = Some(Motion::Linear);
+            s.flags.set(Flags::NOT_MODELLED);
+            s.breaks = true;
+            let axes: Vec<_> = rest
+                .iter()
+                .filter(|t| {
+                    let txt = upper(bytes, t);
+                    txt.len() >= 2
+                        && matches!(txt[0], b'X' | b'Y' | b'Z')
+                        && !txt[1].is_ascii_alphabetic()
+                })
+                .cloned()
+                .collect();
+            w.read(interp, &axes, &mut s, words)?;
+            // The tool axis follows the normal vectors: rotary positions unknown.
+            for i in [A, B, C] {
+                s.axes_expr |= 1 << i;
+            }
+        }
+        b"C" | b"CR" | b"CT" => {
+            s.motion = Some(Motion::ArcCw);
+            w.read(interp, rest, &mut s, words)?;
+            s.breaks = true;
+        }
+        b"LP" | b"CP" | b"APPR" | b"DEP" => {
+            s.motion = Some(if key == b"LP" {
+                Motion::Linear
+            } else {
+                Motion::ArcCw
+            });
+            s.flags.set(Flags::ARC);
+            s.xy_unknown_after = true;
+            if key != b"LP" {
+                s.unknown_after = true;
+            }
+            s.breaks = true;
+        }
+        b"CC" | b"BLK" => {
+            // A circle centre or the blank: axis words that are not a move.
+            s.no_move = true;
+        }
+        b"RND" | b"CHF" => s.breaks = true,
+        b"TOOL" => {
+            if second == b"CALL" {
+                s.flags.set(Flags::TOOL_CHANGE);
+            }
+            s.breaks = true;
+        }
+        b"CYCL" => {
+            if second == b"DEF" {
+                let number = rest.get(1).map(|t| upper(bytes, t)).unwrap_or_default();
+                let major = number.split(|&c| c == b'.').next().unwrap_or_default();
+                if matches!(major, b"7" | b"247" | b"8" | b"10" | b"11" | b"19" | b"26") {
+                    s.datum_shift = true;
+                    s.unknown_after = true;
+                } else {
+                    s.no_move = true;
+                }
+            } else {
+                s.unknown_after = true;
+            }
+            s.breaks = true;
+        }
+        b"LBL" | b"CALL" | b"TCH" => {
+            s.unknown_after = true;
+            s.breaks = true;
+        }
+        b"FN" => {
+            let n = rest
+                .first()
+                .map(|t| {
+                    bytes[t.clone()]
+                        .iter()
+                        .take_while(|c| c.is_ascii_digit())
+                        .fold(0u32, |a, &d| {
+                            a.saturating_mul(10).saturating_add(u32::from(d - b'0'))
+                        })
+                })
+                .unwrap_or(0);
+            if (9..=12).contains(&n) {
+                s.unknown_after = true;
+            }
+            s.breaks = true;
+        }
+        k if k.first() == Some(&b'Q') => s.breaks = true,
+        b"FUNCTION" => function(&bytes[first.start..span.end], &mut s),
+        b"PLANE" => {
+            s.datum_shift = true;
+            s.unknown_after = true;
+            s.breaks = true;
+        }
+        b"STOP" => {
+            s.breaks = true;
+            w.read(interp, rest, &mut s, words)?;
+        }
+        k if k.first() == Some(&b'M') && k.len() > 1 && k[1].is_ascii_digit() => {
+            w.read(interp, &toks, &mut s, words)?;
+        }
+        _ => {
+            s.flags.set(Flags::NOT_MODELLED);
+            s.unknown_after = true;
+            s.breaks = true;
+        }
+    }
+    if s.axes_expr != 0 || s.feed_expr {
+        s.flags.set(Flags::NOT_ANALYSABLE);
+        s.breaks = true;
+    }
+    Ok(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::modal::{A, C, Motion, Tcpm, X, Z};
+    use crate::{Dialect, Flags, parse, runs};
+
+    const PGM: &str = "0  BEGIN PGM SING MM\n\
+        1  BLK FORM 0.1 Z  X-50  Y-50  Z-40\n\
+        2  BLK FORM 0.2  X+50  Y+50  Z+0\n\
+        3  TOOL CALL 5 Z S12000\n\
+        4  L  Z+100 R0 FMAX M3\n\
+        5  FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS\n\
+        6  L  X+0  Y+0  A+10  C+0 R0 FMAX\n\
+        7  L  Z+5 R0 FMAX M8\n\
+        8  L  X+10  Y-5  Z+0  A+14.351  C+135.638 R0 F2000\n\
+        9  L  X+11  A+13.2  C+140.1\n\
+        10 L  X+12  A+12.2  C+145.1 ; cut\n\
+        11 * - RETRACT\n\
+        12 FUNCTION RESET TCPM\n\
+        13 L  Z+100 R0 FMAX M30\n\
+        14 END PGM SING MM\n";
+
+    #[test]
+    fn a_program() {
+        let p = parse(PGM.as_bytes().to_vec(), Dialect::Auto).unwrap();
+        assert_eq!(p.dialect, Dialect::Conversational);
+        // BLK FORM's axis words are not positions.
+        assert_eq!(p.state(2).pos[X], None);
+        assert!(p.blocks[3].flags.has(Flags::TOOL_CHANGE));
+        assert_eq!(p.state(4).motion, Motion::Rapid, "FMAX");
+        assert_eq!(p.state(5).tcpm, Tcpm::On);
+        assert_eq!(p.state(8).motion, Motion::Linear);
+        assert_eq!(p.state(8).feed_mm_min, Some(2000.0));
+        assert_eq!(p.state(9).pos[A], Some(13.2));
+        assert_eq!(p.state(9).pos[Z], Some(0.0));
+        assert_eq!(p.state(12).tcpm, Tcpm::Off);
+        assert!(p.blocks[14].flags.has(Flags::PROGRAM_END));
+        let r = runs(&p);
+        assert_eq!(r.len(), 1);
+        assert_eq!(r[0].blocks, vec![7, 8, 9, 10]);
+        assert!(r[0].tcpm.is_on());
+        assert_eq!(r[0].pos[3][C], Some(145.1));
+        // The words keep their bytes.
+        let w = p.word(9, b'C').unwrap();
+        assert_eq!(&p.bytes[w.value_span()], b"+140.1");
+        assert_eq!(crate::write(&p, &[]), PGM.as_bytes());
+    }
+
+    #[test]
+    fn what_is_not_followed() {
+        let p = |body: &str| {
+            parse(
+                format!(
+                    "0 BEGIN PGM T MM\n1 L X+0 Y+0 Z+0 A+1 C+0 R0 F1000\n{body}\n3 L X+5 Y+0 Z+0\n"
+                )
+                .into_bytes(),
+                Dialect::Auto,
+            )
+            .unwrap()
+        };
+        // An incremental word: never changed, ends runs.
+        let q = p("2 L IX+2 IC+5");
+        assert!(q.blocks[2].breaks_run && q.blocks[2].flags.has(Flags::INCREMENTAL_WORDS));
+        assert_eq!(q.state(2).pos[X], Some(2.0));
+        assert_eq!(q.state(2).pos[C], Some(5.0));
+        // A Q parameter: not analysable, the axis unknown after.
+        let q = p("2 L X+Q1 C+5");
+        assert!(q.blocks[2].flags.has(Flags::NOT_ANALYSABLE));
+        assert_eq!(q.state(2).pos[X], None);
+        // Arcs and labels end runs; a label or call leaves positions unknown.
+        let q = p("2 CR X+3 Y+3 R+5 DR-");
+        assert!(q.blocks[2].breaks_run && q.blocks[2].flags.has(Flags::ARC));
+        assert_eq!(q.state(2).pos[X], Some(3.0));
+        for line in [
+            "2 LBL 1",
+            "2 CALL LBL 1",
+            "2 CYCL CALL",
+            "2 PLANE RESET STAY",
+            "2 SOMETHING NEW",
+        ] {
+            let q = p(line);
+            assert!(q.blocks[2].breaks_run, "{line}");
+            assert_eq!(q.state(2).pos[X], None, "{line}");
+        }
+        assert!(
+            p("2 SOMETHING NEW").blocks[2]
+                .flags
+                .has(Flags::NOT_MODELLED)
+        );
+        // A datum shift's axis words are not moves.
+        let q = p("2 CYCL DEF 7.1 X+10");
+        assert!(!q.blocks[2].is_move);
+        // Duplicated words are refused with their column.
+        let e = parse(
+            b"0 BEGIN PGM T MM\n1 L X+1 C+5 C+6\n".to_vec(),
+            Dialect::Auto,
+        )
+        .unwrap_err();
+        assert_eq!((e.line, e.column), (2, 13));
+        // INCH: lengths in inches, F in 1/10 inch/min.
+        let q = parse(
+            b"0 BEGIN PGM T INCH\n1 L X+1 Y+0 Z+0 R0 F100\n".to_vec(),
+            Dialect::Auto,
+        )
+        .unwrap();
+        assert_eq!(q.state(1).pos[X], Some(25.4));
+        assert!((q.state(1).feed_mm_min.unwrap() - 254.0).abs() < 1e-9);
+        let _ = A;
+    }
+}

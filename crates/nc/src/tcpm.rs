@@ -1,0 +1,251 @@
+//! Which codes switch tool-centre-point management (TCPM) on and off: each dialect's
+//! built-in codes, and the machine's own ([`ControllerCodes`], from the machine file's
+//! `[controller]` section).
+//!
+//! With TCPM on, X Y Z are tool-tip positions in the part frame and the controller moves
+//! the linear axes to follow the rotary ones: a patch may change rotary words alone. With
+//! it off, X Y Z are machine-axis positions, and a rotary word changed alone would move
+//! the part under the tool. So every code that ends or *replaces* TCPM counts as off — a
+//! code the reader mistook for "on" would gouge, one mistaken for "off" only leaves a run
+//! unpatched — and a switch in a block that block delete (`/`) may skip leaves the state
+//! [`crate::Tcpm::Uncertain`], which every caller treats as off.
+//!
+//! The built-in table (docs/reading.md shows it with an example block each):
+//!
+//! | dialect | on | off (ends or replaces TCPM) |
+//! |---|---|---|
+//! | Heidenhain (ISO and conversational) | `M128`, `FUNCTION TCPM …` | `M129`, `FUNCTION RESET TCPM`, `M2`, `M30`, `END PGM` |
+//! | Sinumerik | `TRAORI` | `TRAFOOF`, `TRANSMIT`, `TRACYL`, `TRAANG`, `M2`, `M30` |
+//! | Fanuc, Haas, LinuxCNC and other ISO | `G43.4`, `G43.5`, `G234` (Haas TCPC) | `G49`, `G43`, `G44` (group 8 replaces G43.4), `G43.1`, `G43.7`, `M2`, `M30` |
+//!
+//! A machine adds its own codes (`tcpm_on = ["M428"]`, `tcpm_off = ["M429", "M430"]` for
+//! LinuxCNC's switchable kinematics), or says its kinematics are always TCP
+//! (`tcpm_always = true`: every block is read with TCPM on and no code turns it off).
+
+use crate::program::Dialect;
+
+/// A code that can switch TCPM: a G or M code (number × 10: `G43.4` → 434) or an
+/// identifier (`TRAORI`, upper case).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Code {
+    /// `G` code, number × 10.
+    G(i64),
+    /// `M` code, number × 10.
+    M(i64),
+    /// An identifier such as `TRAORI` (upper case).
+    Ident(String),
+}
+
+impl Code {
+    /// Read a code as a machine file writes it: `"M428"`, `"G43.4"`, `"TRAORI"`.
+    pub fn parse(text: &str) -> Result<Code, String> {
+        let t = text.trim();
+        let bad = || {
+            format!(
+                "TCPM code '{text}' is not a G or M code (`G43.4`, `M428`) or an identifier \
+                 (`TRAORI`)"
+            )
+        };
+        let first = t.chars().next().ok_or_else(bad)?;
+        let rest = &t[first.len_utf8()..];
+        let g_or_m = matches!(first, 'G' | 'g' | 'M' | 'm');
+        if g_or_m && !rest.is_empty() && rest.bytes().all(|b| b.is_ascii_digit() || b == b'.') {
+            let v = crate::lexer::parse_number(rest.as_bytes()).ok_or_else(bad)?;
+            let code = code10(v).ok_or_else(bad)?;
+            return Ok(if first.eq_ignore_ascii_case(&'G') {
+                Code::G(code)
+            } else {
+                Code::M(code)
+            });
+        }
+        // An identifier: two or more letters, digits or `_`, starting with letters (not a
+        // G or M code with a bad number).
+        let starts_as_code = g_or_m && !rest.starts_with(|c: char| c.is_ascii_alphabetic());
+        if t.len() >= 2
+            && t.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_')
+            && first.is_ascii_alphabetic()
+            && !starts_as_code
+        {
+            return Ok(Code::Ident(t.to_ascii_uppercase()));
+        }
+        Err(bad())
+    }
+}
+
+impl std::fmt::Display for Code {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let num = |c: i64| {
+            if c % 10 == 0 {
+                format!("{}", c / 10)
+            } else {
+                format!("{}.{}", c / 10, c % 10)
+            }
+        };
+        match self {
+            Code::G(c) => write!(f, "G{}", num(*c)),
+            Code::M(c) => write!(f, "M{}", num(*c)),
+            Code::Ident(s) => f.write_str(s),
+        }
+    }
+}
+
+/// `G`/`M` code number times ten (`G43.4` → 434, `M128` → 1280), if it is one.
+pub(crate) fn code10(v: f64) -> Option<i64> {
+    let t = v * 10.0;
+    let r = t.round();
+    ((t - r).abs() < 1e-6 && (0.0..1e9).contains(&r)).then_some(r as i64)
+}
+
+/// A machine's own TCPM codes, added to its dialect's built-in ones (module docs).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct ControllerCodes {
+    /// Codes that switch TCPM on. Default none.
+    pub on: Vec<Code>,
+    /// Codes that end it. Default none.
+    pub off: Vec<Code>,
+    /// The machine's kinematics are always TCP: X Y Z are always part-frame tool-tip
+    /// positions. Default false.
+    pub always: bool,
+}
+
+/// What a code does to TCPM.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Switch {
+    On,
+    Off,
+}
+
+impl ControllerCodes {
+    fn find(&self, code: &Code) -> Option<Switch> {
+        if self.on.contains(code) {
+            Some(Switch::On)
+        } else if self.off.contains(code) {
+            Some(Switch::Off)
+        } else {
+            None
+        }
+    }
+
+    /// What G code `g` (× 10) does in `dialect`: the machine's codes first, then the table.
+    pub(crate) fn g(&self, dialect: Dialect, g: i64) -> Option<Switch> {
+        if let Some(s) = self.find(&Code::G(g)) {
+            return Some(s);
+        }
+        match dialect {
+            Dialect::Fanuc | Dialect::Auto => match g {
+                434 | 435 | 2340 => Some(Switch::On),
+                490 | 430 | 440 | 431 | 437 => Some(Switch::Off),
+                _ => None,
+            },
+            Dialect::Sinumerik | Dialect::Heidenhain | Dialect::Conversational => None,
+        }
+    }
+
+    /// What M code `m` (× 10) does in `dialect`.
+    pub(crate) fn m(&self, dialect: Dialect, m: i64) -> Option<Switch> {
+        if let Some(s) = self.find(&Code::M(m)) {
+            return Some(s);
+        }
+        match (dialect, m) {
+            (_, 20 | 300) => Some(Switch::Off),
+            (Dialect::Heidenhain | Dialect::Conversational, 1280) => Some(Switch::On),
+            (Dialect::Heidenhain | Dialect::Conversational, 1290) => Some(Switch::Off),
+            _ => None,
+        }
+    }
+
+    /// What identifier `name` does in `dialect` (any case).
+    pub(crate) fn ident(&self, dialect: Dialect, name: &[u8]) -> Option<Switch> {
+        if !self.on.is_empty() || !self.off.is_empty() {
+            let upper = String::from_utf8_lossy(name).to_ascii_uppercase();
+            if let Some(s) = self.find(&Code::Ident(upper)) {
+                return Some(s);
+            }
+        }
+        let is = |n: &[u8]| name.eq_ignore_ascii_case(n);
+        match dialect {
+            Dialect::Sinumerik => {
+                if is(b"TRAORI") {
+                    Some(Switch::On)
+                } else if is(b"TRAFOOF") || is(b"TRANSMIT") || is(b"TRACYL") || is(b"TRAANG") {
+                    Some(Switch::Off)
+                } else {
+                    None
+                }
+            }
+            _ => None,
+        }
+    }
+}
+
+/// How to read a program: its dialect and the machine's TCPM codes.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct ReadOptions {
+    /// Dialect (default: detected).
+    pub dialect: Dialect,
+    /// The machine's own TCPM codes (default: none beyond the dialect's).
+    pub controller: ControllerCodes,
+}
+
+impl ReadOptions {
+    /// Read as `dialect` with the built-in codes only.
+    pub fn dialect(dialect: Dialect) -> Self {
+        ReadOptions {
+            dialect,
+            controller: ControllerCodes::default(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn codes_parse_and_print() {
+        assert_eq!(Code::parse("M428"), Ok(Code::M(4280)));
+        assert_eq!(Code::parse("g43.4"), Ok(Code::G(434)));
+        assert_eq!(Code::parse(" TRAORI "), Ok(Code::Ident("TRAORI".into())));
+        assert_eq!(Code::parse("traori"), Ok(Code::Ident("TRAORI".into())));
+        for bad in ["", "M", "G1.2.3", "M-5", "X 1", "43.4", "M4e2"] {
+            assert!(Code::parse(bad).is_err(), "{bad}");
+        }
+        for t in ["M428", "G43.4", "G234", "TRAORI"] {
+            assert_eq!(Code::parse(t).unwrap().to_string(), t);
+        }
+    }
+
+    #[test]
+    fn the_table() {
+        let c = ControllerCodes::default();
+        assert_eq!(c.g(Dialect::Fanuc, 434), Some(Switch::On));
+        assert_eq!(
+            c.g(Dialect::Fanuc, 430),
+            Some(Switch::Off),
+            "G43 replaces G43.4"
+        );
+        assert_eq!(c.g(Dialect::Fanuc, 440), Some(Switch::Off));
+        assert_eq!(
+            c.g(Dialect::Heidenhain, 430),
+            None,
+            "G43 is paraxial compensation in Heidenhain ISO"
+        );
+        assert_eq!(c.m(Dialect::Fanuc, 1280), None, "M128 is Heidenhain's");
+        assert_eq!(c.m(Dialect::Heidenhain, 1280), Some(Switch::On));
+        assert_eq!(c.m(Dialect::Sinumerik, 300), Some(Switch::Off));
+        assert_eq!(c.ident(Dialect::Sinumerik, b"Tracyl"), Some(Switch::Off));
+        assert_eq!(c.ident(Dialect::Fanuc, b"TRAORI"), None);
+        let own = ControllerCodes {
+            on: vec![Code::parse("M428").unwrap()],
+            off: vec![Code::parse("M429").unwrap(), Code::parse("G43.4").unwrap()],
+            always: false,
+        };
+        assert_eq!(own.m(Dialect::Fanuc, 4280), Some(Switch::On));
+        assert_eq!(own.m(Dialect::Fanuc, 4290), Some(Switch::Off));
+        assert_eq!(
+            own.g(Dialect::Fanuc, 434),
+            Some(Switch::Off),
+            "the machine's own first"
+        );
+    }
+}

@@ -1,0 +1,263 @@
+//! What the reader carried through without analysing it, for the report: every block that
+//! could change the motion is honoured or named, never passed over in silence.
+//!
+//! [`Notes`] takes the blocks in file order (from any read: the stream survey, the
+//! no-zone fast path, a whole parsed program) and gives the same list for each:
+//! - blocks whose axis or feed words are expressions or variables (`A#<a>`, `X=R1+2`,
+//!   `X+Q5`): kept byte for byte, their axes unknown after them, so no run spans them;
+//! - arcs (G2/G3, conversational `C`/`CR`/`CT`/`CP`/`LP`/`APPR`/`DEP`) and blocks that
+//!   block delete may skip, when they move near the pole (the primary axis within the cone
+//!   at their start or end, or unknown there): the rotary motion across them is not
+//!   analysed, so a slowdown there would go unseen;
+//! - conversational lines polepatch does not model;
+//! - moves with a feed per revolution (G95), which has no time base;
+//! - and, as warnings: letters carried through without analysis (`E`, `U`, `V`, `W`) and
+//!   `(` comments without `)` that hide what looks like axis words.
+//!
+//! `--strict` counts the items (not the warnings) as a failure: the file was read, but
+//! not all of it was analysed.
+
+use polepatch_nc::modal::{A, B};
+use polepatch_nc::{Block, FeedMode, Flags, Modal, Motion, Word};
+use serde::Serialize;
+
+/// Why a stretch of blocks was not analysed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SkipReason {
+    /// An axis or feed word is an expression or a variable.
+    Expression,
+    /// An arc or polar move near the pole.
+    ArcNearPole,
+    /// A block that block delete (`/`) may skip, moving near the pole.
+    SkippableNearPole,
+    /// A conversational line polepatch does not model.
+    NotModelled,
+    /// A move with a feed per revolution (G95).
+    FeedPerRevolution,
+}
+
+/// Lines carried through without analysis, and why.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct NotAnalysed {
+    /// First and last file line.
+    pub lines: [usize; 2],
+    /// Why.
+    pub reason: SkipReason,
+    /// For people.
+    pub message: String,
+}
+
+/// An item in progress: the smallest |A| and |B| at the start or end of its blocks
+/// (unknown counts as 0), since the tilting letter in use and the cone are known only at
+/// the end.
+#[derive(Debug, Clone)]
+struct Item {
+    lines: [usize; 2],
+    reason: SkipReason,
+    min_abs_deg: [f64; 2],
+}
+
+/// The collector (module docs).
+#[derive(Debug, Clone, Default)]
+pub struct Notes {
+    items: Vec<Item>,
+    /// First line of each letter carried through (E U V W), in `b"EUVW"` order.
+    other_letters: [Option<usize>; 4],
+    /// Lines of unclosed comments that hide axis-like words (the first few).
+    unclosed: Vec<usize>,
+    unclosed_count: usize,
+}
+
+/// At most this many lines are named for one kind of warning.
+const NAMED_LINES: usize = 5;
+
+impl Notes {
+    /// An empty collector.
+    pub fn new() -> Self {
+        Notes::default()
+    }
+
+    fn add(&mut self, line: usize, reason: SkipReason, min_abs_deg: [f64; 2]) {
+        if let Some(last) = self.items.last_mut()
+            && last.reason == reason
+            && line <= last.lines[1] + 1
+        {
+            last.lines[1] = line;
+            last.min_abs_deg[0] = last.min_abs_deg[0].min(min_abs_deg[0]);
+            last.min_abs_deg[1] = last.min_abs_deg[1].min(min_abs_deg[1]);
+            return;
+        }
+        self.items.push(Item {
+            lines: [line, line],
+            reason,
+            min_abs_deg,
+        });
+    }
+
+    /// Take the next block of the file: its words, the state before and after it.
+    pub fn push(&mut self, block: &Block, words: &[Word], before: &Modal, after: &Modal) {
+        let f = block.flags;
+        let line = block.line;
+        let min_abs = |idx: usize| {
+            let abs = |v: Option<f64>| v.map_or(0.0, f64::abs);
+            abs(before.pos[idx]).min(abs(after.pos[idx]))
+        };
+        let near = [min_abs(A), min_abs(B)];
+        let always = [0.0, 0.0];
+        if f.has(Flags::NOT_ANALYSABLE) {
+            self.add(line, SkipReason::Expression, always);
+        }
+        if f.has(Flags::NOT_MODELLED) {
+            self.add(line, SkipReason::NotModelled, always);
+        }
+        if block.is_move {
+            if f.has(Flags::ARC) {
+                self.add(line, SkipReason::ArcNearPole, near);
+            }
+            if f.has(Flags::SKIPPABLE) {
+                self.add(line, SkipReason::SkippableNearPole, near);
+            }
+            if after.feed_mode == FeedMode::PerRevolution && after.motion == Motion::Linear {
+                self.add(line, SkipReason::FeedPerRevolution, always);
+            }
+        }
+        if f.has(Flags::UNCLOSED_COMMENT) {
+            self.unclosed_count += 1;
+            if self.unclosed.len() < NAMED_LINES {
+                self.unclosed.push(line);
+            }
+        }
+        for w in words {
+            if let Some(k) = b"EUVW".iter().position(|&l| l == w.letter) {
+                self.other_letters[k].get_or_insert(line);
+            }
+        }
+    }
+
+    /// The list for a program whose tilting letter is at `p_idx` (`modal::A` or
+    /// `modal::B`) and the singular cone `cone_deg`, and the warnings (named `name`).
+    pub fn finish(
+        &self,
+        p_idx: usize,
+        cone_deg: f64,
+        name: &str,
+    ) -> (Vec<NotAnalysed>, Vec<String>) {
+        let l = usize::from(p_idx == B);
+        let items = self
+            .items
+            .iter()
+            .filter(|it| it.min_abs_deg[l] <= cone_deg)
+            .map(|it| NotAnalysed {
+                lines: it.lines,
+                reason: it.reason,
+                message: message(it.reason, it.lines),
+            })
+            .collect();
+        let mut warnings = Vec::new();
+        let letters: Vec<String> = b"EUVW"
+            .iter()
+            .zip(self.other_letters)
+            .filter_map(|(&l, first)| {
+                first.map(|line| format!("{} (first at line {line})", l as char))
+            })
+            .collect();
+        if !letters.is_empty() {
+            warnings.push(format!(
+                "{name}: words {} are carried through as written and not analysed (polepatch \
+                 analyses X Y Z, the tilting axis and C)",
+                letters.join(", ")
+            ));
+        }
+        if self.unclosed_count > 0 {
+            let lines: Vec<String> = self.unclosed.iter().map(|l| l.to_string()).collect();
+            warnings.push(format!(
+                "{name}: {} comment(s) opened with '(' and not closed hide what looks like axis \
+                 words (line {}{}); polepatch reads them as comments, as most controllers do — \
+                 check the program",
+                self.unclosed_count,
+                lines.join(", "),
+                if self.unclosed_count > lines.len() {
+                    ", …"
+                } else {
+                    ""
+                }
+            ));
+        }
+        (items, warnings)
+    }
+}
+
+fn message(reason: SkipReason, lines: [usize; 2]) -> String {
+    let at = if lines[0] == lines[1] {
+        format!("line {}", lines[0])
+    } else {
+        format!("lines {}–{}", lines[0], lines[1])
+    };
+    match reason {
+        SkipReason::Expression => format!(
+            "{at}: an axis or feed word is an expression or a variable; the blocks are kept as \
+             written and no run is analysed across them"
+        ),
+        SkipReason::ArcNearPole => format!(
+            "{at}: an arc or polar move near the pole; polepatch does not analyse the rotary \
+             motion along it, so a slowdown there is not measured"
+        ),
+        SkipReason::SkippableNearPole => format!(
+            "{at}: a block that block delete (/) may skip, moving near the pole; the motion \
+             across it depends on the switch and is not analysed"
+        ),
+        SkipReason::NotModelled => format!(
+            "{at}: a line polepatch does not model (carried through as written); positions \
+             after it are unknown until the program states them again"
+        ),
+        SkipReason::FeedPerRevolution => {
+            format!("{at}: feed per revolution (G95) has no time base for Equation 6; not analysed")
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use polepatch_nc::{Dialect, parse};
+
+    fn notes(text: &str, p_idx: usize) -> (Vec<NotAnalysed>, Vec<String>) {
+        let p = parse(text.as_bytes().to_vec(), Dialect::Auto).unwrap();
+        let mut n = Notes::new();
+        for b in 0..p.blocks.len() {
+            n.push(
+                &p.blocks[b],
+                p.block_words(b),
+                &p.state_before(b),
+                &p.state(b),
+            );
+        }
+        n.finish(p_idx, 5.0, "t")
+    }
+
+    #[test]
+    fn arcs_near_the_pole_only() {
+        let text = "G1 X0 Y0 Z0 A2 C0 F100\nG2 X10 Y0 I5 J0 A1\nG1 X11 A20\nG2 X20 Y0 I5 J0 A30\n";
+        let (items, _) = notes(text, A);
+        assert_eq!(items.len(), 1);
+        assert_eq!(items[0].reason, SkipReason::ArcNearPole);
+        assert_eq!(items[0].lines, [2, 2]);
+        // With B as the tilting letter (never programmed: read as unknown), both are near.
+        assert_eq!(notes(text, B).0.len(), 2);
+    }
+
+    #[test]
+    fn expressions_merge_into_one_item_and_letters_are_warned_once() {
+        let text = "G1 X0 Y0 Z0 A2 C0 F100\nX#1\nX#2 E0.5\nX3 E0.6 U1 A20\n/X4 A30\n";
+        let (items, warnings) = notes(text, A);
+        assert_eq!(items.len(), 1, "{items:?}");
+        assert_eq!(items[0].lines, [2, 3]);
+        assert_eq!(items[0].reason, SkipReason::Expression);
+        assert_eq!(warnings.len(), 1);
+        assert!(
+            warnings[0].contains("E (first at line 3), U (first at line 4)"),
+            "{warnings:?}"
+        );
+    }
+}

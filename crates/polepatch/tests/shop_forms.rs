@@ -1,0 +1,196 @@
+//! Issue 20: the programs shops have — Heidenhain conversational (FUNCTION TCPM and M128),
+//! inverse-time feed (Fanuc and LinuxCNC), spaces inside words, a machine whose TCP is
+//! switched by its own M codes or always on, variables in one run — are read, analysed
+//! and patched like the G94 ISO program of the same path: the same zones and ratios, the
+//! same rotary values written, and nothing but rotary words changed (the F words of G93
+//! blocks included).
+
+use polepatch::kinematics::{Controller, Machine};
+use polepatch::nc::modal::{A, C};
+use polepatch::nc::{Dialect, parse};
+use polepatch::{FileReport, PatchOptions, UntouchedReason, patch_nc};
+use std::path::PathBuf;
+
+fn shop(name: &str) -> Vec<u8> {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/shop")
+        .join(name);
+    std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+/// The UCP710 with LinuxCNC's switchable-kinematics codes, or always TCP.
+fn linuxcnc(always: bool) -> Machine {
+    let mut m = Machine::builtin("mikron-ucp710").unwrap();
+    m.controller = Controller {
+        tcpm_on: if always { vec![] } else { vec!["M428".into()] },
+        tcpm_off: if always {
+            vec![]
+        } else {
+            vec!["M429".into(), "M430".into()]
+        },
+        tcpm_always: always,
+    };
+    m
+}
+
+/// The pass's points as written: (X, A, C) of every move that ends on the cut (Y0 Z-5), in
+/// file order, repeats dropped.
+fn pass_values(bytes: &[u8]) -> Vec<[f64; 3]> {
+    let p = parse(bytes.to_vec(), Dialect::Auto).unwrap();
+    let mut out = Vec::new();
+    for b in 0..p.blocks.len() {
+        let st = p.state(b);
+        if p.blocks[b].is_move && st.pos[2] == Some(-5.0) && st.pos[1] == Some(0.0) {
+            let v = [st.pos[0].unwrap(), st.pos[A].unwrap(), st.pos[C].unwrap()];
+            if out.last() != Some(&v) {
+                out.push(v);
+            }
+        }
+    }
+    out
+}
+
+/// The program with the numbers of its rotary words taken out: what must not change.
+fn without_rotary_values(bytes: &[u8]) -> Vec<u8> {
+    let p = parse(bytes.to_vec(), Dialect::Auto).unwrap();
+    let mut out = Vec::new();
+    let mut at = 0;
+    for w in &p.words {
+        if matches!(w.letter, b'A' | b'B' | b'C') {
+            out.extend_from_slice(&bytes[at..w.value_span().start]);
+            at = w.value_span().end;
+        }
+    }
+    out.extend_from_slice(&bytes[at..]);
+    out
+}
+
+fn patched(bytes: &[u8], m: &Machine) -> (Vec<u8>, FileReport) {
+    patch_nc(bytes, m, &PatchOptions::default()).unwrap()
+}
+
+#[test]
+fn every_form_patches_like_its_g94_iso_twin() {
+    for stem in ["ac-flip-d0.5", "ac-swing-d1"] {
+        let ucp = Machine::builtin("mikron-ucp710").unwrap();
+        let twin = shop(&format!("{stem}-fanuc-g94.nc"));
+        let (twin_out, twin_report) = patched(&twin, &ucp);
+        assert!(!twin_report.zones.is_empty(), "{stem}: the twin has a zone");
+        assert!(twin_report.zones.iter().all(|z| z.outcome == "reached"));
+        let want = pass_values(&twin_out);
+        for (form, machine) in [
+            ("conv-function-tcpm.H", ucp.clone()),
+            ("conv-m128.H", ucp.clone()),
+            ("fanuc-g93.nc", ucp.clone()),
+            ("linuxcnc-g93-m428.ngc", linuxcnc(false)),
+            ("always-tcp.ngc", linuxcnc(true)),
+            ("spaced-words.nc", ucp.clone()),
+            ("variables.nc", ucp.clone()),
+        ] {
+            let name = format!("{stem}-{form}");
+            let input = shop(&name);
+            let (out, report) = patched(&input, &machine);
+            assert!(out != input, "{name}: patched");
+            assert_eq!(
+                without_rotary_values(&out),
+                without_rotary_values(&input),
+                "{name}: only rotary values change (F words of G93 blocks included)"
+            );
+            assert_eq!(report.zones.len(), twin_report.zones.len(), "{name}");
+            for (z, t) in report.zones.iter().zip(&twin_report.zones) {
+                assert_eq!(z.kind, t.kind, "{name}");
+                assert_eq!(z.outcome, t.outcome, "{name}");
+                for (a, b) in [
+                    (z.before.c_ratio, t.before.c_ratio),
+                    (z.before.primary_ratio, t.before.primary_ratio),
+                    (z.after.c_ratio, t.after.c_ratio),
+                    (z.after.primary_ratio, t.after.primary_ratio),
+                    (z.max_deviation_deg, t.max_deviation_deg),
+                ] {
+                    assert!(
+                        (a - b).abs() <= 1e-9 * b.abs().max(1.0),
+                        "{name}: {a} vs {b}"
+                    );
+                }
+                let g93 = form.contains("g93");
+                assert_eq!(z.feed_mode, if g93 { "G93" } else { "G94" }, "{name}");
+            }
+            assert_eq!(
+                pass_values(&out),
+                want,
+                "{name}: the same rotary values written"
+            );
+            let expression = report
+                .not_analysed
+                .iter()
+                .any(|n| n.reason == polepatch::notes::SkipReason::Expression);
+            assert_eq!(
+                expression,
+                form == "variables.nc",
+                "{name}: {:?}",
+                report.not_analysed
+            );
+        }
+    }
+}
+
+/// Without the machine's word for M428 (or that its kinematics are always TCP), the same
+/// LinuxCNC programs are machine coordinates: left byte for byte, reported.
+#[test]
+fn linuxcnc_tcp_needs_the_machines_codes() {
+    let ucp = Machine::builtin("mikron-ucp710").unwrap();
+    for name in [
+        "ac-flip-d0.5-linuxcnc-g93-m428.ngc",
+        "ac-flip-d0.5-always-tcp.ngc",
+    ] {
+        let input = shop(name);
+        let (out, report) = patched(&input, &ucp);
+        assert!(out == input, "{name}");
+        assert!(
+            report
+                .untouched_runs
+                .iter()
+                .any(|u| u.reason == UntouchedReason::NoTcpm && u.zones > 0),
+            "{name}: {:?}",
+            report.untouched_runs
+        );
+    }
+}
+
+/// Issue 20 §3: Equation 6 on a G93 run is the G94 analysis at the same block feeds.
+#[test]
+fn equation_6_on_g93_is_g94_at_the_block_feeds() {
+    let ucp = Machine::builtin("mikron-ucp710").unwrap();
+    let g93 = polepatch::analyze_nc(
+        &shop("ac-swing-d1-fanuc-g93.nc"),
+        &ucp,
+        &polepatch::AnalyzeOptions::default(),
+    )
+    .unwrap();
+    let g94 = polepatch::analyze_nc(
+        &shop("ac-swing-d1-fanuc-g94.nc"),
+        &ucp,
+        &polepatch::AnalyzeOptions::default(),
+    )
+    .unwrap();
+    let cut = |r: &polepatch::AnalyzeReport| {
+        r.runs
+            .iter()
+            .filter(|run| run.points > 50)
+            .cloned()
+            .collect::<Vec<_>>()
+    };
+    let (a, b) = (cut(&g93), cut(&g94));
+    assert_eq!(a.len(), 1);
+    assert_eq!(b.len(), 1);
+    assert_eq!(a[0].feed_mode, "G93");
+    assert_eq!(a[0].feed_mm_min, Some(2000.0));
+    let (fa, fb) = (
+        a[0].figures.as_ref().unwrap(),
+        b[0].figures.as_ref().unwrap(),
+    );
+    assert_eq!(fa.min_ratio, fb.min_ratio);
+    assert_eq!(fa.time_s, fb.time_s);
+    assert_eq!(fa.axis_min_ratio, fb.axis_min_ratio);
+    assert_eq!(fa.zones.len(), fb.zones.len());
+}
