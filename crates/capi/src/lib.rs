@@ -474,13 +474,31 @@ pub unsafe extern "C" fn pp_cl_to_joints(
             if p.iter().any(|v| !v.is_finite()) {
                 return Err(bad(format!("point {k}: a value is not finite")));
             }
-            let norm = (p[3] * p[3] + p[4] * p[4] + p[5] * p[5]).sqrt();
-            if norm < 1e-9 {
+            // Scaled before normalising: the squares of (1e300, 0, 1e300) overflow to
+            // infinity and the axis would become (0, 0, 0), then NaN joints.
+            let m = p[3].abs().max(p[4].abs()).max(p[5].abs());
+            if m == 0.0 {
                 return Err(bad(format!("point {k}: the tool axis (i, j, k) is zero")));
             }
-            axes.push([p[3] / norm, p[4] / norm, p[5] / norm]);
+            let v = [p[3] / m, p[4] / m, p[5] / m];
+            let norm = v[0].hypot(v[1]).hypot(v[2]);
+            if m * norm < 1e-9 {
+                return Err(bad(format!("point {k}: the tool axis (i, j, k) is zero")));
+            }
+            axes.push([v[0] / norm, v[1] / norm, v[2] / norm]);
         }
         let joints = inverse_path(machine, &axes, rule);
+        // Nothing is written unless every point has joints.
+        if let Some(k) = joints
+            .iter()
+            .position(|s| !(s.p_deg.is_finite() && s.c_deg.is_finite()))
+        {
+            let p = &cl[6 * k..6 * k + 6];
+            return Err(bad(format!(
+                "point {k}: no joint values for the tool axis ({}, {}, {})",
+                p[3], p[4], p[5]
+            )));
+        }
         for (k, (p, s)) in cl.chunks_exact(6).zip(&joints).enumerate() {
             out[5 * k..5 * k + 5].copy_from_slice(&[p[0], p[1], p[2], s.p_deg, s.c_deg]);
         }

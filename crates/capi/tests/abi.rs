@@ -140,6 +140,51 @@ fn cl_to_joints_inverts_forward_kinematics() {
     unsafe { pp_machine_free(m) };
 }
 
+/// Issue 19 §5: (1e300, 0, 1e300) gave PP_OK with NaN joints (the squares overflowed).
+/// Huge axes are normalised; an axis shorter than 1e-9 is "zero" (bad input), and nothing
+/// is written then.
+#[test]
+fn cl_to_joints_normalises_huge_axes() {
+    let m = machine("mikron-ucp710");
+    let rust_machine = Machine::builtin("mikron-ucp710").unwrap();
+    for scale in [1e300, f64::MAX, 1e5, 1.0] {
+        let cl = [1.0, 2.0, 3.0, scale, 0.0, scale];
+        let mut out = [f64::NAN; 5];
+        let status = unsafe {
+            pp_cl_to_joints(
+                m,
+                cl.as_ptr(),
+                1,
+                PpBranchRule::PpBranchPositive as i32,
+                out.as_mut_ptr(),
+            )
+        };
+        assert_eq!(status, PpStatus::PpOk, "{scale}: {}", last_error());
+        assert!(out.iter().all(|v| v.is_finite()), "{scale}: {out:?}");
+        assert!((out[3] - 45.0).abs() < 1e-9, "{scale}: {out:?}");
+        let o = forward(&rust_machine, out[3], out[4]);
+        let h = 0.5f64.sqrt();
+        assert!((o[0] - h).abs() < 1e-12 && o[1].abs() < 1e-12 && (o[2] - h).abs() < 1e-12);
+    }
+    for scale in [0.0, 1e-300, 1e-10] {
+        let cl = [1.0, 2.0, 3.0, scale, 0.0, scale];
+        let mut out = [7.0; 5];
+        let status = unsafe {
+            pp_cl_to_joints(
+                m,
+                cl.as_ptr(),
+                1,
+                PpBranchRule::PpBranchNearest as i32,
+                out.as_mut_ptr(),
+            )
+        };
+        assert_eq!(status, PpStatus::PpBadInput, "{scale}");
+        assert!(last_error().contains("zero"), "{}", last_error());
+        assert_eq!(out, [7.0; 5], "nothing written");
+    }
+    unsafe { pp_machine_free(m) };
+}
+
 #[test]
 fn patch_joints_is_the_patcher_on_the_arrays() {
     // SING's long TCPM run, as a CAM plugin would hold it.

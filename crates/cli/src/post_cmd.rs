@@ -2,9 +2,10 @@
 
 use crate::{check_positive, machine};
 use anyhow::{Context, Result, bail};
+use polepatch::cl::{ParseOptions, Units};
 use polepatch::kinematics::BranchRule;
 use polepatch::nc::Dialect;
-use polepatch::post::{PostOptions, post_cl, read_cl};
+use polepatch::post::{ARC_TOLERANCE_MM, PostOptions, post_cl, read_cl_with};
 use polepatch_cli::files::read;
 use polepatch_cli::outputs::{Input, Output, plan};
 use std::path::PathBuf;
@@ -15,6 +16,14 @@ enum DialectArg {
     Heidenhain,
     Sinumerik,
     Fanuc,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum UnitsArg {
+    /// Millimetres (G21, G71, G71).
+    Mm,
+    /// Inches (G20, G700; not for Heidenhain).
+    Inch,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -57,6 +66,24 @@ pub(crate) struct PostArgs {
     /// Decimals of the rotary words.
     #[arg(long, default_value_t = 3)]
     rotary_decimals: usize,
+    /// Units of the program written (default: the CL file's).
+    #[arg(long, value_enum)]
+    units: Option<UnitsArg>,
+    /// Write every arc as chords (default: G2/G3 where the arc lies in a principal plane
+    /// with a fixed tool axis).
+    #[arg(long)]
+    linearize: bool,
+    /// Chordal tolerance of arcs written as chords, mm.
+    #[arg(long, default_value_t = ARC_TOLERANCE_MM)]
+    arc_tolerance: f64,
+    /// Skip every APT record with this major word (e.g. THREAD) instead of refusing the
+    /// file; repeat for several. Only records polepatch would refuse can be skipped.
+    #[arg(long, value_name = "RECORD")]
+    ignore: Vec<String>,
+    /// Drill peck cycles whose first peck differs from the following ones (CAMWorks'
+    /// 1STPECK/SUBPECK) with the smaller peck throughout (default: refused).
+    #[arg(long)]
+    uniform_peck: bool,
 }
 
 pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
@@ -76,7 +103,14 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
         outputs.push(Output::new("--report", path));
     }
     let targets = plan(&inputs, outputs)?;
-    let cl = read_cl(&read(&args.cl)?, &name)?;
+    let parse = ParseOptions {
+        ignore: args.ignore.clone(),
+        uniform_peck: args.uniform_peck,
+    };
+    if let Err(m) = parse.check() {
+        bail!("{m}");
+    }
+    let cl = read_cl_with(&read(&args.cl)?, &name, &parse)?;
     let opts = PostOptions {
         dialect: match args.dialect {
             DialectArg::Heidenhain => Dialect::Heidenhain,
@@ -97,6 +131,12 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
         },
         rotary_decimals: args.rotary_decimals,
         linear_decimals: 3,
+        units: args.units.map(|u| match u {
+            UnitsArg::Mm => Units::Mm,
+            UnitsArg::Inch => Units::Inch,
+        }),
+        linearize: args.linearize,
+        arc_tolerance_mm: args.arc_tolerance,
     };
     let (bytes, report) = post_cl(&cl, &machine, &opts)?;
     targets[0]
@@ -105,7 +145,20 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
     for n in &cl.notes {
         eprintln!("polepatch: note: {name}: {n}");
     }
-    let points = cl.points.len();
+    // Every record kind read, once, with its count (and what was skipped on request).
+    if !cl.records.is_empty() {
+        let list = cl
+            .records
+            .iter()
+            .map(|(w, n)| match cl.skipped.get(w) {
+                Some(_) => format!("{w} {n} (skipped, --ignore)"),
+                None => format!("{w} {n}"),
+            })
+            .collect::<Vec<_>>()
+            .join(", ");
+        eprintln!("polepatch: note: {name}: records read: {list}");
+    }
+    let points = cl.point_count();
     match &report {
         Some(r) => {
             let reached = r.zones.iter().filter(|z| z.outcome == "reached").count();
@@ -121,8 +174,21 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
                     .with_context(|| format!("cannot write {}", target.path.display()))?;
             }
         }
-        None => println!(
+        None if args.report.is_some() => {
+            eprintln!(
+                "polepatch: note: {name}: no patch report written (the program was not patched)"
+            );
+            println!(
+                "{name} → {}: {points} points, not patched",
+                args.output.display()
+            );
+        }
+        None if args.no_patch => println!(
             "{name} → {}: {points} points, not patched (--no-patch)",
+            args.output.display()
+        ),
+        None => println!(
+            "{name} → {}: {points} points, no G1 run to patch (holes and rapids only)",
             args.output.display()
         ),
     }

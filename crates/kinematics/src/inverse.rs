@@ -48,7 +48,14 @@ pub enum BranchRule {
 /// `o_wp` need not be normalised. A zero or non-finite `o_wp` gives NaN solutions (never
 /// `None`), so bad input is not mistaken for the pole.
 pub fn inverse(machine: &Machine, o_wp: [f64; 3]) -> Option<[IkSolution; 2]> {
-    let [i, j, k] = o_wp;
+    // Scaled to the largest component first: (f64::MAX, 0, f64::MAX) has a direction, but
+    // its length overflows.
+    let m = o_wp[0].abs().max(o_wp[1].abs()).max(o_wp[2].abs());
+    let [i, j, k] = if m > 0.0 && m.is_finite() {
+        [o_wp[0] / m, o_wp[1] / m, o_wp[2] / m]
+    } else {
+        o_wp
+    };
     let h = i.hypot(j);
     let norm = h.hypot(k);
     if !(norm > 0.0 && norm.is_finite()) {
@@ -310,6 +317,18 @@ mod tests {
             path[2], path[0],
             "the path continues from the last finite point"
         );
+    }
+
+    /// Issue 19 §5: a huge but finite axis has a direction; its length overflowed.
+    #[test]
+    fn huge_tool_axes_are_scaled_not_nan() {
+        let m = ucp710();
+        for big in [1e300, f64::MAX] {
+            let s = inverse(&m, [big, 0.0, big]).expect("not the pole");
+            assert!((s[0].p_deg - 45.0).abs() < 1e-12, "{big}: {s:?}");
+            let t = inverse(&m, [1.0, 0.0, 1.0]).unwrap();
+            assert_eq!(s, t);
+        }
     }
 
     /// G16 Table 1, both solutions, every cell, for the UCP710 (k = cos 30°).

@@ -19,13 +19,13 @@ fn main() {
         .filter_map(|b| {
             let st = p.state(b);
             let v = |i: usize| st.pos[i];
-            Some(ClPoint {
-                pos_mm: [v(modal::X)?, v(modal::Y)?, v(modal::Z)?],
-                axis: forward(&machine, v(modal::A)?, v(modal::C)?),
-                feed_mm_min: st.feed_mm_min,
-                rapid: st.motion == Motion::Rapid,
-                line: p.blocks[b].line,
-            })
+            Some(ClPoint::straight(
+                [v(modal::X)?, v(modal::Y)?, v(modal::Z)?],
+                forward(&machine, v(modal::A)?, v(modal::C)?),
+                st.feed_mm_min,
+                st.motion == Motion::Rapid,
+                p.blocks[b].line,
+            ))
         })
         .collect();
     print!("{}", to_apt(&points, "SING", 7));

@@ -1,17 +1,44 @@
-//! `polepatch post`: CL points (G16's stage 1) → joints by the machine's inverse
-//! kinematics → a TCPM NC program in a chosen dialect → (unless asked not to) the one
-//! patch pipeline, [`crate::patch_nc`], on that program.
+//! `polepatch post`: a CL program (G16's stage 1, [`polepatch_cl`]) → joints by the
+//! machine's inverse kinematics → an NC program in a chosen dialect ([`polepatch_nc::emit`])
+//! → (unless asked not to) the one patch pipeline, [`crate::patch_nc`], on that program.
 //!
-//! A post-processor with pole handling: the program is written first exactly as the IK
-//! gives it (`--no-patch` stops there), then patched like any other program, so `post` and
-//! `patch` can never disagree.
+//! A post-processor is judged on one rule: every record that changes what the machine
+//! does is posted correctly or refused with its line and column, naming it. Here:
+//!
+//! - straight and rapid moves: X Y Z and the joints of the tool axis, under TCPM;
+//! - arcs: `G2`/`G3` when the arc lies in a principal plane (within `arc_tolerance_mm`)
+//!   with a fixed tool axis and a sweep of at most one turn (a helix along the plane's
+//!   normal included; Heidenhain: the XY plane only, no helix); otherwise, or with `linearize`, chords within `arc_tolerance_mm` of the true
+//!   arc (the tool axis turned along the arc by great-circle interpolation), which the pole
+//!   analysis and patch then see like any other points;
+//! - holes of canned cycles and moves under cutter compensation: with the tool along +Z
+//!   only. The rotary axes are first put at P 0, C 0 under TCPM (the tool tip stays where
+//!   it is), TCPM is switched off, and the cycles / G41–G42 are the plain 3-axis ones of
+//!   the dialect. A tilted hole, or a tool axis other than +Z under compensation, is
+//!   refused (no tilted working plane or 3D compensation is written);
+//! - tool change, spindle, coolant, dwell, stops, comments: the dialect's words.
+//!
+//! The program is written first exactly as the IK gives it (`patch: false` stops there),
+//! then patched like any other program, so `post` and `patch` can never disagree.
 
 use crate::error::Error;
 use crate::patch::FileReport;
-use polepatch_cl::ClProgram;
-use polepatch_kinematics::{BranchRule, Machine, inverse_path};
+use polepatch_cl::{
+    Arc, ClError, ClItem, ClPoint, ClProgram, CompSide, Coolant, CycleKind, MoveKind, ParseOptions,
+    Plane, SpindleDir, Units,
+};
+use polepatch_kinematics::{BranchRule, IkSolution, Machine, inverse, inverse_path_from};
 use polepatch_nc::Dialect;
-use polepatch_nc::emit::{EmitOptions, EmitPoint, emit};
+use polepatch_nc::emit::{
+    self, ArcPlane, Comp, EmitArc, EmitHole, EmitOptions, EmitPoint, HoleKind, Item, Spindle, emit,
+};
+
+/// Default chordal tolerance of arcs, mm.
+pub const ARC_TOLERANCE_MM: f64 = 0.001;
+
+/// Two tool axes closer than this (unit vectors, |a − b|) are the same axis: an arc
+/// between them keeps a fixed tool axis. CAM files write i j k with 6–9 decimals.
+pub const SAME_AXIS_TOL: f64 = 1e-6;
 
 /// Options of [`post_cl`]. Plain struct; see each field for its default.
 #[derive(Debug, Clone, PartialEq)]
@@ -27,8 +54,15 @@ pub struct PostOptions {
     pub patch_options: crate::PatchOptions,
     /// Decimals of rotary words. Default 3.
     pub rotary_decimals: usize,
-    /// Decimals of linear words. Default 3.
+    /// Decimals of linear words in mm (inch output writes one more). Default 3.
     pub linear_decimals: usize,
+    /// Units written (`None`: the CL file's). Default `None`.
+    pub units: Option<Units>,
+    /// Write every arc as chords (default `false`: `G2`/`G3` where the module docs say).
+    pub linearize: bool,
+    /// Chordal tolerance of arcs written as chords, and how far an arc may leave a
+    /// principal plane to be written as `G2`/`G3`, mm. Default [`ARC_TOLERANCE_MM`].
+    pub arc_tolerance_mm: f64,
 }
 
 impl Default for PostOptions {
@@ -40,77 +74,612 @@ impl Default for PostOptions {
             patch_options: crate::PatchOptions::default(),
             rotary_decimals: 3,
             linear_decimals: 3,
+            units: None,
+            linearize: false,
+            arc_tolerance_mm: ARC_TOLERANCE_MM,
         }
     }
 }
 
-/// Read a CL file (APT or CSV, [`polepatch_cl::parse`]); errors name `name`, the line and
-/// the column.
-pub fn read_cl(bytes: &[u8], name: &str) -> Result<ClProgram, Error> {
-    polepatch_cl::parse(bytes).map_err(|record| Error::Cl {
+/// Read a CL file (APT or CSV, [`polepatch_cl::parse_with`]); errors name `name`, the line
+/// and the column.
+pub fn read_cl_with(bytes: &[u8], name: &str, opts: &ParseOptions) -> Result<ClProgram, Error> {
+    polepatch_cl::parse_with(bytes, opts).map_err(|record| Error::Cl {
         path: name.to_string(),
         record,
     })
 }
 
-/// The points of `cl` as joints for `machine` (x y z as given, primary and C by IK).
-/// Errors name the CL line of a point that needs the primary axis outside its range or has
-/// no feed.
-pub fn cl_joints(
+/// [`read_cl_with`] with the default options.
+pub fn read_cl(bytes: &[u8], name: &str) -> Result<ClProgram, Error> {
+    read_cl_with(bytes, name, &ParseOptions::default())
+}
+
+/// What is being written: 5-axis under TCPM, or with the tool along +Z and TCPM off
+/// (holes, cutter compensation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Frame {
+    Tcpm,
+    Vertical,
+}
+
+/// Why the tool must be vertical: a hole's cycle or the cutter compensation.
+#[derive(Debug, Clone)]
+struct VerticalReason {
+    what: String,
+    line: usize,
+    column: usize,
+}
+
+/// The post's state while it walks the CL items.
+struct Poster<'a> {
+    machine: &'a Machine,
+    opts: &'a PostOptions,
+    items: Vec<Item>,
+    /// The last IK solution (C continuity), in the program's terms.
+    prev: Option<IkSolution>,
+    /// Tool tip after the last move, mm.
+    pos: Option<[f64; 3]>,
+    /// P and C after the last move.
+    rotary: Option<(f64, f64)>,
+    frame: Frame,
+    /// Cutter compensation on (since which CUTCOM record), and whether the next move is the
+    /// cancel move after `CUTCOM/OFF` (still vertical).
+    comp: Option<VerticalReason>,
+    comp_cancel_pending: Option<VerticalReason>,
+    /// A compensation start waiting for its first straight move.
+    comp_start_pending: Option<VerticalReason>,
+    tool: Option<u32>,
+    spindle: Option<(f64, SpindleDir)>,
+}
+
+fn cl_error(name: &str, line: usize, column: usize, message: String) -> Error {
+    Error::Cl {
+        path: name.to_string(),
+        record: ClError {
+            line,
+            column,
+            message,
+        },
+    }
+}
+
+impl Poster<'_> {
+    fn name(&self) -> &str {
+        &self.opts.patch_options.name
+    }
+
+    /// An error at CL point `p`'s record.
+    fn at_point(&self, p: &ClPoint, what: String) -> Error {
+        cl_error(self.name(), p.line, p.column, what)
+    }
+
+    /// The joints of tool axis `axis` for the move of CL point `src`, continuing from the
+    /// last point.
+    fn joints(&mut self, axis: [f64; 3], src: &ClPoint) -> Result<IkSolution, Error> {
+        let s = inverse_path_from(self.machine, &[axis], self.opts.branch, self.prev)[0];
+        let (lo, hi) = self.machine.primary_range_deg;
+        if !(lo <= s.p_deg && s.p_deg <= hi) {
+            return Err(self.at_point(
+                src,
+                format!(
+                    "the tool axis ({:.6}, {:.6}, {:.6}) needs {}{:.3}, outside the machine's range [{lo}, {hi}] on either IK branch",
+                    axis[0],
+                    axis[1],
+                    axis[2],
+                    self.machine.primary_letter(),
+                    s.p_deg
+                ),
+            ));
+        }
+        self.prev = Some(s);
+        Ok(s)
+    }
+
+    /// The tool must be along +Z here (on the pole, P = 0): else refused naming why.
+    fn check_vertical(
+        &self,
+        axis: [f64; 3],
+        line: usize,
+        why: &VerticalReason,
+    ) -> Result<(), Error> {
+        if inverse(self.machine, axis).is_none() && axis[2] > 0.0 {
+            return Ok(());
+        }
+        Err(cl_error(
+            self.name(),
+            why.line,
+            why.column,
+            format!(
+                "{}: the tool axis ({:.6}, {:.6}, {:.6}) at line {line} is not +Z; polepatch posts {} with the tool along +Z only (no tilted working plane — PLANE, CYCLE800, G68.2 — and no 3D compensation is written): refused",
+                why.what,
+                axis[0],
+                axis[1],
+                axis[2],
+                if why.what.starts_with("CUTCOM") {
+                    "cutter compensation"
+                } else {
+                    "canned cycles"
+                }
+            ),
+        ))
+    }
+
+    /// Into the vertical frame: the rotary axes to P 0, C 0 under TCPM at the current tool
+    /// tip (the tip stays; only the orientation may turn), then TCPM off (by the emitter).
+    fn enter_vertical(&mut self) {
+        if self.frame == Frame::Vertical {
+            return;
+        }
+        if let Some(pos) = self.pos
+            && self.rotary != Some((0.0, 0.0))
+        {
+            self.items.push(Item::Move(EmitPoint {
+                xyz_mm: pos,
+                p_deg: 0.0,
+                c_deg: 0.0,
+                feed_mm_min: None,
+                rapid: true,
+                tcpm: true,
+            }));
+        }
+        self.rotary = Some((0.0, 0.0));
+        self.prev = Some(IkSolution {
+            p_deg: 0.0,
+            c_deg: 0.0,
+        });
+        self.frame = Frame::Vertical;
+    }
+
+    /// The feed of a feed move, or the error naming its line.
+    fn feed(&self, p: &ClPoint) -> Result<f64, Error> {
+        p.feed_mm_min
+            .or(self.opts.patch_options.feed_fallback_mm_min)
+            .ok_or_else(|| {
+                self.at_point(
+                    p,
+                    "no feed for this move (no FEDRAT before it, no f column): give --feed".into(),
+                )
+            })
+    }
+
+    /// The reason the next straight move must be vertical, if any.
+    fn vertical_reason(&self) -> Option<VerticalReason> {
+        self.comp
+            .clone()
+            .or_else(|| self.comp_cancel_pending.clone())
+    }
+
+    /// A straight move to `pos` with tool axis `axis`, for the move of CL point `src`.
+    fn straight(
+        &mut self,
+        pos: [f64; 3],
+        axis: [f64; 3],
+        feed: Option<f64>,
+        rapid: bool,
+        src: &ClPoint,
+    ) -> Result<(), Error> {
+        let (p_deg, c_deg, tcpm) = match self.vertical_reason() {
+            Some(why) => {
+                self.check_vertical(axis, src.line, &why)?;
+                self.enter_vertical();
+                (0.0, 0.0, false)
+            }
+            None => {
+                let s = self.joints(axis, src)?;
+                self.frame = Frame::Tcpm;
+                (s.p_deg, s.c_deg, true)
+            }
+        };
+        self.comp_start_pending = None;
+        self.comp_cancel_pending = None;
+        self.items.push(Item::Move(EmitPoint {
+            xyz_mm: pos,
+            p_deg,
+            c_deg,
+            feed_mm_min: if rapid { None } else { feed },
+            rapid,
+            tcpm,
+        }));
+        self.pos = Some(pos);
+        self.rotary = Some((p_deg, c_deg));
+        Ok(())
+    }
+
+    fn arc(&mut self, p: &ClPoint, a: &Arc) -> Result<(), Error> {
+        let feed = self.feed(p)?;
+        let tol = self.opts.arc_tolerance_mm;
+        let fixed_axis = (0..3).all(|i| (p.axis[i] - a.start_axis[i]).abs() <= SAME_AXIS_TOL);
+        let one_turn = a.sweep_rad <= std::f64::consts::TAU * (1.0 + 1e-12);
+        let heidenhain = matches!(
+            self.opts.dialect,
+            Dialect::Heidenhain | Dialect::Conversational | Dialect::Auto
+        );
+        // Heidenhain's circle in ISO programs: the XY plane, no helix (its helix is a polar
+        // block polepatch does not write).
+        let plane = a
+            .principal_plane(tol)
+            .filter(|pl| !heidenhain || (*pl == Plane::Xy && a.lead_mm.abs() <= tol));
+        if let Some(why) = &self.comp_cancel_pending {
+            return Err(cl_error(
+                self.name(),
+                why.line,
+                why.column,
+                format!(
+                    "{}: the compensation would end on a circular move (line {}); controllers end it on a straight move: refused",
+                    why.what, p.line
+                ),
+            ));
+        }
+        let comp = self.comp.clone();
+        if let Some(why) = &comp
+            && self.comp_start_pending.is_some()
+        {
+            return Err(cl_error(
+                self.name(),
+                why.line,
+                why.column,
+                format!(
+                    "{}: the compensation would start on a circular move (line {}); controllers start it on a straight move: refused",
+                    why.what, p.line
+                ),
+            ));
+        }
+        match plane {
+            Some(pl) if !self.opts.linearize && fixed_axis && one_turn => {
+                if let Some(why) = &comp
+                    && pl != Plane::Xy
+                {
+                    return Err(cl_error(
+                        self.name(),
+                        why.line,
+                        why.column,
+                        format!(
+                            "{}: a circular move outside the XY plane (line {}) under compensation: refused",
+                            why.what, p.line
+                        ),
+                    ));
+                }
+                let Some(start) = self.pos else {
+                    return Err(self.at_point(p, "an arc with no point before it".into()));
+                };
+                let tcpm = match self.vertical_reason() {
+                    Some(why) => {
+                        self.check_vertical(p.axis, p.line, &why)?;
+                        self.enter_vertical();
+                        false
+                    }
+                    None => {
+                        // The orientation does not change along the arc: the joints are
+                        // the start's (restated in place if the IK names them otherwise,
+                        // e.g. after a vertical section).
+                        let s = self.joints(p.axis, p)?;
+                        if self.rotary != Some((s.p_deg, s.c_deg)) {
+                            self.items.push(Item::Move(EmitPoint {
+                                xyz_mm: start,
+                                p_deg: s.p_deg,
+                                c_deg: s.c_deg,
+                                feed_mm_min: None,
+                                rapid: true,
+                                tcpm: true,
+                            }));
+                            self.rotary = Some((s.p_deg, s.c_deg));
+                        }
+                        self.frame = Frame::Tcpm;
+                        true
+                    }
+                };
+                let normal_axis = pl.normal_index();
+                self.items.push(Item::Arc(EmitArc {
+                    end_mm: p.pos_mm,
+                    center_mm: a.center_mm,
+                    start_mm: start,
+                    plane: match pl {
+                        Plane::Xy => ArcPlane::Xy,
+                        Plane::Zx => ArcPlane::Zx,
+                        Plane::Yz => ArcPlane::Yz,
+                    },
+                    ccw: a.normal[normal_axis] > 0.0,
+                    feed_mm_min: feed,
+                    tcpm,
+                }));
+                self.pos = Some(p.pos_mm);
+                Ok(())
+            }
+            _ => {
+                // Chords within the tolerance; the tool axis turns along the arc.
+                let pts = a.chord_points(tol, p.pos_mm);
+                let n = pts.len();
+                for (k, q) in pts.into_iter().enumerate() {
+                    let t = (k + 1) as f64 / n as f64;
+                    let axis = if k + 1 == n {
+                        p.axis
+                    } else {
+                        a.axis_at(t, p.axis).ok_or_else(|| {
+                            self.at_point(
+                                p,
+                                "the tool axis turns by 180° along the arc: no unique way to turn it"
+                                    .into(),
+                            )
+                        })?
+                    };
+                    self.straight(q, axis, Some(feed), false, p)?;
+                }
+                Ok(())
+            }
+        }
+    }
+
+    fn hole(&mut self, p: &ClPoint, c: &polepatch_cl::Cycle) -> Result<(), Error> {
+        let why = VerticalReason {
+            what: format!("CYCLE/{} (line {})", c.mode, c.at.line),
+            line: c.at.line,
+            column: c.at.column,
+        };
+        if let Some(comp) = &self.comp {
+            return Err(cl_error(
+                self.name(),
+                c.at.line,
+                c.at.column,
+                format!("{}: a hole while {} is on: refused", why.what, comp.what),
+            ));
+        }
+        self.check_vertical(p.axis, p.line, &why)?;
+        let refuse = |m: String| cl_error(self.name(), c.at.line, c.at.column, m);
+        let kind = match c.kind {
+            CycleKind::Drill => HoleKind::Drill,
+            CycleKind::Deep | CycleKind::ChipBreak if c.dwell_s > 0.0 => {
+                return Err(refuse(format!(
+                    "CYCLE/{}: DWELL on a peck-drilling cycle is not posted",
+                    c.mode
+                )));
+            }
+            CycleKind::Deep | CycleKind::ChipBreak => {
+                // The reader requires STEP; a cycle built otherwise may lack it.
+                let Some(peck) = c.peck_mm.filter(|p| *p > 0.0) else {
+                    return Err(refuse(format!(
+                        "CYCLE/{} (peck drilling) without a positive peck",
+                        c.mode
+                    )));
+                };
+                if c.kind == CycleKind::Deep {
+                    HoleKind::Deep(peck)
+                } else {
+                    HoleKind::ChipBreak(peck)
+                }
+            }
+            CycleKind::Tap => match self.spindle {
+                Some((rpm, dir)) if dir != SpindleDir::Off => HoleKind::Tap {
+                    rpm,
+                    cw: dir == SpindleDir::Cw,
+                },
+                _ => {
+                    return Err(refuse(format!(
+                        "CYCLE/{}: tapping with the spindle stopped (no SPINDL/rpm,CLW|CCLW before it)",
+                        c.mode
+                    )));
+                }
+            },
+            CycleKind::Bore => HoleKind::Bore,
+        };
+        self.enter_vertical();
+        self.items.push(Item::Hole(EmitHole {
+            top_mm: p.pos_mm,
+            depth_mm: c.depth_mm,
+            clearance_mm: c.clearance_mm,
+            return_mm: c.return_mm(),
+            feed_mm_min: c.feed_mm_min,
+            dwell_s: c.dwell_s,
+            kind,
+        }));
+        let [x, y, z] = p.pos_mm;
+        self.pos = Some([x, y, z + c.return_mm()]);
+        Ok(())
+    }
+
+    fn item(&mut self, item: &ClItem) -> Result<(), Error> {
+        match item {
+            ClItem::Move(p) => match &p.kind {
+                MoveKind::Linear => {
+                    let f = self.feed(p)?;
+                    self.straight(p.pos_mm, p.axis, Some(f), false, p)
+                }
+                MoveKind::Rapid => self.straight(p.pos_mm, p.axis, None, true, p),
+                MoveKind::Arc(a) => self.arc(p, a),
+                MoveKind::Hole(c) => self.hole(p, c),
+            },
+            ClItem::ToolChange {
+                tool,
+                length_offset,
+                at,
+            } => {
+                if let Some(why) = &self.comp {
+                    return Err(cl_error(
+                        self.name(),
+                        at.line,
+                        at.column,
+                        format!("LOADTL while {} is on: refused", why.what),
+                    ));
+                }
+                self.items.push(Item::ToolChange {
+                    tool: *tool,
+                    length_offset: *length_offset,
+                });
+                self.tool = Some(*tool);
+                // After a tool change the tool is where the changer left it.
+                self.pos = None;
+                self.rotary = None;
+                self.frame = Frame::Tcpm;
+                Ok(())
+            }
+            ClItem::Spindle { rpm, dir, at } => {
+                let s = match (dir, rpm) {
+                    (SpindleDir::Off, _) => Spindle::Off,
+                    (SpindleDir::Cw, Some(r)) => Spindle::Cw(*r),
+                    (SpindleDir::Ccw, Some(r)) => Spindle::Ccw(*r),
+                    // The reader gives every start its speed; a program built otherwise
+                    // may not.
+                    (_, None) => {
+                        return Err(cl_error(
+                            self.name(),
+                            at.line,
+                            at.column,
+                            "SPINDL starts the spindle without a speed".into(),
+                        ));
+                    }
+                };
+                self.spindle = match (dir, rpm) {
+                    (SpindleDir::Off, _) => None,
+                    (d, Some(r)) => Some((*r, *d)),
+                    _ => None,
+                };
+                self.items.push(Item::Spindle(s));
+                Ok(())
+            }
+            ClItem::Coolant { mode, .. } => {
+                self.items.push(Item::Coolant(match mode {
+                    Coolant::Flood => emit::Coolant::Flood,
+                    Coolant::Mist => emit::Coolant::Mist,
+                    Coolant::Off => emit::Coolant::Off,
+                }));
+                Ok(())
+            }
+            ClItem::CutterComp { side, register, at } => self.cutcom(*side, *register, *at),
+            ClItem::Dwell { seconds, .. } => {
+                self.items.push(Item::Dwell(*seconds));
+                Ok(())
+            }
+            ClItem::Stop { optional, .. } => {
+                self.items.push(Item::Stop(*optional));
+                Ok(())
+            }
+            ClItem::Comment(c) => {
+                self.items.push(Item::Comment(c.clone()));
+                Ok(())
+            }
+        }
+    }
+
+    fn cutcom(
+        &mut self,
+        side: CompSide,
+        register: Option<u32>,
+        at: polepatch_cl::At,
+    ) -> Result<(), Error> {
+        let what = format!(
+            "CUTCOM/{} (line {})",
+            match side {
+                CompSide::Left => "LEFT",
+                CompSide::Right => "RIGHT",
+                CompSide::Off => "OFF",
+            },
+            at.line
+        );
+        let why = VerticalReason {
+            what: what.clone(),
+            line: at.line,
+            column: at.column,
+        };
+        if side == CompSide::Off {
+            if self.comp.take().is_some() {
+                self.items.push(Item::Comp(Comp::Off));
+                // The cancel move is still a compensated (vertical) move.
+                self.comp_cancel_pending = Some(why);
+            }
+            return Ok(());
+        }
+        let fanuc = self.opts.dialect == Dialect::Fanuc;
+        if let Some(r) = register
+            && !fanuc
+            && Some(r) != self.tool
+        {
+            return Err(cl_error(
+                self.name(),
+                at.line,
+                at.column,
+                format!(
+                    "{what}: offset register {r} is not the tool's ({}); Heidenhain and Sinumerik compensate with the radius of the active tool: refused",
+                    self.tool
+                        .map_or("no tool loaded".to_string(), |t| format!("T{t}"))
+                ),
+            ));
+        }
+        let d = register.or(self.tool).unwrap_or(1);
+        self.items.push(Item::Comp(match side {
+            CompSide::Left => Comp::Left(d),
+            _ => Comp::Right(d),
+        }));
+        self.comp_start_pending = Some(why.clone());
+        self.comp = Some(why);
+        Ok(())
+    }
+}
+
+/// The items of the NC program for `cl` on `machine` (module docs): IK, arcs, holes,
+/// set-up. Errors name the CL line (and column for a record).
+pub fn post_items(
     cl: &ClProgram,
     machine: &Machine,
     opts: &PostOptions,
-) -> Result<Vec<EmitPoint>, Error> {
-    let name = &opts.patch_options.name;
-    let axes: Vec<[f64; 3]> = cl.points.iter().map(|p| p.axis).collect();
-    let ik = inverse_path(machine, &axes, opts.branch);
-    let (lo, hi) = machine.primary_range_deg;
-    let fallback = opts.patch_options.feed_fallback_mm_min;
-    cl.points
-        .iter()
-        .zip(ik)
-        .map(|(p, s)| {
-            if !(lo <= s.p_deg && s.p_deg <= hi) {
-                return Err(Error::Unsupported {
-                    path: name.clone(),
-                    line: p.line,
-                    what: format!(
-                        "the tool axis ({:.6}, {:.6}, {:.6}) needs {}{:.3}, outside the machine's range [{lo}, {hi}] on either IK branch",
-                        p.axis[0],
-                        p.axis[1],
-                        p.axis[2],
-                        machine.primary_letter(),
-                        s.p_deg
-                    ),
-                });
-            }
-            let feed = p.feed_mm_min.or(fallback);
-            if !p.rapid && feed.is_none() {
-                return Err(Error::Unsupported {
-                    path: name.clone(),
-                    line: p.line,
-                    what: "no feed for this move (no FEDRAT before it, no f column): give --feed"
-                        .into(),
-                });
-            }
-            Ok(EmitPoint {
-                xyz_mm: p.pos_mm,
-                p_deg: s.p_deg,
-                c_deg: s.c_deg,
-                feed_mm_min: if p.rapid { None } else { feed },
-                rapid: p.rapid,
-            })
-        })
-        .collect()
+) -> Result<Vec<Item>, Error> {
+    if !(opts.arc_tolerance_mm.is_finite() && (1e-6..=1.0).contains(&opts.arc_tolerance_mm)) {
+        return Err(Error::Options(format!(
+            "arc tolerance {} mm must be within 0.000001…1 mm",
+            opts.arc_tolerance_mm
+        )));
+    }
+    let mut p = Poster {
+        machine,
+        opts,
+        items: Vec::with_capacity(cl.items.len() + 8),
+        prev: None,
+        pos: None,
+        rotary: None,
+        frame: Frame::Tcpm,
+        comp: None,
+        comp_cancel_pending: None,
+        comp_start_pending: None,
+        tool: None,
+        spindle: None,
+    };
+    for item in &cl.items {
+        p.item(item)?;
+    }
+    if let Some(why) = &p.comp_start_pending {
+        return Err(cl_error(
+            p.name(),
+            why.line,
+            why.column,
+            format!(
+                "{}: no move after it to start the compensation on",
+                why.what
+            ),
+        ));
+    }
+    Ok(p.items)
 }
 
-/// Post a CL program for `machine`: the NC bytes and, when patched, the patch report.
+/// Post a CL program for `machine`: the NC bytes and, when patched, the patch report
+/// (`None` with `patch: false`, or when the program has no G1 run for the patch to look at:
+/// holes and rapids only).
 pub fn post_cl(
     cl: &ClProgram,
     machine: &Machine,
     opts: &PostOptions,
 ) -> Result<(Vec<u8>, Option<FileReport>), Error> {
-    let points = cl_joints(cl, machine, opts)?;
+    let inch = opts.units.unwrap_or(cl.units) == Units::Inch;
+    if inch
+        && matches!(
+            opts.dialect,
+            Dialect::Heidenhain | Dialect::Conversational | Dialect::Auto
+        )
+    {
+        return Err(Error::Options(
+            "inch output for Heidenhain is not written: Heidenhain inch programs take F in 0.1 inch/min, which polepatch's reader does not read; post in mm (--units mm)"
+                .into(),
+        ));
+    }
+    let items = post_items(cl, machine, opts)?;
     let program_name = cl
         .name
         .clone()
@@ -123,21 +692,28 @@ pub fn post_cl(
         "posted by polepatch for {} from {}",
         machine.name, opts.patch_options.name
     )];
-    comments.extend(cl.notes.iter().take(20).cloned());
+    for (w, n) in &cl.skipped {
+        comments.push(format!("{w} records skipped by --ignore {w}: {n}"));
+    }
     let bytes = emit(
-        &points,
+        &items,
         &EmitOptions {
             dialect: opts.dialect,
             name: program_name,
             primary_letter: machine.primary_letter() as u8,
             rotary_decimals: opts.rotary_decimals,
-            linear_decimals: opts.linear_decimals,
+            linear_decimals: opts.linear_decimals + usize::from(inch),
             comments,
+            inch,
         },
     );
     if !opts.patch {
         return Ok((bytes, None));
     }
-    let (out, report) = crate::patch_nc(&bytes, machine, &opts.patch_options)?;
-    Ok((out, Some(report)))
+    match crate::patch_nc(&bytes, machine, &opts.patch_options) {
+        Ok((out, report)) => Ok((out, Some(report))),
+        // A program of holes and rapids only: nothing for the patch to look at.
+        Err(Error::NoRuns { .. }) => Ok((bytes, None)),
+        Err(e) => Err(e),
+    }
 }

@@ -47,12 +47,14 @@ fn tcpm_moves(lp: &LoadedProgram) -> Vec<[f64; 5]> {
 fn cl_points(lp: &LoadedProgram, machine: &Machine) -> Vec<ClPoint> {
     tcpm_blocks(lp)
         .into_iter()
-        .map(|(b, st, q)| ClPoint {
-            pos_mm: [q[0], q[1], q[2]],
-            axis: forward(machine, q[3], q[4]),
-            feed_mm_min: st.feed_mm_min,
-            rapid: st.motion == Motion::Rapid,
-            line: lp.program.blocks[b].line,
+        .map(|(b, st, q)| {
+            ClPoint::straight(
+                [q[0], q[1], q[2]],
+                forward(machine, q[3], q[4]),
+                st.feed_mm_min,
+                st.motion == Motion::Rapid,
+                lp.program.blocks[b].line,
+            )
         })
         .collect()
 }
