@@ -24,6 +24,8 @@ pub(crate) struct Scan {
     /// The feed is not per minute for this block (conversational `FU`, `FZ`, `FAUTO`).
     pub(crate) feed_unknown: bool,
     pub(crate) motion: Option<Motion>,
+    /// A canned cycle switched on (`G81`…) or off (`G80`).
+    pub(crate) cycle: Option<bool>,
     /// Conversational `FMAX`: this block is a rapid, the next one is not.
     pub(crate) rapid_once: bool,
     pub(crate) incremental: Option<bool>,
@@ -128,8 +130,19 @@ impl Interpreter {
             Some(10) => s.motion = Some(Motion::Linear),
             Some(20) => s.motion = Some(Motion::ArcCw),
             Some(30) => s.motion = Some(Motion::ArcCcw),
-            // Plane, cutter compensation off, canned cycle off, path control modes.
-            Some(170 | 180 | 190 | 400 | 800 | 600 | 610 | 640 | 6410..=6450) => {}
+            // Canned cycles (Fanuc, Haas, LinuxCNC; Heidenhain ISO uses G2xx + G79).
+            Some(730 | 740 | 760 | 810..=890) if !heidenhain => {
+                s.cycle = Some(true);
+                s.breaks = true;
+            }
+            Some(800) => s.cycle = Some(false),
+            // Heidenhain ISO cycle call: the cycle moves the tool.
+            Some(790) if heidenhain => {
+                s.unknown_after = true;
+                s.breaks = true;
+            }
+            // Plane, cutter compensation off, path control modes, initial/R plane return.
+            Some(170 | 180 | 190 | 400 | 600 | 610 | 640 | 6410..=6450 | 980 | 990) => {}
             Some(900) => s.incremental = Some(false),
             Some(910) => s.incremental = Some(true),
             Some(200 | 700 | 7000) => s.inch = Some(true),
@@ -172,6 +185,11 @@ impl Interpreter {
             }
             Some(20 | 300) => {
                 s.flags.set(Flags::PROGRAM_END);
+                s.breaks = true;
+            }
+            // Subprogram call and return, cycle call (Heidenhain M99): other blocks run.
+            Some(980 | 990) => {
+                s.unknown_after = true;
                 s.breaks = true;
             }
             // A TCPM switch (breaks through the state change).
@@ -379,6 +397,11 @@ impl Interpreter {
         let mut flags = s.flags;
         if let Some(mo) = s.motion {
             m.motion = mo;
+            // A motion code ends a canned cycle (Fanuc group 01 over group 09).
+            m.canned_cycle = false;
+        }
+        if let Some(c) = s.cycle {
+            m.canned_cycle = c;
         }
         if s.rapid_once {
             // FMAX holds for its own block: the state after it is a rapid, and the next
@@ -474,7 +497,13 @@ impl Interpreter {
                 m.pos[X] = None;
                 m.pos[Y] = None;
             }
-            if has_axes || s.xy_unknown_after {
+            if m.canned_cycle && has_axes {
+                // A hole: the tool goes down and back to a plane the reader does not
+                // follow.
+                m.pos[Z] = None;
+                is_move = true;
+                breaks = true;
+            } else if has_axes || s.xy_unknown_after {
                 is_move = m.motion != Motion::None;
                 if m.motion != Motion::Linear {
                     breaks = true;

@@ -24,7 +24,11 @@
 //! - work-offset selection (Fanuc/Sinumerik `G54`…`G59`, `G500`, `G505`…`G599`) makes
 //!   X Y Z unknown, then the block's own axis words apply in the new frame;
 //! - `G4` dwell and `G65`/`G66` macro calls take axis letters as arguments (a macro call
-//!   makes every position unknown).
+//!   makes every position unknown);
+//! - canned drilling cycles (`G73 G74 G76 G81`…`G89`) are modal until `G80` or a motion
+//!   code: a block with axis words then drills a hole (a move that ends runs, Z unknown
+//!   after it: the tool returns to a plane the reader does not follow); Heidenhain ISO
+//!   `G79`, conversational `CYCL CALL`/`M99` call a cycle (positions unknown after).
 //!
 //! A block breaks runs ([`crate::Block::breaks_run`]) if it moves other than by G1, has
 //! a T, D, H, U, V, W, P, Q, L or E word, an M code other than spindle/coolant
@@ -115,6 +119,9 @@ pub struct Modal {
     pub feed_mode: FeedMode,
     /// Tool-centre-point management.
     pub tcpm: Tcpm,
+    /// A canned drilling cycle is active (Fanuc/LinuxCNC `G73 G74 G76 G81`…`G89`, until
+    /// `G80` or a `G0`…`G3`): a block with axis words drills a hole there.
+    pub canned_cycle: bool,
     /// Incremental mode (G91).
     pub incremental: bool,
     /// Inch units (G20 / G70): values are converted to mm on read.
@@ -130,6 +137,7 @@ impl Default for Modal {
             inverse_time_per_min: None,
             feed_mode: FeedMode::PerMinute,
             tcpm: Tcpm::Off,
+            canned_cycle: false,
             incremental: false,
             inch: false,
         }
@@ -161,7 +169,7 @@ pub(crate) struct PackedModal {
     /// Bits 0–5: `pos[i]` is known; bit 6: the feed is known; bit 7: the inverse-time F.
     known: u8,
     /// Bits 0–2: motion (0 none … 4 G3); bit 3 TCPM on; bit 4 incremental; bit 5 inch;
-    /// bit 6 TCPM uncertain.
+    /// bit 6 TCPM uncertain; bit 7 canned cycle.
     flags: u8,
     /// Feed mode: 0 G94, 1 G93, 2 G95.
     feed_mode: u8,
@@ -205,7 +213,8 @@ impl PackedModal {
                 | u8::from(m.tcpm == Tcpm::On) << 3
                 | u8::from(m.incremental) << 4
                 | u8::from(m.inch) << 5
-                | u8::from(m.tcpm == Tcpm::Uncertain) << 6,
+                | u8::from(m.tcpm == Tcpm::Uncertain) << 6
+                | u8::from(m.canned_cycle) << 7,
             feed_mode: match m.feed_mode {
                 FeedMode::PerMinute => 0,
                 FeedMode::InverseTime => 1,
@@ -241,6 +250,7 @@ impl PackedModal {
             },
             incremental: self.flags & 16 != 0,
             inch: self.flags & 32 != 0,
+            canned_cycle: self.flags & 128 != 0,
         }
     }
 }
@@ -275,6 +285,7 @@ mod tests {
                 FeedMode::PerRevolution,
             ][k % 3];
             m.tcpm = [Tcpm::Off, Tcpm::On, Tcpm::Uncertain][k % 3];
+            m.canned_cycle = k % 2 == 0;
             m.incremental = k % 3 == 1;
             m.inch = k >= 3;
             let back = PackedModal::pack(&m).unpack();

@@ -592,7 +592,7 @@ pub fn detect(bytes: &[u8]) -> Dialect {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::modal::{A, C, Motion, Tcpm, X, Y};
+    use crate::modal::{A, C, Motion, Tcpm, X, Y, Z};
     use crate::tcpm::{Code, ControllerCodes};
 
     fn p(s: &str) -> Program {
@@ -1130,5 +1130,31 @@ mod tests {
         let mut q = prog.state(3);
         q.pos = prog.state(6).pos;
         assert_eq!(q.pos[X], None, "o100 call");
+    }
+
+    /// Canned cycles are modal until G80 or a motion code: their hole blocks are moves
+    /// that end runs, with Z unknown after them (found reading posted drilling programs).
+    #[test]
+    fn canned_cycles_drill_holes_until_g80() {
+        let prog = p(
+            "(F)\nG90 G1 X0 Y0 Z5 F100\nG98 G81 X10 Y10 Z-5 R2 F50\nX20 Y10\nG80\nG0 X30 Y30 Z5\nG81 X1 Y1 Z-1 R1\nG1 X2 Y2 Z3\n",
+        );
+        assert!(prog.state(2).canned_cycle);
+        assert!(prog.blocks[2].is_move && prog.blocks[2].breaks_run);
+        assert_eq!(prog.state(2).pos[Z], None, "the hole returns to a plane");
+        assert!(
+            prog.blocks[3].is_move && prog.blocks[3].breaks_run,
+            "modal: X20 Y10 is a hole"
+        );
+        assert!(!prog.state(4).canned_cycle, "G80");
+        assert_eq!(prog.state(5).pos[Z], Some(5.0));
+        assert!(!prog.state(7).canned_cycle, "G1 ends the cycle");
+        assert!(!prog.blocks[7].flags.has(Flags::ARC));
+        // M98/M99 and Heidenhain's G79 run other blocks: positions unknown after.
+        assert_eq!(p("(F)\nG1 X0 Y0 Z0 F1\nM98 P100\n").state(2).pos[X], None);
+        assert_eq!(
+            p("%P G71 *\nN1 G01 X0 Y0 Z0 F1 *\nN2 G79 *\n").state(2).pos[X],
+            None
+        );
     }
 }
