@@ -122,7 +122,7 @@ def export(objectslist: Any, filename: str, argstring: Optional[str]) -> str:
     to ``filename`` (not written when ``filename`` is ``"-"``) and returned."""
     machine, base, only_c, base_args = split_arguments(argstring)
     # "-": the base post returns its program without writing it.
-    gcode = base_post(base).export(objectslist, "-", base_args)
+    gcode: str = base_post(base).export(objectslist, "-", base_args)
     if not gcode:
         return gcode
     patched = patch_program(gcode, machine, name=filename, only_c=only_c)

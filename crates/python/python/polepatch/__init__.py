@@ -166,6 +166,12 @@ def _bytes(data: Any, what: str) -> bytes:
     )
 
 
+def _report(text: str) -> Dict[str, Any]:
+    """A report as a dict: the library's JSON document, read once."""
+    report: Dict[str, Any] = json.loads(text)
+    return report
+
+
 def _options(arguments: Dict[str, Any], *positional: str) -> Dict[str, Any]:
     """A call's keyword options (its ``locals()`` less its positional arguments): the
     native module reads them by name."""
@@ -227,7 +233,7 @@ def patch_nc(
     """
     text_options = _options(locals(), "data", "machine")
     out, report = _native.patch_nc(_bytes(data, "data"), _machine(machine), text_options)
-    return out, json.loads(report)
+    return out, _report(report)
 
 
 def analyze_nc(
@@ -256,7 +262,7 @@ def analyze_nc(
     report = _native.analyze_nc(
         _bytes(data, "data"), _machine(machine), cone_deg, tcy_ms, rest
     )
-    return json.loads(report)
+    return _report(report)
 
 
 def feed_profile(
@@ -376,7 +382,7 @@ def reorient(
     out, report = _native.reorient(
         _bytes(data, "data"), _machine(machine), theta_x, theta_z, pivot_mm, cone_deg, name
     )
-    return out, json.loads(report)
+    return out, _report(report)
 
 
 def _rows(a: Any, n_cols: int, what: str) -> np.ndarray:
@@ -454,4 +460,5 @@ def patch_joints(
     options = _options(locals(), "xyzpc", "machine", "feed_mm_min")
     arr = _rows(xyzpc, 5, "xyzpc")
     out, zones = _native.patch_joints(arr, _machine(machine), float(feed_mm_min), options)
-    return out, json.loads(zones)
+    zone_reports: List[Dict[str, Any]] = json.loads(zones)
+    return out, zone_reports
