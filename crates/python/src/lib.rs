@@ -16,7 +16,7 @@ use errors::{Failure, detached};
 use machine::NativeMachine;
 use numpy::ndarray::Array2;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
-use options::{FileKw, PatcherKw, PostKw};
+use options::{AnalysisKw, FileKw, PatcherKw, PostKw};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::pybacked::PyBackedBytes;
@@ -55,12 +55,11 @@ fn analyze_nc(
     py: Python<'_>,
     data: PyBackedBytes,
     machine: &NativeMachine,
-    cone_deg: f64,
-    tcy_ms: Option<f64>,
     options: &Bound<'_, PyDict>,
 ) -> PyResult<String> {
+    let a: AnalysisKw = options.extract()?;
     let f: FileKw = options.extract()?;
-    let opts = f.analyze(cone_deg, tcy_ms);
+    let opts = f.analyze(&a);
     let m = &machine.0;
     detached(py, || {
         polepatch::analyze_nc(&data, m, &opts)
@@ -169,13 +168,12 @@ fn feed_profile<'py>(
     py: Python<'py>,
     data: PyBackedBytes,
     machine: &NativeMachine,
-    cone_deg: f64,
-    tcy_ms: Option<f64>,
     options: &Bound<'py, PyDict>,
 ) -> PyResult<Vec<RunProfile<'py>>> {
     use polepatch::kinematics::Axis;
+    let a: AnalysisKw = options.extract()?;
     let f: FileKw = options.extract()?;
-    let opts = f.analyze(cone_deg, tcy_ms);
+    let opts = f.analyze(&a);
     let m = &machine.0;
     let (runs, axes) = detached(py, || {
         let profile = || -> Result<(Vec<RunSamples>, Vec<String>), polepatch::Error> {

@@ -71,6 +71,25 @@ impl PatcherKw {
     }
 }
 
+/// The analysis options (`polepatch::patcher::AnalysisOptions`) by their Python names.
+#[derive(Debug, Clone, FromPyObject, IntoPyObject)]
+#[pyo3(from_item_all)]
+pub(crate) struct AnalysisKw {
+    /// Singular cone, degrees.
+    cone_deg: f64,
+    /// Interpolation cycle time, ms (None: the machine's).
+    tcy_ms: Option<f64>,
+}
+
+impl AnalysisKw {
+    fn of(a: &patcher::AnalysisOptions) -> AnalysisKw {
+        AnalysisKw {
+            cone_deg: a.cone_deg,
+            tcy_ms: a.tcy_s.map(|s| s * 1e3),
+        }
+    }
+}
+
 /// What the file-level calls add: feed fallback, work offset, the input's name.
 #[derive(Debug, Clone, FromPyObject, IntoPyObject)]
 #[pyo3(from_item_all)]
@@ -106,12 +125,12 @@ impl FileKw {
         }
     }
 
-    /// The library's analysis options.
-    pub(crate) fn analyze(&self, cone_deg: f64, tcy_ms: Option<f64>) -> polepatch::AnalyzeOptions {
+    /// The library's analysis options with the analysis's `a`.
+    pub(crate) fn analyze(&self, a: &AnalysisKw) -> polepatch::AnalyzeOptions {
         polepatch::AnalyzeOptions {
             analysis: patcher::AnalysisOptions {
-                cone_deg,
-                tcy_s: tcy_ms.map(|ms| ms / 1e3),
+                cone_deg: a.cone_deg,
+                tcy_s: a.tcy_ms.map(|ms| ms / 1e3),
                 ..patcher::AnalysisOptions::default()
             },
             feed_fallback_mm_min: self.feed_fallback_mm_min,
@@ -230,9 +249,6 @@ pub(crate) fn defaults(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyDict
         },
     )?;
     d.set_item("post", PostKw::of(&polepatch::post::PostOptions::default()))?;
-    let a = pyo3::types::PyDict::new(py);
-    a.set_item("cone_deg", analyze.analysis.cone_deg)?;
-    a.set_item("tcy_ms", analyze.analysis.tcy_s.map(|s| s * 1e3))?;
-    d.set_item("analyze", a)?;
+    d.set_item("analyze", AnalysisKw::of(&analyze.analysis))?;
     Ok(d)
 }

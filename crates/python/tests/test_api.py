@@ -18,6 +18,7 @@ def test_keyword_defaults_are_the_librarys() -> None:
         polepatch.post_cl: ["patch", "file", "post"],
         polepatch.patch_joints: ["patch"],
         polepatch.analyze_nc: ["analyze", "file"],
+        polepatch.feed_profile: ["analyze", "file"],
     }
     for fn, names in groups.items():
         params = inspect.signature(fn).parameters

@@ -231,8 +231,8 @@ def patch_nc(
         MachineError: an unknown built-in name.
         ValueError: an option out of range (named).
     """
-    text_options = _options(locals(), "data", "machine")
-    out, report = _native.patch_nc(_bytes(data, "data"), _machine(machine), text_options)
+    options = _options(locals(), "data", "machine")
+    out, report = _native.patch_nc(_bytes(data, "data"), _machine(machine), options)
     return out, _report(report)
 
 
@@ -258,10 +258,8 @@ def analyze_nc(
     Raises:
         InputError, MachineError, ValueError: as :func:`patch_nc`.
     """
-    rest = _options(locals(), "data", "machine", "cone_deg", "tcy_ms")
-    report = _native.analyze_nc(
-        _bytes(data, "data"), _machine(machine), cone_deg, tcy_ms, rest
-    )
+    options = _options(locals(), "data", "machine")
+    report = _native.analyze_nc(_bytes(data, "data"), _machine(machine), options)
     return _report(report)
 
 
@@ -295,8 +293,8 @@ def feed_profile(
     Raises:
         InputError, MachineError, ValueError: as :func:`analyze_nc`.
     """
-    rest = _options(locals(), "data", "machine", "cone_deg", "tcy_ms")
-    return _native.feed_profile(_bytes(data, "data"), _machine(machine), cone_deg, tcy_ms, rest)
+    options = _options(locals(), "data", "machine")
+    return _native.feed_profile(_bytes(data, "data"), _machine(machine), options)
 
 
 def post_cl(

@@ -36,19 +36,9 @@ class NativeMachine:
 def patch_nc(
     data: bytes, machine: NativeMachine, options: Mapping[str, Any]
 ) -> Tuple[bytes, str]: ...
-def analyze_nc(
-    data: bytes,
-    machine: NativeMachine,
-    cone_deg: float,
-    tcy_ms: Optional[float],
-    options: Mapping[str, Any],
-) -> str: ...
+def analyze_nc(data: bytes, machine: NativeMachine, options: Mapping[str, Any]) -> str: ...
 def feed_profile(
-    data: bytes,
-    machine: NativeMachine,
-    cone_deg: float,
-    tcy_ms: Optional[float],
-    options: Mapping[str, Any],
+    data: bytes, machine: NativeMachine, options: Mapping[str, Any]
 ) -> List[Dict[str, Any]]: ...
 def post_cl(cl: bytes, machine: NativeMachine, options: Mapping[str, Any]) -> bytes: ...
 def reorient(
