@@ -16,8 +16,8 @@
 //!   a [`PpBuffer`] filled by the library is freed with [`pp_buffer_free`]; everything the
 //!   caller passes in stays the caller's and is only read during the call.
 
-use polepatch::kinematics::{BranchRule, Machine, inverse_path};
-use polepatch::patcher::{Outcome, PatchAxes, Path, patch_path};
+use polepatch::kinematics::{BranchRule, Machine};
+use polepatch::patcher::{Outcome, PatchAxes};
 use std::cell::RefCell;
 use std::ffi::{CStr, CString, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -261,21 +261,8 @@ unsafe fn options(opts: *const PpOptions) -> Result<polepatch::PatchOptions, Fai
     }
     // SAFETY: non-NULL, points to a PpOptions (header contract).
     let o = unsafe { &*opts };
-    if !(o.cone_deg.is_finite() && o.cone_deg > 0.0) {
-        return Err(bad(format!(
-            "cone_deg must be positive, got {}",
-            o.cone_deg
-        )));
-    }
-    if !(0.0..0.5).contains(&o.margin) {
-        return Err(bad(format!("margin must be in [0, 0.5), got {}", o.margin)));
-    }
-    if o.max_decimals > 9 {
-        return Err(bad(format!(
-            "max_decimals must be at most 9, got {}",
-            o.max_decimals
-        )));
-    }
+    // The fields where ≤ 0 means "none" must be numbers; the ranges of every field are
+    // checked by the library (`polepatch::PatchOptions::check`) on each call.
     for (what, v) in [
         ("max_deviation_deg", o.max_deviation_deg),
         ("tcy_ms", o.tcy_ms),
@@ -291,7 +278,7 @@ unsafe fn options(opts: *const PpOptions) -> Result<polepatch::PatchOptions, Fai
     let p = &mut out.patch;
     p.cone_deg = o.cone_deg;
     p.margin = o.margin;
-    p.max_decimals = o.max_decimals as usize;
+    p.max_decimals = usize::try_from(o.max_decimals).unwrap_or(usize::MAX);
     p.max_deviation_deg = (o.max_deviation_deg > 0.0).then_some(o.max_deviation_deg);
     p.axes = if o.only_c {
         PatchAxes::OnlyC
@@ -462,46 +449,15 @@ pub unsafe extern "C" fn pp_cl_to_joints(
             return Err(bad("no points (n = 0)"));
         }
         let rule = branch_rule_of(branch_rule)?;
-        let n6 = n.checked_mul(6).ok_or_else(|| bad("n is too large"))?;
-        // SAFETY: header contract.
-        let cl = unsafe { slice(cl_xyzijk, n6, "cl_xyzijk") }?;
-        // SAFETY: header contract.
-        let out = unsafe { slice_mut(out_xyzpc, n * 5, "out_xyzpc") }?;
+        // SAFETY: header contract: `6·n` readable doubles, read as `n` rows of 6.
+        let cl = unsafe { slice(cl_xyzijk.cast::<[f64; 6]>(), n, "cl_xyzijk") }?;
+        // SAFETY: header contract: `5·n` writable doubles, written as `n` rows of 5.
+        let out = unsafe { slice_mut(out_xyzpc.cast::<[f64; 5]>(), n, "out_xyzpc") }?;
         // SAFETY: non-NULL, a live machine (header contract).
         let machine = unsafe { &(*m).0 };
-        let mut axes = Vec::with_capacity(n);
-        for (k, p) in cl.chunks_exact(6).enumerate() {
-            if p.iter().any(|v| !v.is_finite()) {
-                return Err(bad(format!("point {k}: a value is not finite")));
-            }
-            // Scaled before normalising: the squares of (1e300, 0, 1e300) overflow to
-            // infinity and the axis would become (0, 0, 0), then NaN joints.
-            let m = p[3].abs().max(p[4].abs()).max(p[5].abs());
-            if m == 0.0 {
-                return Err(bad(format!("point {k}: the tool axis (i, j, k) is zero")));
-            }
-            let v = [p[3] / m, p[4] / m, p[5] / m];
-            let norm = v[0].hypot(v[1]).hypot(v[2]);
-            if m * norm < 1e-9 {
-                return Err(bad(format!("point {k}: the tool axis (i, j, k) is zero")));
-            }
-            axes.push([v[0] / norm, v[1] / norm, v[2] / norm]);
-        }
-        let joints = inverse_path(machine, &axes, rule);
-        // Nothing is written unless every point has joints.
-        if let Some(k) = joints
-            .iter()
-            .position(|s| !(s.p_deg.is_finite() && s.c_deg.is_finite()))
-        {
-            let p = &cl[6 * k..6 * k + 6];
-            return Err(bad(format!(
-                "point {k}: no joint values for the tool axis ({}, {}, {})",
-                p[3], p[4], p[5]
-            )));
-        }
-        for (k, (p, s)) in cl.chunks_exact(6).zip(&joints).enumerate() {
-            out[5 * k..5 * k + 5].copy_from_slice(&[p[0], p[1], p[2], s.p_deg, s.c_deg]);
-        }
+        let joints =
+            polepatch::joints::cl_to_joints(machine, cl, rule).map_err(|e| bad(e.to_string()))?;
+        out.copy_from_slice(&joints);
         Ok(())
     })
 }
@@ -534,71 +490,20 @@ pub unsafe extern "C" fn pp_patch_joints(
         if m.is_null() {
             return Err(Fail(PpStatus::PpBadMachine, "machine is NULL".into()));
         }
-        if n < 2 {
-            return Err(bad(format!("a run needs at least 2 points, got {n}")));
-        }
-        if !(feed_mm_min.is_finite() && feed_mm_min > 0.0) {
-            return Err(bad(format!(
-                "feed_mm_min must be positive, got {feed_mm_min}"
-            )));
-        }
         if out_zone_count.is_null() {
             return Err(bad("out_zone_count is NULL"));
         }
-        let n5 = n.checked_mul(5).ok_or_else(|| bad("n is too large"))?;
-        // SAFETY: header contract.
-        let input = unsafe { slice(xyzpc, n5, "xyzpc") }?;
-        // SAFETY: header contract.
-        let out = unsafe { slice_mut(out_xyzpc, n5, "out_xyzpc") }?;
+        // SAFETY: header contract: `5·n` readable doubles, read as `n` rows of 5.
+        let input = unsafe { slice(xyzpc.cast::<[f64; 5]>(), n, "xyzpc") }?;
+        // SAFETY: header contract: `5·n` writable doubles, written as `n` rows of 5.
+        let out = unsafe { slice_mut(out_xyzpc.cast::<[f64; 5]>(), n, "out_xyzpc") }?;
         // SAFETY: header contract.
         let opts = unsafe { options(opts) }?;
         // SAFETY: non-NULL, a live machine (header contract).
         let machine = unsafe { &(*m).0 };
-        let axes: Vec<[f64; 5]> = input
-            .chunks_exact(5)
-            .map(|q| [q[0], q[1], q[2], q[3], q[4]])
-            .collect();
-        if axes.iter().flatten().any(|v| !v.is_finite()) {
-            return Err(bad("a value in xyzpc is not finite"));
-        }
-        let mut s_mm = Vec::with_capacity(n);
-        let mut s = 0.0;
-        for k in 0..n {
-            if k > 0 {
-                let d = ((axes[k][0] - axes[k - 1][0]).powi(2)
-                    + (axes[k][1] - axes[k - 1][1]).powi(2)
-                    + (axes[k][2] - axes[k - 1][2]).powi(2))
-                .sqrt();
-                if d <= 1e-9 {
-                    return Err(bad(format!(
-                        "points {} and {k} have the same tool tip: split the run there",
-                        k - 1
-                    )));
-                }
-                s += d;
-            }
-            s_mm.push(s);
-        }
-        let path = Path {
-            s_mm,
-            axes,
-            feed_mm_min,
-        };
-        let mut popts = opts.patch.clone();
-        popts.c_decimals = popts.max_decimals;
-        popts.p_decimals = popts.max_decimals;
-        popts.keep_last_point = true;
-        let result = patch_path(&path, machine, &popts).map_err(|e| bad(e.to_string()))?;
-        for k in 0..n {
-            let q = &path.axes[k];
-            out[5 * k..5 * k + 5].copy_from_slice(&[
-                q[0],
-                q[1],
-                q[2],
-                result.p_deg[k],
-                result.c_deg[k],
-            ]);
-        }
+        let result = polepatch::joints::patch_joints(machine, input, feed_mm_min, &opts.patch)
+            .map_err(|e| bad(e.to_string()))?;
+        out.copy_from_slice(&result.xyzpc);
         // SAFETY: non-NULL, writable (header contract).
         unsafe { *out_zone_count = result.zones.len() };
         if zones_cap > 0 {

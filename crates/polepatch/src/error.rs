@@ -68,4 +68,17 @@ pub enum Error {
         /// Size of the input, bytes.
         bytes: usize,
     },
+    /// A bad point in joint or CL arrays held in memory ([`crate::joints`]), by its
+    /// 0-based index.
+    #[error("point {index}: {message}")]
+    Point {
+        /// 0-based point index.
+        index: usize,
+        /// What is wrong, naming the value.
+        message: String,
+    },
+    /// A path the patcher refuses ([`crate::joints::patch_joints`]: too few points, a feed
+    /// that is not positive, …).
+    #[error("{0}")]
+    Path(#[from] polepatch_patcher::PathError),
 }

@@ -37,13 +37,14 @@ struct Seen {
 
 /// The report of a program that is proven to have no run point within `opts.cone_deg`
 /// of the pole (no zone: the output is the input), or `None` when that is not proven and
-/// the full path must run. Errors are the input's syntax errors, as [`crate::patch_nc`]
-/// gives them.
+/// the full path must run. Errors are bad options ([`crate::PatchOptions::check`]) and the
+/// input's syntax errors, as [`crate::patch_nc`] gives them.
 pub fn far_from_pole(
     bytes: &[u8],
     machine: &Machine,
     opts: &crate::PatchOptions,
 ) -> Result<Option<FileReport>, crate::Error> {
+    opts.check()?;
     let cone_deg = opts.patch.cone_deg;
     let fallback = opts.feed_fallback_mm_min;
     let mut seen = Seen {

@@ -28,6 +28,7 @@ pub use polepatch_patcher as patcher;
 pub mod end_pose;
 pub mod error;
 pub mod far;
+pub mod joints;
 pub mod machine_frame;
 pub mod notes;
 pub mod patch;
@@ -101,6 +102,90 @@ impl Default for AnalyzeOptions {
     }
 }
 
+/// Most decimal places a rotary value may be written with (`max_decimals`): beyond 9 the
+/// written digits are below any control's resolution and only lengthen the file.
+pub const MAX_WRITTEN_DECIMALS: usize = 9;
+
+/// `v` is a positive, finite number, else an [`Error::Options`] naming `field` and `unit`.
+pub(crate) fn positive(field: &str, unit: &str, v: f64) -> Result<(), Error> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::Options(format!(
+            "{field} must be a positive number of {unit}, got {v}"
+        )))
+    }
+}
+
+/// The options every entry point shares: feed fallback and work offset.
+fn check_common(
+    feed_fallback_mm_min: Option<f64>,
+    work_offset_mm: Option<[f64; 3]>,
+) -> Result<(), Error> {
+    if let Some(f) = feed_fallback_mm_min {
+        positive("feed_fallback_mm_min", "mm/min", f)?;
+    }
+    if let Some(w) = work_offset_mm
+        && w.iter().any(|v| !v.is_finite())
+    {
+        return Err(Error::Options(format!(
+            "work_offset_mm must be three finite numbers of mm, got {w:?}"
+        )));
+    }
+    Ok(())
+}
+
+/// Check the patcher's options: every value in range, or an [`Error::Options`] naming the
+/// field, its unit and the value. [`PatchOptions::check`] and
+/// [`joints::patch_joints`] call it.
+pub fn check_patcher_options(p: &patcher::PatchOptions) -> Result<(), Error> {
+    positive("cone_deg", "degrees", p.cone_deg)?;
+    if let Some(d) = p.max_deviation_deg {
+        positive("max_deviation_deg", "degrees", d)?;
+    }
+    if let Some(t) = p.tcy_s {
+        positive("tcy_s (interpolation cycle time)", "seconds", t)?;
+    }
+    if let Some(l) = p.max_patch_length_mm {
+        positive("max_patch_length_mm", "mm", l)?;
+    }
+    if !(0.0..0.5).contains(&p.margin) {
+        return Err(Error::Options(format!(
+            "margin must be a fraction in [0, 0.5), got {}",
+            p.margin
+        )));
+    }
+    if p.max_decimals > MAX_WRITTEN_DECIMALS {
+        return Err(Error::Options(format!(
+            "max_decimals must be at most {MAX_WRITTEN_DECIMALS}, got {}",
+            p.max_decimals
+        )));
+    }
+    Ok(())
+}
+
+impl PatchOptions {
+    /// Every value in range, or an [`Error::Options`] naming the field. The entry points
+    /// ([`patch_nc`], [`far::far_from_pole`], [`stream::patch_nc_to`]) call it, so a
+    /// caller need not; a front end checks earlier only to name its own flags.
+    pub fn check(&self) -> Result<(), Error> {
+        check_patcher_options(&self.patch)?;
+        check_common(self.feed_fallback_mm_min, self.work_offset_mm)
+    }
+}
+
+impl AnalyzeOptions {
+    /// Every value in range, or an [`Error::Options`] naming the field ([`analyze_nc`] and
+    /// [`stream::analyze_nc_each`] call it).
+    pub fn check(&self) -> Result<(), Error> {
+        positive("cone_deg", "degrees", self.analysis.cone_deg)?;
+        if let Some(t) = self.analysis.tcy_s {
+            positive("tcy_s (interpolation cycle time)", "seconds", t)?;
+        }
+        check_common(self.feed_fallback_mm_min, self.work_offset_mm)
+    }
+}
+
 /// Patch an NC program held in memory: the rewritten bytes (identical to `bytes` except
 /// the rotary words that had to change) and the report. [`patch_nc_to`] into a `Vec`.
 ///
@@ -159,4 +244,115 @@ pub fn analyze_nc(
     opts: &AnalyzeOptions,
 ) -> Result<AnalyzeReport, Error> {
     stream::analyze_nc_stretches(bytes, machine, opts)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The default options with one change.
+    fn with(change: impl Fn(&mut PatchOptions)) -> PatchOptions {
+        let mut o = PatchOptions::default();
+        change(&mut o);
+        o
+    }
+
+    #[test]
+    fn defaults_pass_the_checks() {
+        assert!(PatchOptions::default().check().is_ok());
+        assert!(AnalyzeOptions::default().check().is_ok());
+    }
+
+    #[test]
+    fn every_option_out_of_range_is_named() {
+        let bad: Vec<(&str, PatchOptions)> = vec![
+            ("cone_deg", with(|o| o.patch.cone_deg = 0.0)),
+            ("cone_deg", with(|o| o.patch.cone_deg = f64::NAN)),
+            (
+                "max_deviation_deg",
+                with(|o| o.patch.max_deviation_deg = Some(-1.0)),
+            ),
+            ("tcy_s", with(|o| o.patch.tcy_s = Some(f64::INFINITY))),
+            (
+                "max_patch_length_mm",
+                with(|o| o.patch.max_patch_length_mm = Some(0.0)),
+            ),
+            ("margin", with(|o| o.patch.margin = 0.5)),
+            ("margin", with(|o| o.patch.margin = -0.01)),
+            (
+                "max_decimals",
+                with(|o| o.patch.max_decimals = MAX_WRITTEN_DECIMALS + 1),
+            ),
+            (
+                "feed_fallback_mm_min",
+                with(|o| o.feed_fallback_mm_min = Some(0.0)),
+            ),
+            (
+                "work_offset_mm",
+                with(|o| o.work_offset_mm = Some([0.0, f64::NAN, 0.0])),
+            ),
+        ];
+        let program = b"%P G71 *\nN10 G01 X0 Y0 Z0 A1 C0 F1000 *\nN20 X1 A0.5 C90 *\n";
+        let m = kinematics::Machine::builtin("mikron-ucp710").unwrap();
+        for (field, o) in bad {
+            match o.check() {
+                Err(Error::Options(msg)) => assert!(msg.starts_with(field), "{field}: {msg}"),
+                other => panic!("{field}: {other:?}"),
+            }
+            // Every entry point refuses them, before reading the program.
+            assert!(
+                matches!(patch_nc(program, &m, &o), Err(Error::Options(_))),
+                "{field}"
+            );
+            let mut sink = Vec::new();
+            assert!(
+                matches!(
+                    stream::patch_nc_to(program, &m, &o, &mut sink),
+                    Err(Error::Options(_))
+                ),
+                "{field}"
+            );
+        }
+    }
+
+    #[test]
+    fn analysis_and_reorientation_options_are_checked() {
+        let program = b"%P G71 *\nN10 G01 X0 Y0 Z0 A1 C0 F1000 *\nN20 X1 A0.5 C90 *\n";
+        let m = kinematics::Machine::builtin("mikron-ucp710").unwrap();
+        let analyze = |cone_deg, tcy_s| {
+            let opts = AnalyzeOptions {
+                analysis: patcher::AnalysisOptions {
+                    cone_deg,
+                    tcy_s,
+                    ..patcher::AnalysisOptions::default()
+                },
+                ..AnalyzeOptions::default()
+            };
+            match analyze_nc(program, &m, &opts) {
+                Err(Error::Options(msg)) => msg,
+                other => panic!("{other:?}"),
+            }
+        };
+        assert!(analyze(-5.0, None).starts_with("cone_deg"));
+        assert!(analyze(5.0, Some(0.0)).starts_with("tcy_s"));
+        let tilt = |theta_x_deg, pivot_mm| reorient::Tilt {
+            theta_x_deg,
+            theta_z_deg: 0.0,
+            pivot_mm,
+        };
+        for (t, cone, field) in [
+            (tilt(f64::NAN, [0.0; 3]), 5.0, "theta_x_deg"),
+            (tilt(10.0, [0.0, f64::INFINITY, 0.0]), 5.0, "pivot_mm"),
+            (tilt(10.0, [0.0; 3]), 0.0, "cone_deg"),
+        ] {
+            match reorient::reorient_nc(program, &m, &t, "p", cone) {
+                Err(Error::Options(msg)) => assert!(msg.starts_with(field), "{msg}"),
+                other => panic!("{field}: {other:?}"),
+            }
+        }
+        assert!(matches!(
+            reorient::search(program, &m, [0.0; 3], "p", -1.0),
+            Err(Error::Options(msg)) if msg.starts_with("cone_deg")
+        ));
+    }
 }

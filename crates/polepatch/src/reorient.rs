@@ -429,11 +429,18 @@ pub fn program_figures(
     f
 }
 
-fn analysis_options(cone_deg: f64) -> AnalysisOptions {
-    AnalysisOptions {
+/// The analysis options of a cone, checked; and the pivot, checked.
+fn analysis_options(cone_deg: f64, pivot_mm: [f64; 3]) -> Result<AnalysisOptions, Error> {
+    crate::positive("cone_deg", "degrees", cone_deg)?;
+    if pivot_mm.iter().any(|v| !v.is_finite()) {
+        return Err(Error::Options(format!(
+            "pivot_mm must be three finite numbers of mm, got {pivot_mm:?}"
+        )));
+    }
+    Ok(AnalysisOptions {
         cone_deg,
         ..AnalysisOptions::default()
-    }
+    })
 }
 
 /// Reorient a program held in memory by `tilt`: the new bytes (only the changed or
@@ -446,8 +453,8 @@ pub fn reorient_nc(
     cone_deg: f64,
 ) -> Result<(Vec<u8>, ReorientReport), Error> {
     check_tilt(tilt)?;
+    let opts = analysis_options(cone_deg, tilt.pivot_mm)?;
     let lp = load_nc(bytes.to_vec(), name, machine, None)?;
-    let opts = analysis_options(cone_deg);
     let before = program_figures(&lp, machine, &opts);
     let (out, after, words, untouched) = apply(&lp, machine, tilt, &opts)?;
     let report = ReorientReport {
@@ -511,8 +518,8 @@ pub fn search(
     name: &str,
     cone_deg: f64,
 ) -> Result<(Vec<u8>, ReorientReport), Error> {
+    let opts = analysis_options(cone_deg, pivot_mm)?;
     let lp = load_nc(bytes.to_vec(), name, machine, None)?;
-    let opts = analysis_options(cone_deg);
     let before = program_figures(&lp, machine, &opts);
     let primary = lp.primary_letter;
     let mut alternatives: Vec<Alternative> = Vec::new();

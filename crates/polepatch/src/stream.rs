@@ -322,6 +322,7 @@ pub fn patch_nc_to(
     opts: &crate::PatchOptions,
     out: &mut dyn Write,
 ) -> Result<FileReport, Error> {
+    opts.check()?;
     let rd = Reading {
         name: &opts.name,
         cone_deg: opts.patch.cone_deg,
@@ -424,6 +425,7 @@ pub fn analyze_nc_each(
     opts: &crate::AnalyzeOptions,
     each: &mut dyn FnMut(Piece<'_>) -> std::io::Result<()>,
 ) -> Result<(), Error> {
+    opts.check()?;
     let rd = Reading {
         name: &opts.name,
         cone_deg: opts.analysis.cone_deg,
