@@ -6,9 +6,9 @@
 //! - blocks whose axis or feed words are expressions or variables (`A#<a>`, `X=R1+2`,
 //!   `X+Q5`): kept byte for byte, their axes unknown after them, so no run spans them;
 //! - arcs (G2/G3, conversational `C`/`CR`/`CT`/`CP`/`LP`/`APPR`/`DEP`) and blocks that
-//!   block delete may skip, when they move near the pole (the primary axis within the cone
-//!   at their start or end, or unknown there): the rotary motion across them is not
-//!   analysed, so a slowdown there would go unseen;
+//!   block delete may skip, when they turn a rotary axis near the pole (the primary axis
+//!   within the cone at their start or end, or unknown there): the rotary motion across
+//!   them is not analysed, so a slowdown there would go unseen;
 //! - conversational lines polepatch does not model;
 //! - moves with a feed per revolution (G95), which has no time base;
 //! - and, as warnings: letters carried through without analysis (`E`, `U`, `V`, `W`) and
@@ -17,7 +17,7 @@
 //! `--strict` counts the items (not the warnings) as a failure: the file was read, but
 //! not all of it was analysed.
 
-use polepatch_nc::modal::{A, B};
+use polepatch_nc::modal::{A, B, C};
 use polepatch_nc::{Block, FeedMode, Flags, Modal, Motion, Word};
 use serde::Serialize;
 
@@ -111,16 +111,23 @@ impl Notes {
         if f.has(Flags::NOT_MODELLED) {
             self.add(line, SkipReason::NotModelled, always);
         }
-        if block.is_move {
+        // An arc or a skippable move that turns no rotary axis cannot swing C.
+        let turns = [A, B, C]
+            .into_iter()
+            .any(|i| before.pos[i] != after.pos[i]);
+        if block.is_move && turns {
             if f.has(Flags::ARC) {
                 self.add(line, SkipReason::ArcNearPole, near);
             }
             if f.has(Flags::SKIPPABLE) {
                 self.add(line, SkipReason::SkippableNearPole, near);
             }
-            if after.feed_mode == FeedMode::PerRevolution && after.motion == Motion::Linear {
-                self.add(line, SkipReason::FeedPerRevolution, always);
-            }
+        }
+        if block.is_move
+            && after.feed_mode == FeedMode::PerRevolution
+            && after.motion == Motion::Linear
+        {
+            self.add(line, SkipReason::FeedPerRevolution, always);
         }
         if f.has(Flags::UNCLOSED_COMMENT) {
             self.unclosed_count += 1;
@@ -245,6 +252,9 @@ mod tests {
         assert_eq!(items[0].lines, [2, 2]);
         // With B as the tilting letter (never programmed: read as unknown), both are near.
         assert_eq!(notes(text, B).0.len(), 2);
+        // A 3-axis arc at the pole turns no rotary axis: nothing to swing.
+        let flat = "G1 X0 Y0 Z0 A0 C0 F100\nG2 X10 Y0 I5 J0\n";
+        assert!(notes(flat, A).0.is_empty());
     }
 
     #[test]
