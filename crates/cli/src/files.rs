@@ -156,6 +156,22 @@ pub fn stage(
     Ok(tmp)
 }
 
+/// [`stage`] for output written as it is made (a trajectory): `write` gets a buffered
+/// writer on the temporary file beside `path`; `persist(path)` puts it in place.
+pub fn stage_streamed(
+    path: &FsPath,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> std::io::Result<tempfile::NamedTempFile> {
+    let mut tmp = temp_beside(path)?;
+    {
+        let mut w = std::io::BufWriter::with_capacity(1 << 16, tmp.as_file_mut());
+        write(&mut w)?;
+        w.flush()?;
+    }
+    finish_staged(&mut tmp, path, None)?;
+    Ok(tmp)
+}
+
 /// An empty temporary file in `path`'s folder (deleted when dropped).
 fn temp_beside(path: &FsPath) -> std::io::Result<tempfile::NamedTempFile> {
     let dir = match path.parent() {

@@ -34,6 +34,9 @@ enum Command {
     /// Tilt the workpiece on a jig (C17's avoidance): given angles, or the smallest tilt
     /// that makes the program reach feed on both rotary axes.
     Reorient(reorient_cmd::ReorientArgs),
+    /// The cycle time a jerk-limited controller would take, per run, next to Equation 6's
+    /// estimate and L/F; the trajectory (CSV) and the feed along s (SVG), before and after.
+    Simulate(simulate_cmd::SimulateArgs),
     /// Quality suite: analyze and patch every program × machine, compare the deviation
     /// with the best possible for C-only changes, and print one table.
     Bench(bench_cmd::BenchArgs),
@@ -153,6 +156,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench_cmd::run(args),
         Command::Reorient(args) => reorient_cmd::run(args),
         Command::Post(args) => post_cmd::run(args),
+        Command::Simulate(args) => simulate_cmd::run(args),
     };
     match result {
         Ok(code) => code,
@@ -167,6 +171,7 @@ mod bench_cmd;
 mod patch;
 mod post_cmd;
 mod reorient_cmd;
+mod simulate_cmd;
 
 pub(crate) fn machine(name: &str) -> Result<Machine> {
     Ok(Machine::load(name)?)

@@ -7,6 +7,7 @@ use polepatch_patcher::{Path, PathError};
 
 use crate::caps::Local;
 use crate::error::SimError;
+use crate::tolerances::LIMIT_USE;
 
 /// A motion's path: the parts (runs that follow one another without a stop) joined at
 /// their shared points, one analysis spline per axis over all their points.
@@ -96,6 +97,19 @@ impl Geometry {
         std::array::from_fn(|a| self.splines[a].eval(s))
     }
 
+    /// The programmed feed at `s`, mm/s (at a shared point, the lower of the two parts').
+    pub fn feed_at(&self, s: f64) -> f64 {
+        let k = self.knots.partition_point(|&v| v <= s);
+        let span = k.saturating_sub(1).min(self.knots.len() - 2);
+        let p = self.part_of_span(span);
+        let f = self.feed_mm_s[p];
+        if k >= 1 && k - 1 < self.knots.len() && self.knots[k - 1] == s && span > 0 {
+            f.min(self.feed_mm_s[self.part_of_span(span - 1)])
+        } else {
+            f
+        }
+    }
+
     /// The part that span `k` (between points k and k + 1) belongs to.
     pub fn part_of_span(&self, k: usize) -> usize {
         self.part_end.partition_point(|&e| e <= k)
@@ -116,12 +130,20 @@ const CHUNK: usize = 4096;
 
 impl Grid {
     /// Cut each span into `⌈h/(F·Tcy)⌉` cells (at most `max_cells`), and bound the feed on
-    /// each cell by Equation 6 with the largest |q_s|, |q_ss|, |q_sss| of each axis over the
+    /// each cell by Equation 6 (limits × [`LIMIT_USE`]) with the largest |q_s|, |q_ss|, |q_sss| of each axis over the
     /// cell (exact for the cubic pieces: q_s is quadratic, q_ss linear, q_sss constant on a
     /// span), capped by F. The limit at a grid point is the lower of its two cells', and the
     /// limit curve is linear between grid points: below Equation 6 everywhere on the cell.
     pub fn new(geo: &Geometry, machine: &Machine, tcy_s: f64, max_cells: usize) -> Grid {
         let n = geo.knots.len();
+        // Equation 6 with the limits the passes plan with.
+        let mut planned = machine.clone();
+        for l in &mut planned.limits {
+            l.v *= LIMIT_USE;
+            l.a *= LIMIT_USE;
+            l.j *= LIMIT_USE;
+        }
+        let machine = &planned;
         let mut s = Vec::with_capacity(n);
         for k in 0..n - 1 {
             let f = geo.feed_mm_s[geo.part_of_span(k)];

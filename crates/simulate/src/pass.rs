@@ -22,7 +22,9 @@ use polepatch_kinematics::Machine;
 
 use crate::caps::Local;
 use crate::grid::Geometry;
-use crate::tolerances::{CEILING_REL, CRUISE_ACCEL_MM_S2, CRUISE_REL, END_MM, JERK_BISECTIONS};
+use crate::tolerances::{
+    CEILING_REL, CRAWL_JERK_SHARE, CRUISE_ACCEL_MM_S2, CRUISE_REL, END_MM, JERK_BISECTIONS,
+};
 
 /// A ceiling along a pass: values at increasing pass positions, and between them W^(3/2)
 /// linear, or (given the acceleration of the profile it was recorded from) cubic Hermite;
@@ -134,6 +136,9 @@ pub(crate) struct Pass<'a> {
     pub geo: &'a Geometry,
     pub machine: &'a Machine,
     pub ceiling: Ceiling<'a>,
+    /// The velocity limit curve, when the ceiling is another profile: a crawl (below)
+    /// may use it where the profile stopped.
+    pub limit: Option<Ceiling<'a>>,
     /// Forward (x = s) or backward (x = L − s).
     pub forward: bool,
     /// Cycle time, s.
@@ -161,8 +166,22 @@ impl Pass<'_> {
         (ac, jc)
     }
 
-    /// Whether (x1, v1, a1) is safe (module docs).
-    fn safe(&self, loc: &Local, x1: f64, v1: f64, a1: f64, hint: usize, len: f64) -> bool {
+    /// Whether (x1, v1, a1) is safe (module docs); `vmax` is the feed and the axes' V
+    /// here.
+    #[allow(clippy::too_many_arguments)]
+    fn safe(
+        &self,
+        loc: &Local,
+        vmax: f64,
+        x1: f64,
+        v1: f64,
+        a1: f64,
+        hint: usize,
+        len: f64,
+    ) -> bool {
+        if v1 > vmax {
+            return false;
+        }
         let (ac, jc) = self.caps(loc, v1.max(0.0), a1.abs());
         if a1.abs() > ac.max(0.0) * (1.0 + 1e-12) + 1e-12 || jc < 0.0 {
             return false;
@@ -214,6 +233,9 @@ impl Pass<'_> {
         while st.x < len - END_MM {
             let d = self.geo.derivs(self.s_of(st.x, len));
             let loc = Local::from_derivs(&d);
+            let vmax = loc
+                .v_cap(self.machine)
+                .min(self.geo.feed_at(self.s_of(st.x, len)));
             let (w, _, i) = self.ceiling.at(st.x, hint);
             hint = i;
             // A cruise on a flat stretch of the ceiling: jump to the next grid point
@@ -228,7 +250,7 @@ impl Pass<'_> {
                 if xn > st.x
                     && self.ceiling.v[i] == self.ceiling.v[nx]
                     && self.ceiling.a.is_none_or(|a| a[i] == 0.0 && a[nx] == 0.0)
-                    && self.safe(&loc, xn, st.v, 0.0, i, len)
+                    && self.safe(&loc, vmax, xn, st.v, 0.0, i, len)
                 {
                     let to = State {
                         t: st.t + (xn - st.x) / st.v,
@@ -261,7 +283,7 @@ impl Pass<'_> {
             };
             let ok = |j: f64| {
                 let (x1, v1, a1) = next(j);
-                self.safe(&loc, x1, v1, a1, hint, len)
+                self.safe(&loc, vmax, x1, v1, a1, hint, len)
             };
             let j = if ok(hi) {
                 hi
@@ -282,10 +304,41 @@ impl Pass<'_> {
             let (mut x1, mut v1, mut a1) = next(j);
             let mut t1 = st.t + dt;
             if v1 < 0.0 {
-                // Stopped within the cycle (only near a standstill): rest there.
+                // Stopped within the cycle (only near a standstill): rest where v = 0.
+                let (mut lo_t, mut hi_t) = (0.0, dt);
+                for _ in 0..60 {
+                    let tm = 0.5 * (lo_t + hi_t);
+                    if st.v + st.a * tm + 0.5 * j * tm * tm > 0.0 {
+                        lo_t = tm;
+                    } else {
+                        hi_t = tm;
+                    }
+                }
+                let tm = lo_t;
+                x1 = (st.x + st.v * tm + 0.5 * st.a * tm * tm + j * tm * tm * tm / 6.0).max(st.x);
                 v1 = 0.0;
                 a1 = 0.0;
             }
+            if x1 <= st.x && st.v <= 0.0 {
+                // At rest where the ceiling is below what one cycle at the jerk cap makes
+                // (W < j_cap·Tcy²): go on at a crawl whose step from rest is a part of the
+                // jerk cap (counted as a clip).
+                let xc = x1.max(st.x);
+                let w0 = match &self.limit {
+                    Some(l) if st.v <= 0.0 => l.at(xc, 0).0,
+                    _ => self.ceiling.at(xc, hint).0,
+                };
+                v1 = (w0.min(vmax) * (1.0 - 1e-9))
+                    .min(CRAWL_JERK_SHARE * jm * dt * dt)
+                    .max(0.0);
+                a1 = 0.0;
+                x1 = x1.max(st.x) + v1 * dt;
+                if v1 > 0.0 {
+                    stats.clips += 1;
+                }
+            }
+            // Never backwards (a cycle in which the speed dips below 0 and back).
+            x1 = x1.max(st.x);
             if x1 > len {
                 // The last, partial cycle: the time at which x reaches L.
                 let (mut t_lo, mut t_hi) = (0.0, dt);
@@ -305,6 +358,7 @@ impl Pass<'_> {
                 t1 = st.t + tm;
             }
             let (w1, aw1, _) = self.ceiling.at(x1, hint);
+            let w1 = w1.min(vmax);
             if v1 > w1 * (1.0 + CEILING_REL) {
                 v1 = w1;
                 a1 = aw1.clamp(-ac, ac);

@@ -23,9 +23,9 @@ pub const MAX_CELLS_PER_SPAN: usize = 8;
 
 /// Fractions of the acceleration and jerk caps the backward pass plans with: the forward
 /// pass follows the backward profile with the full caps, and this room lets it do so
-/// within a cycle's discretisation (0.5 % of A, 2 % of J: the recorded profile is
+/// within a cycle's discretisation (1 % of A, 2 % of J: the recorded profile is
 /// interpolated between grid points, which bends it most where the jerk switches).
-pub const BACKWARD_USE: [f64; 2] = [0.995, 0.98];
+pub const BACKWARD_USE: [f64; 2] = [0.99, 0.98];
 
 /// The backward pass records its state where the jerk changes by more than this fraction
 /// of its size from one cycle to the next (a switch of the bang-bang profile).
@@ -37,3 +37,8 @@ pub const CRUISE_REL: f64 = 1e-9;
 /// point in one step (when no trajectory is asked for). The acceleration set to 0 there
 /// is far below any machine's A·Tcy.
 pub const CRUISE_ACCEL_MM_S2: f64 = 1e-6;
+
+/// Where the velocity limit is below what one cycle at the jerk cap makes
+/// (W < j_cap·Tcy²), a pass at rest crawls at a speed whose step from rest is at most this
+/// share of the jerk cap (finite differences: a jerk of this share for one cycle).
+pub const CRAWL_JERK_SHARE: f64 = 0.5;
