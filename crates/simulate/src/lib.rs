@@ -303,16 +303,12 @@ pub fn simulate(
     let back = Pass {
         geo: &geo,
         machine,
-        ceiling: Ceiling {
-            x: &xb,
-            v: &wb,
-            a: None,
-        },
+        ceiling: Ceiling::new(&xb, &wb, None),
         limit: None,
         forward: false,
         dt: tcy_s,
         use_caps: tolerances::BACKWARD_USE,
-        every_cycle: false,
+        every_cycle: opts.every_cycle,
     };
     let mut store = Store {
         grid: &xb,
@@ -336,16 +332,8 @@ pub fn simulate(
     let fwd = Pass {
         geo: &geo,
         machine,
-        ceiling: Ceiling {
-            x: &bx,
-            v: &bv,
-            a: Some(&ba),
-        },
-        limit: Some(Ceiling {
-            x: &grid.s,
-            v: &grid.limit,
-            a: None,
-        }),
+        ceiling: Ceiling::new(&bx, &bv, Some(&ba)),
+        limit: Some(Ceiling::new(&grid.s, &grid.limit, None)),
         forward: true,
         dt: tcy_s,
         use_caps: [1.0, 1.0],

@@ -12,7 +12,7 @@ pub const CEILING_REL: f64 = 1e-9;
 /// taken as reached (the spline is evaluated there exactly).
 pub const END_MM: f64 = 1e-5;
 
-/// Bisection steps on the jerk of one cycle (the chosen jerk is within 2^-24 of the
+/// Bisection steps on the jerk of one cycle (the chosen jerk is within 2^-16 of the
 /// largest safe one, relative to the jerk range).
 pub const JERK_BISECTIONS: usize = 24;
 

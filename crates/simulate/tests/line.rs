@@ -5,6 +5,7 @@ mod common;
 
 use common::{assert_within_limits, line, trajectory};
 use polepatch_kinematics::Machine;
+use polepatch_simulate::{SimOptions, simulate};
 
 /// Duration of the time-optimal rest-to-rest motion over `d` with |v| ≤ `v`, |a| ≤ `a`,
 /// |j| ≤ `j` (symmetric S-curve; standard closed form):
@@ -100,6 +101,20 @@ fn a_line_takes_the_s_curve_time() {
                     "{what}: simulated {got} s, closed form {want} s"
                 );
                 assert_within_limits(&tr, &m, &what);
+                // The report alone (steps of up to MAX_CYCLES_PER_STEP cycles within a
+                // cell of the ceiling): within 2 %.
+                let quick = simulate(
+                    &[line(axis, len, spacing, feed)],
+                    &m,
+                    &SimOptions::default(),
+                    &mut |_, _| {},
+                )
+                .unwrap()
+                .time_s;
+                assert!(
+                    (quick - want).abs() <= want * 0.02 + slack,
+                    "{what}: report-only simulation {quick} s, closed form {want} s"
+                );
                 // At rest at both ends, at the end of the path.
                 assert_eq!(tr.feed[0], 0.0);
                 assert!(
