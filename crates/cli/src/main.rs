@@ -101,6 +101,11 @@ pub(crate) struct PatchArgs {
     /// Worker threads for batches (default: all cores).
     #[arg(long)]
     pub(crate) jobs: Option<usize>,
+    /// Simulate the input and the output (`polepatch simulate`) and put the cycle times
+    /// before and after in the report and the summary (takes about as long as
+    /// simulating both).
+    #[arg(long)]
+    pub(crate) simulate: bool,
     /// Work offset X,Y,Z (mm, machine coordinates of the program's zero) for a machine
     /// with a kinematic chain, where the program only names it (G54); default: the
     /// program's datum shift (Heidenhain G54 X Y Z).

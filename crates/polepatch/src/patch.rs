@@ -294,6 +294,10 @@ pub struct FileReport {
     pub warnings: Vec<String>,
     /// One row per zone.
     pub zones: Vec<ZoneRow>,
+    /// The simulated cycle time of the input and of the output
+    /// ([`crate::simulate::compare`]), when the caller asked for it (`patch --simulate`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub simulated: Option<crate::simulate::SimulatedTimes>,
 }
 
 impl FileReport {
@@ -311,6 +315,7 @@ impl FileReport {
             untouched_runs: Vec::new(),
             warnings,
             zones: Vec::new(),
+            simulated: None,
         }
     }
     /// Zones that stay below feed (including those of untouched runs).

@@ -360,3 +360,55 @@ pub fn simulate_nc_with(
     sim.report.warnings = warnings;
     Ok(sim.report)
 }
+
+/// The simulated times of a program before and after a patch, for the patch report.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct SimulatedTimes {
+    /// Simulated time of the input, s.
+    pub before_s: f64,
+    /// Simulated time of the output, s.
+    pub after_s: f64,
+    /// Equation 6's estimate of the input, s.
+    pub eq6_before_s: f64,
+    /// Equation 6's estimate of the output, s.
+    pub eq6_after_s: f64,
+    /// The runs whose simulated time changed.
+    pub runs: Vec<RunTimes>,
+}
+
+/// One run of [`SimulatedTimes`].
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct RunTimes {
+    /// Run number, from 1.
+    pub run: usize,
+    /// File lines of its first point and last block.
+    pub lines: [usize; 2],
+    /// Simulated, before and after, s.
+    pub time_s: [f64; 2],
+    /// Equation 6's estimate, before and after, s.
+    pub eq6_time_s: [f64; 2],
+}
+
+/// The times of `before` and `after` (the same program before and after a patch: the
+/// same runs) side by side.
+pub fn compare(before: &SimulateReport, after: &SimulateReport) -> SimulatedTimes {
+    let runs = before
+        .runs
+        .iter()
+        .zip(&after.runs)
+        .filter(|(b, a)| b.run == a.run && (b.time_s != a.time_s || b.eq6_time_s != a.eq6_time_s))
+        .map(|(b, a)| RunTimes {
+            run: b.run,
+            lines: b.lines,
+            time_s: [b.time_s, a.time_s],
+            eq6_time_s: [b.eq6_time_s, a.eq6_time_s],
+        })
+        .collect();
+    SimulatedTimes {
+        before_s: before.total.time_s,
+        after_s: after.total.time_s,
+        eq6_before_s: before.total.eq6_time_s,
+        eq6_after_s: after.total.eq6_time_s,
+        runs,
+    }
+}
