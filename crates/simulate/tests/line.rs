@@ -101,6 +101,12 @@ fn a_line_takes_the_s_curve_time() {
                     "{what}: simulated {got} s, closed form {want} s"
                 );
                 assert_within_limits(&tr, &m, &what);
+                // The figures of docs/simulation.md (`-- --nocapture`).
+                println!(
+                    "| {name} | {} | {len} | {feed} | {kind} | {want:.4} | {got:.4} | {:+.2} % |",
+                    ["X", "Y", "Z"][axis],
+                    100.0 * (got / want - 1.0)
+                );
                 // The report alone (steps of up to MAX_CYCLES_PER_STEP cycles within a
                 // cell of the ceiling): within 2 %.
                 let quick = simulate(
