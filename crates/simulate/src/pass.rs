@@ -23,7 +23,8 @@ use polepatch_kinematics::Machine;
 use crate::caps::Local;
 use crate::grid::Geometry;
 use crate::tolerances::{
-    CEILING_REL, CRAWL_JERK_SHARE, CRUISE_ACCEL_MM_S2, CRUISE_REL, END_MM, JERK_BISECTIONS,
+    CEILING_REL, CRAWL_CRUISE_REL, CRAWL_JERK_SHARE, CRUISE_ABS_MM_S, CRUISE_REL, END_MM,
+    JERK_BISECTIONS, SETTLE_REL,
 };
 
 /// A ceiling along a pass: values at increasing pass positions, and between them W^(3/2)
@@ -285,11 +286,14 @@ impl Pass<'_> {
             let dt = self.dt;
             // A cruise on a flat stretch of the ceiling: jump to the next grid point
             // when the state there is safe (then it is everywhere before it).
-            if !self.every_cycle
-                && st.a.abs() <= CRUISE_ACCEL_MM_S2
-                && st.v > 0.0
-                && st.v >= w * (1.0 - CRUISE_REL)
-            {
+            // Within CRUISE_REL of the ceiling, or of one cycle at the jerk cap where the
+            // ceiling is below that (the crawl regime, where a cycle's jerk is coarser
+            // than the speed).
+            let one_cycle = self.caps(&loc, st.v, st.a.abs()).1.max(0.0) * self.dt * self.dt;
+            let near = (CRUISE_REL * w)
+                .max(CRAWL_CRUISE_REL * w.min(one_cycle))
+                .max(CRUISE_ABS_MM_S);
+            if !self.every_cycle && st.a.abs() * self.dt <= near && st.v > 0.0 && st.v >= w - near {
                 let nx = (i + 1).min(self.ceiling.x.len() - 1);
                 let xn = self.ceiling.x[nx].min(len);
                 if xn > st.x
@@ -334,8 +338,15 @@ impl Pass<'_> {
                 let (x1, v1, a1) = next(j);
                 self.safe(&loc, vmax, x1, v1, a1, hint, len)
             };
+            // On a flat ceiling, just under it: settle (a → 0) rather than take the
+            // largest safe jerk, which would overshoot and chatter about the ceiling.
+            let (w0, aw0, _) = self.ceiling.at(st.x, hint);
+            let jz = (-st.a / dt).clamp(lo, hi);
+            let settle = aw0 == 0.0 && w0 - st.v <= SETTLE_REL * w0;
             let j = if ok(hi) {
                 hi
+            } else if settle && ok(jz) {
+                jz
             } else if !ok(lo) {
                 lo
             } else {

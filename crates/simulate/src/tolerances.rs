@@ -31,14 +31,24 @@ pub const BACKWARD_USE: [f64; 2] = [0.99, 0.98];
 /// of its size from one cycle to the next (a switch of the bang-bang profile).
 pub const JERK_SWITCH: f64 = 0.25;
 
-/// A state whose speed is within this fraction of a flat ceiling …
-pub const CRUISE_REL: f64 = 1e-9;
-/// … and whose |acceleration| is below this, mm/s², cruises: it may jump to the next grid
-/// point in one step (when no trajectory is asked for). The acceleration set to 0 there
-/// is far below any machine's A·Tcy.
-pub const CRUISE_ACCEL_MM_S2: f64 = 1e-6;
+/// A state within this fraction of a flat ceiling (or [`CRUISE_ABS_MM_S`], the larger),
+/// whose acceleration changes its speed by less than that in a cycle, cruises: when no
+/// trajectory is asked for it jumps to the next grid point in one step with a = 0. The
+/// speed and acceleration it drops are below 10⁻⁷ of the feed and 10⁻⁷·F/Tcy.
+pub const CRUISE_REL: f64 = 1e-7;
+/// … or this, mm/s (the resolution of the jerk bisection at the slowest feeds).
+pub const CRUISE_ABS_MM_S: f64 = 1e-9;
 
 /// Where the velocity limit is below what one cycle at the jerk cap makes
 /// (W < j_cap·Tcy²), a pass at rest crawls at a speed whose step from rest is at most this
 /// share of the jerk cap (finite differences: a jerk of this share for one cycle).
 pub const CRAWL_JERK_SHARE: f64 = 0.5;
+
+/// Within this fraction under a flat ceiling a pass settles (takes the jerk that brings
+/// the acceleration to 0 when that is safe) instead of the largest safe jerk.
+pub const SETTLE_REL: f64 = 1e-6;
+
+/// Where the ceiling is below one cycle at the jerk cap (j_cap·Tcy², the crawl regime) a
+/// state within this fraction of the ceiling cruises (see [`CRUISE_REL`]): the cycle is
+/// too coarse there to come closer without chattering.
+pub const CRAWL_CRUISE_REL: f64 = 1e-3;
