@@ -243,6 +243,23 @@ enum PpStatus pp_patch_nc(const struct PpMachine *m,
                           struct PpBuffer *out_report_json);
 
 /*
+ Simulate an NC program held in memory: `*out_report_json` gets the JSON of
+ `polepatch simulate --json` for one program (per run the simulated time of a
+ jerk-limited controller, Equation 6's estimate, L/F, the lowest feed and its line; the
+ totals). Of `opts` (NULL for the defaults) it uses `tcy_ms`, `feed_fallback_mm_min`,
+ the work offset and `name`. The buffer is the caller's to free with `pp_buffer_free`.
+
+ # Safety
+ `m` is a live machine; `input` points to `len` readable bytes; `opts` is NULL or a
+ valid `PpOptions`; `out_report_json` points to a writable `PpBuffer`.
+ */
+enum PpStatus pp_simulate_nc(const struct PpMachine *m,
+                             const uint8_t *input,
+                             size_t len,
+                             const struct PpOptions *opts,
+                             struct PpBuffer *out_report_json);
+
+/*
  Joints for CL points: `cl_xyzijk` holds `n` points of x y z i j k (mm; a tool axis,
  normalised here, must not be zero); `out_xyzpc` gets `n` points of x y z p c (x y z as
  given, the tool tip in the part frame for a TCPM program; p and c in degrees, C

@@ -374,3 +374,41 @@ fn refusals_give_a_status_and_a_message() {
         pp_buffer_free(std::ptr::null_mut());
     }
 }
+
+/// `pp_simulate_nc` is `polepatch::simulate_nc`: the same report JSON on SING for both
+/// machines; a NULL output is refused with a message.
+#[test]
+fn simulate_nc_through_the_abi_is_the_library() {
+    let bytes = std::fs::read(root().join("fixtures/c17/SING.I")).unwrap();
+    for name in Machine::builtin_names() {
+        let m = machine(name);
+        let mut out = PpBuffer {
+            data: std::ptr::null_mut(),
+            len: 0,
+        };
+        let status =
+            unsafe { pp_simulate_nc(m, bytes.as_ptr(), bytes.len(), std::ptr::null(), &mut out) };
+        assert_eq!(status, PpStatus::PpOk, "{}", last_error());
+        let got: serde_json::Value = serde_json::from_slice(&take(&mut out)).unwrap();
+        let lib = polepatch::simulate_nc(
+            &bytes,
+            &Machine::builtin(name).unwrap(),
+            &polepatch::SimulateOptions::default(),
+        )
+        .unwrap();
+        assert_eq!(got, serde_json::to_value(&lib).unwrap());
+        assert!(got["total"]["time_s"].as_f64().unwrap() > 0.0);
+        let status = unsafe {
+            pp_simulate_nc(
+                m,
+                bytes.as_ptr(),
+                bytes.len(),
+                std::ptr::null(),
+                std::ptr::null_mut(),
+            )
+        };
+        assert_eq!(status, PpStatus::PpBadInput);
+        assert!(last_error().contains("out_report_json"), "{}", last_error());
+        unsafe { pp_machine_free(m) };
+    }
+}

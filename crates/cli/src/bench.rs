@@ -194,6 +194,9 @@ pub struct BenchCase {
     /// over the whole runs, the written program analysed), and their ideal L/F: the same
     /// stretch for every strategy.
     pub time_s: [f64; 3],
+    /// Simulated time of the same runs (`polepatch simulate`: a jerk-limited controller),
+    /// before and after, s.
+    pub sim_time_s: [f64; 2],
     /// One entry per zone.
     pub zones: Vec<BenchZone>,
 }
@@ -241,6 +244,8 @@ pub struct Summary {
     pub max_deviation_deg: f64,
     /// Estimated time of the runs holding zones before and after, and L/F, s.
     pub time_s: [f64; 3],
+    /// Simulated time of the same runs before and after, s.
+    pub sim_time_s: [f64; 2],
 }
 
 /// SPEC §6: ours within this factor of the reference.
@@ -280,8 +285,12 @@ impl BenchReport {
             }
         });
         let mut time_s = [0.0; 3];
+        let mut sim_time_s = [0.0; 2];
         for c in self.cases.iter().filter(|c| c.strategy == strategy) {
             for (t, v) in time_s.iter_mut().zip(c.time_s) {
+                *t += v;
+            }
+            for (t, v) in sim_time_s.iter_mut().zip(c.sim_time_s) {
                 *t += v;
             }
         }
@@ -302,6 +311,7 @@ impl BenchReport {
                 .map(|z| z.row.max_deviation_deg)
                 .fold(0.0, f64::max),
             time_s,
+            sim_time_s,
         }
     }
 }
@@ -385,6 +395,29 @@ pub fn bench_program(
         .map(|f| f.zones.len())
         .sum();
     let zones = analysis_zones(lp, machine, &opts.patch);
+    // The simulated time of the runs with a zone (as `time_s`), of a program's bytes.
+    let sim_opts = polepatch::SimulateOptions {
+        name: lp.name.clone(),
+        feed_fallback_mm_min: opts.feed_fallback_mm_min,
+        work_offset_mm: lp.work_offset_mm,
+        sim: polepatch::sim::SimOptions {
+            tcy_s: opts.patch.tcy_s,
+            ..Default::default()
+        },
+    };
+    let simulated = |bytes: &[u8]| -> f64 {
+        polepatch::simulate_nc(bytes, machine, &sim_opts)
+            .map(|rep| {
+                rep.runs
+                    .iter()
+                    .enumerate()
+                    .filter(|(r, _)| zones.get(*r).is_some_and(|z| !z.is_empty()))
+                    .map(|(_, run)| run.time_s)
+                    .fold(0.0, |a, b| a + b)
+            })
+            .unwrap_or(f64::NAN)
+    };
+    let sim_before = simulated(&lp.program.bytes);
     // References, computed once per zone and strategy kind (both axes / C only).
     let mut refs: std::collections::HashMap<(usize, usize, bool), ZoneBound> =
         std::collections::HashMap::new();
@@ -394,6 +427,11 @@ pub fn bench_program(
         let t0 = Instant::now();
         let (bytes, report): (_, FileReport) = patch_loaded(lp, machine, &popts);
         let patch_time_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let sim_after = if report.words_changed > 0 {
+            simulated(&bytes)
+        } else {
+            sim_before
+        };
         let after = if report.words_changed > 0 {
             Some(load_nc(
                 bytes,
@@ -480,6 +518,7 @@ pub fn bench_program(
             warnings: report.warnings,
             patch_time_ms,
             time_s,
+            sim_time_s: [sim_before, sim_after],
             zones: out,
         });
     }

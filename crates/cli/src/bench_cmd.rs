@@ -326,11 +326,11 @@ pub(crate) fn table(report: &BenchReport) -> String {
     if strategies.len() > 1 {
         let _ = writeln!(
             out,
-            "\nSide by side (zones at feed on C / on both rotary axes, of all zones; largest deviation °; estimated time of the runs with zones, s):"
+            "\nSide by side (zones at feed on C / on both rotary axes, of all zones; largest deviation °; estimated time of the runs with zones and their simulated time, s):"
         );
         let mut head = format!("{:<30} {:<13}", "file", "machine");
         for s in &strategies {
-            let _ = write!(head, " {:>26}", s.name());
+            let _ = write!(head, " {:>36}", s.name());
         }
         let _ = writeln!(out, "{head}");
         let mut k = 0;
@@ -351,11 +351,12 @@ pub(crate) fn table(report: &BenchReport) -> String {
                     .fold(0.0, f64::max);
                 let _ = write!(
                     line,
-                    " {:>26}",
+                    " {:>36}",
                     format!(
-                        "{zc}/{zb} of {} {dev:.3}° {:.3}s",
+                        "{zc}/{zb} of {} {dev:.3}° {:.3}s sim {:.3}s",
                         c.zones.len(),
-                        c.time_s[1]
+                        c.time_s[1],
+                        c.sim_time_s[1]
                     )
                 );
                 k += 1;
@@ -373,7 +374,7 @@ pub(crate) fn table(report: &BenchReport) -> String {
         };
         let _ = writeln!(
             out,
-            "\n{}: {} zone(s): {} at feed on C, {} on both rotary axes; reference unreachable for {}; largest deviation {:.3}°; time of the runs with zones {:.3} → {:.3} s (L/F {:.3} s).",
+            "\n{}: {} zone(s): {} at feed on C, {} on both rotary axes; reference unreachable for {}; largest deviation {:.3}°; time of the runs with zones {:.3} → {:.3} s (L/F {:.3} s), simulated {:.3} → {:.3} s.",
             strategy.name(),
             s.zones,
             s.at_feed_c,
@@ -382,7 +383,9 @@ pub(crate) fn table(report: &BenchReport) -> String {
             s.max_deviation_deg,
             s.time_s[0],
             s.time_s[1],
-            s.time_s[2]
+            s.time_s[2],
+            s.sim_time_s[0],
+            s.sim_time_s[1]
         );
         let _ = writeln!(
             out,

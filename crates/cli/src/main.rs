@@ -34,6 +34,9 @@ enum Command {
     /// Tilt the workpiece on a jig (C17's avoidance): given angles, or the smallest tilt
     /// that makes the program reach feed on both rotary axes.
     Reorient(reorient_cmd::ReorientArgs),
+    /// The cycle time a jerk-limited controller would take, per run, next to Equation 6's
+    /// estimate and L/F; the trajectory (CSV) and the feed along s (SVG), before and after.
+    Simulate(simulate_cmd::SimulateArgs),
     /// Quality suite: analyze and patch every program × machine, compare the deviation
     /// with the best possible for C-only changes, and print one table.
     Bench(bench_cmd::BenchArgs),
@@ -99,6 +102,11 @@ pub(crate) struct PatchArgs {
     /// Worker threads for batches (default: all cores).
     #[arg(long)]
     pub(crate) jobs: Option<usize>,
+    /// Simulate the input and the output (`polepatch simulate`) and put the cycle times
+    /// before and after in the report and the summary (takes about as long as
+    /// simulating both).
+    #[arg(long)]
+    pub(crate) simulate: bool,
     /// Work offset X,Y,Z (mm, machine coordinates of the program's zero) for a machine
     /// with a kinematic chain, where the program only names it (G54); default: the
     /// program's datum shift (Heidenhain G54 X Y Z).
@@ -165,6 +173,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench_cmd::run(args),
         Command::Reorient(args) => reorient_cmd::run(args),
         Command::Post(args) => post_cmd::run(args),
+        Command::Simulate(args) => simulate_cmd::run(args),
     };
     match result {
         Ok(code) => code,
@@ -195,6 +204,7 @@ mod bench_cmd;
 mod patch;
 mod post_cmd;
 mod reorient_cmd;
+mod simulate_cmd;
 
 pub(crate) fn machine(name: &str) -> Result<Machine> {
     Ok(Machine::load(name)?)

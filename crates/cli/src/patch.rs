@@ -198,6 +198,10 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
     let report_target = args.report.as_ref().and_then(|_| extra.next());
     let csv_target = args.csv.as_ref().and_then(|_| extra.next());
 
+    let mut reports = reports;
+    if args.simulate {
+        simulate_both(&mut reports, &names, &machine, &opts);
+    }
     let mut ok: Vec<&FileReport> = Vec::new();
     let mut failed = 0;
     for r in &reports {
@@ -369,6 +373,53 @@ fn print_summary(inputs: &[PathBuf], reports: &[Result<FileReport, JobError>]) {
                 println!(
                     "  note: {letter} written with {written} decimals (the file uses {file}) so that Equation 6 holds on the written values"
                 );
+            }
+        }
+    }
+}
+
+/// `--simulate`: the simulated times of every input and its output, into the reports
+/// (a file that cannot be simulated gets a warning and no figures).
+fn simulate_both(
+    reports: &mut [Result<FileReport, JobError>],
+    names: &[PathBuf],
+    machine: &polepatch::kinematics::Machine,
+    opts: &polepatch::PatchOptions,
+) {
+    for (rep, input) in reports.iter_mut().zip(names) {
+        let Ok(rep) = rep else { continue };
+        let Some(output) = rep.output.clone() else {
+            continue;
+        };
+        let sim = |path: &Path| -> Result<polepatch::SimulateReport> {
+            let bytes = polepatch_cli::files::read(path)?;
+            let o = polepatch::SimulateOptions {
+                name: path.display().to_string(),
+                feed_fallback_mm_min: opts.feed_fallback_mm_min,
+                work_offset_mm: opts.work_offset_mm,
+                sim: polepatch::sim::SimOptions {
+                    tcy_s: opts.patch.tcy_s,
+                    ..Default::default()
+                },
+            };
+            Ok(polepatch::simulate_nc(&bytes, machine, &o)?)
+        };
+        match (sim(input), sim(Path::new(&output))) {
+            (Ok(b), Ok(a)) => {
+                let t = polepatch::simulate::compare(&b, &a);
+                println!(
+                    "{}: simulated {:.3} s → {:.3} s ({:+.1} %), Equation 6 {:.3} s → {:.3} s",
+                    rep.file,
+                    t.before_s,
+                    t.after_s,
+                    100.0 * (t.after_s / t.before_s - 1.0),
+                    t.eq6_before_s,
+                    t.eq6_after_s
+                );
+                rep.simulated = Some(t);
+            }
+            (Err(e), _) | (_, Err(e)) => {
+                eprintln!("polepatch: warning: {}: not simulated: {e:#}", rep.file);
             }
         }
     }

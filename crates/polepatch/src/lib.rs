@@ -24,6 +24,7 @@ pub use polepatch_cl as cl;
 pub use polepatch_kinematics as kinematics;
 pub use polepatch_nc as nc;
 pub use polepatch_patcher as patcher;
+pub use polepatch_simulate as sim;
 
 pub mod end_pose;
 pub mod error;
@@ -36,11 +37,13 @@ pub mod post;
 pub mod program;
 pub mod reorient;
 pub mod report;
+pub mod simulate;
 pub mod stream;
 
 pub use error::Error;
 pub use patch::{FileReport, UntouchedReason, UntouchedRun, ZoneRow, patch_loaded, patch_program};
 pub use report::AnalyzeReport;
+pub use simulate::{SimulateOptions, SimulateReport, simulate_nc, simulate_nc_with};
 
 use polepatch_kinematics::Machine;
 use polepatch_patcher::AnalysisOptions;

@@ -112,9 +112,7 @@ impl Notes {
             self.add(line, SkipReason::NotModelled, always);
         }
         // An arc or a skippable move that turns no rotary axis cannot swing C.
-        let turns = [A, B, C]
-            .into_iter()
-            .any(|i| before.pos[i] != after.pos[i]);
+        let turns = [A, B, C].into_iter().any(|i| before.pos[i] != after.pos[i]);
         if block.is_move && turns {
             if f.has(Flags::ARC) {
                 self.add(line, SkipReason::ArcNearPole, near);

@@ -342,6 +342,10 @@ pub struct FileReport {
     pub warnings: Vec<String>,
     /// One row per zone.
     pub zones: Vec<ZoneRow>,
+    /// The simulated cycle time of the input and of the output
+    /// ([`crate::simulate::compare`]), when the caller asked for it (`patch --simulate`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub simulated: Option<crate::simulate::SimulatedTimes>,
 }
 
 impl FileReport {
@@ -360,6 +364,7 @@ impl FileReport {
             not_analysed: Vec::new(),
             warnings,
             zones: Vec::new(),
+            simulated: None,
         }
     }
     /// Zones that stay below feed (including those of untouched runs).

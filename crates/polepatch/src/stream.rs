@@ -475,6 +475,42 @@ pub fn analyze_nc_each(
     )
 }
 
+/// Every run of the program as a loaded program of its own (every run a stretch, as
+/// [`analyze_nc_each`] reads), in file order: `work` on all cores, `sink` in file order.
+/// Returns the tilting letter in use and the warnings. For readers of every run
+/// (`crate::simulate`).
+pub(crate) fn each_run<T: Send>(
+    bytes: &[u8],
+    machine: &Machine,
+    name: &str,
+    fallback: Option<f64>,
+    work_offset_mm: Option<[f64; 3]>,
+    work: impl Fn(&LoadedProgram) -> T + Sync,
+    mut sink: impl FnMut(T) -> std::io::Result<()>,
+) -> Result<(char, Vec<String>), Error> {
+    let rd = Reading {
+        name,
+        cone_deg: polepatch_patcher::AnalysisOptions::default().cone_deg,
+        fallback,
+        work_offset_mm,
+        read: crate::program::read_options(machine)?,
+        chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
+    };
+    let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
+        Begun::Whole(lp) => {
+            sink(work(&lp)).map_err(Error::Output)?;
+            return Ok((lp.primary_letter as char, lp.warnings.clone()));
+        }
+        Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx),
+    };
+    let warnings = primary_mismatch_warning(name, machine, p_idx)
+        .into_iter()
+        .collect();
+    let todo = stretches(&sv.runs, |_| true);
+    each_stretch(bytes, &sv, &todo, l, &rd, |lp| work(&lp), |t, _| sink(t))?;
+    Ok((LETTERS[l] as char, warnings))
+}
+
 /// The second read (module docs, step 3): each stretch of `todo` built as a program with
 /// its runs and what the rest of the file says, handed to `work` — in batches on all
 /// cores — and the results to `sink` in file order, with the bytes of the file the

@@ -1,0 +1,414 @@
+//! The cycle time of a program: every run simulated as a jerk-limited controller would
+//! move ([`polepatch_simulate`]), next to Equation 6's estimate and L/F.
+//!
+//! The program is read as `analyze` reads it ([`crate::stream`]: every run a stretch,
+//! the same runs and paths). Runs that follow one another without a stop — a feed change
+//! between them, which makes them share a point — are one motion; every other break (a
+//! G0/G2/G3 move, a stop, a TCPM switch, a tool change, a block without tool-tip motion,
+//! the end) is a rest. With a machine's `[chain]` and a known work offset the axes are the
+//! machine's (X Y Z in the machine frame, [`crate::machine_frame`]); else the program's
+//! (under TCPM the tool tip in the part frame with the rotary axes following). Blocks
+//! without tool-tip motion, rapid moves and arcs are not simulated: the times are those
+//! of the G1 runs.
+
+use crate::error::Error;
+use crate::program::LoadedProgram;
+use polepatch_kinematics::Machine;
+use polepatch_nc::RunBreak;
+use polepatch_patcher::Path;
+use polepatch_simulate::{Geometry, SimOptions, Step, simulate};
+use serde::Serialize;
+
+/// Options of [`simulate_nc`]. Plain struct; see each field for its default.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimulateOptions {
+    /// Options of the simulator (Tcy, grid). Default: [`SimOptions`]'s.
+    pub sim: SimOptions,
+    /// Feed, mm/min, for runs with no F in force. Default `None` (such runs are listed
+    /// with the reason and not simulated).
+    pub feed_fallback_mm_min: Option<f64>,
+    /// Name of the input in messages and in the report. Default `"input"`.
+    pub name: String,
+    /// Work offset for a machine with a kinematic chain (as [`crate::PatchOptions::work_offset_mm`]).
+    pub work_offset_mm: Option<[f64; 3]>,
+}
+
+impl Default for SimulateOptions {
+    fn default() -> Self {
+        SimulateOptions {
+            sim: SimOptions::default(),
+            feed_fallback_mm_min: None,
+            name: "input".to_string(),
+            work_offset_mm: None,
+        }
+    }
+}
+
+/// One run in the simulation report.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct SimRun {
+    /// Run number, from 1.
+    pub run: usize,
+    /// File lines of its first point and last block.
+    pub lines: [usize; 2],
+    /// CL points.
+    pub points: usize,
+    /// Path length, mm.
+    pub length_mm: f64,
+    /// Feed, mm/min (`null` if none).
+    pub feed_mm_min: Option<f64>,
+    /// Why it was not simulated.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+    /// Simulated time, s.
+    pub time_s: f64,
+    /// Equation 6's estimate ∫ds/ṡ, s.
+    pub eq6_time_s: f64,
+    /// L/F, s.
+    pub ideal_time_s: f64,
+    /// The lowest feed at one of its points (first and last excluded), mm/min.
+    pub min_feed_mm_min: Option<f64>,
+    /// The file line of that point.
+    pub min_feed_line: Option<usize>,
+    /// Moves on from the run before without a stop (a feed change between them).
+    pub joined: bool,
+    /// `machine` (X Y Z through the machine's chain) or `program` (the values as written).
+    pub frame: &'static str,
+}
+
+/// Totals of a simulation report.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq, Default)]
+pub struct SimTotals {
+    /// Simulated, s.
+    pub time_s: f64,
+    /// Equation 6's estimate, s.
+    pub eq6_time_s: f64,
+    /// L/F, s.
+    pub ideal_time_s: f64,
+    /// Runs simulated.
+    pub runs: usize,
+    /// Cycles where the simulator had to put the motion on its ceiling (see
+    /// `polepatch_simulate::Simulation::clips`).
+    pub clips: usize,
+}
+
+/// The whole simulation document.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct SimulateReport {
+    /// File name.
+    pub file: String,
+    /// Machine name.
+    pub machine: String,
+    /// Interpolation cycle time used, s.
+    pub tcy_s: f64,
+    /// The tilting letter the program uses.
+    pub primary: String,
+    /// Notes for the user.
+    pub warnings: Vec<String>,
+    /// Runs in file order.
+    pub runs: Vec<SimRun>,
+    /// Totals over the simulated runs.
+    pub total: SimTotals,
+}
+
+/// One state of the simulated motion, for a trajectory or a plot.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimState {
+    /// Run number, from 1.
+    pub run: usize,
+    /// Time from the start of the first simulated run (simulated runs only), s.
+    pub t_s: f64,
+    /// s from the start of the run, mm.
+    pub s_mm: f64,
+    /// s from the start of the first run, summed over the simulated runs, mm.
+    pub s_total_mm: f64,
+    /// Axis values X Y Z P C (mm, degrees) at this state.
+    pub axes: [f64; 5],
+    /// Feed, mm/min.
+    pub feed_mm_min: f64,
+    /// Each axis' use of its limits: the largest of |q̇|/V, |q̈|/A, |q⃛|/J.
+    pub shares: [f64; 5],
+    /// One interpolation cycle after the state before (false: a run's first state, its
+    /// last partial cycle, or a jumped cruise).
+    pub cycle: bool,
+}
+
+/// What the per-run reading keeps of a run.
+struct RunIn {
+    row: SimRun,
+    point_lines: Vec<usize>,
+    path: Option<Path>,
+    feed_change_after: bool,
+}
+
+fn run_inputs(lp: &LoadedProgram, machine: &Machine, opts: &SimulateOptions) -> Vec<RunIn> {
+    lp.runs
+        .iter()
+        .enumerate()
+        .map(|(r, rp)| {
+            let n = rp.run.len();
+            let mut row = SimRun {
+                run: lp.run_number(r),
+                lines: [lp.line_of(r, 0), lp.line_of(r, n - 1)],
+                points: n,
+                length_mm: rp.run.length_mm(),
+                feed_mm_min: rp.path.as_ref().ok().map(|p| p.feed_mm_min),
+                error: None,
+                time_s: 0.0,
+                eq6_time_s: 0.0,
+                ideal_time_s: 0.0,
+                min_feed_mm_min: None,
+                min_feed_line: None,
+                joined: false,
+                frame: "program",
+            };
+            let path = match &rp.path {
+                Err(problem) => {
+                    row.error = Some(problem.to_string());
+                    None
+                }
+                Ok(path) => {
+                    let frame = machine.chain.as_ref().and_then(|chain| {
+                        let datum = crate::machine_frame::run_datum(lp, r, opts.work_offset_mm)?;
+                        Some(crate::machine_frame::machine_frame_path(
+                            chain,
+                            machine,
+                            datum,
+                            rp.run.tcpm.is_on(),
+                            &path.axes,
+                            &path.s_mm,
+                            path.feed_mm_min,
+                        ))
+                    });
+                    if frame.is_some() {
+                        row.frame = "machine";
+                    }
+                    Some(frame.unwrap_or_else(|| path.clone()))
+                }
+            };
+            RunIn {
+                row,
+                point_lines: (0..n).map(|k| lp.line_of(r, k)).collect(),
+                path,
+                feed_change_after: rp.run.ended_by == RunBreak::FeedChange,
+            }
+        })
+        .collect()
+}
+
+/// The simulation in progress: the motion being gathered and the report.
+struct Simulating<'a, 'f> {
+    machine: &'a Machine,
+    opts: &'a SimulateOptions,
+    chain: Vec<RunIn>,
+    report: SimulateReport,
+    on_state: Option<&'f mut dyn FnMut(&SimState)>,
+    t0_s: f64,
+    s0_mm: f64,
+}
+
+impl Simulating<'_, '_> {
+    fn take(&mut self, run: RunIn) {
+        let joins = self.chain.last().is_some_and(|prev| {
+            prev.feed_change_after
+                && prev.path.is_some()
+                && run.path.is_some()
+                && prev.row.lines[1] == run.row.lines[0]
+                && prev.row.frame == run.row.frame
+                && prev.path.as_ref().and_then(|p| p.axes.last())
+                    == run.path.as_ref().map(|p| &p.axes[0])
+        });
+        if !joins {
+            self.flush();
+        }
+        if run.path.is_none() {
+            self.report.runs.push(run.row);
+            return;
+        }
+        self.chain.push(run);
+        if joins && let Some(r) = self.chain.last_mut() {
+            r.row.joined = true;
+        }
+    }
+
+    fn flush(&mut self) {
+        if self.chain.is_empty() {
+            return;
+        }
+        let mut chain = std::mem::take(&mut self.chain);
+        let parts: Vec<Path> = chain.iter_mut().filter_map(|r| r.path.take()).collect();
+        let runs: Vec<usize> = chain.iter().map(|r| r.row.run).collect();
+        let (t0, s0) = (self.t0_s, self.s0_mm);
+        let machine = self.machine;
+        let mut sim_opts = self.opts.sim.clone();
+        let mut user = self.on_state.take();
+        sim_opts.every_cycle &= user.is_some();
+        let mut part_start_s = vec![0.0; parts.len()];
+        let mut acc = 0.0;
+        for (k, p) in parts.iter().enumerate() {
+            part_start_s[k] = acc;
+            acc += p.s_mm[p.s_mm.len() - 1] - p.s_mm[0];
+        }
+        let result = {
+            let mut sink = |st: &Step, geo: &Geometry| {
+                if let Some(f) = user.as_mut() {
+                    let d = geo.derivs(st.s_mm);
+                    let shares = polepatch_simulate::caps::shares(
+                        machine,
+                        &d,
+                        st.feed_mm_s,
+                        st.accel_mm_s2,
+                        st.jerk_mm_s3,
+                    );
+                    f(&SimState {
+                        run: runs[st.part],
+                        t_s: t0 + st.t_s,
+                        s_mm: st.s_mm - part_start_s[st.part],
+                        s_total_mm: s0 + st.s_mm,
+                        axes: d.map(|e| e[0]),
+                        feed_mm_min: st.feed_mm_s * 60.0,
+                        shares,
+                        cycle: st.cycle,
+                    });
+                }
+            };
+            simulate(&parts, machine, &sim_opts, &mut sink)
+        };
+        self.on_state = user;
+        match result {
+            Ok(sim) => {
+                for (r, ps) in chain.iter_mut().zip(&sim.parts) {
+                    r.row.time_s = ps.time_s;
+                    r.row.eq6_time_s = ps.eq6_time_s;
+                    r.row.ideal_time_s = ps.ideal_time_s;
+                    if let Some(m) = ps.min_feed {
+                        r.row.min_feed_mm_min = Some(m.feed_mm_s * 60.0);
+                        r.row.min_feed_line = r.point_lines.get(m.point).copied();
+                    }
+                    let t = &mut self.report.total;
+                    t.time_s += ps.time_s;
+                    t.eq6_time_s += ps.eq6_time_s;
+                    t.ideal_time_s += ps.ideal_time_s;
+                    t.runs += 1;
+                }
+                self.report.total.clips += sim.clips;
+                self.t0_s += sim.time_s;
+                self.s0_mm += acc;
+            }
+            Err(e) => {
+                for r in &mut chain {
+                    r.row.error = Some(e.to_string());
+                }
+            }
+        }
+        self.report.runs.extend(chain.into_iter().map(|r| r.row));
+    }
+}
+
+/// Simulate every run of an NC program held in memory (module docs).
+pub fn simulate_nc(
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &SimulateOptions,
+) -> Result<SimulateReport, Error> {
+    simulate_nc_with(bytes, machine, opts, None)
+}
+
+/// [`simulate_nc`], handing every state of the motion to `on_state` (every interpolation
+/// cycle when `opts.sim.every_cycle`), in order, as it is computed: a trajectory is
+/// written as it goes, never held.
+pub fn simulate_nc_with(
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &SimulateOptions,
+    on_state: Option<&mut dyn FnMut(&SimState)>,
+) -> Result<SimulateReport, Error> {
+    let tcy_s = opts.sim.tcy_s.unwrap_or(machine.tcy_s);
+    let mut sim = Simulating {
+        machine,
+        opts,
+        chain: Vec::new(),
+        report: SimulateReport {
+            file: opts.name.clone(),
+            machine: machine.name.clone(),
+            tcy_s,
+            primary: String::new(),
+            warnings: Vec::new(),
+            runs: Vec::new(),
+            total: SimTotals::default(),
+        },
+        on_state,
+        t0_s: 0.0,
+        s0_mm: 0.0,
+    };
+    let (primary, warnings) = crate::stream::each_run(
+        bytes,
+        machine,
+        &opts.name,
+        opts.feed_fallback_mm_min,
+        opts.work_offset_mm,
+        |lp| run_inputs(lp, machine, opts),
+        |runs| {
+            for r in runs {
+                sim.take(r);
+            }
+            Ok(())
+        },
+    )?;
+    sim.flush();
+    sim.report.primary = primary.to_string();
+    sim.report.warnings = warnings;
+    Ok(sim.report)
+}
+
+/// The simulated times of a program before and after a patch, for the patch report.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct SimulatedTimes {
+    /// Simulated time of the input, s.
+    pub before_s: f64,
+    /// Simulated time of the output, s.
+    pub after_s: f64,
+    /// Equation 6's estimate of the input, s.
+    pub eq6_before_s: f64,
+    /// Equation 6's estimate of the output, s.
+    pub eq6_after_s: f64,
+    /// The runs whose simulated time changed.
+    pub runs: Vec<RunTimes>,
+}
+
+/// One run of [`SimulatedTimes`].
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct RunTimes {
+    /// Run number, from 1.
+    pub run: usize,
+    /// File lines of its first point and last block.
+    pub lines: [usize; 2],
+    /// Simulated, before and after, s.
+    pub time_s: [f64; 2],
+    /// Equation 6's estimate, before and after, s.
+    pub eq6_time_s: [f64; 2],
+}
+
+/// The times of `before` and `after` (the same program before and after a patch: the
+/// same runs) side by side.
+pub fn compare(before: &SimulateReport, after: &SimulateReport) -> SimulatedTimes {
+    let runs = before
+        .runs
+        .iter()
+        .zip(&after.runs)
+        .filter(|(b, a)| b.run == a.run && (b.time_s != a.time_s || b.eq6_time_s != a.eq6_time_s))
+        .map(|(b, a)| RunTimes {
+            run: b.run,
+            lines: b.lines,
+            time_s: [b.time_s, a.time_s],
+            eq6_time_s: [b.eq6_time_s, a.eq6_time_s],
+        })
+        .collect();
+    SimulatedTimes {
+        before_s: before.total.time_s,
+        after_s: after.total.time_s,
+        eq6_before_s: before.total.eq6_time_s,
+        eq6_after_s: after.total.eq6_time_s,
+        runs,
+    }
+}

@@ -1,0 +1,170 @@
+//! The axes' limits as limits on the motion along the path (the 1-D reduction).
+//!
+//! With `v = ṡ`, `a = s̈`, `j = s⃛` and an axis q(s) with derivatives q_s, q_ss, q_sss
+//! (per mm, from the analysis spline):
+//!
+//! ```text
+//! q̇ = q_s·v        q̈ = q_ss·v² + q_s·a        q⃛ = q_sss·v³ + 3·q_ss·v·a + q_s·j
+//! ```
+//!
+//! The triangle inequality gives a sufficient condition for every axis i:
+//!
+//! ```text
+//! |q_s|·v ≤ V_i,    |q_ss|·v² + |q_s|·|a| ≤ A_i,    |q_sss|·v³ + 3·|q_ss|·v·|a| + |q_s|·|j| ≤ J_i
+//! ```
+//!
+//! so at a point of the path, with speed v and acceleration a,
+//!
+//! ```text
+//! |a| ≤ a_cap(v)    = min_i (A_i − |q_ss^i|·v²) / |q_s^i|
+//! |j| ≤ j_cap(v,|a|) = min_i (J_i − |q_sss^i|·v³ − 3·|q_ss^i|·v·|a|) / |q_s^i|
+//! ```
+//!
+//! (an axis with q_s = 0 only needs its own curvature terms within its limits). The
+//! condition is exact on a straight line (q_ss = q_sss = 0): the 1-D problem is then
+//! V, A, J divided by the largest |q_s|. At a = 0, j = 0 it is Equation 6 itself: v may
+//! be anything up to the Equation-6 bound. It is symmetric in the signs of a and j, so a
+//! motion along the path is allowed forward exactly when it is allowed backward (what the
+//! backward pass relies on).
+
+use polepatch_kinematics::Machine;
+
+use crate::tolerances::LIMIT_USE;
+
+/// |q_s|, |q_ss|, |q_sss| of the five axes at one point of the path ([`polepatch_kinematics::Axis`] order).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Local {
+    /// |q_s| per axis (mm/mm or °/mm).
+    pub qs: [f64; 5],
+    /// |q_ss| per axis (per mm²).
+    pub qss: [f64; 5],
+    /// |q_sss| per axis (per mm³).
+    pub qsss: [f64; 5],
+}
+
+impl Local {
+    /// From `[q, q', q'', q''']` of each axis.
+    pub fn from_derivs(d: &[[f64; 4]; 5]) -> Local {
+        Local {
+            qs: d.map(|e| e[1].abs()),
+            qss: d.map(|e| e[2].abs()),
+            qsss: d.map(|e| e[3].abs()),
+        }
+    }
+
+    /// Largest speed along the path the axes' velocity limits allow, mm/s (+∞ if no axis
+    /// moves).
+    pub fn v_cap(&self, m: &Machine) -> f64 {
+        let mut c = f64::INFINITY;
+        for (l, qs) in m.limits.iter().zip(self.qs) {
+            if qs > 0.0 {
+                c = c.min(LIMIT_USE * l.v / qs);
+            }
+        }
+        c
+    }
+
+    /// Largest |path acceleration| at speed `v`, mm/s²; negative when no acceleration
+    /// keeps every axis within A at this speed.
+    pub fn a_cap(&self, m: &Machine, v: f64) -> f64 {
+        let mut c = f64::INFINITY;
+        for i in 0..5 {
+            let room = LIMIT_USE * m.limits[i].a - self.qss[i] * v * v;
+            if self.qs[i] > 0.0 {
+                c = c.min(room / self.qs[i]);
+            } else if room < 0.0 {
+                c = c.min(room);
+            }
+        }
+        c
+    }
+
+    /// Largest |path jerk| at speed `v` and |acceleration| `a_abs`, mm/s³; negative when
+    /// no jerk keeps every axis within J.
+    pub fn j_cap(&self, m: &Machine, v: f64, a_abs: f64) -> f64 {
+        let mut c = f64::INFINITY;
+        for i in 0..5 {
+            let room = LIMIT_USE * m.limits[i].j
+                - self.qsss[i] * v * v * v
+                - 3.0 * self.qss[i] * v * a_abs;
+            if self.qs[i] > 0.0 {
+                c = c.min(room / self.qs[i]);
+            } else if room < 0.0 {
+                c = c.min(room);
+            }
+        }
+        c
+    }
+}
+
+/// Each axis' use of its limits at a state of the motion: the largest of |q̇|/V, |q̈|/A,
+/// |q⃛|/J (signed chain rule, not the bound above), per axis.
+pub fn shares(m: &Machine, d: &[[f64; 4]; 5], v: f64, a: f64, j: f64) -> [f64; 5] {
+    std::array::from_fn(|i| {
+        let [_, qs, qss, qsss] = d[i];
+        let l = &m.limits[i];
+        let vel = (qs * v).abs() / l.v;
+        let acc = (qss * v * v + qs * a).abs() / l.a;
+        let jerk = (qsss * v * v * v + 3.0 * qss * v * a + qs * j).abs() / l.j;
+        vel.max(acc).max(jerk)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn m() -> Machine {
+        Machine::builtin("mikron-ucp710").unwrap()
+    }
+
+    /// On a line along X the caps are X's limits (times the planning margin).
+    #[test]
+    fn a_line_has_the_axis_limits() {
+        let mut d = [[0.0; 4]; 5];
+        d[0][1] = 1.0;
+        let l = Local::from_derivs(&d);
+        let x = m().limits[0];
+        assert_eq!(l.v_cap(&m()), LIMIT_USE * x.v);
+        assert_eq!(l.a_cap(&m(), 123.0), LIMIT_USE * x.a);
+        assert_eq!(l.j_cap(&m(), 123.0, 999.0), LIMIT_USE * x.j);
+    }
+
+    /// Planted state on a curve: any (a, j) within the caps keeps every axis within its
+    /// limits by the signed chain rule, and the caps are reached (the binding axis at 1).
+    #[test]
+    fn within_the_caps_every_axis_is_within_its_limits() {
+        let m = m();
+        let mut d = [[0.0; 4]; 5];
+        d[0] = [0.0, 0.8, 0.01, -0.002];
+        d[1] = [0.0, -0.6, 0.02, 0.001];
+        d[4] = [0.0, 2.0, 3.0, 18.0];
+        let l = Local::from_derivs(&d);
+        let v = 5.0;
+        let a = 0.7 * l.a_cap(&m, v);
+        let j = l.j_cap(&m, v, a);
+        assert!(a > 0.0 && j > 0.0, "{a} {j}");
+        for sa in [-1.0, 1.0] {
+            for sj in [-1.0, 1.0] {
+                let sh = shares(&m, &d, v, sa * a, sj * j);
+                assert!(sh.iter().all(|&s| s <= LIMIT_USE + 1e-12), "{sh:?}");
+            }
+        }
+        // Same signs of the terms as the bound: the binding axis reaches its jerk share.
+        let sh = shares(&m, &d, v, a, j);
+        assert!((sh[4] - LIMIT_USE).abs() < 1e-9, "{sh:?}");
+    }
+
+    /// Above the Equation-6 bound there is no room at a = 0 (negative caps).
+    #[test]
+    fn above_equation_6_the_caps_are_negative() {
+        let m = m();
+        let mut d = [[0.0; 4]; 5];
+        d[0][1] = 1.0;
+        d[4] = [0.0, 0.0, 3.0, 0.0];
+        let l = Local::from_derivs(&d);
+        let eq6 = (m.limits[4].a / 3.0).sqrt();
+        assert!(l.a_cap(&m, 0.99 * eq6) > 0.0);
+        assert!(l.a_cap(&m, 1.01 * eq6) < 0.0);
+    }
+}

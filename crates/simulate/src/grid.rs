@@ -1,0 +1,219 @@
+//! The path of a motion and its velocity limit curve on a grid of s.
+
+use polepatch_kinematics::{Machine, feed_bound};
+use polepatch_patcher::analysis::validate;
+use polepatch_patcher::spline::{AnalysisSpline, SplineSystem};
+use polepatch_patcher::{Path, PathError};
+
+use crate::caps::Local;
+use crate::error::SimError;
+use crate::tolerances::LIMIT_USE;
+
+/// A motion's path: the parts (runs that follow one another without a stop) joined at
+/// their shared points, one analysis spline per axis over all their points.
+#[derive(Debug, Clone)]
+pub struct Geometry {
+    /// s of every point, mm, from 0 (the parts' own s shifted to follow one another).
+    pub knots: Vec<f64>,
+    splines: Vec<AnalysisSpline>,
+    /// Index in `knots` of the last point of each part.
+    pub part_end: Vec<usize>,
+    /// Programmed feed of each part, mm/s.
+    pub feed_mm_s: Vec<f64>,
+}
+
+impl Geometry {
+    /// Join `parts` (each a valid path; each part's first point equal to the last point
+    /// of the part before) and fit the analysis spline of each axis over all points.
+    pub fn new(parts: &[Path]) -> Result<Geometry, SimError> {
+        if parts.is_empty() {
+            return Err(SimError::Empty);
+        }
+        let mut knots = Vec::new();
+        let mut values: Vec<[f64; 5]> = Vec::new();
+        let mut part_end = Vec::new();
+        let mut feed_mm_s = Vec::new();
+        for (k, p) in parts.iter().enumerate() {
+            validate(p).map_err(|source| SimError::Path { part: k, source })?;
+            let skip = if k == 0 {
+                0
+            } else {
+                let end = *values.last().expect("a part has points");
+                if p.axes[0] != end {
+                    return Err(SimError::NotJoined {
+                        part: k,
+                        previous: k - 1,
+                        start: p.axes[0],
+                        end,
+                    });
+                }
+                1
+            };
+            let base = knots.last().copied().unwrap_or(0.0) - p.s_mm[0];
+            knots.extend(p.s_mm[skip..].iter().map(|s| s + base));
+            values.extend_from_slice(&p.axes[skip..]);
+            part_end.push(knots.len() - 1);
+            feed_mm_s.push(p.feed_mm_min / 60.0);
+        }
+        // Shifted sums may lose strict increase only through rounding of huge s.
+        if let Some(i) = (1..knots.len()).find(|&i| knots[i] <= knots[i - 1]) {
+            return Err(SimError::Path {
+                part: part_end.partition_point(|&e| e < i),
+                source: PathError::NotIncreasing {
+                    index: i,
+                    value: knots[i],
+                    previous: knots[i - 1],
+                },
+            });
+        }
+        let sys = SplineSystem::new(&knots).map_err(|source| SimError::Path { part: 0, source })?;
+        let splines = (0..5)
+            .map(|a| {
+                let y: Vec<f64> = values.iter().map(|q| q[a]).collect();
+                sys.fit(&y)
+            })
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|source| SimError::Path { part: 0, source })?;
+        Ok(Geometry {
+            knots,
+            splines,
+            part_end,
+            feed_mm_s,
+        })
+    }
+
+    /// Path length, mm.
+    pub fn length(&self) -> f64 {
+        *self.knots.last().expect("a geometry has points")
+    }
+
+    /// `[q, q_s, q_ss, q_sss]` of each axis at `s`.
+    pub fn derivs(&self, s: f64) -> [[f64; 4]; 5] {
+        std::array::from_fn(|a| self.splines[a].eval_derivs(s))
+    }
+
+    /// Axis values X Y Z P C at `s`.
+    pub fn axes(&self, s: f64) -> [f64; 5] {
+        std::array::from_fn(|a| self.splines[a].eval(s))
+    }
+
+    /// The programmed feed at `s`, mm/s (at a shared point, the lower of the two parts').
+    pub fn feed_at(&self, s: f64) -> f64 {
+        let k = self.knots.partition_point(|&v| v <= s);
+        let span = k.saturating_sub(1).min(self.knots.len() - 2);
+        let p = self.part_of_span(span);
+        let f = self.feed_mm_s[p];
+        if k >= 1 && k - 1 < self.knots.len() && self.knots[k - 1] == s && span > 0 {
+            f.min(self.feed_mm_s[self.part_of_span(span - 1)])
+        } else {
+            f
+        }
+    }
+
+    /// The part that span `k` (between points k and k + 1) belongs to.
+    pub fn part_of_span(&self, k: usize) -> usize {
+        self.part_end.partition_point(|&e| e <= k)
+    }
+}
+
+/// The grid of s and the velocity limit curve on it.
+#[derive(Debug, Clone)]
+pub struct Grid {
+    /// Grid points, mm: every point of the path and cells between.
+    pub s: Vec<f64>,
+    /// The velocity limit at each grid point, mm/s (module docs of [`crate`]).
+    pub limit: Vec<f64>,
+}
+
+/// Grid points evaluated per batch.
+const CHUNK: usize = 4096;
+
+impl Grid {
+    /// Cut each span into `⌈h/(F·Tcy)⌉` cells (at most `max_cells`), and bound the feed on
+    /// each cell by Equation 6 (limits × [`LIMIT_USE`]) with the largest |q_s|, |q_ss|, |q_sss| of each axis over the
+    /// cell (exact for the cubic pieces: q_s is quadratic, q_ss linear, q_sss constant on a
+    /// span), capped by F. The limit at a grid point is the lower of its two cells', and the
+    /// limit curve is linear between grid points: below Equation 6 everywhere on the cell.
+    pub fn new(geo: &Geometry, machine: &Machine, tcy_s: f64, max_cells: usize) -> Grid {
+        let n = geo.knots.len();
+        // Equation 6 with the limits the passes plan with.
+        let mut planned = machine.clone();
+        for l in &mut planned.limits {
+            l.v *= LIMIT_USE;
+            l.a *= LIMIT_USE;
+            l.j *= LIMIT_USE;
+        }
+        let machine = &planned;
+        let mut s = Vec::with_capacity(n);
+        for k in 0..n - 1 {
+            let f = geo.feed_mm_s[geo.part_of_span(k)];
+            let (a, b) = (geo.knots[k], geo.knots[k + 1]);
+            let cells = ((b - a) / (f * tcy_s))
+                .ceil()
+                .clamp(1.0, max_cells.max(1) as f64) as usize;
+            for i in 0..cells {
+                s.push(a + (b - a) * i as f64 / cells as f64);
+            }
+        }
+        s.push(geo.knots[n - 1]);
+        let mut cell = Vec::with_capacity(s.len() - 1);
+        let mut derivs: Vec<[[f64; 4]; 5]> = Vec::with_capacity(CHUNK + 1);
+        let mut buf = vec![[0.0; 4]; CHUNK + 1];
+        let mut span = 0usize;
+        let mut start = 0usize;
+        while start + 1 < s.len() {
+            let end = (start + CHUNK).min(s.len() - 1);
+            let ts = &s[start..=end];
+            derivs.clear();
+            derivs.resize(ts.len(), [[0.0; 4]; 5]);
+            for a in 0..5 {
+                geo.splines[a].eval_derivs_sorted(ts, &mut buf[..ts.len()]);
+                for (d, e) in derivs.iter_mut().zip(&buf) {
+                    d[a] = *e;
+                }
+            }
+            for i in 0..ts.len() - 1 {
+                let t0 = ts[i];
+                while geo.knots[span + 1] <= t0 {
+                    span += 1;
+                }
+                let f = geo.feed_mm_s[geo.part_of_span(span)];
+                let h = ts[i + 1] - t0;
+                let mut d = [[0.0; 3]; 5];
+                for a in 0..5 {
+                    let [_, q1, q2, q3] = derivs[i][a];
+                    let e = derivs[i + 1][a];
+                    // End of the cell from the left piece (the right end may be a knot,
+                    // where the next piece starts with another q_sss).
+                    let q1e = q1 + q2 * h + 0.5 * q3 * h * h;
+                    let q2e = q2 + q3 * h;
+                    let mut m1 = q1.abs().max(q1e.abs()).max(e[1].abs());
+                    if q3 != 0.0 {
+                        let u = -q2 / q3;
+                        if u > 0.0 && u < h {
+                            m1 = m1.max((q1 + q2 * u + 0.5 * q3 * u * u).abs());
+                        }
+                    }
+                    d[a] = [m1, q2.abs().max(q2e.abs()).max(e[2].abs()), q3.abs()];
+                }
+                cell.push(feed_bound(machine, &d, f).feed_mm_s);
+            }
+            start = end;
+        }
+        let m = cell.len();
+        let limit = (0..s.len())
+            .map(|i| {
+                let l = if i > 0 { cell[i - 1] } else { f64::INFINITY };
+                let r = if i < m { cell[i] } else { f64::INFINITY };
+                l.min(r)
+            })
+            .collect();
+        Grid { s, limit }
+    }
+}
+
+/// The local limits at `s`.
+pub fn local_at(geo: &Geometry, s: f64) -> (Local, [[f64; 4]; 5]) {
+    let d = geo.derivs(s);
+    (Local::from_derivs(&d), d)
+}

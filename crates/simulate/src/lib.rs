@@ -1,0 +1,383 @@
+//! How long a jerk-limited controller takes along a program's path: a trajectory within
+//! every axis' V, A and J and the programmed feed, as fast as those allow.
+//!
+//! Equation 6 (`polepatch_kinematics::feed`) bounds the feed at each point of a path with
+//! s̈ = s⃛ = 0; its time estimate ∫ds/ṡ ignores the time the machine needs to change
+//! speed between points. This crate builds the motion itself.
+//!
+//! # The path
+//! A *motion* is one or more runs that follow one another without a stop (a feed change
+//! between two runs: they share a point). Its path is the analysis spline
+//! (`polepatch_patcher::spline`: the not-a-knot cubic of each axis over s, the
+//! interpolation Equation 6 uses) through all their points; s is the tool-tip path length
+//! the programmed feed refers to. The motion starts and ends at rest.
+//!
+//! # The method
+//! With v = ṡ, a = s̈, j = s⃛ and the chain rule q̇ = q_s·v, q̈ = q_ss·v² + q_s·a,
+//! q⃛ = q_sss·v³ + 3·q_ss·v·a + q_s·j, the axes' limits become limits of the motion along
+//! s ([`caps`]):
+//!
+//! ```text
+//! v ≤ W(s)        |a| ≤ a_cap(s, v) = min_i (A_i − |q_ss^i|·v²) / |q_s^i|
+//!                 |j| ≤ j_cap(s, v, |a|) = min_i (J_i − |q_sss^i|·v³ − 3·|q_ss^i|·v·|a|) / |q_s^i|
+//! ```
+//!
+//! (a sufficient condition by the triangle inequality; exact on a straight line).
+//!
+//! 1. **Velocity limit curve W(s)** ([`grid::Grid`]): each span between two points is cut
+//!    into cells (Equation 6's step F·Tcy, at most [`tolerances::MAX_CELLS_PER_SPAN`]); on
+//!    each cell `kinematics::feed_bound` (Equation 6) with the largest |q_s|, |q_ss|,
+//!    |q_sss| over the cell, capped by F; W is linear between grid points and below
+//!    Equation 6 everywhere. On W with a = j = 0 every axis is within its limits.
+//! 2. **Backward pass** ([`pass`]): from rest at the end of the path towards its start,
+//!    the largest jerk each cycle that keeps the motion under W, with a look-ahead that
+//!    starts ramping the acceleration down when the ramp would just meet W (Ruckig's
+//!    S-curve rule against a moving target). Read forward, it is the latest the motion
+//!    can brake for every slow-down ahead and still stop at the end. The limits are
+//!    symmetric in the signs of a and j, so a motion allowed backward is allowed forward.
+//! 3. **Forward pass**: from rest at the start, the same rule under the backward profile
+//!    B(s) (its speed and acceleration at the grid points). Accelerating as hard as the
+//!    limits allow until the ramp-down meets B, then following B to the end, it is the
+//!    trajectory: one state per interpolation cycle Tcy.
+//!
+//! Both passes step at Tcy (the controller's cycle), with every limit used at
+//! [`tolerances::LIMIT_USE`] of its value to absorb the change within a cycle, and jump a
+//! cruise at a flat ceiling in one step when no trajectory is asked for (so the work is
+//! bounded by the points and the speed changes, not by the run time). Memory is the
+//! spline and the grid (a few words per grid point): bounded by the motion's points.
+//!
+//! On a straight line this is the time-optimal jerk-limited rest-to-rest profile (the
+//! 7-segment S-curve) to a cycle; on a curved path it is a jerk-limited motion under the
+//! velocity limit curve, within the sufficient condition above; `docs/simulation.md`
+//! compares it with the closed form and with Equation 6 and L/F.
+
+pub mod caps;
+pub mod error;
+pub mod grid;
+mod pass;
+pub mod tolerances;
+
+pub use error::SimError;
+pub use grid::{Geometry, Grid};
+
+use pass::{Ceiling, Pass, Sink, State};
+use polepatch_kinematics::Machine;
+use polepatch_patcher::{AnalysisOptions, Path, analyze_path};
+
+/// Options of [`simulate`]. Plain struct; see each field for its default.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimOptions {
+    /// Interpolation cycle time, s; `None` (default) uses the machine's `tcy_s`.
+    pub tcy_s: Option<f64>,
+    /// Largest number of grid cells per span. Default [`tolerances::MAX_CELLS_PER_SPAN`].
+    pub max_cells_per_span: usize,
+    /// Hand out every interpolation cycle (for a trajectory at Tcy); default `false`: a
+    /// cruise at a flat limit is one step.
+    pub every_cycle: bool,
+}
+
+impl Default for SimOptions {
+    fn default() -> Self {
+        SimOptions {
+            tcy_s: None,
+            max_cells_per_span: tolerances::MAX_CELLS_PER_SPAN,
+            every_cycle: false,
+        }
+    }
+}
+
+/// One state of the simulated motion, as handed to the caller's sink.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Step {
+    /// Time since the start of the motion, s.
+    pub t_s: f64,
+    /// Path parameter from the start of the motion, mm.
+    pub s_mm: f64,
+    /// Feed ṡ, mm/s.
+    pub feed_mm_s: f64,
+    /// Path acceleration s̈, mm/s².
+    pub accel_mm_s2: f64,
+    /// Path jerk s⃛ over the step that ended here, mm/s³.
+    pub jerk_mm_s3: f64,
+    /// The part (run) of the motion this state is in (a shared point: the earlier part).
+    pub part: usize,
+    /// Whether this state is one interpolation cycle after the previous one (false: the
+    /// first state, the last, partial cycle, or a jumped cruise).
+    pub cycle: bool,
+}
+
+/// The lowest feed at a programmed point of a part (its first and last points excluded).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MinFeed {
+    /// Feed there, mm/s.
+    pub feed_mm_s: f64,
+    /// Index of the point in its part.
+    pub point: usize,
+    /// s of the point in its part, mm.
+    pub s_mm: f64,
+}
+
+/// What the simulation found for one part (run) of a motion.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PartSim {
+    /// Simulated time over the part, s.
+    pub time_s: f64,
+    /// Equation 6's estimate ∫ds/ṡ on the part's own path (what `analyze` reports), s.
+    pub eq6_time_s: f64,
+    /// L/F, s.
+    pub ideal_time_s: f64,
+    /// Path length, mm.
+    pub length_mm: f64,
+    /// Programmed feed, mm/min.
+    pub feed_mm_min: f64,
+    /// The lowest feed at one of its points (`None` for a part of two points).
+    pub min_feed: Option<MinFeed>,
+}
+
+/// The result of [`simulate`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Simulation {
+    /// Per part, in order.
+    pub parts: Vec<PartSim>,
+    /// Total simulated time, s.
+    pub time_s: f64,
+    /// Cycles where a pass had to put the motion on its ceiling (0 on every path the
+    /// tests know; any other count says the plan may exceed a limit there).
+    pub clips: usize,
+    /// Steps of the forward pass.
+    pub steps: u64,
+}
+
+/// Backward pass: the speed and (forward) acceleration at each grid point, and at every
+/// state where the jerk switches (so that no cell of the recorded profile holds a switch,
+/// which an interpolant between grid points would round off).
+struct Store<'a> {
+    /// Pass positions of the grid points (backward order).
+    grid: &'a [f64],
+    next: usize,
+    prev_j: f64,
+    x: Vec<f64>,
+    v: Vec<f64>,
+    a: Vec<f64>,
+}
+
+impl Store<'_> {
+    fn push(&mut self, x: f64, v: f64, a: f64) {
+        if self.x.last().is_none_or(|&l| x > l) {
+            self.x.push(x);
+            self.v.push(v);
+            self.a.push(a);
+        }
+    }
+}
+
+impl Sink for Store<'_> {
+    fn step(&mut self, from: &State, to: &State, j: f64, _d: &[[f64; 4]; 5], _c: bool) {
+        if (j - self.prev_j).abs() > tolerances::JERK_SWITCH * j.abs().max(self.prev_j.abs()) {
+            self.push(from.x, from.v, from.a);
+        }
+        self.prev_j = j;
+        while self.next < self.grid.len() && self.grid[self.next] <= to.x {
+            let g = self.grid[self.next];
+            let u = if to.x > from.x {
+                ((g - from.x) / (to.x - from.x)).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            self.push(
+                g,
+                from.v + u * (to.v - from.v),
+                from.a + u * (to.a - from.a),
+            );
+            self.next += 1;
+        }
+    }
+}
+
+/// Forward pass: the results and the caller's sink.
+struct Forward<'a> {
+    geo: &'a Geometry,
+    user: &'a mut dyn FnMut(&Step, &Geometry),
+    part: usize,
+    part_start_t: f64,
+    part_times: Vec<f64>,
+    next_knot: usize,
+    min: Vec<Option<MinFeed>>,
+    started: bool,
+}
+
+impl Forward<'_> {
+    fn part_start_knot(&self, p: usize) -> usize {
+        if p == 0 { 0 } else { self.geo.part_end[p - 1] }
+    }
+}
+
+impl Sink for Forward<'_> {
+    fn step(&mut self, from: &State, to: &State, j: f64, _d: &[[f64; 4]; 5], cycle: bool) {
+        if !self.started {
+            self.started = true;
+            (self.user)(
+                &Step {
+                    t_s: from.t,
+                    s_mm: from.x,
+                    feed_mm_s: from.v,
+                    accel_mm_s2: from.a,
+                    jerk_mm_s3: 0.0,
+                    part: 0,
+                    cycle: false,
+                },
+                self.geo,
+            );
+        }
+        // Points passed in this step: the feed there, part ends.
+        let knots = &self.geo.knots;
+        let end = self.geo.length();
+        while self.next_knot < knots.len()
+            && (knots[self.next_knot] <= to.x || (to.x >= end && self.next_knot + 1 == knots.len()))
+        {
+            let k = self.next_knot;
+            let u = if to.x > from.x {
+                ((knots[k] - from.x) / (to.x - from.x)).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            let v = from.v + u * (to.v - from.v);
+            let t = from.t + u * (to.t - from.t);
+            let p = self.part;
+            let first = self.part_start_knot(p);
+            if k > first && k < self.geo.part_end[p] {
+                let better = self.min[p].is_none_or(|m| v < m.feed_mm_s);
+                if better {
+                    self.min[p] = Some(MinFeed {
+                        feed_mm_s: v,
+                        point: k - first,
+                        s_mm: knots[k] - knots[first],
+                    });
+                }
+            }
+            if k == self.geo.part_end[p] {
+                self.part_times.push(t - self.part_start_t);
+                self.part_start_t = t;
+                if p + 1 < self.geo.part_end.len() {
+                    self.part += 1;
+                }
+            }
+            self.next_knot += 1;
+        }
+        (self.user)(
+            &Step {
+                t_s: to.t,
+                s_mm: to.x,
+                feed_mm_s: to.v,
+                accel_mm_s2: to.a,
+                jerk_mm_s3: j,
+                part: self.part,
+                cycle: cycle && (to.t - from.t) > 0.0,
+            },
+            self.geo,
+        );
+    }
+}
+
+/// Simulate a motion: `parts` are runs that follow one another without a stop (each
+/// part's first point is the last point of the part before), at rest at the start and
+/// the end. `sink` gets every state of the motion in order (with the geometry, to
+/// evaluate axis values): every cycle with [`SimOptions::every_cycle`], else every step.
+pub fn simulate(
+    parts: &[Path],
+    machine: &Machine,
+    opts: &SimOptions,
+    sink: &mut dyn FnMut(&Step, &Geometry),
+) -> Result<Simulation, SimError> {
+    let tcy_s = opts.tcy_s.unwrap_or(machine.tcy_s);
+    if !(tcy_s.is_finite() && tcy_s > 0.0) {
+        return Err(SimError::BadCycleTime(tcy_s));
+    }
+    let geo = Geometry::new(parts)?;
+    let grid = Grid::new(&geo, machine, tcy_s, opts.max_cells_per_span);
+    let len = geo.length();
+
+    // Backward pass under W.
+    let xb: Vec<f64> = grid.s.iter().rev().map(|s| len - s).collect();
+    let wb: Vec<f64> = grid.limit.iter().rev().copied().collect();
+    let back = Pass {
+        geo: &geo,
+        machine,
+        ceiling: Ceiling::new(&xb, &wb, None),
+        limit: None,
+        forward: false,
+        dt: tcy_s,
+        use_caps: tolerances::BACKWARD_USE,
+        every_cycle: opts.every_cycle,
+    };
+    let mut store = Store {
+        grid: &xb,
+        next: 1,
+        prev_j: 0.0,
+        x: vec![0.0],
+        v: vec![0.0],
+        a: vec![0.0],
+    };
+    back.run(&mut store)
+        .map_err(|s| SimError::Stalled { s_mm: s })?;
+    if store.x.last().is_some_and(|&x| x < len) {
+        let (v, a) = (*store.v.last().expect("non-empty"), 0.0);
+        store.push(len, v, a);
+    }
+    let bx: Vec<f64> = store.x.iter().rev().map(|x| len - x).collect();
+    let bv: Vec<f64> = store.v.iter().rev().copied().collect();
+    let ba: Vec<f64> = store.a.iter().rev().map(|a| -a).collect();
+
+    // Forward pass under B: the trajectory.
+    let fwd = Pass {
+        geo: &geo,
+        machine,
+        ceiling: Ceiling::new(&bx, &bv, Some(&ba)),
+        limit: Some(Ceiling::new(&grid.s, &grid.limit, None)),
+        forward: true,
+        dt: tcy_s,
+        use_caps: [1.0, 1.0],
+        every_cycle: opts.every_cycle,
+    };
+    let mut out = Forward {
+        geo: &geo,
+        user: sink,
+        part: 0,
+        part_start_t: 0.0,
+        part_times: Vec::with_capacity(parts.len()),
+        next_knot: 1,
+        min: vec![None; parts.len()],
+        started: false,
+    };
+    let stats_f = fwd
+        .run(&mut out)
+        .map_err(|s| SimError::Stalled { s_mm: s })?;
+    let mut part_times = out.part_times;
+    let min = out.min;
+    while part_times.len() < parts.len() {
+        part_times.push(0.0);
+    }
+    let aopts = AnalysisOptions {
+        tcy_s: Some(tcy_s),
+        ..AnalysisOptions::default()
+    };
+    let mut out_parts = Vec::with_capacity(parts.len());
+    for (k, p) in parts.iter().enumerate() {
+        let a = analyze_path(p, machine, &aopts)
+            .map_err(|source| SimError::Path { part: k, source })?;
+        out_parts.push(PartSim {
+            time_s: part_times[k],
+            eq6_time_s: a.time_s,
+            ideal_time_s: a.ideal_time_s,
+            length_mm: a.length_mm,
+            feed_mm_min: p.feed_mm_min,
+            min_feed: min[k],
+        });
+    }
+    Ok(Simulation {
+        parts: out_parts,
+        time_s: stats_f.time_s,
+        clips: stats_f.clips,
+        steps: stats_f.steps,
+    })
+}

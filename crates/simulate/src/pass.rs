@@ -1,0 +1,471 @@
+//! One pass of the jerk-limited integrator along the path (forward or backward).
+//!
+//! Cycle by cycle (step `dt` = Tcy), the pass takes the largest path jerk `j` that is
+//! within the local caps ([`crate::caps`]) and keeps the next state *safe* under a ceiling
+//! curve W(x) given at grid points (x is the distance along the pass). A state (x, v, a)
+//! is safe when v ≤ W(x), |a| ≤ a_cap(v), j_cap(v, |a|) ≥ 0, and — when it accelerates
+//! harder than the ceiling does (a > a_W) — the ramp of a down to a_W at the jerk cap
+//! still ends under the ceiling:
+//!
+//! ```text
+//! τ = (a − a_W)/j_cap,   x_e = x + v·τ + a·τ²/2 − j_cap·τ³/6,   v_e = v + a·τ − j_cap·τ²/2 ≤ W(x_e)
+//! ```
+//!
+//! (a_W taken at x_e, found by two fixed-point steps). Safety is monotone in j, so the
+//! largest safe j is found by bisection. This is the Ruckig/S-curve rule "start the
+//! ramp-down when the ramp would just reach the target" applied to a moving target.
+//! Where no jerk keeps the state under W (W falls faster than the limits allow, which
+//! only the backward pass meets, on the limit curve), the state is put on W: a *clip*,
+//! counted; the forward pass runs under the backward pass's profile, which it can follow.
+
+use polepatch_kinematics::Machine;
+
+use crate::caps::Local;
+use crate::grid::Geometry;
+use crate::tolerances::{
+    CEILING_REL, CRAWL_CRUISE_REL, CRAWL_JERK_SHARE, CRUISE_ABS_MM_S, CRUISE_REL, END_MM,
+    JERK_BISECTIONS, SETTLE_REL,
+};
+
+/// A ceiling along a pass: values at increasing pass positions, and between them W^(3/2)
+/// linear, or (given the acceleration of the profile it was recorded from) cubic Hermite;
+/// with the acceleration of a motion that follows it, a = W·dW/dx.
+pub(crate) struct Ceiling<'a> {
+    pub x: &'a [f64],
+    pub v: &'a [f64],
+    /// P = W^(3/2) at the points.
+    p: Vec<f64>,
+    /// dP/dx = 1.5·a/√v at the points (NaN at rest), when the profile's acceleration is
+    /// given.
+    m: Option<Vec<f64>>,
+}
+
+impl<'a> Ceiling<'a> {
+    /// A ceiling through `v` at `x`; with `a`, the acceleration of the profile there.
+    pub fn new(x: &'a [f64], v: &'a [f64], a: Option<&[f64]>) -> Ceiling<'a> {
+        Ceiling {
+            x,
+            v,
+            p: v.iter().map(|w| w * w.sqrt()).collect(),
+            m: a.map(|a| {
+                v.iter()
+                    .zip(a)
+                    .map(|(&w, &acc)| {
+                        if w > 0.0 {
+                            1.5 * acc / w.sqrt()
+                        } else {
+                            f64::NAN
+                        }
+                    })
+                    .collect()
+            }),
+        }
+    }
+
+    /// Cell index of `x`: `i` with `x[i] ≤ x < x[i+1]`, clamped to the cells; `hint` first.
+    fn cell(&self, x: f64, hint: usize) -> usize {
+        let n = self.x.len();
+        let last = n.saturating_sub(2);
+        let h = hint.min(last);
+        if self.x[h] <= x && (h + 1 >= n || x < self.x[h + 1]) {
+            return h;
+        }
+        if h + 2 < n && self.x[h + 1] <= x && x < self.x[h + 2] {
+            return h + 1;
+        }
+        self.x
+            .partition_point(|&p| p <= x)
+            .saturating_sub(1)
+            .min(last)
+    }
+
+    /// (W, a_W) at `x`, and the cell.
+    fn at(&self, x: f64, hint: usize) -> (f64, f64, usize) {
+        let i = self.cell(x, hint);
+        if self.x.len() < 2 {
+            return (self.v[0], 0.0, 0);
+        }
+        let (x0, x1) = (self.x[i], self.x[i + 1]);
+        let u = ((x - x0) / (x1 - x0)).clamp(0.0, 1.0);
+        let (p0, p1) = (self.p[i], self.p[i + 1]);
+        let h = x1 - x0;
+        let (p, dp) = match &self.m {
+            // P as the cubic Hermite interpolant of the values and slopes of the profile
+            // the ceiling was recorded from (C¹: a motion can follow it with a continuous
+            // acceleration). At rest the slope is the other end's: P is linear in the jerk
+            // phase from rest (x = J·t³/6, P = (J/2)^(3/2)·t³).
+            Some(m) => {
+                let secant = (p1 - p0) / h;
+                let pick = |a: f64, b: f64| {
+                    if !a.is_nan() {
+                        a
+                    } else if !b.is_nan() {
+                        b
+                    } else {
+                        secant
+                    }
+                };
+                let m0 = pick(m[i], m[i + 1]) * h;
+                let m1 = pick(m[i + 1], m[i]) * h;
+                let (u2, u3) = (u * u, u * u * u);
+                let p = (2.0 * u3 - 3.0 * u2 + 1.0) * p0
+                    + (u3 - 2.0 * u2 + u) * m0
+                    + (-2.0 * u3 + 3.0 * u2) * p1
+                    + (u3 - u2) * m1;
+                let dp = ((6.0 * u2 - 6.0 * u) * p0
+                    + (3.0 * u2 - 4.0 * u + 1.0) * m0
+                    + (-6.0 * u2 + 6.0 * u) * p1
+                    + (3.0 * u2 - 2.0 * u) * m1)
+                    / h;
+                (p.max(0.0), dp)
+            }
+            // P linear: exact for the jerk phase from rest, between the two values
+            // elsewhere.
+            None => (p0 + u * (p1 - p0), (p1 - p0) / h),
+        };
+        let c = cbrt(p);
+        let w = c * c;
+        // a = W·dW/dx = √W·(dP/dx)/1.5.
+        let aw = w.sqrt() * dp / 1.5;
+        (w, aw, i)
+    }
+}
+
+/// Cube root of a non-negative `p` (the library's is a slow software routine on this
+/// target): exponent-halving first guess, then three Halley steps (cubic convergence: far
+/// below rounding after the third).
+fn cbrt(p: f64) -> f64 {
+    if p <= 0.0 || !p.is_finite() {
+        return p.max(0.0);
+    }
+    let mut y = f64::from_bits(p.to_bits() / 3 + 0x2A9F_7893_782D_A1CE);
+    for _ in 0..3 {
+        let y3 = y * y * y;
+        y *= (y3 + 2.0 * p) / (2.0 * y3 + p);
+    }
+    y
+}
+
+/// The state of the motion along a pass.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct State {
+    /// Time, s.
+    pub t: f64,
+    /// Distance along the pass, mm.
+    pub x: f64,
+    /// Speed, mm/s.
+    pub v: f64,
+    /// Acceleration along the pass, mm/s².
+    pub a: f64,
+}
+
+/// What a pass hands out.
+pub(crate) trait Sink {
+    /// One step from `from` to `to` under jerk `j` (mm/s³); `d` are the derivatives at
+    /// the start (geometric s), `cycle` is false for a step that jumped a cruise.
+    fn step(&mut self, from: &State, to: &State, j: f64, d: &[[f64; 4]; 5], cycle: bool);
+}
+
+/// Outcome of a pass.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct PassStats {
+    /// Cycles where the state had to be put on the ceiling.
+    pub clips: usize,
+    /// Steps taken.
+    pub steps: u64,
+    /// Time at the end, s.
+    pub time_s: f64,
+}
+
+/// One pass.
+pub(crate) struct Pass<'a> {
+    pub geo: &'a Geometry,
+    pub machine: &'a Machine,
+    pub ceiling: Ceiling<'a>,
+    /// The velocity limit curve, when the ceiling is another profile: a crawl (below)
+    /// may use it where the profile stopped.
+    pub limit: Option<Ceiling<'a>>,
+    /// Forward (x = s) or backward (x = L − s).
+    pub forward: bool,
+    /// Cycle time, s.
+    pub dt: f64,
+    /// Fractions of the acceleration and jerk caps this pass plans with (≤ 1).
+    pub use_caps: [f64; 2],
+    /// Every step is one cycle (no cruise jumps): for a trajectory at Tcy.
+    pub every_cycle: bool,
+}
+
+/// Pieces of the look-ahead ramp (module docs).
+const RAMP_STEPS: usize = 8;
+
+/// Steps without progress after which a pass gives up (the limits allow no motion).
+const STALL_STEPS: u32 = 1_000_000;
+
+impl Pass<'_> {
+    fn s_of(&self, x: f64, len: f64) -> f64 {
+        if self.forward { x } else { len - x }
+    }
+
+    fn caps(&self, loc: &Local, v: f64, a_abs: f64) -> (f64, f64) {
+        let ac = loc.a_cap(self.machine, v) * self.use_caps[0];
+        let jc = loc.j_cap(self.machine, v, a_abs) * self.use_caps[1];
+        (ac, jc)
+    }
+
+    /// Whether (x1, v1, a1) is safe (module docs); `vmax` is the feed and the axes' V
+    /// here.
+    #[allow(clippy::too_many_arguments)]
+    fn safe(
+        &self,
+        loc: &Local,
+        vmax: f64,
+        x1: f64,
+        v1: f64,
+        a1: f64,
+        hint: usize,
+        len: f64,
+    ) -> bool {
+        if v1 > vmax {
+            return false;
+        }
+        let (ac, jc) = self.caps(loc, v1.max(0.0), a1.abs());
+        if a1.abs() > ac.max(0.0) * (1.0 + 1e-12) + 1e-12 || jc < 0.0 {
+            return false;
+        }
+        let (w, aw, i) = self.ceiling.at(x1, hint);
+        if v1 > w * (1.0 + CEILING_REL) {
+            return false;
+        }
+        if a1 <= aw {
+            return true;
+        }
+        // The ramp of a down at the jerk cap, in RAMP_STEPS pieces, until it meets the
+        // ceiling's acceleration: under the ceiling all the way.
+        let jb = jc.max(1e-300);
+        let dtau = (a1 - aw) / jb / RAMP_STEPS as f64;
+        let (mut x, mut v, mut a, mut c) = (x1, v1, a1, i);
+        for _ in 0..4 * RAMP_STEPS {
+            x += v * dtau + 0.5 * a * dtau * dtau - jb * dtau * dtau * dtau / 6.0;
+            v += a * dtau - 0.5 * jb * dtau * dtau;
+            a -= jb * dtau;
+            if v <= 0.0 || x >= len {
+                return v <= 0.0 || v <= self.ceiling.at(len, c).0 * (1.0 + CEILING_REL);
+            }
+            let (w, aw, k) = self.ceiling.at(x, c);
+            c = k;
+            if v > w * (1.0 + CEILING_REL) {
+                return false;
+            }
+            if a <= aw {
+                return true;
+            }
+        }
+        true
+    }
+
+    /// Run the pass from rest at x = 0 to x = L; `sink` gets every step.
+    pub fn run(&self, sink: &mut dyn Sink) -> Result<PassStats, f64> {
+        let len = self.geo.length();
+        let mut st = State {
+            t: 0.0,
+            x: 0.0,
+            v: 0.0,
+            a: 0.0,
+        };
+        let mut stats = PassStats::default();
+        let mut hint = 0usize;
+        let mut idle = 0u32;
+        while st.x < len - END_MM {
+            let d = self.geo.derivs(self.s_of(st.x, len));
+            let loc = Local::from_derivs(&d);
+            let vmax = loc
+                .v_cap(self.machine)
+                .min(self.geo.feed_at(self.s_of(st.x, len)));
+            let (w, _, i) = self.ceiling.at(st.x, hint);
+            hint = i;
+            let dt = self.dt;
+            // A cruise on a flat stretch of the ceiling: jump to the next grid point
+            // when the state there is safe (then it is everywhere before it).
+            // Within CRUISE_REL of the ceiling, or of one cycle at the jerk cap where the
+            // ceiling is below that (the crawl regime, where a cycle's jerk is coarser
+            // than the speed).
+            let one_cycle = self.caps(&loc, st.v, st.a.abs()).1.max(0.0) * self.dt * self.dt;
+            let near = (CRUISE_REL * w)
+                .max(CRAWL_CRUISE_REL * w.min(one_cycle))
+                .max(CRUISE_ABS_MM_S);
+            if !self.every_cycle && st.a.abs() * self.dt <= near && st.v > 0.0 && st.v >= w - near {
+                let nx = (i + 1).min(self.ceiling.x.len() - 1);
+                let xn = self.ceiling.x[nx].min(len);
+                if xn > st.x
+                    && self.ceiling.v[i] == self.ceiling.v[nx]
+                    && self
+                        .ceiling
+                        .m
+                        .as_ref()
+                        .is_none_or(|m| m[i] == 0.0 && m[nx] == 0.0)
+                    && self.safe(&loc, vmax, xn, st.v, 0.0, i, len)
+                {
+                    let to = State {
+                        t: st.t + (xn - st.x) / st.v,
+                        x: xn,
+                        v: st.v,
+                        a: 0.0,
+                    };
+                    sink.step(&st, &to, 0.0, &d, false);
+                    st = to;
+                    stats.steps += 1;
+                    continue;
+                }
+            }
+            let (ac, jc) = self.caps(&loc, st.v, st.a.abs());
+            let jm = jc.max(0.0);
+            let ac = ac.max(0.0);
+            let mut lo = (-jm).max((-ac - st.a) / dt);
+            let mut hi = jm.min((ac - st.a) / dt);
+            if lo > hi {
+                // |a| above the cap at this speed: bring it back as fast as allowed.
+                let j = -st.a.signum() * jm;
+                lo = j;
+                hi = j;
+            }
+            let next = |j: f64| {
+                let x1 = st.x + st.v * dt + 0.5 * st.a * dt * dt + j * dt * dt * dt / 6.0;
+                let v1 = st.v + st.a * dt + 0.5 * j * dt * dt;
+                let a1 = st.a + j * dt;
+                (x1, v1, a1)
+            };
+            let ok = |j: f64| {
+                let (x1, v1, a1) = next(j);
+                self.safe(&loc, vmax, x1, v1, a1, hint, len)
+            };
+            // On a flat ceiling, just under it: settle (a → 0) rather than take the
+            // largest safe jerk, which would overshoot and chatter about the ceiling.
+            let (w0, aw0, _) = self.ceiling.at(st.x, hint);
+            let jz = (-st.a / dt).clamp(lo, hi);
+            let settle = aw0 == 0.0 && w0 - st.v <= SETTLE_REL * w0;
+            let j = if ok(hi) {
+                hi
+            } else if settle && ok(jz) {
+                jz
+            } else if !ok(lo) {
+                lo
+            } else {
+                let (mut good, mut bad) = (lo, hi);
+                for _ in 0..JERK_BISECTIONS {
+                    let mid = 0.5 * (good + bad);
+                    if ok(mid) {
+                        good = mid;
+                    } else {
+                        bad = mid;
+                    }
+                }
+                good
+            };
+            let (mut x1, mut v1, mut a1) = next(j);
+            let mut t1 = st.t + dt;
+            if v1 < 0.0 {
+                // Stopped within the cycle (only near a standstill): rest where v = 0.
+                let (mut lo_t, mut hi_t) = (0.0, dt);
+                for _ in 0..60 {
+                    let tm = 0.5 * (lo_t + hi_t);
+                    if st.v + st.a * tm + 0.5 * j * tm * tm > 0.0 {
+                        lo_t = tm;
+                    } else {
+                        hi_t = tm;
+                    }
+                }
+                let tm = lo_t;
+                x1 = (st.x + st.v * tm + 0.5 * st.a * tm * tm + j * tm * tm * tm / 6.0).max(st.x);
+                v1 = 0.0;
+                a1 = 0.0;
+            }
+            if x1 <= st.x && st.v <= 0.0 {
+                // At rest where the ceiling is below what one cycle at the jerk cap makes
+                // (W < j_cap·Tcy²): go on at a crawl whose step from rest is a part of the
+                // jerk cap (counted as a clip).
+                let xc = x1.max(st.x);
+                let w0 = match &self.limit {
+                    Some(l) if st.v <= 0.0 => l.at(xc, 0).0,
+                    _ => self.ceiling.at(xc, hint).0,
+                };
+                v1 = (w0.min(vmax) * (1.0 - 1e-9))
+                    .min(CRAWL_JERK_SHARE * jm * dt * dt)
+                    .max(0.0);
+                a1 = 0.0;
+                x1 = x1.max(st.x) + v1 * dt;
+                if v1 > 0.0 {
+                    stats.clips += 1;
+                }
+            }
+            // Never backwards (a cycle in which the speed dips below 0 and back).
+            x1 = x1.max(st.x);
+            if x1 > len {
+                // The last, partial cycle: the time at which x reaches L.
+                let (mut t_lo, mut t_hi) = (0.0, dt);
+                for _ in 0..60 {
+                    let tm = 0.5 * (t_lo + t_hi);
+                    let xm = st.x + st.v * tm + 0.5 * st.a * tm * tm + j * tm * tm * tm / 6.0;
+                    if xm < len {
+                        t_lo = tm;
+                    } else {
+                        t_hi = tm;
+                    }
+                }
+                let tm = t_hi;
+                x1 = len;
+                v1 = (st.v + st.a * tm + 0.5 * j * tm * tm).max(0.0);
+                a1 = st.a + j * tm;
+                t1 = st.t + tm;
+            }
+            let (w1, aw1, _) = self.ceiling.at(x1, hint);
+            let w1 = w1.min(vmax);
+            if v1 > w1 * (1.0 + CEILING_REL) {
+                v1 = w1;
+                a1 = aw1.clamp(-ac, ac);
+                stats.clips += 1;
+            }
+            if x1 <= st.x {
+                idle += 1;
+                if idle > STALL_STEPS {
+                    return Err(self.s_of(st.x, len));
+                }
+            } else {
+                idle = 0;
+            }
+            let to = State {
+                t: t1,
+                x: x1,
+                v: v1,
+                a: a1,
+            };
+            sink.step(&st, &to, j, &d, t1 - st.t == self.dt);
+            st = to;
+            stats.steps += 1;
+        }
+        if st.x < len {
+            // Within END_MM of the end: the end is reached.
+            let to = State { x: len, ..st };
+            let d = self.geo.derivs(self.s_of(st.x, len));
+            sink.step(&st, &to, 0.0, &d, false);
+            st = to;
+        }
+        stats.time_s = st.t;
+        Ok(stats)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// The cube root agrees with the library's to rounding over 600 decades.
+    #[test]
+    fn cube_root() {
+        let mut x = 1e-300;
+        while x < 1e300 {
+            let (a, b) = (super::cbrt(x), x.cbrt());
+            assert!((a - b).abs() <= 4.0 * f64::EPSILON * b, "{x}: {a} {b}");
+            x *= 1.7;
+        }
+        assert_eq!(super::cbrt(0.0), 0.0);
+        assert_eq!(super::cbrt(-1.0), 0.0);
+    }
+}
