@@ -344,8 +344,8 @@ mod tests {
             pivot_mm,
         };
         for (t, cone, field) in [
-            (tilt(f64::NAN, [0.0; 3]), 5.0, "theta_x_deg"),
-            (tilt(10.0, [0.0, f64::INFINITY, 0.0]), 5.0, "pivot_mm"),
+            (tilt(f64::NAN, [0.0; 3]), 5.0, "θx"),
+            (tilt(10.0, [0.0, f64::INFINITY, 0.0]), 5.0, "the pivot"),
             (tilt(10.0, [0.0; 3]), 0.0, "cone_deg"),
         ] {
             match reorient::reorient_nc(program, &m, &t, "p", cone) {
