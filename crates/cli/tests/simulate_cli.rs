@@ -91,7 +91,10 @@ fn two_programs_are_compared_and_outputs_never_overwrite_inputs() {
         "fixtures/c17/SING.I",
     ]);
     assert_ne!(code, 0);
-    assert!(err.contains("polepatch never writes over a file it reads"), "{err}");
+    assert!(
+        err.contains("polepatch never writes over a file it reads"),
+        "{err}"
+    );
     assert_eq!(std::fs::read(&input).unwrap(), before);
     // One trajectory, one program.
     let (code, _, err) = polepatch(&[
