@@ -538,7 +538,6 @@ fn reference(
     };
     let p: Vec<f64> = path.axes.iter().map(|q| q[Axis::Primary.index()]).collect();
     let c: Vec<f64> = path.axes.iter().map(|q| q[Axis::C.index()]).collect();
-    let step_mm = path.feed_mm_min / 60.0 * opts.tcy_s.unwrap_or(machine.tcy_s);
     let t0 = Instant::now();
     if both {
         let res = zone_reference(
@@ -550,7 +549,6 @@ fn reference(
             hi,
             machine,
             path.feed_mm_min,
-            step_mm,
             opts.max_decimals,
         );
         out.status = match res {
@@ -576,7 +574,7 @@ fn reference(
             hi,
             (zone.first, zone.last),
             &lim,
-            step_mm,
+            polepatch_patcher::direct::BOUND_SAMPLES_PER_SPAN,
         );
         out.status = match res {
             Ok((b, _)) => {

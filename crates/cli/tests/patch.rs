@@ -136,7 +136,6 @@ fn impossible_zone_keeps_the_best_improvement() {
         0..n - 1,
         &m,
         path.feed_mm_min,
-        path.feed_mm_min / 60.0 * m.tcy_s,
         PatchOptions::default().max_decimals,
     )
     .unwrap();

@@ -105,7 +105,6 @@ struct Ctx<'a> {
     machine: &'a Machine,
     opts: &'a PatchOptions,
     feed_mm_min: f64,
-    step_mm: f64,
 }
 
 /// Patch every zone of `path` with both rotary axes (module docs).
@@ -142,7 +141,6 @@ pub(crate) fn patch_both(
         machine,
         opts,
         feed_mm_min: path.feed_mm_min,
-        step_mm: analysis.step_mm,
     };
     let (mut cur_p, mut cur_c) = (p0.clone(), c0.clone());
     let mut decimals = (opts.p_decimals, opts.c_decimals);
@@ -397,7 +395,6 @@ impl Ctx<'_> {
                 (zone.first.max(lo) - lo, zone.last.min(hi) - lo),
                 self.machine,
                 self.feed_mm_min / 60.0,
-                self.step_mm,
             )
         };
         let (pd0, cd0) = (self.opts.p_decimals, self.opts.c_decimals);
@@ -567,7 +564,6 @@ impl Ctx<'_> {
                         core.clone(),
                         self.machine,
                         self.feed_mm_min,
-                        self.step_mm,
                         self.opts.max_decimals,
                     ) != Ok(false)
                 })
@@ -598,7 +594,6 @@ impl Ctx<'_> {
                         crate::joint::SCP_MAX_SOLVES
                     },
                     rel_tol: crate::joint::SCP_REL_TOL,
-                    step_mm: self.step_mm,
                     core: core.clone(),
                     round_p_deg: round_deg,
                     round_c_deg: round_deg,
@@ -644,7 +639,6 @@ impl Ctx<'_> {
                         max_deviation_deg: self.opts.max_deviation_deg,
                         max_solves: crate::joint::SCP_MAX_SOLVES - SCREEN_SOLVES,
                         rel_tol: crate::joint::SCP_REL_TOL,
-                        step_mm: self.step_mm,
                         core: core.clone(),
                         round_p_deg: round_deg,
                         round_c_deg: round_deg,
@@ -702,16 +696,13 @@ impl Ctx<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::Sample;
     use crate::testutil::{machine, planted, sing_path};
     use crate::verify::NOT_WORSE_REL;
 
-    fn samples(path: &Path, m: &Machine) -> Vec<Sample> {
-        let opts = AnalysisOptions {
-            keep_samples: true,
-            ..AnalysisOptions::default()
-        };
-        analyze_path(path, m, &opts).unwrap().samples
+    fn spans(path: &Path, m: &Machine) -> Vec<crate::analysis::SpanFigures> {
+        crate::analysis::analyze_spans(path, m, &AnalysisOptions::default())
+            .unwrap()
+            .1
     }
 
     /// The path with the result's values.
@@ -725,7 +716,7 @@ mod tests {
     }
 
     /// The invariants of the default method: X Y Z unchanged and the changed flags right;
-    /// at every analysis sample no axis ratio falls below `min(before, 1)` (to
+    /// on every span no axis ratio falls below `min(before, 1)` (to
     /// NOT_WORSE_REL); every zone reaches feed on both rotary axes; the result read back
     /// has no zone left. Returns the largest orientation change.
     fn check_both(path: &Path, m: &Machine, res: &PatchResult, what: &str) -> f64 {
@@ -739,13 +730,13 @@ mod tests {
             !res.p_changed[0] && !res.c_changed[0],
             "{what}: the first point moved"
         );
-        for (x, y) in samples(path, m).iter().zip(&samples(&after, m)) {
+        for (x, y) in spans(path, m).iter().zip(&spans(&after, m)) {
             for k in 0..5 {
                 let floor = x.axis_ratio[k].min(1.0) * (1.0 - NOT_WORSE_REL) - 1e-12;
                 assert!(
                     y.axis_ratio[k] >= floor,
                     "{what}: axis {k} at s = {:.3}: {} → {}",
-                    x.s_mm,
+                    x.min_s_mm,
                     x.axis_ratio[k],
                     y.axis_ratio[k]
                 );

@@ -108,7 +108,6 @@ pub(crate) fn patch_c_only(
         lim: std::cell::Cell::new(CLimits::new(machine, path.feed_mm_min, opts.margin)),
         machine,
         feed_mm_s: path.feed_mm_min / 60.0,
-        step: analysis.step_mm,
         opts,
         methods,
     };
@@ -239,7 +238,6 @@ struct Ctx<'a> {
     machine: &'a Machine,
     /// Programmed feed, mm/s.
     feed_mm_s: f64,
-    step: f64,
     opts: &'a PatchOptions,
     methods: Methods,
 }
@@ -448,7 +446,6 @@ impl Ctx<'_> {
                 last - lo,
                 self.machine,
                 self.feed_mm_s,
-                self.step,
             )
         };
         let mut last_checked = None;
@@ -536,7 +533,6 @@ mod tests {
         for (mname, feed) in [("mikron-hsm600", 3000.0), ("mikron-ucp710", 1000.0)] {
             let m = machine(mname);
             let lim0 = CLimits::new(&m, feed, 0.0);
-            let step = feed / 60.0 * m.tcy_s;
             for flip in [false, true] {
                 for d in [0.01, 0.5, 2.0, 4.0] {
                     for spacing in [1.0, 0.5] {
@@ -549,7 +545,13 @@ mod tests {
                         for z in &res.zones {
                             // The bound over the points this patch moved (zone ∪ patch).
                             let (bound, _) = deviation_bound_sampled(
-                                &path.s_mm, &p, &c, z.first, z.last, &lim0, step,
+                                &path.s_mm,
+                                &p,
+                                &c,
+                                z.first,
+                                z.last,
+                                &lim0,
+                                crate::direct::BOUND_SAMPLES_PER_SPAN,
                             )
                             .unwrap();
                             assert!(
@@ -626,10 +628,17 @@ mod tests {
             let p: Vec<f64> = path.axes.iter().map(|q| q[3]).collect();
             let c: Vec<f64> = path.axes.iter().map(|q| q[4]).collect();
             let z = &res.zones[0];
-            let step = 2000.0 / 60.0 * m.tcy_s;
             let lim0 = CLimits::new(&m, 2000.0, 0.0);
-            let (bound, _) =
-                deviation_bound_sampled(&path.s_mm, &p, &c, z.first, z.last, &lim0, step).unwrap();
+            let (bound, _) = deviation_bound_sampled(
+                &path.s_mm,
+                &p,
+                &c,
+                z.first,
+                z.last,
+                &lim0,
+                crate::direct::BOUND_SAMPLES_PER_SPAN,
+            )
+            .unwrap();
             assert!(bound <= z.max_deviation_deg + 1e-6, "{mname}");
             assert!(
                 z.max_deviation_deg <= 1.25 * bound,

@@ -61,6 +61,10 @@ pub const JOINT_WINDOW_POINTS: usize = 24;
 /// it has decayed by 0.27⁸ ≈ 3·10⁻⁵.
 pub const EDGE_SPANS: usize = 8;
 
+/// Rows per span (plus the current spline's vertex of q') of the "not worse" velocity rows
+/// on a span that exceeded the velocity limit before (`Hermite::push_limits`).
+pub const NOT_WORSE_SAMPLES_PER_SPAN: usize = 8;
+
 /// Relative slack of a "not worse than before" bound (round-off only).
 pub const NOT_WORSE_SLACK: f64 = 1e-9;
 
@@ -358,8 +362,9 @@ impl<'a> Hermite<'a> {
     /// movable, or in `core` (the spans that must reach feed), gets `limit − room`; any
     /// other span that touches a fixed point gets
     /// `max(limit, |current value|·(1 + NOT_WORSE_SLACK)) − room` — for q', where the span
-    /// exceeded the velocity limit before, at the analysis samples (step `step_mm`) against
-    /// the span's sampled peak instead of the hull: it may not get worse, and need not reach
+    /// exceeded the velocity limit before, at [`NOT_WORSE_SAMPLES_PER_SPAN`] samples and the
+    /// current spline's vertex of q' (where its exact peak is) against that exact peak
+    /// instead of the hull: it may not get worse, and need not reach
     /// feed (a fixed neighbour may already exceed the limits, e.g. through the file's own
     /// rounding). `room[k − lo][r]` ([`Hermite::rounding_room`]) is
     /// what rounding the written values can add to the (r+1)-th derivative on span k, so
@@ -374,7 +379,6 @@ impl<'a> Hermite<'a> {
         lim: &crate::limits::GeomLimits,
         current: &[f64],
         room: &[[f64; 3]],
-        step_mm: f64,
         core: std::ops::Range<usize>,
     ) {
         // Spans next to a window end inside the path are left out: there the fixed end
@@ -419,15 +423,26 @@ impl<'a> Hermite<'a> {
                 let b = (lim.v - room[0]).max(1e-3 * lim.v);
                 push_abs(qp, &self.b1(k), b);
             } else {
-                // Beyond the limit before: "not worse" on q' where it is measured, at the
-                // analysis samples, against the span's sampled peak (the hull overstates
-                // the peak, so it cannot stand for it).
-                crate::spline::span_offsets(self.h(k), step_mm, true, &mut taus);
-                let peak = taus
-                    .iter()
-                    .fold(0.0f64, |m, &t| m.max(self.d1(k, t).at(current).abs()));
+                // Beyond the limit before: "not worse" on q' against the span's exact peak
+                // before (the hull overstates the peak, so it cannot stand for it).
+                crate::spline::span_offsets(self.h(k), NOT_WORSE_SAMPLES_PER_SPAN, &mut taus);
+                // Rows at the samples and at the current spline's vertex of q' (its peak
+                // on the span, when inside), against that peak.
+                let d1 = |t: f64| self.d1(k, t).at(current);
+                let (qa, qm, qb) = (d1(0.0), d1(0.5 * self.h(k)), d1(self.h(k)));
+                // q'(τ) = qa + c1·τ + c2·τ² through the three values.
+                let h = self.h(k);
+                let c2 = 2.0 * (qa - 2.0 * qm + qb) / (h * h);
+                let c1 = (qb - qa) / h - c2 * h;
+                if c2 != 0.0 {
+                    let v = -c1 / (2.0 * c2);
+                    if v > 0.0 && v < h {
+                        taus.push(v);
+                    }
+                }
+                let peak = taus.iter().fold(0.0f64, |m, &t| m.max(d1(t).abs()));
                 let b = (lim.v.max(peak * (1.0 + NOT_WORSE_SLACK)) - room[0]).max(1e-3 * lim.v);
-                for &tau in taus.iter().skip(1).take(taus.len().saturating_sub(2)) {
+                for &tau in taus.iter().filter(|&&t| t > 0.0 && t < h) {
                     push_abs(qp, &self.d1(k, tau), b);
                 }
             }

@@ -143,8 +143,6 @@ pub struct JointProblem<'a> {
     /// Relative improvement below which an accepted step ends the iteration
     /// ([`SCP_REL_TOL`] by default).
     pub rel_tol: f64,
-    /// The analysis step F·Tcy, mm ("not worse" is bounded at these samples).
-    pub step_mm: f64,
     /// The spans that must reach feed (the zone's), `k` for `[s_k, s_{k+1}]`: they get the
     /// limits even where they touch a fixed point.
     pub core: std::ops::Range<usize>,
@@ -215,22 +213,8 @@ pub fn solve_joint(pr: &JointProblem) -> Result<JointSolution, PatchFailure> {
         hp.rounding_room(pr.round_p_deg)?,
         hc.rounding_room(pr.round_c_deg)?,
     );
-    hp.push_limits(
-        &mut base,
-        &pr.lim_p,
-        &current,
-        &rp,
-        pr.step_mm,
-        pr.core.clone(),
-    );
-    hc.push_limits(
-        &mut base,
-        &pr.lim_c,
-        &current,
-        &rc,
-        pr.step_mm,
-        pr.core.clone(),
-    );
+    hp.push_limits(&mut base, &pr.lim_p, &current, &rp, pr.core.clone());
+    hc.push_limits(&mut base, &pr.lim_c, &current, &rc, pr.core.clone());
     let (p_lo, p_hi) = pr.machine.primary_range_deg;
     for i in first..=last {
         let v = hp.delta_var(i);

@@ -92,7 +92,6 @@ pub fn reachable(
     core: std::ops::Range<usize>,
     machine: &Machine,
     feed_mm_min: f64,
-    step_mm: f64,
     max_decimals: usize,
 ) -> Result<bool, PatchFailure> {
     let hp = Hermite::with_offset(s_mm, p_deg, first, last, JOINT_WINDOW_POINTS, 0)?;
@@ -107,15 +106,8 @@ pub fn reachable(
     let lim = |axis| GeomLimits::of(machine, axis, feed_mm_min, 0.0);
     let eps = 0.5 * 10f64.powi(-(max_decimals as i32));
     let (rp, rc) = (hp.rounding_room(eps)?, hc.rounding_room(eps)?);
-    hp.push_limits(
-        &mut qp,
-        &lim(Axis::Primary),
-        &current,
-        &rp,
-        step_mm,
-        core.clone(),
-    );
-    hc.push_limits(&mut qp, &lim(Axis::C), &current, &rc, step_mm, core);
+    hp.push_limits(&mut qp, &lim(Axis::Primary), &current, &rp, core.clone());
+    hc.push_limits(&mut qp, &lim(Axis::C), &current, &rc, core);
     let (lo, hi) = machine.primary_range_deg;
     for (i, p) in p_deg.iter().enumerate().take(last + 1).skip(first) {
         let v = hp.delta_var(i);
@@ -131,8 +123,7 @@ pub fn reachable(
 }
 
 /// The reference of `zone` on a path given by `s_mm`, `p_deg`, `c_deg` (the program's
-/// values), with points `first..=last` movable (module docs). `step_mm` is the analysis
-/// step F·Tcy; `max_decimals` the most decimals that may be written (the unreachability
+/// values), with points `first..=last` movable (module docs). `max_decimals` the most decimals that may be written (the unreachability
 /// proof leaves room for their rounding).
 #[allow(clippy::too_many_arguments)]
 pub fn zone_reference(
@@ -144,7 +135,6 @@ pub fn zone_reference(
     last: usize,
     machine: &Machine,
     feed_mm_min: f64,
-    step_mm: f64,
     max_decimals: usize,
 ) -> Result<Reference, PatchFailure> {
     let n = s_mm.len();
@@ -161,7 +151,6 @@ pub fn zone_reference(
         core,
         machine,
         feed_mm_min,
-        step_mm,
         max_decimals,
     )? {
         return Ok(Reference::Unreachable);
@@ -191,7 +180,6 @@ pub fn zone_reference(
             (zone.first, zone.last),
             machine,
             feed_mm_min / 60.0,
-            step_mm,
         )
         .passes()
     };
@@ -267,7 +255,6 @@ pub fn zone_reference(
             max_deviation_deg: None,
             max_solves: REFERENCE_MAX_SOLVES,
             rel_tol: REFERENCE_REL_TOL,
-            step_mm,
             core: zone_core(zone, n),
             round_p_deg: 0.0,
             round_c_deg: 0.0,

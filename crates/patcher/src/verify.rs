@@ -12,7 +12,7 @@
 //! the checks are made.
 
 use crate::analysis::RATIO_TOL;
-use crate::spline::{SplineSystem, span_peaks};
+use crate::spline::{SplineSystem, span_maxima};
 use polepatch_kinematics::{Axis, Machine, axis_feed_ratio};
 
 /// Points of unchanged path kept either side of a change when verifying it.
@@ -86,12 +86,11 @@ fn span_ratios(
     machine: &Machine,
     axis: Axis,
     feed_mm_s: f64,
-    step_mm: f64,
 ) -> Option<Vec<f64>> {
     let sp = sys.fit(y).ok()?;
     let lim = machine.limit(axis);
     Some(
-        span_peaks(s, &sp, step_mm)
+        span_maxima(s, &sp)
             .into_iter()
             .map(|pk| axis_feed_ratio(lim, pk, feed_mm_s))
             .collect(),
@@ -102,7 +101,7 @@ fn span_ratios(
 /// as written) differ at most in `first..` (points `first..=last` modified, later points
 /// possibly changed as a block that keeps every derivative's size: a 360° offset of C, or
 /// a branch re-selection `(P, C) → (−P, C ± 180°)`).
-/// `feed_mm_s` is the programmed feed, `step_mm` the sampling step F·Tcy.
+/// `feed_mm_s` is the programmed feed.
 ///
 /// Every axis must reach feed (ratio ≥ 1 − [`RATIO_TOL`]) on every sample of the spans
 /// within [`CORE_MARGIN_POINTS`] points of the modified range, and no sample of the window
@@ -115,7 +114,6 @@ pub fn verify_change(
     last: usize,
     machine: &Machine,
     feed_mm_s: f64,
-    step_mm: f64,
 ) -> Verdict {
     verify_change_with_core(
         s_mm,
@@ -124,7 +122,6 @@ pub fn verify_change(
         (first, last),
         machine,
         feed_mm_s,
-        step_mm,
     )
 }
 
@@ -142,7 +139,6 @@ pub fn verify_change_with_core(
     core: (usize, usize),
     machine: &Machine,
     feed_mm_s: f64,
-    step_mm: f64,
 ) -> Verdict {
     let n = s_mm.len();
     let first = changed.0.min(core.0);
@@ -168,8 +164,7 @@ pub fn verify_change_with_core(
         worse_somewhere: false,
     };
     for ch in changes {
-        let ratios =
-            |y: &[f64]| span_ratios(&sys, s, &y[lo..=hi], machine, ch.axis, feed_mm_s, step_mm);
+        let ratios = |y: &[f64]| span_ratios(&sys, s, &y[lo..=hi], machine, ch.axis, feed_mm_s);
         let (Some(before), Some(after)) = (ratios(ch.before), ratios(ch.after)) else {
             return Verdict::failed();
         };
@@ -212,7 +207,7 @@ mod tests {
                 before: &y,
                 after,
             }];
-            verify_change(&s, &ch, 20, 20, &m, feed_mm_s, 0.02)
+            verify_change(&s, &ch, 20, 20, &m, feed_mm_s)
         };
         assert!(c(&y).passes(), "{:?}", c(&y));
         let mut bumped = y.clone();
@@ -237,7 +232,7 @@ mod tests {
             before: &line,
             after: &line,
         }];
-        assert!(verify_change(&s, &only_c, 18, 22, &m, feed_mm_s, 0.02).passes());
+        assert!(verify_change(&s, &only_c, 18, 22, &m, feed_mm_s).passes());
         let both = [
             only_c[0],
             AxisChange {
@@ -246,7 +241,7 @@ mod tests {
                 after: &kinked,
             },
         ];
-        let v = verify_change(&s, &both, 18, 22, &m, feed_mm_s, 0.02);
+        let v = verify_change(&s, &both, 18, 22, &m, feed_mm_s);
         assert!(!v.passes() && v.worse_somewhere, "{v:?}");
     }
 
@@ -263,9 +258,6 @@ mod tests {
             before: &y,
             after: &bad,
         }];
-        assert_eq!(
-            verify_change(&s, &ch, 5, 5, &m, 10.0, 0.01),
-            Verdict::failed()
-        );
+        assert_eq!(verify_change(&s, &ch, 5, 5, &m, 10.0), Verdict::failed());
     }
 }
