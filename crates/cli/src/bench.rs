@@ -359,7 +359,9 @@ fn analysis_zones(lp: &LoadedProgram, machine: &Machine, opts: &PatchOptions) ->
         .iter()
         .map(|rp| match &rp.path {
             Ok(p) => analyze_path(p, machine, &aopts)
-                .map(|a| polepatch_patcher::patch::merged_zones(&a.zones))
+                .map(|a| {
+                    polepatch_patcher::driver::merge_zones(&a.zones, opts.solver.merge_gap_points)
+                })
                 .unwrap_or_default(),
             Err(_) => Vec::new(),
         })

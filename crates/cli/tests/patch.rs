@@ -136,7 +136,8 @@ fn impossible_zone_keeps_the_best_improvement() {
         0..n - 1,
         &m,
         path.feed_mm_min,
-        PatchOptions::default().max_decimals,
+        polepatch::patcher::PatchAxes::Both,
+        true,
     )
     .unwrap();
     assert!(!reachable, "the planted zone must be unreachable");

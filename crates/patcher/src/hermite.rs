@@ -117,6 +117,10 @@ pub(crate) struct Hermite<'a> {
     offset: usize,
     /// Current spline's slope at `lo` / `hi` when that end is inside the path.
     fixed: [Option<f64>; 2],
+    /// In coefficient form ([`Hermite::coefficient_form`]): the window's cubic B-spline
+    /// (clamped knots at every CL point of the window) with the current spline's
+    /// coefficients; the variables are the changes of those coefficients.
+    basis: Option<polepatch_bspline::BSpline>,
 }
 
 impl<'a> Hermite<'a> {
@@ -170,7 +174,89 @@ impl<'a> Hermite<'a> {
             nd: last - first + 1,
             offset,
             fixed,
+            basis: None,
         })
+    }
+
+    /// The same window in **coefficient form**: the variables are the `hi − lo + 3`
+    /// coefficients of the cubic B-spline with a knot at every CL point of the window
+    /// (clamped at its ends), numbered from `offset`. Every value and slope is then a
+    /// combination of three neighbouring coefficients, C² continuity holds by
+    /// construction (no rows for it), and the equalities are the fixed points' values and
+    /// the two end conditions. The forms (`d1`, `d2`, `d3`, `b1`, …) and
+    /// [`Hermite::push_limits`] are the same functions of the values and slopes; the
+    /// changes are [`Hermite::delta`]. About a third of the unknowns of the point form and
+    /// a third of its bandwidth: what the banded interior-point method wants
+    /// ([`crate::ipm`]).
+    pub(crate) fn coefficient_form(mut self) -> Result<Hermite<'a>, PatchFailure> {
+        // The current spline on the window: the clamped interpolant with its own end
+        // slopes (it is C² with these values, so it is that spline exactly); the variables
+        // are changes of its coefficients, so a fixed point's value is exact (its row has
+        // right-hand side 0) whatever the solver's tolerance.
+        let (a, b) = (self.lo, self.hi);
+        let sp = self.widened()?;
+        let cl = polepatch_bspline::interpolate_clamped(
+            &self.s[a..=b],
+            &self.c[a..=b],
+            sp.eval_derivs(self.s[a])[1],
+            sp.eval_derivs(self.s[b])[1],
+        )
+        .map_err(|_| PatchFailure::TooShort)?;
+        self.basis = Some(cl);
+        Ok(self)
+    }
+
+    /// The current spline's coefficients (coefficient form only).
+    pub(crate) fn coefficients(&self) -> Option<&[f64]> {
+        self.basis.as_ref().map(|b| b.coeffs())
+    }
+
+    /// The analysis spline of the current values on the window widened by
+    /// [`WINDOW_POINTS`] or more (where the window's slopes are taken from).
+    fn widened(&self) -> Result<AnalysisSpline, PatchFailure> {
+        let n = self.s.len();
+        let w = (self.hi - self.last)
+            .max(self.first - self.lo)
+            .max(WINDOW_POINTS);
+        let lo2 = self.lo.saturating_sub(w);
+        let hi2 = (self.hi + w).min(n - 1);
+        AnalysisSpline::new(&self.s[lo2..=hi2], &self.c[lo2..=hi2])
+            .map_err(|_| PatchFailure::TooShort)
+    }
+
+    /// The value (`order` 0) or slope (1) at knot `k` as an affine form of the changes of
+    /// the coefficients: the current spline's plus the basis row.
+    fn basis_aff(&self, b: &polepatch_bspline::BSpline, k: usize, order: usize) -> Aff {
+        let r = b.basis_row(self.s[k], order);
+        let cur = &b.coeffs()[r.first..];
+        Aff {
+            row: (0..4)
+                .filter(|&j| r.weights[j] != 0.0)
+                .map(|j| (self.offset + r.first + j, r.weights[j]))
+                .collect(),
+            c: (0..4)
+                .map(|j| r.weights[j] * cur.get(j).copied().unwrap_or(0.0))
+                .sum(),
+        }
+    }
+
+    /// The change `δ_i` of the value at point `i` (in `first..=last`): one variable in
+    /// point form, a combination of coefficients minus the current value in coefficient
+    /// form.
+    pub(crate) fn delta(&self, i: usize) -> Aff {
+        match &self.basis {
+            None => Aff::var(self.delta_var(i)),
+            Some(b) => {
+                let mut a = self.basis_aff(b, i, 0);
+                a.c -= self.c[i];
+                a
+            }
+        }
+    }
+
+    /// Index of this Hermite's first variable.
+    pub(crate) fn offset(&self) -> usize {
+        self.offset
     }
 
     /// Index of the variable `δ_i` (point `i` in `first..=last`).
@@ -178,9 +264,12 @@ impl<'a> Hermite<'a> {
         self.offset + i - self.first
     }
 
-    /// Number of variables (changes, then slopes).
+    /// Number of variables (changes, then slopes; or the coefficients).
     pub(crate) fn vars(&self) -> usize {
-        self.nd + self.hi - self.lo + 1
+        match &self.basis {
+            None => self.nd + self.hi - self.lo + 1,
+            Some(_) => self.hi - self.lo + 3,
+        }
     }
 
     pub(crate) fn h(&self, k: usize) -> f64 {
@@ -189,6 +278,9 @@ impl<'a> Hermite<'a> {
 
     /// Value at path point k.
     fn y(&self, k: usize) -> Aff {
+        if let Some(b) = &self.basis {
+            return self.basis_aff(b, k, 0);
+        }
         let mut a = Aff::constant(self.c[k]);
         if (self.first..=self.last).contains(&k) {
             a.row.push((self.delta_var(k), 1.0));
@@ -198,7 +290,10 @@ impl<'a> Hermite<'a> {
 
     /// Slope at path knot k (lo ≤ k ≤ hi).
     pub(crate) fn m(&self, k: usize) -> Aff {
-        Aff::var(self.offset + self.nd + k - self.lo)
+        match &self.basis {
+            None => Aff::var(self.offset + self.nd + k - self.lo),
+            Some(b) => self.basis_aff(b, k, 1),
+        }
     }
 
     fn secant(&self, k: usize) -> Aff {
@@ -257,7 +352,17 @@ impl<'a> Hermite<'a> {
     pub(crate) fn equalities(&self) -> Vec<Aff> {
         let (lo, hi) = (self.lo, self.hi);
         let mut eqs = Vec::with_capacity(hi - lo + 1);
-        for k in lo + 1..hi {
+        if self.basis.is_some() {
+            // Coefficient form: C² holds by construction; the fixed points keep their
+            // values.
+            for k in (lo..=hi).filter(|k| !(self.first..=self.last).contains(k)) {
+                eqs.push(Aff::sum(&[
+                    (1.0, &self.y(k)),
+                    (-self.c[k], &Aff::constant(1.0)),
+                ]));
+            }
+        }
+        for k in (lo + 1..hi).filter(|_| self.basis.is_none()) {
             let (ha, hb) = (self.h(k - 1), self.h(k));
             let w = 1.0 / (ha + hb);
             eqs.push(Aff::sum(&[
@@ -316,6 +421,13 @@ impl<'a> Hermite<'a> {
             .max(WINDOW_POINTS);
         let lo2 = self.lo.saturating_sub(w);
         let hi2 = (self.hi + w).min(n - 1);
+        if self.basis.is_some() {
+            // The current spline: no change of its coefficients.
+            for j in 0..self.vars() {
+                x[self.offset + j] = 0.0;
+            }
+            return Ok(());
+        }
         let sp = AnalysisSpline::new(&self.s[lo2..=hi2], &self.c[lo2..=hi2])
             .map_err(|_| PatchFailure::TooShort)?;
         for i in self.first..=self.last {
@@ -457,6 +569,21 @@ impl<'a> Hermite<'a> {
                 }
             }
         }
+    }
+
+    /// The position along the path (the knot index) of each of this Hermite's variables,
+    /// in variable order: the changes `δ_i` at `i`, the slopes `m_k` at `k`.
+    pub(crate) fn positions(&self) -> Vec<f64> {
+        if self.basis.is_some() {
+            // Coefficient j of a clamped cubic lives around knot j − 1 of the window.
+            return (0..self.vars())
+                .map(|j| (self.lo + j).saturating_sub(1).clamp(self.lo, self.hi) as f64)
+                .collect();
+        }
+        (self.first..=self.last)
+            .chain(self.lo..=self.hi)
+            .map(|k| k as f64)
+            .collect()
     }
 
     /// Add this Hermite's equalities to `qp`.

@@ -33,6 +33,18 @@ const WINDOW_GUARD_SPANS: usize = 10;
 /// through the spline's decay, beyond the window a solver constrains.
 pub const NOT_WORSE_REL: f64 = 1e-4;
 
+/// The lowest ratio a span may have after a change when it had `before`: a span at feed
+/// (`before ≥ 1 − RATIO_TOL`) stays at feed — a patch never makes a new slow spot — and a
+/// span below feed may lose [`NOT_WORSE_REL`] of its ratio (round-off, the solvers'
+/// tolerance).
+pub fn not_worse_floor(before: f64) -> f64 {
+    if before >= 1.0 - RATIO_TOL {
+        1.0 - RATIO_TOL
+    } else {
+        before * (1.0 - NOT_WORSE_REL)
+    }
+}
+
 /// One axis of a change: its values along the whole path before and after (degrees or
 /// mm, as written), and which axis it is (for its limits).
 #[derive(Debug, Clone, Copy)]
@@ -104,8 +116,8 @@ fn span_ratios(
 /// `feed_mm_s` is the programmed feed.
 ///
 /// Every axis must reach feed (ratio ≥ 1 − [`RATIO_TOL`]) on every sample of the spans
-/// within [`CORE_MARGIN_POINTS`] points of the modified range, and no sample of the window
-/// may get a ratio below `min(before, 1 − RATIO_TOL)` on any checked axis.
+/// within [`CORE_MARGIN_POINTS`] points of the modified range, and no span of the window
+/// may get a ratio below [`not_worse_floor`] of its ratio before on any checked axis.
 #[allow(clippy::too_many_arguments)]
 pub fn verify_change(
     s_mm: &[f64],
@@ -174,8 +186,7 @@ pub fn verify_change_with_core(
                 v.core_min_after = v.core_min_after.min(after[k]);
                 v.core_min_before = v.core_min_before.min(before[k]);
             }
-            if (in_core || (k >= guard_lo && k < guard_hi))
-                && after[k] < before[k].min(1.0 - RATIO_TOL) * (1.0 - NOT_WORSE_REL)
+            if (in_core || (k >= guard_lo && k < guard_hi)) && after[k] < not_worse_floor(before[k])
             {
                 v.worse_somewhere = true;
             }

@@ -87,6 +87,10 @@ pub struct ZoneRow {
     pub patch_length_mm: f64,
     /// `reached`, `improved` or `unchanged`.
     pub outcome: &'static str,
+    /// Why (a fixed set: [`polepatch_patcher::Reason`]): `reached`, `reselected`,
+    /// `end_pinned`, `range`, `deviation_cap`, `proven_unreachable`, `not_found`,
+    /// `not_patched`.
+    pub reason: &'static str,
     /// `reselect`, `joint`, `g16-patch`, `direct` or `none`.
     pub method: &'static str,
     /// Last solver status.
@@ -127,7 +131,7 @@ fn method_name(m: Method) -> &'static str {
 
 impl ZoneRow {
     /// CSV column names of [`ZoneRow::csv_fields`] (the row's fields after `file`).
-    pub const CSV_COLUMNS: [&'static str; 31] = [
+    pub const CSV_COLUMNS: [&'static str; 32] = [
         "run",
         "first_line",
         "last_line",
@@ -151,6 +155,7 @@ impl ZoneRow {
         "reselected_points",
         "patch_length_mm",
         "outcome",
+        "reason",
         "method",
         "qp_status",
         "qp_iterations",
@@ -194,6 +199,7 @@ impl ZoneRow {
             self.reselected_points.to_string(),
             format!("{:.3}", self.patch_length_mm),
             self.outcome.to_string(),
+            self.reason.to_string(),
             self.method.to_string(),
             self.qp_status.to_string(),
             self.qp_iterations.to_string(),
@@ -223,6 +229,7 @@ impl ZoneRow {
             reselected_points: z.reselected_points,
             patch_length_mm: z.patch_length_mm,
             outcome: outcome_name(z.outcome),
+            reason: z.reason.name(),
             method: method_name(z.method),
             qp_status: z.qp.status,
             qp_iterations: z.qp.iterations,
@@ -513,6 +520,7 @@ pub fn patch_program(
                 Err(why) => {
                     for row in &mut report.zones[first_row..] {
                         row.outcome = "unchanged";
+                        row.reason = polepatch_patcher::Reason::NotPatched.name();
                     }
                     report.untouched_runs.push(untouched(
                         lp,

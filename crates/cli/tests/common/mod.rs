@@ -245,8 +245,8 @@ pub fn check_patch_both(
 
 /// Whether the zone of report row `z` is proven unreachable: with every point of its run
 /// but the first (and the last, where `polepatch::end_pose` keeps it) free, no values
-/// written with `opts.max_decimals` decimals bring the zone's original singular zones to
-/// feed on both rotary axes ([`polepatch::patcher::reference::reachable`]).
+/// bring the zone's original singular zones to feed on both rotary axes (the relaxation
+/// [`polepatch::patcher::reference::reachable`] is infeasible).
 pub fn proven_unreachable(
     lp: &LoadedProgram,
     z: &polepatch::ZoneRow,
@@ -294,10 +294,11 @@ pub fn proven_unreachable(
         &c,
         1,
         end,
-        polepatch::patcher::reference::zone_core(&zone, n),
+        polepatch::patcher::driver::zone_core(&zone, n, opts.solver.core_margin_points),
         machine,
         path.feed_mm_min,
-        opts.max_decimals,
+        opts.axes,
+        true,
     )
     .unwrap_or(true)
 }
