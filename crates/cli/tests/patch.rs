@@ -201,7 +201,8 @@ fn zigzag_program_with_many_zones() {
 
 /// Issue 8: a generated HSM600 pass at F4000 with 3-decimal rotary words reached feed only
 /// with `--max-decimals 6` (the old default, 4, left it "improved"). With the defaults it
-/// reaches feed on both axes, written with more decimals, and the report says how many.
+/// reaches feed on both axes — written with the file's decimals when the patch's values
+/// hold Equation 6 rounded to them, else with more, up to 6 — and the report says how many.
 #[test]
 fn f4000_on_the_hsm600_with_three_decimals_reaches_feed_by_default() {
     let m = polepatch::kinematics::Machine::builtin("mikron-hsm600").unwrap();
@@ -220,7 +221,7 @@ fn f4000_on_the_hsm600_with_three_decimals_reaches_feed_by_default() {
         assert!(rep.zones.iter().all(|z| z.outcome == "reached"), "{rep:?}");
         assert_eq!(rep.file_c_decimals, Some(3));
         let written = rep.written_c_decimals.unwrap();
-        assert!((4..=6).contains(&written), "{rep:?}");
+        assert!((3..=6).contains(&written), "{rep:?}");
         assert!(
             rep.zones
                 .iter()

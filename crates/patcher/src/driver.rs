@@ -640,7 +640,13 @@ pub fn patch_with(
             };
             for m in methods.iter_mut() {
                 m.propose(&ctx, &mut sel);
-                if sel.best_passing_deg() == Some(0.0) {
+                // Re-selection keeps every tool axis (its deviation is the rounding's):
+                // nothing can do better.
+                if sel
+                    .passed
+                    .as_ref()
+                    .is_some_and(|c| c.prop.method == Method::Reselect)
+                {
                     break;
                 }
             }

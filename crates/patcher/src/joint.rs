@@ -86,7 +86,7 @@ use crate::{
     hermite::{Aff, Hermite, JOINT_WINDOW_POINTS},
     ipm::IpmStatus,
     limits::GeomLimits,
-    qp::QpBuilder,
+    qp::{QpBuilder, Row},
     report::{QpStats, QpStatus},
     settings::SolverSettings,
 };
@@ -197,9 +197,11 @@ struct Model<'a> {
     /// Index of t and e.
     t: usize,
     e: usize,
+    /// Equalities, objective's linear part, `e ≥ 0`, the cap.
     base: QpBuilder,
-    /// The limit rows (relaxed by e).
-    limit_rows: std::ops::Range<usize>,
+    /// The limit rows, relaxed by e (`row·x − e ≤ rhs`), and the range rows (hard).
+    limits: Vec<(Row, f64)>,
+    ranges: Vec<(Row, f64)>,
     position: Vec<Option<f64>>,
 }
 
@@ -259,29 +261,31 @@ impl<'a> Model<'a> {
             hp.rounding_room(pr.round_p_deg)?,
             hc.rounding_room(pr.round_c_deg)?,
         );
-        let r0 = base.le_len();
-        hp.push_limits(&mut base, &pr.lim_p, &current, &rp, pr.core.clone());
-        hc.push_limits(&mut base, &pr.lim_c, &current, &rc, pr.core.clone());
-        let limit_rows = r0..base.le_len();
-        base.extend_le(limit_rows.clone(), e, -1.0);
+        let mut lim = QpBuilder::new(t + 2);
+        hp.push_limits(&mut lim, &pr.lim_p, &current, &rp, pr.core.clone());
+        hc.push_limits(&mut lim, &pr.lim_c, &current, &rc, pr.core.clone());
+        lim.extend_le(0..lim.le_len(), e, -1.0);
+        let limits = lim.le_rows(0..lim.le_len()).to_vec();
         base.add_le(&[(e, -1.0)], 0.0);
+        let mut rng = QpBuilder::new(t + 2);
         let (p_lo, p_hi) = pr.machine.primary_range_deg;
         for i in first..=last {
             push_between(
-                &mut base,
+                &mut rng,
                 &hp.delta(i),
                 p_lo - pr.p_deg[i],
                 p_hi - pr.p_deg[i],
             );
             if let Some((c_lo, c_hi)) = pr.machine.c_range_deg {
                 push_between(
-                    &mut base,
+                    &mut rng,
                     &hc.delta(i),
                     c_lo - pr.c_deg[i],
                     c_hi - pr.c_deg[i],
                 );
             }
         }
+        let ranges = rng.le_rows(0..rng.le_len()).to_vec();
         if let Some(d) = pr.cap_deg {
             base.add_le(&[(t, 1.0)], chord(d));
         }
@@ -301,7 +305,8 @@ impl<'a> Model<'a> {
             t,
             e,
             base,
-            limit_rows,
+            limits,
+            ranges,
             position,
         })
     }
@@ -320,19 +325,20 @@ impl<'a> Model<'a> {
         Ok(x)
     }
 
+    /// `row·x − rhs` of a limit row without its `−e`: the relative excess over its bound.
+    fn limit_excess(&self, (row, rhs): &(Row, f64), x: &[f64]) -> f64 {
+        row.iter()
+            .filter(|&&(j, _)| j != self.e)
+            .map(|&(j, v)| v * x[j])
+            .sum::<f64>()
+            - rhs
+    }
+
     /// The exact largest relative excess of `x` over the limit rows (linear: exact).
     fn excess(&self, x: &[f64]) -> f64 {
-        self.base
-            .le_rows(self.limit_rows.clone())
+        self.limits
             .iter()
-            .map(|(row, rhs)| {
-                // The rows carry −e: take it out.
-                row.iter()
-                    .filter(|&&(j, _)| j != self.e)
-                    .map(|&(j, v)| v * x[j])
-                    .sum::<f64>()
-                    - rhs
-            })
+            .map(|r| self.limit_excess(r, x))
             .fold(0.0f64, f64::max)
     }
 
@@ -361,6 +367,9 @@ impl<'a> Model<'a> {
         let pr = self.pr;
         let st = pr.settings;
         let mut qp = self.base.clone();
+        for (row, rhs) in self.limits.iter().chain(&self.ranges) {
+            qp.add_le(row, *rhs);
+        }
         for i in pr.first..=pr.last {
             let (fp, fc) = (self.hp.delta(i), self.hc.delta(i));
             let (dp, dc) = (fp.at(xbar), fc.at(xbar));
@@ -411,7 +420,14 @@ pub fn solve_joint(pr: &JointProblem) -> Result<JointSolution, PatchFailure> {
         (st.first_trust_p_deg, st.first_trust_c_deg)
     };
     let mut solved_any = false;
-    for _ in 0..pr.max_solves {
+    // A start already within the limits with no orientation change cannot be bettered.
+    let solves = if exc <= st.elastic_tol && dev <= 1e-9 {
+        solved_any = true;
+        0
+    } else {
+        pr.max_solves
+    };
+    for _ in 0..solves {
         let qp = model.linearised(&xbar, rho);
         let started = Instant::now();
         let banded = qp.to_banded(model.position.clone());

@@ -12,9 +12,10 @@
 //!   changing sign at almost constant C. When the points after the zone may move to the
 //!   other branch, the start is the program with the points after its branch switch (or
 //!   after the point of least |P|) on the other branch ([`crate::reselect::other_branch`]);
-//!   otherwise it is FREEZE's rule across the cone (C held at its entry value, P on C's
-//!   meridian: [`crate::peers`]), which passes through the pole inside the range. The
-//!   program's own values are the second start. Each start gets
+//!   the range is wide enough to hold the cone stretch;
+//!   FREEZE's and LINEARIZE's rules across the cone (C held at its entry value, or linear
+//!   in s, P on C's meridian: [`crate::peers`]) pass through the pole inside the range; the
+//!   program's own values are the last start. Each start gets
 //!   [`SolverSettings::screen_solves`] solves; the better (less excess over the limits, then
 //!   smaller deviation) goes on warm for the rest of [`SolverSettings::scp_max_solves`].
 //! - **Proposals.** The refined solution, then the other start's; and, with
@@ -32,6 +33,27 @@ use polepatch_kinematics::Axis;
 
 /// The joint method (module docs).
 pub struct JointMethod;
+
+/// On a point exactly on the pole (|P| ≤ [`crate::reselect::POLE_DEG`]) C does not orient
+/// the tool: give it C linear between its nearest neighbours off the pole within
+/// `first..=last`, so a start does not carry a spike of C there (a post writes anything:
+/// `atan2(0, 0)`). The tool axes are unchanged.
+fn smooth_pole_c(p: &[f64], c: &mut [f64], first: usize, last: usize) {
+    let on_pole = |i: usize| p[i].abs() <= crate::reselect::POLE_DEG;
+    for i in first..=last {
+        if !on_pole(i) {
+            continue;
+        }
+        let a = (first..i).rev().find(|&j| !on_pole(j));
+        let b = (i + 1..=last).find(|&j| !on_pole(j));
+        c[i] = match (a, b) {
+            (Some(a), Some(b)) => c[a] + (c[b] - c[a]) * (i - a) as f64 / (b - a) as f64,
+            (Some(a), None) => c[a],
+            (None, Some(b)) => c[b],
+            (None, None) => c[i],
+        };
+    }
+}
 
 /// A start: values of the whole path and what the points after the range do.
 struct Start {
@@ -75,6 +97,12 @@ impl Proposer for JointMethod {
         let mut extra = st
             .joint_range_min_points
             .max(((z.last - z.first) as f64 * st.joint_range_zone_factor).ceil() as usize);
+        // Wide enough to hold the cone stretch the peers' starts rewrite.
+        if let Some([e0, _, _, e1]) = cone_stretch(ctx.p, z, ctx.opts.cone_deg) {
+            extra = extra
+                .max(z.first.saturating_sub(e0))
+                .max(e1.saturating_sub(z.last));
+        }
         loop {
             let Some((first, last)) = Self::range(ctx, extra) else {
                 return;
@@ -115,30 +143,54 @@ impl JointMethod {
                 tail: Tail::Reselect { shift_deg: shift },
                 rule: false,
             });
-        } else if let (Some(stretch), Ok(spline)) = (
+        }
+        // The peers' rules across the cone stretch: C held (FREEZE) or linear (LINEARIZE),
+        // P on C's meridian — through the pole inside the range.
+        if let (Some(stretch), Ok(spline)) = (
             cone_stretch(p, ctx.zone, ctx.opts.cone_deg),
             crate::spline::AnalysisSpline::new(ctx.s, c),
         ) && stretch[1] >= first
             && stretch[2] <= last
         {
-            let (mut fp, mut fc) = (p.to_vec(), c.to_vec());
-            apply_rule(
-                Strategy::Freeze,
-                ctx.machine,
-                ctx.s,
-                c,
-                &spline,
-                ctx.target,
-                stretch,
-                &mut fp,
-                &mut fc,
-            );
-            starts.push(Start {
-                p: fp,
-                c: fc,
-                tail: Tail::Keep,
-                rule: true,
-            });
+            for rule in [Strategy::Freeze, Strategy::Linearize] {
+                let (mut fp, mut fc) = (p.to_vec(), c.to_vec());
+                apply_rule(
+                    rule,
+                    ctx.machine,
+                    ctx.s,
+                    c,
+                    &spline,
+                    ctx.target,
+                    stretch,
+                    &mut fp,
+                    &mut fc,
+                );
+                // Through the pole: P on C's meridian comes out of the stretch on the other
+                // branch when the path passed the pole; then the points after it follow
+                // on that branch (when they may move).
+                let b = stretch[2];
+                if rule == Strategy::Freeze
+                    && b < last
+                    && fp[b].abs() > crate::reselect::POLE_DEG
+                    && fp[b].signum() != p[b + 1].signum()
+                    && let Some(shift) =
+                        tail_shift(ctx.machine, &fp, &fc, b, ctx.opts.keep_last_point)
+                {
+                    let (op, oc) = other_branch(&fp, &fc, b, shift);
+                    starts.push(Start {
+                        p: op,
+                        c: oc,
+                        tail: Tail::Reselect { shift_deg: shift },
+                        rule: true,
+                    });
+                }
+                starts.push(Start {
+                    p: fp,
+                    c: fc,
+                    tail: Tail::Keep,
+                    rule: true,
+                });
+            }
         }
         starts.push(Start {
             p: p.to_vec(),
@@ -146,6 +198,9 @@ impl JointMethod {
             tail: Tail::Keep,
             rule: false,
         });
+        for s0 in &mut starts {
+            smooth_pole_c(&s0.p, &mut s0.c, first, last);
+        }
         let lim_p = GeomLimits::of(ctx.machine, Axis::Primary, ctx.feed_mm_min, ctx.margin);
         let lim_c = GeomLimits::of(ctx.machine, Axis::C, ctx.feed_mm_min, ctx.margin);
         let round_deg = 0.5 * 10f64.powi(-(ctx.opts.max_decimals as i32));
@@ -186,17 +241,24 @@ impl JointMethod {
                 screen
             };
             match problem(&s0.p, &s0.c, s0.rule, None, false, solves) {
-                Ok(sol) => screened.push((i, sol)),
+                Ok(sol) => {
+                    let perfect = sol.excess <= st.elastic_tol && sol.max_deviation_deg <= 1e-9;
+                    screened.push((i, sol));
+                    if perfect {
+                        break; // within the limits, no orientation change: the best there is
+                    }
+                }
                 Err(crate::candidate::PatchFailure::Solver(q)) => sink.add_stats(&q),
                 Err(_) => {}
             }
         }
+        // Within the limits first (by deviation), then the least excess.
         let key = |s: &JointSolution| {
-            (
-                (s.excess > st.elastic_tol) as u8,
-                s.excess,
-                s.max_deviation_deg,
-            )
+            if s.excess <= st.elastic_tol {
+                (0u8, s.max_deviation_deg)
+            } else {
+                (1u8, s.excess)
+            }
         };
         screened.sort_by(|a, b| {
             key(&a.1)
@@ -232,7 +294,12 @@ impl JointMethod {
             }
             return false;
         }
+        let mut offered_all = true;
         for (i, sol) in screened {
+            if !offered_all {
+                sink.add_stats(&sol.qp);
+                continue;
+            }
             let passed = sink.offer(Proposal {
                 method: Method::Joint,
                 first,
@@ -243,7 +310,7 @@ impl JointMethod {
                 qp: sol.qp,
             });
             if passed.is_some_and(|o| o.passes) {
-                break;
+                offered_all = false; // the rest only count their solves
             }
         }
         // With a cap that nothing passing met: the least excess within it.

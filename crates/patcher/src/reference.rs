@@ -33,9 +33,10 @@
 //! - branch re-selection alone (deviation 0) when it reaches feed;
 //! - the joint SCP ([`crate::joint`]) over the given points, with a margin of
 //!   [`SolverSettings::reference_margin`] only, unrounded, from four starts: the values as
-//!   they are; the tail after the zone's singular point on the other branch; C held at its
-//!   value at the singular point across the zone (ModuleWorks' FREEZE); C linear in s
-//!   across the zone (LINEARIZE).
+//!   they are; the tail after the zone's singular point on the other branch (only when the
+//!   run's last point may move: the tail includes it); C held at its value at the singular
+//!   point across the zone (ModuleWorks' FREEZE); C linear in s across the zone
+//!   (LINEARIZE).
 //!
 //! It is not a lower bound: the problem is not convex, and a better patch may exist. The
 //! suite reports `ours / reference`; below 1 means the patcher beat every reference start.
@@ -311,8 +312,11 @@ pub fn zone_reference(
     };
     let (lo, hi) = machine.primary_range_deg;
     let in_range = |p: &[f64]| p.iter().all(|v| (lo..=hi).contains(v));
+    // The points after the range keep their values unless the last point may move: then
+    // they may go to the other branch as a block.
+    let tail_free = last == n - 1;
     // Re-selection alone: the flip point of a domain-rule program, if any.
-    if let Some(f) = (zone.first..zone.last).find(|&i| {
+    if let Some(f) = (zone.first..zone.last).filter(|_| tail_free).find(|&i| {
         p_deg[i] != 0.0 && p_deg[i + 1] != 0.0 && p_deg[i].signum() != p_deg[i + 1].signum()
     }) {
         let (p, c) = flipped(f);
@@ -326,7 +330,7 @@ pub fn zone_reference(
     let mut starts: Vec<(&'static str, Vec<f64>, Vec<f64>)> =
         vec![("as-is", p_deg.to_vec(), c_deg.to_vec())];
     let (op, oc) = flipped(k);
-    if in_range(&op) {
+    if tail_free && in_range(&op) {
         starts.push(("other-branch", op, oc));
     }
     // FREEZE and LINEARIZE across the cone stretch (the peers' rules, crate::peers).
