@@ -243,6 +243,13 @@ impl Selection<'_> {
         if !matches!(prop.tail, Tail::Keep) && self.opts.keep_last_point {
             return None; // the tail would move the last point, which must stay
         }
+        if self
+            .opts
+            .max_patch_length_mm
+            .is_some_and(|l| self.s[last] - self.s[first] > l)
+        {
+            return None; // longer than the caller allows
+        }
         let changed_hi = match prop.tail {
             Tail::Keep => last,
             _ => (last + 1).min(n - 1),

@@ -5,7 +5,7 @@
 //!   `max(joint_range_min_points, joint_range_zone_factor · zone length)` points
 //!   ([`crate::settings::SolverSettings`]), within what the zone may change (after the
 //!   previous zone's patch, before the run's last point when it must stay) and within
-//!   `max_patch_length_mm` around the zone. When no solution on it meets the limits (the
+//!   `max_patch_length_mm` around the zone (a zone longer than that is not patched). When no solution on it meets the limits (the
 //!   range is too short for the turn the axes must make), the widening doubles, up to all
 //!   the points the zone may change.
 //! - **Start.** Near the pole the best patch lets the tool axis pass through the pole, P
@@ -86,7 +86,11 @@ impl JointMethod {
                 }
             }
         }
-        (first <= last).then_some((first, last))
+        let too_long = ctx
+            .opts
+            .max_patch_length_mm
+            .is_some_and(|l| ctx.s[last] - ctx.s[first] > l);
+        (first <= last && !too_long).then_some((first, last))
     }
 }
 
