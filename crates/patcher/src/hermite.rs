@@ -700,6 +700,101 @@ mod tests {
         }
     }
 
+    /// Coefficient form, the planted response: with the changes of points `first..=last`
+    /// fixed, the coefficients the equalities determine give the analysis spline of the
+    /// changed data — its value, first, second and third derivatives at points of every
+    /// span of the window, through the same forms (`d1`, `d2`, `d3`, `b1`) the limits use
+    /// — on a window inside the path (fixed end slopes) and on the whole path (not-a-knot).
+    #[test]
+    fn coefficient_form_is_the_spline_of_the_changed_data() {
+        let (s, y) = data(60);
+        for (first, last, window) in [(28, 32, WINDOW_POINTS), (1, 58, 60)] {
+            let hm = Hermite::new(&s, &y, first, last, window)
+                .unwrap()
+                .coefficient_form()
+                .unwrap();
+            let delta: Vec<f64> = (first..=last)
+                .map(|i| (i as f64 * 0.9).sin() * 4.0)
+                .collect();
+            // The equalities and the changes make a square system in the coefficients:
+            // solve it exactly (Gaussian elimination with partial pivoting).
+            let nv = hm.vars();
+            let mut rows: Vec<(Vec<f64>, f64)> = Vec::new();
+            let dense = |f: &Aff| {
+                let mut r = vec![0.0; nv];
+                for &(j, v) in &f.row {
+                    r[j] += v;
+                }
+                r
+            };
+            for e in hm.equalities() {
+                rows.push((dense(&e), -e.c));
+            }
+            for (i, d) in (first..=last).zip(&delta) {
+                let f = hm.delta(i);
+                rows.push((dense(&f), d - f.c));
+            }
+            assert_eq!(rows.len(), nv, "one row per coefficient");
+            for col in 0..nv {
+                let piv = (col..nv)
+                    .max_by(|&a, &b| rows[a].0[col].abs().total_cmp(&rows[b].0[col].abs()))
+                    .unwrap();
+                rows.swap(col, piv);
+                let (head, tail) = rows.split_at_mut(col + 1);
+                let p = &head[col];
+                for r in tail.iter_mut() {
+                    let f = r.0[col] / p.0[col];
+                    for j in col..nv {
+                        r.0[j] -= f * p.0[j];
+                    }
+                    r.1 -= f * p.1;
+                }
+            }
+            let mut x = vec![0.0; nv];
+            for col in (0..nv).rev() {
+                let acc: f64 = (col + 1..nv).map(|j| rows[col].0[j] * x[j]).sum();
+                x[col] = (rows[col].1 - acc) / rows[col].0[col];
+            }
+            let mut y2 = y.clone();
+            for (i, d) in (first..=last).zip(&delta) {
+                y2[i] += d;
+            }
+            let sp = interpolate_not_a_knot(&s, &y2).unwrap();
+            // Inside a window cut from the path the end slopes are fixed: the spline there
+            // differs from the whole path's by what a change propagates (≈ 0.27^16).
+            for k in hm.lo..hm.hi {
+                let h = hm.h(k);
+                for tau in [0.0, 0.37 * h, h] {
+                    // q' and q'' are continuous: at τ = h either span's piece will do.
+                    let d = sp.eval_derivs(s[k] + tau);
+                    assert!((hm.d1(k, tau).at(&x) - d[1]).abs() < 1e-7, "{k}: q'");
+                    assert!((hm.d2(k, tau).at(&x) - d[2]).abs() < 1e-6, "{k}: q''");
+                }
+                assert!((hm.d3(k).at(&x) - sp.eval_derivs(s[k] + 0.5 * h)[3]).abs() < 1e-5);
+                // b1 is the middle Bernstein coefficient of q': its average is the secant.
+                let b1 = hm.b1(k).at(&x);
+                let secant = (y2[k + 1] - y2[k]) / h;
+                let avg = (hm.m(k).at(&x) + b1 + hm.m(k + 1).at(&x)) / 3.0;
+                assert!((avg - secant).abs() < 1e-6, "{k}");
+            }
+            for i in first..=last {
+                assert!((hm.delta(i).at(&x) - delta[i - first]).abs() < 1e-9);
+            }
+            // With no change at all the variables are zero: the current spline.
+            let mut cur = vec![0.0; hm.vars()];
+            hm.write_current(&mut cur).unwrap();
+            assert!(cur.iter().all(|&v| v == 0.0));
+            assert!(
+                (hm.m(first).at(&cur)
+                    - interpolate_not_a_knot(&s, &y)
+                        .unwrap()
+                        .eval_derivs(s[first])[1])
+                    .abs()
+                    < 1e-6
+            );
+        }
+    }
+
     /// With an offset, the same rows move to the offset's variables.
     #[test]
     fn offset_shifts_every_variable() {

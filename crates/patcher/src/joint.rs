@@ -487,3 +487,213 @@ pub fn solve_joint(pr: &JointProblem) -> Result<JointSolution, PatchFailure> {
         qp: stats,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testutil::{machine, planted, sing_path};
+    use polepatch_kinematics::Axis;
+
+    /// The linearisation the QPs use, against finite differences and exactly: the
+    /// Jacobian of the tool axis (per degree) matches central differences, and the
+    /// linearised change `r0 + a·δP + b·δC` is off the exact `fk(P̄ + δP, C̄ + δC) − o`
+    /// by at most the second-order bound `½·(π/180)²·(|δP| + |δC|)²` (the tool axis' second
+    /// derivatives in degrees are at most (π/180)² in size).
+    #[test]
+    fn linearisation_against_finite_differences_and_its_error_bound() {
+        let k = (1.0f64).to_radians().powi(2);
+        for name in ["mikron-ucp710", "mikron-hsm600"] {
+            let m = machine(name);
+            for (p, c) in [(0.3, 40.0), (-2.0, 170.0), (12.0, -75.0), (0.0, 10.0)] {
+                let [o, a, b] = forward_jacobian(&m, p, c);
+                let h = 1e-5;
+                let fp = |dp: f64, dc: f64| forward(&m, p + dp, c + dc);
+                for i in 0..3 {
+                    let dp = (fp(h, 0.0)[i] - fp(-h, 0.0)[i]) / (2.0 * h);
+                    let dc = (fp(0.0, h)[i] - fp(0.0, -h)[i]) / (2.0 * h);
+                    assert!((dp - a[i]).abs() < 1e-9, "{name} ∂P {p} {c}");
+                    assert!((dc - b[i]).abs() < 1e-9, "{name} ∂C {p} {c}");
+                }
+                for (dp, dc) in [(0.5, 3.0), (-2.0, 30.0), (2.0, -180.0), (0.01, 0.1)] {
+                    let exact = fp(dp, dc);
+                    let err = (0..3)
+                        .map(|i| (exact[i] - o[i] - a[i] * dp - b[i] * dc).powi(2))
+                        .sum::<f64>()
+                        .sqrt();
+                    let bound = 0.5 * k * (f64::abs(dp) + f64::abs(dc)).powi(2);
+                    assert!(
+                        err <= bound * (1.0 + 1e-9),
+                        "{name} {p} {c} step {dp} {dc}: {err} > {bound}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// The tangent-plane change the cones bound is the chord's component orthogonal to
+    /// the target: `‖E·(o' − o)‖ = sin θ ≤ 2·sin(θ/2)`, equal to first order, so bounding
+    /// it by `t` bounds the angle θ through `asin`.
+    #[test]
+    fn tangent_plane_change_is_the_sine_of_the_angle() {
+        let m = machine("mikron-ucp710");
+        for (p, c, p2, c2) in [
+            (1.0, 20.0, 1.5, 35.0),
+            (0.2, 0.0, -0.3, 180.0),
+            (10.0, 5.0, 9.0, 5.0),
+        ] {
+            let (o, o2) = (forward(&m, p, c), forward(&m, p2, c2));
+            let [e1, e2] = tangent_basis(o);
+            let r = [o2[0] - o[0], o2[1] - o[1], o2[2] - o[2]];
+            let tang = (dot3(e1, r).powi(2) + dot3(e2, r).powi(2)).sqrt();
+            let theta = angle_between_deg(o, o2).to_radians();
+            assert!(
+                (tang - theta.sin()).abs() < 1e-12,
+                "{tang} vs sin {}",
+                theta.sin()
+            );
+            assert!(tang <= chord(theta.to_degrees()) + 1e-15);
+            // The basis is orthonormal and orthogonal to o.
+            assert!(
+                dot3(e1, o).abs() < 1e-15
+                    && dot3(e2, o).abs() < 1e-15
+                    && dot3(e1, e2).abs() < 1e-15
+            );
+        }
+    }
+
+    fn problem<'a>(
+        path: &'a crate::path::Path,
+        p: &'a [f64],
+        c: &'a [f64],
+        target: &'a [[f64; 3]],
+        m: &'a Machine,
+        st: &'a SolverSettings,
+        cap: Option<f64>,
+    ) -> JointProblem<'a> {
+        let n = path.s_mm.len();
+        JointProblem {
+            s_mm: &path.s_mm,
+            p_deg: p,
+            c_deg: c,
+            target,
+            first: 1,
+            last: n - 1,
+            lim_p: GeomLimits::of(m, Axis::Primary, path.feed_mm_min, 0.02),
+            lim_c: GeomLimits::of(m, Axis::C, path.feed_mm_min, 0.02),
+            machine: m,
+            core: 0..n - 1,
+            round_p_deg: 0.0,
+            round_c_deg: 0.0,
+            reference: None,
+            cap_deg: cap,
+            warm: false,
+            max_solves: st.scp_max_solves,
+            settings: st,
+        }
+    }
+
+    /// `%SING` from the program's values: the solution meets every limit row (excess 0)
+    /// and its largest exact change is what passing through the pole costs (about the
+    /// 1° the path passes from it); the rows it meets are the spline's limits, checked on
+    /// the analysis spline of the solution's values (the model is the spline).
+    #[test]
+    fn sing_solution_meets_the_limits_on_the_analysis_spline() {
+        let m = machine("mikron-ucp710");
+        let path = sing_path();
+        let st = SolverSettings::default();
+        let p: Vec<f64> = path.axes.iter().map(|q| q[3]).collect();
+        let c: Vec<f64> = path.axes.iter().map(|q| q[4]).collect();
+        let target: Vec<[f64; 3]> = p.iter().zip(&c).map(|(a, b)| forward(&m, *a, *b)).collect();
+        // Start on the other branch after the point of least |P| (through the pole).
+        let k = (0..p.len())
+            .min_by(|&a, &b| p[a].abs().total_cmp(&p[b].abs()))
+            .unwrap();
+        let shift = crate::reselect::tail_shift(&m, &p, &c, k, false).unwrap();
+        let (op, oc) = crate::reselect::other_branch(&p, &c, k, shift);
+        let sol = solve_joint(&problem(&path, &op, &oc, &target, &m, &st, None)).unwrap();
+        assert!(sol.excess <= st.elastic_tol, "{sol:?}");
+        assert!(sol.max_deviation_deg < 1.05, "{}", sol.max_deviation_deg);
+        let (mut np, mut nc) = (op.clone(), oc.clone());
+        np[1..].copy_from_slice(&sol.p_deg);
+        nc[1..].copy_from_slice(&sol.c_deg);
+        for (axis, y) in [(Axis::Primary, &np), (Axis::C, &nc)] {
+            let lim = GeomLimits::of(&m, axis, path.feed_mm_min, 0.02);
+            let sp = crate::spline::AnalysisSpline::new(&path.s_mm, y).unwrap();
+            for (k, pk) in crate::spline::span_maxima(&path.s_mm, &sp)
+                .iter()
+                .enumerate()
+            {
+                let slack = 1e-6;
+                assert!(
+                    pk[0] <= lim.v * (1.0 + slack),
+                    "{axis:?} span {k}: q' {} > {}",
+                    pk[0],
+                    lim.v
+                );
+                assert!(
+                    pk[1] <= lim.a * (1.0 + slack),
+                    "{axis:?} span {k}: q'' {} > {}",
+                    pk[1],
+                    lim.a
+                );
+                assert!(
+                    pk[2] <= lim.j * (1.0 + slack),
+                    "{axis:?} span {k}: q''' {} > {}",
+                    pk[2],
+                    lim.j
+                );
+            }
+        }
+        // The exact deviation reported is the exact angle of the values returned.
+        let dev = (1..p.len())
+            .map(|i| angle_between_deg(target[i], forward(&m, np[i], nc[i])))
+            .fold(0.0, f64::max);
+        assert!((dev - sol.max_deviation_deg).abs() < 1e-12);
+    }
+
+    /// Capped: no point's exact orientation change exceeds the cap (the cone bounds the
+    /// tangent-plane change by the cap's chord, which is at least its sine), and the
+    /// excess over the limits is what the cap leaves — positive when the cap is far
+    /// below what reaching feed needs.
+    #[test]
+    fn capped_solve_stays_within_the_cap() {
+        let m = machine("mikron-ucp710");
+        let path = planted(241, 0.5, 0.5, false, 1000.0);
+        let st = SolverSettings::default();
+        let p: Vec<f64> = path.axes.iter().map(|q| q[3]).collect();
+        let c: Vec<f64> = path.axes.iter().map(|q| q[4]).collect();
+        let target: Vec<[f64; 3]> = p.iter().zip(&c).map(|(a, b)| forward(&m, *a, *b)).collect();
+        for cap in [0.05, 0.2] {
+            let mut pr = problem(&path, &p, &c, &target, &m, &st, Some(cap));
+            pr.warm = true;
+            let sol = solve_joint(&pr).unwrap();
+            assert!(
+                sol.max_deviation_deg <= cap * 1.01 + 1e-6,
+                "cap {cap}: {}",
+                sol.max_deviation_deg
+            );
+            assert!(
+                sol.excess > 0.0,
+                "cap {cap}: a 0.5° pass cannot reach feed within {cap}°"
+            );
+        }
+    }
+
+    /// A start that already meets every limit with no orientation change costs no solve.
+    #[test]
+    fn a_perfect_start_costs_no_solve() {
+        let m = machine("mikron-ucp710");
+        // Far from the pole and gentle: every limit met as programmed.
+        let mut path = planted(81, 1.0, 20.0, false, 500.0);
+        for q in &mut path.axes {
+            q[4] *= 0.01;
+        }
+        let st = SolverSettings::default();
+        let p: Vec<f64> = path.axes.iter().map(|q| q[3]).collect();
+        let c: Vec<f64> = path.axes.iter().map(|q| q[4]).collect();
+        let target: Vec<[f64; 3]> = p.iter().zip(&c).map(|(a, b)| forward(&m, *a, *b)).collect();
+        let sol = solve_joint(&problem(&path, &p, &c, &target, &m, &st, None)).unwrap();
+        assert_eq!(sol.qp.solves, 0, "{sol:?}");
+        assert!(sol.max_deviation_deg < 1e-9 && sol.excess == 0.0, "{sol:?}");
+    }
+}

@@ -389,3 +389,204 @@ pub fn zone_reference(
         None => Reference::Failed,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testutil::{machine, planted, sing_path};
+
+    fn pc(path: &Path) -> (Vec<f64>, Vec<f64>) {
+        (
+            path.axes.iter().map(|q| q[3]).collect(),
+            path.axes.iter().map(|q| q[4]).collect(),
+        )
+    }
+
+    /// A relaxation holds whatever passes: where the patcher writes values that reach feed
+    /// (verified), the relaxation over the same points is feasible — on SING and planted
+    /// flips and swings, both machines.
+    #[test]
+    fn what_passes_satisfies_the_relaxation() {
+        let cases = [
+            ("mikron-ucp710", sing_path()),
+            ("mikron-hsm600", sing_path()),
+            ("mikron-ucp710", planted(241, 0.5, 0.5, false, 1000.0)),
+            ("mikron-hsm600", planted(241, 0.5, 2.0, true, 3000.0)),
+        ];
+        for (name, path) in cases {
+            let m = machine(name);
+            let res = crate::patch_path(&path, &m, &PatchOptions::default()).unwrap();
+            assert!(!res.zones.is_empty());
+            let (p, c) = pc(&path);
+            let n = p.len();
+            let a = crate::analyze_path(&path, &m, &Default::default()).unwrap();
+            for z in &a.zones {
+                let core = zone_core(z, n, 3);
+                assert_eq!(
+                    reachable(
+                        &path.s_mm,
+                        &p,
+                        &c,
+                        1,
+                        n - 1,
+                        core,
+                        &m,
+                        path.feed_mm_min,
+                        PatchAxes::Both,
+                        true
+                    ),
+                    Ok(true),
+                    "{name}: the patcher reached feed, so the relaxation must be feasible"
+                );
+            }
+        }
+    }
+
+    /// The proof, planted: a pass 1° from the pole on a 5° circle, 15 mm long at F5000 on
+    /// the UCP710 — the tool axis must turn far more than A and C can in 15 mm — is
+    /// infeasible with its last point held; and a relaxation with fewer points movable is
+    /// never feasible where one with more is not (monotone, as a relaxation must be).
+    #[test]
+    fn an_impossible_zone_is_proven_unreachable() {
+        let m = machine("mikron-ucp710");
+        let pass = polepatch_fixturegen::Pass {
+            pole_distance_deg: 1.0,
+            circle_radius_deg: 5.0,
+            half_sweep_deg: 80.0,
+            length_mm: 15.0,
+            spacing_mm: 0.5,
+            feed_mm_min: 5000.0,
+            ..polepatch_fixturegen::Pass::default()
+        };
+        let axes = polepatch_fixturegen::joints(&pass);
+        let path = Path {
+            s_mm: axes.iter().map(|q| q[0]).collect(),
+            axes,
+            feed_mm_min: 5000.0,
+        };
+        let (p, c) = pc(&path);
+        let n = p.len();
+        let lp = |last: usize| {
+            reachable(
+                &path.s_mm,
+                &p,
+                &c,
+                1,
+                last,
+                0..n - 1,
+                &m,
+                5000.0,
+                PatchAxes::Both,
+                true,
+            )
+        };
+        assert_eq!(lp(n - 2), Ok(false), "pinned: no values reach feed");
+        // Movable points a subset: still infeasible.
+        assert_eq!(
+            reachable(
+                &path.s_mm,
+                &p,
+                &c,
+                5,
+                n - 6,
+                0..n - 1,
+                &m,
+                5000.0,
+                PatchAxes::Both,
+                true
+            ),
+            Ok(false)
+        );
+        // The driver's reason for it.
+        let opts = PatchOptions {
+            keep_last_point: true,
+            ..PatchOptions::default()
+        };
+        let res = crate::patch_path(&path, &m, &opts).unwrap();
+        for z in &res.zones {
+            assert_ne!(z.outcome, crate::Outcome::Reached);
+            assert!(
+                matches!(z.reason, Reason::ProvenUnreachable | Reason::EndPinned),
+                "{z:?}"
+            );
+        }
+    }
+
+    /// The range rows are what `ranges` adds: a swing 0.5° from the pole over 30 mm at
+    /// F1000 on the UCP710, every point but the two ends movable. Without the range rows
+    /// the relaxation is feasible (C can make its half turn in 30 mm at ≤ 7.2 °/mm); with a
+    /// primary range [20°, 30°] it is not (the ends sit near 6°, and A, at feed there
+    /// before, cannot jump 14° within one 0.5 mm span) — the two LPs the driver's reason
+    /// `range` compares. (The relaxation says nothing about the orientation: only fixed
+    /// points and the ranges can make it infeasible.)
+    #[test]
+    fn the_range_rows_are_what_ranges_adds() {
+        let mut m = machine("mikron-ucp710");
+        m.primary_range_deg = (20.0, 30.0);
+        let path = planted(61, 0.5, 0.5, false, 1000.0);
+        let (p, c) = pc(&path);
+        let a = crate::analyze_path(&path, &m, &Default::default()).unwrap();
+        let core = zone_core(&a.zones[0], 61, 3);
+        let lp = |ranges| {
+            reachable(
+                &path.s_mm,
+                &p,
+                &c,
+                1,
+                59,
+                core.clone(),
+                &m,
+                1000.0,
+                PatchAxes::Both,
+                ranges,
+            )
+        };
+        assert_eq!(lp(false), Ok(true), "without the range rows");
+        assert_eq!(lp(true), Ok(false), "with them");
+    }
+
+    /// The reference on SING: the best found is at most what the patcher writes (it is
+    /// the same method with more effort) to within the patcher's rounding, and a flip that
+    /// re-selection fixes has reference 0.
+    #[test]
+    fn references_of_sing_and_a_reselectable_flip() {
+        for name in ["mikron-ucp710", "mikron-hsm600"] {
+            let m = machine(name);
+            let path = sing_path();
+            let (p, c) = pc(&path);
+            let n = p.len();
+            let a = crate::analyze_path(&path, &m, &Default::default()).unwrap();
+            let r =
+                zone_reference(&path.s_mm, &p, &c, &a.zones[0], 1, n - 1, &m, 2000.0, 6).unwrap();
+            let ours = crate::patch_path(&path, &m, &PatchOptions::default())
+                .unwrap()
+                .zones[0]
+                .max_deviation_deg;
+            match r {
+                Reference::Best { deviation_deg, .. } => {
+                    assert!(
+                        deviation_deg <= ours * 1.1 + 1e-3,
+                        "{name}: ref {deviation_deg} ours {ours}"
+                    );
+                    assert!(
+                        ours <= 1.25 * deviation_deg,
+                        "{name}: ours {ours} ref {deviation_deg}"
+                    );
+                }
+                other => panic!("{name}: {other:?}"),
+            }
+        }
+        let m = machine("mikron-ucp710");
+        let flip = planted(241, 0.5, 4.0, true, 1000.0);
+        let (p, c) = pc(&flip);
+        let a = crate::analyze_path(&flip, &m, &Default::default()).unwrap();
+        let r = zone_reference(&flip.s_mm, &p, &c, &a.zones[0], 1, 240, &m, 1000.0, 6).unwrap();
+        assert_eq!(
+            r,
+            Reference::Best {
+                deviation_deg: 0.0,
+                method: "reselect"
+            }
+        );
+    }
+}
