@@ -121,6 +121,9 @@ pub(crate) struct Hermite<'a> {
     /// (clamped knots at every CL point of the window) with the current spline's
     /// coefficients; the variables are the changes of those coefficients.
     basis: Option<polepatch_bspline::BSpline>,
+    /// In coefficient form: the value and slope forms at each knot of the window
+    /// (`lo..=hi`), computed once.
+    knot_forms: Vec<[Aff; 2]>,
 }
 
 impl<'a> Hermite<'a> {
@@ -175,6 +178,7 @@ impl<'a> Hermite<'a> {
             offset,
             fixed,
             basis: None,
+            knot_forms: Vec::new(),
         })
     }
 
@@ -202,8 +206,33 @@ impl<'a> Hermite<'a> {
             sp.eval_derivs(self.s[b])[1],
         )
         .map_err(|_| PatchFailure::TooShort)?;
+        self.knot_forms = (self.lo..=self.hi)
+            .map(|k| {
+                [
+                    Self::form_at(&cl, self.s[k], self.offset, 0),
+                    Self::form_at(&cl, self.s[k], self.offset, 1),
+                ]
+            })
+            .collect();
         self.basis = Some(cl);
         Ok(self)
+    }
+
+    /// The value (`order` 0) or slope (1) at `t` as an affine form of the changes of the
+    /// coefficients of `b` (numbered from `offset`): the current spline's plus the basis
+    /// row.
+    fn form_at(b: &polepatch_bspline::BSpline, t: f64, offset: usize, order: usize) -> Aff {
+        let r = b.basis_row(t, order);
+        let cur = &b.coeffs()[r.first..];
+        Aff {
+            row: (0..4)
+                .filter(|&j| r.weights[j] != 0.0)
+                .map(|j| (offset + r.first + j, r.weights[j]))
+                .collect(),
+            c: (0..4)
+                .map(|j| r.weights[j] * cur.get(j).copied().unwrap_or(0.0))
+                .sum(),
+        }
     }
 
     /// The current spline's coefficients (coefficient form only).
@@ -224,20 +253,9 @@ impl<'a> Hermite<'a> {
             .map_err(|_| PatchFailure::TooShort)
     }
 
-    /// The value (`order` 0) or slope (1) at knot `k` as an affine form of the changes of
-    /// the coefficients: the current spline's plus the basis row.
-    fn basis_aff(&self, b: &polepatch_bspline::BSpline, k: usize, order: usize) -> Aff {
-        let r = b.basis_row(self.s[k], order);
-        let cur = &b.coeffs()[r.first..];
-        Aff {
-            row: (0..4)
-                .filter(|&j| r.weights[j] != 0.0)
-                .map(|j| (self.offset + r.first + j, r.weights[j]))
-                .collect(),
-            c: (0..4)
-                .map(|j| r.weights[j] * cur.get(j).copied().unwrap_or(0.0))
-                .sum(),
-        }
+    /// The value (`order` 0) or slope (1) at knot `k` of the window, in coefficient form.
+    fn basis_aff(&self, k: usize, order: usize) -> Aff {
+        self.knot_forms[k - self.lo][order].clone()
     }
 
     /// The change `δ_i` of the value at point `i` (in `first..=last`): one variable in
@@ -246,8 +264,8 @@ impl<'a> Hermite<'a> {
     pub(crate) fn delta(&self, i: usize) -> Aff {
         match &self.basis {
             None => Aff::var(self.delta_var(i)),
-            Some(b) => {
-                let mut a = self.basis_aff(b, i, 0);
+            Some(_) => {
+                let mut a = self.basis_aff(i, 0);
                 a.c -= self.c[i];
                 a
             }
@@ -278,8 +296,8 @@ impl<'a> Hermite<'a> {
 
     /// Value at path point k.
     fn y(&self, k: usize) -> Aff {
-        if let Some(b) = &self.basis {
-            return self.basis_aff(b, k, 0);
+        if self.basis.is_some() {
+            return self.basis_aff(k, 0);
         }
         let mut a = Aff::constant(self.c[k]);
         if (self.first..=self.last).contains(&k) {
@@ -292,7 +310,7 @@ impl<'a> Hermite<'a> {
     pub(crate) fn m(&self, k: usize) -> Aff {
         match &self.basis {
             None => Aff::var(self.offset + self.nd + k - self.lo),
-            Some(b) => self.basis_aff(b, k, 1),
+            Some(_) => self.basis_aff(k, 1),
         }
     }
 

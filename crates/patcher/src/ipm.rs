@@ -69,7 +69,7 @@ pub struct IpmSettings {
     /// Default 1e-9.
     pub regularisation: f64,
     /// Most iterative refinement steps per solve (it stops earlier when the residual is
-    /// below 1e-13 of the right-hand side). Default 8.
+    /// below 1e-13 of the right-hand side). Default 4.
     pub refinement_steps: u32,
 }
 
@@ -81,7 +81,7 @@ impl Default for IpmSettings {
             tol_gap: 1e-8,
             step_fraction: 0.99,
             regularisation: 1e-9,
-            refinement_steps: 8,
+            refinement_steps: 4,
         }
     }
 }
@@ -124,7 +124,7 @@ pub struct Banded {
     /// Inequality rows `row·x ≤ rhs`.
     pub le: Vec<(Row, f64)>,
     /// Second-order cones: each block of rows `(row_k, rhs_k)` says
-    /// `‖(rhs_k − row_k·x)_{k≥1}‖₂ ≤ rhs_0 − row_0·x`.
+    /// `‖(rhs_k − row_k·x)_{k≥1}‖₂ ≤ rhs_0 − row_0·x` (at most [`MAX_CONE`] rows).
     pub soc: Vec<Vec<(Row, f64)>>,
 }
 
@@ -246,7 +246,9 @@ struct BorderedBand {
     nb: usize,
     w: usize,
     k: usize,
-    /// `band[i·(w+1) + d] = M[i][i−d]`.
+    /// Row i's band from left to right: `band[i·(w+1) + t] = M[i][i + t − w]`
+    /// (`t = w` is the diagonal; entries left of column 0 stay 0). After factoring, the
+    /// unit L below the diagonal and D on it.
     band: Vec<f64>,
     /// `border[r·nb + i] = M[nb + r][i]`.
     border: Vec<f64>,
@@ -283,7 +285,7 @@ impl BorderedBand {
         match (a, b) {
             (Slot::Band(i), Slot::Band(j)) => {
                 let (i, j) = if i >= j { (i, j) } else { (j, i) };
-                self.band[i * (self.w + 1) + (i - j)] += v;
+                self.band[i * (self.w + 1) + (j + self.w - i)] += v;
             }
             (Slot::Border(r), Slot::Band(i)) | (Slot::Band(i), Slot::Border(r)) => {
                 self.border[r * self.nb + i] += v;
@@ -300,19 +302,18 @@ impl BorderedBand {
     /// `M·x` (unfactored; call before [`BorderedBand::factor`] or on a copy).
     fn mul(&self, x: &[f64], out: &mut [f64]) {
         let (nb, w, k) = (self.nb, self.w, self.k);
+        let wp = w + 1;
         out.iter_mut().for_each(|v| *v = 0.0);
         for i in 0..nb {
-            for d in 0..=w.min(i) {
-                let v = self.band[i * (w + 1) + d];
-                if v == 0.0 {
-                    continue;
-                }
-                let j = i - d;
-                out[i] += v * x[j];
-                if d > 0 {
-                    out[j] += v * x[i];
-                }
+            let lo = i.saturating_sub(w);
+            let row = &self.band[i * wp + (lo + w - i)..i * wp + w];
+            let xi = x[i];
+            let mut acc = self.band[i * wp + w] * xi;
+            for ((v, xm), om) in row.iter().zip(&x[lo..i]).zip(&mut out[lo..i]) {
+                acc += v * xm;
+                *om += v * xi;
             }
+            out[i] += acc;
         }
         for r in 0..k {
             let row = &self.border[r * nb..(r + 1) * nb];
@@ -333,29 +334,39 @@ impl BorderedBand {
     fn factor(&mut self) -> bool {
         let (nb, w, k) = (self.nb, self.w, self.k);
         let wp = w + 1;
+        // u[m − lo] = L_jm·D_m for the row j in hand.
+        let mut u = vec![0.0; w];
         for j in 0..nb {
-            // D_j = M_jj − Σ L_jm² D_m.
-            let mut dj = self.band[j * wp];
-            for m in j.saturating_sub(w)..j {
-                let ljm = self.band[j * wp + (j - m)];
-                dj -= ljm * ljm * self.band[m * wp];
+            let lo = j.saturating_sub(w);
+            let cnt = j - lo;
+            let (head, rest) = self.band.split_at_mut(j * wp);
+            let rowj = &rest[..wp];
+            for (idx, m) in (lo..j).enumerate() {
+                u[idx] = rowj[w - cnt + idx] * head[m * wp + w];
             }
+            // D_j = M_jj − Σ L_jm·D_m·L_jm.
+            let dj = rowj[w]
+                - rowj[w - cnt..w]
+                    .iter()
+                    .zip(&u[..cnt])
+                    .map(|(a, b)| a * b)
+                    .sum::<f64>();
             if !(dj.is_finite() && dj != 0.0) {
                 return false;
             }
-            self.band[j * wp] = dj;
+            self.band[j * wp + w] = dj;
             for i in j + 1..(j + wp).min(nb) {
-                let mut v = self.band[i * wp + (i - j)];
-                if v == 0.0 && i.saturating_sub(w) >= j {
-                    // Nothing to the left can fill it in either.
-                    continue;
-                }
-                for m in i.saturating_sub(w)..j {
-                    v -= self.band[i * wp + (i - m)]
-                        * self.band[j * wp + (j - m)]
-                        * self.band[m * wp];
-                }
-                self.band[i * wp + (i - j)] = v / dj;
+                // L_ij = (M_ij − Σ_m L_im·L_jm·D_m) / D_j, m from max(i − w, lo) to j − 1.
+                let lo_i = i - w.min(i);
+                let from = lo_i.max(lo);
+                let row_i = &self.band[i * wp..(i + 1) * wp];
+                let acc: f64 = row_i[from + w - i..j + w - i]
+                    .iter()
+                    .zip(&u[from - lo..cnt])
+                    .map(|(a, b)| a * b)
+                    .sum();
+                let at = i * wp + (j + w - i);
+                self.band[at] = (self.band[at] - acc) / dj;
             }
         }
         if k == 0 {
@@ -406,19 +417,20 @@ impl BorderedBand {
         let (nb, w) = (self.nb, self.w);
         let wp = w + 1;
         for i in 0..nb {
-            let mut v = x[i];
-            for m in i.saturating_sub(w)..i {
-                v -= self.band[i * wp + (i - m)] * x[m];
-            }
-            x[i] = v;
+            let lo = i.saturating_sub(w);
+            let row = &self.band[i * wp + (lo + w - i)..i * wp + w];
+            let acc: f64 = row.iter().zip(&x[lo..i]).map(|(a, b)| a * b).sum();
+            x[i] -= acc;
         }
         for i in 0..nb {
-            x[i] /= self.band[i * wp];
+            x[i] /= self.band[i * wp + w];
         }
+        // Lᵀ: column i of L is L_ri = band[r·wp + (i + w − r)] for r in i+1 ..= i+w.
         for i in (0..nb).rev() {
+            let hi = (i + wp).min(nb);
             let mut v = x[i];
-            for r in i + 1..(i + wp).min(nb) {
-                v -= self.band[r * wp + (r - i)] * x[r];
+            for r in i + 1..hi {
+                v -= self.band[r * wp + (i + w - r)] * x[r];
             }
             x[i] = v;
         }
@@ -494,6 +506,9 @@ fn refine(
     }
 }
 
+/// The largest second-order cone (rows) [`Banded::solve`] takes.
+pub const MAX_CONE: usize = 8;
+
 fn dot(row: &Row, x: &[f64]) -> f64 {
     row.iter().map(|&(j, v)| v * x[j]).sum()
 }
@@ -506,9 +521,12 @@ fn inf_norm(v: &[f64]) -> f64 {
 /// `W` (symmetric, q × q, row-major) with `W·z = W⁻¹·s = λ`, its inverse, and `λ`
 /// (Vandenberghe, "The CVXOPT linear and quadratic cone program solvers", §4.2).
 struct SocScaling {
-    w: Vec<f64>,
-    winv: Vec<f64>,
-    lambda: Vec<f64>,
+    /// `W`, q × q row-major (first q² entries used).
+    w: [f64; MAX_CONE * MAX_CONE],
+    /// `W⁻¹`, likewise.
+    winv: [f64; MAX_CONE * MAX_CONE],
+    /// `λ` (first q entries).
+    lambda: [f64; MAX_CONE],
 }
 
 fn soc_norm(v: &[f64]) -> f64 {
@@ -519,17 +537,20 @@ fn soc_norm(v: &[f64]) -> f64 {
 fn soc_scaling(s: &[f64], z: &[f64]) -> SocScaling {
     let q = s.len();
     let (sn, zn) = (soc_norm(s), soc_norm(z));
-    let sb: Vec<f64> = s.iter().map(|v| v / sn).collect();
-    let zb: Vec<f64> = z.iter().map(|v| v / zn).collect();
-    let gamma = ((1.0 + sb.iter().zip(&zb).map(|(a, b)| a * b).sum::<f64>()) / 2.0).sqrt();
-    let mut wb = vec![0.0; q];
+    let (mut sb, mut zb) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
+    for i in 0..q {
+        sb[i] = s[i] / sn;
+        zb[i] = z[i] / zn;
+    }
+    let gamma = ((1.0 + (0..q).map(|i| sb[i] * zb[i]).sum::<f64>()) / 2.0).sqrt();
+    let mut wb = [0.0; MAX_CONE];
     wb[0] = (sb[0] + zb[0]) / (2.0 * gamma);
     for i in 1..q {
         wb[i] = (sb[i] - zb[i]) / (2.0 * gamma);
     }
     let eta = (sn / zn).sqrt();
-    let mut w = vec![0.0; q * q];
-    let mut winv = vec![0.0; q * q];
+    let mut w = [0.0; MAX_CONE * MAX_CONE];
+    let mut winv = [0.0; MAX_CONE * MAX_CONE];
     w[0] = eta * wb[0];
     winv[0] = wb[0] / eta;
     for i in 1..q {
@@ -543,9 +564,10 @@ fn soc_scaling(s: &[f64], z: &[f64]) -> SocScaling {
             winv[i * q + j] = m / eta;
         }
     }
-    let lambda = (0..q)
-        .map(|i| (0..q).map(|j| w[i * q + j] * z[j]).sum())
-        .collect();
+    let mut lambda = [0.0; MAX_CONE];
+    for i in 0..q {
+        lambda[i] = (0..q).map(|j| w[i * q + j] * z[j]).sum();
+    }
     SocScaling { w, winv, lambda }
 }
 
@@ -769,6 +791,10 @@ impl Banded {
     }
 
     fn solve_scaled(&self, x0: &[f64], st: &IpmSettings) -> IpmSolution {
+        assert!(
+            self.soc.iter().all(|c| (2..=MAX_CONE).contains(&c.len())),
+            "second-order cones have 2 to {MAX_CONE} rows"
+        );
         let n = self.n;
         let me = self.eq.len();
         let ml = self.le.len();
@@ -892,6 +918,7 @@ impl Banded {
             vec![0.0; mi],
         );
         let (mut dz_a, mut ds_a, mut rc) = (vec![0.0; mi], vec![0.0; mi], vec![0.0; mi]);
+        let mut dxy: Vec<f64> = Vec::with_capacity(n + me);
         for it in 0..st.max_iter {
             // Residuals.
             rd.copy_from_slice(&self.c);
@@ -944,7 +971,7 @@ impl Banded {
             scal.clear();
             for &(b0, q) in &blocks {
                 let sc = soc_scaling(&s[b0..b0 + q], &z[b0..b0 + q]);
-                lam[b0..b0 + q].copy_from_slice(&sc.lambda);
+                lam[b0..b0 + q].copy_from_slice(&sc.lambda[..q]);
                 scal.push(sc);
             }
             // The matrix: H + Gᵀ·V·G on the variables, A and Aᵀ, regularised.
@@ -988,11 +1015,14 @@ impl Banded {
                     w_r[r] = z[r] / s[r] * rg[r] + (z[r] / s[r]).sqrt() * u[r];
                 }
                 for (bi, &(b0, q)) in blocks.iter().enumerate() {
-                    let neg: Vec<f64> = rc[b0..b0 + q].iter().map(|v| -v).collect();
-                    soc_div(&lam[b0..b0 + q], &neg, &mut u[b0..b0 + q]);
+                    let mut neg = [0.0; MAX_CONE];
+                    for (d, v) in neg.iter_mut().zip(&rc[b0..b0 + q]) {
+                        *d = -v;
+                    }
+                    soc_div(&lam[b0..b0 + q], &neg[..q], &mut u[b0..b0 + q]);
                     let wi = &scal[bi].winv;
                     // W⁻¹·(W⁻¹·r_g + u).
-                    let mut t = vec![0.0; q];
+                    let mut t = [0.0; MAX_CONE];
                     for a in 0..q {
                         t[a] = (0..q).map(|m| wi[a * q + m] * rg[b0 + m]).sum::<f64>() + u[b0 + a];
                     }
@@ -1027,7 +1057,7 @@ impl Banded {
                 }
                 for (bi, &(b0, q)) in blocks.iter().enumerate() {
                     let wi = &scal[bi].winv;
-                    let mut t = vec![0.0; q];
+                    let mut t = [0.0; MAX_CONE];
                     for a in 0..q {
                         t[a] = (0..q).map(|m| wi[a * q + m] * gdx[b0 + m]).sum();
                     }
@@ -1054,10 +1084,10 @@ impl Banded {
                 rc[r] = lam[r] * lam[r];
             }
             for &(b0, q) in &blocks {
-                let l = lam[b0..b0 + q].to_vec();
-                soc_prod(&l, &l, &mut rc[b0..b0 + q]);
+                let mut l = [0.0; MAX_CONE];
+                l[..q].copy_from_slice(&lam[b0..b0 + q]);
+                soc_prod(&l[..q], &l[..q], &mut rc[b0..b0 + q]);
             }
-            let mut dxy = Vec::with_capacity(n + me);
             newton(&rc, &mut dz_a, &mut ds_a, &mut dxy);
             let a_aff = max_step(&s, &ds_a).min(max_step(&z, &dz_a)).min(1.0);
             let mu_aff = (0..mi)
@@ -1075,17 +1105,16 @@ impl Banded {
             }
             for (bi, &(b0, q)) in blocks.iter().enumerate() {
                 let (w, wi) = (&scal[bi].w, &scal[bi].winv);
-                let sd: Vec<f64> = (0..q)
-                    .map(|a| (0..q).map(|m| wi[a * q + m] * ds_a[b0 + m]).sum())
-                    .collect();
-                let zd: Vec<f64> = (0..q)
-                    .map(|a| (0..q).map(|m| w[a * q + m] * dz_a[b0 + m]).sum())
-                    .collect();
-                let l = lam[b0..b0 + q].to_vec();
-                let mut ll = vec![0.0; q];
-                let mut sz = vec![0.0; q];
-                soc_prod(&l, &l, &mut ll);
-                soc_prod(&sd, &zd, &mut sz);
+                let (mut sd, mut zd) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
+                for a in 0..q {
+                    sd[a] = (0..q).map(|m| wi[a * q + m] * ds_a[b0 + m]).sum();
+                    zd[a] = (0..q).map(|m| w[a * q + m] * dz_a[b0 + m]).sum();
+                }
+                let mut l = [0.0; MAX_CONE];
+                l[..q].copy_from_slice(&lam[b0..b0 + q]);
+                let (mut ll, mut sz) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
+                soc_prod(&l[..q], &l[..q], &mut ll[..q]);
+                soc_prod(&sd[..q], &zd[..q], &mut sz[..q]);
                 for a in 0..q {
                     rc[b0 + a] = ll[a] + sz[a];
                 }
@@ -1255,9 +1284,9 @@ mod tests {
             }
             let r = [rnd(), rnd(), rnd()];
             let mut u = [0.0; 3];
-            soc_div(&sc.lambda, &r, &mut u);
+            soc_div(&sc.lambda[..3], &r, &mut u);
             let mut back = [0.0; 3];
-            soc_prod(&sc.lambda, &u, &mut back);
+            soc_prod(&sc.lambda[..3], &u, &mut back);
             for a in 0..3 {
                 assert!((back[a] - r[a]).abs() < 1e-9);
             }
