@@ -16,6 +16,8 @@ pub struct HeldOut {
     pub path: Path,
     /// The run's last point must stay (what follows it programs the rotary axes).
     pub keep_last_point: bool,
+    /// Decimal places of the rotary words (what the NC pipeline reads from the file).
+    pub decimals: usize,
 }
 
 /// splitmix64 in [0, 1), so the set is the same on every machine.
@@ -52,6 +54,7 @@ pub fn held_out_zones(seed: u64, count: usize) -> Vec<HeldOut> {
         let d = 5.0 * unit(&mut st);
         let domain_rule = unit(&mut st) < 0.5;
         let pinned = unit(&mut st) < 0.5;
+        let decimals = if unit(&mut st) < 0.5 { 3 } else { 4 };
         let pass = Pass {
             pole_distance_deg: d,
             circle_radius_deg: 5.0 + 25.0 * unit(&mut st),
@@ -62,7 +65,7 @@ pub fn held_out_zones(seed: u64, count: usize) -> Vec<HeldOut> {
             feed_mm_min: feed,
             b_axis,
             domain_rule,
-            rotary_decimals: if unit(&mut st) < 0.5 { 3 } else { 4 },
+            rotary_decimals: decimals,
         };
         let axes = joints(&pass);
         let path = Path {
@@ -79,6 +82,7 @@ pub fn held_out_zones(seed: u64, count: usize) -> Vec<HeldOut> {
             machine,
             path,
             keep_last_point: pinned,
+            decimals,
         });
     }
     out

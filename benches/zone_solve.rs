@@ -41,11 +41,17 @@ fn zone_solve(c: &mut Criterion) {
     for (k, h) in held_out_zones(0x5EED_0021, 24).into_iter().enumerate() {
         let opts = PatchOptions {
             keep_last_point: h.keep_last_point,
+            p_decimals: h.decimals,
+            c_decimals: h.decimals,
             ..PatchOptions::default()
         };
         let res = patch_path(&h.path, &h.machine, &opts).unwrap();
         if res.zones.len() != 1 {
-            eprintln!("held-out {k} ({}): {} zones, skipped from the per-zone set", h.label, res.zones.len());
+            eprintln!(
+                "held-out {k} ({}): {} zones, skipped from the per-zone set",
+                h.label,
+                res.zones.len()
+            );
             continue;
         }
         g.bench_function(format!("both/held-out/{k:02}"), |b| {

@@ -42,9 +42,9 @@ fn main() {
             }
         }
     }
-    let mut cases: Vec<(String, Machine, Path, bool)> = held_out_zones(0x5EED_0021, count)
+    let mut cases: Vec<(String, Machine, Path, bool, usize)> = held_out_zones(0x5EED_0021, count)
         .into_iter()
-        .map(|h| (h.label, h.machine, h.path, h.keep_last_point))
+        .map(|h| (h.label, h.machine, h.path, h.keep_last_point, h.decimals))
         .collect();
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let sing = std::fs::read(root.join("fixtures/c17/SING.I")).expect("SING.I");
@@ -55,18 +55,20 @@ fn main() {
             if let Ok(p) = r.path
                 && p.axes.iter().any(|q| q[3].abs() < 5.0)
             {
-                cases.push((format!("SING/{name}"), m.clone(), p, false));
+                cases.push((format!("SING/{name}"), m.clone(), p, false, 3));
             }
         }
     }
     let mut times = Vec::new();
     let mut ratios = Vec::new();
-    for (label, m, path, pinned) in &cases {
+    for (label, m, path, pinned, decimals) in &cases {
         if only.as_ref().is_some_and(|o| !label.contains(o.as_str())) {
             continue;
         }
         let opts = PatchOptions {
             keep_last_point: *pinned,
+            p_decimals: *decimals,
+            c_decimals: *decimals,
             solver: solver.clone(),
             ..PatchOptions::default()
         };
