@@ -1,5 +1,93 @@
 //! Shared helpers for the criterion benches.
 
+use polepatch_fixturegen::{Pass, joints};
+use polepatch_kinematics::Machine;
+use polepatch_patcher::Path;
+
+/// One near-pole zone like those of programs nobody here has seen (issue 21's held-out
+/// set): a generated pass and how it is patched.
+#[derive(Debug, Clone)]
+pub struct HeldOut {
+    /// `machine/flip|swing/dD/Ffeed/hSpacing/pinned|free`.
+    pub label: String,
+    /// The machine.
+    pub machine: Machine,
+    /// The run (s = X, the tool tip runs along X).
+    pub path: Path,
+    /// The run's last point must stay (what follows it programs the rotary axes).
+    pub keep_last_point: bool,
+    /// Decimal places of the rotary words (what the NC pipeline reads from the file).
+    pub decimals: usize,
+}
+
+/// splitmix64 in [0, 1), so the set is the same on every machine.
+fn unit(state: &mut u64) -> f64 {
+    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// `count` held-out-like zones from `seed`: feeds 800–5000 mm/min, spacings 0.25–1 mm,
+/// flips (domain-rule posts) and swings (continuous branch) 0–5° from the pole, both
+/// built-in machines, pinned and free ends, 3 or 4 decimals. Runs are long enough for a
+/// C-only patch to exist (the tool axis' azimuth turns up to 180° near the pole).
+pub fn held_out_zones(seed: u64, count: usize) -> Vec<HeldOut> {
+    let mut st = seed;
+    let mut out = Vec::with_capacity(count);
+    for k in 0..count {
+        let b_axis = k % 2 == 1;
+        let name = if b_axis {
+            "mikron-hsm600"
+        } else {
+            "mikron-ucp710"
+        };
+        let machine = Machine::builtin(name).expect("built-in machine");
+        let pick = |st: &mut u64, xs: &[f64]| {
+            xs[((unit(st) * xs.len() as f64) as usize).min(xs.len() - 1)]
+        };
+        let feed = pick(&mut st, &[800.0, 1500.0, 2000.0, 3000.0, 5000.0]);
+        let v_deg_mm = machine.limit(polepatch_kinematics::Axis::C).v / (feed / 60.0);
+        let length_mm = (20.0 + 60.0 * unit(&mut st)).max(1.5 * 180.0 / v_deg_mm + 10.0);
+        let spacing_mm = pick(&mut st, &[0.25, 0.5, 1.0]).max(length_mm / 300.0);
+        let d = 5.0 * unit(&mut st);
+        let domain_rule = unit(&mut st) < 0.5;
+        let pinned = unit(&mut st) < 0.5;
+        let decimals = if unit(&mut st) < 0.5 { 3 } else { 4 };
+        let pass = Pass {
+            pole_distance_deg: d,
+            circle_radius_deg: 5.0 + 25.0 * unit(&mut st),
+            half_sweep_deg: 30.0 + 60.0 * unit(&mut st),
+            azimuth_deg: 360.0 * unit(&mut st),
+            length_mm,
+            spacing_mm,
+            feed_mm_min: feed,
+            b_axis,
+            domain_rule,
+            rotary_decimals: decimals,
+        };
+        let axes = joints(&pass);
+        let path = Path {
+            s_mm: axes.iter().map(|q| q[0]).collect(),
+            axes,
+            feed_mm_min: feed,
+        };
+        out.push(HeldOut {
+            label: format!(
+                "{name}/{}/d{d:.2}/F{feed}/h{spacing_mm}/{}",
+                if domain_rule { "flip" } else { "swing" },
+                if pinned { "pinned" } else { "free" }
+            ),
+            machine,
+            path,
+            keep_last_point: pinned,
+            decimals,
+        });
+    }
+    out
+}
+
 /// File style of a generated program.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Style {

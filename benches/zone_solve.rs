@@ -1,64 +1,74 @@
-//! Time to patch one singular zone (SPEC §6: ≤ 1 ms median): `patch_path` on whole runs
-//! whose zones are known, with the default method (both rotary axes: re-selection or the
-//! joint SOCP) and with `--only-c` (G16's C-only method). Each benched run holds one zone;
-//! the figure includes detection, every solve, verification and the report figures. Run:
-//! `cargo bench -p polepatch-benches --bench zone_solve -- --warm-up-time 1 --measurement-time 5`
-//! Figures are written up in docs/performance-patcher.md.
+//! Time to patch one singular zone (SPEC §6, issue 21: median ≤ 1 ms, p90 ≤ 3 ms on one
+//! core): `patch_path` on whole runs that hold one zone, with the default method (both
+//! rotary axes: re-selection or the joint patch), on
+//! - the held-out-like zones of `polepatch_benches::held_out_zones` (seed `0x5EED_0021`,
+//!   24 zones: feeds 800–5000, spacings 0.25–1 mm, flips and swings 0–5° from the pole,
+//!   both machines, pinned and free ends), and
+//! - C17's `SING.I` main run on both machines;
+//!
+//! and `--only-c` on SING. The figure includes detection, every solve, verification and
+//! the report figures. Run (one thread; the machine is shared):
+//! `RAYON_NUM_THREADS=1 cargo bench -p polepatch-benches --bench zone_solve -- --warm-up-time 1 --measurement-time 3`
+//! then `benches/zone_medians.sh` for the median and p90 over the zones. Figures are
+//! written up in docs/performance-patcher.md.
 
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use polepatch::program::load_nc;
+use polepatch_benches::held_out_zones;
 use polepatch_kinematics::Machine;
 use polepatch_patcher::{PatchAxes, PatchOptions, Path, patch_path};
 
-/// The runs of a fixture that have zones on `machine`, as the pipeline builds them.
-fn zone_runs(file: &str, machine: &Machine) -> Vec<Path> {
+/// The runs of SING that hold a zone on `machine`.
+fn sing_runs(machine: &Machine) -> Vec<Path> {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let bytes = std::fs::read(root.join(file)).expect("fixture");
-    let lp = load_nc(bytes, file, machine, None).expect("parsable fixture");
-    let opts = PatchOptions::default();
+    let bytes = std::fs::read(root.join("fixtures/c17/SING.I")).expect("fixture");
+    let lp = load_nc(bytes, "SING", machine, None).expect("parsable fixture");
     lp.runs
         .into_iter()
         .filter_map(|r| {
             let path = r.path.ok()?;
-            let res = patch_path(&path, machine, &opts).ok()?;
+            let res = patch_path(&path, machine, &PatchOptions::default()).ok()?;
             (!res.zones.is_empty()).then_some(path)
         })
         .collect()
 }
 
 fn zone_solve(c: &mut Criterion) {
-    let cases = [
-        ("sing", "fixtures/c17/SING.I"),
-        ("ac-flip-d2", "fixtures/generated/heidenhain-ac-flip-d2.I"),
-        (
-            "ac-swing-d0.5",
-            "fixtures/generated/heidenhain-ac-swing-d0.5.I",
-        ),
-    ];
     let mut g = c.benchmark_group("patcher/zone_solve");
     g.sample_size(10);
-    for (method, axes) in [("both", PatchAxes::Both), ("only-c", PatchAxes::OnlyC)] {
+    for (k, h) in held_out_zones(0x5EED_0021, 24).into_iter().enumerate() {
         let opts = PatchOptions {
-            axes,
+            keep_last_point: h.keep_last_point,
+            p_decimals: h.decimals,
+            c_decimals: h.decimals,
             ..PatchOptions::default()
         };
-        for mname in ["mikron-ucp710", "mikron-hsm600"] {
-            let m = Machine::builtin(mname).expect("built-in machine");
-            for (label, file) in cases {
-                for (k, path) in zone_runs(file, &m).into_iter().enumerate() {
-                    let res = patch_path(&path, &m, &opts).unwrap();
-                    eprintln!(
-                        "{method}/{label}/{mname}/run{k}: {} zone(s), {} points, {} solves",
-                        res.zones.len(),
-                        path.s_mm.len(),
-                        res.zones.iter().map(|z| z.qp.solves).sum::<u32>()
-                    );
-                    g.bench_function(format!("{method}/{label}/{mname}/run{k}"), |b| {
-                        b.iter(|| patch_path(black_box(&path), &m, &opts).unwrap())
-                    });
-                }
+        let res = patch_path(&h.path, &h.machine, &opts).unwrap();
+        if res.zones.len() != 1 {
+            eprintln!(
+                "held-out {k} ({}): {} zones, skipped from the per-zone set",
+                h.label,
+                res.zones.len()
+            );
+            continue;
+        }
+        g.bench_function(format!("both/held-out/{k:02}"), |b| {
+            b.iter(|| patch_path(black_box(&h.path), &h.machine, &opts).unwrap())
+        });
+    }
+    for mname in ["mikron-ucp710", "mikron-hsm600"] {
+        let m = Machine::builtin(mname).expect("built-in machine");
+        for (method, axes) in [("both", PatchAxes::Both), ("only-c", PatchAxes::OnlyC)] {
+            let opts = PatchOptions {
+                axes,
+                ..PatchOptions::default()
+            };
+            for (k, path) in sing_runs(&m).into_iter().enumerate() {
+                g.bench_function(format!("{method}/sing/{mname}/run{k}"), |b| {
+                    b.iter(|| patch_path(black_box(&path), &m, &opts).unwrap())
+                });
             }
         }
     }

@@ -107,11 +107,13 @@ typedef struct PpOptions {
    */
   bool only_c;
   /*
-   Allow a 360° multiple offset of C after a zone (default false).
+   Allow a 360° multiple offset of C after a zone (G16's join option: needs `only_c`,
+   refused without it; default false).
    */
   bool allow_c_offset;
   /*
-   Interpolation cycle time, ms; ≤ 0: the machine's (default 0).
+   Interpolation cycle time, ms; ≤ 0: the machine's (default 0). No figure depends on
+   it (Equation 6 is bounded exactly over every span); kept for layout compatibility.
    */
   double tcy_ms;
   /*

@@ -94,9 +94,11 @@ pub struct PpOptions {
     pub max_deviation_deg: f64,
     /// Change C only (G16's method) instead of both rotary axes (default false).
     pub only_c: bool,
-    /// Allow a 360° multiple offset of C after a zone (default false).
+    /// Allow a 360° multiple offset of C after a zone (G16's join option: needs `only_c`,
+    /// refused without it; default false).
     pub allow_c_offset: bool,
-    /// Interpolation cycle time, ms; ≤ 0: the machine's (default 0).
+    /// Interpolation cycle time, ms; ≤ 0: the machine's (default 0). No figure depends on
+    /// it (Equation 6 is bounded exactly over every span); kept for layout compatibility.
     pub tcy_ms: f64,
     /// Feed for runs without F, mm/min; ≤ 0: none (default 0).
     pub feed_fallback_mm_min: f64,
@@ -272,6 +274,11 @@ unsafe fn options(opts: *const PpOptions) -> Result<polepatch::PatchOptions, Fai
         if !v.is_finite() {
             return Err(bad(format!("{what} must be finite, got {v}")));
         }
+    }
+    if o.allow_c_offset && !o.only_c {
+        return Err(bad(
+            "allow_c_offset is G16's join option: it needs only_c (the default method re-selects the branch instead)",
+        ));
     }
     if o.has_work_offset && o.work_offset_mm.iter().any(|v| !v.is_finite()) {
         return Err(bad("work_offset_mm must be finite"));

@@ -369,7 +369,9 @@ fn analysis_zones(lp: &LoadedProgram, machine: &Machine, opts: &PatchOptions) ->
         .iter()
         .map(|rp| match &rp.path {
             Ok(p) => analyze_path(p, machine, &aopts)
-                .map(|a| polepatch_patcher::patch::merged_zones(&a.zones))
+                .map(|a| {
+                    polepatch_patcher::driver::merge_zones(&a.zones, opts.solver.merge_gap_points)
+                })
                 .unwrap_or_default(),
             Err(_) => Vec::new(),
         })
@@ -577,7 +579,6 @@ fn reference(
     };
     let p: Vec<f64> = path.axes.iter().map(|q| q[Axis::Primary.index()]).collect();
     let c: Vec<f64> = path.axes.iter().map(|q| q[Axis::C.index()]).collect();
-    let step_mm = path.feed_mm_min / 60.0 * opts.tcy_s.unwrap_or(machine.tcy_s);
     let t0 = Instant::now();
     if both {
         let res = zone_reference(
@@ -589,7 +590,6 @@ fn reference(
             hi,
             machine,
             path.feed_mm_min,
-            step_mm,
             opts.max_decimals,
         );
         out.status = match res {
@@ -615,7 +615,7 @@ fn reference(
             hi,
             (zone.first, zone.last),
             &lim,
-            step_mm,
+            polepatch_patcher::direct::BOUND_SAMPLES_PER_SPAN,
         );
         out.status = match res {
             Ok((b, _)) => {

@@ -37,13 +37,10 @@ pub(crate) struct BenchArgs {
     #[arg(long)]
     feed: Option<f64>,
     /// Singular cone, degrees.
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, default_value_t = PatchOptions::default().cone_deg)]
     cone: f64,
-    /// Interpolation cycle time override, ms (default: the machine's).
-    #[arg(long)]
-    tcy_ms: Option<f64>,
-    /// Safety margin on the C limits of the patch, as a fraction.
-    #[arg(long, default_value_t = 0.02)]
+    /// Safety margin on the rotary axes' limits the patch aims at, as a fraction.
+    #[arg(long, default_value_t = PatchOptions::default().margin)]
     margin: f64,
     /// Strategies to compare, repeatable: polepatch (the default of `patch`), only-c,
     /// freeze, linearize, smooth, or all (default: polepatch).
@@ -95,7 +92,6 @@ fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
 
 pub(crate) fn run(args: BenchArgs) -> Result<ExitCode> {
     check_positive("--feed", args.feed)?;
-    crate::check_tcy_ms(args.tcy_ms)?;
     check_positive("--cone", Some(args.cone))?;
     if !(0.0..0.5).contains(&args.margin) {
         bail!("--margin must be in [0, 0.5), got {}", args.margin);
@@ -160,7 +156,6 @@ pub(crate) fn run(args: BenchArgs) -> Result<ExitCode> {
     let opts = BenchOptions {
         patch: PatchOptions {
             cone_deg: args.cone,
-            tcy_s: args.tcy_ms.map(|ms| ms / 1000.0),
             margin: args.margin,
             ..PatchOptions::default()
         },

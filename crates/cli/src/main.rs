@@ -3,7 +3,7 @@
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use polepatch::kinematics::{Axis, Machine};
-use polepatch::patcher::AnalysisOptions;
+use polepatch::patcher::{AnalysisOptions, PatchOptions};
 use polepatch::report::{AnalyzeReport, axis_letter};
 use polepatch::stream::Piece;
 use polepatch_cli::files;
@@ -26,7 +26,9 @@ struct Cli {
 enum Command {
     /// Report where and why the machine slows down (Equation 6 along every G1 run).
     Analyze(AnalyzeArgs),
-    /// Rewrite the C words near the pole so that C reaches the programmed feed.
+    /// Rewrite the rotary words near the pole so that both rotary axes reach the programmed
+    /// feed (re-selecting the IK branch where that suffices, else the smallest change of
+    /// tool orientation); `--only-c` keeps the primary axis (G16's method).
     Patch(PatchArgs),
     /// Post a CL file (APT or CSV x,y,z,i,j,k) as a TCPM program for a machine, with pole
     /// handling (the same patch as `patch`, unless --no-patch).
@@ -70,34 +72,36 @@ pub(crate) struct PatchArgs {
     /// Feed in mm/min for runs with no F in force.
     #[arg(long)]
     pub(crate) feed: Option<f64>,
-    /// Singular cone, degrees.
-    #[arg(long, default_value_t = 5.0)]
+    /// Singular cone, degrees: a zone needs a point with |primary| within it.
+    #[arg(long, default_value_t = PatchOptions::default().cone_deg)]
     pub(crate) cone: f64,
-    /// Largest orientation deviation allowed, degrees (default: no limit, still minimised).
+    /// Largest orientation change allowed at any point, degrees, on the exact angle of the
+    /// written words (default: no limit; the change is always minimised). A cap at or above
+    /// what the default achieves changes nothing.
     #[arg(long)]
     pub(crate) max_deviation: Option<f64>,
-    /// Interpolation cycle time override, ms (default: the machine's).
-    #[arg(long)]
-    pub(crate) tcy_ms: Option<f64>,
-    /// Safety margin on the C limits, as a fraction.
-    #[arg(long, default_value_t = 0.02)]
+    /// Safety margin on the rotary axes' limits the solvers aim at, as a fraction (what is
+    /// verified is Equation 6 on the written values, without margin).
+    #[arg(long, default_value_t = PatchOptions::default().margin)]
     pub(crate) margin: f64,
-    /// Most decimal places to write for C when the file's precision cannot hold Equation 6.
-    #[arg(long, default_value_t = 6)]
+    /// Most decimal places to write for the rotary words when the file's precision cannot
+    /// hold Equation 6.
+    #[arg(long, default_value_t = PatchOptions::default().max_decimals)]
     pub(crate) max_decimals: usize,
-    /// Longest patch, mm (default: up to the whole run).
+    /// Longest patch, mm (default: up to the whole run; both methods hold to it).
     #[arg(long)]
     pub(crate) max_patch_length: Option<f64>,
     /// Change C only, never the primary axis (G16's method). Default: both rotary axes may
     /// change (re-selecting the IK branch where that suffices), so that both reach feed.
     #[arg(long)]
     pub(crate) only_c: bool,
-    /// Do not ask for third-derivative continuity at the joins.
-    #[arg(long)]
+    /// With --only-c: do not ask for third-derivative continuity at G16's joins.
+    #[arg(long, requires = "only_c")]
     pub(crate) no_jerk_continuity: bool,
-    /// Allow a 360° multiple offset of C after a zone when it shortens the join (off by
-    /// default: the move after the run would then turn C the extra revolution back).
-    #[arg(long)]
+    /// With --only-c: allow a 360° multiple offset of C after a zone when it shortens G16's
+    /// join (off by default: the move after the run would then turn C the extra revolution
+    /// back; the default method re-selects the branch instead).
+    #[arg(long, requires = "only_c")]
     pub(crate) c_offset: bool,
     /// Worker threads for batches (default: all cores).
     #[arg(long)]
@@ -131,12 +135,9 @@ struct AnalyzeArgs {
     /// Feed in mm/min for runs with no F in force.
     #[arg(long)]
     feed: Option<f64>,
-    /// Singular cone, degrees.
-    #[arg(long, default_value_t = 5.0)]
+    /// Singular cone, degrees: a zone needs a point with |primary| within it.
+    #[arg(long, default_value_t = AnalysisOptions::default().cone_deg)]
     cone: f64,
-    /// Interpolation cycle time override, ms (default: the machine's).
-    #[arg(long)]
-    tcy_ms: Option<f64>,
     /// Print one JSON document instead of the table.
     #[arg(long)]
     json: bool,
@@ -229,15 +230,13 @@ pub(crate) fn check_positive(name: &str, v: Option<f64>) -> Result<()> {
 
 fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
     check_positive("--feed", args.feed)?;
-    check_tcy_ms(args.tcy_ms)?;
     check_positive("--cone", Some(args.cone))?;
     let machine = machine(&args.machine)?;
     let name = args.file.display().to_string();
     let opts = polepatch::AnalyzeOptions {
         analysis: AnalysisOptions {
             cone_deg: args.cone,
-            tcy_s: args.tcy_ms.map(|ms| ms / 1000.0),
-            keep_samples: false,
+            ..AnalysisOptions::default()
         },
         feed_fallback_mm_min: args.feed,
         name: name.clone(),

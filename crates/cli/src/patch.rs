@@ -14,8 +14,11 @@ use std::process::ExitCode;
 
 fn options(args: &PatchArgs) -> Result<PatchOptions> {
     check_positive("--cone", Some(args.cone))?;
-    check_positive("--max-deviation", args.max_deviation)?;
-    crate::check_tcy_ms(args.tcy_ms)?;
+    if let Some(d) = args.max_deviation
+        && !(d.is_finite() && d >= 0.0)
+    {
+        bail!("--max-deviation must be an angle ≥ 0°, got {d}");
+    }
     check_positive("--feed", args.feed)?;
     check_positive("--max-patch-length", args.max_patch_length)?;
     if !(0.0..0.5).contains(&args.margin) {
@@ -30,7 +33,6 @@ fn options(args: &PatchArgs) -> Result<PatchOptions> {
     Ok(PatchOptions {
         cone_deg: args.cone,
         max_deviation_deg: args.max_deviation,
-        tcy_s: args.tcy_ms.map(|ms| ms / 1000.0),
         margin: args.margin,
         third_derivative_continuity: !args.no_jerk_continuity,
         max_decimals: args.max_decimals,
@@ -359,6 +361,15 @@ fn print_summary(inputs: &[PathBuf], reports: &[Result<FileReport, JobError>]) {
             rep.zones.iter().map(|z| z.points_modified).sum::<usize>(),
             rep.words_changed,
         );
+        // Why each zone ended as it did (a fixed set, docs/user-guide.md), counted.
+        let counts: Vec<String> = polepatch::patcher::Reason::ALL
+            .iter()
+            .filter_map(|r| {
+                let k = rep.zones.iter().filter(|z| z.reason == r.name()).count();
+                (k > 0).then(|| format!("{} {k}", r.name()))
+            })
+            .collect();
+        println!("  reasons: {}", counts.join(", "));
         for (letter, written, file) in [
             ("C", rep.written_c_decimals, rep.file_c_decimals),
             (

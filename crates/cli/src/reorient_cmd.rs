@@ -37,7 +37,7 @@ pub(crate) struct ReorientArgs {
     #[arg(long)]
     plot: Option<PathBuf>,
     /// Singular cone, degrees.
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, default_value_t = polepatch::patcher::PatchOptions::default().cone_deg)]
     cone: f64,
 }
 

@@ -108,7 +108,7 @@ impl Binned {
 
 pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
     check_positive("--feed", args.feed)?;
-    check_positive("--tcy-ms", args.tcy_ms)?;
+    crate::check_tcy_ms(args.tcy_ms)?;
     if args.trajectory.is_some() && args.programs.len() > 1 {
         bail!("--trajectory writes one program's trajectory: give one program");
     }

@@ -181,10 +181,8 @@ fn absurd_machine_values_are_refused_naming_the_field() {
     let (code, _, err) = polepatch_in(
         &dir,
         &[
-            "patch",
+            "simulate",
             "SING.I",
-            "-o",
-            "o.I",
             "--machine",
             "mikron-ucp710",
             "--tcy-ms",

@@ -277,3 +277,47 @@ fn the_cli_writes_what_the_library_returns() {
         }
     }
 }
+
+/// Issue 21 §6: options mean what they say. G16's join options need `--only-c` (the
+/// default method has no joins) and are refused without it; `--max-patch-length` holds for
+/// the default method too; the summary counts the zones' reasons.
+#[test]
+fn options_mean_what_they_say() {
+    let dir = temp_dir("options");
+    let out = dir.join("o.I");
+    let o = out.to_str().unwrap();
+    for flag in ["--c-offset", "--no-jerk-continuity"] {
+        let (code, _, err) = polepatch(&[
+            "patch",
+            "fixtures/c17/SING.I",
+            "-o",
+            o,
+            "--machine",
+            "mikron-ucp710",
+            flag,
+        ]);
+        assert_eq!(code, 2, "{flag}: {err}");
+        assert!(err.contains("--only-c"), "{flag}: {err}");
+        assert!(!out.exists(), "{flag}: nothing written");
+    }
+    let report = dir.join("r.json");
+    let (code, stdout, err) = polepatch(&[
+        "patch",
+        "fixtures/c17/SING.I",
+        "-o",
+        o,
+        "--machine",
+        "mikron-ucp710",
+        "--max-patch-length",
+        "12",
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("reasons:"), "{stdout}");
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    for z in doc["zones"].as_array().unwrap() {
+        assert!(z["patch_length_mm"].as_f64().unwrap() <= 12.0 + 1e-9, "{z}");
+        assert!(z["reason"].is_string(), "{z}");
+    }
+}

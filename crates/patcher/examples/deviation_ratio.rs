@@ -10,7 +10,7 @@
 //! `fixtures/generated` (Heidenhain, both kinematics, flips and swings at pole distances
 //! 0.01°, 0.5°, 2°, 4°). Each file is read with `polepatch_nc::parse` and `runs` (as the
 //! CLI does), on both built-in machines. "bound" is [`deviation_bound_sampled`] over the
-//! whole run (points 1..n−1, step F·Tcy, limits without margin); "ours" the largest exact
+//! whole run (points 1..n−1, `BOUND_SAMPLES_PER_SPAN` samples per span, limits without margin); "ours" the largest exact
 //! deviation of `patch_path`'s written values. Prints a Markdown table.
 
 use polepatch_kinematics::Machine;
@@ -88,10 +88,17 @@ fn main() {
                     .map(|i| orientation_deviation_deg(p[i], res.c_deg[i] - c[i]))
                     .fold(0.0, f64::max);
                 let lim0 = CLimits::new(&m, feed, 0.0);
-                let step = feed / 60.0 * m.tcy_s;
-                let bound = deviation_bound_sampled(&path.s_mm, &p, &c, 1, n - 1, &lim0, step)
-                    .ok()
-                    .map(|b| b.0);
+                let bound = deviation_bound_sampled(
+                    &path.s_mm,
+                    &p,
+                    &c,
+                    1,
+                    n - 1,
+                    &lim0,
+                    polepatch_patcher::direct::BOUND_SAMPLES_PER_SPAN,
+                )
+                .ok()
+                .map(|b| b.0);
                 let ratio = bound.map(|b| if b > 0.0 { ours / b } else { f64::NAN });
                 if let Some(r) = ratio
                     && r.is_finite()

@@ -1,18 +1,52 @@
 //! Equation-6 analysis of one run with the analysis spline (SPEC §2), and detection of
 //! singular zones (SPEC §3 step 2).
+//!
+//! # Bounded work: per span, not per F·Tcy
+//! The run is analysed span by span (a span is the stretch between two consecutive CL
+//! points), never sample by sample:
+//! - **Equation 6** on a span uses the exact largest `|q'|`, `|q''|`, `|q'''|` of each axis
+//!   over the span ([`crate::spline::SpanCubic::peaks`]): one evaluation per span and axis.
+//!   The span's ratio is then the exact lowest ratio over the span, which is at most the
+//!   lowest ratio over SPEC §2's samples every F·Tcy (the maximum over the span is at least
+//!   the maximum over any sample set): at least as strict, for any Tcy.
+//! - **Time** ∫ds/ṡ over a span is exactly h/F when the span reaches feed everywhere (its
+//!   lowest ratio is 1). Otherwise the integrand `1/ṡ(s) = max(1/F, max over axes and terms
+//!   |q'|/V, √(|q''|/A), ∛(|q'''|/J))` is integrated by the trapezoidal rule on an adaptive
+//!   bisection of the span: on each piece `[a, b]` it lies between the Equation-6 values of
+//!   the exact smallest and the exact largest derivative sizes over the piece
+//!   ([`crate::spline::SpanCubic::abs_range`]; each term is increasing in its derivative's
+//!   size), and so do the trapezoid and the exact integral: the piece's error is at most
+//!   `(upper − lower)·(b − a)`. A piece is bisected while that exceeds
+//!   [`TIME_REL_TOL`] of its time, at most [`TIME_MAX_DEPTH`] times. The sum of those bounds
+//!   is [`RunAnalysis::time_error_s`], a rigorous bound on the estimate's error.
+//!
+//! Work per span is therefore at most `2^TIME_MAX_DEPTH + 1` evaluations of Equation 6, and
+//! one on a span at feed: bounded by the number of blocks, whatever the feed and the
+//! length of the blocks ([`RunAnalysis::evaluations`] counts them). Memory is one running
+//! reduction (and one record per span for [`analyze_spans`]).
 
 use crate::path::{Path, PathError};
-use crate::spline::{AnalysisSpline, SplineSystem, span_offsets};
+use crate::spline::{AnalysisSpline, SpanCubic, SplineSystem};
 use polepatch_kinematics::{Axis, FeedBound, LimitKind, Machine, axis_feed_bound, feed_bound};
+
+/// A piece of a span is bisected while the bound on its time error exceeds this fraction of
+/// its time (module docs).
+pub const TIME_REL_TOL: f64 = 1e-3;
+
+/// Most bisections of a span for its time (at most `2^TIME_MAX_DEPTH` pieces).
+pub const TIME_MAX_DEPTH: u32 = 6;
 
 /// Options of [`analyze_path`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct AnalysisOptions {
     /// Singular cone: a zone needs a point with |primary| ≤ this, degrees. Default 5.
     pub cone_deg: f64,
-    /// Interpolation cycle time override, seconds; `None` uses the machine's `tcy_s`.
+    /// Interpolation cycle time override, seconds; `None` uses the machine's `tcy_s`. It
+    /// does not change any figure: Equation 6 is bounded exactly over every span, which is
+    /// at least as strict as sampling every F·Tcy for any Tcy (module docs). Kept for the
+    /// callers that pass it (the C ABI's `PpOptions::tcy_ms`).
     pub tcy_s: Option<f64>,
-    /// Keep every sample in [`RunAnalysis::samples`] (for plots). Default false.
+    /// Keep the evaluation points in [`RunAnalysis::samples`] (for plots). Default false.
     pub keep_samples: bool,
 }
 
@@ -54,7 +88,8 @@ pub struct Zone {
     pub c_ratio_min: f64,
 }
 
-/// One analysis sample.
+/// One point where Equation 6 was evaluated (a span's start, or a piece of its time
+/// integral).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sample {
     /// Path parameter, mm.
@@ -65,6 +100,23 @@ pub struct Sample {
     pub bound: FeedBound,
 }
 
+/// Equation 6 over one span (exact over the span, module docs) and its time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpanFigures {
+    /// Lowest ratio min(1, bound/F) of each axis over the span, axis order.
+    pub axis_ratio: [f64; 5],
+    /// The limit binding each axis' lowest ratio.
+    pub axis_kind: [LimitKind; 5],
+    /// The lowest overall bound over the span.
+    pub bound: FeedBound,
+    /// Where it is reached, mm.
+    pub min_s_mm: f64,
+    /// Estimated time ∫ds/ṡ over the span, s.
+    pub time_s: f64,
+    /// Bound on the error of `time_s`, s.
+    pub time_error_s: f64,
+}
+
 /// Result of analysing one run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunAnalysis {
@@ -72,8 +124,6 @@ pub struct RunAnalysis {
     pub length_mm: f64,
     /// Programmed feed, mm/min.
     pub feed_mm_min: f64,
-    /// Sampling step used, mm (F·Tcy).
-    pub step_mm: f64,
     /// The lowest bound over the run.
     pub min: FeedBound,
     /// Where it occurs, mm.
@@ -82,18 +132,20 @@ pub struct RunAnalysis {
     pub axis_min: [(f64, LimitKind); 5],
     /// Estimated time ∫ds/ṡ over the run, s.
     pub time_s: f64,
+    /// Bound on the error of `time_s`, s (module docs).
+    pub time_error_s: f64,
     /// L/F, s.
     pub ideal_time_s: f64,
     /// Peak speed per axis at the programmed feed: max |q_s|·F, mm/s or °/s.
     pub peak_speed: [f64; 5],
     /// Singular zones.
     pub zones: Vec<Zone>,
-    /// Samples (only with `keep_samples`).
+    /// Points where Equation 6 was evaluated (only with `keep_samples`).
     pub samples: Vec<Sample>,
+    /// Evaluations of Equation 6 made (all axes at one point count one): at most
+    /// `spans·(2^TIME_MAX_DEPTH + 2)`, whatever the feed.
+    pub evaluations: usize,
 }
-
-/// Samples evaluated per batch (bounds memory on long runs).
-const CHUNK: usize = 4096;
 
 /// Ratios below `1 − RATIO_TOL` count as "below feed" (absorbs round-off in the bound).
 pub const RATIO_TOL: f64 = 1e-9;
@@ -153,144 +205,205 @@ pub fn axis_splines(path: &Path) -> Result<Vec<AnalysisSpline>, PathError> {
         .collect()
 }
 
-/// Sample parameters of span `i` ([`span_offsets`]: `[s_i, s_{i+1})`, plus `s_{n-1}` on
-/// the last span), with the span index.
-fn span_samples(
-    s: &[f64],
-    i: usize,
-    step: f64,
-    scratch: &mut Vec<f64>,
-    out: &mut Vec<(f64, usize)>,
-) {
-    span_offsets(s[i + 1] - s[i], step, i + 2 == s.len(), scratch);
-    out.extend(scratch.iter().map(|&t| (s[i] + t, i)));
-}
-
-/// Analyse a run: the not-a-knot spline of each axis over s, sampled every F·Tcy and at
-/// every knot, Equation 6 at every sample, time by the trapezoidal rule on 1/ṡ, zones.
+/// Analyse a run (module docs): the not-a-knot spline of each axis over s, Equation 6
+/// exact over every span, the time, the zones.
 pub fn analyze_path(
     path: &Path,
     machine: &Machine,
     opts: &AnalysisOptions,
 ) -> Result<RunAnalysis, PathError> {
+    run_analysis(path, machine, opts, None)
+}
+
+/// [`analyze_path`], with each span's figures too (one record per span).
+pub fn analyze_spans(
+    path: &Path,
+    machine: &Machine,
+    opts: &AnalysisOptions,
+) -> Result<(RunAnalysis, Vec<SpanFigures>), PathError> {
+    let mut spans = Vec::with_capacity(path.s_mm.len().saturating_sub(1));
+    let a = run_analysis(path, machine, opts, Some(&mut spans))?;
+    Ok((a, spans))
+}
+
+fn run_analysis(
+    path: &Path,
+    machine: &Machine,
+    opts: &AnalysisOptions,
+    mut spans: Option<&mut Vec<SpanFigures>>,
+) -> Result<RunAnalysis, PathError> {
     validate(path)?;
     let splines = axis_splines(path)?;
     let s = &path.s_mm;
-    let n = s.len();
     let feed_mm_s = path.feed_mm_min / 60.0;
-    let tcy_s = opts.tcy_s.unwrap_or(machine.tcy_s);
-    let step_mm = feed_mm_s * tcy_s;
-    if !(step_mm.is_finite() && step_mm > 0.0) {
-        return Err(PathError::BadFeed(path.feed_mm_min));
-    }
-
-    let mut acc = Accumulator::new(n, feed_mm_s, opts.keep_samples);
-    let mut params: Vec<(f64, usize)> = Vec::with_capacity(CHUNK + 64);
-    let mut scratch = Vec::new();
-    let mut ts: Vec<f64> = Vec::with_capacity(CHUNK + 64);
-    let mut derivs: Vec<Vec<[f64; 4]>> = (0..5).map(|_| Vec::with_capacity(CHUNK + 64)).collect();
-    for i in 0..n - 1 {
-        span_samples(s, i, step_mm, &mut scratch, &mut params);
-        if params.len() >= CHUNK || i + 2 == n {
-            ts.clear();
-            ts.extend(params.iter().map(|p| p.0));
-            for (k, sp) in splines.iter().enumerate() {
-                derivs[k].resize(ts.len(), [0.0; 4]);
-                sp.eval_derivs_sorted(&ts, &mut derivs[k]);
-            }
-            for (m, &(t, span)) in params.iter().enumerate() {
-                let mut d = [[0.0; 3]; 5];
-                for k in 0..5 {
-                    let e = derivs[k][m];
-                    d[k] = [e[1], e[2], e[3]];
-                }
-                acc.add(machine, t, span, &d);
-            }
-            params.clear();
+    let mut acc = Accumulator::new(feed_mm_s, opts.keep_samples);
+    for k in 0..s.len() - 1 {
+        let h = s[k + 1] - s[k];
+        let cubics: [SpanCubic; 5] = std::array::from_fn(|ax| splines[ax].span(s[k], h));
+        let fig = acc.span(machine, k, s[k], &cubics, k + 2 == s.len());
+        if let Some(out) = spans.as_deref_mut() {
+            out.push(fig);
         }
     }
-    let (mut analysis, below) = acc.finish(path, step_mm);
+    let (mut analysis, below) = acc.finish(path);
     analysis.zones = detect_zones(path, &below, opts.cone_deg);
     Ok(analysis)
 }
 
-/// A stretch of consecutive samples whose C-limited ratio is below 1.
+/// A stretch of consecutive spans whose C-limited ratio is below 1.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BelowFeed {
-    /// Span index of the first sample.
+    /// First span.
     pub first_span: usize,
-    /// Span index of the last sample.
+    /// Last span.
     pub last_span: usize,
     /// Lowest C ratio in the stretch.
     pub min_ratio: f64,
 }
 
-/// Running reductions over the samples of a run.
+/// Equation 6 at one point of a span: `d[axis] = [q', q'', q''']`.
+fn bound_at(machine: &Machine, cubics: &[SpanCubic; 5], tau: f64, feed_mm_s: f64) -> FeedBound {
+    let d: [[f64; 3]; 5] = std::array::from_fn(|ax| cubics[ax].derivs(tau));
+    feed_bound(machine, &d, feed_mm_s)
+}
+
+/// Running reductions over the spans of a run.
 struct Accumulator {
     feed_mm_s: f64,
     min: Option<FeedBound>,
     min_s_mm: f64,
     axis_min: [(f64, LimitKind); 5],
     time_s: f64,
-    prev: Option<(f64, f64)>,
+    time_error_s: f64,
     peak_slope: [f64; 5],
     keep: bool,
     samples: Vec<Sample>,
     below: Vec<BelowFeed>,
     open: Option<BelowFeed>,
+    evaluations: usize,
 }
 
 impl Accumulator {
-    fn new(_n: usize, feed_mm_s: f64, keep: bool) -> Self {
+    fn new(feed_mm_s: f64, keep: bool) -> Self {
         Accumulator {
             feed_mm_s,
             min: None,
             min_s_mm: 0.0,
             axis_min: [(1.0, LimitKind::Feed); 5],
             time_s: 0.0,
-            prev: None,
+            time_error_s: 0.0,
             peak_slope: [0.0; 5],
             keep,
             samples: Vec::new(),
             below: Vec::new(),
             open: None,
+            evaluations: 0,
         }
     }
 
-    fn add(&mut self, machine: &Machine, s_mm: f64, span: usize, d: &[[f64; 3]; 5]) {
-        let bound = feed_bound(machine, d, self.feed_mm_s);
+    fn sample(&mut self, machine: &Machine, s_mm: f64, cubics: &[SpanCubic; 5], tau: f64) {
+        if !self.keep {
+            return;
+        }
+        let d: [[f64; 3]; 5] = std::array::from_fn(|ax| cubics[ax].derivs(tau));
+        let axis_ratio: [f64; 5] = std::array::from_fn(|ax| {
+            let b = axis_feed_bound(machine.limit(Axis::ALL[ax]), d[ax]);
+            (b.feed_mm_s / self.feed_mm_s).min(1.0)
+        });
+        self.samples.push(Sample {
+            s_mm,
+            axis_ratio,
+            bound: feed_bound(machine, &d, self.feed_mm_s),
+        });
+    }
+
+    /// Span `k` starting at `s0_mm` with the axes' cubics: its figures, folded into the
+    /// run's.
+    fn span(
+        &mut self,
+        machine: &Machine,
+        k: usize,
+        s0_mm: f64,
+        cubics: &[SpanCubic; 5],
+        last: bool,
+    ) -> SpanFigures {
+        let h = cubics[0].h;
+        let mut peaks = [[0.0; 3]; 5];
+        let mut at = [[0.0; 2]; 5];
+        for ax in 0..5 {
+            (peaks[ax], at[ax]) = cubics[ax].peaks();
+        }
+        self.evaluations += 1;
+        // Equation 6 at the peaks: the exact lowest bound of each axis over the span.
+        let mut axis_ratio = [1.0; 5];
+        let mut axis_kind = [LimitKind::Feed; 5];
+        let mut bound = FeedBound {
+            feed_mm_s: self.feed_mm_s,
+            ratio: 1.0,
+            axis: None,
+            kind: LimitKind::Feed,
+        };
+        let mut min_tau = 0.0;
+        for axis in Axis::ALL {
+            let ax = axis.index();
+            let b = axis_feed_bound(machine.limit(axis), peaks[ax]);
+            let r = (b.feed_mm_s / self.feed_mm_s).min(1.0);
+            axis_ratio[ax] = if r.is_nan() { 0.0 } else { r };
+            axis_kind[ax] = b.kind;
+            if axis_ratio[ax] < self.axis_min[ax].0 {
+                self.axis_min[ax] = (axis_ratio[ax], b.kind);
+            }
+            self.peak_slope[ax] = self.peak_slope[ax].max(peaks[ax][0]);
+            if b.feed_mm_s < bound.feed_mm_s || b.feed_mm_s.is_nan() {
+                bound.feed_mm_s = if b.feed_mm_s.is_nan() {
+                    0.0
+                } else {
+                    b.feed_mm_s
+                };
+                bound.axis = Some(axis);
+                bound.kind = b.kind;
+                min_tau = match b.kind {
+                    LimitKind::Velocity => at[ax][0],
+                    LimitKind::Acceleration => at[ax][1],
+                    _ => 0.0,
+                };
+            }
+        }
+        bound.ratio = bound.feed_mm_s / self.feed_mm_s;
         if self.min.is_none_or(|m| bound.feed_mm_s < m.feed_mm_s) {
             self.min = Some(bound);
-            self.min_s_mm = s_mm;
+            self.min_s_mm = s0_mm + min_tau;
         }
-        let mut axis_ratio = [1.0; 5];
-        for axis in Axis::ALL {
-            let k = axis.index();
-            let b = axis_feed_bound(machine.limit(axis), d[k]);
-            // = axis_feed_ratio(…): the bound is needed for its kind too.
-            let r = (b.feed_mm_s / self.feed_mm_s).min(1.0);
-            axis_ratio[k] = r;
-            if r < self.axis_min[k].0 {
-                self.axis_min[k] = (r, b.kind);
-            }
-            self.peak_slope[k] = self.peak_slope[k].max(d[k][0].abs());
+        // Time: exact at feed, else adaptive trapezoid with a rigorous bracket.
+        let (time_s, time_error_s) = if bound.ratio >= 1.0 {
+            self.sample(machine, s0_mm, cubics, 0.0);
+            (h / self.feed_mm_s, 0.0)
+        } else {
+            let g = |acc: &mut Accumulator, tau: f64| {
+                acc.evaluations += 1;
+                1.0 / bound_at(machine, cubics, tau, acc.feed_mm_s).feed_mm_s
+            };
+            let (g0, gh) = (g(self, 0.0), g(self, h));
+            let mut out = (0.0, 0.0);
+            self.piece(machine, cubics, s0_mm, (0.0, g0), (h, gh), 0, &mut out);
+            out
+        };
+        if last {
+            self.sample(machine, s0_mm + h, cubics, h);
         }
-        let inv = 1.0 / bound.feed_mm_s;
-        if let Some((s0, inv0)) = self.prev {
-            self.time_s += 0.5 * (inv0 + inv) * (s_mm - s0);
-        }
-        self.prev = Some((s_mm, inv));
+        self.time_s += time_s;
+        self.time_error_s += time_error_s;
         let rc = axis_ratio[Axis::C.index()];
         if rc < 1.0 - RATIO_TOL {
             match &mut self.open {
                 Some(b) => {
-                    b.last_span = span;
+                    b.last_span = k;
                     b.min_ratio = b.min_ratio.min(rc);
                 }
                 None => {
                     self.open = Some(BelowFeed {
-                        first_span: span,
-                        last_span: span,
+                        first_span: k,
+                        last_span: k,
                         min_ratio: rc,
                     })
                 }
@@ -298,35 +411,74 @@ impl Accumulator {
         } else if let Some(b) = self.open.take() {
             self.below.push(b);
         }
-        if self.keep {
-            self.samples.push(Sample {
-                s_mm,
-                axis_ratio,
-                bound,
-            });
+        SpanFigures {
+            axis_ratio,
+            axis_kind,
+            bound,
+            min_s_mm: s0_mm + min_tau,
+            time_s,
+            time_error_s,
         }
     }
 
-    fn finish(mut self, path: &Path, step_mm: f64) -> (RunAnalysis, Vec<BelowFeed>) {
+    /// The time over the piece `[a, b]` of a span (with `1/ṡ` there), bisected while its
+    /// bracket is wider than [`TIME_REL_TOL`] (module docs); adds (estimate, error bound)
+    /// to `out`.
+    #[allow(clippy::too_many_arguments)]
+    fn piece(
+        &mut self,
+        machine: &Machine,
+        cubics: &[SpanCubic; 5],
+        s0_mm: f64,
+        (a, ga): (f64, f64),
+        (b, gb): (f64, f64),
+        depth: u32,
+        out: &mut (f64, f64),
+    ) {
+        let mut lo = [[0.0; 3]; 5];
+        let mut hi = [[0.0; 3]; 5];
+        for ax in 0..5 {
+            (lo[ax], hi[ax]) = cubics[ax].abs_range(a, b);
+        }
+        // 1/ṡ is increasing in every derivative's size: its values over the piece lie
+        // between these two.
+        let g_lo = 1.0 / feed_bound(machine, &lo, self.feed_mm_s).feed_mm_s;
+        let g_hi = 1.0 / feed_bound(machine, &hi, self.feed_mm_s).feed_mm_s;
+        let w = b - a;
+        if (g_hi - g_lo) * w <= TIME_REL_TOL * g_lo * w || depth >= TIME_MAX_DEPTH {
+            self.sample(machine, s0_mm + a, cubics, a);
+            out.0 += 0.5 * (ga + gb) * w;
+            out.1 += (g_hi - g_lo) * w;
+            return;
+        }
+        let m = 0.5 * (a + b);
+        self.evaluations += 1;
+        let gm = 1.0 / bound_at(machine, cubics, m, self.feed_mm_s).feed_mm_s;
+        self.piece(machine, cubics, s0_mm, (a, ga), (m, gm), depth + 1, out);
+        self.piece(machine, cubics, s0_mm, (m, gm), (b, gb), depth + 1, out);
+    }
+
+    fn finish(mut self, path: &Path) -> (RunAnalysis, Vec<BelowFeed>) {
         if let Some(b) = self.open.take() {
             self.below.push(b);
         }
         let length_mm = path.s_mm[path.s_mm.len() - 1] - path.s_mm[0];
-        let min = self.min.expect("a validated path has at least one sample");
+        let min = self.min.expect("a validated path has at least one span");
         let peak_speed = self.peak_slope.map(|d| d * self.feed_mm_s);
         (
             RunAnalysis {
                 length_mm,
                 feed_mm_min: path.feed_mm_min,
-                step_mm,
                 min,
                 min_s_mm: self.min_s_mm,
                 axis_min: self.axis_min,
                 time_s: self.time_s,
+                time_error_s: self.time_error_s,
                 ideal_time_s: length_mm / self.feed_mm_s,
                 peak_speed,
                 zones: Vec::new(),
                 samples: self.samples,
+                evaluations: self.evaluations,
             },
             self.below,
         )
@@ -414,7 +566,87 @@ mod tests {
         assert!((a.time_s - a.ideal_time_s).abs() < 1e-12, "{a:?}");
         assert!((a.ideal_time_s - 20.0 / 50.0).abs() < 1e-12);
         assert!(a.zones.is_empty());
-        assert_eq!(a.step_mm, 50.0 * m.tcy_s);
+        assert_eq!(a.evaluations, 20, "one evaluation per span at feed");
+        assert_eq!(a.time_error_s, 0.0);
+    }
+
+    /// Issue 19 §4: work is bounded by the blocks, not by run time ÷ Tcy. A program at
+    /// F0.0001 (its run time is 5.5 days for 48 mm) and a single 46 m G1 move are analysed
+    /// with a number of Equation-6 evaluations bounded per span (at F·Tcy sampling they
+    /// took 5·10⁸ and 2.8·10⁶ samples at F1000, 2.8·10¹⁰ at F0.0001 for 46 m).
+    #[test]
+    fn slow_feeds_and_long_moves_take_bounded_work() {
+        let m = machine("mikron-ucp710");
+        let per_span = (1usize << TIME_MAX_DEPTH) + 2;
+        // A near-pole pass at F0.0001: nothing binds but the feed.
+        let mut slow = planted(97, 0.5, 0.5, false, 0.0001);
+        slow.feed_mm_min = 0.0001;
+        let a = analyze_path(&slow, &m, &AnalysisOptions::default()).unwrap();
+        assert!(a.evaluations <= 96 * per_span, "{}", a.evaluations);
+        assert_eq!(a.evaluations, 96, "every span at feed: one evaluation each");
+        assert!((a.time_s - a.ideal_time_s).abs() <= 1e-9 * a.ideal_time_s);
+        // One 46 m move (2 points) with the rotary axes turning along it.
+        for feed in [0.0001, 1000.0, 20000.0] {
+            let long = Path {
+                s_mm: vec![0.0, 46_000.0],
+                axes: vec![
+                    [0.0, 0.0, 0.0, 10.0, 0.0],
+                    [46_000.0, 0.0, 0.0, 30.0, 720.0],
+                ],
+                feed_mm_min: feed,
+            };
+            let a = analyze_path(
+                &long,
+                &m,
+                &AnalysisOptions {
+                    keep_samples: true,
+                    ..AnalysisOptions::default()
+                },
+            )
+            .unwrap();
+            assert!(a.evaluations <= per_span, "F{feed}: {}", a.evaluations);
+            assert!(a.samples.len() <= per_span, "F{feed}: {}", a.samples.len());
+        }
+        // The same at F·Tcy sampling would have been 46 m / (F·Tcy) samples: at F1000,
+        // 2.76 million.
+        assert!(46_000.0 / (1000.0 / 60.0 * m.tcy_s) > 2.7e6);
+    }
+
+    /// The time estimate against an independent fine integration (midpoint rule on 2 000
+    /// points per span of 1/ṡ from Equation 6 at each point), on zones that slow down: the
+    /// estimate is within its stated error bound of it, and that bound is small.
+    #[test]
+    fn time_estimate_is_within_its_stated_error() {
+        let m = machine("mikron-ucp710");
+        for (d, flip) in [(0.5, false), (2.0, true), (0.01, false)] {
+            let path = planted(121, 0.5, d, flip, 2000.0);
+            let a = analyze_path(&path, &m, &AnalysisOptions::default()).unwrap();
+            assert!(a.min.ratio < 0.5, "the planted pass slows down");
+            let splines = axis_splines(&path).unwrap();
+            let f = path.feed_mm_min / 60.0;
+            let mut fine = 0.0;
+            for w in path.s_mm.windows(2) {
+                let h = w[1] - w[0];
+                let cubics: [SpanCubic; 5] = std::array::from_fn(|ax| splines[ax].span(w[0], h));
+                for i in 0..2000 {
+                    let t = h * (i as f64 + 0.5) / 2000.0;
+                    fine += h / 2000.0 / bound_at(&m, &cubics, t, f).feed_mm_s;
+                }
+            }
+            let err = (a.time_s - fine).abs();
+            assert!(
+                err <= a.time_error_s + 1e-6 * fine,
+                "d {d}: {err} > {}",
+                a.time_error_s
+            );
+            assert!(
+                a.time_error_s <= 0.02 * a.time_s,
+                "d {d}: bound {} of {}",
+                a.time_error_s,
+                a.time_s
+            );
+            assert!(err <= 2e-3 * fine, "d {d}: error {err} of {fine}");
+        }
     }
 
     /// Planted constant slowdown: C turning at twice V/F everywhere halves the feed, so the

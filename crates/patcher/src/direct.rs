@@ -44,7 +44,8 @@
 //!
 //! [`deviation_bound`] is the exact minimax of the *exact* deviation for C-only changes at
 //! `first..=last` with the constraints checked on the samples (every `step_mm` on each span
-//! and at every knot), no monotonicity: since the deviation of point i is increasing in
+//! and at every knot, a bounded number per span: [`BOUND_SAMPLES_PER_SPAN`]), no
+//! monotonicity: since the deviation of point i is increasing in
 //! |δ_i| on [0°, 180°], `max_i dev_i ≤ T` ⇔ `|δ_i| ≤ g_i(T) = 2·asin(sin(T/2)/w_i)` (no
 //! bound when `sin(T/2) ≥ w_i`), an LP feasibility problem on the same Hermite rows;
 //! bisection on T.
@@ -67,10 +68,10 @@ pub const DEVIATION_QUAD_WEIGHT: f64 = 1e-4;
 /// Added to `sin² P` in the quadratic term so a point exactly at the pole stays determined.
 pub const PURE_POLE_REGULARISATION: f64 = 1e-6;
 
-/// Sampling step of [`deviation_bound`], mm: finer than F·Tcy at the feeds of interest
-/// (F·Tcy = 0.033 mm at F2000 and Tcy 1 ms); use [`deviation_bound_sampled`] to give the
-/// analysis step.
-pub const BOUND_STEP_MM: f64 = 0.02;
+/// Samples per span of [`deviation_bound`] (both ends included): the bound checks the
+/// limits there only, a relaxation of the exact requirement (every s of the span), so it
+/// stays a lower bound; more samples tighten it. Bounded per span whatever the feed.
+pub const BOUND_SAMPLES_PER_SPAN: usize = 32;
 
 /// Most bisection steps of [`deviation_bound`].
 pub const BOUND_BISECTIONS: usize = 25;
@@ -195,13 +196,13 @@ pub fn deviation_bound(
     last: usize,
     lim: &CLimits,
 ) -> Result<(f64, QpStats), PatchFailure> {
-    deviation_bound_sampled(s_mm, p_deg, c_deg, first, last, lim, BOUND_STEP_MM)
+    deviation_bound_sampled(s_mm, p_deg, c_deg, first, last, lim, BOUND_SAMPLES_PER_SPAN)
 }
 
-/// [`deviation_bound`] with the constraints on the samples every `step_mm` (> 0) of each
-/// span of the constrained range (spans within [`CONSTRAINED_MARGIN_POINTS`] of the range)
-/// and at every knot: pass the analysis step F·Tcy to get the bound for what the
-/// verification checks. Bisection (at most [`BOUND_BISECTIONS`] steps, to
+/// [`deviation_bound`] with the constraints on `samples_per_span + 1` equally spaced
+/// samples of each span of the constrained range (spans within
+/// [`CONSTRAINED_MARGIN_POINTS`] of the range), knots included: a relaxation of what the
+/// verification checks (every s), hence a lower bound. Bisection (at most [`BOUND_BISECTIONS`] steps, to
 /// [`BOUND_REL_TOL`]) on the exact deviation, an LP feasibility problem per step (module
 /// docs); returns the smallest feasible T found.
 pub fn deviation_bound_sampled(
@@ -211,9 +212,9 @@ pub fn deviation_bound_sampled(
     first: usize,
     last: usize,
     lim: &CLimits,
-    step_mm: f64,
+    samples_per_span: usize,
 ) -> Result<(f64, QpStats), PatchFailure> {
-    deviation_bound_in(s_mm, p_deg, c_deg, first, last, None, lim, step_mm)
+    deviation_bound_in(s_mm, p_deg, c_deg, first, last, None, lim, samples_per_span)
 }
 
 /// The bound of one zone, as the patcher is held to it: [`deviation_bound_sampled`] with
@@ -230,12 +231,21 @@ pub fn deviation_bound_zone(
     last: usize,
     zone: (usize, usize),
     lim: &CLimits,
-    step_mm: f64,
+    samples_per_span: usize,
 ) -> Result<(f64, QpStats), PatchFailure> {
     if zone.0 > zone.1 || zone.1 >= s_mm.len() {
         return Err(PatchFailure::TooShort);
     }
-    deviation_bound_in(s_mm, p_deg, c_deg, first, last, Some(zone), lim, step_mm)
+    deviation_bound_in(
+        s_mm,
+        p_deg,
+        c_deg,
+        first,
+        last,
+        Some(zone),
+        lim,
+        samples_per_span,
+    )
 }
 
 /// Relative slack on "not worse than before" outside the zone (round-off only).
@@ -250,11 +260,8 @@ fn deviation_bound_in(
     last: usize,
     zone: Option<(usize, usize)>,
     lim: &CLimits,
-    step_mm: f64,
+    samples_per_span: usize,
 ) -> Result<(f64, QpStats), PatchFailure> {
-    if step_mm.is_nan() || step_mm <= 0.0 {
-        return Err(PatchFailure::TooShort);
-    }
     let hm = Hermite::new(s_mm, c_deg, first, last, WINDOW_POINTS)?;
     let nd = hm.nd;
     let mut base = hm.builder(0);
@@ -274,7 +281,7 @@ fn deviation_bound_in(
     };
     let mut ts = Vec::new();
     for k in spans.clone() {
-        span_offsets(hm.h(k), step_mm, k + 1 == spans.end, &mut ts);
+        span_offsets(hm.h(k), samples_per_span, &mut ts);
         for &tau in &ts {
             let t = s_mm[k] + tau;
             push_abs(&mut base, &hm.d1(k, tau), relaxed(t, 1, lim.v));
@@ -435,15 +442,7 @@ mod tests {
             before: &c,
             after: &c2,
         }];
-        let v = verify_change(
-            &s,
-            &ch,
-            first,
-            last,
-            &m,
-            1000.0 / 60.0,
-            1000.0 / 60.0 * 1e-3,
-        );
+        let v = verify_change(&s, &ch, first, last, &m, 1000.0 / 60.0);
         assert!(
             v.core_min_before < 0.5,
             "planted case must be below feed: {v:?}"
@@ -453,7 +452,8 @@ mod tests {
             .map(|i| orientation_deviation_deg(p[i], c2[i] - c[i]))
             .fold(0.0, f64::max);
         let (bound, _) =
-            deviation_bound_sampled(&s, &p, &c, first, last, &lim0, 1000.0 / 60.0 * 1e-3).unwrap();
+            deviation_bound_sampled(&s, &p, &c, first, last, &lim0, BOUND_SAMPLES_PER_SPAN)
+                .unwrap();
         assert!(bound <= dev + 1e-6, "bound {bound} vs achieved {dev}");
         assert!(
             dev <= 1.25 * bound + 1e-3,

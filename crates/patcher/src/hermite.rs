@@ -61,6 +61,10 @@ pub const JOINT_WINDOW_POINTS: usize = 24;
 /// it has decayed by 0.27⁸ ≈ 3·10⁻⁵.
 pub const EDGE_SPANS: usize = 8;
 
+/// Rows per span (plus the current spline's vertex of q') of the "not worse" velocity rows
+/// on a span that exceeded the velocity limit before (`Hermite::push_limits`).
+pub const NOT_WORSE_SAMPLES_PER_SPAN: usize = 8;
+
 /// Relative slack of a "not worse than before" bound (round-off only).
 pub const NOT_WORSE_SLACK: f64 = 1e-9;
 
@@ -113,6 +117,13 @@ pub(crate) struct Hermite<'a> {
     offset: usize,
     /// Current spline's slope at `lo` / `hi` when that end is inside the path.
     fixed: [Option<f64>; 2],
+    /// In coefficient form ([`Hermite::coefficient_form`]): the window's cubic B-spline
+    /// (clamped knots at every CL point of the window) with the current spline's
+    /// coefficients; the variables are the changes of those coefficients.
+    basis: Option<polepatch_bspline::BSpline>,
+    /// In coefficient form: the value and slope forms at each knot of the window
+    /// (`lo..=hi`), computed once.
+    knot_forms: Vec<[Aff; 2]>,
 }
 
 impl<'a> Hermite<'a> {
@@ -166,7 +177,104 @@ impl<'a> Hermite<'a> {
             nd: last - first + 1,
             offset,
             fixed,
+            basis: None,
+            knot_forms: Vec::new(),
         })
+    }
+
+    /// The same window in **coefficient form**: the variables are the `hi − lo + 3`
+    /// coefficients of the cubic B-spline with a knot at every CL point of the window
+    /// (clamped at its ends), numbered from `offset`. Every value and slope is then a
+    /// combination of three neighbouring coefficients, C² continuity holds by
+    /// construction (no rows for it), and the equalities are the fixed points' values and
+    /// the two end conditions. The forms (`d1`, `d2`, `d3`, `b1`, …) and
+    /// [`Hermite::push_limits`] are the same functions of the values and slopes; the
+    /// changes are [`Hermite::delta`]. About a third of the unknowns of the point form and
+    /// a third of its bandwidth: what the banded interior-point method wants
+    /// ([`crate::ipm`]).
+    pub(crate) fn coefficient_form(mut self) -> Result<Hermite<'a>, PatchFailure> {
+        // The current spline on the window: the clamped interpolant with its own end
+        // slopes (it is C² with these values, so it is that spline exactly); the variables
+        // are changes of its coefficients, so a fixed point's value is exact (its row has
+        // right-hand side 0) whatever the solver's tolerance.
+        let (a, b) = (self.lo, self.hi);
+        let sp = self.widened()?;
+        let cl = polepatch_bspline::interpolate_clamped(
+            &self.s[a..=b],
+            &self.c[a..=b],
+            sp.eval_derivs(self.s[a])[1],
+            sp.eval_derivs(self.s[b])[1],
+        )
+        .map_err(|_| PatchFailure::TooShort)?;
+        self.knot_forms = (self.lo..=self.hi)
+            .map(|k| {
+                [
+                    Self::form_at(&cl, self.s[k], self.offset, 0),
+                    Self::form_at(&cl, self.s[k], self.offset, 1),
+                ]
+            })
+            .collect();
+        self.basis = Some(cl);
+        Ok(self)
+    }
+
+    /// The value (`order` 0) or slope (1) at `t` as an affine form of the changes of the
+    /// coefficients of `b` (numbered from `offset`): the current spline's plus the basis
+    /// row.
+    fn form_at(b: &polepatch_bspline::BSpline, t: f64, offset: usize, order: usize) -> Aff {
+        let r = b.basis_row(t, order);
+        let cur = &b.coeffs()[r.first..];
+        Aff {
+            row: (0..4)
+                .filter(|&j| r.weights[j] != 0.0)
+                .map(|j| (offset + r.first + j, r.weights[j]))
+                .collect(),
+            c: (0..4)
+                .map(|j| r.weights[j] * cur.get(j).copied().unwrap_or(0.0))
+                .sum(),
+        }
+    }
+
+    /// The current spline's coefficients (coefficient form only).
+    pub(crate) fn coefficients(&self) -> Option<&[f64]> {
+        self.basis.as_ref().map(|b| b.coeffs())
+    }
+
+    /// The analysis spline of the current values on the window widened by
+    /// [`WINDOW_POINTS`] or more (where the window's slopes are taken from).
+    fn widened(&self) -> Result<AnalysisSpline, PatchFailure> {
+        let n = self.s.len();
+        let w = (self.hi - self.last)
+            .max(self.first - self.lo)
+            .max(WINDOW_POINTS);
+        let lo2 = self.lo.saturating_sub(w);
+        let hi2 = (self.hi + w).min(n - 1);
+        AnalysisSpline::new(&self.s[lo2..=hi2], &self.c[lo2..=hi2])
+            .map_err(|_| PatchFailure::TooShort)
+    }
+
+    /// The value (`order` 0) or slope (1) at knot `k` of the window, in coefficient form.
+    fn basis_aff(&self, k: usize, order: usize) -> Aff {
+        self.knot_forms[k - self.lo][order].clone()
+    }
+
+    /// The change `δ_i` of the value at point `i` (in `first..=last`): one variable in
+    /// point form, a combination of coefficients minus the current value in coefficient
+    /// form.
+    pub(crate) fn delta(&self, i: usize) -> Aff {
+        match &self.basis {
+            None => Aff::var(self.delta_var(i)),
+            Some(_) => {
+                let mut a = self.basis_aff(i, 0);
+                a.c -= self.c[i];
+                a
+            }
+        }
+    }
+
+    /// Index of this Hermite's first variable.
+    pub(crate) fn offset(&self) -> usize {
+        self.offset
     }
 
     /// Index of the variable `δ_i` (point `i` in `first..=last`).
@@ -174,9 +282,12 @@ impl<'a> Hermite<'a> {
         self.offset + i - self.first
     }
 
-    /// Number of variables (changes, then slopes).
+    /// Number of variables (changes, then slopes; or the coefficients).
     pub(crate) fn vars(&self) -> usize {
-        self.nd + self.hi - self.lo + 1
+        match &self.basis {
+            None => self.nd + self.hi - self.lo + 1,
+            Some(_) => self.hi - self.lo + 3,
+        }
     }
 
     pub(crate) fn h(&self, k: usize) -> f64 {
@@ -185,6 +296,9 @@ impl<'a> Hermite<'a> {
 
     /// Value at path point k.
     fn y(&self, k: usize) -> Aff {
+        if self.basis.is_some() {
+            return self.basis_aff(k, 0);
+        }
         let mut a = Aff::constant(self.c[k]);
         if (self.first..=self.last).contains(&k) {
             a.row.push((self.delta_var(k), 1.0));
@@ -194,7 +308,10 @@ impl<'a> Hermite<'a> {
 
     /// Slope at path knot k (lo ≤ k ≤ hi).
     pub(crate) fn m(&self, k: usize) -> Aff {
-        Aff::var(self.offset + self.nd + k - self.lo)
+        match &self.basis {
+            None => Aff::var(self.offset + self.nd + k - self.lo),
+            Some(_) => self.basis_aff(k, 1),
+        }
     }
 
     fn secant(&self, k: usize) -> Aff {
@@ -253,7 +370,17 @@ impl<'a> Hermite<'a> {
     pub(crate) fn equalities(&self) -> Vec<Aff> {
         let (lo, hi) = (self.lo, self.hi);
         let mut eqs = Vec::with_capacity(hi - lo + 1);
-        for k in lo + 1..hi {
+        if self.basis.is_some() {
+            // Coefficient form: C² holds by construction; the fixed points keep their
+            // values.
+            for k in (lo..=hi).filter(|k| !(self.first..=self.last).contains(k)) {
+                eqs.push(Aff::sum(&[
+                    (1.0, &self.y(k)),
+                    (-self.c[k], &Aff::constant(1.0)),
+                ]));
+            }
+        }
+        for k in (lo + 1..hi).filter(|_| self.basis.is_none()) {
             let (ha, hb) = (self.h(k - 1), self.h(k));
             let w = 1.0 / (ha + hb);
             eqs.push(Aff::sum(&[
@@ -312,6 +439,13 @@ impl<'a> Hermite<'a> {
             .max(WINDOW_POINTS);
         let lo2 = self.lo.saturating_sub(w);
         let hi2 = (self.hi + w).min(n - 1);
+        if self.basis.is_some() {
+            // The current spline: no change of its coefficients.
+            for j in 0..self.vars() {
+                x[self.offset + j] = 0.0;
+            }
+            return Ok(());
+        }
         let sp = AnalysisSpline::new(&self.s[lo2..=hi2], &self.c[lo2..=hi2])
             .map_err(|_| PatchFailure::TooShort)?;
         for i in self.first..=self.last {
@@ -358,8 +492,9 @@ impl<'a> Hermite<'a> {
     /// movable, or in `core` (the spans that must reach feed), gets `limit − room`; any
     /// other span that touches a fixed point gets
     /// `max(limit, |current value|·(1 + NOT_WORSE_SLACK)) − room` — for q', where the span
-    /// exceeded the velocity limit before, at the analysis samples (step `step_mm`) against
-    /// the span's sampled peak instead of the hull: it may not get worse, and need not reach
+    /// exceeded the velocity limit before, at [`NOT_WORSE_SAMPLES_PER_SPAN`] samples and the
+    /// current spline's vertex of q' (where its exact peak is) against that exact peak
+    /// instead of the hull: it may not get worse, and need not reach
     /// feed (a fixed neighbour may already exceed the limits, e.g. through the file's own
     /// rounding). `room[k − lo][r]` ([`Hermite::rounding_room`]) is
     /// what rounding the written values can add to the (r+1)-th derivative on span k, so
@@ -374,7 +509,6 @@ impl<'a> Hermite<'a> {
         lim: &crate::limits::GeomLimits,
         current: &[f64],
         room: &[[f64; 3]],
-        step_mm: f64,
         core: std::ops::Range<usize>,
     ) {
         // Spans next to a window end inside the path are left out: there the fixed end
@@ -419,15 +553,26 @@ impl<'a> Hermite<'a> {
                 let b = (lim.v - room[0]).max(1e-3 * lim.v);
                 push_abs(qp, &self.b1(k), b);
             } else {
-                // Beyond the limit before: "not worse" on q' where it is measured, at the
-                // analysis samples, against the span's sampled peak (the hull overstates
-                // the peak, so it cannot stand for it).
-                crate::spline::span_offsets(self.h(k), step_mm, true, &mut taus);
-                let peak = taus
-                    .iter()
-                    .fold(0.0f64, |m, &t| m.max(self.d1(k, t).at(current).abs()));
+                // Beyond the limit before: "not worse" on q' against the span's exact peak
+                // before (the hull overstates the peak, so it cannot stand for it).
+                crate::spline::span_offsets(self.h(k), NOT_WORSE_SAMPLES_PER_SPAN, &mut taus);
+                // Rows at the samples and at the current spline's vertex of q' (its peak
+                // on the span, when inside), against that peak.
+                let d1 = |t: f64| self.d1(k, t).at(current);
+                let (qa, qm, qb) = (d1(0.0), d1(0.5 * self.h(k)), d1(self.h(k)));
+                // q'(τ) = qa + c1·τ + c2·τ² through the three values.
+                let h = self.h(k);
+                let c2 = 2.0 * (qa - 2.0 * qm + qb) / (h * h);
+                let c1 = (qb - qa) / h - c2 * h;
+                if c2 != 0.0 {
+                    let v = -c1 / (2.0 * c2);
+                    if v > 0.0 && v < h {
+                        taus.push(v);
+                    }
+                }
+                let peak = taus.iter().fold(0.0f64, |m, &t| m.max(d1(t).abs()));
                 let b = (lim.v.max(peak * (1.0 + NOT_WORSE_SLACK)) - room[0]).max(1e-3 * lim.v);
-                for &tau in taus.iter().skip(1).take(taus.len().saturating_sub(2)) {
+                for &tau in taus.iter().filter(|&&t| t > 0.0 && t < h) {
                     push_abs(qp, &self.d1(k, tau), b);
                 }
             }
@@ -442,6 +587,21 @@ impl<'a> Hermite<'a> {
                 }
             }
         }
+    }
+
+    /// The position along the path (the knot index) of each of this Hermite's variables,
+    /// in variable order: the changes `δ_i` at `i`, the slopes `m_k` at `k`.
+    pub(crate) fn positions(&self) -> Vec<f64> {
+        if self.basis.is_some() {
+            // Coefficient j of a clamped cubic lives around knot j − 1 of the window.
+            return (0..self.vars())
+                .map(|j| (self.lo + j).saturating_sub(1).clamp(self.lo, self.hi) as f64)
+                .collect();
+        }
+        (self.first..=self.last)
+            .chain(self.lo..=self.hi)
+            .map(|k| k as f64)
+            .collect()
     }
 
     /// Add this Hermite's equalities to `qp`.
@@ -555,6 +715,101 @@ mod tests {
         for k in hm.lo..=hm.hi {
             let m = sp.eval_derivs(s[k])[1];
             assert!((x[hm.nd + k - hm.lo] - m).abs() < 1e-5, "knot {k}");
+        }
+    }
+
+    /// Coefficient form, the planted response: with the changes of points `first..=last`
+    /// fixed, the coefficients the equalities determine give the analysis spline of the
+    /// changed data — its value, first, second and third derivatives at points of every
+    /// span of the window, through the same forms (`d1`, `d2`, `d3`, `b1`) the limits use
+    /// — on a window inside the path (fixed end slopes) and on the whole path (not-a-knot).
+    #[test]
+    fn coefficient_form_is_the_spline_of_the_changed_data() {
+        let (s, y) = data(60);
+        for (first, last, window) in [(28, 32, WINDOW_POINTS), (1, 58, 60)] {
+            let hm = Hermite::new(&s, &y, first, last, window)
+                .unwrap()
+                .coefficient_form()
+                .unwrap();
+            let delta: Vec<f64> = (first..=last)
+                .map(|i| (i as f64 * 0.9).sin() * 4.0)
+                .collect();
+            // The equalities and the changes make a square system in the coefficients:
+            // solve it exactly (Gaussian elimination with partial pivoting).
+            let nv = hm.vars();
+            let mut rows: Vec<(Vec<f64>, f64)> = Vec::new();
+            let dense = |f: &Aff| {
+                let mut r = vec![0.0; nv];
+                for &(j, v) in &f.row {
+                    r[j] += v;
+                }
+                r
+            };
+            for e in hm.equalities() {
+                rows.push((dense(&e), -e.c));
+            }
+            for (i, d) in (first..=last).zip(&delta) {
+                let f = hm.delta(i);
+                rows.push((dense(&f), d - f.c));
+            }
+            assert_eq!(rows.len(), nv, "one row per coefficient");
+            for col in 0..nv {
+                let piv = (col..nv)
+                    .max_by(|&a, &b| rows[a].0[col].abs().total_cmp(&rows[b].0[col].abs()))
+                    .unwrap();
+                rows.swap(col, piv);
+                let (head, tail) = rows.split_at_mut(col + 1);
+                let p = &head[col];
+                for r in tail.iter_mut() {
+                    let f = r.0[col] / p.0[col];
+                    for j in col..nv {
+                        r.0[j] -= f * p.0[j];
+                    }
+                    r.1 -= f * p.1;
+                }
+            }
+            let mut x = vec![0.0; nv];
+            for col in (0..nv).rev() {
+                let acc: f64 = (col + 1..nv).map(|j| rows[col].0[j] * x[j]).sum();
+                x[col] = (rows[col].1 - acc) / rows[col].0[col];
+            }
+            let mut y2 = y.clone();
+            for (i, d) in (first..=last).zip(&delta) {
+                y2[i] += d;
+            }
+            let sp = interpolate_not_a_knot(&s, &y2).unwrap();
+            // Inside a window cut from the path the end slopes are fixed: the spline there
+            // differs from the whole path's by what a change propagates (≈ 0.27^16).
+            for k in hm.lo..hm.hi {
+                let h = hm.h(k);
+                for tau in [0.0, 0.37 * h, h] {
+                    // q' and q'' are continuous: at τ = h either span's piece will do.
+                    let d = sp.eval_derivs(s[k] + tau);
+                    assert!((hm.d1(k, tau).at(&x) - d[1]).abs() < 1e-7, "{k}: q'");
+                    assert!((hm.d2(k, tau).at(&x) - d[2]).abs() < 1e-6, "{k}: q''");
+                }
+                assert!((hm.d3(k).at(&x) - sp.eval_derivs(s[k] + 0.5 * h)[3]).abs() < 1e-5);
+                // b1 is the middle Bernstein coefficient of q': its average is the secant.
+                let b1 = hm.b1(k).at(&x);
+                let secant = (y2[k + 1] - y2[k]) / h;
+                let avg = (hm.m(k).at(&x) + b1 + hm.m(k + 1).at(&x)) / 3.0;
+                assert!((avg - secant).abs() < 1e-6, "{k}");
+            }
+            for i in first..=last {
+                assert!((hm.delta(i).at(&x) - delta[i - first]).abs() < 1e-9);
+            }
+            // With no change at all the variables are zero: the current spline.
+            let mut cur = vec![0.0; hm.vars()];
+            hm.write_current(&mut cur).unwrap();
+            assert!(cur.iter().all(|&v| v == 0.0));
+            assert!(
+                (hm.m(first).at(&cur)
+                    - interpolate_not_a_knot(&s, &y)
+                        .unwrap()
+                        .eval_derivs(s[first])[1])
+                    .abs()
+                    < 1e-6
+            );
         }
     }
 

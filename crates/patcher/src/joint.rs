@@ -23,7 +23,8 @@
 //! δP_i, δC_i        i ∈ first..=last        change from the base, degrees
 //! m^P_k, m^C_k      k ∈ window               knot slopes of the analysis splines of P and C
 //!                                            (crate::hermite, one Hermite per axis)
-//! t                                          chord bound (dimensionless)
+//! t                                          largest orientation change (chord, linearised)
+//! e ≥ 0                                      largest relative excess over a limit row
 //! ```
 //!
 //! The exact problem is
@@ -40,80 +41,57 @@
 //!           p_min ≤ P̂_i + δP_i ≤ p_max      (the machine's primary range; C's when finite)
 //! ```
 //!
-//! with `(v, a, j) = (1 − margin)·(V/F, A/F², J/F³)` per axis ([`GeomLimits`]). The
-//! constraints are linear in the values (hence in δ), exactly as in the C-only direct QP;
-//! the objective is not convex. It is solved by sequential convex programming: at the
-//! iterate `(P̄, C̄) = base + δ̄` the tool axis is linearised,
+//! with `(v, a, j) = (1 − margin)·(V/F, A/F², J/F³)` per axis ([`GeomLimits`]), less what
+//! rounding the written values can add (`Hermite::rounding_room`). The constraints are
+//! linear in the values (hence in δ); the objective is not convex. It is solved by
+//! sequential convex programming: at the iterate `(P̄, C̄) = base + δ̄` the tool axis is
+//! linearised, `fk(P̂ + δP, Ĉ + δC) ≈ ō + a·(δP − δ̄P) + b·(δC − δ̄C)` with `ō = fk(P̄, C̄)`,
+//! `a = ∂fk/∂P`, `b = ∂fk/∂C` (per degree, `forward_jacobian`), the change
+//! `r_i = ō_i − o_i + a_i·(δP_i − δ̄P_i) + b_i·(δC_i − δ̄C_i)` is taken in the tangent plane
+//! of `o_i` (basis `E_i`, 2 × 3), and the QP
 //!
 //! ```text
-//! fk(P̂_i + δP_i, Ĉ_i + δC_i) ≈ ō_i + a_i·(δP_i − δ̄P_i) + b_i·(δC_i − δ̄C_i)
-//! ō_i = fk(P̄_i, C̄_i),  a_i = ∂fk/∂P,  b_i = ∂fk/∂C  (per degree, forward_jacobian)
-//! ```
-//!
-//! and the second-order-cone program
-//!
-//! ```text
-//! minimise  t + μ·Σ_i ‖r_i‖² + ε·Σ_i ((δP_i − δ̄P_i)² + (δC_i − δ̄C_i)²)
-//! s.t.      ‖r_i‖₂ ≤ t,   r_i = ō_i − o_i + a_i·(δP_i − δ̄P_i) + b_i·(δC_i − δ̄C_i)
-//!           the Hermite, limit and range rows above
+//! minimise  t + M·e + μ·Σ_i ‖E_i·r_i‖² + ε·Σ_i ((δP_i − δ̄P_i)² + (δC_i − δ̄C_i)²)
+//! s.t.      u_k·E_i·r_i ≤ t     k = 0 … K−1, u_k = (cos 2πk/K, sin 2πk/K)   (a K-gon ⊇ the
+//!                                                                     circle ‖E_i·r_i‖ ≤ t)
+//!           each limit row relaxed by e:  row/bound ≤ 1 + e,   e ≥ 0
+//!           the Hermite and range rows above, exactly
 //!           |δP_i − δ̄P_i| ≤ ρ_P,  |δC_i − δ̄C_i| ≤ ρ_C                   (trust region)
-//!           t ≤ 2·sin(d_max/2)                                          (with max_deviation)
+//!           t ≤ 2·sin(d/2)                                  (only for a capped solve, d)
 //! ```
 //!
-//! is solved with clarabel. `‖o' − o‖ = 2·sin(∠/2)` (the chord) is increasing in the angle,
-//! so the largest chord bounds the largest angle. μ ([`JOINT_QUAD_WEIGHT`]) pulls the points
-//! that do not bind the maximum towards their targets; ε ([`PROXIMAL_WEIGHT`]) keeps a
-//! point exactly on the pole (where C does not move the tool) determined.
+//! is solved by the banded interior-point method of [`crate::ipm`] (all rows touch two or
+//! three neighbouring points; `t` and `e` are its border). The elastic `e` makes every
+//! QP feasible whatever the start (the values may start far outside the limits: that is
+//! the zone), and its weight M ([`SolverSettings::elastic_weight`]) puts reaching feed
+//! first; the limit rows are linear, so the excess of a point is exact, not a model. The
+//! exact angle is what is accepted and reported.
 //!
-//! The iteration: the first solve starts from the base (which violates the limits — that
-//! is the zone) with a wide trust region ([`FIRST_TRUST_P_DEG`], [`FIRST_TRUST_C_DEG`],
-//! doubled while the solve is infeasible, up to the primary axis' whole range);
-//! its solution satisfies every limit row, and every later iterate does too (the rows are
-//! exact). A solution becomes the iterate when its **exact** largest angle is lower than the
-//! iterate's; otherwise the trust region halves. It stops when an accepted step improves the
-//! largest angle by less than [`SCP_REL_TOL`], after [`SCP_MAX_SOLVES`] solves, or when the
-//! trust region falls below [`SCP_MIN_TRUST_DEG`]. The caller rounds the result as it will be
-//! written and verifies Equation 6 on it (`crate::verify`).
+//! **Iteration.** The merit of values is `chord(exact largest angle) + M·(exact excess)`.
+//! A QP's solution becomes the iterate when its merit is lower; otherwise the trust
+//! region halves. The first solve uses a wide trust region
+//! ([`SolverSettings::first_trust_p_deg`], [`SolverSettings::first_trust_c_deg`]) unless the
+//! start already meets the limits ([`JointProblem::warm`]). It stops when an accepted step
+//! improves the merit by less than [`SolverSettings::scp_rel_tol`], after
+//! [`JointProblem::max_solves`] solves, or when the trust region falls below
+//! [`SolverSettings::min_trust_deg`]. The caller rounds the result as it will be written and
+//! verifies Equation 6 on it (`crate::verify`).
+//!
+//! **Capped.** With [`JointProblem::cap_deg`] the QP keeps `t ≤ 2·sin(d/2)` and the
+//! iteration lowers the excess e instead: the least excess over the limits with no point's
+//! orientation changed by more than d (from a start within the cap: the base has 0).
 
 use crate::{
     candidate::PatchFailure,
-    hermite::{Hermite, JOINT_WINDOW_POINTS},
+    hermite::{Aff, Hermite, JOINT_WINDOW_POINTS},
+    ipm::IpmStatus,
     limits::GeomLimits,
-    qp::QpBuilder,
-    report::QpStats,
+    qp::{QpBuilder, Row},
+    report::{QpStats, QpStatus},
+    settings::SolverSettings,
 };
 use polepatch_kinematics::{Machine, angle_between_deg, forward, forward_jacobian};
-
-/// μ: weight of the sum of squared (linearised) chords against the largest chord `t`
-/// (dimensionless): small, it only chooses among the minimax solutions.
-pub const JOINT_QUAD_WEIGHT: f64 = 1e-2;
-
-/// ε: weight of the proximal term on each step, per degree².
-pub const PROXIMAL_WEIGHT: f64 = 1e-8;
-
-/// Trust region of the first solve (from the base, which violates the limits), degrees:
-/// the primary axis may move by this much.
-pub const FIRST_TRUST_P_DEG: f64 = 15.0;
-
-/// Trust region of the first solve for C, degrees (a half turn: near the pole C may have to
-/// move that far).
-pub const FIRST_TRUST_C_DEG: f64 = 180.0;
-
-/// Trust region of the later solves (around a feasible iterate), primary axis, degrees.
-pub const TRUST_P_DEG: f64 = 2.0;
-
-/// Trust region of the later solves, C, degrees.
-pub const TRUST_C_DEG: f64 = 30.0;
-
-/// An accepted step that lowers the exact largest angle by less than this fraction ends
-/// the iteration.
-pub const SCP_REL_TOL: f64 = 0.01;
-
-/// Most solves of one [`solve_joint`].
-pub const SCP_MAX_SOLVES: usize = 8;
-
-/// The iteration ends when the primary trust region falls below this, degrees.
-pub const SCP_MIN_TRUST_DEG: f64 = 1e-3;
+use std::time::Instant;
 
 /// One joint solve's inputs. Every slice is per point of the whole path.
 #[derive(Debug, Clone)]
@@ -136,15 +114,6 @@ pub struct JointProblem<'a> {
     pub lim_c: GeomLimits,
     /// The machine (kinematics and axis ranges).
     pub machine: &'a Machine,
-    /// Largest orientation change allowed, degrees (`None`: no limit).
-    pub max_deviation_deg: Option<f64>,
-    /// Most solves ([`SCP_MAX_SOLVES`] by default).
-    pub max_solves: usize,
-    /// Relative improvement below which an accepted step ends the iteration
-    /// ([`SCP_REL_TOL`] by default).
-    pub rel_tol: f64,
-    /// The analysis step F·Tcy, mm ("not worse" is bounded at these samples).
-    pub step_mm: f64,
     /// The spans that must reach feed (the zone's), `k` for `[s_k, s_{k+1}]`: they get the
     /// limits even where they touch a fixed point.
     pub core: std::ops::Range<usize>,
@@ -153,9 +122,21 @@ pub struct JointProblem<'a> {
     pub round_p_deg: f64,
     /// The same for C.
     pub round_c_deg: f64,
-    /// The base already satisfies every row (a previous solution): iterate from it with
-    /// the narrow trust region, accepting only steps that lower its largest deviation.
+    /// The values "not worse" compares against, when not the base's (a start that
+    /// rewrote points of the range by a rule, FREEZE say, is not what the verification
+    /// compares with: the values before it are). Per point of the whole path.
+    pub reference: Option<(&'a [f64], &'a [f64])>,
+    /// `None`: minimise the largest orientation change. `Some(d)`: the least excess over
+    /// the limits with no point's orientation changed by more than `d` degrees (module
+    /// docs: capped).
+    pub cap_deg: Option<f64>,
+    /// The base already meets the limits (a previous solution): iterate from it with the
+    /// narrow trust region.
     pub warm: bool,
+    /// Most QP solves.
+    pub max_solves: u32,
+    /// The numerical settings.
+    pub settings: &'a SolverSettings,
 }
 
 /// The result of [`solve_joint`]: new values for `first..=last` (unrounded).
@@ -167,182 +148,552 @@ pub struct JointSolution {
     pub c_deg: Vec<f64>,
     /// Exact largest orientation change against `target` over `first..=last`, degrees.
     pub max_deviation_deg: f64,
+    /// Largest relative excess over a limit row (0: every row within its bound).
+    pub excess: f64,
     /// Solver statistics of every solve made.
     pub qp: QpStats,
 }
 
-/// Largest exact angle between `target` and the tool axes of the values `base + δ` over
-/// `first..=last`, degrees.
-fn exact_max_deviation(pr: &JointProblem, dp: &[f64], dc: &[f64]) -> f64 {
-    (pr.first..=pr.last)
-        .map(|i| {
-            let k = i - pr.first;
-            let o = forward(pr.machine, pr.p_deg[i] + dp[k], pr.c_deg[i] + dc[k]);
-            angle_between_deg(o, pr.target[i])
+/// The chord of an angle in degrees, `2·sin(d/2)`.
+fn chord(deg: f64) -> f64 {
+    2.0 * (deg.to_radians() / 2.0).sin()
+}
+
+/// An orthonormal basis of the plane orthogonal to the unit vector `o`.
+fn tangent_basis(o: [f64; 3]) -> [[f64; 3]; 2] {
+    let a = if o[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let d = a[0] * o[0] + a[1] * o[1] + a[2] * o[2];
+    let mut e1 = [a[0] - d * o[0], a[1] - d * o[1], a[2] - d * o[2]];
+    let n1 = (e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]).sqrt();
+    e1.iter_mut().for_each(|v| *v /= n1);
+    let e2 = [
+        o[1] * e1[2] - o[2] * e1[1],
+        o[2] * e1[0] - o[0] * e1[2],
+        o[0] * e1[1] - o[1] * e1[0],
+    ];
+    [e1, e2]
+}
+
+/// Push `lo ≤ f ≤ hi` for an affine form `f`.
+fn push_between(qp: &mut QpBuilder, f: &Aff, lo: f64, hi: f64) {
+    qp.add_le(&f.row, hi - f.c);
+    let neg: Vec<(usize, f64)> = f.row.iter().map(|&(j, c)| (j, -c)).collect();
+    qp.add_le(&neg, f.c - lo);
+}
+
+fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// The problem's fixed part: variables, equalities, limit and range rows.
+struct Model<'a> {
+    pr: &'a JointProblem<'a>,
+    hp: Hermite<'a>,
+    hc: Hermite<'a>,
+    /// Index of t and e.
+    t: usize,
+    e: usize,
+    /// Equalities, objective's linear part, `e ≥ 0`, the cap.
+    base: QpBuilder,
+    /// The limit rows, relaxed by e (`row·x − e ≤ rhs`), and the range rows (hard).
+    limits: Vec<(Row, f64)>,
+    ranges: Vec<(Row, f64)>,
+    position: Vec<Option<f64>>,
+}
+
+impl<'a> Model<'a> {
+    fn new(pr: &'a JointProblem<'a>) -> Result<Model<'a>, PatchFailure> {
+        let (first, last) = (pr.first, pr.last);
+        let cf = |h: Hermite<'a>| h.coefficient_form();
+        let hp = cf(Hermite::with_offset(
+            pr.s_mm,
+            pr.p_deg,
+            first,
+            last,
+            JOINT_WINDOW_POINTS,
+            0,
+        )?)?;
+        let hc = cf(Hermite::with_offset(
+            pr.s_mm,
+            pr.c_deg,
+            first,
+            last,
+            JOINT_WINDOW_POINTS,
+            hp.vars(),
+        )?)?;
+        let t = hp.vars() + hc.vars();
+        let e = t + 1;
+        let mut base = QpBuilder::new(t + 2);
+        hp.add_equalities(&mut base);
+        hc.add_equalities(&mut base);
+        let mut current = vec![0.0; t + 2];
+        match pr.reference {
+            None => {
+                hp.write_current(&mut current)?;
+                hc.write_current(&mut current)?;
+            }
+            Some((rp, rc)) => {
+                // The reference's spline in the same variables: in point form its own
+                // changes and slopes; in coefficient form its coefficients less the base's.
+                for (h, y) in [(&hp, rp), (&hc, rc)] {
+                    let r = cf(Hermite::with_offset(
+                        pr.s_mm,
+                        y,
+                        first,
+                        last,
+                        JOINT_WINDOW_POINTS,
+                        h.offset(),
+                    )?)?;
+                    r.write_current(&mut current)?;
+                    if let (Some(cr), Some(cb)) = (r.coefficients(), h.coefficients()) {
+                        for (j, (a, b)) in cr.iter().zip(cb).enumerate() {
+                            current[h.offset() + j] = a - b;
+                        }
+                    }
+                }
+            }
+        }
+        let (rp, rc) = (
+            hp.rounding_room(pr.round_p_deg)?,
+            hc.rounding_room(pr.round_c_deg)?,
+        );
+        let mut lim = QpBuilder::new(t + 2);
+        hp.push_limits(&mut lim, &pr.lim_p, &current, &rp, pr.core.clone());
+        hc.push_limits(&mut lim, &pr.lim_c, &current, &rc, pr.core.clone());
+        lim.extend_le(0..lim.le_len(), e, -1.0);
+        let limits = lim.le_rows(0..lim.le_len()).to_vec();
+        base.add_le(&[(e, -1.0)], 0.0);
+        let mut rng = QpBuilder::new(t + 2);
+        let (p_lo, p_hi) = pr.machine.primary_range_deg;
+        for i in first..=last {
+            push_between(
+                &mut rng,
+                &hp.delta(i),
+                p_lo - pr.p_deg[i],
+                p_hi - pr.p_deg[i],
+            );
+            if let Some((c_lo, c_hi)) = pr.machine.c_range_deg {
+                push_between(
+                    &mut rng,
+                    &hc.delta(i),
+                    c_lo - pr.c_deg[i],
+                    c_hi - pr.c_deg[i],
+                );
+            }
+        }
+        let ranges = rng.le_rows(0..rng.le_len()).to_vec();
+        if let Some(d) = pr.cap_deg {
+            base.add_le(&[(t, 1.0)], chord(d));
+        }
+        base.add_linear(t, 1.0);
+        base.add_linear(e, pr.settings.elastic_weight);
+        let position: Vec<Option<f64>> = hp
+            .positions()
+            .into_iter()
+            .chain(hc.positions())
+            .map(Some)
+            .chain([None, None])
+            .collect();
+        Ok(Model {
+            pr,
+            hp,
+            hc,
+            t,
+            e,
+            base,
+            limits,
+            ranges,
+            position,
         })
-        .fold(0.0, f64::max)
+    }
+
+    /// The changes of point i, primary and C, at `x`.
+    fn deltas(&self, i: usize, x: &[f64]) -> (f64, f64) {
+        (self.hp.delta(i).at(x), self.hc.delta(i).at(x))
+    }
+
+    /// The current spline's variables (changes 0), t and e of it.
+    fn start(&self) -> Result<Vec<f64>, PatchFailure> {
+        let mut x = vec![0.0; self.t + 2];
+        self.hp.write_current(&mut x)?;
+        self.hc.write_current(&mut x)?;
+        x[self.e] = self.excess(&x);
+        Ok(x)
+    }
+
+    /// `row·x − rhs` of a limit row without its `−e`: the relative excess over its bound.
+    fn limit_excess(&self, (row, rhs): &(Row, f64), x: &[f64]) -> f64 {
+        row.iter()
+            .filter(|&&(j, _)| j != self.e)
+            .map(|&(j, v)| v * x[j])
+            .sum::<f64>()
+            - rhs
+    }
+
+    /// The exact largest relative excess of `x` over the limit rows (linear: exact).
+    fn excess(&self, x: &[f64]) -> f64 {
+        self.limits
+            .iter()
+            .map(|r| self.limit_excess(r, x))
+            .fold(0.0f64, f64::max)
+    }
+
+    /// Exact largest angle of `x`'s values against the targets, degrees.
+    fn deviation(&self, x: &[f64]) -> f64 {
+        let pr = self.pr;
+        (pr.first..=pr.last)
+            .map(|i| {
+                let (dp, dc) = self.deltas(i, x);
+                let o = forward(pr.machine, pr.p_deg[i] + dp, pr.c_deg[i] + dc);
+                angle_between_deg(o, pr.target[i])
+            })
+            .fold(0.0, f64::max)
+    }
+
+    fn merit(&self, dev_deg: f64, excess: f64) -> f64 {
+        match self.pr.cap_deg {
+            None => chord(dev_deg) + self.pr.settings.elastic_weight * excess,
+            // Capped: the excess first, the angle only to break ties.
+            Some(_) => self.pr.settings.elastic_weight * excess + 1e-6 * chord(dev_deg),
+        }
+    }
+
+    /// The QP linearised at `x̄` with trust regions `(ρ_P, ρ_C)` (module docs).
+    fn linearised(&self, xbar: &[f64], rho: (f64, f64)) -> QpBuilder {
+        let pr = self.pr;
+        let st = pr.settings;
+        let mut qp = self.base.clone();
+        for (row, rhs) in self.limits.iter().chain(&self.ranges) {
+            qp.add_le(row, *rhs);
+        }
+        for i in pr.first..=pr.last {
+            let (fp, fc) = (self.hp.delta(i), self.hc.delta(i));
+            let (dp, dc) = (fp.at(xbar), fc.at(xbar));
+            let [o, a, b] = forward_jacobian(pr.machine, pr.p_deg[i] + dp, pr.c_deg[i] + dc);
+            // r = r0 + a·δP + b·δC with r0 = ō − o_target − a·δ̄P − b·δ̄C.
+            let r0: [f64; 3] =
+                std::array::from_fn(|m| o[m] - pr.target[i][m] - a[m] * dp - b[m] * dc);
+            let [e1, e2] = tangent_basis(pr.target[i]);
+            let (u0, ua, ub) = (dot3(e1, r0), dot3(e1, a), dot3(e1, b));
+            let (v0, va, vb) = (dot3(e2, r0), dot3(e2, a), dot3(e2, b));
+            // u = u0 + ua·δP + ub·δC (an affine form of the variables), v likewise.
+            let u = Aff::sum(&[(ua, &fp), (ub, &fc), (u0, &Aff::constant(1.0))]);
+            let v = Aff::sum(&[(va, &fp), (vb, &fc), (v0, &Aff::constant(1.0))]);
+            // ‖(u, v)‖ ≤ t: slacks s_k = rhs_k − row_k·x are (t, u, v).
+            let neg = |f: &Aff| f.row.iter().map(|&(j, c)| (j, -c)).collect::<Vec<_>>();
+            qp.add_soc(&[(vec![(self.t, -1.0)], 0.0), (neg(&u), u.c), (neg(&v), v.c)]);
+            qp.add_square(&u.row, st.joint_quad_weight, -u.c);
+            qp.add_square(&v.row, st.joint_quad_weight, -v.c);
+            qp.add_square(&fp.row, st.proximal_weight, dp - fp.c);
+            qp.add_square(&fc.row, st.proximal_weight, dc - fc.c);
+            push_between(&mut qp, &fp, dp - rho.0, dp + rho.0);
+            push_between(&mut qp, &fc, dc - rho.1, dc + rho.1);
+        }
+        qp
+    }
 }
 
 /// Solve the joint problem (module docs) by sequential convex programming.
 ///
-/// `Err(PatchFailure::Solver)` when the first solve finds no solution (infeasible within
-/// the first trust region, or a solver failure); `Err(PatchFailure::TooShort)` for a range
-/// outside the path.
+/// `Err(PatchFailure::Solver)` when no QP could be solved; `Err(PatchFailure::TooShort)`
+/// for a range outside the path.
 pub fn solve_joint(pr: &JointProblem) -> Result<JointSolution, PatchFailure> {
     let (first, last) = (pr.first, pr.last);
     let n = pr.s_mm.len();
     if first > last || last >= n || pr.target.len() != n {
         return Err(PatchFailure::TooShort);
     }
-    let hp = Hermite::with_offset(pr.s_mm, pr.p_deg, first, last, JOINT_WINDOW_POINTS, 0)?;
-    let hc = Hermite::with_offset(
-        pr.s_mm,
-        pr.c_deg,
-        first,
-        last,
-        JOINT_WINDOW_POINTS,
-        hp.vars(),
-    )?;
-    let t = hp.vars() + hc.vars();
-    let nd = last - first + 1;
-    let mut base = QpBuilder::new(t + 1);
-    hp.add_equalities(&mut base);
-    hc.add_equalities(&mut base);
-    let mut current = vec![0.0; t + 1];
-    hp.write_current(&mut current)?;
-    hc.write_current(&mut current)?;
-    let (rp, rc) = (
-        hp.rounding_room(pr.round_p_deg)?,
-        hc.rounding_room(pr.round_c_deg)?,
-    );
-    hp.push_limits(
-        &mut base,
-        &pr.lim_p,
-        &current,
-        &rp,
-        pr.step_mm,
-        pr.core.clone(),
-    );
-    hc.push_limits(
-        &mut base,
-        &pr.lim_c,
-        &current,
-        &rc,
-        pr.step_mm,
-        pr.core.clone(),
-    );
-    let (p_lo, p_hi) = pr.machine.primary_range_deg;
-    for i in first..=last {
-        let v = hp.delta_var(i);
-        base.add_le(&[(v, 1.0)], p_hi - pr.p_deg[i]);
-        base.add_le(&[(v, -1.0)], pr.p_deg[i] - p_lo);
-        if let Some((c_lo, c_hi)) = pr.machine.c_range_deg {
-            let v = hc.delta_var(i);
-            base.add_le(&[(v, 1.0)], c_hi - pr.c_deg[i]);
-            base.add_le(&[(v, -1.0)], pr.c_deg[i] - c_lo);
-        }
-    }
-    if let Some(d) = pr.max_deviation_deg {
-        base.add_le(&[(t, 1.0)], 2.0 * (d.to_radians() / 2.0).sin());
-    }
-    base.add_linear(t, 1.0);
-
+    let st = pr.settings;
+    let model = Model::new(pr)?;
     let mut stats = QpStats::default();
-    // The iterate: δ̄ (zero = the base) and its exact largest angle (None: not yet feasible).
-    let mut dbar_p = vec![0.0; nd];
-    let mut dbar_c = vec![0.0; nd];
-    let mut dev: Option<f64> = None;
-    let (mut rho_p, mut rho_c) = (FIRST_TRUST_P_DEG, FIRST_TRUST_C_DEG);
-    if pr.warm {
-        dev = Some(exact_max_deviation(pr, &dbar_p, &dbar_c));
-        (rho_p, rho_c) = (TRUST_P_DEG, TRUST_C_DEG);
-    }
-    for _ in 0..pr.max_solves {
-        let mut qp = base.clone();
-        for i in first..=last {
-            let k = i - first;
-            let (ip, ic) = (hp.delta_var(i), hc.delta_var(i));
-            let (pb, cb) = (pr.p_deg[i] + dbar_p[k], pr.c_deg[i] + dbar_c[k]);
-            let [o, a, b] = forward_jacobian(pr.machine, pb, cb);
-            // r = r0 + a·δP + b·δC with r0 = ō − o_target − a·δ̄P − b·δ̄C.
-            let r0: [f64; 3] = std::array::from_fn(|m| {
-                o[m] - pr.target[i][m] - a[m] * dbar_p[k] - b[m] * dbar_c[k]
-            });
-            let mut block = vec![(vec![(t, -1.0)], 0.0)];
-            for m in 0..3 {
-                block.push((vec![(ip, -a[m]), (ic, -b[m])], r0[m]));
-                qp.add_square(&[(ip, a[m]), (ic, b[m])], JOINT_QUAD_WEIGHT, -r0[m]);
-            }
-            qp.add_soc(&block);
-            qp.add_square(&[(ip, 1.0)], PROXIMAL_WEIGHT, dbar_p[k]);
-            qp.add_square(&[(ic, 1.0)], PROXIMAL_WEIGHT, dbar_c[k]);
-            qp.add_le(&[(ip, 1.0)], dbar_p[k] + rho_p);
-            qp.add_le(&[(ip, -1.0)], rho_p - dbar_p[k]);
-            qp.add_le(&[(ic, 1.0)], dbar_c[k] + rho_c);
-            qp.add_le(&[(ic, -1.0)], rho_c - dbar_c[k]);
-        }
-        let x = match qp.solve(&mut stats) {
-            Ok(x) => x,
-            Err(st) if dev.is_none() => {
-                // No feasible point near the base: widen the first trust region (the limits
-                // may force the values far from the program's) up to the primary axis'
-                // whole range before giving up.
-                let (lo, hi) = pr.machine.primary_range_deg;
-                if st.is_infeasible() && rho_p < hi - lo {
-                    rho_p = (2.0 * rho_p).min(hi - lo);
-                    rho_c = 2.0 * FIRST_TRUST_C_DEG;
-                    continue;
-                }
-                return Err(PatchFailure::Solver(stats));
-            }
-            Err(_) => {
-                // Around a feasible iterate the problem is feasible: a numerical failure.
-                // Try a smaller step.
-                rho_p *= 0.5;
-                rho_c *= 0.5;
-                if rho_p < SCP_MIN_TRUST_DEG {
-                    break;
-                }
-                continue;
-            }
-        };
-        let xp: Vec<f64> = (first..=last).map(|i| x[hp.delta_var(i)]).collect();
-        let xc: Vec<f64> = (first..=last).map(|i| x[hc.delta_var(i)]).collect();
-        if xp.iter().chain(&xc).any(|v| !v.is_finite()) {
-            return Err(PatchFailure::Solver(stats));
-        }
-        let d = exact_max_deviation(pr, &xp, &xc);
-        match dev {
-            None => {
-                (dbar_p, dbar_c, dev) = (xp, xc, Some(d));
-                (rho_p, rho_c) = (TRUST_P_DEG, TRUST_C_DEG);
-            }
-            Some(cur) if d < cur => {
-                (dbar_p, dbar_c, dev) = (xp, xc, Some(d));
-                if cur - d < pr.rel_tol * cur {
-                    break;
-                }
-            }
-            Some(_) => {
-                rho_p *= 0.5;
-                rho_c *= 0.5;
-                if rho_p < SCP_MIN_TRUST_DEG {
-                    break;
-                }
-            }
-        }
-    }
-    let Some(max_deviation_deg) = dev else {
-        return Err(PatchFailure::Solver(stats));
+    let mut xbar = model.start()?;
+    let mut dev = model.deviation(&xbar);
+    let mut exc = xbar[model.e];
+    let mut merit = model.merit(dev, exc);
+    let mut rho = if pr.warm || exc <= st.elastic_tol {
+        (st.trust_p_deg, st.trust_c_deg)
+    } else {
+        (st.first_trust_p_deg, st.first_trust_c_deg)
     };
+    let mut solved_any = false;
+    // A start already within the limits with no orientation change cannot be bettered.
+    let solves = if exc <= st.elastic_tol && dev <= 1e-9 {
+        solved_any = true;
+        0
+    } else {
+        pr.max_solves
+    };
+    for _ in 0..solves {
+        let qp = model.linearised(&xbar, rho);
+        let started = Instant::now();
+        let banded = qp.to_banded(model.position.clone());
+        let mut x0 = xbar.clone();
+        x0[model.t] = chord(dev) + 1e-3;
+        let sol = banded.solve(&x0, &st.ipm);
+        stats.solves += 1;
+        stats.iterations += sol.iterations;
+        stats.solve_time_s += started.elapsed().as_secs_f64();
+        stats.status = match sol.status {
+            IpmStatus::Solved => QpStatus::Solved,
+            IpmStatus::MaxIterations => QpStatus::MaxIterations,
+            IpmStatus::NumericalError => QpStatus::NumericalError,
+        };
+        let x = sol.x;
+        let usable = sol.status != IpmStatus::NumericalError && x.iter().all(|v| v.is_finite());
+        if !usable {
+            rho = (0.5 * rho.0, 0.5 * rho.1);
+            if rho.0 < st.min_trust_deg {
+                break;
+            }
+            continue;
+        }
+        solved_any = true;
+        let (d, ex) = (model.deviation(&x), model.excess(&x));
+        let m = model.merit(d, ex);
+        if m < merit {
+            let gain = merit - m;
+            let was_infeasible = exc > st.elastic_tol;
+            (xbar, dev, exc, merit) = (x, d, ex, m);
+            if exc <= st.elastic_tol {
+                rho = (st.trust_p_deg, st.trust_c_deg);
+            }
+            // Stop on a small gain once the limits are met (not while reaching them).
+            if !was_infeasible && gain < st.scp_rel_tol * merit.max(1e-12) {
+                break;
+            }
+        } else {
+            rho = (0.5 * rho.0, 0.5 * rho.1);
+            if rho.0 < st.min_trust_deg {
+                break;
+            }
+        }
+    }
+    if !solved_any {
+        return Err(PatchFailure::Solver(stats));
+    }
     Ok(JointSolution {
         p_deg: (first..=last)
-            .map(|i| pr.p_deg[i] + dbar_p[i - first])
+            .map(|i| pr.p_deg[i] + model.deltas(i, &xbar).0)
             .collect(),
         c_deg: (first..=last)
-            .map(|i| pr.c_deg[i] + dbar_c[i - first])
+            .map(|i| pr.c_deg[i] + model.deltas(i, &xbar).1)
             .collect(),
-        max_deviation_deg,
+        max_deviation_deg: dev,
+        excess: exc,
         qp: stats,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testutil::{machine, planted, sing_path};
+    use polepatch_kinematics::Axis;
+
+    /// The linearisation the QPs use, against finite differences and exactly: the
+    /// Jacobian of the tool axis (per degree) matches central differences, and the
+    /// linearised change `r0 + a·δP + b·δC` is off the exact `fk(P̄ + δP, C̄ + δC) − o`
+    /// by at most the second-order bound `½·(π/180)²·(|δP| + |δC|)²` (the tool axis' second
+    /// derivatives in degrees are at most (π/180)² in size).
+    #[test]
+    fn linearisation_against_finite_differences_and_its_error_bound() {
+        let k = (1.0f64).to_radians().powi(2);
+        for name in ["mikron-ucp710", "mikron-hsm600"] {
+            let m = machine(name);
+            for (p, c) in [(0.3, 40.0), (-2.0, 170.0), (12.0, -75.0), (0.0, 10.0)] {
+                let [o, a, b] = forward_jacobian(&m, p, c);
+                let h = 1e-5;
+                let fp = |dp: f64, dc: f64| forward(&m, p + dp, c + dc);
+                for i in 0..3 {
+                    let dp = (fp(h, 0.0)[i] - fp(-h, 0.0)[i]) / (2.0 * h);
+                    let dc = (fp(0.0, h)[i] - fp(0.0, -h)[i]) / (2.0 * h);
+                    assert!((dp - a[i]).abs() < 1e-9, "{name} ∂P {p} {c}");
+                    assert!((dc - b[i]).abs() < 1e-9, "{name} ∂C {p} {c}");
+                }
+                for (dp, dc) in [(0.5, 3.0), (-2.0, 30.0), (2.0, -180.0), (0.01, 0.1)] {
+                    let exact = fp(dp, dc);
+                    let err = (0..3)
+                        .map(|i| (exact[i] - o[i] - a[i] * dp - b[i] * dc).powi(2))
+                        .sum::<f64>()
+                        .sqrt();
+                    let bound = 0.5 * k * (f64::abs(dp) + f64::abs(dc)).powi(2);
+                    assert!(
+                        err <= bound * (1.0 + 1e-9),
+                        "{name} {p} {c} step {dp} {dc}: {err} > {bound}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// The tangent-plane change the cones bound is the chord's component orthogonal to
+    /// the target: `‖E·(o' − o)‖ = sin θ ≤ 2·sin(θ/2)`, equal to first order, so bounding
+    /// it by `t` bounds the angle θ through `asin`.
+    #[test]
+    fn tangent_plane_change_is_the_sine_of_the_angle() {
+        let m = machine("mikron-ucp710");
+        for (p, c, p2, c2) in [
+            (1.0, 20.0, 1.5, 35.0),
+            (0.2, 0.0, -0.3, 180.0),
+            (10.0, 5.0, 9.0, 5.0),
+        ] {
+            let (o, o2) = (forward(&m, p, c), forward(&m, p2, c2));
+            let [e1, e2] = tangent_basis(o);
+            let r = [o2[0] - o[0], o2[1] - o[1], o2[2] - o[2]];
+            let tang = (dot3(e1, r).powi(2) + dot3(e2, r).powi(2)).sqrt();
+            let theta = angle_between_deg(o, o2).to_radians();
+            assert!(
+                (tang - theta.sin()).abs() < 1e-12,
+                "{tang} vs sin {}",
+                theta.sin()
+            );
+            assert!(tang <= chord(theta.to_degrees()) + 1e-15);
+            // The basis is orthonormal and orthogonal to o.
+            assert!(
+                dot3(e1, o).abs() < 1e-15
+                    && dot3(e2, o).abs() < 1e-15
+                    && dot3(e1, e2).abs() < 1e-15
+            );
+        }
+    }
+
+    fn problem<'a>(
+        path: &'a crate::path::Path,
+        p: &'a [f64],
+        c: &'a [f64],
+        target: &'a [[f64; 3]],
+        m: &'a Machine,
+        st: &'a SolverSettings,
+        cap: Option<f64>,
+    ) -> JointProblem<'a> {
+        let n = path.s_mm.len();
+        JointProblem {
+            s_mm: &path.s_mm,
+            p_deg: p,
+            c_deg: c,
+            target,
+            first: 1,
+            last: n - 1,
+            lim_p: GeomLimits::of(m, Axis::Primary, path.feed_mm_min, 0.02),
+            lim_c: GeomLimits::of(m, Axis::C, path.feed_mm_min, 0.02),
+            machine: m,
+            core: 0..n - 1,
+            round_p_deg: 0.0,
+            round_c_deg: 0.0,
+            reference: None,
+            cap_deg: cap,
+            warm: false,
+            max_solves: st.scp_max_solves,
+            settings: st,
+        }
+    }
+
+    /// `%SING` from the program's values: the solution meets every limit row (excess 0)
+    /// and its largest exact change is what passing through the pole costs (about the
+    /// 1° the path passes from it); the rows it meets are the spline's limits, checked on
+    /// the analysis spline of the solution's values (the model is the spline).
+    #[test]
+    fn sing_solution_meets_the_limits_on_the_analysis_spline() {
+        let m = machine("mikron-ucp710");
+        let path = sing_path();
+        let st = SolverSettings::default();
+        let p: Vec<f64> = path.axes.iter().map(|q| q[3]).collect();
+        let c: Vec<f64> = path.axes.iter().map(|q| q[4]).collect();
+        let target: Vec<[f64; 3]> = p.iter().zip(&c).map(|(a, b)| forward(&m, *a, *b)).collect();
+        // Start on the other branch after the point of least |P| (through the pole).
+        let k = (0..p.len())
+            .min_by(|&a, &b| p[a].abs().total_cmp(&p[b].abs()))
+            .unwrap();
+        let shift = crate::reselect::tail_shift(&m, &p, &c, k, false).unwrap();
+        let (op, oc) = crate::reselect::other_branch(&p, &c, k, shift);
+        let sol = solve_joint(&problem(&path, &op, &oc, &target, &m, &st, None)).unwrap();
+        assert!(sol.excess <= st.elastic_tol, "{sol:?}");
+        assert!(sol.max_deviation_deg < 1.05, "{}", sol.max_deviation_deg);
+        let (mut np, mut nc) = (op.clone(), oc.clone());
+        np[1..].copy_from_slice(&sol.p_deg);
+        nc[1..].copy_from_slice(&sol.c_deg);
+        for (axis, y) in [(Axis::Primary, &np), (Axis::C, &nc)] {
+            let lim = GeomLimits::of(&m, axis, path.feed_mm_min, 0.02);
+            let sp = crate::spline::AnalysisSpline::new(&path.s_mm, y).unwrap();
+            for (k, pk) in crate::spline::span_maxima(&path.s_mm, &sp)
+                .iter()
+                .enumerate()
+            {
+                let slack = 1e-6;
+                assert!(
+                    pk[0] <= lim.v * (1.0 + slack),
+                    "{axis:?} span {k}: q' {} > {}",
+                    pk[0],
+                    lim.v
+                );
+                assert!(
+                    pk[1] <= lim.a * (1.0 + slack),
+                    "{axis:?} span {k}: q'' {} > {}",
+                    pk[1],
+                    lim.a
+                );
+                assert!(
+                    pk[2] <= lim.j * (1.0 + slack),
+                    "{axis:?} span {k}: q''' {} > {}",
+                    pk[2],
+                    lim.j
+                );
+            }
+        }
+        // The exact deviation reported is the exact angle of the values returned.
+        let dev = (1..p.len())
+            .map(|i| angle_between_deg(target[i], forward(&m, np[i], nc[i])))
+            .fold(0.0, f64::max);
+        assert!((dev - sol.max_deviation_deg).abs() < 1e-12);
+    }
+
+    /// Capped: no point's exact orientation change exceeds the cap (the cone bounds the
+    /// tangent-plane change by the cap's chord, which is at least its sine), and the
+    /// excess over the limits is what the cap leaves — positive when the cap is far
+    /// below what reaching feed needs.
+    #[test]
+    fn capped_solve_stays_within_the_cap() {
+        let m = machine("mikron-ucp710");
+        let path = planted(241, 0.5, 0.5, false, 1000.0);
+        let st = SolverSettings::default();
+        let p: Vec<f64> = path.axes.iter().map(|q| q[3]).collect();
+        let c: Vec<f64> = path.axes.iter().map(|q| q[4]).collect();
+        let target: Vec<[f64; 3]> = p.iter().zip(&c).map(|(a, b)| forward(&m, *a, *b)).collect();
+        for cap in [0.05, 0.2] {
+            let mut pr = problem(&path, &p, &c, &target, &m, &st, Some(cap));
+            pr.warm = true;
+            let sol = solve_joint(&pr).unwrap();
+            assert!(
+                sol.max_deviation_deg <= cap * 1.01 + 1e-6,
+                "cap {cap}: {}",
+                sol.max_deviation_deg
+            );
+            assert!(
+                sol.excess > 0.0,
+                "cap {cap}: a 0.5° pass cannot reach feed within {cap}°"
+            );
+        }
+    }
+
+    /// A start that already meets every limit with no orientation change costs no solve.
+    #[test]
+    fn a_perfect_start_costs_no_solve() {
+        let m = machine("mikron-ucp710");
+        // Far from the pole and gentle: every limit met as programmed.
+        let mut path = planted(81, 1.0, 20.0, false, 500.0);
+        for q in &mut path.axes {
+            q[4] *= 0.01;
+        }
+        let st = SolverSettings::default();
+        let p: Vec<f64> = path.axes.iter().map(|q| q[3]).collect();
+        let c: Vec<f64> = path.axes.iter().map(|q| q[4]).collect();
+        let target: Vec<[f64; 3]> = p.iter().zip(&c).map(|(a, b)| forward(&m, *a, *b)).collect();
+        let sol = solve_joint(&problem(&path, &p, &c, &target, &m, &st, None)).unwrap();
+        assert_eq!(sol.qp.solves, 0, "{sol:?}");
+        assert!(sol.max_deviation_deg < 1e-9 && sol.excess == 0.0, "{sol:?}");
+    }
 }

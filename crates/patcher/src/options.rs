@@ -1,5 +1,8 @@
 //! Options of the patcher.
 
+use crate::path::PathError;
+use crate::settings::SolverSettings;
+
 /// Which rotary axes the patcher may change.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub enum PatchAxes {
@@ -28,7 +31,10 @@ pub struct PatchOptions {
     pub tcy_s: Option<f64>,
     /// Safety margin on the C limits: the QP uses (1 − margin)·V, A, J. Default 0.02.
     pub margin: f64,
-    /// Ask for third-derivative continuity at the joins where feasible. Default true.
+    /// Ask for third-derivative continuity at the joins of G16's patch where feasible.
+    /// [`PatchAxes::OnlyC`] only: the default method has no joins (its values are those of
+    /// one analysis spline), and [`PatchOptions::validate`] refuses `false` with it.
+    /// Default true.
     pub third_derivative_continuity: bool,
     /// Decimal places of the file's C words (values are verified rounded to these).
     /// Default 3.
@@ -41,7 +47,8 @@ pub struct PatchOptions {
     /// budget (J/F³ = 0.0144 °/mm³) is eaten to 28 % by rounding to 4 decimals, to 0.3 % by
     /// rounding to 6. The machine's control must accept that many.
     pub max_decimals: usize,
-    /// Longest patch, mm; `None` = up to the whole run. Default `None`.
+    /// Longest patch, mm; `None` = up to the whole run. Both methods hold to it (the joint
+    /// patch's range is cut to it around the zone). Default `None`.
     pub max_patch_length_mm: Option<f64>,
     /// Keep the path's last point as it is, like its first (default false). A caller sets
     /// it when what follows the path depends on the pose the path ends in (the NC pipeline
@@ -49,9 +56,13 @@ pub struct PatchOptions {
     /// and the path may end on the other IK branch.
     pub keep_last_point: bool,
     /// Allow a 360° multiple offset of C after the singular point when it shortens the
-    /// join. The rest of the run then carries the offset, and the move after the run has to
-    /// turn C the extra revolution back, so it is off by default. Default false.
+    /// join (G16's method, [`PatchAxes::OnlyC`] only; [`PatchOptions::validate`] refuses it
+    /// with the default method, which re-selects the branch instead). The rest of the run
+    /// then carries the offset, and the move after the run has to turn C the extra
+    /// revolution back, so it is off by default. Default false.
     pub allow_c_offset: bool,
+    /// Numerical settings ([`SolverSettings`]). Default [`SolverSettings::default`].
+    pub solver: SolverSettings,
 }
 
 impl Default for PatchOptions {
@@ -70,7 +81,53 @@ impl Default for PatchOptions {
             max_patch_length_mm: None,
             keep_last_point: false,
             allow_c_offset: false,
+            solver: SolverSettings::default(),
         }
+    }
+}
+
+impl PatchOptions {
+    /// Refuse options that would mean nothing: G16's join options with the default
+    /// method, a cone, margin or cap out of range.
+    pub fn validate(&self) -> Result<(), PathError> {
+        let bad = |what: &str| Err(PathError::Options(what.to_string()));
+        if self.axes == PatchAxes::Both && self.strategy == crate::peers::Strategy::Polepatch {
+            if self.allow_c_offset {
+                return bad(
+                    "a 360° C offset (allow_c_offset) is G16's join option: it needs the C-only method",
+                );
+            }
+            if !self.third_derivative_continuity {
+                return bad(
+                    "third-derivative continuity at the joins is G16's option: it needs the C-only method",
+                );
+            }
+        }
+        if !(self.cone_deg.is_finite() && self.cone_deg > 0.0) {
+            return bad(&format!(
+                "the singular cone must be a positive angle, got {}°",
+                self.cone_deg
+            ));
+        }
+        if !(0.0..1.0).contains(&self.margin) {
+            return bad(&format!(
+                "the margin must be in [0, 1), got {}",
+                self.margin
+            ));
+        }
+        if let Some(d) = self.max_deviation_deg
+            && !(d.is_finite() && d >= 0.0)
+        {
+            return bad(&format!("the largest deviation must be ≥ 0°, got {d}°"));
+        }
+        if let Some(l) = self.max_patch_length_mm
+            && !(l.is_finite() && l > 0.0)
+        {
+            return bad(&format!(
+                "the longest patch must be a positive length, got {l} mm"
+            ));
+        }
+        Ok(())
     }
 }
 

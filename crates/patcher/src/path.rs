@@ -52,6 +52,9 @@ pub enum PathError {
     /// The analysis spline could not be built (should not happen for a validated path).
     #[error("analysis spline: {0}")]
     Spline(String),
+    /// Options that mean nothing together, or out of range.
+    #[error("options: {0}")]
+    Options(String),
     /// Feed not positive and finite.
     #[error("programmed feed must be positive, got {0} mm/min")]
     BadFeed(f64),

@@ -21,15 +21,12 @@
 //! nothing is kept back: a peer's result is what it is, and the suite reports it.
 
 use crate::{
-    analysis::{AnalysisOptions, Zone, analyze_path, validate},
-    options::{PatchOptions, round_written},
-    patch::{PatchResult, merge_zones, zone_figures},
-    path::{Path, PathError},
-    report::{Method, Outcome, QpStats, ZoneReport},
+    analysis::Zone,
+    driver::{Proposal, Proposer, Sink, Tail, ZoneCtx},
+    report::{Method, QpStats},
     spline::AnalysisSpline,
-    verify::CORE_MARGIN_POINTS,
 };
-use polepatch_kinematics::{Axis, Machine, angle_between_deg, forward, forward_jacobian};
+use polepatch_kinematics::{Machine, forward_jacobian};
 use serde::Serialize;
 
 /// How the patcher treats a zone: polepatch's method (see [`PatchOptions::axes`]) or one of
@@ -137,114 +134,54 @@ pub fn apply_rule(
     }
 }
 
-/// Apply a peer strategy to every zone of `path` (module docs). `opts.c_decimals` and
-/// `opts.p_decimals` are the file's; the cone is `opts.cone_deg`.
-pub fn peer_patch(
-    path: &Path,
-    machine: &Machine,
-    opts: &PatchOptions,
-    strategy: Strategy,
-) -> Result<PatchResult, PathError> {
-    validate(path)?;
-    let n = path.s_mm.len();
-    let (pi, ci) = (Axis::Primary.index(), Axis::C.index());
-    if !path.axes.iter().any(|q| q[pi].abs() <= opts.cone_deg) {
-        return Ok(PatchResult::unchanged(path, opts));
-    }
-    let aopts = AnalysisOptions {
-        cone_deg: opts.cone_deg,
-        tcy_s: opts.tcy_s,
-        keep_samples: false,
-    };
-    let analysis = analyze_path(path, machine, &aopts)?;
-    let zones = merge_zones(&analysis.zones);
-    if zones.is_empty() {
-        return Ok(PatchResult::unchanged(path, opts));
-    }
-    let p0: Vec<f64> = path.axes.iter().map(|q| q[pi]).collect();
-    let c0: Vec<f64> = path.axes.iter().map(|q| q[ci]).collect();
-    let target: Vec<[f64; 3]> = p0
-        .iter()
-        .zip(&c0)
-        .map(|(p, c)| forward(machine, *p, *c))
-        .collect();
-    let c_spline = AnalysisSpline::new(&path.s_mm, &c0)?;
-    let (mut p, mut c) = (p0.clone(), c0.clone());
-    let mut stretches = Vec::new();
-    for zone in &zones {
-        let Some(st) = cone_stretch(&p0, zone, opts.cone_deg) else {
-            continue;
+/// A peer strategy as a method of the driver (module docs): it proposes its rule's values
+/// over the zone's cone stretch, and the driver writes them as they are (unverified).
+#[derive(Debug, Clone, Copy)]
+pub struct Peer(pub Strategy);
+
+impl Proposer for Peer {
+    fn propose(&mut self, ctx: &ZoneCtx<'_>, sink: &mut dyn Sink) {
+        let Some(st) = cone_stretch(ctx.p, ctx.zone, ctx.opts.cone_deg) else {
+            return;
         };
+        let Ok(spline) = AnalysisSpline::new(ctx.s, ctx.c) else {
+            return;
+        };
+        let (mut p, mut c) = (ctx.p.to_vec(), ctx.c.to_vec());
         apply_rule(
-            strategy, machine, &path.s_mm, &c0, &c_spline, &target, st, &mut p, &mut c,
+            self.0,
+            ctx.machine,
+            ctx.s,
+            ctx.c,
+            &spline,
+            ctx.target,
+            st,
+            &mut p,
+            &mut c,
         );
         let [_, a, b, _] = st;
-        for i in a..=b {
-            c[i] = round_written(c[i], opts.c_decimals);
-            p[i] = round_written(p[i], opts.p_decimals);
+        if a < ctx.lower || b > ctx.end {
+            return;
         }
-        stretches.push((zone.clone(), a, b));
-    }
-    let mut after_path = path.clone();
-    for (q, (pv, cv)) in after_path.axes.iter_mut().zip(p.iter().zip(&c)) {
-        q[pi] = *pv;
-        q[ci] = *cv;
-    }
-    let mut reports = Vec::new();
-    for (zone, a, b) in stretches {
-        // Figures over the zone's core and the rewritten stretch, with the margin the
-        // verification uses: a jump at the stretch's ends counts.
-        let fa = zone.first.min(a).saturating_sub(CORE_MARGIN_POINTS);
-        let fb = (zone.last.max(b) + CORE_MARGIN_POINTS).min(n - 1);
-        let before = zone_figures(path, machine, &aopts, fa, fb)?;
-        let after = zone_figures(&after_path, machine, &aopts, fa, fb)?;
-        let worst = |f: &crate::ZoneFigures| f.c_ratio.min(f.primary_ratio);
-        let outcome = if worst(&after) >= 1.0 - crate::analysis::RATIO_TOL {
-            Outcome::Reached
-        } else if worst(&after) > worst(&before) {
-            Outcome::Improved
-        } else {
-            Outcome::Unchanged
-        };
-        reports.push(ZoneReport {
-            first: fa,
-            last: fb,
-            kind: zone.kind,
-            min_abs_primary_deg: zone.min_abs_primary_deg,
-            before,
-            after,
-            ideal_time_s: (path.s_mm[fb] - path.s_mm[fa]) / (path.feed_mm_min / 60.0),
-            max_deviation_deg: (a..=b)
-                .map(|i| angle_between_deg(target[i], forward(machine, p[i], c[i])))
-                .fold(0.0, f64::max),
-            points_modified: (a..=b).filter(|&i| p[i] != p0[i] || c[i] != c0[i]).count(),
-            primary_points_modified: (a..=b).filter(|&i| p[i] != p0[i]).count(),
-            reselected_points: 0,
-            patch_length_mm: path.s_mm[b] - path.s_mm[a],
-            outcome,
+        sink.offer(Proposal {
             method: Method::Peer,
+            first: a,
+            last: b,
+            p: p[a..=b].to_vec(),
+            c: c[a..=b].to_vec(),
+            tail: Tail::Keep,
             qp: QpStats::default(),
-            decimals: opts.c_decimals,
-            p_decimals: opts.p_decimals,
-            c_offset_deg: 0.0,
         });
     }
-    let p_changed = p.iter().zip(&p0).map(|(x, y)| x != y).collect();
-    let c_changed = c.iter().zip(&c0).map(|(x, y)| x != y).collect();
-    Ok(PatchResult {
-        p_deg: p,
-        p_changed,
-        p_decimals: opts.p_decimals,
-        c_deg: c,
-        c_changed,
-        c_decimals: opts.c_decimals,
-        zones: reports,
-    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::options::{PatchOptions, round_written};
+    use crate::path::Path;
+    use crate::report::Reason;
+    use polepatch_kinematics::{angle_between_deg, forward};
 
     /// The meridian projection is exact for a tool axis on the meridian (either side of
     /// the pole) and the closest point otherwise.
@@ -301,13 +238,21 @@ mod tests {
             axes,
             feed_mm_min: 2000.0,
         };
-        let opts = PatchOptions::default();
+        let opts = |strategy| PatchOptions {
+            strategy,
+            ..PatchOptions::default()
+        };
         let inside: Vec<usize> = (1..n - 1)
             .filter(|&i| path.axes[i][3].abs() <= 5.0)
             .collect();
         let (a, b) = (inside[0], *inside.last().unwrap());
         for strategy in [Strategy::Freeze, Strategy::Linearize, Strategy::Smooth] {
-            let r = peer_patch(&path, &m, &opts, strategy).unwrap();
+            let r = crate::patch_path(&path, &m, &opts(strategy)).unwrap();
+            assert_eq!(r.zones[0].method, Method::Peer);
+            assert!(matches!(
+                r.zones[0].reason,
+                Reason::Reached | Reason::NotFound
+            ));
             assert_eq!(r.zones.len(), 1, "{strategy:?}");
             assert!(
                 (a..=b).any(|i| r.c_changed[i]),

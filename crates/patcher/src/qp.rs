@@ -1,5 +1,5 @@
-//! Small clarabel helpers: a QP builder with sparse rows, the solver settings, one timed
-//! solve.
+//! A QP builder with sparse rows, for clarabel (one timed solve) or the banded
+//! interior-point method of [`crate::ipm`].
 
 use crate::report::{QpStats, QpStatus};
 use clarabel::algebra::CscMatrix;
@@ -74,6 +74,9 @@ pub(crate) fn scaled(c: f64, r: &[(usize, f64)]) -> Row {
 ///                                         ‖(b_k − a_k·x)_{k≥1}‖ ≤ b_0 − a_0·x   per block
 /// ```
 ///
+/// It is solved by clarabel ([`QpBuilder::solve`]) or, banded, by [`crate::ipm`]
+/// ([`QpBuilder::to_banded`]).
+///
 /// Only the upper triangle of `H` is stored (clarabel reads nothing else).
 #[derive(Debug, Clone)]
 pub(crate) struct QpBuilder {
@@ -137,6 +140,44 @@ impl QpBuilder {
         debug_assert!(block.len() >= 2, "a second-order cone needs 2 rows or more");
         self.soc
             .push(block.iter().map(|(r, b)| (compact(r), *b)).collect());
+    }
+
+    /// Number of inequality rows so far.
+    pub(crate) fn le_len(&self) -> usize {
+        self.le.len()
+    }
+
+    /// Add `coef·x[var]` to the left side of the inequality rows `rows` (an elastic
+    /// variable: `row·x − e ≤ rhs` with `coef = −1`).
+    pub(crate) fn extend_le(&mut self, rows: std::ops::Range<usize>, var: usize, coef: f64) {
+        for (row, _) in &mut self.le[rows] {
+            row.push((var, coef));
+        }
+    }
+
+    /// The inequality rows `rows` as `(row, rhs)`.
+    pub(crate) fn le_rows(&self, rows: std::ops::Range<usize>) -> &[(Row, f64)] {
+        &self.le[rows]
+    }
+
+    /// This problem for [`crate::ipm::Banded`], with each variable's position along the
+    /// path (`None`: a border variable).
+    pub(crate) fn to_banded(&self, position: Vec<Option<f64>>) -> crate::ipm::Banded {
+        debug_assert_eq!(position.len(), self.n);
+        let mut b = crate::ipm::Banded::new(self.n);
+        b.position = position;
+        b.h = self
+            .h_rows
+            .iter()
+            .zip(&self.h_cols)
+            .zip(&self.h_vals)
+            .map(|((&i, &j), &v)| (i, j, v))
+            .collect();
+        b.c = self.q.clone();
+        b.eq = self.eq.clone();
+        b.le = self.le.clone();
+        b.soc = self.soc.clone();
+        b
     }
 
     /// Solve with clarabel ([`settings`]), adding this solve's figures to `stats` (status of
@@ -248,28 +289,6 @@ mod qp_builder_tests {
         let want = 1.0 / (2.0 + 1e-3);
         assert!(
             (x[0] - want).abs() < 1e-6 && (x[1] + want).abs() < 1e-6,
-            "{x:?}"
-        );
-    }
-
-    /// Planted SOCP: minimise t s.t. ‖(x0 − 3, x1 − 4)‖ ≤ t, x0 + x1 = 0 → the distance
-    /// from (3, 4) to the line x0 + x1 = 0 is 7/√2.
-    #[test]
-    fn builder_second_order_cone_planted() {
-        let mut qp = QpBuilder::new(3);
-        qp.add_linear(2, 1.0);
-        qp.add_eq(&[(0, 1.0), (1, 1.0)], 0.0);
-        // s0 = t, s1 = 3 − x0 → −(x0 − 3), s2 = 4 − x1.
-        qp.add_soc(&[
-            (vec![(2, -1.0)], 0.0),
-            (vec![(0, 1.0)], 3.0),
-            (vec![(1, 1.0)], 4.0),
-        ]);
-        let mut st = QpStats::default();
-        let x = qp.solve(&mut st).unwrap();
-        assert!((x[2] - 7.0 / 2f64.sqrt()).abs() < 1e-6, "{x:?}");
-        assert!(
-            (x[0] + 0.5).abs() < 1e-5 && (x[1] - 0.5).abs() < 1e-5,
             "{x:?}"
         );
     }

@@ -1,60 +1,76 @@
-//! The reference a zone's joint patch is judged against (the quality suite, SPEC §6):
-//! the best orientation change *found* when both rotary axes may change, and a proof of
-//! unreachability when there is none.
+//! What a zone's patch is judged against (the quality suite, SPEC §6), and the proofs
+//! behind the driver's reasons `proven_unreachable`, `end_pinned` and `range`.
 //!
-//! # Unreachable (a proof)
-//! With the orientation left free, reaching feed on both rotary axes is a convex
-//! feasibility problem: the Hermite rows of the analysis splines of P and C
-//! ([`crate::hermite`]) with Equation 6's bounds (no margin, convex-hull form) on every
-//! span between movable points, "not worse than before" on the spans that touch a fixed
-//! point, and the machine's primary range, in the values of the movable points. If that
-//! LP is infeasible, no values of the movable points whatsoever reach feed without making
-//! something worse: the zone is [`Reference::Unreachable`], whatever the patcher does.
-//! Every bound leaves the room rounding to the most decimals allowed can take (a zone that
-//! reaches feed only with unrounded values, exactly at a limit, cannot be written).
+//! # The relaxation (a proof when infeasible)
+//! A written patch passes when, on the values as written ([`crate::driver`]):
+//! - every checked rotary axis reaches feed on the zone's core spans: its ratio, the
+//!   minimum over the span of Equation 6, is at least `X = 1 − RATIO_TOL`;
+//! - no other span gets worse: its ratio is at least
+//!   `X = crate::verify::not_worse_floor(before)`;
+//! - the primary axis (and C, where its range is finite) stays within the machine's range.
+//!
+//! Equation 6's ratio is at least X on a span exactly when, for the derivative of order
+//! p = 1, 2, 3, `|q⁽ᵖ⁾(s)| ≤ L_p / (F·X)^p` at **every** s of the span (the limits V, A, J).
+//! [`reachable`] keeps these bounds at finitely many s only — `PROOF_SAMPLES_PER_SPAN + 1`
+//! points of each span for q', both ends for q'', q''' (constant) — on the spans within
+//! [`PROOF_SPAN_MARGIN`] of the movable points and the core, and no rounding room and no
+//! margin at all. The analysis spline is modelled exactly: the Hermite rows of
+//! [`crate::hermite`] over the **whole** run (not-a-knot at both of its ends). Every
+//! values that pass therefore satisfy the LP (rounded or not, on either IK branch, with a
+//! tail re-selected or not: the LP's variables are any values of the movable points): the
+//! LP is a relaxation of the requirement. So when clarabel proves it infeasible
+//! (`PrimalInfeasible`, to its certificate tolerance), **no** values of the movable points
+//! pass. A solver error proves nothing (the zone is then `not_found`).
+//!
+//! The driver asks it three ways for a zone that did not reach feed: with the points it
+//! may change (infeasible: `proven_unreachable`, unless one of the next two is feasible);
+//! with the run's last point free too when it must stay (feasible: `end_pinned`); without
+//! the range rows (feasible: `range`).
 //!
 //! # The best found (an upper bound on the optimum)
-//! Otherwise the reference is the smallest exact largest deviation over several methods,
-//! each run with more effort than the patcher spends by default:
+//! [`zone_reference`] is the smallest exact largest deviation over several methods, each
+//! run with [`SolverSettings::reference`] — the patcher's settings with more effort:
 //! - branch re-selection alone (deviation 0) when it reaches feed;
-//! - the joint SCP ([`crate::joint`]) over the whole movable territory, with a margin of
-//!   [`REFERENCE_MARGIN`] only, unrounded, from four starts: the values as they are; the tail after the zone's
-//!   singular point on the other branch; C held at its value at the singular point across
-//!   the zone (ModuleWorks' FREEZE); C linear in s across the zone (LINEARIZE).
+//! - the joint SCP ([`crate::joint`]) over the given points, with a margin of
+//!   [`SolverSettings::reference_margin`] only, unrounded, from four starts: the values as
+//!   they are; the tail after the zone's singular point on the other branch (only when the
+//!   run's last point may move: the tail includes it); C held at its value at the singular
+//!   point across the zone (ModuleWorks' FREEZE); C linear in s across the zone
+//!   (LINEARIZE).
 //!
 //! It is not a lower bound: the problem is not convex, and a better patch may exist. The
 //! suite reports `ours / reference`; below 1 means the patcher beat every reference start.
 
+use crate::analysis::RATIO_TOL;
 use crate::peers::Strategy;
 use crate::{
     analysis::Zone,
     candidate::PatchFailure,
-    hermite::{Hermite, JOINT_WINDOW_POINTS},
+    driver::zone_core,
+    hermite::{Aff, Hermite, push_abs},
     joint::{JointProblem, solve_joint},
     limits::GeomLimits,
+    options::{PatchAxes, PatchOptions},
+    path::Path,
     qp::QpBuilder,
-    report::QpStats,
+    report::{QpStats, Reason},
+    settings::SolverSettings,
+    spline::{AnalysisSpline, span_offsets},
     verify::{AxisChange, verify_change_with_core},
 };
-use polepatch_kinematics::{Axis, Machine, forward, unwrap_near_deg};
+use polepatch_kinematics::{Axis, Machine, axis_feed_ratio, forward, unwrap_near_deg};
 
-/// Most solves of each reference start (the patcher allows
-/// [`crate::joint::SCP_MAX_SOLVES`]).
-pub const REFERENCE_MAX_SOLVES: usize = 24;
+/// Samples of q' per span in the relaxation (its ends included).
+pub const PROOF_SAMPLES_PER_SPAN: usize = 8;
 
-/// A reference start stops when a step improves its largest deviation by less than this
-/// fraction (the patcher: [`crate::joint::SCP_REL_TOL`]).
-pub const REFERENCE_REL_TOL: f64 = 1e-3;
-
-/// Margin of the reference solves on the limits (the patcher's default is 0.02): just
-/// enough that the solution passes the verification's round-off tolerances, so the
-/// reference is what the limits themselves allow.
-pub const REFERENCE_MARGIN: f64 = 1e-3;
+/// Spans beyond the movable points and the core that the relaxation constrains (fewer
+/// constraints keep it a relaxation; these are where a change still matters).
+pub const PROOF_SPAN_MARGIN: usize = 40;
 
 /// The reference of one zone.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Reference {
-    /// No values of the movable points reach feed on both rotary axes (the LP is
+    /// No values of the movable points reach feed on both rotary axes (the relaxation is
     /// infeasible: a proof).
     Unreachable,
     /// The smallest largest deviation found, degrees, and the method that found it.
@@ -68,20 +84,11 @@ pub enum Reference {
     Failed,
 }
 
-/// Whether some values of points `first..=last` make both rotary axes meet Equation 6 on
-/// every constrained span (the convex feasibility LP of the module docs). `p_deg`, `c_deg`
-/// are the current values of the whole path.
-/// The spans a zone's patch must bring to feed: the zone's, ± the verification's core
-/// margin (as `crate::verify` checks them).
-pub fn zone_core(zone: &Zone, n: usize) -> std::ops::Range<usize> {
-    let m = crate::verify::CORE_MARGIN_POINTS;
-    zone.first.saturating_sub(m)..(zone.last + m).min(n - 1)
-}
-
-/// Whether some values of points `first..=last`, written with `max_decimals` decimals,
-/// bring the spans `core` to feed on both rotary axes while no other span of the window
-/// gets worse (the LP of the module docs; every bound leaves the room rounding to that many
-/// decimals can take, [`Hermite::rounding_room`], and no other margin).
+/// Whether some values of points `first..=last` could pass (the relaxation of the module
+/// docs; `Ok(false)` is a proof that none can). `p_deg`, `c_deg` are the values of the
+/// whole path before the change, `core` the spans that must reach feed; `axes` which
+/// rotary axes may change and are checked; `ranges` whether the machine's axis ranges
+/// count.
 #[allow(clippy::too_many_arguments)]
 pub fn reachable(
     s_mm: &[f64],
@@ -92,35 +99,77 @@ pub fn reachable(
     core: std::ops::Range<usize>,
     machine: &Machine,
     feed_mm_min: f64,
-    step_mm: f64,
-    max_decimals: usize,
+    axes: PatchAxes,
+    ranges: bool,
 ) -> Result<bool, PatchFailure> {
-    let hp = Hermite::with_offset(s_mm, p_deg, first, last, JOINT_WINDOW_POINTS, 0)?;
-    let hc = Hermite::with_offset(s_mm, c_deg, first, last, JOINT_WINDOW_POINTS, hp.vars())?;
-    let nv = hp.vars() + hc.vars();
-    let mut qp = QpBuilder::new(nv);
-    hp.add_equalities(&mut qp);
-    hc.add_equalities(&mut qp);
-    let mut current = vec![0.0; nv];
-    hp.write_current(&mut current)?;
-    hc.write_current(&mut current)?;
-    let lim = |axis| GeomLimits::of(machine, axis, feed_mm_min, 0.0);
-    let eps = 0.5 * 10f64.powi(-(max_decimals as i32));
-    let (rp, rc) = (hp.rounding_room(eps)?, hc.rounding_room(eps)?);
-    hp.push_limits(
-        &mut qp,
-        &lim(Axis::Primary),
-        &current,
-        &rp,
-        step_mm,
-        core.clone(),
-    );
-    hc.push_limits(&mut qp, &lim(Axis::C), &current, &rc, step_mm, core);
-    let (lo, hi) = machine.primary_range_deg;
-    for (i, p) in p_deg.iter().enumerate().take(last + 1).skip(first) {
-        let v = hp.delta_var(i);
-        qp.add_le(&[(v, 1.0)], hi - p);
-        qp.add_le(&[(v, -1.0)], p - lo);
+    let n = s_mm.len();
+    if first > last || last >= n {
+        return Err(PatchFailure::TooShort);
+    }
+    let feed_mm_s = feed_mm_min / 60.0;
+    let moving: &[Axis] = match axes {
+        PatchAxes::Both => &[Axis::Primary, Axis::C],
+        PatchAxes::OnlyC => &[Axis::C],
+    };
+    let mut hermites: Vec<(Axis, Hermite)> = Vec::new();
+    let mut offset = 0;
+    for &axis in moving {
+        let y = if axis == Axis::C { c_deg } else { p_deg };
+        let h = Hermite::with_offset(s_mm, y, first, last, n, offset)?;
+        offset += h.vars();
+        hermites.push((axis, h));
+    }
+    let mut qp = QpBuilder::new(offset);
+    for (_, h) in &hermites {
+        h.add_equalities(&mut qp);
+    }
+    let spans = first.min(core.start).saturating_sub(PROOF_SPAN_MARGIN)
+        ..(last.max(core.end) + PROOF_SPAN_MARGIN).min(n - 1);
+    let mut taus = Vec::new();
+    for (axis, h) in &hermites {
+        let y = if *axis == Axis::C { c_deg } else { p_deg };
+        let before = AnalysisSpline::new(s_mm, y).map_err(|_| PatchFailure::TooShort)?;
+        let lim = GeomLimits::of(machine, *axis, feed_mm_min, 0.0);
+        let limits = machine.limit(*axis);
+        for k in spans.clone() {
+            let hk = s_mm[k + 1] - s_mm[k];
+            let x = if core.contains(&k) {
+                1.0 - RATIO_TOL
+            } else {
+                let peaks = before.span(s_mm[k], hk).peaks().0;
+                let r = axis_feed_ratio(limits, peaks, feed_mm_s);
+                crate::verify::not_worse_floor(r)
+            };
+            if x <= 0.0 || x.is_nan() {
+                continue; // the span may be anything
+            }
+            let row = |qp: &mut QpBuilder, f: &Aff, b: f64| {
+                if b.is_finite() {
+                    push_abs(qp, f, b);
+                }
+            };
+            span_offsets(hk, PROOF_SAMPLES_PER_SPAN, &mut taus);
+            for &tau in &taus {
+                row(&mut qp, &h.d1(k, tau), lim.v / x);
+            }
+            row(&mut qp, &h.d2(k, 0.0), lim.a / (x * x));
+            row(&mut qp, &h.d2(k, hk), lim.a / (x * x));
+            row(&mut qp, &h.d3(k), lim.j / (x * x * x));
+        }
+        if ranges {
+            let range = if *axis == Axis::C {
+                machine.c_range_deg
+            } else {
+                Some(machine.primary_range_deg)
+            };
+            if let Some((lo, hi)) = range {
+                for (i, yi) in y.iter().enumerate().take(last + 1).skip(first) {
+                    let v = h.delta_var(i);
+                    qp.add_le(&[(v, 1.0)], hi - yi);
+                    qp.add_le(&[(v, -1.0)], yi - lo);
+                }
+            }
+        }
     }
     let mut st = QpStats::default();
     match qp.solve(&mut st) {
@@ -130,10 +179,56 @@ pub fn reachable(
     }
 }
 
+/// The reason a zone that did not reach feed (and whose patch was not refused by the cap)
+/// ended so (module docs): the relaxation with the points the zone could change
+/// (`lower..=end` on the current values `p`, `c`), then with the last point free, then
+/// without the ranges.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn why_not_reached(
+    path: &Path,
+    p: &[f64],
+    c: &[f64],
+    zone: &Zone,
+    machine: &Machine,
+    opts: &PatchOptions,
+    lower: usize,
+    end: usize,
+) -> Reason {
+    let n = path.s_mm.len();
+    let core = zone_core(zone, n, opts.solver.core_margin_points);
+    let lp = |last: usize, ranges: bool| {
+        reachable(
+            &path.s_mm,
+            p,
+            c,
+            lower,
+            last,
+            core.clone(),
+            machine,
+            path.feed_mm_min,
+            opts.axes,
+            ranges,
+        )
+    };
+    if lower > end {
+        return Reason::NotFound;
+    }
+    match lp(end, true) {
+        Ok(false) => {}
+        _ => return Reason::NotFound,
+    }
+    if end < n - 1 && lp(n - 1, true) == Ok(true) {
+        return Reason::EndPinned;
+    }
+    if lp(end, false) == Ok(true) {
+        return Reason::Range;
+    }
+    Reason::ProvenUnreachable
+}
+
 /// The reference of `zone` on a path given by `s_mm`, `p_deg`, `c_deg` (the program's
-/// values), with points `first..=last` movable (module docs). `step_mm` is the analysis
-/// step F·Tcy; `max_decimals` the most decimals that may be written (the unreachability
-/// proof leaves room for their rounding).
+/// values), with points `first..=last` movable (module docs). `max_decimals` is unused by
+/// the relaxation (it allows any values) and kept for the callers.
 #[allow(clippy::too_many_arguments)]
 pub fn zone_reference(
     s_mm: &[f64],
@@ -144,25 +239,26 @@ pub fn zone_reference(
     last: usize,
     machine: &Machine,
     feed_mm_min: f64,
-    step_mm: f64,
     max_decimals: usize,
 ) -> Result<Reference, PatchFailure> {
+    let _ = max_decimals;
     let n = s_mm.len();
     if first > last || last >= n || first == 0 {
         return Err(PatchFailure::TooShort);
     }
-    let core = zone_core(zone, n);
+    let st = SolverSettings::reference();
+    let core = zone_core(zone, n, st.core_margin_points);
     if !reachable(
         s_mm,
         p_deg,
         c_deg,
         first,
         last,
-        core,
+        core.clone(),
         machine,
         feed_mm_min,
-        step_mm,
-        max_decimals,
+        PatchAxes::Both,
+        true,
     )? {
         return Ok(Reference::Unreachable);
     }
@@ -191,7 +287,6 @@ pub fn zone_reference(
             (zone.first, zone.last),
             machine,
             feed_mm_min / 60.0,
-            step_mm,
         )
         .passes()
     };
@@ -205,7 +300,7 @@ pub fn zone_reference(
             // Continuous with the last point off the pole (on it C does not orient the tool).
             let r = (0..=after)
                 .rev()
-                .find(|&i| p_deg[i].abs() > crate::both::POLE_DEG)
+                .find(|&i| p_deg[i].abs() > crate::reselect::POLE_DEG)
                 .unwrap_or(after);
             let shift = unwrap_near_deg(c_deg[after + 1] + 180.0, c_deg[r]) - c_deg[after + 1];
             for i in after + 1..n {
@@ -217,8 +312,11 @@ pub fn zone_reference(
     };
     let (lo, hi) = machine.primary_range_deg;
     let in_range = |p: &[f64]| p.iter().all(|v| (lo..=hi).contains(v));
+    // The points after the range keep their values unless the last point may move: then
+    // they may go to the other branch as a block.
+    let tail_free = last == n - 1;
     // Re-selection alone: the flip point of a domain-rule program, if any.
-    if let Some(f) = (zone.first..zone.last).find(|&i| {
+    if let Some(f) = (zone.first..zone.last).filter(|_| tail_free).find(|&i| {
         p_deg[i] != 0.0 && p_deg[i + 1] != 0.0 && p_deg[i].signum() != p_deg[i + 1].signum()
     }) {
         let (p, c) = flipped(f);
@@ -232,14 +330,14 @@ pub fn zone_reference(
     let mut starts: Vec<(&'static str, Vec<f64>, Vec<f64>)> =
         vec![("as-is", p_deg.to_vec(), c_deg.to_vec())];
     let (op, oc) = flipped(k);
-    if in_range(&op) {
+    if tail_free && in_range(&op) {
         starts.push(("other-branch", op, oc));
     }
     // FREEZE and LINEARIZE across the cone stretch (the peers' rules, crate::peers).
     let cone = 5.0f64.max(zone.min_abs_primary_deg);
-    if let (Some(st), Ok(spline)) = (
+    if let (Some(stretch), Ok(spline)) = (
         crate::peers::cone_stretch(p_deg, zone, cone),
-        crate::spline::AnalysisSpline::new(s_mm, c_deg),
+        AnalysisSpline::new(s_mm, c_deg),
     ) {
         for (name, rule) in [
             ("freeze", Strategy::Freeze),
@@ -247,7 +345,7 @@ pub fn zone_reference(
         ] {
             let (mut rp, mut rc) = (p_deg.to_vec(), c_deg.to_vec());
             crate::peers::apply_rule(
-                rule, machine, s_mm, c_deg, &spline, &target, st, &mut rp, &mut rc,
+                rule, machine, s_mm, c_deg, &spline, &target, stretch, &mut rp, &mut rc,
             );
             starts.push((name, rp, rc));
         }
@@ -261,17 +359,17 @@ pub fn zone_reference(
             target: &target,
             first,
             last,
-            lim_p: GeomLimits::of(machine, Axis::Primary, feed_mm_min, REFERENCE_MARGIN),
-            lim_c: GeomLimits::of(machine, Axis::C, feed_mm_min, REFERENCE_MARGIN),
+            lim_p: GeomLimits::of(machine, Axis::Primary, feed_mm_min, st.reference_margin),
+            lim_c: GeomLimits::of(machine, Axis::C, feed_mm_min, st.reference_margin),
             machine,
-            max_deviation_deg: None,
-            max_solves: REFERENCE_MAX_SOLVES,
-            rel_tol: REFERENCE_REL_TOL,
-            step_mm,
-            core: zone_core(zone, n),
+            core: core.clone(),
             round_p_deg: 0.0,
             round_c_deg: 0.0,
+            reference: Some((p_deg, c_deg)),
+            cap_deg: None,
             warm: false,
+            max_solves: st.scp_max_solves,
+            settings: &st,
         };
         let Ok(sol) = solve_joint(&pr) else { continue };
         let (mut p, mut c) = (sp.clone(), sc.clone());
@@ -290,4 +388,205 @@ pub fn zone_reference(
         },
         None => Reference::Failed,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testutil::{machine, planted, sing_path};
+
+    fn pc(path: &Path) -> (Vec<f64>, Vec<f64>) {
+        (
+            path.axes.iter().map(|q| q[3]).collect(),
+            path.axes.iter().map(|q| q[4]).collect(),
+        )
+    }
+
+    /// A relaxation holds whatever passes: where the patcher writes values that reach feed
+    /// (verified), the relaxation over the same points is feasible — on SING and planted
+    /// flips and swings, both machines.
+    #[test]
+    fn what_passes_satisfies_the_relaxation() {
+        let cases = [
+            ("mikron-ucp710", sing_path()),
+            ("mikron-hsm600", sing_path()),
+            ("mikron-ucp710", planted(241, 0.5, 0.5, false, 1000.0)),
+            ("mikron-hsm600", planted(241, 0.5, 2.0, true, 3000.0)),
+        ];
+        for (name, path) in cases {
+            let m = machine(name);
+            let res = crate::patch_path(&path, &m, &PatchOptions::default()).unwrap();
+            assert!(!res.zones.is_empty());
+            let (p, c) = pc(&path);
+            let n = p.len();
+            let a = crate::analyze_path(&path, &m, &Default::default()).unwrap();
+            for z in &a.zones {
+                let core = zone_core(z, n, 3);
+                assert_eq!(
+                    reachable(
+                        &path.s_mm,
+                        &p,
+                        &c,
+                        1,
+                        n - 1,
+                        core,
+                        &m,
+                        path.feed_mm_min,
+                        PatchAxes::Both,
+                        true
+                    ),
+                    Ok(true),
+                    "{name}: the patcher reached feed, so the relaxation must be feasible"
+                );
+            }
+        }
+    }
+
+    /// The proof, planted: a pass 1° from the pole on a 5° circle, 15 mm long at F5000 on
+    /// the UCP710 — the tool axis must turn far more than A and C can in 15 mm — is
+    /// infeasible with its last point held; and a relaxation with fewer points movable is
+    /// never feasible where one with more is not (monotone, as a relaxation must be).
+    #[test]
+    fn an_impossible_zone_is_proven_unreachable() {
+        let m = machine("mikron-ucp710");
+        let pass = polepatch_fixturegen::Pass {
+            pole_distance_deg: 1.0,
+            circle_radius_deg: 5.0,
+            half_sweep_deg: 80.0,
+            length_mm: 15.0,
+            spacing_mm: 0.5,
+            feed_mm_min: 5000.0,
+            ..polepatch_fixturegen::Pass::default()
+        };
+        let axes = polepatch_fixturegen::joints(&pass);
+        let path = Path {
+            s_mm: axes.iter().map(|q| q[0]).collect(),
+            axes,
+            feed_mm_min: 5000.0,
+        };
+        let (p, c) = pc(&path);
+        let n = p.len();
+        let lp = |last: usize| {
+            reachable(
+                &path.s_mm,
+                &p,
+                &c,
+                1,
+                last,
+                0..n - 1,
+                &m,
+                5000.0,
+                PatchAxes::Both,
+                true,
+            )
+        };
+        assert_eq!(lp(n - 2), Ok(false), "pinned: no values reach feed");
+        // Movable points a subset: still infeasible.
+        assert_eq!(
+            reachable(
+                &path.s_mm,
+                &p,
+                &c,
+                5,
+                n - 6,
+                0..n - 1,
+                &m,
+                5000.0,
+                PatchAxes::Both,
+                true
+            ),
+            Ok(false)
+        );
+        // The driver's reason for it.
+        let opts = PatchOptions {
+            keep_last_point: true,
+            ..PatchOptions::default()
+        };
+        let res = crate::patch_path(&path, &m, &opts).unwrap();
+        for z in &res.zones {
+            assert_ne!(z.outcome, crate::Outcome::Reached);
+            assert!(
+                matches!(z.reason, Reason::ProvenUnreachable | Reason::EndPinned),
+                "{z:?}"
+            );
+        }
+    }
+
+    /// The range rows are what `ranges` adds: a swing 0.5° from the pole over 30 mm at
+    /// F1000 on the UCP710, every point but the two ends movable. Without the range rows
+    /// the relaxation is feasible (C can make its half turn in 30 mm at ≤ 7.2 °/mm); with a
+    /// primary range [20°, 30°] it is not (the ends sit near 6°, and A, at feed there
+    /// before, cannot jump 14° within one 0.5 mm span) — the two LPs the driver's reason
+    /// `range` compares. (The relaxation says nothing about the orientation: only fixed
+    /// points and the ranges can make it infeasible.)
+    #[test]
+    fn the_range_rows_are_what_ranges_adds() {
+        let mut m = machine("mikron-ucp710");
+        m.primary_range_deg = (20.0, 30.0);
+        let path = planted(61, 0.5, 0.5, false, 1000.0);
+        let (p, c) = pc(&path);
+        let a = crate::analyze_path(&path, &m, &Default::default()).unwrap();
+        let core = zone_core(&a.zones[0], 61, 3);
+        let lp = |ranges| {
+            reachable(
+                &path.s_mm,
+                &p,
+                &c,
+                1,
+                59,
+                core.clone(),
+                &m,
+                1000.0,
+                PatchAxes::Both,
+                ranges,
+            )
+        };
+        assert_eq!(lp(false), Ok(true), "without the range rows");
+        assert_eq!(lp(true), Ok(false), "with them");
+    }
+
+    /// The reference on SING: the best found is at most what the patcher writes (it is
+    /// the same method with more effort) to within the patcher's rounding, and a flip that
+    /// re-selection fixes has reference 0.
+    #[test]
+    fn references_of_sing_and_a_reselectable_flip() {
+        for name in ["mikron-ucp710", "mikron-hsm600"] {
+            let m = machine(name);
+            let path = sing_path();
+            let (p, c) = pc(&path);
+            let n = p.len();
+            let a = crate::analyze_path(&path, &m, &Default::default()).unwrap();
+            let r =
+                zone_reference(&path.s_mm, &p, &c, &a.zones[0], 1, n - 1, &m, 2000.0, 6).unwrap();
+            let ours = crate::patch_path(&path, &m, &PatchOptions::default())
+                .unwrap()
+                .zones[0]
+                .max_deviation_deg;
+            match r {
+                Reference::Best { deviation_deg, .. } => {
+                    assert!(
+                        deviation_deg <= ours * 1.1 + 1e-3,
+                        "{name}: ref {deviation_deg} ours {ours}"
+                    );
+                    assert!(
+                        ours <= 1.25 * deviation_deg,
+                        "{name}: ours {ours} ref {deviation_deg}"
+                    );
+                }
+                other => panic!("{name}: {other:?}"),
+            }
+        }
+        let m = machine("mikron-ucp710");
+        let flip = planted(241, 0.5, 4.0, true, 1000.0);
+        let (p, c) = pc(&flip);
+        let a = crate::analyze_path(&flip, &m, &Default::default()).unwrap();
+        let r = zone_reference(&flip.s_mm, &p, &c, &a.zones[0], 1, 240, &m, 1000.0, 6).unwrap();
+        assert_eq!(
+            r,
+            Reference::Best {
+                deviation_deg: 0.0,
+                method: "reselect"
+            }
+        );
+    }
 }

@@ -32,6 +32,65 @@ pub enum Outcome {
     Unchanged,
 }
 
+/// Why a zone ended as it did: one of a fixed set (Ruckig's `Result` manner), documented
+/// in [`crate::driver`] and `docs/method.md`; the summary table counts them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Reason {
+    /// A patch reaches feed (joint, G16, direct, or a peer's rule).
+    Reached,
+    /// Branch re-selection alone reaches feed: no orientation change.
+    Reselected,
+    /// The run's last point must keep its values, and with it held no values reach feed
+    /// while with it free some would (proven by the relaxation).
+    EndPinned,
+    /// The machine's axis ranges forbid every values that would reach feed (proven).
+    Range,
+    /// A patch reaching feed exists, but it changes the orientation by more than
+    /// `max_deviation_deg`.
+    DeviationCap,
+    /// No values of the movable points reach feed (the relaxation is infeasible: a proof).
+    ProvenUnreachable,
+    /// No patch found, and no proof that there is none (or a patch failed the whole-run
+    /// verification).
+    NotFound,
+    /// The run may not be patched (no TCPM, incremental, …): the zone is only reported.
+    NotPatched,
+}
+
+impl Reason {
+    /// Every reason, in report order.
+    pub const ALL: [Reason; 8] = [
+        Reason::Reached,
+        Reason::Reselected,
+        Reason::EndPinned,
+        Reason::Range,
+        Reason::DeviationCap,
+        Reason::ProvenUnreachable,
+        Reason::NotFound,
+        Reason::NotPatched,
+    ];
+    /// The name used in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Reason::Reached => "reached",
+            Reason::Reselected => "reselected",
+            Reason::EndPinned => "end_pinned",
+            Reason::Range => "range",
+            Reason::DeviationCap => "deviation_cap",
+            Reason::ProvenUnreachable => "proven_unreachable",
+            Reason::NotFound => "not_found",
+            Reason::NotPatched => "not_patched",
+        }
+    }
+}
+
+impl std::fmt::Display for Reason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// Which formulation produced the written values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub enum Method {
@@ -164,11 +223,10 @@ pub struct ZoneReport {
     pub kind: ZoneKind,
     /// Smallest |primary| in the zone, degrees.
     pub min_abs_primary_deg: f64,
-    /// Figures before patching: over `[s(first), s(last)]` for the C-only method, over the
-    /// zone ± `verify::CORE_MARGIN_POINTS` (the stretch that must reach feed) for the joint
-    /// method.
+    /// Figures before patching, over the spans of the zone and of the patch, ± the core
+    /// margin (from the analysis of the whole run).
     pub before: ZoneFigures,
-    /// Figures after patching, same s range, on the values as written.
+    /// Figures after patching, same spans, from the analysis of the whole run as written.
     pub after: ZoneFigures,
     /// L/F over the same range, s.
     pub ideal_time_s: f64,
@@ -185,6 +243,8 @@ pub struct ZoneReport {
     pub patch_length_mm: f64,
     /// Outcome.
     pub outcome: Outcome,
+    /// Why it ended so.
+    pub reason: Reason,
     /// Formulation that produced the values.
     pub method: Method,
     /// Solver statistics.

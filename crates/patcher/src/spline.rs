@@ -1,16 +1,34 @@
 //! The analysis spline (SPEC §2), in one place.
 //!
 //! For each axis of a run, the analysis spline is the not-a-knot interpolating cubic of the
-//! axis values over the tool-tip path length s (knots at the CL points), evaluated at the
-//! samples of [`span_offsets`]: every `F·Tcy` from each CL point and at the last CL point
-//! (so at every knot). Equation 6 is evaluated on its derivatives. Everything in the
-//! patcher that evaluates the spline goes through here:
+//! axis values over the tool-tip path length s (knots at the CL points). Everything in the
+//! patcher that evaluates it goes through here:
 //! - [`SplineSystem`] factors the not-a-knot system once per knot vector (a run, or a
 //!   window of it) and fits any number of axes on it ([`SplineSystem::fit`]);
-//! - [`AnalysisSpline`] evaluates a fitted axis (piecewise-polynomial form);
-//! - [`span_peaks`] reduces a spline to the largest |q'|, |q''|, |q'''| on each span's
-//!   samples, which is all Equation 6 needs to bound a span (its ratio is decreasing in
-//!   each derivative's size).
+//! - [`AnalysisSpline`] evaluates a fitted axis (piecewise-polynomial form), and hands out
+//!   one span at a time as a [`SpanCubic`];
+//! - [`SpanCubic::peaks`] is the exact largest `|q'|`, `|q''|`, `|q'''|` over a span, which
+//!   is all Equation 6 needs to bound it (its ratio is decreasing in each derivative's
+//!   size); [`span_maxima`] does it for every span.
+//!
+//! # Exact per-span bounds instead of sampling at F·Tcy
+//! On a span `[s_k, s_{k+1}]` of length h the spline is one cubic
+//! `q(τ) = a0 + a1·τ + a2·τ² + a3·τ³`, `τ ∈ [0, h]`, so
+//!
+//! ```text
+//! q'(τ)   = a1 + 2·a2·τ + 3·a3·τ²   a quadratic: max |q'| at τ = 0, τ = h or the vertex
+//!                                    τ* = −a2/(3·a3) when it lies inside
+//! q''(τ)  = 2·a2 + 6·a3·τ           linear: max |q''| at τ = 0 or τ = h
+//! q'''    = 6·a3                    constant
+//! ```
+//!
+//! These maxima are exact (to rounding), and the largest of a continuous function over the
+//! span is at least its largest over **any** set of samples in the span — in particular
+//! over SPEC §2's samples every F·Tcy and at every knot. Equation 6 evaluated at the peaks
+//! therefore gives a ratio that is at most the sampled one: the check is at least as strict
+//! as sampling at any Tcy, and costs one evaluation per span and axis whatever the feed and
+//! the block length (a 46 m move at F0.0001 is one span: one evaluation, where sampling at
+//! F·Tcy took 2.8·10¹⁰ samples). See `docs/method.md`.
 //!
 //! The solvers use the same spline in linear form (`crate::hermite`: the knot slopes tied
 //! to the values by the same end conditions), tested against this module.
@@ -18,20 +36,106 @@
 use crate::path::PathError;
 use polepatch_bspline::{NotAKnotSystem, PpCubic};
 
-/// The sampling rule of the analysis on one span of length `h`: local offsets
-/// `0, step, 2·step, … < h` from the span's first knot, and `h` itself when `with_end` (the
-/// last span of a run). `out` is cleared first.
-pub fn span_offsets(h: f64, step: f64, with_end: bool, out: &mut Vec<f64>) {
+/// `count + 1` equally spaced offsets `0, h/count, …, h` on a span of length `h` (both ends
+/// included; `count ≥ 1`), into `out` (cleared first): where a solver places sampled rows
+/// on a span (a bounded number per span, whatever the feed).
+pub fn span_offsets(h: f64, count: usize, out: &mut Vec<f64>) {
     out.clear();
-    let count = (h / step).ceil().max(1.0) as usize;
-    for i in 0..count {
-        let t = i as f64 * step;
-        if t < h {
-            out.push(t);
+    let count = count.max(1);
+    out.extend((0..=count).map(|i| h * i as f64 / count as f64));
+}
+
+/// Range `[min, max]` of `|p|` over `[lo, hi]` for the quadratic `p(τ) = c0 + c1·τ + c2·τ²`
+/// (exact: the range of a continuous function on an interval is spanned by its values at
+/// the ends and at an interior critical point; `|p|` has minimum 0 when that range holds
+/// 0). NaN coefficients give NaN.
+fn abs_range_quadratic(c: [f64; 3], lo: f64, hi: f64) -> (f64, f64) {
+    let p = |t: f64| c[0] + t * (c[1] + t * c[2]);
+    let (a, b) = (p(lo), p(hi));
+    if [a, b, c[0], c[1], c[2]].iter().any(|x| !x.is_finite()) {
+        return (f64::NAN, f64::NAN);
+    }
+    let (mut mn, mut mx) = (a.min(b), a.max(b));
+    if c[2] != 0.0 {
+        let v = -c[1] / (2.0 * c[2]);
+        if v > lo && v < hi {
+            let pv = p(v);
+            mn = mn.min(pv);
+            mx = mx.max(pv);
         }
     }
-    if with_end {
-        out.push(h);
+    let top = mx.abs().max(mn.abs());
+    let bottom = if mn <= 0.0 && mx >= 0.0 {
+        0.0
+    } else {
+        mn.abs().min(mx.abs())
+    };
+    (bottom, top)
+}
+
+/// One span of an analysis spline: its length `h` (mm) and the Taylor coefficients of its
+/// cubic about the span's left knot, `q(τ) = a[0] + a[1]·τ + a[2]·τ² + a[3]·τ³`, τ ∈ [0, h]
+/// (module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpanCubic {
+    /// Span length, mm.
+    pub h: f64,
+    /// Taylor coefficients about the left knot.
+    pub a: [f64; 4],
+}
+
+impl SpanCubic {
+    /// Coefficients of `q'(τ) = c0 + c1·τ + c2·τ²`.
+    fn d1(&self) -> [f64; 3] {
+        [self.a[1], 2.0 * self.a[2], 3.0 * self.a[3]]
+    }
+
+    /// `[q', q'', q''']` at `τ`.
+    pub fn derivs(&self, tau: f64) -> [f64; 3] {
+        let a = &self.a;
+        [
+            a[1] + tau * (2.0 * a[2] + tau * 3.0 * a[3]),
+            2.0 * a[2] + 6.0 * a[3] * tau,
+            6.0 * a[3],
+        ]
+    }
+
+    /// The exact largest `|q'|`, `|q''|`, `|q'''|` over the span, and where the first two
+    /// are reached (τ, mm from the left knot). Non-finite coefficients give NaN peaks (a
+    /// bad spline cannot pass for a smooth one).
+    pub fn peaks(&self) -> ([f64; 3], [f64; 2]) {
+        if self.a.iter().any(|x| !x.is_finite()) || !self.h.is_finite() {
+            return ([f64::NAN; 3], [0.0, 0.0]);
+        }
+        let c = self.d1();
+        let h = self.h;
+        let q1 = |t: f64| (c[0] + t * (c[1] + t * c[2])).abs();
+        let (mut p1, mut at1) = (q1(0.0), 0.0);
+        if q1(h) > p1 {
+            (p1, at1) = (q1(h), h);
+        }
+        if c[2] != 0.0 {
+            let v = -c[1] / (2.0 * c[2]);
+            if v > 0.0 && v < h && q1(v) > p1 {
+                (p1, at1) = (q1(v), v);
+            }
+        }
+        let (d2a, d2b) = (2.0 * self.a[2], 2.0 * self.a[2] + 6.0 * self.a[3] * h);
+        let (p2, at2) = if d2b.abs() > d2a.abs() {
+            (d2b.abs(), h)
+        } else {
+            (d2a.abs(), 0.0)
+        };
+        ([p1, p2, (6.0 * self.a[3]).abs()], [at1, at2])
+    }
+
+    /// The exact smallest and largest `|q'|`, `|q''|`, `|q'''|` over `[lo, hi] ⊂ [0, h]`,
+    /// as `(mins, maxs)`.
+    pub fn abs_range(&self, lo: f64, hi: f64) -> ([f64; 3], [f64; 3]) {
+        let (m1, x1) = abs_range_quadratic(self.d1(), lo, hi);
+        let (m2, x2) = abs_range_quadratic([2.0 * self.a[2], 6.0 * self.a[3], 0.0], lo, hi);
+        let j = (6.0 * self.a[3]).abs();
+        ([m1, m2, j], [x1, x2, j])
     }
 }
 
@@ -91,33 +195,23 @@ impl AnalysisSpline {
     pub fn eval_derivs_sorted(&self, ts: &[f64], out: &mut [[f64; 4]]) {
         self.pp.eval_derivs_sorted(ts, out);
     }
-}
 
-/// For every span `k` of `s_mm` (`[s_k, s_{k+1}]`), the largest `|q'|`, `|q''|`, `|q'''|`
-/// of `spline` over the span's samples ([`span_offsets`] with `step_mm`, the end knot
-/// included on the last span).
-pub fn span_peaks(s_mm: &[f64], spline: &AnalysisSpline, step_mm: f64) -> Vec<[f64; 3]> {
-    let n = s_mm.len();
-    let mut ts = Vec::new();
-    let mut at = Vec::new();
-    let mut span_of = Vec::new();
-    for k in 0..n.saturating_sub(1) {
-        span_offsets(s_mm[k + 1] - s_mm[k], step_mm, k + 2 == n, &mut ts);
-        at.extend(ts.iter().map(|t| s_mm[k] + t));
-        span_of.extend(std::iter::repeat_n(k, ts.len()));
-    }
-    let mut d = vec![[0.0; 4]; at.len()];
-    spline.eval_derivs_sorted(&at, &mut d);
-    let mut peak = vec![[0.0f64; 3]; n.saturating_sub(1)];
-    for (k, e) in span_of.iter().zip(&d) {
-        let pk = &mut peak[*k];
-        for (m, v) in pk.iter_mut().zip(&e[1..]) {
-            // NaN propagates as NaN (f64::max would drop it), so a bad spline cannot
-            // pass for a smooth one.
-            *m = if v.is_nan() { f64::NAN } else { m.max(v.abs()) };
+    /// The span `[s0, s0 + h]` (between two consecutive knots) as a [`SpanCubic`].
+    pub fn span(&self, s0: f64, h: f64) -> SpanCubic {
+        let d = self.pp.eval_derivs(s0);
+        SpanCubic {
+            h,
+            a: [d[0], d[1], 0.5 * d[2], d[3] / 6.0],
         }
     }
-    peak
+}
+
+/// For every span `k` of `s_mm` (`[s_k, s_{k+1}]`), the exact largest `|q'|`, `|q''|`,
+/// `|q'''|` of `spline` over the span ([`SpanCubic::peaks`]).
+pub fn span_maxima(s_mm: &[f64], spline: &AnalysisSpline) -> Vec<[f64; 3]> {
+    s_mm.windows(2)
+        .map(|w| spline.span(w[0], w[1] - w[0]).peaks().0)
+        .collect()
 }
 
 /// The largest change of `|q'|`, `|q''|`, `|q'''|` on the spans `spans` of the knots `s_mm`
@@ -144,36 +238,147 @@ pub fn rounding_gain(s_mm: &[f64], spans: std::ops::Range<usize>) -> Result<[f64
 mod tests {
     use super::*;
 
-    /// The sample offsets: every step from 0, below h, and h itself on request.
+    /// The solver's sample offsets: `count + 1` points, both ends, equally spaced.
     #[test]
-    fn offsets_follow_the_sampling_rule() {
+    fn offsets_cover_the_span() {
         let mut o = Vec::new();
-        span_offsets(1.0, 0.3, false, &mut o);
-        assert_eq!(o.len(), 4);
-        span_offsets(1.0, 0.3, true, &mut o);
-        assert_eq!(*o.last().unwrap(), 1.0);
-        span_offsets(0.1, 0.3, false, &mut o);
-        assert_eq!(o, vec![0.0]);
+        span_offsets(1.0, 4, &mut o);
+        assert_eq!(o, vec![0.0, 0.25, 0.5, 0.75, 1.0]);
+        span_offsets(0.1, 0, &mut o);
+        assert_eq!(o, vec![0.0, 0.1]);
     }
 
     /// A cubic is reproduced by its not-a-knot interpolant, so the peaks are the cubic's:
-    /// q = s³ on [0, 4]: q' = 3s², q'' = 6s, q''' = 6, largest at each span's right end
-    /// (sampled exactly when the step divides the spacing).
+    /// q = s³ on [0, 4]: q' = 3s², q'' = 6s, q''' = 6, largest at each span's right end,
+    /// exactly (no sampling).
     #[test]
     fn peaks_of_a_planted_cubic() {
         let s: Vec<f64> = (0..5).map(|i| i as f64).collect();
         let y: Vec<f64> = s.iter().map(|x| x * x * x).collect();
         let sp = AnalysisSpline::new(&s, &y).unwrap();
-        let pk = span_peaks(&s, &sp, 0.25);
+        let pk = span_maxima(&s, &sp);
         assert_eq!(pk.len(), 4);
         for (k, p) in pk.iter().enumerate() {
-            // The right end of span k is sampled only on the last span; elsewhere the last
-            // sample is 0.25 before it.
-            let r = if k == 3 { 4.0 } else { k as f64 + 0.75 };
+            let r = k as f64 + 1.0;
             assert!((p[0] - 3.0 * r * r).abs() < 1e-9, "{k}: {p:?}");
             assert!((p[1] - 6.0 * r).abs() < 1e-9, "{k}: {p:?}");
             assert!((p[2] - 6.0).abs() < 1e-9, "{k}: {p:?}");
         }
+    }
+
+    /// splitmix64, for the seeded sweeps below.
+    fn rng(seed: u64) -> impl FnMut() -> f64 {
+        let mut x = seed;
+        move || {
+            x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = x;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        }
+    }
+
+    /// The exact peaks and ranges against dense sampling, on random cubics (vertex inside
+    /// or outside, sign changes, degenerate a3 = 0 and a2 = a3 = 0): every sample lies in
+    /// the range, and the range's ends are reached by some sample to within the sampling's
+    /// resolution. The peak is where it says it is.
+    #[test]
+    fn exact_peaks_and_ranges_bound_dense_samples() {
+        let mut r = rng(7);
+        for case in 0..500 {
+            let mut a = [r() * 10.0, r() * 10.0, r() * 10.0, r() * 10.0];
+            if case % 7 == 0 {
+                a[3] = 0.0;
+            }
+            if case % 11 == 0 {
+                a[2] = 0.0;
+                a[3] = 0.0;
+            }
+            let h = 0.1 + 2.0 * (r() + 1.0);
+            let sc = SpanCubic { h, a };
+            let (pk, at) = sc.peaks();
+            let (lo, hi) = (h * 0.25 * (r() + 1.0), h * (0.5 + 0.25 * (r() + 1.0)));
+            let (mins, maxs) = sc.abs_range(lo, hi);
+            let mut dense_max = [0.0f64; 3];
+            let (mut in_min, mut in_max) = ([f64::INFINITY; 3], [0.0f64; 3]);
+            for i in 0..=20_000 {
+                let t = h * f64::from(i) / 20_000.0;
+                let d = sc.derivs(t);
+                for m in 0..3 {
+                    dense_max[m] = dense_max[m].max(d[m].abs());
+                    assert!(d[m].abs() <= pk[m] * (1.0 + 1e-12) + 1e-12, "{case}: {m}");
+                }
+                if t >= lo && t <= hi {
+                    for m in 0..3 {
+                        in_min[m] = in_min[m].min(d[m].abs());
+                        in_max[m] = in_max[m].max(d[m].abs());
+                        assert!(d[m].abs() >= mins[m] - 1e-9 && d[m].abs() <= maxs[m] + 1e-9);
+                    }
+                }
+            }
+            for m in 0..3 {
+                let tol = 1e-3 * (1.0 + pk[m]);
+                assert!(
+                    pk[m] - dense_max[m] < tol,
+                    "{case}: {m} {pk:?} {dense_max:?}"
+                );
+                assert!(
+                    in_min[m] - mins[m] < tol && maxs[m] - in_max[m] < tol,
+                    "{case}: {m}"
+                );
+            }
+            assert!((sc.derivs(at[0])[0].abs() - pk[0]).abs() < 1e-9);
+            assert!((sc.derivs(at[1])[1].abs() - pk[1]).abs() < 1e-9);
+        }
+        // NaN never passes for a smooth span.
+        let bad = SpanCubic {
+            h: 1.0,
+            a: [0.0, f64::NAN, 0.0, 0.0],
+        };
+        assert!(bad.peaks().0.iter().all(|v| v.is_nan()));
+        assert!(bad.abs_range(0.0, 1.0).1[0].is_nan());
+    }
+
+    /// At least as strict as SPEC §2's sampling: on an interpolant of random data, the exact
+    /// span maxima are ≥ the largest derivative over the samples every F·Tcy and at every
+    /// knot, for several steps — and the vertex of q' between samples is found.
+    #[test]
+    fn exact_maxima_are_at_least_the_sampled_ones() {
+        let mut r = rng(11);
+        let s: Vec<f64> = (0..40)
+            .scan(0.0, |acc, _| {
+                *acc += 0.2 + r().abs();
+                Some(*acc)
+            })
+            .collect();
+        let y: Vec<f64> = s.iter().map(|_| 20.0 * r()).collect();
+        let sp = AnalysisSpline::new(&s, &y).unwrap();
+        let exact = span_maxima(&s, &sp);
+        let mut strictly_above = 0;
+        for step in [0.5, 0.1, 1.0 / 60.0] {
+            for k in 0..s.len() - 1 {
+                let (a, b) = (s[k], s[k + 1]);
+                let mut t = a;
+                let mut sampled = [0.0f64; 3];
+                while t <= b {
+                    let d = sp.eval_derivs(t.min(b - 1e-12));
+                    for m in 0..3 {
+                        sampled[m] = sampled[m].max(d[m + 1].abs());
+                    }
+                    t += step;
+                }
+                for m in 0..3 {
+                    assert!(
+                        exact[k][m] >= sampled[m] * (1.0 - 1e-12),
+                        "span {k} order {m}"
+                    );
+                    if exact[k][m] > sampled[m] * (1.0 + 1e-6) {
+                        strictly_above += 1;
+                    }
+                }
+            }
+        }
+        assert!(strictly_above > 0, "coarse sampling misses some peaks");
     }
 
     /// The rounding gain bounds what an actual worst-case perturbation does, and is reached

@@ -1,60 +1,90 @@
-//! Whether a run may end in another pose than the program's.
+//! Whether a run may end in another pose than the program's, which block says so, and
+//! which blocks after it restate its last values.
 //!
-//! A patch may change the values of a run's last point — and a branch re-selection puts the
-//! last point on the other IK branch, `(P, C) → (−P, C ± 180°)`: the same tool axis, but
-//! the table turned half a revolution about it. What happens after the run then moves from
-//! that pose. Writing the program's values back into the next move (a "restoring" word)
-//! does not help: that move would then swing the table during its own motion — with TCPM
-//! off and the tool still at the part, that moves the part under the tool.
+//! A patch may change the values of a run's last point — and a branch re-selection puts
+//! the last point on the other IK branch, `(P, C) → (−P, C ± 180°)`: the same tool axis,
+//! but the table turned half a revolution about it. What happens after the run then moves
+//! from that pose. The blocks after the run are read in order until one decides:
 //!
-//! So the last point of a run may change only when every move after it, up to the block
-//! that programs both rotary axes again, is independent of the pose:
-//! - a move with TCPM active and no rotary word (the controller keeps the tool axis and
-//!   moves the tool tip in part coordinates: the same motion relative to the part);
-//! - a move with TCPM off and no rotary word that changes only Z (along the tool axis, which
-//!   both poses share);
-//! - the block that programs both rotary axes again counts when it moves nothing else (a
-//!   rotary-only repositioning, as the program already had there);
-//! - a tool change (T, M6) or the program's end (M2, M30), or the end of the file, ends the
-//!   scan (free).
+//! **Independent of the pose** (the scan goes on):
+//! - a move with TCPM active and no rotary word: the controller keeps the tool axis and
+//!   moves the tool tip in part coordinates — the same motion relative to the part from
+//!   either pose. A Z-only move up under TCPM is a **retract**: the highest part-frame Z it
+//!   reaches is the program's **clearance**;
+//! - a move with TCPM off and no rotary word that changes only Z (along the tool axis,
+//!   which both poses share);
+//! - a move that **restates** the run's last rotary values (every rotary word it has
+//!   equals the value in force: a retract such as `G0 Z+50 A… C…`), with TCPM active or
+//!   moving only Z: it moves nothing rotary from either pose. It is rewritten with the
+//!   run's new last values — the same orientation on the new branch — so it restates them
+//!   still ([`EndPose::restate`]).
 //!
-//! Anything else — a move with X or Y in machine coordinates, a move that programs one
-//! rotary axis alone, a rotary word together with a linear move, incremental mode — fixes
-//! the last point (`keep_last_point`). No rotary word is ever written after a run's last
-//! point. (A next run that starts at this run's last block is covered by the same rules:
-//! if its first move programs the rotary axes, the last point stays; if not, its rotary
-//! values are the modal ones, whatever they are.)
+//! **Free** (the last point may change):
+//! - a tool change (T, M6) or the program's end (M2, M30), or the end of the file;
+//! - a block that programs both rotary axes and moves nothing else (a rotary-only
+//!   repositioning, as C17's `%SING` has);
+//! - **a positioning move above the clearance**: under TCPM, a move with rotary words whose
+//!   tool tip starts and ends at or above the clearance the program itself retracted to
+//!   (X and Y may move). *Proof.* The part and its fixtures lie below the clearance the
+//!   program retracted to (that is what a retract height is). Under TCPM the controller
+//!   moves the tool tip in the part frame on the programmed line between the block's end
+//!   points, both at Z ≥ clearance, so the tip stays at Z ≥ clearance during the move,
+//!   whatever the rotary axes do and from whichever pose they start; the tool extends
+//!   from the tip along the tool axis, away from the part (|P| < 90°: the axis points up),
+//!   so no point of the tool comes below the clearance. Starting from the other branch
+//!   only changes how the table turns under that tool tip (C travels up to 180° more).
+//!   (This holds for controllers that interpolate the tool tip linearly under TCPM, which
+//!   Heidenhain M128, Sinumerik TRAORI and Fanuc G43.4 with linear rapid do; a machine
+//!   set up for non-linear rapid positioning under TCPM should pin run ends — a caller
+//!   can — as this module cannot see its parameters.)
+//!
+//! **Pinned** (the last point keeps its values; [`EndPose::decided_line`] says which block):
+//! anything else — a move with X or Y in machine coordinates, a move that changes a rotary
+//! axis below the clearance or with TCPM off (together with a linear move, or one rotary
+//! axis alone), a positioning move before any retract, incremental mode, a non-move naming
+//! a rotary axis (a datum shift on it), or a restating block that belongs to another run
+//! (it cannot be rewritten for this one). No rotary word other than a restating block's is
+//! ever written after a run's last point.
+//!
+//! A run without TCPM is pinned by the pipeline whatever follows (its X Y Z are machine
+//! coordinates: [`crate::patch`]).
 
 use crate::program::LoadedProgram;
-use polepatch_nc::modal::{C, X, Y};
-use polepatch_nc::{Modal, Word};
+use polepatch_nc::modal::{C, X, Y, Z};
+use polepatch_nc::{Flags, Modal, Word};
 
-/// Whether the moves after run `r` of `lp` are independent of the pose its last point is
-/// in (module docs).
-pub fn end_pose_is_free(lp: &LoadedProgram, r: usize) -> bool {
-    if let Some(w) = &lp.window {
-        return w.end_free[r];
-    }
-    let program = &lp.program;
-    let run = &lp.runs[r].run;
-    let Some(&last) = run.blocks.last() else {
-        return false;
-    };
-    let mut prev = program.state(last);
-    for b in last + 1..program.blocks.len() {
-        let st = program.state(b);
-        let after = After {
-            words: program.block_words(b),
-            is_move: program.blocks[b].is_move,
-            state: &st,
-            before: &prev,
-        };
-        if let Some(free) = after.verdict(lp.primary_letter) {
-            return free;
-        }
-        prev = st;
-    }
-    true
+/// What the blocks after a run say about its last point.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct EndPose {
+    /// The last point may change (module docs).
+    pub free: bool,
+    /// The 1-based file line of the block that decided (`None`: the end of the file).
+    pub decided_line: Option<usize>,
+    /// Blocks before the deciding one that restate the run's last rotary values: when the
+    /// last point changes they are rewritten with its new values.
+    pub restate: Vec<usize>,
+}
+
+/// One block's answer (see [`After::verdict`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Step {
+    /// The last point may change.
+    Free,
+    /// The last point keeps its values.
+    Pinned,
+    /// This block does not decide.
+    Continue,
+    /// This block restates the run's last values (rewritten when they change); it does
+    /// not decide.
+    Restate,
+}
+
+/// What the scan after a run has seen so far (the program's clearance).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Scan {
+    /// The highest part-frame Z a retract (a Z-only move up under TCPM) reached since the
+    /// run's last point, mm.
+    pub clearance_mm: Option<f64>,
 }
 
 /// One block after a run's last point, for [`After::verdict`].
@@ -64,6 +94,10 @@ pub struct After<'a> {
     pub words: &'a [Word],
     /// It moves ([`polepatch_nc::Block::is_move`]).
     pub is_move: bool,
+    /// What the reader marked on it ([`polepatch_nc::Block::flags`]): a tool change or the
+    /// program's end in any dialect (Heidenhain `TOOL CALL`, `END PGM` included), and
+    /// block delete.
+    pub flags: Flags,
     /// The modal state after it.
     pub state: &'a Modal,
     /// The modal state before it.
@@ -71,19 +105,33 @@ pub struct After<'a> {
 }
 
 impl After<'_> {
-    /// What this block says about the pose of the last point before it, for a program
-    /// whose tilting letter is `primary` (`b'A'` or `b'B'`): `Some(true)` free,
-    /// `Some(false)` fixed, `None` the next block decides (module docs). The answer for a
-    /// run is that of the first block after it that decides, free at the end of the file.
-    pub fn verdict(&self, primary: u8) -> Option<bool> {
+    /// What this block says about the pose of the run's last point before it, for a
+    /// program whose tilting letter is `primary` (`b'A'` or `b'B'`), given what the scan
+    /// saw so far (updated: a retract raises the clearance). Module docs.
+    pub fn verdict(&self, primary: u8, scan: &mut Scan) -> Step {
+        let step = self.verdict_executed(primary, scan);
+        // A block the operator may skip (block delete) cannot free the end: skipped, the
+        // blocks after it move from the run's last pose. As a restatement it is still
+        // rewritten (executed, it restates the new values; skipped, it does nothing).
+        if step == Step::Free && self.flags.has(Flags::SKIPPABLE) {
+            return Step::Pinned;
+        }
+        step
+    }
+
+    /// [`After::verdict`] for a block that is executed.
+    fn verdict_executed(&self, primary: u8, scan: &mut Scan) -> Step {
+        if self.flags.has(Flags::TOOL_CHANGE) || self.flags.has(Flags::PROGRAM_END) {
+            return Step::Free;
+        }
         let has = |l: u8| self.words.iter().any(|w| w.letter == l);
         let m_code = |v: f64| self.words.iter().any(|w| w.letter == b'M' && w.value == v);
         if has(b'T') || m_code(6.0) || m_code(2.0) || m_code(30.0) {
-            return Some(true);
+            return Step::Free;
         }
         let (st, prev) = (self.state, self.before);
         if st.incremental {
-            return Some(false);
+            return Step::Pinned;
         }
         let p_idx = if primary == b'A' {
             polepatch_nc::modal::A
@@ -91,24 +139,118 @@ impl After<'_> {
             polepatch_nc::modal::B
         };
         let (has_p, has_c) = (has(primary), has(b'C'));
-        let linear_moves = st.pos[..3] != prev.pos[..3];
-        if self.is_move {
-            if has_p && has_c {
-                return Some(!linear_moves);
-            }
-            if has_p || has_c {
-                return Some(false);
-            }
-            let xy_moves = st.pos[X] != prev.pos[X] || st.pos[Y] != prev.pos[Y];
-            if !st.tcpm.is_on() && xy_moves {
-                return Some(false);
-            }
-        } else if st.pos[p_idx] != prev.pos[p_idx] || st.pos[C] != prev.pos[C] {
+        let rotary_moves = st.pos[p_idx] != prev.pos[p_idx] || st.pos[C] != prev.pos[C];
+        let xy_moves = st.pos[X] != prev.pos[X] || st.pos[Y] != prev.pos[Y];
+        let z_moves = st.pos[Z] != prev.pos[Z];
+        if !self.is_move {
             // A non-move that names a rotary axis (a datum shift on it): be safe.
-            return Some(false);
+            return if rotary_moves {
+                Step::Pinned
+            } else {
+                Step::Continue
+            };
         }
-        None
+        // A Z-only move up under TCPM (restating the rotary values or not) is a retract.
+        if st.tcpm.is_on()
+            && !xy_moves
+            && !rotary_moves
+            && let (Some(z0), Some(z1)) = (prev.pos[Z], st.pos[Z])
+            && z1 > z0
+        {
+            scan.clearance_mm = Some(scan.clearance_mm.map_or(z1, |c| c.max(z1)));
+        }
+        if has_p || has_c {
+            if !rotary_moves && (st.tcpm.is_on() || !xy_moves) {
+                return Step::Restate;
+            }
+            if has_p && has_c && !xy_moves && !z_moves {
+                return Step::Free; // a rotary-only repositioning
+            }
+            let above =
+                |z: Option<f64>| matches!((z, scan.clearance_mm), (Some(z), Some(c)) if z >= c);
+            if st.tcpm.is_on() && prev.tcpm.is_on() && above(prev.pos[Z]) && above(st.pos[Z]) {
+                return Step::Free; // a positioning move above the clearance
+            }
+            return Step::Pinned;
+        }
+        if st.tcpm.is_on() {
+            return Step::Continue;
+        }
+        if xy_moves {
+            return Step::Pinned;
+        }
+        Step::Continue
     }
+}
+
+/// The end pose of run `r` of `lp` (module docs): from the whole file when `lp` is a
+/// stretch of it ([`crate::program::Window`]), else from the blocks after the run.
+pub fn end_pose(lp: &LoadedProgram, r: usize) -> EndPose {
+    if let Some(w) = &lp.window {
+        return w.end[r].clone();
+    }
+    let program = &lp.program;
+    let run = &lp.runs[r].run;
+    let Some(&last) = run.blocks.last() else {
+        return EndPose::default();
+    };
+    // Restating blocks must lie before the next run's first block (it cannot be rewritten
+    // for this run once it is another's).
+    let next_run_start = lp
+        .runs
+        .iter()
+        .filter_map(|rp| rp.run.blocks.first().copied())
+        .filter(|&b| b > last)
+        .min();
+    let mut prev = program.state(last);
+    let mut scan = Scan::default();
+    let mut restate = Vec::new();
+    for b in last + 1..program.blocks.len() {
+        let st = program.state(b);
+        let after = After {
+            words: program.block_words(b),
+            is_move: program.blocks[b].is_move,
+            flags: program.blocks[b].flags,
+            state: &st,
+            before: &prev,
+        };
+        match after.verdict(lp.primary_letter, &mut scan) {
+            Step::Free => {
+                return EndPose {
+                    free: true,
+                    decided_line: Some(program.blocks[b].line),
+                    restate,
+                };
+            }
+            Step::Pinned => {
+                return EndPose {
+                    free: false,
+                    decided_line: Some(program.blocks[b].line),
+                    restate: Vec::new(),
+                };
+            }
+            Step::Restate if next_run_start.is_some_and(|n| b >= n) => {
+                return EndPose {
+                    free: false,
+                    decided_line: Some(program.blocks[b].line),
+                    restate: Vec::new(),
+                };
+            }
+            Step::Restate => restate.push(b),
+            Step::Continue => {}
+        }
+        prev = st;
+    }
+    EndPose {
+        free: true,
+        decided_line: None,
+        restate,
+    }
+}
+
+/// Whether the moves after run `r` of `lp` leave its last point free ([`end_pose`]).
+pub fn end_pose_is_free(lp: &LoadedProgram, r: usize) -> bool {
+    end_pose(lp, r).free
 }
 
 #[cfg(test)]
@@ -117,12 +259,14 @@ mod tests {
     use crate::program::load_nc;
     use polepatch_kinematics::Machine;
 
-    fn free(text: &str) -> Vec<bool> {
+    fn poses(text: &str) -> Vec<EndPose> {
         let m = Machine::builtin("mikron-ucp710").unwrap();
         let lp = load_nc(text.as_bytes().to_vec(), "t", &m, None).unwrap();
-        (0..lp.runs.len())
-            .map(|r| end_pose_is_free(&lp, r))
-            .collect()
+        (0..lp.runs.len()).map(|r| end_pose(&lp, r)).collect()
+    }
+
+    fn free(text: &str) -> Vec<bool> {
+        poses(text).iter().map(|e| e.free).collect()
     }
 
     const CUT: &str = "M128\nG1 X0 Y0 Z0 A5 C10 F1000\nX1 A4 C20\nX2 A3 C30\n";
@@ -132,13 +276,16 @@ mod tests {
         assert_eq!(free(&format!("{CUT}M30\n")), [true]);
         assert_eq!(free(&format!("{CUT}T2 M6\nG0 X50 Y50\n")), [true]);
         assert_eq!(free(CUT), [true]);
+        assert_eq!(poses(CUT)[0].decided_line, None);
     }
 
     /// C17's `%SING` ends with M00, M129, a Z-only retract, a rotary-only move: free.
     #[test]
     fn retract_along_the_tool_axis_then_rotary_only_is_free() {
         let text = format!("{CUT}M00\nM129\nG1 Z150\nA0 C0\nX0 Y0\nM30\n");
-        assert!(free(&text)[0]);
+        let e = &poses(&text)[0];
+        assert!(e.free);
+        assert_eq!(e.decided_line, Some(8), "the rotary-only block decides");
     }
 
     #[test]
@@ -150,13 +297,44 @@ mod tests {
     }
 
     /// Machine-coordinate X/Y moves, one rotary word alone, rotary words with a linear
-    /// move: the pose matters, the last point stays.
+    /// move below any clearance: the pose matters, the last point stays.
     #[test]
     fn pose_dependent_moves_fix_the_last_point() {
         assert_eq!(free(&format!("{CUT}M129\nG0 X50\nM30\n")), [false]);
         assert_eq!(free(&format!("{CUT}G0 Z50 C0\nM30\n")), [false]);
         assert_eq!(free(&format!("{CUT}G0 Z50 A0 C0\nM30\n")), [false]);
         assert_eq!(free(&format!("{CUT}G91\nG0 Z5\nM30\n")), [false]);
+        // A positioning move with no retract before it, or one that descends below the
+        // clearance, or with TCPM off.
+        assert_eq!(free(&format!("{CUT}G0 X40 Y5 A10 C90\nM30\n")), [false]);
+        assert_eq!(
+            free(&format!("{CUT}G0 Z50\nG0 X40 Y5 Z20 A10 C90\nM30\n")),
+            [false]
+        );
+        assert_eq!(
+            free(&format!("{CUT}G0 Z50\nM129\nG0 X40 Y5 A10 C90\nM30\n")),
+            [false]
+        );
+    }
+
+    /// Issue 21 §3: the way CAM posts start the next pass — a retract, then one
+    /// positioning move with X Y and both rotary axes at that clearance under TCPM — leaves
+    /// the last point free, decided by the positioning move; a retract that restates the
+    /// run's last values is listed for rewriting.
+    #[test]
+    fn positioning_above_the_clearance_is_free() {
+        let e = &poses(&format!("{CUT}G0 Z50\nG0 X40 Y5 A10 C90\nG1 Z0\nM30\n"))[0];
+        assert!(e.free, "{e:?}");
+        assert_eq!(e.decided_line, Some(6));
+        assert!(e.restate.is_empty());
+        // With the retract restating A and C (line 5), and the positioning move above it.
+        let e = &poses(&format!("{CUT}G0 Z50 A3 C30\nG0 X40 Y5 Z60 A10 C90\nM30\n"))[0];
+        assert!(e.free, "{e:?}");
+        assert_eq!((e.decided_line, e.restate.clone()), (Some(6), vec![4]));
+        // A restating block whose Z is below a later positioning move's start is fine; one
+        // that is another run's first point is not rewritten: pinned.
+        let e = &poses(&format!("{CUT}G0 Z50 A3 C30\nG1 Z0 F500\nX5\nM30\n"))[0];
+        assert!(!e.free, "{e:?}");
     }
 
     /// A feed change splits the motion into two runs sharing a point: when the second

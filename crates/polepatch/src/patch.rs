@@ -88,6 +88,16 @@ pub struct ZoneRow {
     pub patch_length_mm: f64,
     /// `reached`, `improved` or `unchanged`.
     pub outcome: &'static str,
+    /// Why (a fixed set: [`polepatch_patcher::Reason`]): `reached`, `reselected`,
+    /// `end_pinned`, `range`, `deviation_cap`, `proven_unreachable`, `not_found`,
+    /// `not_patched`.
+    pub reason: &'static str,
+    /// Whether the run's last point could change: `free` or `pinned`
+    /// ([`crate::end_pose`]); `-` for a run that was not patched.
+    pub end_pose: &'static str,
+    /// File line of the block after the run that decided its end pose (`None`: the end of
+    /// the file, or a run without TCPM, whose end is always pinned).
+    pub end_pose_line: Option<usize>,
     /// `reselect`, `joint`, `g16-patch`, `direct` or `none`.
     pub method: &'static str,
     /// Last solver status.
@@ -158,7 +168,7 @@ fn method_name(m: Method) -> &'static str {
 
 impl ZoneRow {
     /// CSV column names of [`ZoneRow::csv_fields`] (the row's fields after `file`).
-    pub const CSV_COLUMNS: [&'static str; 32] = [
+    pub const CSV_COLUMNS: [&'static str; 35] = [
         "run",
         "first_line",
         "last_line",
@@ -182,6 +192,9 @@ impl ZoneRow {
         "reselected_points",
         "patch_length_mm",
         "outcome",
+        "reason",
+        "end_pose",
+        "end_pose_line",
         "method",
         "qp_status",
         "qp_iterations",
@@ -226,6 +239,9 @@ impl ZoneRow {
             self.reselected_points.to_string(),
             format!("{:.3}", self.patch_length_mm),
             self.outcome.to_string(),
+            self.reason.to_string(),
+            self.end_pose.to_string(),
+            self.end_pose_line.map_or(String::new(), |l| l.to_string()),
             self.method.to_string(),
             self.qp_status.to_string(),
             self.qp_iterations.to_string(),
@@ -256,6 +272,9 @@ impl ZoneRow {
             reselected_points: z.reselected_points,
             patch_length_mm: z.patch_length_mm,
             outcome: outcome_name(z.outcome),
+            reason: z.reason.name(),
+            end_pose: "-",
+            end_pose_line: None,
             method: method_name(z.method),
             qp_status: z.qp.status,
             qp_iterations: z.qp.iterations,
@@ -549,10 +568,11 @@ pub fn patch_program(
             }
             continue;
         }
+        let end = crate::end_pose::end_pose(lp, r);
         let run_opts = PatchOptions {
             // Without TCPM the moves after the run are in machine coordinates: the last
             // point keeps its values (X Y Z included).
-            keep_last_point: !rp.run.tcpm.is_on() || !crate::end_pose::end_pose_is_free(lp, r),
+            keep_last_point: !rp.run.tcpm.is_on() || !end.free,
             ..opts.clone()
         };
         // Without TCPM (and with a chain) the patcher works on the part-frame path.
@@ -583,9 +603,20 @@ pub fn patch_program(
             }
         };
         let first_row = report.zones.len();
-        report
-            .zones
-            .extend(result.zones.iter().map(|z| ZoneRow::new(lp, r, z)));
+        report.zones.extend(result.zones.iter().map(|z| {
+            let mut row = ZoneRow::new(lp, r, z);
+            row.end_pose = if run_opts.keep_last_point {
+                "pinned"
+            } else {
+                "free"
+            };
+            row.end_pose_line = if rp.run.tcpm.is_on() {
+                end.decided_line
+            } else {
+                None
+            };
+            row
+        }));
         let mut run_edits: Vec<Edit> = Vec::new();
         if let Some((ch, d)) = chain {
             match through_chain(
@@ -605,6 +636,7 @@ pub fn patch_program(
                 Err(why) => {
                     for row in &mut report.zones[first_row..] {
                         row.not_written();
+                        row.reason = polepatch_patcher::Reason::NotPatched.name();
                     }
                     report.untouched_runs.push(untouched(
                         lp,
@@ -650,6 +682,21 @@ pub fn patch_program(
                     decimals,
                 });
             }
+            // The run ends on new values: the blocks after it that restated its last
+            // values restate the new ones (crate::end_pose).
+            let n = rp.run.len();
+            if !run_opts.keep_last_point && changed[n - 1] {
+                for &b in &end.restate {
+                    if program.block_words(b).iter().any(|w| w.letter == letter) {
+                        edits.push(Edit {
+                            block: b,
+                            letter,
+                            value: values[n - 1],
+                            decimals,
+                        });
+                    }
+                }
+            }
         }
     }
     let file_decimals = |l: u8| {
@@ -659,9 +706,9 @@ pub fn patch_program(
             p_style.decimals
         }
     };
-    // Inside a run, a point that relied on a modal value keeps it; after a run nothing is
-    // written: its end point only moves when what follows does not depend on the pose
-    // (crate::end_pose).
+    // Inside a run, a point that relied on a modal value keeps it; after a run only the
+    // blocks that restate its last values are written: its end point only moves when what
+    // follows does not depend on the pose (crate::end_pose).
     let run_of: std::collections::HashMap<usize, usize> = lp
         .runs
         .iter()

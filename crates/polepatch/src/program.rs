@@ -121,9 +121,9 @@ pub struct Window {
     pub first_run: usize,
     /// The whole file's number style.
     pub style: FileStyle,
-    /// Whether the run's end pose is free ([`crate::end_pose`]), decided on the blocks
-    /// after it in the whole file.
-    pub end_free: Vec<bool>,
+    /// The run's end pose ([`crate::end_pose`]), decided on the blocks after it in the
+    /// whole file (restating blocks numbered in the stretch's program).
+    pub end: Vec<crate::end_pose::EndPose>,
     /// The run's work offset ([`crate::machine_frame::run_datum`]) from the whole file's
     /// frame changes.
     pub datum_mm: Vec<Option<[f64; 3]>>,

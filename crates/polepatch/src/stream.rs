@@ -12,11 +12,14 @@
 //!    either tilting letter, whether it has a feed; which letters the runs use (the
 //!    tilting letter in use, [`polepatch_nc::primary_in_use`]); the file's number style
 //!    ([`polepatch_nc::StyleEvidence`]); the frame changes (for the work offset,
-//!    [`crate::machine_frame::datum_at`]); and for every run whether its end pose is free
+//!    [`crate::machine_frame::datum_at`]); and for every run its end pose
 //!    ([`crate::end_pose::After::verdict`], decided by the first block after the run that
-//!    decides, for both tilting letters since the one in use is known only at the end).
+//!    decides, with the blocks before it that restate the run's last values — for both
+//!    tilting letters since the one in use is known only at the end).
 //! 2. **Stretches.** A run near the pole (or without a feed, which the report lists) is
-//!    a stretch from its first block (point 0) to its last. Two runs may share a block (a
+//!    a stretch from its first block (point 0) to its last — or to the last block after
+//!    it that restates its last values, when its end is free (that block is rewritten
+//!    with it; such a block never belongs to another run). Two runs may share a block (a
 //!    feed change splits a path into two runs with a common point): the block is then in
 //!    both stretches, and written with the first (the whole-program path builds every
 //!    run's path from the original values too, and never changes a run's first point, so
@@ -45,7 +48,7 @@
 //! so one giant run costs ~10× its own bytes; runs that share a block are not joined, so a
 //! program of many runs is bounded by its longest run.
 
-use crate::end_pose::After;
+use crate::end_pose::{After, EndPose, Scan, Step};
 use crate::error::Error;
 use crate::patch::{FileReport, patch_loaded, patch_program};
 use crate::program::{LoadedProgram, RunPath, Window, load_nc, primary_mismatch_warning, run_path};
@@ -79,13 +82,55 @@ struct RunRec {
     /// (a value never programmed reads as 0, as [`Run::axes5`] reads it).
     near: [bool; 2],
     /// The run cannot be analysed if A (index 0) or B (index 1) is the tilting letter (no
-    /// feed, a feed too low, G93 with differing block feeds, an unknown rotary value:
-    /// [`crate::program::run_check`]): the report lists it.
+    /// feed, a feed too low, an unknown rotary value: [`crate::program::run_check`]): the
+    /// report lists it.
     feedless: [bool; 2],
-    /// End pose free, per tilting letter; `None` until a later block decides.
-    end_free: [Option<bool>; 2],
+    /// End pose per tilting letter, as the blocks after the run decide it.
+    end: [EndRec; 2],
     /// Work offset for this run ([`crate::machine_frame::datum_at`]).
     datum_mm: Option<[f64; 3]>,
+}
+
+/// The end pose of a run as the survey finds it ([`crate::end_pose`]).
+#[derive(Debug, Clone, Default)]
+struct EndRec {
+    /// Free or not, and the 1-based line of the block that decided; `None` until one does.
+    decided: Option<(bool, usize)>,
+    /// Blocks that restate the run's last values: (file block index, 1-based line).
+    restate: Vec<(usize, usize)>,
+    scan: Scan,
+}
+
+impl EndRec {
+    /// Let block `i` (on `line`) have its say, when undecided.
+    fn step(&mut self, after: &After<'_>, letter: u8, i: usize, line: usize) {
+        if self.decided.is_some() {
+            return;
+        }
+        match after.verdict(letter, &mut self.scan) {
+            Step::Free => self.decided = Some((true, line)),
+            Step::Pinned => {
+                self.decided = Some((false, line));
+                self.restate.clear();
+            }
+            Step::Restate => self.restate.push((i, line)),
+            Step::Continue => {}
+        }
+    }
+
+    /// The end pose, block indices re-based by `first` (the stretch's first block).
+    fn pose(&self, first: usize) -> EndPose {
+        let (free, line) = self.decided.map_or((true, None), |(f, l)| (f, Some(l)));
+        EndPose {
+            free,
+            decided_line: line,
+            restate: if free {
+                self.restate.iter().map(|&(b, _)| b - first).collect()
+            } else {
+                Vec::new()
+            },
+        }
+    }
 }
 
 /// The first read's findings.
@@ -110,8 +155,9 @@ struct Surveying {
     frame_changes: Vec<usize>,
     /// Runs given out whose end pose is not decided yet, per letter.
     pending: [Vec<usize>; 2],
-    /// The first deciding block's verdict after the open run's last block, per letter.
-    first_after: [Option<bool>; 2],
+    /// The end pose of the open run so far, from the blocks after its last block, per
+    /// letter.
+    first_after: [EndRec; 2],
 }
 
 impl Surveying {
@@ -128,8 +174,8 @@ impl Surveying {
         }
         let first_block = run.blocks[0];
         let r = self.runs.len();
-        for (l, decided) in self.first_after.iter().enumerate() {
-            if decided.is_none() {
+        for (l, rec) in self.first_after.iter().enumerate() {
+            if rec.decided.is_none() {
                 self.pending[l].push(r);
             }
         }
@@ -138,7 +184,7 @@ impl Surveying {
             last_block: *run.blocks.last().unwrap_or(&first_block),
             near,
             feedless: [A, B].map(|p| crate::program::run_check(&run, p, self.fallback, 0).is_err()),
-            end_free: self.first_after,
+            end: self.first_after.clone(),
             datum_mm: crate::machine_frame::datum_at(
                 &self.datum_shifts,
                 &self.frame_changes,
@@ -148,15 +194,16 @@ impl Surveying {
         });
     }
 
-    /// A block's verdict on the end pose of the runs before it, per letter.
-    fn decide(&mut self, verdict: [Option<bool>; 2]) {
-        for (l, v) in verdict.into_iter().enumerate() {
-            if let Some(free) = v {
-                for r in self.pending[l].drain(..) {
-                    self.runs[r].end_free[l] = Some(free);
-                }
-                self.first_after[l].get_or_insert(free);
-            }
+    /// Block `i` (on `line`) has its say on the end pose of the runs before it, per
+    /// letter.
+    fn decide(&mut self, after: &After<'_>, i: usize, line: usize) {
+        for (l, letter) in LETTERS.into_iter().enumerate() {
+            let runs = &mut self.runs;
+            self.pending[l].retain(|&r| {
+                runs[r].end[l].step(after, letter, i, line);
+                runs[r].end[l].decided.is_none()
+            });
+            self.first_after[l].step(after, letter, i, line);
         }
     }
 }
@@ -184,7 +231,7 @@ fn survey(bytes: &[u8], opts: &Reading<'_>) -> Result<Survey, Error> {
         datum_shifts: Vec::new(),
         frame_changes: Vec::new(),
         pending: [Vec::new(), Vec::new()],
-        first_after: [None, None],
+        first_after: [EndRec::default(), EndRec::default()],
     };
     let mut style = StyleEvidence::default();
     let mut notes = crate::notes::Notes::new();
@@ -203,15 +250,16 @@ fn survey(bytes: &[u8], opts: &Reading<'_>) -> Result<Survey, Error> {
         let after = After {
             words: s.words,
             is_move: s.block.is_move,
+            flags: s.block.flags,
             state: s.state,
             before: &prev,
         };
-        sv.decide(LETTERS.map(|l| after.verdict(l)));
+        sv.decide(&after, i, s.block.line);
         builder.push(i, s.block, s.state, &mut |run| sv.take(run));
         // Deciding blocks count from the open run's last block on: when this block
         // extended it, or no run is open, the verdicts seen so far are spent.
         if builder.open_run_last_block().is_none_or(|last| last == i) {
-            sv.first_after = [None, None];
+            sv.first_after = [EndRec::default(), EndRec::default()];
         }
         prev = *s.state;
         i += 1;
@@ -219,10 +267,19 @@ fn survey(bytes: &[u8], opts: &Reading<'_>) -> Result<Survey, Error> {
     })
     .map_err(|e| Error::Parse(e.with_path(opts.name)))?;
     builder.finish(&mut |run| sv.take(run));
-    // Nothing after them decides: the end of the file leaves the pose free.
-    for rec in &mut sv.runs {
-        for f in &mut rec.end_free {
-            f.get_or_insert(true);
+    // A restating block that another run holds (from its first block on) cannot be
+    // rewritten for this one: the run's last point stays (decided there). Nothing after
+    // the others decides: the end of the file leaves them free.
+    let firsts: Vec<usize> = sv.runs.iter().map(|r| r.first_block).collect();
+    for r in 0..sv.runs.len() {
+        let next_first = firsts[r + 1..].iter().copied().min();
+        for e in &mut sv.runs[r].end {
+            if let Some(nf) = next_first
+                && let Some(&(_, line)) = e.restate.iter().find(|&&(b, _)| b >= nf)
+            {
+                e.decided = Some((false, line));
+                e.restate.clear();
+            }
         }
     }
     Ok(Survey {
@@ -244,14 +301,25 @@ struct Stretch {
 }
 
 /// The stretches (module docs, step 2): one per run `wanted` picks.
-fn stretches(runs: &[RunRec], wanted: impl Fn(&RunRec) -> bool) -> Vec<Stretch> {
+/// A stretch reaches to the last block that restates its run's last values (for the
+/// tilting letter `l`), when the run's end is free: those blocks are rewritten with it.
+fn stretches(runs: &[RunRec], l: usize, wanted: impl Fn(&RunRec) -> bool) -> Vec<Stretch> {
     runs.iter()
         .enumerate()
         .filter(|(_, rec)| wanted(rec))
-        .map(|(r, rec)| Stretch {
-            first_block: rec.first_block,
-            last_block: rec.last_block,
-            runs: r..r + 1,
+        .map(|(r, rec)| {
+            let end = &rec.end[l];
+            let restated = end
+                .restate
+                .iter()
+                .map(|&(b, _)| b)
+                .max()
+                .filter(|_| end.decided.is_none_or(|(free, _)| free));
+            Stretch {
+                first_block: rec.first_block,
+                last_block: rec.last_block.max(restated.unwrap_or(0)),
+                runs: r..r + 1,
+            }
         })
         .collect()
 }
@@ -349,7 +417,7 @@ pub fn patch_nc_to(
     let (not_analysed, warnings) = sv.notes.finish(p_idx, rd.cone_deg, &opts.name);
     report.not_analysed = not_analysed;
     report.warnings.extend(warnings);
-    let todo = stretches(&sv.runs, |rec| rec.near[l] || rec.feedless[l]);
+    let todo = stretches(&sv.runs, l, |rec| rec.near[l] || rec.feedless[l]);
     let mut copied_to = 0usize;
     each_stretch(
         bytes,
@@ -460,7 +528,7 @@ pub fn analyze_nc_each(
         runs: Vec::new(),
     }))
     .map_err(Error::Output)?;
-    let todo = stretches(&sv.runs, |_| true);
+    let todo = stretches(&sv.runs, l, |_| true);
     each_stretch(
         bytes,
         &sv,
@@ -506,7 +574,7 @@ pub(crate) fn each_run<T: Send>(
     let warnings = primary_mismatch_warning(name, machine, p_idx)
         .into_iter()
         .collect();
-    let todo = stretches(&sv.runs, |_| true);
+    let todo = stretches(&sv.runs, l, |_| true);
     each_stretch(bytes, &sv, &todo, l, &rd, |lp| work(&lp), |t, _| sink(t))?;
     Ok((LETTERS[l] as char, warnings))
 }
@@ -654,7 +722,7 @@ fn loaded(bytes: &[u8], hand: InHand, sv: &Survey, l: usize, rd: &Reading<'_>) -
         window: Some(Window {
             first_run: hand.stretch.runs.start,
             style: sv.style,
-            end_free: recs.iter().map(|r| r.end_free[l].unwrap_or(true)).collect(),
+            end: recs.iter().map(|r| r.end[l].pose(first)).collect(),
             datum_mm: recs.iter().map(|r| r.datum_mm).collect(),
         }),
         notes: crate::notes::Notes::new(),

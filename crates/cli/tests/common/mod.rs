@@ -3,9 +3,10 @@
 
 use polepatch::kinematics::{Axis, Machine};
 use polepatch::nc::{Dialect, parse};
+use polepatch::patcher::analysis::{SpanFigures, analyze_spans};
 use polepatch::patcher::direct::deviation_bound_zone;
 use polepatch::patcher::verify::NOT_WORSE_REL;
-use polepatch::patcher::{AnalysisOptions, CLimits, PatchAxes, PatchOptions, Sample, analyze_path};
+use polepatch::patcher::{AnalysisOptions, CLimits, PatchAxes, PatchOptions, analyze_path};
 use polepatch::program::{LoadedProgram, load_nc};
 use polepatch::{FileReport, patch_loaded};
 use std::path::{Path, PathBuf};
@@ -159,11 +160,11 @@ pub fn check_patch(
     }
 }
 
-/// Per run, the analysis samples (`None` for a run not analysed).
-fn run_samples(lp: &LoadedProgram, machine: &Machine, cone: f64) -> Vec<Option<Vec<Sample>>> {
+/// Per run, Equation 6 over every span (exact over the span; `None` for a run not
+/// analysed).
+fn run_spans(lp: &LoadedProgram, machine: &Machine, cone: f64) -> Vec<Option<Vec<SpanFigures>>> {
     let opts = AnalysisOptions {
         cone_deg: cone,
-        keep_samples: true,
         ..AnalysisOptions::default()
     };
     lp.runs
@@ -172,7 +173,7 @@ fn run_samples(lp: &LoadedProgram, machine: &Machine, cone: f64) -> Vec<Option<V
             r.path
                 .as_ref()
                 .ok()
-                .map(|p| analyze_path(p, machine, &opts).unwrap().samples)
+                .map(|p| analyze_spans(p, machine, &opts).unwrap().1)
         })
         .collect()
 }
@@ -181,9 +182,8 @@ fn run_samples(lp: &LoadedProgram, machine: &Machine, cone: f64) -> Vec<Option<V
 /// - a program without zone comes out byte-identical; only rotary words differ;
 /// - every zone the report lists reaches feed on both rotary axes (on the written values,
 ///   read back) and the file read back has no singular zone left;
-/// - nothing is worse: at every analysis sample of every run, the primary and C ratios are
-///   at least `min(before, 1)` (to `NOT_WORSE_REL`), and X Y Z (hence s and their ratios)
-///   are unchanged.
+/// - nothing is worse: on every span of every run, the lowest ratio of every axis is at
+///   least `min(before, 1)` (to `NOT_WORSE_REL`), and X Y Z (hence s) are unchanged.
 pub fn check_patch_both(
     name: &str,
     bytes: &[u8],
@@ -235,19 +235,18 @@ pub fn check_patch_both(
         );
     }
     let (sb, sa) = (
-        run_samples(&lp, machine, opts.cone_deg),
-        run_samples(&lp2, machine, opts.cone_deg),
+        run_spans(&lp, machine, opts.cone_deg),
+        run_spans(&lp2, machine, opts.cone_deg),
     );
     for (k, (b, a)) in sb.iter().zip(&sa).enumerate() {
         let (Some(b), Some(a)) = (b, a) else { continue };
         assert_eq!(
             b.len(),
             a.len(),
-            "{name} on {m}: run {}: samples moved",
+            "{name} on {m}: run {}: spans moved",
             k + 1
         );
         for (x, y) in b.iter().zip(a) {
-            assert_eq!(x.s_mm, y.s_mm);
             for axis in 0..5 {
                 // "Not worse" to the patcher's resolution (0.01 % of the ratio).
                 let floor = x.axis_ratio[axis].min(1.0) * (1.0 - NOT_WORSE_REL) - 1e-12;
@@ -255,7 +254,7 @@ pub fn check_patch_both(
                     y.axis_ratio[axis] >= floor,
                     "{name} on {m}: run {}, s = {:.3} mm: axis {axis} ratio {:.4} → {:.4}",
                     k + 1,
-                    x.s_mm,
+                    x.min_s_mm,
                     x.axis_ratio[axis],
                     y.axis_ratio[axis]
                 );
@@ -267,8 +266,8 @@ pub fn check_patch_both(
 
 /// Whether the zone of report row `z` is proven unreachable: with every point of its run
 /// but the first (and the last, where `polepatch::end_pose` keeps it) free, no values
-/// written with `opts.max_decimals` decimals bring the zone's original singular zones to
-/// feed on both rotary axes ([`polepatch::patcher::reference::reachable`]).
+/// bring the zone's original singular zones to feed on both rotary axes (the relaxation
+/// [`polepatch::patcher::reference::reachable`] is infeasible).
 pub fn proven_unreachable(
     lp: &LoadedProgram,
     z: &polepatch::ZoneRow,
@@ -310,18 +309,17 @@ pub fn proven_unreachable(
     };
     let p: Vec<f64> = path.axes.iter().map(|q| q[Axis::Primary.index()]).collect();
     let c: Vec<f64> = path.axes.iter().map(|q| q[Axis::C.index()]).collect();
-    let step = path.feed_mm_min / 60.0 * opts.tcy_s.unwrap_or(machine.tcy_s);
     !polepatch::patcher::reference::reachable(
         &path.s_mm,
         &p,
         &c,
         1,
         end,
-        polepatch::patcher::reference::zone_core(&zone, n),
+        polepatch::patcher::driver::zone_core(&zone, n, opts.solver.core_margin_points),
         machine,
         path.feed_mm_min,
-        step,
-        opts.max_decimals,
+        opts.axes,
+        true,
     )
     .unwrap_or(true)
 }
@@ -435,10 +433,18 @@ pub fn reachable_bound_deg(lp: &LoadedProgram, r: usize, machine: &Machine) -> O
     let p: Vec<f64> = path.axes.iter().map(|q| q[Axis::Primary.index()]).collect();
     let c: Vec<f64> = path.axes.iter().map(|q| q[Axis::C.index()]).collect();
     let lim = CLimits::new(machine, path.feed_mm_min, 0.0);
-    let step = path.feed_mm_min / 60.0 * machine.tcy_s;
-    deviation_bound_zone(&path.s_mm, &p, &c, 1, n - 1, zone, &lim, step)
-        .ok()
-        .map(|b| b.0)
+    deviation_bound_zone(
+        &path.s_mm,
+        &p,
+        &c,
+        1,
+        n - 1,
+        zone,
+        &lim,
+        polepatch::patcher::direct::BOUND_SAMPLES_PER_SPAN,
+    )
+    .ok()
+    .map(|b| b.0)
 }
 
 pub fn machines() -> Vec<Machine> {

@@ -1,0 +1,157 @@
+//! Per-zone patch time and deviation on the held-out-like zones (`polepatch_benches::
+//! held_out_zones`) and C17's SING on both machines: each run is patched `REPS` times and
+//! the fastest is kept (wall time, one core), with the number of solves and IPM
+//! iterations; with `--reference`, each zone's deviation is compared with the bench
+//! reference (`polepatch_patcher::reference::zone_reference`).
+//!
+//! `cargo run --release -p polepatch-benches --example zone_times -- [COUNT] [--reference]
+//! [--only LABEL-TEXT] [--set SETTING=VALUE …]`
+//! (the criterion figures are `benches/zone_solve.rs`; this is for quick looks).
+
+use polepatch::program::load_nc;
+use polepatch_benches::held_out_zones;
+use polepatch_kinematics::Machine;
+use polepatch_patcher::reference::{Reference, zone_reference};
+use polepatch_patcher::{PatchOptions, Path, analyze_path, patch_path};
+use std::time::Instant;
+
+const REPS: usize = 5;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let count: usize = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(24);
+    let with_ref = args.iter().any(|a| a == "--reference");
+    // `--set field=value` overrides of the solver settings, `--only TEXT` a label filter.
+    let mut solver = polepatch_patcher::SolverSettings::default();
+    let mut only: Option<String> = None;
+    for w in args.windows(2) {
+        if w[0] == "--only" {
+            only = Some(w[1].clone());
+        }
+        if w[0] == "--set"
+            && let Some((k, v)) = w[1].split_once('=')
+        {
+            let f: f64 = v.parse().expect("a number");
+            match k {
+                "joint_range_min_points" => solver.joint_range_min_points = f as usize,
+                "joint_range_zone_factor" => solver.joint_range_zone_factor = f,
+                "scp_max_solves" => solver.scp_max_solves = f as u32,
+                "screen_solves" => solver.screen_solves = f as u32,
+                "scp_rel_tol" => solver.scp_rel_tol = f,
+                other => panic!("unknown setting {other}"),
+            }
+        }
+    }
+    let mut cases: Vec<(String, Machine, Path, bool, usize)> = held_out_zones(0x5EED_0021, count)
+        .into_iter()
+        .map(|h| (h.label, h.machine, h.path, h.keep_last_point, h.decimals))
+        .collect();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let sing = std::fs::read(root.join("fixtures/c17/SING.I")).expect("SING.I");
+    for name in ["mikron-ucp710", "mikron-hsm600"] {
+        let m = Machine::builtin(name).expect("machine");
+        let lp = load_nc(sing.clone(), "SING", &m, None).expect("SING parses");
+        for r in lp.runs {
+            if let Ok(p) = r.path
+                && p.axes.iter().any(|q| q[3].abs() < 5.0)
+            {
+                cases.push((format!("SING/{name}"), m.clone(), p, false, 3));
+            }
+        }
+    }
+    let mut times = Vec::new();
+    let mut ratios = Vec::new();
+    for (label, m, path, pinned, decimals) in &cases {
+        if only.as_ref().is_some_and(|o| !label.contains(o.as_str())) {
+            continue;
+        }
+        let opts = PatchOptions {
+            keep_last_point: *pinned,
+            p_decimals: *decimals,
+            c_decimals: *decimals,
+            solver: solver.clone(),
+            ..PatchOptions::default()
+        };
+        let mut best = f64::INFINITY;
+        let mut res = None;
+        for _ in 0..REPS {
+            let t = Instant::now();
+            let r = patch_path(path, m, &opts).expect("valid path");
+            best = best.min(t.elapsed().as_secs_f64());
+            res = Some(r);
+        }
+        let Some(res) = res else { continue };
+        if res.zones.is_empty() {
+            println!("{label}: no zone");
+            continue;
+        }
+        let per_zone = best / res.zones.len() as f64;
+        for z in &res.zones {
+            times.push(per_zone * 1e3);
+            let mut line = format!(
+                "{label}: {:?} {} dev {:.4}° solves {} it {} | {:.3} ms/zone",
+                z.outcome,
+                z.reason,
+                z.max_deviation_deg,
+                z.qp.solves,
+                z.qp.iterations,
+                per_zone * 1e3
+            );
+            if with_ref {
+                let n = path.s_mm.len();
+                let a = analyze_path(path, m, &Default::default()).expect("analysis");
+                let zone = a
+                    .zones
+                    .iter()
+                    .find(|x| x.first <= z.last && x.last >= z.first)
+                    .cloned();
+                if let Some(zone) = zone {
+                    let p: Vec<f64> = path.axes.iter().map(|q| q[3]).collect();
+                    let c: Vec<f64> = path.axes.iter().map(|q| q[4]).collect();
+                    let last = if *pinned { n - 2 } else { n - 1 };
+                    let r =
+                        zone_reference(&path.s_mm, &p, &c, &zone, 1, last, m, path.feed_mm_min, 6);
+                    match r {
+                        Ok(Reference::Best {
+                            deviation_deg,
+                            method,
+                        }) => {
+                            let ratio = if deviation_deg > 1e-9 {
+                                z.max_deviation_deg / deviation_deg
+                            } else if z.max_deviation_deg < 1e-9 {
+                                1.0
+                            } else {
+                                f64::INFINITY
+                            };
+                            ratios.push(ratio);
+                            line +=
+                                &format!(" | ref {deviation_deg:.4}° ({method}) ratio {ratio:.3}");
+                        }
+                        other => line += &format!(" | ref {other:?}"),
+                    }
+                }
+            }
+            println!("{line}");
+        }
+    }
+    let q = |v: &mut Vec<f64>, f: f64| {
+        v.sort_by(f64::total_cmp);
+        v[((v.len() as f64 - 1.0) * f).round() as usize]
+    };
+    if !times.is_empty() {
+        println!(
+            "{} zones: median {:.3} ms, p90 {:.3} ms, max {:.3} ms",
+            times.len(),
+            q(&mut times, 0.5),
+            q(&mut times, 0.9),
+            q(&mut times, 1.0)
+        );
+    }
+    if !ratios.is_empty() {
+        println!(
+            "deviation / reference: median {:.3}, worst {:.3}",
+            q(&mut ratios, 0.5),
+            q(&mut ratios, 1.0)
+        );
+    }
+}

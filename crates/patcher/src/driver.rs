@@ -1,0 +1,1121 @@
+//! The one driver: where a reader learns the algorithm. Every method (branch
+//! re-selection, the joint patch, G16's C-only method, the peers' rules) only *proposes*
+//! new values for a zone; this module owns the sequence around them:
+//!
+//! 1. **Validate** the path; a path with no point within the singular cone is returned
+//!    unchanged without any spline work.
+//! 2. **Analyse** the run ([`crate::analysis::analyze_spans`]: Equation 6 exact over every
+//!    span) and find its singular zones; zones closer than
+//!    [`SolverSettings::merge_gap_points`] are one.
+//! 3. For each zone, in path order, on the values the zones before it left:
+//!    - the methods of the strategy ([`methods`]) propose candidates through a [`Sink`],
+//!      for each rung of the margin ladder ([`SolverSettings::margin_ladder`]) until one
+//!      passes;
+//!    - every candidate is **rounded as it will be written** (the file's decimals, then one
+//!      more at a time up to `max_decimals` where rounding alone breaks it) and **verified**
+//!      ([`crate::verify::verify_change_with_core`]): the checked rotary axes (both, or C
+//!      with `--only-c`) reach feed over the zone's core (the zone ±
+//!      [`SolverSettings::core_margin_points`]), and nothing gets worse around it;
+//!    - **selection**: of the passing candidates whose exact largest orientation change
+//!      (the angle between the old and new tool axes, on the written values) is within
+//!      `max_deviation_deg`, the smallest; else the best improvement within it; else
+//!      nothing.
+//! 4. **Verify what is written, whole** ([`whole_run_worse`]): the whole run with the
+//!    written values is analysed again, exactly as `analyze` does; a zone whose patch made
+//!    any span of a checked axis worse than before ([`crate::verify::not_worse_floor`]: a
+//!    span at feed stays at feed, one below it may lose 0.01 % of its ratio) is put back as
+//!    it was, until nothing is worse. The
+//!    report's "after" figures are this analysis.
+//! 5. **Report** each zone with its outcome and a [`Reason`] from a fixed set (below).
+//!
+//! # Reasons
+//! - `reached`: a patch reaches feed (joint, G16, direct, or a peer's rule);
+//! - `reselected`: branch re-selection alone reaches feed: no orientation change at all;
+//! - `deviation_cap`: a patch that reaches feed exists, but its orientation change exceeds
+//!   `max_deviation_deg`;
+//! - `end_pinned`: the run's last point must keep its values (`keep_last_point`, the NC
+//!   pipeline says which block pins it), and with it held **no** values reach feed, while
+//!   with it free some would (both by the relaxation of [`crate::reference::reachable`]);
+//! - `range`: the machine's axis ranges forbid every values that would reach feed (the
+//!   relaxation is infeasible with them, feasible without);
+//! - `proven_unreachable`: no values of the movable points reach feed at all (the
+//!   relaxation is infeasible — a proof, see [`crate::reference`]);
+//! - `not_found`: none of the above: polepatch found no patch, and cannot prove there is
+//!   none (or a patch failed the whole-run verification);
+//! - `not_patched`: the run may not be patched (no TCPM, incremental, …: the caller's
+//!   reason), so the zone is only reported ([`crate::report_unpatched`]).
+
+use crate::{
+    analysis::{AnalysisOptions, RATIO_TOL, SpanFigures, Zone, ZoneKind, analyze_spans, validate},
+    options::{PatchAxes, PatchOptions, round_written},
+    path::{Path, PathError},
+    peers::Strategy,
+    qp::add_stats,
+    report::{Method, Outcome, QpStats, Reason, ZoneFigures, ZoneReport},
+    settings::SolverSettings,
+    verify::{AxisChange, Verdict, verify_change_with_core},
+};
+use polepatch_kinematics::{Axis, LimitKind, Machine, angle_between_deg, forward};
+use std::ops::Range;
+
+/// Points of unchanged path either side of a candidate's change and its zone that the
+/// candidate check verifies (the whole run is verified again at the end).
+pub const CHECK_MARGIN_POINTS: usize = crate::verify::VERIFY_MARGIN_POINTS + 1;
+
+/// What happens to the points after a candidate's last point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Tail {
+    /// They keep their values.
+    Keep,
+    /// They move to the other IK branch as a block, `(P, C) → (−P, C + shift)`: the same
+    /// tool axes, every derivative's size kept.
+    Reselect {
+        /// ±180°.
+        shift_deg: f64,
+    },
+    /// C gets a 360° multiple added (`--c-offset`, the C-only method).
+    COffset {
+        /// The multiple of 360°.
+        deg: f64,
+    },
+}
+
+/// A method's proposal for a zone: new (unrounded) values for points `first..=last`.
+#[derive(Debug, Clone)]
+pub struct Proposal {
+    /// The method that made it.
+    pub method: Method,
+    /// First point with new values.
+    pub first: usize,
+    /// Last point with new values.
+    pub last: usize,
+    /// New primary values for `first..=last`, degrees.
+    pub p: Vec<f64>,
+    /// New C values for `first..=last`, degrees.
+    pub c: Vec<f64>,
+    /// The points after `last`.
+    pub tail: Tail,
+    /// Solver statistics of the solves that made it.
+    pub qp: QpStats,
+}
+
+/// What the driver says about a proposal it was offered.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Offered {
+    /// Reaches feed over the zone's core and nothing got worse, as written.
+    pub passes: bool,
+    /// Exact largest orientation change, degrees, as written.
+    pub deviation_deg: f64,
+}
+
+/// Where a method hands its proposals (the driver's checker).
+pub trait Sink {
+    /// Round, verify and consider `p`; `None` when it cannot be evaluated (non-finite
+    /// values, a range the zone may not change).
+    fn offer(&mut self, p: Proposal) -> Option<Offered>;
+    /// Add the statistics of solves that made no proposal.
+    fn add_stats(&mut self, qp: &QpStats);
+    /// The smallest deviation of a passing proposal so far (within the cap), degrees.
+    fn best_passing_deg(&self) -> Option<f64>;
+}
+
+/// What a method sees of one zone.
+pub struct ZoneCtx<'a> {
+    /// Path length per point, mm.
+    pub s: &'a [f64],
+    /// The program's tool axes (what every change is measured against).
+    pub target: &'a [[f64; 3]],
+    /// The machine.
+    pub machine: &'a Machine,
+    /// The caller's options.
+    pub opts: &'a PatchOptions,
+    /// Numerical settings.
+    pub settings: &'a SolverSettings,
+    /// Programmed feed, mm/min.
+    pub feed_mm_min: f64,
+    /// The zone.
+    pub zone: &'a Zone,
+    /// The spans that must reach feed (the zone ± the core margin).
+    pub core: Range<usize>,
+    /// First point a proposal may change.
+    pub lower: usize,
+    /// Last point a proposal may change (the run's last, or the one before it when the
+    /// last must stay).
+    pub end: usize,
+    /// Current primary values of the whole path, degrees.
+    pub p: &'a [f64],
+    /// Current C values of the whole path, degrees.
+    pub c: &'a [f64],
+    /// The margin on the limits for this rung of the ladder.
+    pub margin: f64,
+    /// Index of the rung (0: the configured margin).
+    pub rung: usize,
+}
+
+/// A method: proposes candidates for a zone.
+pub trait Proposer {
+    /// Offer candidates for `ctx`'s zone to `sink`.
+    fn propose(&mut self, ctx: &ZoneCtx<'_>, sink: &mut dyn Sink);
+}
+
+/// The methods of a strategy, in the order they are asked, and whether their proposals
+/// are verified (a peer's rule is scored as it is, never held back).
+pub fn methods(opts: &PatchOptions) -> (Vec<Box<dyn Proposer>>, bool) {
+    match (opts.strategy, opts.axes) {
+        (Strategy::Polepatch, PatchAxes::Both) => (
+            vec![
+                Box::new(crate::reselect::Reselect),
+                Box::new(crate::joint_method::JointMethod),
+            ],
+            true,
+        ),
+        (Strategy::Polepatch, PatchAxes::OnlyC) => {
+            (vec![Box::new(crate::c_only::COnly::default())], true)
+        }
+        (peer, _) => (vec![Box::new(crate::peers::Peer(peer))], false),
+    }
+}
+
+/// A candidate after rounding and verification.
+#[derive(Debug, Clone)]
+struct Checked {
+    prop: Proposal,
+    /// Decimals written for P and C.
+    decimals: (usize, usize),
+    verdict: Verdict,
+    deviation_deg: f64,
+}
+
+/// The driver's [`Sink`] for one zone: checks proposals and keeps the best.
+struct Selection<'a> {
+    s: &'a [f64],
+    target: &'a [[f64; 3]],
+    machine: &'a Machine,
+    opts: &'a PatchOptions,
+    zone: &'a Zone,
+    p: &'a [f64],
+    c: &'a [f64],
+    lower: usize,
+    end: usize,
+    feed_mm_s: f64,
+    verify: bool,
+    stats: QpStats,
+    passed: Option<Checked>,
+    improved: Option<Checked>,
+    /// The smallest deviation of a passing proposal beyond the cap.
+    over_cap_deg: Option<f64>,
+    /// The peer's proposal, taken as it is.
+    as_is: Option<Checked>,
+}
+
+impl Selection<'_> {
+    fn axes(&self) -> &'static [Axis] {
+        match self.opts.axes {
+            PatchAxes::Both => &[Axis::Primary, Axis::C],
+            PatchAxes::OnlyC => &[Axis::C],
+        }
+    }
+
+    /// Values of `(p, c)` on `lo..=hi` with `prop` applied, rounded with `decimals` where
+    /// they change (`None`: unrounded).
+    fn materialize(
+        &self,
+        prop: &Proposal,
+        lo: usize,
+        hi: usize,
+        decimals: Option<(usize, usize)>,
+    ) -> (Vec<f64>, Vec<f64>) {
+        materialize(self.p, self.c, prop, lo, hi, decimals)
+    }
+
+    fn check(&self, prop: &Proposal) -> Option<(Checked, bool)> {
+        let n = self.s.len();
+        let (first, last) = (prop.first, prop.last);
+        if first < self.lower
+            || first > last
+            || last > self.end
+            || prop.p.len() != last - first + 1
+            || prop.c.len() != last - first + 1
+            || prop.p.iter().chain(&prop.c).any(|v| !v.is_finite())
+        {
+            return None;
+        }
+        if !matches!(prop.tail, Tail::Keep) && self.opts.keep_last_point {
+            return None; // the tail would move the last point, which must stay
+        }
+        if self
+            .opts
+            .max_patch_length_mm
+            .is_some_and(|l| self.s[last] - self.s[first] > l)
+        {
+            return None; // longer than the caller allows
+        }
+        let changed_hi = match prop.tail {
+            Tail::Keep => last,
+            _ => (last + 1).min(n - 1),
+        };
+        let lo = first
+            .min(self.zone.first)
+            .saturating_sub(CHECK_MARGIN_POINTS);
+        let hi = (changed_hi.max(self.zone.last) + CHECK_MARGIN_POINTS).min(n - 1);
+        let (bp, bc) = (&self.p[lo..=hi], &self.c[lo..=hi]);
+        let axes = self.axes();
+        let verify = |wp: &[f64], wc: &[f64]| {
+            let ch: Vec<AxisChange> = axes
+                .iter()
+                .map(|&axis| AxisChange {
+                    axis,
+                    before: if axis == Axis::C { bc } else { bp },
+                    after: if axis == Axis::C { wc } else { wp },
+                })
+                .collect();
+            verify_change_with_core(
+                &self.s[lo..=hi],
+                &ch,
+                (first - lo, changed_hi - lo),
+                (self.zone.first.max(lo) - lo, self.zone.last.min(hi) - lo),
+                self.machine,
+                self.feed_mm_s,
+            )
+        };
+        let deviation = |wp: &[f64], wc: &[f64]| {
+            (first..=last)
+                .map(|i| {
+                    angle_between_deg(
+                        self.target[i],
+                        forward(self.machine, wp[i - lo], wc[i - lo]),
+                    )
+                })
+                .fold(0.0, f64::max)
+        };
+        let (pd0, cd0) = (self.opts.p_decimals, self.opts.c_decimals);
+        if !self.verify {
+            let (wp, wc) = self.materialize(prop, lo, hi, Some((pd0, cd0)));
+            return Some((
+                Checked {
+                    prop: prop.clone(),
+                    decimals: (pd0, cd0),
+                    verdict: verify(&wp, &wc),
+                    deviation_deg: deviation(&wp, &wc),
+                },
+                false,
+            ));
+        }
+        let max_d = self.opts.max_decimals.max(pd0).max(cd0);
+        let mut last_checked: Option<Checked> = None;
+        for extra in 0..=max_d - pd0.min(cd0) {
+            let d = ((pd0 + extra).min(max_d), (cd0 + extra).min(max_d));
+            if last_checked.as_ref().is_some_and(|l| l.decimals == d) {
+                break;
+            }
+            let (wp, wc) = self.materialize(prop, lo, hi, Some(d));
+            let verdict = verify(&wp, &wc);
+            let checked = Checked {
+                prop: prop.clone(),
+                decimals: d,
+                verdict,
+                deviation_deg: deviation(&wp, &wc),
+            };
+            if verdict.passes() {
+                return Some((checked, true));
+            }
+            if extra == 0 {
+                // Not a rounding problem if the unrounded values fail too.
+                let (up, uc) = self.materialize(prop, lo, hi, None);
+                if !verify(&up, &uc).passes() {
+                    return Some((checked, false));
+                }
+            }
+            last_checked = Some(checked);
+        }
+        last_checked.map(|l| (l, false))
+    }
+
+    fn within_cap(&self, dev: f64) -> bool {
+        self.opts
+            .max_deviation_deg
+            .is_none_or(|cap| dev <= cap + 1e-9)
+    }
+}
+
+impl Sink for Selection<'_> {
+    fn offer(&mut self, prop: Proposal) -> Option<Offered> {
+        add_stats(&mut self.stats, &prop.qp);
+        let (ck, passes) = self.check(&prop)?;
+        let out = Offered {
+            passes,
+            deviation_deg: ck.deviation_deg,
+        };
+        if !self.verify {
+            self.as_is = Some(ck);
+            return Some(out);
+        }
+        let in_cap = self.within_cap(ck.deviation_deg);
+        if passes && !in_cap {
+            self.over_cap_deg = Some(
+                self.over_cap_deg
+                    .map_or(ck.deviation_deg, |d| d.min(ck.deviation_deg)),
+            );
+        }
+        if passes && in_cap {
+            if self
+                .passed
+                .as_ref()
+                .is_none_or(|b| ck.deviation_deg < b.deviation_deg)
+            {
+                self.passed = Some(ck);
+            }
+        } else if in_cap
+            && ck.verdict.improves()
+            && ck.verdict.core_min_after > 0.0
+            && self
+                .improved
+                .as_ref()
+                .is_none_or(|b| ck.verdict.core_min_after > b.verdict.core_min_after + RATIO_TOL)
+        {
+            self.improved = Some(ck);
+        }
+        Some(out)
+    }
+
+    fn add_stats(&mut self, qp: &QpStats) {
+        add_stats(&mut self.stats, qp);
+    }
+
+    fn best_passing_deg(&self) -> Option<f64> {
+        self.passed.as_ref().map(|c| c.deviation_deg)
+    }
+}
+
+/// `(p, c)` on `lo..=hi` with `prop` applied, rounded with `decimals` (P, C) where they
+/// change (`None`: unrounded).
+fn materialize(
+    p: &[f64],
+    c: &[f64],
+    prop: &Proposal,
+    lo: usize,
+    hi: usize,
+    decimals: Option<(usize, usize)>,
+) -> (Vec<f64>, Vec<f64>) {
+    let rp = |v: f64| decimals.map_or(v, |d| round_written(v, d.0));
+    let rc = |v: f64| decimals.map_or(v, |d| round_written(v, d.1));
+    let mut wp = p[lo..=hi].to_vec();
+    let mut wc = c[lo..=hi].to_vec();
+    for i in lo..=hi {
+        if (prop.first..=prop.last).contains(&i) {
+            let k = i - prop.first;
+            // A value the proposal leaves as it is stays as written.
+            if prop.p[k] != p[i] {
+                wp[i - lo] = rp(prop.p[k]);
+            }
+            if prop.c[k] != c[i] {
+                wc[i - lo] = rc(prop.c[k]);
+            }
+        } else if i > prop.last {
+            match prop.tail {
+                Tail::Keep => {}
+                Tail::Reselect { shift_deg } => {
+                    wp[i - lo] = rp(-p[i]);
+                    wc[i - lo] = rc(c[i] + shift_deg);
+                }
+                Tail::COffset { deg } => wc[i - lo] = rc(c[i] + deg),
+            }
+        }
+    }
+    (wp, wc)
+}
+
+/// What was kept for one zone.
+struct Done {
+    zone: Zone,
+    kept: Option<Checked>,
+    stats: QpStats,
+    over_cap_deg: Option<f64>,
+    /// The zone's patch was put back by the whole-run verification.
+    reverted: bool,
+}
+
+/// Result of patching one path: the values of both rotary axes as they must be written.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PatchResult {
+    /// Primary axis (A or B) per point, degrees, as it must be written (rounded to
+    /// `p_decimals` where changed; the input value where unchanged).
+    pub p_deg: Vec<f64>,
+    /// Which points' primary value changed.
+    pub p_changed: Vec<bool>,
+    /// Decimal places to write the changed primary values with (≥ `opts.p_decimals`).
+    pub p_decimals: usize,
+    /// C per point, degrees, as it must be written (rounded to `c_decimals` where changed;
+    /// the input value where unchanged).
+    pub c_deg: Vec<f64>,
+    /// Which points' C changed.
+    pub c_changed: Vec<bool>,
+    /// Decimal places to write the changed C values with (≥ `opts.c_decimals`).
+    pub c_decimals: usize,
+    /// One row per zone.
+    pub zones: Vec<ZoneReport>,
+}
+
+impl PatchResult {
+    /// The path unchanged: no zone, every value as it was.
+    pub fn unchanged(path: &Path, opts: &PatchOptions) -> PatchResult {
+        let n = path.s_mm.len();
+        PatchResult {
+            p_deg: path.axes.iter().map(|q| q[Axis::Primary.index()]).collect(),
+            p_changed: vec![false; n],
+            p_decimals: opts.p_decimals,
+            c_deg: path.axes.iter().map(|q| q[Axis::C.index()]).collect(),
+            c_changed: vec![false; n],
+            c_decimals: opts.c_decimals,
+            zones: Vec::new(),
+        }
+    }
+    /// Whether any value changed.
+    pub fn any_change(&self) -> bool {
+        self.p_changed.iter().chain(&self.c_changed).any(|&c| c)
+    }
+}
+
+/// The options' analysis options.
+pub(crate) fn analysis_options(opts: &PatchOptions) -> AnalysisOptions {
+    AnalysisOptions {
+        cone_deg: opts.cone_deg,
+        tcy_s: opts.tcy_s,
+        keep_samples: false,
+    }
+}
+
+/// Zones in order, those closer than `gap` points merged.
+pub fn merge_zones(zones: &[Zone], gap: usize) -> Vec<Zone> {
+    let mut out: Vec<Zone> = Vec::new();
+    let mut sorted = zones.to_vec();
+    sorted.sort_by_key(|z| z.first);
+    for z in sorted {
+        match out.last_mut() {
+            Some(m) if z.first <= m.last + gap => {
+                if z.min_abs_primary_deg < m.min_abs_primary_deg {
+                    m.singular = z.singular;
+                    m.min_abs_primary_deg = z.min_abs_primary_deg;
+                }
+                if z.kind == ZoneKind::AFlip {
+                    m.kind = ZoneKind::AFlip;
+                }
+                m.last = m.last.max(z.last);
+                m.c_ratio_min = m.c_ratio_min.min(z.c_ratio_min);
+            }
+            _ => out.push(z),
+        }
+    }
+    out
+}
+
+/// The spans a zone's patch must bring to feed: the zone's, ± `margin` points.
+pub fn zone_core(zone: &Zone, n: usize, margin: usize) -> Range<usize> {
+    zone.first.saturating_sub(margin)..(zone.last + margin).min(n - 1)
+}
+
+/// Equation-6 figures over the spans `spans` of a run's span figures.
+pub fn figures_over(spans: &[SpanFigures], range: Range<usize>) -> ZoneFigures {
+    let mut f = ZoneFigures {
+        c_ratio: 1.0,
+        primary_ratio: 1.0,
+        overall_ratio: 1.0,
+        limiting_axis: None,
+        limiting_kind: LimitKind::Feed,
+        time_s: 0.0,
+    };
+    for sp in &spans[range.start.min(spans.len())..range.end.min(spans.len())] {
+        f.c_ratio = f.c_ratio.min(sp.axis_ratio[Axis::C.index()]);
+        f.primary_ratio = f.primary_ratio.min(sp.axis_ratio[Axis::Primary.index()]);
+        if sp.bound.ratio < f.overall_ratio {
+            f.overall_ratio = sp.bound.ratio;
+            f.limiting_axis = sp.bound.axis;
+            f.limiting_kind = sp.bound.kind;
+        }
+        f.time_s += sp.time_s;
+    }
+    f
+}
+
+/// Spans of `axes` on which `after` is worse than `before`: its ratio below
+/// [`crate::verify::not_worse_floor`] of the ratio before (the verification's rule).
+pub fn whole_run_worse(before: &[SpanFigures], after: &[SpanFigures], axes: &[Axis]) -> Vec<usize> {
+    before
+        .iter()
+        .zip(after)
+        .enumerate()
+        .filter(|(_, (b, a))| {
+            axes.iter().any(|ax| {
+                let k = ax.index();
+                a.axis_ratio[k] < crate::verify::not_worse_floor(b.axis_ratio[k])
+            })
+        })
+        .map(|(k, _)| k)
+        .collect()
+}
+
+/// The path with the rotary values `p`, `c`.
+fn with_values(path: &Path, p: &[f64], c: &[f64]) -> Path {
+    let mut out = path.clone();
+    for (q, (pv, cv)) in out.axes.iter_mut().zip(p.iter().zip(c)) {
+        q[Axis::Primary.index()] = *pv;
+        q[Axis::C.index()] = *cv;
+    }
+    out
+}
+
+/// Patch every singular zone of `path` with the methods of `opts`' strategy (module
+/// docs).
+pub fn patch_path(
+    path: &Path,
+    machine: &Machine,
+    opts: &PatchOptions,
+) -> Result<PatchResult, PathError> {
+    let (m, verify) = methods(opts);
+    patch_with(path, machine, opts, m, verify)
+}
+
+/// [`patch_path`] with the given methods (asked in order) and whether their proposals are
+/// verified.
+pub fn patch_with(
+    path: &Path,
+    machine: &Machine,
+    opts: &PatchOptions,
+    mut methods: Vec<Box<dyn Proposer>>,
+    verify: bool,
+) -> Result<PatchResult, PathError> {
+    validate(path)?;
+    opts.validate()?;
+    let n = path.s_mm.len();
+    let (pi, ci) = (Axis::Primary.index(), Axis::C.index());
+    if !path.axes.iter().any(|q| q[pi].abs() <= opts.cone_deg) {
+        return Ok(PatchResult::unchanged(path, opts));
+    }
+    let st = &opts.solver;
+    let aopts = analysis_options(opts);
+    let (analysis, spans_before) = analyze_spans(path, machine, &aopts)?;
+    if analysis.zones.is_empty() {
+        return Ok(PatchResult::unchanged(path, opts));
+    }
+    let p0: Vec<f64> = path.axes.iter().map(|q| q[pi]).collect();
+    let c0: Vec<f64> = path.axes.iter().map(|q| q[ci]).collect();
+    let target: Vec<[f64; 3]> = p0
+        .iter()
+        .zip(&c0)
+        .map(|(p, c)| forward(machine, *p, *c))
+        .collect();
+    let (mut cur_p, mut cur_c) = (p0.clone(), c0.clone());
+    let end = if opts.keep_last_point { n - 2 } else { n - 1 };
+    let mut lower = 1;
+    let mut done: Vec<Done> = Vec::new();
+    for zone in merge_zones(&analysis.zones, st.merge_gap_points) {
+        let core = zone_core(&zone, n, st.core_margin_points);
+        let mut sel = Selection {
+            s: &path.s_mm,
+            target: &target,
+            machine,
+            opts,
+            zone: &zone,
+            p: &cur_p,
+            c: &cur_c,
+            lower,
+            end,
+            feed_mm_s: path.feed_mm_min / 60.0,
+            verify,
+            stats: QpStats::default(),
+            passed: None,
+            improved: None,
+            over_cap_deg: None,
+            as_is: None,
+        };
+        for (rung, factor) in st.margin_ladder.iter().enumerate() {
+            let ctx = ZoneCtx {
+                s: &path.s_mm,
+                target: &target,
+                machine,
+                opts,
+                settings: st,
+                feed_mm_min: path.feed_mm_min,
+                zone: &zone,
+                core: core.clone(),
+                lower,
+                end,
+                p: &cur_p,
+                c: &cur_c,
+                margin: opts.margin * factor,
+                rung,
+            };
+            for m in methods.iter_mut() {
+                m.propose(&ctx, &mut sel);
+                // Re-selection keeps every tool axis (its deviation is the rounding's):
+                // nothing can do better.
+                if sel
+                    .passed
+                    .as_ref()
+                    .is_some_and(|c| c.prop.method == Method::Reselect)
+                {
+                    break;
+                }
+            }
+            if sel.passed.is_some() || !verify || opts.margin == 0.0 {
+                break;
+            }
+        }
+        let kept = if verify {
+            sel.passed.take().or(sel.improved.take())
+        } else {
+            sel.as_is.take()
+        };
+        let (stats, over_cap_deg) = (sel.stats.clone(), sel.over_cap_deg);
+        if let Some(k) = &kept {
+            let (p, c) = materialize(&cur_p, &cur_c, &k.prop, 0, n - 1, Some(k.decimals));
+            (cur_p, cur_c) = (p, c);
+            lower = k.prop.last + 1;
+        } else {
+            lower = lower.max(zone.last + 1);
+        }
+        done.push(Done {
+            zone,
+            kept,
+            stats,
+            over_cap_deg,
+            reverted: false,
+        });
+    }
+
+    // Verify what is written, whole: the run analysed again; a zone whose patch made a
+    // span of a checked axis worse is put back.
+    let checked_axes: &[Axis] = match opts.axes {
+        PatchAxes::Both => &[Axis::Primary, Axis::C],
+        PatchAxes::OnlyC => &[Axis::C],
+    };
+    let mut spans_after;
+    loop {
+        let after_path = with_values(path, &cur_p, &cur_c);
+        spans_after = analyze_spans(&after_path, machine, &aopts)?.1;
+        if !verify {
+            break;
+        }
+        let worse = whole_run_worse(&spans_before, &spans_after, checked_axes);
+        let Some(&k) = worse.first() else { break };
+        // The kept zone whose change lies nearest the worse span.
+        let culprit = done
+            .iter()
+            .enumerate()
+            .filter(|(_, d)| d.kept.is_some() && !d.reverted)
+            .min_by_key(|(_, d)| {
+                let pr = &d
+                    .kept
+                    .as_ref()
+                    .map(|c| (c.prop.first, c.prop.last))
+                    .unwrap_or((0, 0));
+                if k + 1 < pr.0 {
+                    pr.0 - k - 1
+                } else {
+                    k.saturating_sub(pr.1)
+                }
+            })
+            .map(|(i, _)| i);
+        let Some(i) = culprit else { break };
+        // Put it back: its points (and a re-selected or offset tail) as they were.
+        let d = &mut done[i];
+        let prop = &d.kept.as_ref().map(|c| c.prop.clone());
+        if let Some(prop) = prop {
+            let hi = if matches!(prop.tail, Tail::Keep) {
+                prop.last
+            } else {
+                n - 1
+            };
+            cur_p[prop.first..=hi].copy_from_slice(&p0[prop.first..=hi]);
+            cur_c[prop.first..=hi].copy_from_slice(&c0[prop.first..=hi]);
+        }
+        d.reverted = true;
+    }
+
+    let mut reports = Vec::with_capacity(done.len());
+    let mut decimals = (opts.p_decimals, opts.c_decimals);
+    for d in &done {
+        let kept = d.kept.as_ref().filter(|_| !d.reverted);
+        let (first, last) = match kept {
+            Some(k) => (d.zone.first.min(k.prop.first), d.zone.last.max(k.prop.last)),
+            None => (d.zone.first, d.zone.last),
+        };
+        let core = zone_core(&d.zone, n, st.core_margin_points);
+        // The figures: over the zone's core (what must reach feed) — and over the range a
+        // C-only or peer patch rewrote, which its own limits cover; a joint patch's wider
+        // range may keep a slowness of the program's own (its rounding, say) that it only
+        // must not make worse.
+        let own_range = kept.is_some_and(|k| {
+            matches!(
+                k.prop.method,
+                Method::G16Patch | Method::Direct | Method::Peer
+            )
+        });
+        let range = if own_range {
+            core.start.min(first.saturating_sub(st.core_margin_points))
+                ..core.end.max((last + st.core_margin_points).min(n - 1))
+        } else {
+            core.clone()
+        };
+        let before = figures_over(&spans_before, range.clone());
+        let after = figures_over(&spans_after, range.clone());
+        let core_after = figures_over(&spans_after, core.clone());
+        let reached = match opts.axes {
+            PatchAxes::Both => core_after.c_ratio.min(core_after.primary_ratio),
+            PatchAxes::OnlyC => core_after.c_ratio,
+        } >= 1.0 - RATIO_TOL;
+        let core_before = figures_over(&spans_before, core.clone());
+        let worst = |f: &ZoneFigures| match opts.axes {
+            PatchAxes::Both => f.c_ratio.min(f.primary_ratio),
+            PatchAxes::OnlyC => f.c_ratio,
+        };
+        let outcome = if reached {
+            Outcome::Reached
+        } else if kept.is_some() && worst(&core_after) > worst(&core_before) {
+            Outcome::Improved
+        } else {
+            Outcome::Unchanged
+        };
+        let method = kept.map_or(Method::None, |k| k.prop.method);
+        let reason = if reached && method == Method::Reselect {
+            Reason::Reselected
+        } else if reached {
+            Reason::Reached
+        } else if !verify {
+            Reason::NotFound
+        } else if d.over_cap_deg.is_some() {
+            Reason::DeviationCap
+        } else if d.reverted {
+            Reason::NotFound
+        } else {
+            crate::reference::why_not_reached(
+                path,
+                &cur_p,
+                &cur_c,
+                &d.zone,
+                machine,
+                opts,
+                lower_of(&done, d),
+                end,
+            )
+        };
+        let dev = (first..=last)
+            .map(|i| angle_between_deg(target[i], forward(machine, cur_p[i], cur_c[i])))
+            .fold(0.0, f64::max);
+        if let Some(k) = kept {
+            decimals = (decimals.0.max(k.decimals.0), decimals.1.max(k.decimals.1));
+        }
+        let modified = |v: &[f64], v0: &[f64]| (first..=last).filter(|&i| v[i] != v0[i]).count();
+        reports.push(ZoneReport {
+            first,
+            last,
+            kind: d.zone.kind,
+            min_abs_primary_deg: d.zone.min_abs_primary_deg,
+            before,
+            after,
+            ideal_time_s: (path.s_mm[range.end] - path.s_mm[range.start])
+                / (path.feed_mm_min / 60.0),
+            max_deviation_deg: dev,
+            points_modified: (first..=last)
+                .filter(|&i| cur_p[i] != p0[i] || cur_c[i] != c0[i])
+                .count(),
+            primary_points_modified: modified(&cur_p, &p0),
+            reselected_points: kept
+                .filter(|k| matches!(k.prop.tail, Tail::Reselect { .. }))
+                .map_or(0, |k| n - 1 - k.prop.last),
+            patch_length_mm: kept.map_or(0.0, |k| path.s_mm[k.prop.last] - path.s_mm[k.prop.first]),
+            outcome,
+            reason,
+            method,
+            qp: d.stats.clone(),
+            decimals: kept.map_or(opts.c_decimals, |k| k.decimals.1),
+            p_decimals: kept.map_or(opts.p_decimals, |k| k.decimals.0),
+            c_offset_deg: kept.map_or(0.0, |k| match k.prop.tail {
+                Tail::COffset { deg } => deg,
+                _ => 0.0,
+            }),
+        });
+    }
+    let p_changed: Vec<bool> = cur_p.iter().zip(&p0).map(|(a, b)| a != b).collect();
+    let c_changed: Vec<bool> = cur_c.iter().zip(&c0).map(|(a, b)| a != b).collect();
+    Ok(PatchResult {
+        p_decimals: if p_changed.iter().any(|&x| x) {
+            decimals.0
+        } else {
+            opts.p_decimals
+        },
+        c_decimals: if c_changed.iter().any(|&x| x) {
+            decimals.1
+        } else {
+            opts.c_decimals
+        },
+        p_deg: cur_p,
+        p_changed,
+        c_deg: cur_c,
+        c_changed,
+        zones: reports,
+    })
+}
+
+/// The first point the patch of `d`'s zone could change (after the previous kept zone).
+fn lower_of(done: &[Done], d: &Done) -> usize {
+    done.iter()
+        .take_while(|x| !std::ptr::eq(*x, d))
+        .filter_map(|x| {
+            x.kept
+                .as_ref()
+                .filter(|_| !x.reverted)
+                .map(|k| k.prop.last + 1)
+        })
+        .max()
+        .unwrap_or(1)
+}
+
+/// The singular zones of `path` reported as they are, without patching: what a run that
+/// must not be patched (no TCPM, say) reports. Every zone is [`Outcome::Unchanged`] with
+/// [`Method::None`] and [`Reason::NotPatched`]; its figures before and after are the same.
+pub fn report_unpatched(
+    path: &Path,
+    machine: &Machine,
+    opts: &PatchOptions,
+) -> Result<Vec<ZoneReport>, PathError> {
+    validate(path)?;
+    let pi = Axis::Primary.index();
+    if !path.axes.iter().any(|q| q[pi].abs() <= opts.cone_deg) {
+        return Ok(Vec::new());
+    }
+    let n = path.s_mm.len();
+    let st = &opts.solver;
+    let (analysis, spans) = analyze_spans(path, machine, &analysis_options(opts))?;
+    Ok(merge_zones(&analysis.zones, st.merge_gap_points)
+        .into_iter()
+        .map(|zone| {
+            let core = zone_core(&zone, n, st.core_margin_points);
+            let f = figures_over(&spans, core.clone());
+            ZoneReport {
+                first: zone.first,
+                last: zone.last,
+                kind: zone.kind,
+                min_abs_primary_deg: zone.min_abs_primary_deg,
+                before: f,
+                after: f,
+                ideal_time_s: (path.s_mm[core.end] - path.s_mm[core.start])
+                    / (path.feed_mm_min / 60.0),
+                max_deviation_deg: 0.0,
+                points_modified: 0,
+                primary_points_modified: 0,
+                reselected_points: 0,
+                patch_length_mm: 0.0,
+                outcome: Outcome::Unchanged,
+                reason: Reason::NotPatched,
+                method: Method::None,
+                qp: QpStats::default(),
+                decimals: opts.c_decimals,
+                p_decimals: opts.p_decimals,
+                c_offset_deg: 0.0,
+            }
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::analyze_path;
+    use crate::testutil::{machine, planted, sing_path};
+    use crate::verify::NOT_WORSE_REL;
+
+    fn spans(path: &Path, m: &Machine) -> Vec<crate::analysis::SpanFigures> {
+        crate::analysis::analyze_spans(path, m, &AnalysisOptions::default())
+            .unwrap()
+            .1
+    }
+
+    /// The path with the result's values.
+    fn written(path: &Path, res: &PatchResult) -> Path {
+        let mut out = path.clone();
+        for (q, (p, c)) in out.axes.iter_mut().zip(res.p_deg.iter().zip(&res.c_deg)) {
+            q[3] = *p;
+            q[4] = *c;
+        }
+        out
+    }
+
+    /// The invariants of the default method: X Y Z unchanged and the changed flags right;
+    /// on every span no axis ratio falls below `min(before, 1)` (to
+    /// NOT_WORSE_REL); every zone reaches feed on both rotary axes; the result read back
+    /// has no zone left. Returns the largest orientation change.
+    fn check_both(path: &Path, m: &Machine, res: &PatchResult, what: &str) -> f64 {
+        let after = written(path, res);
+        for (i, (a, b)) in path.axes.iter().zip(&after.axes).enumerate() {
+            assert_eq!(a[..3], b[..3], "{what}: X Y Z moved at {i}");
+            assert_eq!(res.p_changed[i], a[3] != b[3], "{what}");
+            assert_eq!(res.c_changed[i], a[4] != b[4], "{what}");
+        }
+        assert!(
+            !res.p_changed[0] && !res.c_changed[0],
+            "{what}: the first point moved"
+        );
+        for (x, y) in spans(path, m).iter().zip(&spans(&after, m)) {
+            for k in 0..5 {
+                let floor = x.axis_ratio[k].min(1.0) * (1.0 - NOT_WORSE_REL) - 1e-12;
+                assert!(
+                    y.axis_ratio[k] >= floor,
+                    "{what}: axis {k} at s = {:.3}: {} → {}",
+                    x.min_s_mm,
+                    x.axis_ratio[k],
+                    y.axis_ratio[k]
+                );
+            }
+        }
+        for z in &res.zones {
+            assert_eq!(z.outcome, Outcome::Reached, "{what}: {z:#?}");
+            assert!(z.after.c_ratio >= 1.0 - 1e-9 && z.after.primary_ratio >= 1.0 - 1e-9);
+        }
+        let a = analyze_path(&after, m, &AnalysisOptions::default()).unwrap();
+        assert!(a.zones.is_empty(), "{what}: zones left {:?}", a.zones);
+        (0..path.s_mm.len())
+            .map(|i| {
+                let o = forward(m, path.axes[i][3], path.axes[i][4]);
+                angle_between_deg(o, forward(m, res.p_deg[i], res.c_deg[i]))
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// Issue 8's planted check: a domain-rule flip 4° from the pole on the UCP710 (F1000,
+    /// 0.5 mm spacing) reaches feed on both axes by re-selection alone, every point's tool
+    /// axis unchanged (< 0.01°).
+    #[test]
+    fn domain_rule_flip_at_4_degrees_is_reselected() {
+        let m = machine("mikron-ucp710");
+        let path = planted(241, 0.5, 4.0, true, 1000.0);
+        let before = analyze_path(&path, &m, &AnalysisOptions::default()).unwrap();
+        assert_eq!(before.zones.len(), 1, "the planted zone");
+        assert!(
+            before.axis_min[Axis::Primary.index()].0 < 0.5,
+            "A crawls before"
+        );
+        let res = patch_path(&path, &m, &PatchOptions::default()).unwrap();
+        assert_eq!(res.zones.len(), 1);
+        let z = &res.zones[0];
+        assert_eq!(z.method, Method::Reselect, "{z:#?}");
+        assert!(z.reselected_points > 100, "{z:#?}");
+        let dev = check_both(&path, &m, &res, "flip 4°");
+        assert!(dev < 0.01, "largest deviation {dev}°");
+        assert!(z.max_deviation_deg < 0.01);
+        // Every primary value past the switch has the other sign, on one branch.
+        assert!(res.p_deg.iter().all(|&p| p >= 0.0));
+    }
+
+    /// Flips and swings 0 … 4° from the pole, both machines: both rotary axes reach feed,
+    /// nothing gets worse, and the orientation changes by no more than going through the
+    /// pole costs (about the distance to it), to SPEC §6's 1.25×.
+    #[test]
+    fn planted_passes_reach_feed_on_both_axes() {
+        let opts = PatchOptions::default();
+        let mut zones = 0;
+        for (mname, feed) in [("mikron-hsm600", 3000.0), ("mikron-ucp710", 1000.0)] {
+            let m = machine(mname);
+            for flip in [false, true] {
+                for d in [0.0, 0.01, 0.5, 2.0, 4.0] {
+                    let path = planted(241, 0.5, d, flip, feed);
+                    let res = patch_path(&path, &m, &opts).unwrap();
+                    zones += res.zones.len();
+                    let what = format!("{mname} F{feed} flip={flip} d={d}");
+                    let dev = check_both(&path, &m, &res, &what);
+                    assert!(dev <= 1.25 * d + 0.01, "{what}: {dev}°");
+                }
+            }
+        }
+        assert!(zones >= 16, "{zones}");
+    }
+
+    /// C17's `%SING` on the UCP710: A and C both reach feed, the tool passes (within
+    /// rounding) through the pole, about 1° from the programmed axes (C-only: 3.35°).
+    #[test]
+    fn sing_reaches_feed_on_both_axes() {
+        let m = machine("mikron-ucp710");
+        let path = sing_path();
+        let res = patch_path(&path, &m, &PatchOptions::default()).unwrap();
+        let dev = check_both(&path, &m, &res, "SING");
+        assert!(dev < 1.01, "{dev}°");
+        let sign_changes = res.p_deg.windows(2).filter(|w| w[0] * w[1] < 0.0).count();
+        assert_eq!(sign_changes, 1, "A passes through zero once");
+    }
+
+    /// A machine whose primary range forbids the other branch ([0°, 120°]): nothing is ever
+    /// written outside it, and the zones are still patched on the programmed side.
+    #[test]
+    fn primary_range_forbids_the_other_branch() {
+        let mut m = machine("mikron-ucp710");
+        m.primary_range_deg = (0.0, 120.0);
+        for d in [0.01, 0.5, 2.0] {
+            let path = planted(241, 0.5, d, false, 1000.0);
+            let res = patch_path(&path, &m, &PatchOptions::default()).unwrap();
+            assert!(
+                res.p_deg.iter().all(|&p| (0.0..=120.0).contains(&p)),
+                "d={d}: a primary value left the range"
+            );
+            assert!(!res.zones.is_empty(), "d={d}");
+            check_both(&path, &m, &res, &format!("range [0, 120], d={d}"));
+        }
+    }
+
+    /// Degenerate inputs: three points across the pole, and a point exactly on the pole.
+    #[test]
+    fn tiny_paths_and_the_exact_pole_do_not_panic() {
+        let m = machine("mikron-ucp710");
+        let three = Path {
+            s_mm: vec![0.0, 1.0, 2.0],
+            axes: vec![
+                [0.0, 0.0, 0.0, 1.0, 0.0],
+                [1.0, 0.0, 0.0, 0.0, 90.0],
+                [2.0, 0.0, 0.0, -1.0, 180.0],
+            ],
+            feed_mm_min: 2000.0,
+        };
+        let res = patch_path(&three, &m, &PatchOptions::default()).unwrap();
+        assert_eq!(res.c_deg.len(), 3);
+        assert!(!res.p_changed[0] && !res.c_changed[0]);
+        let mut pole = planted(81, 1.0, 0.0, false, 2000.0);
+        pole.axes[40][3] = 0.0;
+        let res = patch_path(&pole, &m, &PatchOptions::default()).unwrap();
+        check_both(&pole, &m, &res, "exact pole");
+    }
+    /// No point within the cone: nothing changes, with either method, and no spline work
+    /// is needed (no zone reported).
+    #[test]
+    fn no_point_in_cone_is_unchanged() {
+        let m = machine("mikron-hsm600");
+        let mut path = planted(41, 1.0, 8.0, false, 2000.0);
+        for q in &mut path.axes {
+            q[3] = q[3].abs().max(6.0);
+        }
+        for axes in [PatchAxes::Both, PatchAxes::OnlyC] {
+            let opts = PatchOptions {
+                axes,
+                ..PatchOptions::default()
+            };
+            let res = patch_path(&path, &m, &opts).unwrap();
+            assert!(res.zones.is_empty());
+            assert!(!res.any_change());
+            let c: Vec<f64> = path.axes.iter().map(|q| q[4]).collect();
+            assert_eq!(res.c_deg, c);
+            assert!(report_unpatched(&path, &m, &opts).unwrap().is_empty());
+        }
+    }
+
+    /// A zone reported without patching: unchanged, same figures before and after.
+    #[test]
+    fn report_unpatched_reports_the_zone_as_it_is() {
+        let m = machine("mikron-ucp710");
+        let path = planted(241, 0.5, 0.5, false, 1000.0);
+        let z = report_unpatched(&path, &m, &PatchOptions::default()).unwrap();
+        assert_eq!(z.len(), 1);
+        assert_eq!(z[0].outcome, Outcome::Unchanged);
+        assert_eq!(z[0].method, Method::None);
+        assert_eq!(z[0].before, z[0].after);
+        assert!(z[0].before.c_ratio < 1.0);
+        assert_eq!((z[0].points_modified, z[0].max_deviation_deg), (0, 0.0));
+    }
+}

@@ -1,0 +1,342 @@
+//! The joint patch as a method of the driver: which points move, from which start, and
+//! what is proposed ([`crate::joint`] solves).
+//!
+//! - **Range.** The zone widened on each side by
+//!   `max(joint_range_min_points, joint_range_zone_factor · zone length)` points
+//!   ([`crate::settings::SolverSettings`]), within what the zone may change (after the
+//!   previous zone's patch, before the run's last point when it must stay) and within
+//!   `max_patch_length_mm` around the zone (a zone longer than that is not patched). When no solution on it meets the limits (the
+//!   range is too short for the turn the axes must make), the widening doubles, up to all
+//!   the points the zone may change.
+//! - **Start.** Near the pole the best patch lets the tool axis pass through the pole, P
+//!   changing sign at almost constant C. When the points after the zone may move to the
+//!   other branch, the start is the program with the points after its branch switch (or
+//!   after the point of least |P|) on the other branch ([`crate::reselect::other_branch`]);
+//!   the range is wide enough to hold the cone stretch;
+//!   FREEZE's and LINEARIZE's rules across the cone (C held at its entry value, or linear
+//!   in s, P on C's meridian: [`crate::peers`]) pass through the pole inside the range; the
+//!   program's own values are the last start. Each start gets
+//!   [`SolverSettings::screen_solves`] solves; the better (less excess over the limits, then
+//!   smaller deviation) goes on warm for the rest of [`SolverSettings::scp_max_solves`].
+//! - **Proposals.** The refined solution, then the other start's; and, with
+//!   `max_deviation_deg` when nothing within it passed, the capped solve from the
+//!   program's values (the least excess over the limits within the cap: the best
+//!   improvement the cap allows, or a patch within it that reaches feed).
+
+use crate::driver::{Proposal, Proposer, Sink, Tail, ZoneCtx};
+use crate::joint::{JointProblem, JointSolution, solve_joint};
+use crate::limits::GeomLimits;
+use crate::peers::{Strategy, apply_rule, cone_stretch};
+use crate::report::Method;
+use crate::reselect::{branch_switch, least_primary, other_branch, tail_shift};
+use polepatch_kinematics::Axis;
+
+/// The joint method (module docs).
+pub struct JointMethod;
+
+/// On a point exactly on the pole (|P| ≤ [`crate::reselect::POLE_DEG`]) C does not orient
+/// the tool: give it C linear between its nearest neighbours off the pole within
+/// `first..=last`, so a start does not carry a spike of C there (a post writes anything:
+/// `atan2(0, 0)`). The tool axes are unchanged.
+fn smooth_pole_c(p: &[f64], c: &mut [f64], first: usize, last: usize) {
+    let on_pole = |i: usize| p[i].abs() <= crate::reselect::POLE_DEG;
+    for i in first..=last {
+        if !on_pole(i) {
+            continue;
+        }
+        let a = (first..i).rev().find(|&j| !on_pole(j));
+        let b = (i + 1..=last).find(|&j| !on_pole(j));
+        c[i] = match (a, b) {
+            (Some(a), Some(b)) => c[a] + (c[b] - c[a]) * (i - a) as f64 / (b - a) as f64,
+            (Some(a), None) => c[a],
+            (None, Some(b)) => c[b],
+            (None, None) => c[i],
+        };
+    }
+}
+
+/// A start: values of the whole path and what the points after the range do.
+struct Start {
+    p: Vec<f64>,
+    c: Vec<f64>,
+    tail: Tail,
+    /// Rewritten by a rule inside the range: "not worse" compares with the values before.
+    rule: bool,
+}
+
+impl JointMethod {
+    /// The range of points to move with `extra` points either side of the zone, or `None`
+    /// when the zone has none.
+    fn range(ctx: &ZoneCtx<'_>, extra: usize) -> Option<(usize, usize)> {
+        let n = ctx.s.len();
+        let z = ctx.zone;
+        let (a, b) = (z.first.saturating_sub(extra), (z.last + extra).min(n - 1));
+        let (mut first, mut last) = (a.max(ctx.lower), b.min(ctx.end));
+        if let Some(l) = ctx.opts.max_patch_length_mm {
+            // Cut the range to the length, around the zone (never inside it).
+            while ctx.s[last] - ctx.s[first] > l && (first < z.first || last > z.last) {
+                let grow_left = z.first.saturating_sub(first);
+                let grow_right = last.saturating_sub(z.last);
+                if grow_left >= grow_right && first < z.first {
+                    first += 1;
+                } else if last > z.last {
+                    last -= 1;
+                } else {
+                    first += 1;
+                }
+            }
+        }
+        let too_long = ctx
+            .opts
+            .max_patch_length_mm
+            .is_some_and(|l| ctx.s[last] - ctx.s[first] > l);
+        (first <= last && !too_long).then_some((first, last))
+    }
+}
+
+impl Proposer for JointMethod {
+    fn propose(&mut self, ctx: &ZoneCtx<'_>, sink: &mut dyn Sink) {
+        let st = ctx.settings;
+        let z = ctx.zone;
+        let mut extra = st
+            .joint_range_min_points
+            .max(((z.last - z.first) as f64 * st.joint_range_zone_factor).ceil() as usize);
+        // Wide enough to hold the cone stretch the peers' starts rewrite.
+        if let Some([e0, _, _, e1]) = cone_stretch(ctx.p, z, ctx.opts.cone_deg) {
+            extra = extra
+                .max(z.first.saturating_sub(e0))
+                .max(e1.saturating_sub(z.last));
+        }
+        loop {
+            let Some((first, last)) = Self::range(ctx, extra) else {
+                return;
+            };
+            let whole = first <= ctx.lower && last >= ctx.end;
+            if Self::solve_range(ctx, sink, first, last, whole) || whole || extra > ctx.s.len() {
+                return;
+            }
+            extra *= 2;
+        }
+    }
+}
+
+impl JointMethod {
+    /// Solve and propose on the range `first..=last`; `true` when a solution within the
+    /// limits was found (else the range is widened, unless `last_try`: then the best
+    /// is proposed anyway, as an improvement).
+    fn solve_range(
+        ctx: &ZoneCtx<'_>,
+        sink: &mut dyn Sink,
+        first: usize,
+        last: usize,
+        last_try: bool,
+    ) -> bool {
+        let st = ctx.settings;
+        let (p, c) = (ctx.p, ctx.c);
+        let mut starts: Vec<Start> = Vec::new();
+        // Through the pole: the other branch after the switch (or the least |P|).
+        let k = branch_switch(p, ctx.zone).unwrap_or_else(|| least_primary(p, ctx.zone));
+        if k + 1 >= first
+            && k < last
+            && let Some(shift) = tail_shift(ctx.machine, p, c, k, ctx.opts.keep_last_point)
+        {
+            let (op, oc) = other_branch(p, c, k, shift);
+            starts.push(Start {
+                p: op,
+                c: oc,
+                tail: Tail::Reselect { shift_deg: shift },
+                rule: false,
+            });
+        }
+        // The peers' rules across the cone stretch: C held (FREEZE) or linear (LINEARIZE),
+        // P on C's meridian — through the pole inside the range.
+        if let (Some(stretch), Ok(spline)) = (
+            cone_stretch(p, ctx.zone, ctx.opts.cone_deg),
+            crate::spline::AnalysisSpline::new(ctx.s, c),
+        ) && stretch[1] >= first
+            && stretch[2] <= last
+        {
+            for rule in [Strategy::Freeze, Strategy::Linearize] {
+                let (mut fp, mut fc) = (p.to_vec(), c.to_vec());
+                apply_rule(
+                    rule,
+                    ctx.machine,
+                    ctx.s,
+                    c,
+                    &spline,
+                    ctx.target,
+                    stretch,
+                    &mut fp,
+                    &mut fc,
+                );
+                // Through the pole: P on C's meridian comes out of the stretch on the other
+                // branch when the path passed the pole; then the points after it follow
+                // on that branch (when they may move).
+                let b = stretch[2];
+                if rule == Strategy::Freeze
+                    && b < last
+                    && fp[b].abs() > crate::reselect::POLE_DEG
+                    && fp[b].signum() != p[b + 1].signum()
+                    && let Some(shift) =
+                        tail_shift(ctx.machine, &fp, &fc, b, ctx.opts.keep_last_point)
+                {
+                    let (op, oc) = other_branch(&fp, &fc, b, shift);
+                    starts.push(Start {
+                        p: op,
+                        c: oc,
+                        tail: Tail::Reselect { shift_deg: shift },
+                        rule: true,
+                    });
+                }
+                starts.push(Start {
+                    p: fp,
+                    c: fc,
+                    tail: Tail::Keep,
+                    rule: true,
+                });
+            }
+        }
+        starts.push(Start {
+            p: p.to_vec(),
+            c: c.to_vec(),
+            tail: Tail::Keep,
+            rule: false,
+        });
+        for s0 in &mut starts {
+            smooth_pole_c(&s0.p, &mut s0.c, first, last);
+        }
+        let lim_p = GeomLimits::of(ctx.machine, Axis::Primary, ctx.feed_mm_min, ctx.margin);
+        let lim_c = GeomLimits::of(ctx.machine, Axis::C, ctx.feed_mm_min, ctx.margin);
+        let round_deg = 0.5 * 10f64.powi(-(ctx.opts.max_decimals as i32));
+        let problem = |sp: &'_ [f64],
+                       sc: &'_ [f64],
+                       rule: bool,
+                       cap: Option<f64>,
+                       warm: bool,
+                       solves: u32| {
+            let pr = JointProblem {
+                s_mm: ctx.s,
+                p_deg: sp,
+                c_deg: sc,
+                target: ctx.target,
+                first,
+                last,
+                lim_p,
+                lim_c,
+                machine: ctx.machine,
+                core: ctx.core.clone(),
+                round_p_deg: round_deg,
+                round_c_deg: round_deg,
+                reference: rule.then_some((p, c)),
+                cap_deg: cap,
+                warm,
+                max_solves: solves,
+                settings: st,
+            };
+            solve_joint(&pr)
+        };
+        // Screen every start, then refine the best.
+        let screen = st.screen_solves.min(st.scp_max_solves).max(1);
+        let mut screened: Vec<(usize, JointSolution)> = Vec::new();
+        for (i, s0) in starts.iter().enumerate() {
+            let solves = if starts.len() == 1 {
+                st.scp_max_solves
+            } else {
+                screen
+            };
+            match problem(&s0.p, &s0.c, s0.rule, None, false, solves) {
+                Ok(sol) => {
+                    let perfect = sol.excess <= st.elastic_tol && sol.max_deviation_deg <= 1e-9;
+                    screened.push((i, sol));
+                    if perfect {
+                        break; // within the limits, no orientation change: the best there is
+                    }
+                }
+                Err(crate::candidate::PatchFailure::Solver(q)) => sink.add_stats(&q),
+                Err(_) => {}
+            }
+        }
+        // Within the limits first (by deviation), then the least excess.
+        let key = |s: &JointSolution| {
+            if s.excess <= st.elastic_tol {
+                (0u8, s.max_deviation_deg)
+            } else {
+                (1u8, s.excess)
+            }
+        };
+        screened.sort_by(|a, b| {
+            key(&a.1)
+                .partial_cmp(&key(&b.1))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
+        if starts.len() > 1
+            && let Some((i, sol)) = screened.first_mut()
+            && st.scp_max_solves > screen
+        {
+            let s0 = &starts[*i];
+            let (mut wp, mut wc) = (s0.p.clone(), s0.c.clone());
+            wp[first..=last].copy_from_slice(&sol.p_deg);
+            wc[first..=last].copy_from_slice(&sol.c_deg);
+            let warm = sol.excess <= st.elastic_tol;
+            if let Ok(refined) = problem(&wp, &wc, s0.rule, None, warm, st.scp_max_solves - screen)
+            {
+                let mut qp = sol.qp.clone();
+                crate::qp::add_stats(&mut qp, &refined.qp);
+                if key(&refined) < key(sol) {
+                    *sol = JointSolution { qp, ..refined };
+                } else {
+                    sol.qp = qp;
+                }
+            }
+        }
+        let within = screened
+            .first()
+            .is_some_and(|(_, s)| s.excess <= st.elastic_tol);
+        if !within && !last_try {
+            for (_, s) in &screened {
+                sink.add_stats(&s.qp);
+            }
+            return false;
+        }
+        let mut offered_all = true;
+        for (i, sol) in screened {
+            if !offered_all {
+                sink.add_stats(&sol.qp);
+                continue;
+            }
+            let passed = sink.offer(Proposal {
+                method: Method::Joint,
+                first,
+                last,
+                p: sol.p_deg,
+                c: sol.c_deg,
+                tail: starts[i].tail,
+                qp: sol.qp,
+            });
+            if passed.is_some_and(|o| o.passes) {
+                offered_all = false; // the rest only count their solves
+            }
+        }
+        // With a cap that nothing passing met: the least excess within it.
+        if let Some(cap) = ctx.opts.max_deviation_deg
+            && sink.best_passing_deg().is_none()
+        {
+            match problem(p, c, false, Some(cap), true, st.scp_max_solves) {
+                Ok(sol) => {
+                    sink.offer(Proposal {
+                        method: Method::Joint,
+                        first,
+                        last,
+                        p: sol.p_deg,
+                        c: sol.c_deg,
+                        tail: Tail::Keep,
+                        qp: sol.qp,
+                    });
+                }
+                Err(crate::candidate::PatchFailure::Solver(q)) => sink.add_stats(&q),
+                Err(_) => {}
+            }
+        }
+        true
+    }
+}

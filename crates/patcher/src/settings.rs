@@ -1,0 +1,123 @@
+//! The patcher's numerical settings in one place (Clarabel's `DefaultSettings` manner):
+//! a plain struct, every field public and documented with its unit and default.
+//!
+//! [`SolverSettings::default`] is what `polepatch patch` uses; [`SolverSettings::reference`]
+//! is the same with more effort, what the quality suite judges the default against
+//! ([`crate::reference`]).
+
+use crate::ipm::IpmSettings;
+
+/// Numerical settings of the patcher (module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolverSettings {
+    // --- The driver -------------------------------------------------------------------
+    /// Factors applied to `PatchOptions::margin`, in order, when no candidate passes
+    /// verification: the configured margin, a quarter of it, none. Default `[1, 0.25, 0]`.
+    pub margin_ladder: Vec<f64>,
+    /// Zones closer than this many points are patched as one. Default 6.
+    pub merge_gap_points: usize,
+    /// Points either side of a zone whose spans must reach feed with it (the zone's
+    /// "core"). Default 3.
+    pub core_margin_points: usize,
+
+    // --- The joint patch (crate::joint) ----------------------------------------------
+    /// Points added on each side of the zone to the range the joint patch may change
+    /// first (clipped to the run): at least this many, or the zone's own length times
+    /// [`SolverSettings::joint_range_zone_factor`]; doubled while no solution meets the
+    /// limits (`crate::joint_method`). Default 10.
+    pub joint_range_min_points: usize,
+    /// See [`SolverSettings::joint_range_min_points`]. Default 1.0.
+    pub joint_range_zone_factor: f64,
+    /// Most SCP solves from the chosen start. Default 6.
+    pub scp_max_solves: u32,
+    /// Solves each start gets when several are screened (the best then goes on): one
+    /// solve from a start far outside the limits does not rank the starts well (on the
+    /// held-out-like zones one gave 1.47× the reference, two 1.11×). Default 2.
+    pub screen_solves: u32,
+    /// An accepted step that lowers the exact largest deviation by less than this fraction
+    /// ends the SCP. Default 0.01.
+    pub scp_rel_tol: f64,
+    /// Trust region of the first solve, primary axis, degrees. Default 15.
+    pub first_trust_p_deg: f64,
+    /// Trust region of the first solve, C, degrees (near the pole C may have to move half
+    /// a turn). Default 180.
+    pub first_trust_c_deg: f64,
+    /// Trust region of later solves, primary axis, degrees. Default 2.
+    pub trust_p_deg: f64,
+    /// Trust region of later solves, C, degrees. Default 30.
+    pub trust_c_deg: f64,
+    /// The SCP ends when the primary trust region falls below this, degrees.
+    /// Default 1e-3.
+    pub min_trust_deg: f64,
+    /// μ: weight of the sum of squared linearised orientation changes against the largest
+    /// (dimensionless): small, it chooses among the minimax solutions. Default 1e-2.
+    pub joint_quad_weight: f64,
+    /// ε: proximal weight on each step, per degree². Default 1e-8.
+    pub proximal_weight: f64,
+    /// M: weight of the elastic variable `e` (the largest relative excess over a limit
+    /// row) against the largest orientation change (chord). Reaching feed comes first.
+    /// Default 1e4.
+    pub elastic_weight: f64,
+    /// Relative excess over the limit rows (`e`) below which a joint solution counts as
+    /// within them (the margin covers it). Default 1e-6.
+    pub elastic_tol: f64,
+    /// The interior-point solver's settings ([`crate::ipm`]).
+    pub ipm: IpmSettings,
+    /// Margin on the limits of the reference's joint solves ([`crate::reference`]; the
+    /// patcher's is `PatchOptions::margin`): just enough that its solution passes the
+    /// verification's round-off tolerances. Default 1e-3.
+    pub reference_margin: f64,
+
+    // --- The C-only method (crate::c_only) --------------------------------------------
+    /// Largest range the direct QP is tried on, points. Default 400.
+    pub direct_max_points: usize,
+    /// A widening level after the first passing candidate that lowers the best deviation
+    /// by less than this fraction of it ends the search. Default 0.05.
+    pub deviation_improvement_min: f64,
+    /// Most widening levels tried after the level of the first passing candidate.
+    /// Default 3.
+    pub max_levels_after_pass: usize,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        SolverSettings {
+            margin_ladder: vec![1.0, 0.25, 0.0],
+            merge_gap_points: 6,
+            core_margin_points: 3,
+            joint_range_min_points: 10,
+            joint_range_zone_factor: 1.0,
+            scp_max_solves: 6,
+            screen_solves: 2,
+            scp_rel_tol: 0.01,
+            first_trust_p_deg: 15.0,
+            first_trust_c_deg: 180.0,
+            trust_p_deg: 2.0,
+            trust_c_deg: 30.0,
+            min_trust_deg: 1e-3,
+            joint_quad_weight: 1e-2,
+            proximal_weight: 1e-8,
+            elastic_weight: 1e4,
+            elastic_tol: 1e-6,
+            ipm: IpmSettings::default(),
+            reference_margin: 1e-3,
+            direct_max_points: 400,
+            deviation_improvement_min: 0.05,
+            max_levels_after_pass: 3,
+        }
+    }
+}
+
+impl SolverSettings {
+    /// The same settings with more effort: the reference the quality suite judges the
+    /// default against: more solves, more screening, a tighter stopping rule (the range
+    /// is the caller's: the whole movable territory).
+    pub fn reference() -> SolverSettings {
+        SolverSettings {
+            scp_max_solves: 24,
+            screen_solves: 3,
+            scp_rel_tol: 1e-3,
+            ..SolverSettings::default()
+        }
+    }
+}
