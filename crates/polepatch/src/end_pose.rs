@@ -279,6 +279,33 @@ mod tests {
         assert_eq!(poses(CUT)[0].decided_line, None);
     }
 
+    /// Heidenhain conversational: `TOOL CALL` and `END PGM` free the end as `T… M6` and
+    /// `M30` do (the reader's block flags, not the words, say so).
+    #[test]
+    fn conversational_tool_call_and_end_pgm_are_free() {
+        let cut = "BEGIN PGM T MM\nM128\nL X+0 Y+0 Z+0 A+5 C+10 R0 F1000\n\
+                   L X+1 A+4 C+20\nL X+2 A+3 C+30\n";
+        let e = &poses(&format!(
+            "{cut}TOOL CALL 2 Z S1000\nL X+50 Y+50 FMAX\nEND PGM T MM\n"
+        ))[0];
+        assert!(e.free, "{e:?}");
+        assert_eq!(e.decided_line, Some(6));
+        let e = &poses(&format!("{cut}M129\nEND PGM T MM\n"))[0];
+        assert!(e.free, "{e:?}");
+        assert_eq!(e.decided_line, Some(7));
+    }
+
+    /// A block the operator may skip cannot free the end: skipped, what follows moves from
+    /// the run's last pose.
+    #[test]
+    fn a_skippable_block_never_frees_the_end() {
+        let e = &poses(&format!("{CUT}M129\nG1 Z150\n/A0 C0\nX0 Y0\nM30\n"))[0];
+        assert!(!e.free, "{e:?}");
+        assert_eq!(e.decided_line, Some(7));
+        let e = &poses(&format!("{CUT}/T2 M6\nG0 X50 Y50\nM30\n"))[0];
+        assert!(!e.free, "{e:?}");
+    }
+
     /// C17's `%SING` ends with M00, M129, a Z-only retract, a rotary-only move: free.
     #[test]
     fn retract_along_the_tool_axis_then_rotary_only_is_free() {
