@@ -137,6 +137,23 @@ pub fn write_styled(program: &Program, edits: &[Edit], file: &FileStyle) -> Vec<
         splices.push((at, at, own_rank, text));
     }
     splices.sort_by_key(|s| (s.0, s.2));
+    // An inserted word ends with a number: when the byte after the insertion point would
+    // run on into it (a digit, a sign, a point; for an `=` word anything but a blank or
+    // `;`, as Sinumerik's `=` values end at a blank: `C=268.358(`), the last word inserted
+    // there is followed by a blank.
+    for k in 0..splices.len() {
+        let (at, end) = (splices[k].0, splices[k].1);
+        let last_here = splices.get(k + 1).is_none_or(|n| n.0 != at);
+        let equals = splices[k].3.contains(&b'=');
+        let runs_on = |b: u8| {
+            b.is_ascii_digit()
+                || matches!(b, b'.' | b'+' | b'-' | b',')
+                || (equals && !(b.is_ascii_whitespace() || b == b';'))
+        };
+        if at == end && last_here && bytes.get(at).copied().is_some_and(runs_on) {
+            splices[k].3.push(b' ');
+        }
+    }
     let extra: usize = splices.iter().map(|s| s.3.len()).sum();
     let mut out = Vec::with_capacity(bytes.len() + extra);
     let mut pos = 0;
@@ -193,6 +210,26 @@ mod tests {
         assert_eq!(
             edit("N10 G1 X=1.25 C=30\n", &[c(0, 31.5)]),
             "N10 G1 X=1.25 C=31.5\n"
+        );
+    }
+
+    /// A word inserted right before a byte that would run on into its number gets a blank
+    /// after it (a Sinumerik `=` value ends at a blank; here the block's `(` opens text the
+    /// reader takes as a comment).
+    #[test]
+    fn an_inserted_word_never_runs_into_what_follows() {
+        let out = edit("N10 X1 A=2 C=3\nN20 X2(5 Y1\n", &[c(1, 4.5)]);
+        assert_eq!(out, "N10 X1 A=2 C=3\nN20 X2 C=4.500 (5 Y1\n");
+        let p = parse(out.into_bytes(), Dialect::Auto).unwrap();
+        assert_eq!(p.word(1, b'C').unwrap().value, 4.5);
+        // Before a letter, a blank or (without `=`) a comment nothing is added.
+        assert_eq!(
+            edit("N1 X1 C2\nN2 X2Y3\n", &[c(1, 7.0)]),
+            "N1 X1 C2\nN2 X2Y3C7.000\n"
+        );
+        assert_eq!(
+            edit("N1 X1 C2\nN2 X2(c)\n", &[c(1, 7.0)]),
+            "N1 X1 C2\nN2 X2 C7.000(c)\n"
         );
     }
 

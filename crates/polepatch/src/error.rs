@@ -25,6 +25,18 @@ pub enum Error {
         /// File.
         path: String,
     },
+    /// Every G1 move's axis or feed words are expressions or variables (the first at
+    /// `line`): nothing can be analysed.
+    #[error(
+        "{path}:{line}: no G1 run can be analysed: the G1 moves' axis or feed words are \
+         expressions or variables (as here), which polepatch carries through but cannot evaluate"
+    )]
+    NothingAnalysable {
+        /// File.
+        path: String,
+        /// 1-based line of the first such G1 move.
+        line: usize,
+    },
     /// No rotary axis words in any G1 run.
     #[error(
         "{path}: no rotary axis words ({primary} or C) in any G1 run; is this a 5-axis program?"
@@ -81,4 +93,18 @@ pub enum Error {
     /// that is not positive, …).
     #[error("{0}")]
     Path(#[from] polepatch_patcher::PathError),
+}
+
+impl Error {
+    /// The program was read but holds nothing to analyse: no G1 motion, no rotary word in
+    /// any G1 run, or every G1 move written with expressions. `patch` writes such a program
+    /// unchanged and `analyze` reports no run, each with this error as a warning (a folder
+    /// of a shop's programs holds 3-axis and drilling programs too); `simulate` and
+    /// `reorient`, which need motion, refuse it.
+    pub fn is_nothing_to_analyse(&self) -> bool {
+        matches!(
+            self,
+            Error::NoRuns { .. } | Error::NoRotary { .. } | Error::NothingAnalysable { .. }
+        )
+    }
 }

@@ -202,13 +202,9 @@ fn why_no_runs(program: &Program, name: &str) -> Error {
             continue;
         }
         if block.flags.has(polepatch_nc::Flags::NOT_ANALYSABLE) {
-            return Error::Unsupported {
+            return Error::NothingAnalysable {
                 path: name.to_string(),
                 line: block.line,
-                what: "no G1 run can be analysed: the G1 moves' axis or feed words are \
-                       expressions or variables (as here), which polepatch carries through but \
-                       cannot evaluate"
-                    .to_string(),
             };
         }
         if st.incremental {

@@ -362,13 +362,30 @@ enum Begun {
         l: usize,
         p_idx: usize,
     },
+    /// The program was read and holds nothing to analyse
+    /// ([`Error::is_nothing_to_analyse`]; `why` says what): the survey for its notes.
+    Nothing {
+        sv: Box<Survey>,
+        p_idx: usize,
+        why: Error,
+    },
 }
 
 fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Error> {
     let sv = survey(bytes, rd)?;
     let p_idx = tilting_index(&sv, machine);
     if sv.runs.is_empty() || (!sv.uses[p_idx] && !sv.uses[C]) {
-        let mut lp = load_nc(bytes.to_vec(), rd.name, machine, rd.fallback)?;
+        let mut lp = match load_nc(bytes.to_vec(), rd.name, machine, rd.fallback) {
+            Ok(lp) => lp,
+            Err(why) if why.is_nothing_to_analyse() => {
+                return Ok(Begun::Nothing {
+                    sv: Box::new(sv),
+                    p_idx,
+                    why,
+                });
+            }
+            Err(e) => return Err(e),
+        };
         lp.work_offset_mm = rd.work_offset_mm;
         lp.chord_tolerance_mm = rd.chord_tolerance_mm;
         return Ok(Begun::Whole(Box::new(lp)));
@@ -403,6 +420,18 @@ pub fn patch_nc_to(
         Begun::Whole(lp) => {
             let (output, report) = patch_loaded(&lp, machine, &opts.patch);
             out.write_all(&output).map_err(Error::Output)?;
+            return Ok(report);
+        }
+        Begun::Nothing { sv, p_idx, why } => {
+            let mut report = FileReport::unchanged(
+                &opts.name,
+                machine,
+                vec![format!("{why}: nothing to patch, written unchanged")],
+            );
+            let (not_analysed, warnings) = sv.notes.finish(p_idx, rd.cone_deg, &opts.name);
+            report.not_analysed = not_analysed;
+            report.warnings.extend(warnings);
+            out.write_all(bytes).map_err(Error::Output)?;
             return Ok(report);
         }
         Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx),
@@ -512,6 +541,23 @@ pub fn analyze_nc_each(
             }
             return Ok(());
         }
+        Begun::Nothing { sv, p_idx, why } => {
+            let (not_analysed, warnings) = sv.notes.finish(p_idx, rd.cone_deg, &opts.name);
+            let l = usize::from(p_idx == B);
+            each(Piece::Head(&AnalyzeReport {
+                file: opts.name.clone(),
+                machine: machine.name.clone(),
+                cone_deg: opts.analysis.cone_deg,
+                primary: (LETTERS[l] as char).to_string(),
+                warnings: std::iter::once(format!("{why}: no run analysed"))
+                    .chain(warnings)
+                    .collect(),
+                not_analysed,
+                runs: Vec::new(),
+            }))
+            .map_err(Error::Output)?;
+            return Ok(());
+        }
         Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx),
     };
     let (not_analysed, notes_warnings) = sv.notes.finish(p_idx, rd.cone_deg, &opts.name);
@@ -569,6 +615,7 @@ pub(crate) fn each_run<T: Send>(
             sink(work(&lp)).map_err(Error::Output)?;
             return Ok((lp.primary_letter as char, lp.warnings.clone()));
         }
+        Begun::Nothing { why, .. } => return Err(why),
         Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx),
     };
     let warnings = primary_mismatch_warning(name, machine, p_idx)

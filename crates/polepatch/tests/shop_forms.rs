@@ -194,3 +194,55 @@ fn equation_6_on_g93_is_g94_at_the_block_feeds() {
     assert_eq!(fa.axis_min_ratio, fb.axis_min_ratio);
     assert_eq!(fa.zones.len(), fb.zones.len());
 }
+
+/// Issue 20 §7: a program that holds nothing to analyse — no G1 motion (a drilling or
+/// subprogram-call program), no rotary word (3-axis), every G1 move an expression — is
+/// read, written unchanged and reported with a warning (exit 0); the expression lines are
+/// listed as not analysed (`--strict`: 2). `simulate`, which needs motion, refuses it.
+#[test]
+fn a_program_with_nothing_to_analyse_is_written_unchanged() {
+    let m = Machine::builtin("mikron-ucp710").unwrap();
+    for (text, why, listed) in [
+        (
+            "G0 X0 Y0 Z50\nG81 X10 Y10 Z-5 R2 F100\nX20\nG80\nM30\n",
+            "no G1 motion",
+            0,
+        ),
+        (
+            "G1 X0 Y0 Z0 F1000\nX10\nX20 Y5\nM30\n",
+            "no rotary axis words",
+            0,
+        ),
+        (
+            "M128\nG1 X0 Y0 Z0 A#1 C0 F1000\nG1 X1 A#2 C#3\nM30\n",
+            "expressions or variables",
+            1,
+        ),
+    ] {
+        let (out, report) = patch_nc(text.as_bytes(), &m, &PatchOptions::default())
+            .unwrap_or_else(|e| panic!("{text}: {e}"));
+        assert_eq!(out, text.as_bytes());
+        assert!(report.zones.is_empty());
+        assert!(
+            report.warnings.iter().any(|w| w.contains(why)),
+            "{:?}",
+            report.warnings
+        );
+        assert_eq!(report.not_analysed.len(), listed, "{text}");
+        assert_eq!(report.strict_failures(), listed, "{text}");
+        let a = polepatch::analyze_nc(text.as_bytes(), &m, &polepatch::AnalyzeOptions::default())
+            .unwrap();
+        assert!(a.runs.is_empty());
+        assert!(
+            a.warnings.iter().any(|w| w.contains(why)),
+            "{:?}",
+            a.warnings
+        );
+        let sim = polepatch::simulate::simulate_nc(
+            text.as_bytes(),
+            &m,
+            &polepatch::simulate::SimulateOptions::default(),
+        );
+        assert!(sim.is_err(), "{text}");
+    }
+}

@@ -6,7 +6,7 @@
 //! |---|---|---|
 //! | `Error::Parse`, `Error::Cl` | `InputError` | `path`, `line`, `column` |
 //! | `Error::Unsupported` | `InputError` | `path`, `line` (`column` None) |
-//! | `Error::Empty`, `NoRuns`, `NoRotary` | `InputError` | `path` |
+//! | `Error::Empty`, `NoRuns`, `NoRotary` (only where a call needs motion: `reorient`, `simulate`) | `InputError` | `path` |
 //! | `Error::Point` | `InputError` | `index` (the array row) |
 //! | `Error::Path` (joint arrays) | `InputError` | — |
 //! | `Error::Options` | `ValueError` | — |
@@ -122,7 +122,8 @@ pub(crate) fn to_python(py: Python<'_>, failure: Failure) -> PyErr {
                 Error::Cl { path: p, record } => {
                     input_error(py, message, path(p), Some(record.line), Some(record.column))
                 }
-                Error::Unsupported { path: p, line, .. } => {
+                Error::Unsupported { path: p, line, .. }
+                | Error::NothingAnalysable { path: p, line } => {
                     input_error(py, message, path(p), Some(*line), None)
                 }
                 Error::Empty { path: p }

@@ -31,16 +31,22 @@ def test_attributes_name_the_input_when_named() -> None:
     assert (info.value.line, info.value.column) == (3, 8)
 
 
-def test_programs_without_work_are_input_errors_with_a_path_and_no_line() -> None:
-    for program in [
-        b"  \n\n",  # empty
-        b"%P G71 *\nN10 G00 X0 Y0 Z0 *\n",  # no G1 motion
-        b"%P G71 *\nN10 G01 X0 Y0 Z0 F100 *\nN20 X1 Y1 Z0 *\n",  # no rotary words
+def test_an_empty_program_is_an_input_error_with_a_path_and_no_line() -> None:
+    with pytest.raises(polepatch.InputError) as info:
+        polepatch.patch_nc(b"  \n\n", "mikron-ucp710", name="p.nc")
+    e = info.value
+    assert e.path == "p.nc" and e.line is None and e.column is None, str(e)
+
+
+def test_programs_without_work_come_back_unchanged_with_a_warning() -> None:
+    for program, why in [
+        (b"%P G71 *\nN10 G00 X0 Y0 Z0 *\n", "no G1 motion"),
+        (b"%P G71 *\nN10 G01 X0 Y0 Z0 F100 *\nN20 X1 Y1 Z0 *\n", "no rotary axis words"),
     ]:
-        with pytest.raises(polepatch.InputError) as info:
-            polepatch.patch_nc(program, "mikron-ucp710", name="p.nc")
-        e = info.value
-        assert e.path == "p.nc" and e.line is None and e.column is None, str(e)
+        out, report = polepatch.patch_nc(program, "mikron-ucp710", name="p.nc")
+        assert out == program
+        assert report["zones"] == []
+        assert any(why in w for w in report["warnings"]), report["warnings"]
 
 
 def test_a_bad_cl_record_has_line_and_column() -> None:
