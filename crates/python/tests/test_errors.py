@@ -63,7 +63,7 @@ def test_an_unsupported_point_has_a_line() -> None:
     cl = "MULTAX/ON\nGOTO/0,0,0,0,0,1\nGOTO/1,0,0,0,0.6,0.8\n"
     with pytest.raises(polepatch.InputError) as info:
         polepatch.post_cl(cl, "mikron-ucp710")
-    assert info.value.line == 2 and info.value.column is None, str(info.value)
+    assert (info.value.line, info.value.column) == (2, 1), str(info.value)
     assert "feed" in str(info.value)
     assert polepatch.post_cl(cl, "mikron-ucp710", feed_fallback_mm_min=1000.0)
 

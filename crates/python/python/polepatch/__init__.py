@@ -211,7 +211,9 @@ def patch_nc(
         cone_deg: singular cone, degrees: a zone needs a point with |primary| ≤ this.
         max_deviation_deg: largest change of tool orientation allowed, degrees
             (``None``: no limit; the deviation is minimised anyway).
-        tcy_ms: interpolation cycle time, ms (``None``: the machine's).
+        tcy_ms: interpolation cycle time, ms (``None``: the machine's). Accepted for
+            compatibility: Equation 6 is bounded exactly over every span, so it changes no
+            figure (the CLI has no such option for `patch`).
         margin: safety margin on the V/A/J limits, a fraction in [0, 0.5).
         max_decimals: most decimals written for a rotary value when the file's are not
             enough to hold Equation 6 (at most 9).
@@ -276,8 +278,9 @@ def feed_profile(
     """Equation 6 sampled along every G1 run: the curves behind :func:`analyze_nc`'s
     minima, for plots (``examples/notebook.py``).
 
-    The samples are those of the analysis spline: every F·Tcy mm along the run and at
-    every CL point. Options as :func:`analyze_nc`'s. The whole program is parsed at once
+    The samples are where the analysis evaluated Equation 6 on the analysis spline: every
+    CL point, and inside a span below feed the points of its adaptive bisection (a span
+    is bounded exactly by its largest derivatives, so no figure depends on Tcy). Options as :func:`analyze_nc`'s. The whole program is parsed at once
     (about ten times its size in memory).
 
     Returns:
