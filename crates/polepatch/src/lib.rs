@@ -232,11 +232,15 @@ pub fn patch_nc_to(
     opts: &PatchOptions,
     out: &mut dyn std::io::Write,
 ) -> Result<FileReport, Error> {
-    if let Some(report) = far::far_from_pole(bytes, machine, opts)? {
+    let cl_instead = |e: Error| match e {
+        Error::Parse(_) => program::cl_file_error(bytes, &opts.name).unwrap_or(e),
+        e => e,
+    };
+    if let Some(report) = far::far_from_pole(bytes, machine, opts).map_err(cl_instead)? {
         out.write_all(bytes).map_err(Error::Output)?;
         return Ok(report);
     }
-    stream::patch_nc_to(bytes, machine, opts, out)
+    stream::patch_nc_to(bytes, machine, opts, out).map_err(cl_instead)
 }
 
 /// Equation 6 along every run of an NC program held in memory (what `polepatch analyze`

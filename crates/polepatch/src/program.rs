@@ -170,8 +170,48 @@ pub fn parse_program(bytes: Vec<u8>, name: &str, machine: &Machine) -> Result<Pr
             path: name.to_string(),
         });
     }
+    let cl = cl_file_error(&bytes, name);
     polepatch_nc::parse_with(bytes, &read_options(machine)?)
-        .map_err(|e| Error::Parse(e.with_path(name)))
+        .map_err(|e| cl.unwrap_or_else(|| Error::Parse(e.with_path(name))))
+}
+
+/// How far into a file [`cl_file_error`] looks for an APT `GOTO/` record, bytes.
+const CL_SNIFF_BYTES: usize = 64 * 1024;
+
+/// When `bytes` is a CL file (an APT `GOTO/` record starts a line within its first
+/// [`CL_SNIFF_BYTES`]), the error that says so, at that line: given instead of the NC
+/// reader's message about the first line it cannot read (`PARTNO`, `SPINDL/RPM,…`), which
+/// would be about the wrong thing.
+pub fn cl_file_error(bytes: &[u8], name: &str) -> Option<Error> {
+    let head = &bytes[..bytes.len().min(CL_SNIFF_BYTES)];
+    let record = head.split(|&b| b == b'\n' || b == b'\r').find(|l| {
+        let t = l.trim_ascii_start();
+        t.len() >= 5 && t[..5].eq_ignore_ascii_case(b"GOTO/")
+    })?;
+    // Line numbers as the reader counts them (CR LF, LF or CR alone each end one line).
+    let line = line_number(head, record.as_ptr() as usize - head.as_ptr() as usize);
+    Some(Error::Unsupported {
+        path: name.to_string(),
+        line,
+        what: "this is a CL file (APT GOTO/ records), not an NC program: post it with \
+               `polepatch post`"
+            .to_string(),
+    })
+}
+
+/// 1-based line of byte `at` of `bytes` (CR LF, LF or a CR alone ends a line).
+fn line_number(bytes: &[u8], at: usize) -> usize {
+    let mut line = 1;
+    let mut k = 0;
+    while k < at {
+        match bytes[k] {
+            b'\n' => line += 1,
+            b'\r' if bytes.get(k + 1) != Some(&b'\n') => line += 1,
+            _ => {}
+        }
+        k += 1;
+    }
+    line
 }
 
 /// Parse `bytes` and build each run's path for `machine`; `feed_fallback_mm_min` is used
@@ -237,18 +277,8 @@ fn why_no_runs(program: &Program, name: &str) -> Error {
         };
     }
     // A CL file handed to `patch`: say what it is.
-    if let Some(k) = program.blocks.iter().position(|b| {
-        let line = &program.bytes[b.span()];
-        let t = line.trim_ascii_start();
-        t.len() >= 5 && t[..5].eq_ignore_ascii_case(b"GOTO/")
-    }) {
-        return Error::Unsupported {
-            path: name.to_string(),
-            line: program.blocks[k].line,
-            what: "this is a CL file (APT GOTO/ records), not an NC program: post it with \
-                   `polepatch post`"
-                .to_string(),
-        };
+    if let Some(e) = cl_file_error(&program.bytes, name) {
+        return e;
     }
     Error::NoRuns {
         path: name.to_string(),

@@ -246,3 +246,35 @@ fn a_program_with_nothing_to_analyse_is_written_unchanged() {
         assert!(sim.is_err(), "{text}");
     }
 }
+
+/// A CL file handed to `patch` or `analyze` is named as one, at its first `GOTO/` record —
+/// whatever line the NC reader would stumble on first (CAMWorks' `SPINDL/RPM,…` on line 1
+/// read as an S word without a number).
+#[test]
+fn a_cl_file_is_named_as_one() {
+    let m = Machine::builtin("mikron-ucp710").unwrap();
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/cl");
+    for (file, line) in [
+        ("camworks_plate.apt", 15),
+        ("camworks_bracket_inch.apt", 9),
+        ("nx_5axis.cls", 13),
+        ("SING.apt", 5),
+    ] {
+        let bytes = std::fs::read(root.join(file)).unwrap();
+        let opts = PatchOptions {
+            name: file.to_string(),
+            ..PatchOptions::default()
+        };
+        let want = format!("{file}:{line}: this is a CL file");
+        let e = patch_nc(&bytes, &m, &opts).unwrap_err().to_string();
+        assert!(e.starts_with(&want), "{e}");
+        let a = polepatch::AnalyzeOptions {
+            name: file.to_string(),
+            ..polepatch::AnalyzeOptions::default()
+        };
+        let e = polepatch::analyze_nc(&bytes, &m, &a)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with(&want), "{e}");
+    }
+}
