@@ -1,6 +1,6 @@
 //! Runs of G1 motion with cumulative tool-tip path length s.
 
-use crate::modal::{Modal, X, Y, Z};
+use crate::modal::{A, B, C, Modal, X, Y, Z};
 
 use crate::program::{Block, Program};
 
@@ -165,6 +165,22 @@ impl RunBuilder {
                             r.tcpm = st.tcpm;
                             r
                         });
+                        // A rotary axis first programmed by this move: its motion over the
+                        // move, from a value the program never stated, is unknown — the run
+                        // starts at this move's end instead (that point never changes).
+                        if r.len() == 1
+                            && [A, B, C]
+                                .iter()
+                                .any(|&k| r.pos[0][k].is_none() && st.pos[k].is_some())
+                        {
+                            *r = Self::start(i, st);
+                            r.feed_mm_min = st.feed_mm_min;
+                            r.feed_mode = st.feed_mode;
+                            r.tcpm = st.tcpm;
+                            self.last_pos = Some(i);
+                            self.prev = *st;
+                            return;
+                        }
                         let s = r.length_mm() + d;
                         r.blocks.push(i);
                         r.s_mm.push(s);
@@ -265,10 +281,12 @@ mod tests {
         let (_, r) =
             runs_of("G0 X0 Y0 Z0\nG1 X3 Y4 F100 C10\n; note\nX6 Y8 C20\nM8\nX6 Y8 Z10\nG0 Z50\n");
         assert_eq!(r.len(), 1);
-        assert_eq!(r[0].blocks, vec![0, 1, 3, 5]);
-        assert_eq!(r[0].s_mm, vec![0.0, 5.0, 10.0, 20.0]);
-        assert_eq!(r[0].pos[2][C], Some(20.0));
-        assert_eq!(r[0].pos[0][C], None);
+        // C is first programmed by the first G1 move (its motion from the unknown value is
+        // unknown): the run starts at that move's end.
+        assert_eq!(r[0].blocks, vec![1, 3, 5]);
+        assert_eq!(r[0].s_mm, vec![0.0, 5.0, 15.0]);
+        assert_eq!(r[0].pos[1][C], Some(20.0));
+        assert_eq!(r[0].pos[0][C], Some(10.0));
         assert_eq!(r[0].feed_mm_min, Some(100.0));
         assert_eq!(r[0].ended_by, RunBreak::Block);
     }

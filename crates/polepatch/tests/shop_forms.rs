@@ -278,3 +278,38 @@ fn a_cl_file_is_named_as_one() {
         assert!(e.starts_with(&want), "{e}");
     }
 }
+
+/// Conversational as manuals and forums show it — no `BEGIN PGM`, `M128` on the approach
+/// block, which leaves A and C unstated — is read as conversational, and the run starts
+/// where the rotary axes are first programmed: its zone is patched, rotary words only.
+#[test]
+fn a_conversational_fragment_with_an_unstated_start_is_patched() {
+    let mut text = String::from("; TNC 5-axis\nL X+0 Y+0 Z+50 R0 FMAX M128 ; TCPM ON\n");
+    for k in 0..41 {
+        let a = if k == 20 {
+            0.3
+        } else {
+            -2.0 + 0.1 * f64::from(k)
+        };
+        let c = 30.0 + f64::from(k) + if a > 0.0 { 150.0 } else { 0.0 };
+        text += &format!(
+            "L X{:+.3} Y{:+.3} Z-5 A{a:+.3} C{c:+.3} F1500\n",
+            10.0 + 0.5 * f64::from(k),
+            0.1 * f64::from(k)
+        );
+    }
+    text += "L Z+50 R0 FMAX\nM129 ; TCPM OFF\nM30\n";
+    let m = Machine::builtin("mikron-ucp710").unwrap();
+    let (out, report) = patched(text.as_bytes(), &m);
+    assert!(
+        report.untouched_runs.is_empty(),
+        "{:?}",
+        report.untouched_runs
+    );
+    assert_eq!(report.zones.len(), 1);
+    assert_eq!(report.zones[0].outcome, "reached");
+    assert_eq!(
+        without_rotary_values(&out),
+        without_rotary_values(text.as_bytes())
+    );
+}
