@@ -521,7 +521,9 @@ pub fn patch_program(
                 if machine.chain.is_none() {
                     "no TCPM active (M128, TRAORI or G43.4) — X Y Z are machine coordinates; \
                      changing rotary words alone would move the part under the tool, so the run is \
-                     left as it is (give the machine's kinematic chain to patch it)"
+                     left as it is (if the controller switches TCPM with other codes, or always \
+                     runs with it, say so in the machine file's [controller] section: tcpm_on, \
+                     tcpm_always; else give the machine's kinematic chain to patch it)"
                 } else if chain.is_none() {
                     "no TCPM active and the work offset is unknown (the program states no datum \
                      with values): X Y Z cannot be recomputed, so the run is left as it is \
