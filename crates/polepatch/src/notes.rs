@@ -201,8 +201,9 @@ fn message(reason: SkipReason, lines: [usize; 2]) -> String {
     };
     match reason {
         SkipReason::Expression => format!(
-            "{at}: an axis or feed word is an expression or a variable; the blocks are kept as \
-             written and no run is analysed across them"
+            "{at}: an axis or feed word is an expression or a variable (or an indexed address \
+             such as Sinumerik's A3= orientation vector); the blocks are kept as written and no \
+             run is analysed across them"
         ),
         SkipReason::ArcNearPole => format!(
             "{at}: an arc or polar move near the pole; polepatch does not analyse the rotary \
