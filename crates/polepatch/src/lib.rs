@@ -232,10 +232,7 @@ pub fn patch_nc_to(
     opts: &PatchOptions,
     out: &mut dyn std::io::Write,
 ) -> Result<FileReport, Error> {
-    let cl_instead = |e: Error| match e {
-        Error::Parse(_) => program::cl_file_error(bytes, &opts.name).unwrap_or(e),
-        e => e,
-    };
+    let cl_instead = |e| program::or_cl_file(e, bytes, &opts.name);
     if let Some(report) = far::far_from_pole(bytes, machine, opts).map_err(cl_instead)? {
         out.write_all(bytes).map_err(Error::Output)?;
         return Ok(report);

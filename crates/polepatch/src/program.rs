@@ -175,6 +175,15 @@ pub fn parse_program(bytes: Vec<u8>, name: &str, machine: &Machine) -> Result<Pr
         .map_err(|e| cl.unwrap_or_else(|| Error::Parse(e.with_path(name))))
 }
 
+/// `e`, or — when it is a syntax error and `bytes` is a CL file — the error that says so
+/// ([`cl_file_error`]).
+pub(crate) fn or_cl_file(e: Error, bytes: &[u8], name: &str) -> Error {
+    match e {
+        Error::Parse(_) => cl_file_error(bytes, name).unwrap_or(e),
+        e => e,
+    }
+}
+
 /// How far into a file [`cl_file_error`] looks for an APT `GOTO/` record, bytes.
 const CL_SNIFF_BYTES: usize = 64 * 1024;
 

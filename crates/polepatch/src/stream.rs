@@ -522,11 +522,9 @@ pub fn analyze_nc_each(
     opts: &crate::AnalyzeOptions,
     each: &mut dyn FnMut(Piece<'_>) -> std::io::Result<()>,
 ) -> Result<(), Error> {
-    analyze_each(bytes, machine, opts, each).map_err(|e| match e {
-        // A CL file handed to `analyze`: say so, not what the NC reader saw first.
-        Error::Parse(_) => crate::program::cl_file_error(bytes, &opts.name).unwrap_or(e),
-        e => e,
-    })
+    // A CL file handed to `analyze`: say so, not what the NC reader saw first.
+    analyze_each(bytes, machine, opts, each)
+        .map_err(|e| crate::program::or_cl_file(e, bytes, &opts.name))
 }
 
 fn analyze_each(
