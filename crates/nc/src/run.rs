@@ -174,19 +174,14 @@ impl RunBuilder {
                                 .any(|&k| r.pos[0][k].is_none() && st.pos[k].is_some())
                         {
                             *r = Self::start(i, st);
-                            r.feed_mm_min = st.feed_mm_min;
-                            r.feed_mode = st.feed_mode;
-                            r.tcpm = st.tcpm;
-                            self.last_pos = Some(i);
-                            self.prev = *st;
-                            return;
-                        }
-                        let s = r.length_mm() + d;
-                        r.blocks.push(i);
-                        r.s_mm.push(s);
-                        r.pos.push(st.pos);
-                        if let Some(f) = st.inverse_time_per_min.filter(|_| inverse_time) {
-                            r.block_feed_mm_min.push(d * f);
+                        } else {
+                            let s = r.length_mm() + d;
+                            r.blocks.push(i);
+                            r.s_mm.push(s);
+                            r.pos.push(st.pos);
+                            if let Some(f) = st.inverse_time_per_min.filter(|_| inverse_time) {
+                                r.block_feed_mm_min.push(d * f);
+                            }
                         }
                     }
                 }
