@@ -462,18 +462,48 @@ impl<'a> Hermite<'a> {
     /// span's `|q'|`, `|q''|`, `|q'''|` at the points the bounds are taken (knots and
     /// middle): `eps·Σ_{i written} |w_i|` over the analysis spline's data rows
     /// ([`crate::spline::SplineSystem::data_row`], on the window).
-    pub(crate) fn rounding_room(&self, eps: f64) -> Result<Vec<[f64; 3]>, PatchFailure> {
-        let sys = crate::spline::SplineSystem::new(&self.s[self.lo..=self.hi])
-            .map_err(|_| PatchFailure::TooShort)?;
+    pub(crate) fn rounding_room(
+        &self,
+        eps: f64,
+        memo: Option<&crate::joint::RoundingMemo>,
+    ) -> Result<Vec<[f64; 3]>, PatchFailure> {
+        let gains = self.rounding_gains(memo)?;
+        Ok(gains
+            .iter()
+            .map(|g| [g[0] * eps, g[1] * eps, g[2] * eps])
+            .collect())
+    }
+
+    /// [`Hermite::rounding_room`] for `eps = 1`. It depends only on the window's knots and
+    /// which of them are written, and one zone's solves (every start, both axes) ask for
+    /// the same window again and again: with a `memo` the results are kept there, keyed
+    /// by exactly those inputs (the knots compared bit for bit).
+    fn rounding_gains(
+        &self,
+        memo: Option<&crate::joint::RoundingMemo>,
+    ) -> Result<Vec<[f64; 3]>, PatchFailure> {
+        let knots = &self.s[self.lo..=self.hi];
         let (a, b) = (self.first - self.lo, self.last - self.lo);
+        let same = |k: &[f64]| {
+            k.len() == knots.len() && k.iter().zip(knots).all(|(x, y)| x.to_bits() == y.to_bits())
+        };
+        if let Some(hit) = memo.and_then(|m| {
+            m.entries
+                .borrow()
+                .iter()
+                .find(|e| e.1 == (a, b) && same(&e.0))
+                .map(|e| e.2.clone())
+        }) {
+            return Ok(hit);
+        }
+        let sys = crate::spline::SplineSystem::new(knots).map_err(|_| PatchFailure::TooShort)?;
         let l1 = |t: f64, order: usize| -> f64 {
             sys.data_row(t, order)[a..=b]
                 .iter()
                 .map(|w| w.abs())
                 .sum::<f64>()
-                * eps
         };
-        Ok((self.lo..self.hi)
+        let gains: Vec<[f64; 3]> = (self.lo..self.hi)
             .map(|k| {
                 let (x0, x1) = (self.s[k], self.s[k + 1]);
                 let mid = 0.5 * (x0 + x1);
@@ -483,7 +513,13 @@ impl<'a> Hermite<'a> {
                     l1(mid, 3),
                 ]
             })
-            .collect())
+            .collect();
+        if let Some(m) = memo {
+            m.entries
+                .borrow_mut()
+                .push((knots.to_vec(), (a, b), gains.clone()));
+        }
+        Ok(gains)
     }
 
     /// Push Equation 6's rows for this axis over every span of the window, in convex-hull

@@ -274,12 +274,6 @@ impl BorderedBand {
         }
     }
 
-    fn clear(&mut self) {
-        self.band.iter_mut().for_each(|v| *v = 0.0);
-        self.border.iter_mut().for_each(|v| *v = 0.0);
-        self.corner.iter_mut().for_each(|v| *v = 0.0);
-    }
-
     /// Add `v` at (a, b) and (b, a) of the symmetric matrix (once on the diagonal).
     fn add(&mut self, a: Slot, b: Slot, v: f64) {
         match (a, b) {
@@ -627,6 +621,220 @@ struct Entry {
     v: f64,
 }
 
+/// The fixed shape of the KKT matrix of one problem, computed once per solve: where each
+/// product of [`Banded::solve`]'s iteration matrix lands (flat indices into the
+/// [`BorderedBand`]'s storage), so that an iteration only multiplies and adds.
+struct Assembler {
+    /// `H` and `A` (the parts that do not change), unregularised.
+    base: BorderedBand,
+    /// Linear row r's pairs `lp_ptr[r]..lp_ptr[r + 1]`: where `d_r·g_a·g_b` is added.
+    lp_ptr: Vec<usize>,
+    lp_dst: Vec<u32>,
+    lp_coef: Vec<f64>,
+    /// Per cone block: its variables' count, `G_c` (q × nv, row-major) and, for every
+    /// pair `i ≤ j` of its variables in order, where `(G_cᵀ·V·G_c)_ij` is added
+    /// (`pair_ptr` into `pair_dst`).
+    cones: Vec<ConePattern>,
+    /// The diagonal entries that get `+δ` (variables) and `−δ` (multipliers).
+    reg_plus: Vec<u32>,
+    reg_minus: Vec<u32>,
+}
+
+struct ConePattern {
+    nv: usize,
+    g: Vec<f64>,
+    pair_ptr: Vec<usize>,
+    pair_dst: Vec<u32>,
+}
+
+impl BorderedBand {
+    /// The flat storage indices (band, then border, then corner) at which [`BorderedBand::add`]
+    /// adds a value at `(a, b)`.
+    fn dsts(&self, a: Slot, b: Slot, out: &mut Vec<u32>) {
+        let nbw = self.band.len();
+        let nbo = self.border.len();
+        let idx = match (a, b) {
+            (Slot::Band(i), Slot::Band(j)) => {
+                let (i, j) = if i >= j { (i, j) } else { (j, i) };
+                i * (self.w + 1) + (j + self.w - i)
+            }
+            (Slot::Border(r), Slot::Band(i)) | (Slot::Band(i), Slot::Border(r)) => {
+                nbw + r * self.nb + i
+            }
+            (Slot::Border(r), Slot::Border(q)) => {
+                if r != q {
+                    out.push((nbw + nbo + q * self.k + r) as u32);
+                }
+                nbw + nbo + r * self.k + q
+            }
+        };
+        out.push(idx as u32);
+    }
+
+    /// Add `v` at the flat storage index `i` ([`BorderedBand::dsts`]).
+    #[inline]
+    fn add_flat(&mut self, i: u32, v: f64) {
+        let i = i as usize;
+        let nbw = self.band.len();
+        if i < nbw {
+            self.band[i] += v;
+        } else if i < nbw + self.border.len() {
+            self.border[i - nbw] += v;
+        } else {
+            self.corner[i - nbw - self.border.len()] += v;
+        }
+    }
+
+    /// Copy another matrix of the same shape.
+    fn copy_from(&mut self, o: &BorderedBand) {
+        self.band.copy_from_slice(&o.band);
+        self.border.copy_from_slice(&o.border);
+        self.corner.copy_from_slice(&o.corner);
+    }
+}
+
+impl Assembler {
+    fn new(p: &Banded, lay: &Layout, entries: &[Vec<Entry>], blocks: &[(usize, usize)]) -> Self {
+        let mut base = BorderedBand::new(lay.nb, lay.w, lay.k);
+        for &(i, j, v) in &p.h {
+            base.add(lay.var_slot(i), lay.var_slot(j), v);
+        }
+        for (r, (row, _)) in p.eq.iter().enumerate() {
+            for &(j, v) in row {
+                base.add(Slot::Band(lay.eq_band[r]), lay.var_slot(j), v);
+            }
+        }
+        let ml = entries.len() - blocks.iter().map(|b| b.1).sum::<usize>();
+        let mut d = Vec::new();
+        let (mut lp_ptr, mut lp_dst, mut lp_coef) = (vec![0], Vec::new(), Vec::new());
+        for row in &entries[..ml] {
+            for (a, ea) in row.iter().enumerate() {
+                for eb in &row[a..] {
+                    d.clear();
+                    base.dsts(ea.slot, eb.slot, &mut d);
+                    for &i in &d {
+                        lp_dst.push(i);
+                        lp_coef.push(ea.v * eb.v);
+                    }
+                }
+            }
+            lp_ptr.push(lp_dst.len());
+        }
+        let cones = blocks
+            .iter()
+            .map(|&(b0, q)| {
+                let mut vars: Vec<Entry> = Vec::new();
+                for r in b0..b0 + q {
+                    for e in &entries[r] {
+                        if !vars.iter().any(|c| c.var == e.var) {
+                            vars.push(*e);
+                        }
+                    }
+                }
+                let nv = vars.len();
+                let mut g = vec![0.0; q * nv];
+                for (a, r) in (b0..b0 + q).enumerate() {
+                    for e in &entries[r] {
+                        let c = vars.iter().position(|c| c.var == e.var).unwrap_or(0);
+                        g[a * nv + c] += e.v;
+                    }
+                }
+                let (mut pair_ptr, mut pair_dst) = (vec![0], Vec::new());
+                for i in 0..nv {
+                    for j in i..nv {
+                        base.dsts(vars[i].slot, vars[j].slot, &mut pair_dst);
+                        pair_ptr.push(pair_dst.len());
+                    }
+                }
+                ConePattern {
+                    nv,
+                    g,
+                    pair_ptr,
+                    pair_dst,
+                }
+            })
+            .collect();
+        let (mut reg_plus, mut reg_minus) = (Vec::new(), Vec::new());
+        for j in 0..p.n {
+            let sl = lay.var_slot(j);
+            base.dsts(sl, sl, &mut reg_plus);
+        }
+        for r in 0..p.eq.len() {
+            let sl = Slot::Band(lay.eq_band[r]);
+            base.dsts(sl, sl, &mut reg_minus);
+        }
+        Assembler {
+            base,
+            lp_ptr,
+            lp_dst,
+            lp_coef,
+            cones,
+            reg_plus,
+            reg_minus,
+        }
+    }
+
+    /// The KKT matrix `[H + Gᵀ·V·G, Aᵀ; A, 0]` into `unreg`, and regularised (`±δ`) into
+    /// `kkt`: `V` is `d_lp` on the linear rows, `v_cone[b]` (q × q) on cone block b.
+    fn assemble(
+        &self,
+        d_lp: &[f64],
+        v_cone: &[Vec<f64>],
+        delta: f64,
+        kkt: &mut BorderedBand,
+        unreg: &mut BorderedBand,
+        vg: &mut Vec<f64>,
+    ) {
+        unreg.copy_from(&self.base);
+        for (r, &d) in d_lp.iter().enumerate() {
+            let (a, b) = (self.lp_ptr[r], self.lp_ptr[r + 1]);
+            for (&i, &c) in self.lp_dst[a..b].iter().zip(&self.lp_coef[a..b]) {
+                unreg.add_flat(i, d * c);
+            }
+        }
+        for (cp, v) in self.cones.iter().zip(v_cone) {
+            let nv = cp.nv;
+            let q = cp.g.len() / nv.max(1);
+            // V·G_c (q × nv), then G_cᵀ·(V·G_c) on the pairs i ≤ j.
+            vg.clear();
+            vg.resize(q * nv, 0.0);
+            for a in 0..q {
+                for b in 0..q {
+                    let vab = v[a * q + b];
+                    if vab == 0.0 {
+                        continue;
+                    }
+                    for j in 0..nv {
+                        vg[a * nv + j] += vab * cp.g[b * nv + j];
+                    }
+                }
+            }
+            let mut pair = 0;
+            for i in 0..nv {
+                for j in i..nv {
+                    let mut acc = 0.0;
+                    for a in 0..q {
+                        acc += cp.g[a * nv + i] * vg[a * nv + j];
+                    }
+                    if acc != 0.0 {
+                        for &dst in &cp.pair_dst[cp.pair_ptr[pair]..cp.pair_ptr[pair + 1]] {
+                            unreg.add_flat(dst, acc);
+                        }
+                    }
+                    pair += 1;
+                }
+            }
+        }
+        kkt.copy_from(unreg);
+        for &i in &self.reg_plus {
+            kkt.add_flat(i, delta);
+        }
+        for &i in &self.reg_minus {
+            kkt.add_flat(i, -delta);
+        }
+    }
+}
+
 impl Banded {
     /// An empty problem in `n` variables, all in the band at position 0.
     pub fn new(n: usize) -> Banded {
@@ -652,91 +860,6 @@ impl Banded {
             if i != j {
                 out[j] += v * x[i];
             }
-        }
-    }
-
-    /// The KKT matrix `[H + Gᵀ·V·G, Aᵀ; A, 0]` into `unreg`, and regularised (`±δ`) into
-    /// `kkt`: `V` is `d_lp` on the linear rows, `v_cone[b]` (q × q) on cone block b.
-    #[allow(clippy::too_many_arguments)]
-    fn assemble(
-        &self,
-        lay: &Layout,
-        entries: &[Vec<Entry>],
-        blocks: &[(usize, usize)],
-        d_lp: &[f64],
-        v_cone: &[Vec<f64>],
-        delta: f64,
-        kkt: &mut BorderedBand,
-        unreg: &mut BorderedBand,
-        cone_vars: &mut Vec<Entry>,
-    ) {
-        kkt.clear();
-        for &(i, j, v) in &self.h {
-            kkt.add(lay.var_slot(i), lay.var_slot(j), v);
-        }
-        for (r, &d) in d_lp.iter().enumerate() {
-            let row = &entries[r];
-            for (a, ea) in row.iter().enumerate() {
-                for eb in &row[a..] {
-                    kkt.add(ea.slot, eb.slot, d * ea.v * eb.v);
-                }
-            }
-        }
-        for (bi, &(b0, q)) in blocks.iter().enumerate() {
-            let v = &v_cone[bi];
-            cone_vars.clear();
-            for r in b0..b0 + q {
-                for e in &entries[r] {
-                    if !cone_vars.iter().any(|c| c.var == e.var) {
-                        cone_vars.push(*e);
-                    }
-                }
-            }
-            let nv = cone_vars.len();
-            // G_c: q × nv, then G_cᵀ·V·G_c over the block's variables.
-            let mut g = vec![0.0; q * nv];
-            for (a, r) in (b0..b0 + q).enumerate() {
-                for e in &entries[r] {
-                    let c = cone_vars.iter().position(|c| c.var == e.var).unwrap_or(0);
-                    g[a * nv + c] += e.v;
-                }
-            }
-            for i in 0..nv {
-                for j in i..nv {
-                    let mut acc = 0.0;
-                    for a in 0..q {
-                        let ga = g[a * nv + i];
-                        if ga == 0.0 {
-                            continue;
-                        }
-                        for b in 0..q {
-                            acc += ga * v[a * q + b] * g[b * nv + j];
-                        }
-                    }
-                    if acc != 0.0 {
-                        kkt.add(cone_vars[i].slot, cone_vars[j].slot, acc);
-                    }
-                }
-            }
-        }
-        for (r, (row, _)) in self.eq.iter().enumerate() {
-            for &(j, v) in row {
-                kkt.add(Slot::Band(lay.eq_band[r]), lay.var_slot(j), v);
-            }
-        }
-        unreg.band.copy_from_slice(&kkt.band);
-        unreg.border.copy_from_slice(&kkt.border);
-        unreg.corner.copy_from_slice(&kkt.corner);
-        for j in 0..self.n {
-            let sl = lay.var_slot(j);
-            kkt.add(sl, sl, delta);
-        }
-        for r in 0..self.eq.len() {
-            kkt.add(
-                Slot::Band(lay.eq_band[r]),
-                Slot::Band(lay.eq_band[r]),
-                -delta,
-            );
         }
     }
 
@@ -830,8 +953,22 @@ impl Banded {
         let mut kkt = BorderedBand::new(lay.nb, lay.w, lay.k);
         let mut unreg = BorderedBand::new(lay.nb, lay.w, lay.k);
         let delta = st.regularisation;
-        let mut cone_vars: Vec<Entry> = Vec::new();
+        let asm = Assembler::new(self, &lay, &entries, &blocks);
+        // The rows of G flat (compressed rows), for the products with G and Gᵀ.
+        let mut ent_ptr: Vec<usize> = Vec::with_capacity(mi + 1);
+        let (mut ent_var, mut ent_v): (Vec<u32>, Vec<f64>) = (Vec::new(), Vec::new());
+        ent_ptr.push(0);
+        for row in &entries {
+            for e in row {
+                ent_var.push(e.var as u32);
+                ent_v.push(e.v);
+            }
+            ent_ptr.push(ent_var.len());
+        }
+        let mut gtw = vec![0.0; n];
+        let mut vg: Vec<f64> = Vec::new();
         let mut d_lp = vec![1.0; ml];
+        let mut d_sqrt = vec![1.0; ml];
         let mut v_cone: Vec<Vec<f64>> = blocks
             .iter()
             .map(|&(_, q)| {
@@ -843,17 +980,7 @@ impl Banded {
         let (mut rhs, mut sol, mut tmp) = (vec![0.0; nk], vec![0.0; nk], vec![0.0; nk]);
         // Start (CVXOPT's): x̂ minimising ½xᵀHx + cᵀx + ½‖G·x − h‖² with A·x = b, then
         // ŝ = h − G·x̂ and ẑ = −ŝ, each moved into the cones' interiors.
-        self.assemble(
-            &lay,
-            &entries,
-            &blocks,
-            &d_lp,
-            &v_cone,
-            delta,
-            &mut kkt,
-            &mut unreg,
-            &mut cone_vars,
-        );
+        asm.assemble(&d_lp, &v_cone, delta, &mut kkt, &mut unreg, &mut vg);
         let mut x = x0.to_vec();
         if kkt.factor() {
             for j in 0..n {
@@ -934,9 +1061,11 @@ impl Banded {
             }
             for r in 0..mi {
                 let mut g = 0.0;
-                for e in &entries[r] {
-                    g += e.v * x[e.var];
-                    rd[e.var] += e.v * z[r];
+                let zr = z[r];
+                for k in ent_ptr[r]..ent_ptr[r + 1] {
+                    let (j, v) = (ent_var[k] as usize, ent_v[k]);
+                    g += v * x[j];
+                    rd[j] += v * zr;
                 }
                 rg[r] = g + s[r] - rows[r].1;
             }
@@ -977,6 +1106,7 @@ impl Banded {
             // The matrix: H + Gᵀ·V·G on the variables, A and Aᵀ, regularised.
             for r in 0..ml {
                 d_lp[r] = z[r] / s[r];
+                d_sqrt[r] = d_lp[r].sqrt();
             }
             for (bi, &(_, q)) in blocks.iter().enumerate() {
                 // V = W⁻¹·W⁻¹ (symmetric).
@@ -988,17 +1118,7 @@ impl Banded {
                     }
                 }
             }
-            self.assemble(
-                &lay,
-                &entries,
-                &blocks,
-                &d_lp,
-                &v_cone,
-                delta,
-                &mut kkt,
-                &mut unreg,
-                &mut cone_vars,
-            );
+            asm.assemble(&d_lp, &v_cone, delta, &mut kkt, &mut unreg, &mut vg);
             if !kkt.factor() {
                 return IpmSolution {
                     x,
@@ -1012,7 +1132,7 @@ impl Banded {
                 for r in 0..ml {
                     u[r] = -rc[r] / lam[r];
                     // V·r_g + W⁻¹·u with V = z/s, W⁻¹ = sqrt(z/s).
-                    w_r[r] = z[r] / s[r] * rg[r] + (z[r] / s[r]).sqrt() * u[r];
+                    w_r[r] = d_lp[r] * rg[r] + d_sqrt[r] * u[r];
                 }
                 for (bi, &(b0, q)) in blocks.iter().enumerate() {
                     let mut neg = [0.0; MAX_CONE];
@@ -1031,13 +1151,15 @@ impl Banded {
                     }
                 }
                 rhs.iter_mut().for_each(|v| *v = 0.0);
-                for j in 0..n {
-                    rhs[x_at[j]] = -rd[j];
-                }
+                gtw.iter_mut().for_each(|v| *v = 0.0);
                 for r in 0..mi {
-                    for e in &entries[r] {
-                        rhs[x_at[e.var]] -= e.v * w_r[r];
+                    let wr = w_r[r];
+                    for k in ent_ptr[r]..ent_ptr[r + 1] {
+                        gtw[ent_var[k] as usize] += ent_v[k] * wr;
                     }
+                }
+                for j in 0..n {
+                    rhs[x_at[j]] = -rd[j] - gtw[j];
                 }
                 for r in 0..me {
                     rhs[lay.eq_band[r]] = -rp[r];
@@ -1049,11 +1171,13 @@ impl Banded {
                 dxy.extend((0..n).map(|j| sol[x_at[j]]));
                 dxy.extend((0..me).map(|r| sol[lay.eq_band[r]]));
                 for r in 0..mi {
-                    gdx[r] = entries[r].iter().map(|e| e.v * dxy[e.var]).sum();
+                    gdx[r] = (ent_ptr[r]..ent_ptr[r + 1])
+                        .map(|k| ent_v[k] * dxy[ent_var[k] as usize])
+                        .sum();
                     ds[r] = -rg[r] - gdx[r];
                 }
                 for r in 0..ml {
-                    dz[r] = z[r] / s[r] * gdx[r] + w_r[r];
+                    dz[r] = d_lp[r] * gdx[r] + w_r[r];
                 }
                 for (bi, &(b0, q)) in blocks.iter().enumerate() {
                     let wi = &scal[bi].winv;

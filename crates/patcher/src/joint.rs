@@ -93,6 +93,19 @@ use crate::{
 use polepatch_kinematics::{Machine, angle_between_deg, forward, forward_jacobian};
 use std::time::Instant;
 
+/// What the solves of one zone share and need not recompute: the rounding room of each
+/// window they constrain (`Hermite::rounding_room`, a function of the window's knots
+/// and written points only). Create one per zone; it grows by one entry per window.
+#[derive(Debug, Default)]
+pub struct RoundingMemo {
+    /// (window knots, written points relative to the window, room per span for a unit
+    /// rounding error).
+    pub(crate) entries: std::cell::RefCell<Vec<RoomEntry>>,
+}
+
+/// An entry of [`RoundingMemo`].
+pub(crate) type RoomEntry = (Vec<f64>, (usize, usize), Vec<[f64; 3]>);
+
 /// One joint solve's inputs. Every slice is per point of the whole path.
 #[derive(Debug, Clone)]
 pub struct JointProblem<'a> {
@@ -135,6 +148,9 @@ pub struct JointProblem<'a> {
     pub warm: bool,
     /// Most QP solves.
     pub max_solves: u32,
+    /// Where the rounding room of a window is kept between the solves of one zone
+    /// (`None`: computed each time).
+    pub memo: Option<&'a RoundingMemo>,
     /// The numerical settings.
     pub settings: &'a SolverSettings,
 }
@@ -199,9 +215,11 @@ struct Model<'a> {
     e: usize,
     /// Equalities, objective's linear part, `e ≥ 0`, the cap.
     base: QpBuilder,
-    /// The limit rows, relaxed by e (`row·x − e ≤ rhs`), and the range rows (hard).
+    /// The limit rows, relaxed by e (`row·x − e ≤ rhs`).
     limits: Vec<(Row, f64)>,
-    ranges: Vec<(Row, f64)>,
+    /// Per point of the range, the machine's ranges as bounds on its changes `(δP, δC)`
+    /// (hard; C's infinite when it turns endlessly).
+    ranges: Vec<[(f64, f64); 2]>,
     position: Vec<Option<f64>>,
 }
 
@@ -258,8 +276,8 @@ impl<'a> Model<'a> {
             }
         }
         let (rp, rc) = (
-            hp.rounding_room(pr.round_p_deg)?,
-            hc.rounding_room(pr.round_c_deg)?,
+            hp.rounding_room(pr.round_p_deg, pr.memo)?,
+            hc.rounding_room(pr.round_c_deg, pr.memo)?,
         );
         let mut lim = QpBuilder::new(t + 2);
         hp.push_limits(&mut lim, &pr.lim_p, &current, &rp, pr.core.clone());
@@ -267,25 +285,20 @@ impl<'a> Model<'a> {
         lim.extend_le(0..lim.le_len(), e, -1.0);
         let limits = lim.le_rows(0..lim.le_len()).to_vec();
         base.add_le(&[(e, -1.0)], 0.0);
-        let mut rng = QpBuilder::new(t + 2);
+        // The machine's ranges as bounds on each point's changes; the trust region
+        // bounds the same forms, so each QP takes the intersection (one pair of rows).
         let (p_lo, p_hi) = pr.machine.primary_range_deg;
-        for i in first..=last {
-            push_between(
-                &mut rng,
-                &hp.delta(i),
-                p_lo - pr.p_deg[i],
-                p_hi - pr.p_deg[i],
-            );
-            if let Some((c_lo, c_hi)) = pr.machine.c_range_deg {
-                push_between(
-                    &mut rng,
-                    &hc.delta(i),
-                    c_lo - pr.c_deg[i],
-                    c_hi - pr.c_deg[i],
-                );
-            }
-        }
-        let ranges = rng.le_rows(0..rng.le_len()).to_vec();
+        let ranges = (first..=last)
+            .map(|i| {
+                let c = pr
+                    .machine
+                    .c_range_deg
+                    .map_or((f64::NEG_INFINITY, f64::INFINITY), |(lo, hi)| {
+                        (lo - pr.c_deg[i], hi - pr.c_deg[i])
+                    });
+                [(p_lo - pr.p_deg[i], p_hi - pr.p_deg[i]), c]
+            })
+            .collect();
         if let Some(d) = pr.cap_deg {
             base.add_le(&[(t, 1.0)], chord(d));
         }
@@ -367,10 +380,10 @@ impl<'a> Model<'a> {
         let pr = self.pr;
         let st = pr.settings;
         let mut qp = self.base.clone();
-        for (row, rhs) in self.limits.iter().chain(&self.ranges) {
+        for (row, rhs) in &self.limits {
             qp.add_le(row, *rhs);
         }
-        for i in pr.first..=pr.last {
+        for (i, [rp, rc]) in (pr.first..=pr.last).zip(&self.ranges) {
             let (fp, fc) = (self.hp.delta(i), self.hc.delta(i));
             let (dp, dc) = (fp.at(xbar), fc.at(xbar));
             let [o, a, b] = forward_jacobian(pr.machine, pr.p_deg[i] + dp, pr.c_deg[i] + dc);
@@ -390,8 +403,16 @@ impl<'a> Model<'a> {
             qp.add_square(&v.row, st.joint_quad_weight, -v.c);
             qp.add_square(&fp.row, st.proximal_weight, dp - fp.c);
             qp.add_square(&fc.row, st.proximal_weight, dc - fc.c);
-            push_between(&mut qp, &fp, dp - rho.0, dp + rho.0);
-            push_between(&mut qp, &fc, dc - rho.1, dc + rho.1);
+            for (f, d, r, range) in [(&fp, dp, rho.0, rp), (&fc, dc, rho.1, rc)] {
+                let (lo, hi) = ((d - r).max(range.0), (d + r).min(range.1));
+                if lo <= hi {
+                    push_between(&mut qp, f, lo, hi);
+                } else {
+                    // Outside the range already: both, as they are (infeasible).
+                    push_between(&mut qp, f, d - r, d + r);
+                    push_between(&mut qp, f, range.0.max(-1e300), range.1.min(1e300));
+                }
+            }
         }
         qp
     }
@@ -588,6 +609,7 @@ mod tests {
             cap_deg: cap,
             warm: false,
             max_solves: st.scp_max_solves,
+            memo: None,
             settings: st,
         }
     }

@@ -107,12 +107,16 @@ impl Proposer for JointMethod {
                 .max(z.first.saturating_sub(e0))
                 .max(e1.saturating_sub(z.last));
         }
+        let memo = crate::joint::RoundingMemo::default();
         loop {
             let Some((first, last)) = Self::range(ctx, extra) else {
                 return;
             };
             let whole = first <= ctx.lower && last >= ctx.end;
-            if Self::solve_range(ctx, sink, first, last, whole) || whole || extra > ctx.s.len() {
+            if Self::solve_range(ctx, sink, &memo, first, last, whole)
+                || whole
+                || extra > ctx.s.len()
+            {
                 return;
             }
             extra *= 2;
@@ -127,6 +131,7 @@ impl JointMethod {
     fn solve_range(
         ctx: &ZoneCtx<'_>,
         sink: &mut dyn Sink,
+        memo: &crate::joint::RoundingMemo,
         first: usize,
         last: usize,
         last_try: bool,
@@ -231,6 +236,7 @@ impl JointMethod {
                 cap_deg: cap,
                 warm,
                 max_solves: solves,
+                memo: Some(memo),
                 settings: st,
             };
             solve_joint(&pr)

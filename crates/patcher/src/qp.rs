@@ -166,13 +166,25 @@ impl QpBuilder {
         debug_assert_eq!(position.len(), self.n);
         let mut b = crate::ipm::Banded::new(self.n);
         b.position = position;
-        b.h = self
+        // Each pair once (the interior-point method multiplies by H every iteration): the
+        // builder adds one square per term, so a pair comes back many times.
+        let mut h: Vec<(usize, usize, f64)> = self
             .h_rows
             .iter()
             .zip(&self.h_cols)
             .zip(&self.h_vals)
-            .map(|((&i, &j), &v)| (i, j, v))
+            .map(|((&i, &j), &v)| (i.min(j), i.max(j), v))
             .collect();
+        h.sort_by_key(|e| (e.0, e.1));
+        let mut merged: Vec<(usize, usize, f64)> = Vec::with_capacity(h.len());
+        for (i, j, v) in h {
+            match merged.last_mut() {
+                Some(last) if (last.0, last.1) == (i, j) => last.2 += v,
+                _ => merged.push((i, j, v)),
+            }
+        }
+        merged.retain(|e| e.2 != 0.0);
+        b.h = merged;
         b.c = self.q.clone();
         b.eq = self.eq.clone();
         b.le = self.le.clone();

@@ -369,6 +369,7 @@ pub fn zone_reference(
             cap_deg: None,
             warm: false,
             max_solves: st.scp_max_solves,
+            memo: None,
             settings: &st,
         };
         let Ok(sol) = solve_joint(&pr) else { continue };
