@@ -276,20 +276,10 @@ impl BorderedBand {
 
     /// Add `v` at (a, b) and (b, a) of the symmetric matrix (once on the diagonal).
     fn add(&mut self, a: Slot, b: Slot, v: f64) {
-        match (a, b) {
-            (Slot::Band(i), Slot::Band(j)) => {
-                let (i, j) = if i >= j { (i, j) } else { (j, i) };
-                self.band[i * (self.w + 1) + (j + self.w - i)] += v;
-            }
-            (Slot::Border(r), Slot::Band(i)) | (Slot::Band(i), Slot::Border(r)) => {
-                self.border[r * self.nb + i] += v;
-            }
-            (Slot::Border(r), Slot::Border(q)) => {
-                self.corner[r * self.k + q] += v;
-                if r != q {
-                    self.corner[q * self.k + r] += v;
-                }
-            }
+        let mut at = Vec::with_capacity(2);
+        self.dsts(a, b, &mut at);
+        for i in at {
+            self.add_flat(i, v);
         }
     }
 
