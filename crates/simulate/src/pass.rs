@@ -12,8 +12,7 @@
 //! ```
 //!
 //! (a_W taken at x_e, found by two fixed-point steps). Safety is monotone in j, so the
-//! largest safe j is found by bisection (bracketed first from the last cycle's j, to
-//! `JERK_TOL_REL` of the jerk range). This is the Ruckig/S-curve rule "start the
+//! largest safe j is found by bisection. This is the Ruckig/S-curve rule "start the
 //! ramp-down when the ramp would just reach the target" applied to a moving target.
 //! Where no jerk keeps the state under W (W falls faster than the limits allow, which
 //! only the backward pass meets, on the limit curve), the state is put on W: a *clip*,
@@ -25,7 +24,7 @@ use crate::caps::Local;
 use crate::grid::Geometry;
 use crate::tolerances::{
     CEILING_REL, CRAWL_CRUISE_REL, CRAWL_JERK_SHARE, CRUISE_ABS_MM_S, CRUISE_REL, END_MM,
-    JERK_BISECTIONS, JERK_BRACKET_REL, JERK_TOL_REL, SETTLE_REL,
+    JERK_BISECTIONS, SETTLE_REL,
 };
 
 /// A ceiling along a pass: values at increasing pass positions, and between them W^(3/2)
@@ -276,7 +275,6 @@ impl Pass<'_> {
         let mut stats = PassStats::default();
         let mut hint = 0usize;
         let mut idle = 0u32;
-        let mut prev_j = 0.0f64;
         while st.x < len - END_MM {
             let d = self.geo.derivs(self.s_of(st.x, len));
             let loc = Local::from_derivs(&d);
@@ -352,45 +350,8 @@ impl Pass<'_> {
             } else if !ok(lo) {
                 lo
             } else {
-                // ok(lo) and not ok(hi): the largest safe jerk lies between. Bracket it
-                // from the last cycle's jerk first (along a ceiling it changes little
-                // from one cycle to the next), widening by doubling, then bisect to
-                // JERK_TOL_REL of the range.
-                let tol = (hi - lo) * JERK_TOL_REL;
-                let guess = prev_j.clamp(lo, hi);
-                let mut step = (hi - lo) * JERK_BRACKET_REL;
-                let (mut good, mut bad) = if ok(guess) {
-                    let mut g = guess;
-                    loop {
-                        let c = g + step;
-                        if c >= hi {
-                            break (g, hi);
-                        }
-                        if ok(c) {
-                            g = c;
-                            step *= 2.0;
-                        } else {
-                            break (g, c);
-                        }
-                    }
-                } else {
-                    let mut b = guess;
-                    loop {
-                        let c = b - step;
-                        if c <= lo {
-                            break (lo, b);
-                        }
-                        if ok(c) {
-                            break (c, b);
-                        }
-                        b = c;
-                        step *= 2.0;
-                    }
-                };
+                let (mut good, mut bad) = (lo, hi);
                 for _ in 0..JERK_BISECTIONS {
-                    if bad - good <= tol {
-                        break;
-                    }
                     let mid = 0.5 * (good + bad);
                     if ok(mid) {
                         good = mid;
@@ -400,7 +361,6 @@ impl Pass<'_> {
                 }
                 good
             };
-            prev_j = j;
             let (mut x1, mut v1, mut a1) = next(j);
             let mut t1 = st.t + dt;
             if v1 < 0.0 {

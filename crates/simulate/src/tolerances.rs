@@ -12,18 +12,9 @@ pub const CEILING_REL: f64 = 1e-9;
 /// taken as reached (the spline is evaluated there exactly).
 pub const END_MM: f64 = 1e-5;
 
-/// Most bisection steps on the jerk of one cycle (a guard: [`JERK_TOL_REL`] ends them
-/// first).
-pub const JERK_BISECTIONS: usize = 40;
-
-/// The jerk of a cycle is the largest safe one to within this fraction of the cycle's
-/// jerk range (2^-16): a jerk short by that for one cycle leaves the speed short by
-/// 2^-16·j_range·Tcy²/2, which the next cycle takes back.
-pub const JERK_TOL_REL: f64 = 1.0 / 65536.0;
-
-/// First widening step, as a fraction of the jerk range, when the largest safe jerk is
-/// bracketed from the last cycle's (doubled while the bracket does not hold it).
-pub const JERK_BRACKET_REL: f64 = 1.0 / 1024.0;
+/// Bisection steps on the jerk of one cycle (the chosen jerk is within 2^-16 of the
+/// largest safe one, relative to the jerk range).
+pub const JERK_BISECTIONS: usize = 24;
 
 /// Default largest number of cells per span of the path (between two programmed points).
 /// A span is cut into ⌈h / (F·Tcy)⌉ cells (Equation 6's sampling step) up to this many,
