@@ -53,6 +53,35 @@ impl PpCubic {
         self.breaks[1..m].partition_point(|&b| b <= t).min(m - 1)
     }
 
+    /// The piece used at `t`, looked for first at `hint` and its neighbours (for
+    /// evaluations that move a little along t, either way); the same piece as
+    /// [`PpCubic::eval_derivs`] uses.
+    pub fn piece_near(&self, t: f64, hint: usize) -> usize {
+        let m = self.coefs.len();
+        // Piece j is used for breaks[j] ≤ t < breaks[j + 1], the first piece below
+        // breaks[1] and the last from breaks[m − 1] on.
+        let fits =
+            |j: usize| (j == 0 || self.breaks[j] <= t) && (j + 1 >= m || t < self.breaks[j + 1]);
+        let h = hint.min(m - 1);
+        if fits(h) {
+            h
+        } else if h + 1 < m && fits(h + 1) {
+            h + 1
+        } else if h > 0 && fits(h - 1) {
+            h - 1
+        } else {
+            self.piece(t)
+        }
+    }
+
+    /// [`PpCubic::eval_derivs`] on piece `j` (from [`PpCubic::piece_near`]).
+    ///
+    /// # Panics
+    /// If `j` is not a piece.
+    pub fn eval_derivs_on(&self, j: usize, t: f64) -> [f64; 4] {
+        horner(&self.coefs[j], t - self.breaks[j])
+    }
+
     /// Value at `t`.
     pub fn eval(&self, t: f64) -> f64 {
         self.eval_derivs(t)[0]
@@ -135,7 +164,13 @@ mod tests {
                 assert!((single[k] - want[k]).abs() < tol, "t={t} k={k}");
             }
             assert_eq!(pp.eval(*t), single[0]);
+            // The hinted search finds the same piece from any hint.
+            for hint in [0, 1, 2, 3, 7] {
+                let j = pp.piece_near(*t, hint);
+                assert_eq!(pp.eval_derivs_on(j, *t), single, "t={t} hint={hint}");
+            }
         }
+        assert_eq!(pp.piece_near(f64::NAN, 2), pp.piece(f64::NAN));
     }
 
     #[test]

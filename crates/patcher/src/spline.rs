@@ -191,6 +191,18 @@ impl AnalysisSpline {
         self.pp.eval_derivs(t)
     }
 
+    /// The polynomial piece used at `t`, looked for first at `hint` and its neighbours;
+    /// splines fitted by one [`SplineSystem`] share their pieces.
+    pub fn piece_near(&self, t: f64, hint: usize) -> usize {
+        self.pp.piece_near(t, hint)
+    }
+
+    /// [`AnalysisSpline::eval_derivs`] on piece `j` (from [`AnalysisSpline::piece_near`]
+    /// of a spline of the same system).
+    pub fn eval_derivs_on(&self, j: usize, t: f64) -> [f64; 4] {
+        self.pp.eval_derivs_on(j, t)
+    }
+
     /// [`AnalysisSpline::eval_derivs`] at sorted parameters `ts`, into `out` (same length).
     pub fn eval_derivs_sorted(&self, ts: &[f64], out: &mut [[f64; 4]]) {
         self.pp.eval_derivs_sorted(ts, out);

@@ -67,33 +67,69 @@ impl Local {
     /// Largest |path acceleration| at speed `v`, mm/s²; negative when no acceleration
     /// keeps every axis within A at this speed.
     pub fn a_cap(&self, m: &Machine, v: f64) -> f64 {
-        let mut c = f64::INFINITY;
-        for i in 0..5 {
-            let room = LIMIT_USE * m.limits[i].a - self.qss[i] * v * v;
-            if self.qs[i] > 0.0 {
-                c = c.min(room / self.qs[i]);
-            } else if room < 0.0 {
-                c = c.min(room);
-            }
-        }
-        c
+        Caps::new(self, m).a_cap(v)
     }
 
     /// Largest |path jerk| at speed `v` and |acceleration| `a_abs`, mm/s³; negative when
     /// no jerk keeps every axis within J.
     pub fn j_cap(&self, m: &Machine, v: f64, a_abs: f64) -> f64 {
+        Caps::new(self, m).j_cap(v, a_abs)
+    }
+}
+
+/// The caps of [`Local`] at one point, prepared for many speeds and accelerations (a
+/// pass asks them some thirty times per cycle): the planned limits and 1/|q_s| of each
+/// axis (0 for an axis that does not move, whose own curvature terms only need room).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Caps {
+    a: [f64; 5],
+    j: [f64; 5],
+    qss: [f64; 5],
+    qsss: [f64; 5],
+    inv_qs: [f64; 5],
+}
+
+impl Caps {
+    /// The caps of `loc` on `m`.
+    pub fn new(loc: &Local, m: &Machine) -> Caps {
+        Caps {
+            a: std::array::from_fn(|i| LIMIT_USE * m.limits[i].a),
+            j: std::array::from_fn(|i| LIMIT_USE * m.limits[i].j),
+            qss: loc.qss,
+            qsss: loc.qsss,
+            inv_qs: loc.qs.map(|q| if q > 0.0 { 1.0 / q } else { 0.0 }),
+        }
+    }
+
+    /// [`Local::a_cap`].
+    pub fn a_cap(&self, v: f64) -> f64 {
         let mut c = f64::INFINITY;
         for i in 0..5 {
-            let room = LIMIT_USE * m.limits[i].j
-                - self.qsss[i] * v * v * v
-                - 3.0 * self.qss[i] * v * a_abs;
-            if self.qs[i] > 0.0 {
-                c = c.min(room / self.qs[i]);
-            } else if room < 0.0 {
-                c = c.min(room);
-            }
+            let room = self.a[i] - self.qss[i] * v * v;
+            c = self.bound(c, i, room);
         }
         c
+    }
+
+    /// [`Local::j_cap`].
+    pub fn j_cap(&self, v: f64, a_abs: f64) -> f64 {
+        let mut c = f64::INFINITY;
+        for i in 0..5 {
+            let room = self.j[i] - self.qsss[i] * v * v * v - 3.0 * self.qss[i] * v * a_abs;
+            c = self.bound(c, i, room);
+        }
+        c
+    }
+
+    /// `c` lowered by axis `i`'s cap with `room` left of its limit.
+    fn bound(&self, c: f64, i: usize, room: f64) -> f64 {
+        if self.inv_qs[i] > 0.0 {
+            c.min(room * self.inv_qs[i])
+        } else if room < 0.0 {
+            c.min(room)
+        } else {
+            c
+        }
     }
 }
 

@@ -92,6 +92,15 @@ impl Geometry {
         std::array::from_fn(|a| self.splines[a].eval_derivs(s))
     }
 
+    /// [`Geometry::derivs`] and [`Geometry::feed_at`] at `s`, starting the searches
+    /// where `cur` was left (for evaluations that move a little along s, either way).
+    pub fn derivs_feed_near(&self, s: f64, cur: &mut Cursor) -> ([[f64; 4]; 5], f64) {
+        cur.piece = self.splines[0].piece_near(s, cur.piece);
+        let d = std::array::from_fn(|a| self.splines[a].eval_derivs_on(cur.piece, s));
+        cur.knot = count_at_most(&self.knots, s, cur.knot);
+        (d, self.feed_of(s, cur.knot))
+    }
+
     /// Axis values X Y Z P C at `s`.
     pub fn axes(&self, s: f64) -> [f64; 5] {
         std::array::from_fn(|a| self.splines[a].eval(s))
@@ -99,7 +108,11 @@ impl Geometry {
 
     /// The programmed feed at `s`, mm/s (at a shared point, the lower of the two parts').
     pub fn feed_at(&self, s: f64) -> f64 {
-        let k = self.knots.partition_point(|&v| v <= s);
+        self.feed_of(s, self.knots.partition_point(|&v| v <= s))
+    }
+
+    /// [`Geometry::feed_at`] given `k`, the number of knots at or before `s`.
+    fn feed_of(&self, s: f64, k: usize) -> f64 {
         let span = k.saturating_sub(1).min(self.knots.len() - 2);
         let p = self.part_of_span(span);
         let f = self.feed_mm_s[p];
@@ -113,6 +126,31 @@ impl Geometry {
     /// The part that span `k` (between points k and k + 1) belongs to.
     pub fn part_of_span(&self, k: usize) -> usize {
         self.part_end.partition_point(|&e| e <= k)
+    }
+}
+
+/// Where the last evaluation along a [`Geometry`] was (see
+/// [`Geometry::derivs_feed_near`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Cursor {
+    piece: usize,
+    knot: usize,
+}
+
+/// The number of elements of the sorted `b` that are ≤ `t`, looked for first at `hint`
+/// and its neighbours.
+fn count_at_most(b: &[f64], t: f64, hint: usize) -> usize {
+    let n = b.len();
+    let fits = |k: usize| (k == 0 || b[k - 1] <= t) && (k == n || t < b[k]);
+    let h = hint.min(n);
+    if fits(h) {
+        h
+    } else if h < n && fits(h + 1) {
+        h + 1
+    } else if h > 0 && fits(h - 1) {
+        h - 1
+    } else {
+        b.partition_point(|&v| v <= t)
     }
 }
 
@@ -216,4 +254,33 @@ impl Grid {
 pub fn local_at(geo: &Geometry, s: f64) -> (Local, [[f64; 4]; 5]) {
     let d = geo.derivs(s);
     (Local::from_derivs(&d), d)
+}
+
+#[cfg(test)]
+mod tests {
+    /// The hinted count is the partition point from every hint, at and between the
+    /// elements, outside them and at NaN.
+    #[test]
+    fn the_hinted_count_is_the_partition_point() {
+        let b = [0.0, 1.0, 1.5, 4.0, 9.0];
+        for t in [
+            -1.0,
+            0.0,
+            0.5,
+            1.0,
+            1.2,
+            1.5,
+            3.0,
+            4.0,
+            8.9,
+            9.0,
+            10.0,
+            f64::NAN,
+        ] {
+            let want = b.partition_point(|&v| v <= t);
+            for hint in 0..8 {
+                assert_eq!(super::count_at_most(&b, t, hint), want, "t={t} hint={hint}");
+            }
+        }
+    }
 }

@@ -20,11 +20,11 @@
 
 use polepatch_kinematics::Machine;
 
-use crate::caps::Local;
-use crate::grid::Geometry;
+use crate::caps::{Caps, Local};
+use crate::grid::{Cursor, Geometry};
 use crate::tolerances::{
     CEILING_REL, CRAWL_CRUISE_REL, CRAWL_JERK_SHARE, CRUISE_ABS_MM_S, CRUISE_REL, END_MM,
-    JERK_BISECTIONS, SETTLE_REL,
+    JERK_BISECTIONS, JERK_RESOLUTION_OF_CRUISE, SETTLE_REL,
 };
 
 /// A ceiling along a pass: values at increasing pass positions, and between them W^(3/2)
@@ -81,21 +81,34 @@ impl<'a> Ceiling<'a> {
 
     /// (W, a_W) at `x`, and the cell.
     fn at(&self, x: f64, hint: usize) -> (f64, f64, usize) {
+        let (p, dp, i) = self.at_p(x, hint);
+        let c = cbrt(p);
+        let w = c * c;
+        // a = W·dW/dx = √W·(dP/dx)/1.5.
+        let aw = c * dp / 1.5;
+        (w, aw, i)
+    }
+
+    /// (P = W^(3/2), dP/dx) at `x`, and the cell: what [`Ceiling::at`] is computed from,
+    /// for the comparisons of [`Under`] that need no cube root.
+    fn at_p(&self, x: f64, hint: usize) -> (f64, f64, usize) {
         let i = self.cell(x, hint);
         if self.x.len() < 2 {
-            return (self.v[0], 0.0, 0);
+            let p0 = self.p[0];
+            return (p0, 0.0, 0);
         }
         let (x0, x1) = (self.x[i], self.x[i + 1]);
-        let u = ((x - x0) / (x1 - x0)).clamp(0.0, 1.0);
-        let (p0, p1) = (self.p[i], self.p[i + 1]);
         let h = x1 - x0;
+        let inv_h = 1.0 / h;
+        let u = ((x - x0) * inv_h).clamp(0.0, 1.0);
+        let (p0, p1) = (self.p[i], self.p[i + 1]);
         let (p, dp) = match &self.m {
             // P as the cubic Hermite interpolant of the values and slopes of the profile
             // the ceiling was recorded from (C¹: a motion can follow it with a continuous
             // acceleration). At rest the slope is the other end's: P is linear in the jerk
             // phase from rest (x = J·t³/6, P = (J/2)^(3/2)·t³).
             Some(m) => {
-                let secant = (p1 - p0) / h;
+                let secant = (p1 - p0) * inv_h;
                 let pick = |a: f64, b: f64| {
                     if !a.is_nan() {
                         a
@@ -116,19 +129,33 @@ impl<'a> Ceiling<'a> {
                     + (3.0 * u2 - 4.0 * u + 1.0) * m0
                     + (-6.0 * u2 + 6.0 * u) * p1
                     + (3.0 * u2 - 2.0 * u) * m1)
-                    / h;
+                    * inv_h;
                 (p.max(0.0), dp)
             }
             // P linear: exact for the jerk phase from rest, between the two values
             // elsewhere.
-            None => (p0 + u * (p1 - p0), (p1 - p0) / h),
+            None => (p0 + u * (p1 - p0), (p1 - p0) * inv_h),
         };
-        let c = cbrt(p);
-        let w = c * c;
-        // a = W·dW/dx = √W·(dP/dx)/1.5.
-        let aw = w.sqrt() * dp / 1.5;
-        (w, aw, i)
+        (p, dp, i)
     }
+}
+
+/// `(1 + CEILING_REL)^(3/2)` to rounding (the next term, 3/8·CEILING_REL², is far below
+/// it).
+const CEILING_REL_P: f64 = 1.0 + 1.5 * CEILING_REL;
+
+/// Whether a speed `v` is above the ceiling W = P^(2/3) by more than [`CEILING_REL`]:
+/// `v > W·(1 + CEILING_REL)` ⟺ `v^(3/2) > P·(1 + CEILING_REL)^(3/2)` (both sides
+/// non-negative, x ↦ x^(3/2) increasing).
+fn above_ceiling(v: f64, p: f64) -> bool {
+    v > 0.0 && v * v.sqrt() > p * CEILING_REL_P
+}
+
+/// Whether an acceleration `a` is at most the ceiling's a_W = √W·(dP/dx)/1.5 = ∛P·r with
+/// r = (dP/dx)/1.5: `a ≤ ∛P·r` ⟺ `a³ ≤ P·r³` (x ↦ x³ increasing on all of ℝ).
+fn accel_within(a: f64, p: f64, dp: f64) -> bool {
+    let r = dp / 1.5;
+    a * a * a <= p * (r * r * r)
 }
 
 /// Cube root of a non-negative `p` (the library's is a slow software routine on this
@@ -206,9 +233,9 @@ impl Pass<'_> {
         if self.forward { x } else { len - x }
     }
 
-    fn caps(&self, loc: &Local, v: f64, a_abs: f64) -> (f64, f64) {
-        let ac = loc.a_cap(self.machine, v) * self.use_caps[0];
-        let jc = loc.j_cap(self.machine, v, a_abs) * self.use_caps[1];
+    fn caps(&self, caps: &Caps, v: f64, a_abs: f64) -> (f64, f64) {
+        let ac = caps.a_cap(v) * self.use_caps[0];
+        let jc = caps.j_cap(v, a_abs) * self.use_caps[1];
         (ac, jc)
     }
 
@@ -217,7 +244,7 @@ impl Pass<'_> {
     #[allow(clippy::too_many_arguments)]
     fn safe(
         &self,
-        loc: &Local,
+        caps: &Caps,
         vmax: f64,
         x1: f64,
         v1: f64,
@@ -228,19 +255,22 @@ impl Pass<'_> {
         if v1 > vmax {
             return false;
         }
-        let (ac, jc) = self.caps(loc, v1.max(0.0), a1.abs());
+        let (ac, jc) = self.caps(caps, v1.max(0.0), a1.abs());
         if a1.abs() > ac.max(0.0) * (1.0 + 1e-12) + 1e-12 || jc < 0.0 {
             return false;
         }
-        let (w, aw, i) = self.ceiling.at(x1, hint);
-        if v1 > w * (1.0 + CEILING_REL) {
+        // The comparisons with W and a_W in P = W^(3/2) (no cube root: see
+        // `above_ceiling` and `accel_within`).
+        let (p, dp, i) = self.ceiling.at_p(x1, hint);
+        if above_ceiling(v1, p) {
             return false;
         }
-        if a1 <= aw {
+        if accel_within(a1, p, dp) {
             return true;
         }
         // The ramp of a down at the jerk cap, in RAMP_STEPS pieces, until it meets the
         // ceiling's acceleration: under the ceiling all the way.
+        let aw = cbrt(p) * dp / 1.5;
         let jb = jc.max(1e-300);
         let dtau = (a1 - aw) / jb / RAMP_STEPS as f64;
         let (mut x, mut v, mut a, mut c) = (x1, v1, a1, i);
@@ -249,14 +279,14 @@ impl Pass<'_> {
             v += a * dtau - 0.5 * jb * dtau * dtau;
             a -= jb * dtau;
             if v <= 0.0 || x >= len {
-                return v <= 0.0 || v <= self.ceiling.at(len, c).0 * (1.0 + CEILING_REL);
+                return v <= 0.0 || !above_ceiling(v, self.ceiling.at_p(len, c).0);
             }
-            let (w, aw, k) = self.ceiling.at(x, c);
+            let (p, dp, k) = self.ceiling.at_p(x, c);
             c = k;
-            if v > w * (1.0 + CEILING_REL) {
+            if above_ceiling(v, p) {
                 return false;
             }
-            if a <= aw {
+            if accel_within(a, p, dp) {
                 return true;
             }
         }
@@ -275,12 +305,12 @@ impl Pass<'_> {
         let mut stats = PassStats::default();
         let mut hint = 0usize;
         let mut idle = 0u32;
+        let mut cursor = Cursor::default();
         while st.x < len - END_MM {
-            let d = self.geo.derivs(self.s_of(st.x, len));
+            let (d, feed) = self.geo.derivs_feed_near(self.s_of(st.x, len), &mut cursor);
             let loc = Local::from_derivs(&d);
-            let vmax = loc
-                .v_cap(self.machine)
-                .min(self.geo.feed_at(self.s_of(st.x, len)));
+            let vmax = loc.v_cap(self.machine).min(feed);
+            let caps = Caps::new(&loc, self.machine);
             let (w, _, i) = self.ceiling.at(st.x, hint);
             hint = i;
             let dt = self.dt;
@@ -289,7 +319,7 @@ impl Pass<'_> {
             // Within CRUISE_REL of the ceiling, or of one cycle at the jerk cap where the
             // ceiling is below that (the crawl regime, where a cycle's jerk is coarser
             // than the speed).
-            let one_cycle = self.caps(&loc, st.v, st.a.abs()).1.max(0.0) * self.dt * self.dt;
+            let one_cycle = self.caps(&caps, st.v, st.a.abs()).1.max(0.0) * self.dt * self.dt;
             let near = (CRUISE_REL * w)
                 .max(CRAWL_CRUISE_REL * w.min(one_cycle))
                 .max(CRUISE_ABS_MM_S);
@@ -303,7 +333,7 @@ impl Pass<'_> {
                         .m
                         .as_ref()
                         .is_none_or(|m| m[i] == 0.0 && m[nx] == 0.0)
-                    && self.safe(&loc, vmax, xn, st.v, 0.0, i, len)
+                    && self.safe(&caps, vmax, xn, st.v, 0.0, i, len)
                 {
                     let to = State {
                         t: st.t + (xn - st.x) / st.v,
@@ -317,7 +347,7 @@ impl Pass<'_> {
                     continue;
                 }
             }
-            let (ac, jc) = self.caps(&loc, st.v, st.a.abs());
+            let (ac, jc) = self.caps(&caps, st.v, st.a.abs());
             let jm = jc.max(0.0);
             let ac = ac.max(0.0);
             let mut lo = (-jm).max((-ac - st.a) / dt);
@@ -336,7 +366,7 @@ impl Pass<'_> {
             };
             let ok = |j: f64| {
                 let (x1, v1, a1) = next(j);
-                self.safe(&loc, vmax, x1, v1, a1, hint, len)
+                self.safe(&caps, vmax, x1, v1, a1, hint, len)
             };
             // On a flat ceiling, just under it: settle (a → 0) rather than take the
             // largest safe jerk, which would overshoot and chatter about the ceiling.
@@ -350,8 +380,13 @@ impl Pass<'_> {
             } else if !ok(lo) {
                 lo
             } else {
+                // Finer than the cruise and settle tests see decides nothing.
+                let resolution = JERK_RESOLUTION_OF_CRUISE * near.min(SETTLE_REL * w0);
                 let (mut good, mut bad) = (lo, hi);
                 for _ in 0..JERK_BISECTIONS {
+                    if (bad - good) * dt * dt <= resolution {
+                        break;
+                    }
                     let mid = 0.5 * (good + bad);
                     if ok(mid) {
                         good = mid;
