@@ -24,7 +24,7 @@ use crate::caps::{Caps, Local};
 use crate::grid::{Cursor, Geometry};
 use crate::tolerances::{
     CEILING_REL, CRAWL_CRUISE_REL, CRAWL_JERK_SHARE, CRUISE_ABS_MM_S, CRUISE_REL, END_MM,
-    JERK_BISECTIONS, JERK_RESOLUTION_OF_CRUISE, SETTLE_REL,
+    JERK_BISECTIONS, SETTLE_REL,
 };
 
 /// A ceiling along a pass: values at increasing pass positions, and between them W^(3/2)
@@ -380,13 +380,8 @@ impl Pass<'_> {
             } else if !ok(lo) {
                 lo
             } else {
-                // Finer than the cruise and settle tests see decides nothing.
-                let resolution = JERK_RESOLUTION_OF_CRUISE * near.min(SETTLE_REL * w0);
                 let (mut good, mut bad) = (lo, hi);
                 for _ in 0..JERK_BISECTIONS {
-                    if (bad - good) * dt * dt <= resolution {
-                        break;
-                    }
                     let mid = 0.5 * (good + bad);
                     if ok(mid) {
                         good = mid;

@@ -16,14 +16,6 @@ pub const END_MM: f64 = 1e-5;
 /// largest safe one, relative to the jerk range).
 pub const JERK_BISECTIONS: usize = 24;
 
-/// The jerk bisection also stops when what is left of its interval changes a cycle's
-/// speed by less than this share of the tolerances that decide a cruise and a settle
-/// (Δj·Tcy² below this × the smaller of the cruise tolerance, [`CRUISE_REL`]·W or more,
-/// and [`SETTLE_REL`]·W): finer than that decides nothing those tests see. (The
-/// settle tolerance matters where the cruise one is coarse, below one cycle of jerk: a
-/// coarser jerk there leaves the state chattering about the ceiling, never settling.)
-pub const JERK_RESOLUTION_OF_CRUISE: f64 = 0.01;
-
 /// Default largest number of cells per span of the path (between two programmed points).
 /// A span is cut into ⌈h / (F·Tcy)⌉ cells (Equation 6's sampling step) up to this many,
 /// so that the grid, and the memory, are bounded by the points, not by the run time.
