@@ -121,6 +121,26 @@ impl Caps {
         c
     }
 
+    /// The largest |path acceleration| at speed `v` at which some jerk keeps every axis
+    /// within J (`j_cap(v, |a|) ≥ 0`), mm/s²: `min_i (J_i − |q_sss^i|·v³)/(3·|q_ss^i|·v)`
+    /// over the axes with curvature, 0 where an axis' `|q_sss|·v³` alone is above its J,
+    /// +∞ when no axis bounds it. Above it the state is beyond the jerk limits whatever the
+    /// jerk, and no jerk can bring |a| back ([`Caps::j_cap`] < 0).
+    pub fn a_for_jerk(&self, v: f64) -> f64 {
+        let mut c = f64::INFINITY;
+        for i in 0..5 {
+            let room = self.j[i] - self.qsss[i] * v * v * v;
+            let per_a = 3.0 * self.qss[i] * v;
+            if room < 0.0 {
+                return 0.0;
+            }
+            if per_a > 0.0 {
+                c = c.min(room / per_a);
+            }
+        }
+        c
+    }
+
     /// `c` lowered by axis `i`'s cap with `room` left of its limit.
     fn bound(&self, c: f64, i: usize, room: f64) -> f64 {
         if self.inv_qs[i] > 0.0 {
@@ -189,6 +209,36 @@ mod tests {
         // Same signs of the terms as the bound: the binding axis reaches its jerk share.
         let sh = shares(&m, &d, v, a, j);
         assert!((sh[4] - LIMIT_USE).abs() < 1e-9, "{sh:?}");
+    }
+
+    /// At the acceleration `a_for_jerk` gives, the jerk cap is 0 (the binding axis has
+    /// no jerk left), below it positive, above it negative.
+    #[test]
+    fn a_for_jerk_is_where_the_jerk_cap_runs_out() {
+        let m = m();
+        let mut d = [[0.0; 4]; 5];
+        d[0] = [0.0, 0.8, 0.01, -0.002];
+        d[4] = [0.0, 2.0, 3.0, 18.0];
+        let c = Caps::new(&Local::from_derivs(&d), &m);
+        let v = 5.0;
+        let a = c.a_for_jerk(v);
+        assert!(a > 0.0 && a.is_finite(), "{a}");
+        assert!(
+            c.j_cap(v, a).abs() < 1e-9 * m.limits[4].j,
+            "{}",
+            c.j_cap(v, a)
+        );
+        assert!(c.j_cap(v, 0.99 * a) > 0.0);
+        assert!(c.j_cap(v, 1.01 * a) < 0.0);
+        // A line has no curvature: any acceleration leaves jerk.
+        let mut line = [[0.0; 4]; 5];
+        line[0][1] = 1.0;
+        let c = Caps::new(&Local::from_derivs(&line), &m);
+        assert_eq!(c.a_for_jerk(v), f64::INFINITY);
+        // Past the speed where q_sss·v³ alone uses up C's J: none.
+        let c = Caps::new(&Local::from_derivs(&d), &m);
+        let v_j = (m.limits[4].j * LIMIT_USE / 18.0).cbrt();
+        assert_eq!(c.a_for_jerk(1.01 * v_j), 0.0);
     }
 
     /// Above the Equation-6 bound there is no room at a = 0 (negative caps).

@@ -17,6 +17,11 @@
 //! Where no jerk keeps the state under W (W falls faster than the limits allow, which
 //! only the backward pass meets, on the limit curve), the state is put on W: a *clip*,
 //! counted; the forward pass runs under the backward pass's profile, which it can follow.
+//! A clip takes W's acceleration only as far as the caps at the new point allow, both
+//! `a_cap(v)` and [`crate::caps::Caps::a_for_jerk`]: with a larger |a| no jerk is within
+//! J (`j_cap < 0`, the 3·|q_ss|·v·|a| term), nothing could bring |a| back, and the pass
+//! would brake under W until the speed made room. A state that is there anyway brings
+//! |a| back at the jerk cap of a = 0.
 
 use polepatch_kinematics::Machine;
 
@@ -352,9 +357,17 @@ impl Pass<'_> {
             let ac = ac.max(0.0);
             let mut lo = (-jm).max((-ac - st.a) / dt);
             let mut hi = jm.min((ac - st.a) / dt);
-            if lo > hi {
-                // |a| above the cap at this speed: bring it back as fast as allowed.
-                let j = -st.a.signum() * jm;
+            if lo > hi || (jc < 0.0 && st.a != 0.0) {
+                // |a| above the cap at this speed: bring it back as fast as allowed; and
+                // where |a| leaves no jerk at all (j_cap < 0: no jerk keeps the axes
+                // within J), at the jerk cap of a = 0 — a |a| held there would brake the
+                // motion to a standstill.
+                let jr = if jc < 0.0 {
+                    (self.caps(&caps, st.v, 0.0).1).max(0.0)
+                } else {
+                    jm
+                };
+                let j = -st.a.signum() * jr;
                 lo = j;
                 hi = j;
             }
@@ -450,8 +463,17 @@ impl Pass<'_> {
             let (w1, aw1, _) = self.ceiling.at(x1, hint);
             let w1 = w1.min(vmax);
             if v1 > w1 * (1.0 + CEILING_REL) {
+                // On the ceiling with its acceleration, within the caps there at that
+                // speed: |a| also where some jerk is left (`Caps::a_for_jerk`) — above it
+                // no jerk could bring |a| back, and the pass would hold it, braking, far
+                // under the ceiling.
                 v1 = w1;
-                a1 = aw1.clamp(-ac, ac);
+                let (d1, _) = self.geo.derivs_feed_near(self.s_of(x1, len), &mut cursor);
+                let caps1 = Caps::new(&Local::from_derivs(&d1), self.machine);
+                let lim = (caps1.a_cap(v1) * self.use_caps[0])
+                    .min(caps1.a_for_jerk(v1))
+                    .max(0.0);
+                a1 = aw1.clamp(-lim, lim);
                 stats.clips += 1;
             }
             if x1 <= st.x {
