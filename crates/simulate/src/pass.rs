@@ -95,12 +95,11 @@ impl<'a> Ceiling<'a> {
     }
 
     /// (P = W^(3/2), dP/dx) at `x`, and the cell: what [`Ceiling::at`] is computed from,
-    /// for the comparisons of [`Under`] that need no cube root.
+    /// for the comparisons that need no cube root (`above_ceiling`, `accel_within`).
     fn at_p(&self, x: f64, hint: usize) -> (f64, f64, usize) {
         let i = self.cell(x, hint);
         if self.x.len() < 2 {
-            let p0 = self.p[0];
-            return (p0, 0.0, 0);
+            return (self.p[0], 0.0, 0);
         }
         let (x0, x1) = (self.x[i], self.x[i + 1]);
         let h = x1 - x0;
