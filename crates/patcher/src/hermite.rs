@@ -68,6 +68,19 @@ pub const NOT_WORSE_SAMPLES_PER_SPAN: usize = 8;
 /// Relative slack of a "not worse than before" bound (round-off only).
 pub const NOT_WORSE_SLACK: f64 = 1e-9;
 
+/// What the solves of one zone share and need not recompute: the rounding room of each
+/// window they constrain (`Hermite::rounding_room`, a function of the window's knots
+/// and written points only). Create one per zone; it grows by one entry per window.
+#[derive(Debug, Default)]
+pub struct RoundingMemo {
+    /// (window knots, written points relative to the window, room per span for a unit
+    /// rounding error).
+    pub(crate) entries: std::cell::RefCell<Vec<RoomEntry>>,
+}
+
+/// An entry of [`RoundingMemo`].
+pub(crate) type RoomEntry = (Vec<f64>, (usize, usize), Vec<[f64; 3]>);
+
 /// An affine form `Σ coeff·x[var] + c`.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Aff {
@@ -465,7 +478,7 @@ impl<'a> Hermite<'a> {
     pub(crate) fn rounding_room(
         &self,
         eps: f64,
-        memo: Option<&crate::joint::RoundingMemo>,
+        memo: Option<&RoundingMemo>,
     ) -> Result<Vec<[f64; 3]>, PatchFailure> {
         let gains = self.rounding_gains(memo)?;
         Ok(gains
@@ -478,10 +491,7 @@ impl<'a> Hermite<'a> {
     /// which of them are written, and one zone's solves (every start, both axes) ask for
     /// the same window again and again: with a `memo` the results are kept there, keyed
     /// by exactly those inputs (the knots compared bit for bit).
-    fn rounding_gains(
-        &self,
-        memo: Option<&crate::joint::RoundingMemo>,
-    ) -> Result<Vec<[f64; 3]>, PatchFailure> {
+    fn rounding_gains(&self, memo: Option<&RoundingMemo>) -> Result<Vec<[f64; 3]>, PatchFailure> {
         let knots = &self.s[self.lo..=self.hi];
         let (a, b) = (self.first - self.lo, self.last - self.lo);
         let same = |k: &[f64]| {

@@ -93,18 +93,7 @@ use crate::{
 use polepatch_kinematics::{Machine, angle_between_deg, forward, forward_jacobian};
 use std::time::Instant;
 
-/// What the solves of one zone share and need not recompute: the rounding room of each
-/// window they constrain (`Hermite::rounding_room`, a function of the window's knots
-/// and written points only). Create one per zone; it grows by one entry per window.
-#[derive(Debug, Default)]
-pub struct RoundingMemo {
-    /// (window knots, written points relative to the window, room per span for a unit
-    /// rounding error).
-    pub(crate) entries: std::cell::RefCell<Vec<RoomEntry>>,
-}
-
-/// An entry of [`RoundingMemo`].
-pub(crate) type RoomEntry = (Vec<f64>, (usize, usize), Vec<[f64; 3]>);
+pub use crate::hermite::RoundingMemo;
 
 /// One joint solve's inputs. Every slice is per point of the whole path.
 #[derive(Debug, Clone)]

@@ -34,8 +34,7 @@ pub(crate) fn add_stats(acc: &mut QpStats, other: &QpStats) {
     }
 }
 
-/// A sparse linear form: `Σ coeff · x[var]` over `(var, coeff)`.
-pub(crate) type Row = Vec<(usize, f64)>;
+pub(crate) use crate::ipm::Row;
 
 /// Merge repeated variables of a row (summing them) and drop zero coefficients.
 pub(crate) fn compact(row: &[(usize, f64)]) -> Row {

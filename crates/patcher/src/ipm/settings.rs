@@ -1,0 +1,34 @@
+//! The interior-point method's settings (Clarabel's `DefaultSettings` manner).
+
+/// Settings of [`super::Banded::solve`]. Plain struct: public fields, documented defaults.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IpmSettings {
+    /// Most iterations. Default 60.
+    pub max_iter: u32,
+    /// Feasibility tolerance, relative to the data's size (`1 + ‖b‖∞`, `1 + ‖h‖∞`,
+    /// `1 + ‖c‖∞`). Default 1e-8.
+    pub tol_feas: f64,
+    /// Complementarity tolerance on `μ`, relative to `1 + |objective|`. Default 1e-8.
+    pub tol_gap: f64,
+    /// Fraction of the way to the boundary of `s, z ≥ 0` a step goes. Default 0.99.
+    pub step_fraction: f64,
+    /// Static regularisation of the KKT matrix (`±δ`, on the equilibrated problem).
+    /// Default 1e-9.
+    pub regularisation: f64,
+    /// Most iterative refinement steps per solve (it stops earlier when the residual is
+    /// below 1e-13 of the right-hand side). Default 4.
+    pub refinement_steps: u32,
+}
+
+impl Default for IpmSettings {
+    fn default() -> Self {
+        IpmSettings {
+            max_iter: 60,
+            tol_feas: 1e-8,
+            tol_gap: 1e-8,
+            step_fraction: 0.99,
+            regularisation: 1e-9,
+            refinement_steps: 4,
+        }
+    }
+}
