@@ -74,7 +74,11 @@ fn main() {
         };
         let mut best = f64::INFINITY;
         let mut res = None;
-        for _ in 0..REPS {
+        let reps = std::env::var("ZT_REPS")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(REPS);
+        for _ in 0..reps {
             let t = Instant::now();
             let r = patch_path(path, m, &opts).expect("valid path");
             best = best.min(t.elapsed().as_secs_f64());
