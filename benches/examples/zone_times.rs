@@ -38,6 +38,11 @@ fn main() {
                 "scp_max_solves" => solver.scp_max_solves = f as u32,
                 "screen_solves" => solver.screen_solves = f as u32,
                 "scp_rel_tol" => solver.scp_rel_tol = f,
+                "ipm_tol" => {
+                    solver.ipm.tol_feas = f;
+                    solver.ipm.tol_gap = f;
+                }
+                "ipm_refinement_steps" => solver.ipm.refinement_steps = f as u32,
                 other => panic!("unknown setting {other}"),
             }
         }

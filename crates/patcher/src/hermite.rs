@@ -137,6 +137,10 @@ pub(crate) struct Hermite<'a> {
     /// In coefficient form: the value and slope forms at each knot of the window
     /// (`lo..=hi`), computed once.
     knot_forms: Vec<[Aff; 2]>,
+    /// In reduced form ([`Hermite::reduced`]): the variables are the free coefficients
+    /// only, variable `r` at index `offset + stride·r`.
+    reduced: bool,
+    stride: usize,
 }
 
 impl<'a> Hermite<'a> {
@@ -192,6 +196,8 @@ impl<'a> Hermite<'a> {
             fixed,
             basis: None,
             knot_forms: Vec::new(),
+            reduced: false,
+            stride: 1,
         })
     }
 
@@ -231,6 +237,90 @@ impl<'a> Hermite<'a> {
         Ok(self)
     }
 
+    /// The coefficient form with its equalities **eliminated**: the variables are the
+    /// `last − first + 1` free coefficients (as many as the movable points), variable `r`
+    /// at index `offset + stride·r` (two axes interleave with strides 2 and offsets 0, 1).
+    ///
+    /// The fixed points' values and the window's end conditions are linear equalities
+    /// `E·δc = 0` in the coefficient changes. At each end of the window they involve the
+    /// `m` outermost coefficients (as many as the equalities there: the fixed points
+    /// outside the movable range and the end condition) and a few free ones `R` next to
+    /// them; so the outer ones are `δc_M = −E_M⁻¹·E_R·δc_R` (a small dense solve per end;
+    /// for a fixed end slope each outer coefficient is a multiple of the one free
+    /// coefficient at the range's edge, decaying by ≈ 0.27 per knot outwards). Every form
+    /// is rewritten in the free coefficients: the same functions of the values (the
+    /// feasible set and every row are those of the coefficient form), no equality rows,
+    /// and about half the unknowns and band of the coefficient form when the window's
+    /// fixed margins are long.
+    pub(crate) fn reduced(
+        mut self,
+        offset: usize,
+        stride: usize,
+    ) -> Result<Hermite<'a>, PatchFailure> {
+        self.offset = 0;
+        let mut h = self.coefficient_form()?;
+        let nc = h.hi - h.lo + 3;
+        let eqs = h.sided_equalities();
+        let ml = eqs.iter().filter(|e| e.1).count();
+        let mr = eqs.len() - ml;
+        let both_ends = h.fixed == [None, None];
+        if (both_ends && h.hi - h.lo < 3) || ml + mr + h.nd != nc {
+            return Err(PatchFailure::TooShort);
+        }
+        // sub[j]: coefficient j as a combination of the free coefficients ml..nc − mr.
+        let mut sub: Vec<Row> = (0..nc).map(|j| vec![(j, 1.0)]).collect();
+        let free = ml..nc - mr;
+        let outer: Vec<usize> = (0..ml).chain(nc - mr..nc).collect();
+        let mut others: Vec<usize> = eqs
+            .iter()
+            .flat_map(|f| f.0.row.iter().map(|e| e.0))
+            .filter(|j| free.contains(j))
+            .collect();
+        others.sort_unstable();
+        others.dedup();
+        let (m, no) = (outer.len(), others.len());
+        // [E_M | E_R] dense, then E_M⁻¹·E_R by elimination with partial pivoting.
+        let mut a = vec![0.0; m * (m + no)];
+        for (r, (f, _)) in eqs.iter().enumerate() {
+            for &(j, v) in &f.row {
+                let col = if free.contains(&j) {
+                    m + others.binary_search(&j).unwrap_or(0)
+                } else if j < ml {
+                    j
+                } else {
+                    ml + j - (nc - mr)
+                };
+                a[r * (m + no) + col] += v;
+            }
+        }
+        let t = solve_dense(&mut a, m, no).ok_or(PatchFailure::TooShort)?;
+        for (r, &j) in outer.iter().enumerate() {
+            sub[j] = others
+                .iter()
+                .enumerate()
+                .map(|(q, &o)| (o, -t[r * no + q]))
+                .filter(|e| e.1 != 0.0)
+                .collect();
+        }
+        let map = |f: &Aff| -> Aff {
+            let mut row: Row = Vec::with_capacity(f.row.len() + 2);
+            for &(j, v) in &f.row {
+                for &(fj, w) in &sub[j] {
+                    row.push((offset + stride * (fj - ml), v * w));
+                }
+            }
+            Aff {
+                row: crate::qp::compact(&row),
+                c: f.c,
+            }
+        };
+        h.knot_forms = h.knot_forms.iter().map(|[v, d]| [map(v), map(d)]).collect();
+        h.offset = offset;
+        h.stride = stride;
+        h.reduced = true;
+        Ok(h)
+    }
+
     /// The value (`order` 0) or slope (1) at `t` as an affine form of the changes of the
     /// coefficients of `b` (numbered from `offset`): the current spline's plus the basis
     /// row.
@@ -246,11 +336,6 @@ impl<'a> Hermite<'a> {
                 .map(|j| r.weights[j] * cur.get(j).copied().unwrap_or(0.0))
                 .sum(),
         }
-    }
-
-    /// The current spline's coefficients (coefficient form only).
-    pub(crate) fn coefficients(&self) -> Option<&[f64]> {
-        self.basis.as_ref().map(|b| b.coeffs())
     }
 
     /// The analysis spline of the current values on the window widened by
@@ -285,11 +370,6 @@ impl<'a> Hermite<'a> {
         }
     }
 
-    /// Index of this Hermite's first variable.
-    pub(crate) fn offset(&self) -> usize {
-        self.offset
-    }
-
     /// Index of the variable `δ_i` (point `i` in `first..=last`).
     pub(crate) fn delta_var(&self, i: usize) -> usize {
         self.offset + i - self.first
@@ -299,6 +379,7 @@ impl<'a> Hermite<'a> {
     pub(crate) fn vars(&self) -> usize {
         match &self.basis {
             None => self.nd + self.hi - self.lo + 1,
+            Some(_) if self.reduced => self.nd,
             Some(_) => self.hi - self.lo + 3,
         }
     }
@@ -381,38 +462,52 @@ impl<'a> Hermite<'a> {
     /// The rows tying the slopes to the values (each `form = 0`): C² continuity at every
     /// interior knot, then the two end conditions (module docs).
     pub(crate) fn equalities(&self) -> Vec<Aff> {
+        self.sided_equalities().into_iter().map(|e| e.0).collect()
+    }
+
+    /// [`Hermite::equalities`], each with the end of the window it belongs to (`true`:
+    /// the `lo` end; C² rows of the point form count as neither and say `false`).
+    fn sided_equalities(&self) -> Vec<(Aff, bool)> {
         let (lo, hi) = (self.lo, self.hi);
         let mut eqs = Vec::with_capacity(hi - lo + 1);
+        if self.reduced {
+            // Eliminated: the fixed points' values and the end conditions hold for every
+            // value of the free coefficients.
+            return eqs;
+        }
         if self.basis.is_some() {
             // Coefficient form: C² holds by construction; the fixed points keep their
             // values.
             for k in (lo..=hi).filter(|k| !(self.first..=self.last).contains(k)) {
-                eqs.push(Aff::sum(&[
-                    (1.0, &self.y(k)),
-                    (-self.c[k], &Aff::constant(1.0)),
-                ]));
+                eqs.push((
+                    Aff::sum(&[(1.0, &self.y(k)), (-self.c[k], &Aff::constant(1.0))]),
+                    k < self.first,
+                ));
             }
         }
         for k in (lo + 1..hi).filter(|_| self.basis.is_none()) {
             let (ha, hb) = (self.h(k - 1), self.h(k));
             let w = 1.0 / (ha + hb);
-            eqs.push(Aff::sum(&[
-                (hb * w, &self.m(k - 1)),
-                (2.0, &self.m(k)),
-                (ha * w, &self.m(k + 1)),
-                (-3.0 * hb * w, &self.secant(k - 1)),
-                (-3.0 * ha * w, &self.secant(k)),
-            ]));
+            eqs.push((
+                Aff::sum(&[
+                    (hb * w, &self.m(k - 1)),
+                    (2.0, &self.m(k)),
+                    (ha * w, &self.m(k + 1)),
+                    (-3.0 * hb * w, &self.secant(k - 1)),
+                    (-3.0 * ha * w, &self.secant(k)),
+                ]),
+                false,
+            ));
         }
         let nw = hi - lo + 1;
         let both_path_ends = self.fixed == [None, None];
         if both_path_ends && nw <= 3 {
             // A line (2 points) or a parabola (3 points).
             for k in lo..hi {
-                eqs.push(Aff::sum(&[(self.h(k) * self.h(k), &self.c3(k))]));
+                eqs.push((Aff::sum(&[(self.h(k) * self.h(k), &self.c3(k))]), false));
             }
             if nw == 2 {
-                eqs.push(Aff::sum(&[(self.h(lo), &self.c2(lo))]));
+                eqs.push((Aff::sum(&[(self.h(lo), &self.c2(lo))]), false));
             }
             return eqs;
         }
@@ -420,14 +515,20 @@ impl<'a> Hermite<'a> {
             let (ha, hb) = (self.h(a), self.h(a + 1));
             Aff::sum(&[(ha * hb, &self.c3(a)), (-ha * hb, &self.c3(a + 1))])
         };
-        eqs.push(match self.fixed[0] {
-            Some(m) => Aff::sum(&[(1.0, &self.m(lo)), (-m, &Aff::constant(1.0))]),
-            None => not_a_knot(lo),
-        });
-        eqs.push(match self.fixed[1] {
-            Some(m) => Aff::sum(&[(1.0, &self.m(hi)), (-m, &Aff::constant(1.0))]),
-            None => not_a_knot(hi - 2),
-        });
+        eqs.push((
+            match self.fixed[0] {
+                Some(m) => Aff::sum(&[(1.0, &self.m(lo)), (-m, &Aff::constant(1.0))]),
+                None => not_a_knot(lo),
+            },
+            true,
+        ));
+        eqs.push((
+            match self.fixed[1] {
+                Some(m) => Aff::sum(&[(1.0, &self.m(hi)), (-m, &Aff::constant(1.0))]),
+                None => not_a_knot(hi - 2),
+            },
+            false,
+        ));
         eqs
     }
 
@@ -445,6 +546,7 @@ impl<'a> Hermite<'a> {
     /// Write the current spline into `x` (the variables of this Hermite): every change 0,
     /// every knot slope the slope of the analysis spline of the current values (on the
     /// window widened by [`WINDOW_POINTS`], as the fixed end slopes are).
+    #[cfg(test)]
     pub(crate) fn write_current(&self, x: &mut [f64]) -> Result<(), PatchFailure> {
         let n = self.s.len();
         let w = (self.hi - self.last)
@@ -455,7 +557,7 @@ impl<'a> Hermite<'a> {
         if self.basis.is_some() {
             // The current spline: no change of its coefficients.
             for j in 0..self.vars() {
-                x[self.offset + j] = 0.0;
+                x[self.offset + self.stride * j] = 0.0;
             }
             return Ok(());
         }
@@ -537,23 +639,25 @@ impl<'a> Hermite<'a> {
     /// `|m_k| ≤ v`, `|b1| ≤ v`, `|q''(knot)| ≤ a`, `|q'''| ≤ j`. A span with both knots
     /// movable, or in `core` (the spans that must reach feed), gets `limit − room`; any
     /// other span that touches a fixed point gets
-    /// `max(limit, |current value|·(1 + NOT_WORSE_SLACK)) − room` — for q', where the span
+    /// `max(limit, |value before|·(1 + NOT_WORSE_SLACK)) − room` — for q', where the span
     /// exceeded the velocity limit before, at [`NOT_WORSE_SAMPLES_PER_SPAN`] samples and the
-    /// current spline's vertex of q' (where its exact peak is) against that exact peak
+    /// spline's vertex of q' before (where its exact peak is) against that exact peak
     /// instead of the hull: it may not get worse, and need not reach
     /// feed (a fixed neighbour may already exceed the limits, e.g. through the file's own
     /// rounding). `room[k − lo][r]` ([`Hermite::rounding_room`]) is
     /// what rounding the written values can add to the (r+1)-th derivative on span k, so
-    /// the bounds still hold on the values as written. `current` holds
-    /// [`Hermite::write_current`]'s values. The window is constrained but for its last
+    /// the bounds still hold on the values as written. "Before" is `before`'s spline (the
+    /// same window; `self` when the values before are the base's): each form's value on
+    /// it is the constant of the same form built on it. Each row `(f, b)` says
+    /// `|f| ≤ b`. The window is constrained but for its last
     /// [`EDGE_SPANS`] spans at each cut end, so that what lies beyond moves by about
     /// 0.27^(window − EDGE_SPANS) of the change only.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn push_limits(
         &self,
-        qp: &mut QpBuilder,
+        before: &Hermite<'_>,
+        out: &mut Vec<(Aff, f64)>,
         lim: &crate::limits::GeomLimits,
-        current: &[f64],
         room: &[[f64; 3]],
         core: std::ops::Range<usize>,
     ) {
@@ -577,34 +681,36 @@ impl<'a> Hermite<'a> {
             let movable = |i: usize| i >= self.first && i <= self.last;
             let strict = (movable(k) && movable(k + 1)) || core.contains(&k);
             let room = room.get(k - self.lo).copied().unwrap_or([0.0; 3]);
-            let bound = |f: &Aff, limit: f64, r: usize| {
+            // `now`: the same form's value on the spline before.
+            let bound = |now: f64, limit: f64, r: usize| {
                 let b = if strict {
                     limit
                 } else {
-                    limit.max(f.at(current).abs() * (1.0 + NOT_WORSE_SLACK))
+                    limit.max(now.abs() * (1.0 + NOT_WORSE_SLACK))
                 };
                 // Never below a sliver of the limit: the row stays well posed.
                 (b - room[r]).max(1e-3 * limit)
             };
-            let rows = vec![
-                (self.m(k), lim.v, 0),
-                (self.d2(k, 0.0), lim.a, 1),
-                (self.d3(k), lim.j, 2),
+            let rows = [
+                (self.m(k), before.m(k).c, lim.v, 0),
+                (self.d2(k, 0.0), before.d2(k, 0.0).c, lim.a, 1),
+                (self.d3(k), before.d3(k).c, lim.j, 2),
             ];
-            let hull = [self.m(k), self.b1(k), self.m(k + 1)];
-            let hull_now = hull.iter().fold(0.0f64, |m, f| m.max(f.at(current).abs()));
+            let hull_now = [before.m(k), before.b1(k), before.m(k + 1)]
+                .iter()
+                .fold(0.0f64, |m, f| m.max(f.c.abs()));
             if strict || hull_now <= lim.v {
                 // |q'| ≤ v on the whole span through its Bernstein coefficients (a span
                 // within the limit before may only stay within it: "not worse").
                 let b = (lim.v - room[0]).max(1e-3 * lim.v);
-                push_abs(qp, &self.b1(k), b);
+                out.push((self.b1(k), b));
             } else {
                 // Beyond the limit before: "not worse" on q' against the span's exact peak
                 // before (the hull overstates the peak, so it cannot stand for it).
                 crate::spline::span_offsets(self.h(k), NOT_WORSE_SAMPLES_PER_SPAN, &mut taus);
-                // Rows at the samples and at the current spline's vertex of q' (its peak
+                // Rows at the samples and at the spline's vertex of q' before (its peak
                 // on the span, when inside), against that peak.
-                let d1 = |t: f64| self.d1(k, t).at(current);
+                let d1 = |t: f64| before.d1(k, t).c;
                 let (qa, qm, qb) = (d1(0.0), d1(0.5 * self.h(k)), d1(self.h(k)));
                 // q'(τ) = qa + c1·τ + c2·τ² through the three values.
                 let h = self.h(k);
@@ -619,35 +725,24 @@ impl<'a> Hermite<'a> {
                 let peak = taus.iter().fold(0.0f64, |m, &t| m.max(d1(t).abs()));
                 let b = (lim.v.max(peak * (1.0 + NOT_WORSE_SLACK)) - room[0]).max(1e-3 * lim.v);
                 for &tau in taus.iter().filter(|&&t| t > 0.0 && t < h) {
-                    push_abs(qp, &self.d1(k, tau), b);
+                    out.push((self.d1(k, tau), b));
                 }
             }
-            for (f, l, r) in rows {
-                let b = bound(&f, l, r);
-                push_abs(qp, &f, b);
+            for (f, now, l, r) in rows {
+                let b = bound(now, l, r);
+                out.push((f, b));
             }
             if k + 1 == spans.end {
-                for (f, l, r) in [(self.m(k + 1), lim.v, 0), (self.d2(k, self.h(k)), lim.a, 1)] {
-                    let b = bound(&f, l, r);
-                    push_abs(qp, &f, b);
+                let h = self.h(k);
+                for (f, now, l, r) in [
+                    (self.m(k + 1), before.m(k + 1).c, lim.v, 0),
+                    (self.d2(k, h), before.d2(k, h).c, lim.a, 1),
+                ] {
+                    let b = bound(now, l, r);
+                    out.push((f, b));
                 }
             }
         }
-    }
-
-    /// The position along the path (the knot index) of each of this Hermite's variables,
-    /// in variable order: the changes `δ_i` at `i`, the slopes `m_k` at `k`.
-    pub(crate) fn positions(&self) -> Vec<f64> {
-        if self.basis.is_some() {
-            // Coefficient j of a clamped cubic lives around knot j − 1 of the window.
-            return (0..self.vars())
-                .map(|j| (self.lo + j).saturating_sub(1).clamp(self.lo, self.hi) as f64)
-                .collect();
-        }
-        (self.first..=self.last)
-            .chain(self.lo..=self.hi)
-            .map(|k| k as f64)
-            .collect()
     }
 
     /// Add this Hermite's equalities to `qp`.
@@ -665,6 +760,46 @@ impl<'a> Hermite<'a> {
         }
         qp
     }
+}
+
+/// `A⁻¹·B` for `a = [A | B]` (`m × (m + no)`, row-major), `A` square: Gaussian
+/// elimination with partial pivoting, in place; `None` when a pivot vanishes (relative
+/// to the largest entry of `A`).
+fn solve_dense(a: &mut [f64], m: usize, no: usize) -> Option<Vec<f64>> {
+    let wd = m + no;
+    let scale = a.iter().fold(0.0f64, |x, v| x.max(v.abs()));
+    for col in 0..m {
+        let piv =
+            (col..m).max_by(|&p, &q| a[p * wd + col].abs().total_cmp(&a[q * wd + col].abs()))?;
+        if a[piv * wd + col].abs() <= 1e-12 * scale {
+            return None;
+        }
+        if piv != col {
+            for j in 0..wd {
+                a.swap(piv * wd + j, col * wd + j);
+            }
+        }
+        let d = a[col * wd + col];
+        for r in col + 1..m {
+            let f = a[r * wd + col] / d;
+            if f != 0.0 {
+                for j in col..wd {
+                    a[r * wd + j] -= f * a[col * wd + j];
+                }
+            }
+        }
+    }
+    let mut t = vec![0.0; m * no];
+    for q in 0..no {
+        for r in (0..m).rev() {
+            let mut v = a[r * wd + m + q];
+            for j in r + 1..m {
+                v -= a[r * wd + j] * t[j * no + q];
+            }
+            t[r * no + q] = v / a[r * wd + r];
+        }
+    }
+    Some(t)
 }
 
 /// Push `|f| ≤ bound` (two rows, scaled by 1/bound).
@@ -772,11 +907,24 @@ mod tests {
     #[test]
     fn coefficient_form_is_the_spline_of_the_changed_data() {
         let (s, y) = data(60);
-        for (first, last, window) in [(28, 32, WINDOW_POINTS), (1, 58, 60)] {
-            let hm = Hermite::new(&s, &y, first, last, window)
-                .unwrap()
-                .coefficient_form()
-                .unwrap();
+        let cases = [
+            (28, 32, WINDOW_POINTS, false),
+            (1, 58, 60, false),
+            (28, 32, WINDOW_POINTS, true),
+            (1, 58, 60, true),
+            (1, 30, JOINT_WINDOW_POINTS, true),
+            (40, 58, JOINT_WINDOW_POINTS, true),
+            (2, 3, 30, true),
+            (57, 59, JOINT_WINDOW_POINTS, true),
+        ];
+        for (first, last, window, reduce) in cases {
+            let hm = Hermite::new(&s, &y, first, last, window).unwrap();
+            let hm = if reduce {
+                hm.reduced(0, 1)
+                    .unwrap_or_else(|e| panic!("{first}..={last} window {window}: {e:?}"))
+            } else {
+                hm.coefficient_form().unwrap()
+            };
             let delta: Vec<f64> = (first..=last)
                 .map(|i| (i as f64 * 0.9).sin() * 4.0)
                 .collect();
@@ -799,6 +947,13 @@ mod tests {
                 rows.push((dense(&f), d - f.c));
             }
             assert_eq!(rows.len(), nv, "one row per coefficient");
+            if reduce {
+                assert_eq!(
+                    nv,
+                    last - first + 1,
+                    "one free coefficient per movable point"
+                );
+            }
             for col in 0..nv {
                 let piv = (col..nv)
                     .max_by(|&a, &b| rows[a].0[col].abs().total_cmp(&rows[b].0[col].abs()))
@@ -856,6 +1011,31 @@ mod tests {
                     .abs()
                     < 1e-6
             );
+        }
+    }
+
+    /// In reduced form with an offset and a stride, free coefficient r is variable
+    /// `offset + stride·r` and nothing else changes.
+    #[test]
+    fn reduced_form_offset_and_stride() {
+        let (s, y) = data(50);
+        let a = Hermite::new(&s, &y, 20, 30, JOINT_WINDOW_POINTS)
+            .unwrap()
+            .reduced(0, 1)
+            .unwrap();
+        let b = Hermite::new(&s, &y, 20, 30, JOINT_WINDOW_POINTS)
+            .unwrap()
+            .reduced(1, 2)
+            .unwrap();
+        assert_eq!(a.vars(), 11);
+        assert!(a.equalities().is_empty());
+        for k in a.lo..a.hi {
+            for (fa, fb) in [(a.d3(k), b.d3(k)), (a.b1(k), b.b1(k)), (a.m(k), b.m(k))] {
+                let fa = crate::qp::compact(&fa.row);
+                let fb = crate::qp::compact(&fb.row);
+                let moved: Row = fa.iter().map(|&(j, v)| (1 + 2 * j, v)).collect();
+                assert_eq!(moved, fb);
+            }
         }
     }
 

@@ -17,21 +17,27 @@
 //! Points `i` of a path with path length `s_i`, target tool axes `o_i` (the program's,
 //! [`polepatch_kinematics::forward`]) and base values `(P̂_i, Ĉ_i)` (the program's values,
 //! possibly re-selected onto the other branch as a block: the same `o_i`). Points
-//! `first..=last` move; every other point keeps its base values. Variables:
+//! `first..=last` move; every other point keeps its base values. Unknowns:
 //!
 //! ```text
-//! δP_i, δC_i        i ∈ first..=last        change from the base, degrees
-//! m^P_k, m^C_k      k ∈ window               knot slopes of the analysis splines of P and C
-//!                                            (crate::hermite, one Hermite per axis)
+//! γ^P_r, γ^C_r      r = 0 … last − first     the free changes of the coefficients of the
+//!                                            analysis splines of P and C on the window
+//!                                            (crate::hermite's reduced form: one per
+//!                                            movable point; the fixed points' values and
+//!                                            the window's end conditions are eliminated),
+//!                                            interleaved P, C along the path
 //! t                                          largest orientation change (chord, linearised)
 //! e ≥ 0                                      largest relative excess over a limit row
 //! ```
+//!
+//! Every value change `δP_i`, `δC_i`, slope and higher derivative of either spline on the
+//! window is a linear form in a few neighbouring γ.
 //!
 //! The exact problem is
 //!
 //! ```text
 //! minimise  max_i ∠(o_i, fk(P̂_i + δP_i, Ĉ_i + δC_i))
-//! s.t.      Hermite equalities of P and of C                          (the analysis splines)
+//! s.t.      P and C are the analysis splines of their values             (by construction)
 //!           |P'| ≤ v_P, |P''| ≤ a_P, |P'''| ≤ j_P on every span between movable points,
 //!           |C'| ≤ v_C, |C''| ≤ a_C, |C'''| ≤ j_C  likewise     (Equation 6 at feed F,
 //!                                                               convex-hull form)
@@ -57,7 +63,7 @@
 //!           each limit row relaxed by e:  row/bound ≤ 1 + e,   e ≥ 0
 //!           the Hermite and range rows above, exactly
 //!           |δP_i − δ̄P_i| ≤ ρ_P,  |δC_i − δ̄C_i| ≤ ρ_C                   (trust region)
-//!           t ≤ 2·sin(d/2)                                  (only for a capped solve, d)
+//!           t ≤ sin d                                       (only for a capped solve, d)
 //! ```
 //!
 //! is solved by the banded interior-point method of [`crate::ipm`] (all rows touch two or
@@ -77,16 +83,17 @@
 //! [`SolverSettings::min_trust_deg`]. The caller rounds the result as it will be written and
 //! verifies Equation 6 on it (`crate::verify`).
 //!
-//! **Capped.** With [`JointProblem::cap_deg`] the QP keeps `t ≤ 2·sin(d/2)` and the
+//! **Capped.** With [`JointProblem::cap_deg`] the QP keeps `t ≤ sin d` (the tangent-plane
+//! change of an exact change by θ is `sin θ`, so this bounds θ by d to first order; the
+//! chord `2·sin(d/2)` would let θ reach `asin(2·sin(d/2)) ≈ d + d³/8`) and the
 //! iteration lowers the excess e instead: the least excess over the limits with no point's
 //! orientation changed by more than d (from a start within the cap: the base has 0).
 
 use crate::{
     candidate::PatchFailure,
     hermite::{Aff, Hermite, JOINT_WINDOW_POINTS},
-    ipm::IpmStatus,
+    ipm::{IpmStatus, Problem},
     limits::GeomLimits,
-    qp::{QpBuilder, Row},
     report::{QpStats, QpStatus},
     settings::SolverSettings,
 };
@@ -183,97 +190,65 @@ fn tangent_basis(o: [f64; 3]) -> [[f64; 3]; 2] {
     [e1, e2]
 }
 
-/// Push `lo ≤ f ≤ hi` for an affine form `f`.
-fn push_between(qp: &mut QpBuilder, f: &Aff, lo: f64, hi: f64) {
-    qp.add_le(&f.row, hi - f.c);
-    let neg: Vec<(usize, f64)> = f.row.iter().map(|&(j, c)| (j, -c)).collect();
-    qp.add_le(&neg, f.c - lo);
-}
-
 fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// The problem's fixed part: variables, equalities, limit and range rows.
+/// The problem's fixed part: the unknowns (each axis' free spline coefficients, interleaved
+/// along the path, then `t` and `e`), the limit rows and the machine's ranges.
 struct Model<'a> {
     pr: &'a JointProblem<'a>,
-    hp: Hermite<'a>,
-    hc: Hermite<'a>,
-    /// Index of t and e.
-    t: usize,
-    e: usize,
-    /// Equalities, objective's linear part, `e ≥ 0`, the cap.
-    base: QpBuilder,
-    /// The limit rows, relaxed by e (`row·x − e ≤ rhs`).
-    limits: Vec<(Row, f64)>,
+    /// The number of band unknowns (two per movable point).
+    nb: usize,
+    /// Per movable point, its changes `(δP_i, δC_i)` as affine forms of the unknowns.
+    deltas: Vec<(Aff, Aff)>,
+    /// The limit rows `|f| ≤ 1` in relative form (`f = row/bound`), relaxed by e.
+    limits: Vec<Aff>,
     /// Per point of the range, the machine's ranges as bounds on its changes `(δP, δC)`
     /// (hard; C's infinite when it turns endlessly).
     ranges: Vec<[(f64, f64); 2]>,
-    position: Vec<Option<f64>>,
 }
 
 impl<'a> Model<'a> {
     fn new(pr: &'a JointProblem<'a>) -> Result<Model<'a>, PatchFailure> {
         let (first, last) = (pr.first, pr.last);
-        let cf = |h: Hermite<'a>| h.coefficient_form();
-        let hp = cf(Hermite::with_offset(
-            pr.s_mm,
-            pr.p_deg,
-            first,
-            last,
-            JOINT_WINDOW_POINTS,
-            0,
-        )?)?;
-        let hc = cf(Hermite::with_offset(
-            pr.s_mm,
-            pr.c_deg,
-            first,
-            last,
-            JOINT_WINDOW_POINTS,
-            hp.vars(),
-        )?)?;
-        let t = hp.vars() + hc.vars();
-        let e = t + 1;
-        let mut base = QpBuilder::new(t + 2);
-        hp.add_equalities(&mut base);
-        hc.add_equalities(&mut base);
-        let mut current = vec![0.0; t + 2];
-        match pr.reference {
-            None => {
-                hp.write_current(&mut current)?;
-                hc.write_current(&mut current)?;
-            }
-            Some((rp, rc)) => {
-                // The reference's spline in the same variables: in point form its own
-                // changes and slopes; in coefficient form its coefficients less the base's.
-                for (h, y) in [(&hp, rp), (&hc, rc)] {
-                    let r = cf(Hermite::with_offset(
-                        pr.s_mm,
-                        y,
-                        first,
-                        last,
-                        JOINT_WINDOW_POINTS,
-                        h.offset(),
-                    )?)?;
-                    r.write_current(&mut current)?;
-                    if let (Some(cr), Some(cb)) = (r.coefficients(), h.coefficients()) {
-                        for (j, (a, b)) in cr.iter().zip(cb).enumerate() {
-                            current[h.offset() + j] = a - b;
-                        }
-                    }
-                }
-            }
-        }
+        let reduced = |y: &'a [f64], offset: usize| {
+            Hermite::with_offset(pr.s_mm, y, first, last, JOINT_WINDOW_POINTS, 0)?
+                .reduced(offset, 2)
+        };
+        let (hp, hc) = (reduced(pr.p_deg, 0)?, reduced(pr.c_deg, 1)?);
+        let nb = 2 * (last - first + 1);
+        // The spline before (what "not worse" compares with): the base's, or the
+        // reference's on the same window.
+        let before = |y: &'a [f64]| {
+            Hermite::with_offset(pr.s_mm, y, first, last, JOINT_WINDOW_POINTS, 0)?
+                .coefficient_form()
+        };
+        let refs = match pr.reference {
+            None => None,
+            Some((rp, rc)) => Some((before(rp)?, before(rc)?)),
+        };
+        let (bp, bc) = match &refs {
+            None => (&hp, &hc),
+            Some((a, b)) => (a, b),
+        };
         let (rp, rc) = (
             hp.rounding_room(pr.round_p_deg, pr.memo)?,
             hc.rounding_room(pr.round_c_deg, pr.memo)?,
         );
-        let mut lim = QpBuilder::new(t + 2);
-        hp.push_limits(&mut lim, &pr.lim_p, &current, &rp, pr.core.clone());
-        hc.push_limits(&mut lim, &pr.lim_c, &current, &rc, pr.core.clone());
-        lim.extend_le(0..lim.le_len(), e, -1.0);
-        let limits = lim.le_rows(0..lim.le_len()).to_vec();
-        base.add_le(&[(e, -1.0)], 0.0);
+        let mut rows: Vec<(Aff, f64)> = Vec::new();
+        hp.push_limits(bp, &mut rows, &pr.lim_p, &rp, pr.core.clone());
+        hc.push_limits(bc, &mut rows, &pr.lim_c, &rc, pr.core.clone());
+        let limits = rows
+            .into_iter()
+            .map(|(f, b)| Aff {
+                row: crate::qp::compact(&f.row)
+                    .into_iter()
+                    .map(|(j, v)| (j, v / b))
+                    .collect(),
+                c: f.c / b,
+            })
+            .collect();
         // The machine's ranges as bounds on each point's changes; the trust region
         // bounds the same forms, so each QP takes the intersection (one pair of rows).
         let (p_lo, p_hi) = pr.machine.primary_range_deg;
@@ -288,59 +263,49 @@ impl<'a> Model<'a> {
                 [(p_lo - pr.p_deg[i], p_hi - pr.p_deg[i]), c]
             })
             .collect();
-        if let Some(d) = pr.cap_deg {
-            base.add_le(&[(t, 1.0)], chord(d));
-        }
-        base.add_linear(t, 1.0);
-        base.add_linear(e, pr.settings.elastic_weight);
-        let position: Vec<Option<f64>> = hp
-            .positions()
-            .into_iter()
-            .chain(hc.positions())
-            .map(Some)
-            .chain([None, None])
+        let deltas = (first..=last)
+            .map(|i| {
+                let (mut a, mut b) = (hp.delta(i), hc.delta(i));
+                a.row = crate::qp::compact(&a.row);
+                b.row = crate::qp::compact(&b.row);
+                (a, b)
+            })
             .collect();
         Ok(Model {
             pr,
-            hp,
-            hc,
-            t,
-            e,
-            base,
+            nb,
+            deltas,
             limits,
             ranges,
-            position,
         })
+    }
+
+    /// Index of `t` and `e` among the unknowns.
+    fn t(&self) -> usize {
+        self.nb
+    }
+    fn e(&self) -> usize {
+        self.nb + 1
     }
 
     /// The changes of point i, primary and C, at `x`.
     fn deltas(&self, i: usize, x: &[f64]) -> (f64, f64) {
-        (self.hp.delta(i).at(x), self.hc.delta(i).at(x))
+        let (a, b) = &self.deltas[i - self.pr.first];
+        (a.at(x), b.at(x))
     }
 
-    /// The current spline's variables (changes 0), t and e of it.
-    fn start(&self) -> Result<Vec<f64>, PatchFailure> {
-        let mut x = vec![0.0; self.t + 2];
-        self.hp.write_current(&mut x)?;
-        self.hc.write_current(&mut x)?;
-        x[self.e] = self.excess(&x);
-        Ok(x)
-    }
-
-    /// `row·x − rhs` of a limit row without its `−e`: the relative excess over its bound.
-    fn limit_excess(&self, (row, rhs): &(Row, f64), x: &[f64]) -> f64 {
-        row.iter()
-            .filter(|&&(j, _)| j != self.e)
-            .map(|&(j, v)| v * x[j])
-            .sum::<f64>()
-            - rhs
+    /// The current spline (changes 0), t and e of it.
+    fn start(&self) -> Vec<f64> {
+        let mut x = vec![0.0; self.nb + 2];
+        x[self.e()] = self.excess(&x);
+        x
     }
 
     /// The exact largest relative excess of `x` over the limit rows (linear: exact).
     fn excess(&self, x: &[f64]) -> f64 {
         self.limits
             .iter()
-            .map(|r| self.limit_excess(r, x))
+            .map(|f| f.at(x).abs() - 1.0)
             .fold(0.0f64, f64::max)
     }
 
@@ -359,21 +324,34 @@ impl<'a> Model<'a> {
     fn merit(&self, dev_deg: f64, excess: f64) -> f64 {
         match self.pr.cap_deg {
             None => chord(dev_deg) + self.pr.settings.elastic_weight * excess,
-            // Capped: the excess first, the angle only to break ties.
-            Some(_) => self.pr.settings.elastic_weight * excess + 1e-6 * chord(dev_deg),
+            // Capped: the excess first — over the limits, and of the exact angle over the
+            // cap (the QP bounds the linearised change only) — the angle only to break
+            // ties.
+            Some(cap) => {
+                let over = (dev_deg - cap).max(0.0) / cap.max(1e-9);
+                self.pr.settings.elastic_weight * (excess + over) + 1e-6 * chord(dev_deg)
+            }
         }
     }
 
     /// The QP linearised at `x̄` with trust regions `(ρ_P, ρ_C)` (module docs).
-    fn linearised(&self, xbar: &[f64], rho: (f64, f64)) -> QpBuilder {
+    fn linearised(&self, xbar: &[f64], rho: (f64, f64)) -> Problem {
         let pr = self.pr;
         let st = pr.settings;
-        let mut qp = self.base.clone();
-        for (row, rhs) in &self.limits {
-            qp.add_le(row, *rhs);
+        let (t, e) = (self.t(), self.e());
+        let mut qp = Problem::new(self.nb, 2);
+        qp.add_linear(t, 1.0);
+        qp.add_linear(e, st.elastic_weight);
+        for f in &self.limits {
+            qp.add_pair(&f.row, -1.0 - f.c, 1.0 - f.c, Some(e));
         }
-        for (i, [rp, rc]) in (pr.first..=pr.last).zip(&self.ranges) {
-            let (fp, fc) = (self.hp.delta(i), self.hc.delta(i));
+        qp.add_le(&[(e, -1.0)], 0.0);
+        if let Some(d) = pr.cap_deg {
+            qp.add_le(&[(t, 1.0)], d.to_radians().sin());
+        }
+        for (i, ((fp, fc), [rp, rc])) in
+            (pr.first..=pr.last).zip(self.deltas.iter().zip(&self.ranges))
+        {
             let (dp, dc) = (fp.at(xbar), fc.at(xbar));
             let [o, a, b] = forward_jacobian(pr.machine, pr.p_deg[i] + dp, pr.c_deg[i] + dc);
             // r = r0 + a·δP + b·δC with r0 = ō − o_target − a·δ̄P − b·δ̄C.
@@ -382,24 +360,25 @@ impl<'a> Model<'a> {
             let [e1, e2] = tangent_basis(pr.target[i]);
             let (u0, ua, ub) = (dot3(e1, r0), dot3(e1, a), dot3(e1, b));
             let (v0, va, vb) = (dot3(e2, r0), dot3(e2, a), dot3(e2, b));
-            // u = u0 + ua·δP + ub·δC (an affine form of the variables), v likewise.
-            let u = Aff::sum(&[(ua, &fp), (ub, &fc), (u0, &Aff::constant(1.0))]);
-            let v = Aff::sum(&[(va, &fp), (vb, &fc), (v0, &Aff::constant(1.0))]);
+            // u = u0 + ua·δP + ub·δC (an affine form of the unknowns), v likewise.
+            let u = Aff::sum(&[(ua, fp), (ub, fc), (u0, &Aff::constant(1.0))]);
+            let v = Aff::sum(&[(va, fp), (vb, fc), (v0, &Aff::constant(1.0))]);
             // ‖(u, v)‖ ≤ t: slacks s_k = rhs_k − row_k·x are (t, u, v).
             let neg = |f: &Aff| f.row.iter().map(|&(j, c)| (j, -c)).collect::<Vec<_>>();
-            qp.add_soc(&[(vec![(self.t, -1.0)], 0.0), (neg(&u), u.c), (neg(&v), v.c)]);
+            let (nu, nv) = (neg(&u), neg(&v));
+            qp.add_soc(&[(&[(t, -1.0)], 0.0), (&nu, u.c), (&nv, v.c)]);
             qp.add_square(&u.row, st.joint_quad_weight, -u.c);
             qp.add_square(&v.row, st.joint_quad_weight, -v.c);
             qp.add_square(&fp.row, st.proximal_weight, dp - fp.c);
             qp.add_square(&fc.row, st.proximal_weight, dc - fc.c);
-            for (f, d, r, range) in [(&fp, dp, rho.0, rp), (&fc, dc, rho.1, rc)] {
+            for (f, d, r, range) in [(fp, dp, rho.0, rp), (fc, dc, rho.1, rc)] {
                 let (lo, hi) = ((d - r).max(range.0), (d + r).min(range.1));
                 if lo <= hi {
-                    push_between(&mut qp, f, lo, hi);
+                    qp.add_pair(&f.row, lo - f.c, hi - f.c, None);
                 } else {
                     // Outside the range already: both, as they are (infeasible).
-                    push_between(&mut qp, f, d - r, d + r);
-                    push_between(&mut qp, f, range.0.max(-1e300), range.1.min(1e300));
+                    qp.add_pair(&f.row, d - r - f.c, d + r - f.c, None);
+                    qp.add_pair(&f.row, range.0 - f.c, range.1 - f.c, None);
                 }
             }
         }
@@ -420,9 +399,9 @@ pub fn solve_joint(pr: &JointProblem) -> Result<JointSolution, PatchFailure> {
     let st = pr.settings;
     let model = Model::new(pr)?;
     let mut stats = QpStats::default();
-    let mut xbar = model.start()?;
+    let mut xbar = model.start();
     let mut dev = model.deviation(&xbar);
-    let mut exc = xbar[model.e];
+    let mut exc = xbar[model.e()];
     let mut merit = model.merit(dev, exc);
     let mut rho = if pr.warm || exc <= st.elastic_tol {
         (st.trust_p_deg, st.trust_c_deg)
@@ -438,12 +417,9 @@ pub fn solve_joint(pr: &JointProblem) -> Result<JointSolution, PatchFailure> {
         pr.max_solves
     };
     for _ in 0..solves {
-        let qp = model.linearised(&xbar, rho);
         let started = Instant::now();
-        let banded = qp.to_banded(model.position.clone());
-        let mut x0 = xbar.clone();
-        x0[model.t] = chord(dev) + 1e-3;
-        let sol = banded.solve(&x0, &st.ipm);
+        let qp = model.linearised(&xbar, rho);
+        let sol = qp.solve(&st.ipm);
         stats.solves += 1;
         stats.iterations += sol.iterations;
         stats.solve_time_s += started.elapsed().as_secs_f64();

@@ -19,9 +19,10 @@
 //!   [`SolverSettings::screen_solves`] solves; the better (less excess over the limits, then
 //!   smaller deviation) goes on warm for the rest of [`SolverSettings::scp_max_solves`].
 //! - **Proposals.** The refined solution, then the other start's; and, with
-//!   `max_deviation_deg` when nothing within it passed, the capped solve from the
-//!   program's values (the least excess over the limits within the cap: the best
-//!   improvement the cap allows, or a patch within it that reaches feed).
+//!   `max_deviation_deg` when nothing within it passed, the capped solve from each start
+//!   that keeps every tool axis — the program's values and the other branch (the least
+//!   excess over the limits within the cap: the best improvement the cap allows, or a
+//!   patch within it that reaches feed).
 
 use crate::driver::{Proposal, Proposer, Sink, Tail, ZoneCtx};
 use crate::joint::{JointProblem, JointSolution, solve_joint};
@@ -295,6 +296,19 @@ impl JointMethod {
                 }
             }
         }
+        // The best solution's values (whole path) and its start's tail, for a capped solve.
+        let best = screened.first().map(|(i, sol)| {
+            let s0 = &starts[*i];
+            let (mut wp, mut wc) = (s0.p.clone(), s0.c.clone());
+            wp[first..=last].copy_from_slice(&sol.p_deg);
+            wc[first..=last].copy_from_slice(&sol.c_deg);
+            Start {
+                p: wp,
+                c: wc,
+                tail: s0.tail,
+                rule: s0.rule,
+            }
+        });
         let within = screened
             .first()
             .is_some_and(|(_, s)| s.excess <= st.elastic_tol);
@@ -323,24 +337,33 @@ impl JointMethod {
                 offered_all = false; // the rest only count their solves
             }
         }
-        // With a cap that nothing passing met: the least excess within it.
+        // With a cap that nothing passing met: the least excess within it — from the best
+        // solution (near the cap when it is just over it: a small step), and from each
+        // start that keeps every tool axis (the program's values, the other branch after
+        // the switch: within any cap; near the pole only the second passes through it).
         if let Some(cap) = ctx.opts.max_deviation_deg
             && sink.best_passing_deg().is_none()
         {
-            match problem(p, c, false, Some(cap), true, st.scp_max_solves) {
-                Ok(sol) => {
-                    sink.offer(Proposal {
-                        method: Method::Joint,
-                        first,
-                        last,
-                        p: sol.p_deg,
-                        c: sol.c_deg,
-                        tail: Tail::Keep,
-                        qp: sol.qp,
-                    });
+            let capped = best
+                .iter()
+                .map(|b| (b, true))
+                .chain(starts.iter().filter(|s0| !s0.rule).map(|s0| (s0, false)));
+            for (s0, warm) in capped {
+                match problem(&s0.p, &s0.c, s0.rule, Some(cap), warm, st.scp_max_solves) {
+                    Ok(sol) => {
+                        sink.offer(Proposal {
+                            method: Method::Joint,
+                            first,
+                            last,
+                            p: sol.p_deg,
+                            c: sol.c_deg,
+                            tail: s0.tail,
+                            qp: sol.qp,
+                        });
+                    }
+                    Err(crate::candidate::PatchFailure::Solver(q)) => sink.add_stats(&q),
+                    Err(_) => {}
                 }
-                Err(crate::candidate::PatchFailure::Solver(q)) => sink.add_stats(&q),
-                Err(_) => {}
             }
         }
         true

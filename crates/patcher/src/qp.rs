@@ -1,5 +1,4 @@
-//! A QP builder with sparse rows, for clarabel (one timed solve) or the banded
-//! interior-point method of [`crate::ipm`].
+//! A QP builder with sparse rows, for clarabel (one timed solve).
 
 use crate::report::{QpStats, QpStatus};
 use clarabel::algebra::CscMatrix;
@@ -34,7 +33,8 @@ pub(crate) fn add_stats(acc: &mut QpStats, other: &QpStats) {
     }
 }
 
-pub(crate) use crate::ipm::Row;
+/// A sparse linear form: `Σ coeff · x[var]` over `(var, coeff)`.
+pub(crate) type Row = Vec<(usize, f64)>;
 
 /// Merge repeated variables of a row (summing them) and drop zero coefficients.
 pub(crate) fn compact(row: &[(usize, f64)]) -> Row {
@@ -73,8 +73,8 @@ pub(crate) fn scaled(c: f64, r: &[(usize, f64)]) -> Row {
 ///                                         ‖(b_k − a_k·x)_{k≥1}‖ ≤ b_0 − a_0·x   per block
 /// ```
 ///
-/// It is solved by clarabel ([`QpBuilder::solve`]) or, banded, by [`crate::ipm`]
-/// ([`QpBuilder::to_banded`]).
+/// It is solved by clarabel ([`QpBuilder::solve`]); the joint patch's QPs go to the
+/// banded interior-point method instead ([`crate::ipm::Problem`]).
 ///
 /// Only the upper triangle of `H` is stored (clarabel reads nothing else).
 #[derive(Debug, Clone)]
@@ -135,60 +135,11 @@ impl QpBuilder {
 
     /// Add the second-order cone `‖(rhs_k − row_k·x)_{k≥1}‖₂ ≤ rhs_0 − row_0·x` over the
     /// rows of `block` (`(row_k, rhs_k)`, at least 2).
+    #[cfg(test)]
     pub(crate) fn add_soc(&mut self, block: &[(Row, f64)]) {
         debug_assert!(block.len() >= 2, "a second-order cone needs 2 rows or more");
         self.soc
             .push(block.iter().map(|(r, b)| (compact(r), *b)).collect());
-    }
-
-    /// Number of inequality rows so far.
-    pub(crate) fn le_len(&self) -> usize {
-        self.le.len()
-    }
-
-    /// Add `coef·x[var]` to the left side of the inequality rows `rows` (an elastic
-    /// variable: `row·x − e ≤ rhs` with `coef = −1`).
-    pub(crate) fn extend_le(&mut self, rows: std::ops::Range<usize>, var: usize, coef: f64) {
-        for (row, _) in &mut self.le[rows] {
-            row.push((var, coef));
-        }
-    }
-
-    /// The inequality rows `rows` as `(row, rhs)`.
-    pub(crate) fn le_rows(&self, rows: std::ops::Range<usize>) -> &[(Row, f64)] {
-        &self.le[rows]
-    }
-
-    /// This problem for [`crate::ipm::Banded`], with each variable's position along the
-    /// path (`None`: a border variable).
-    pub(crate) fn to_banded(&self, position: Vec<Option<f64>>) -> crate::ipm::Banded {
-        debug_assert_eq!(position.len(), self.n);
-        let mut b = crate::ipm::Banded::new(self.n);
-        b.position = position;
-        // Each pair once (the interior-point method multiplies by H every iteration): the
-        // builder adds one square per term, so a pair comes back many times.
-        let mut h: Vec<(usize, usize, f64)> = self
-            .h_rows
-            .iter()
-            .zip(&self.h_cols)
-            .zip(&self.h_vals)
-            .map(|((&i, &j), &v)| (i.min(j), i.max(j), v))
-            .collect();
-        h.sort_by_key(|e| (e.0, e.1));
-        let mut merged: Vec<(usize, usize, f64)> = Vec::with_capacity(h.len());
-        for (i, j, v) in h {
-            match merged.last_mut() {
-                Some(last) if (last.0, last.1) == (i, j) => last.2 += v,
-                _ => merged.push((i, j, v)),
-            }
-        }
-        merged.retain(|e| e.2 != 0.0);
-        b.h = merged;
-        b.c = self.q.clone();
-        b.eq = self.eq.clone();
-        b.le = self.le.clone();
-        b.soc = self.soc.clone();
-        b
     }
 
     /// Solve with clarabel ([`settings`]), adding this solve's figures to `stats` (status of
@@ -312,5 +263,146 @@ mod qp_builder_tests {
         let mut st = QpStats::default();
         assert!(qp.solve(&mut st).is_err());
         assert!(st.status.is_infeasible(), "{}", st.status);
+    }
+}
+
+/// The banded interior-point method ([`crate::ipm::Problem`]) against clarabel on the
+/// same problems: seeded random QPs with second-order cones whose rows couple
+/// neighbouring band unknowns, two-sided rows (some one-sided, some relaxed by an elastic
+/// border unknown), rows on the border unknowns alone and a quadratic objective — the
+/// shapes of the joint patch's QPs. Both solutions agree to 1e-5.
+#[cfg(test)]
+mod ipm_against_clarabel {
+    use super::*;
+    use crate::ipm::{IpmSettings, IpmStatus, Problem};
+
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+        fn sym(&mut self) -> f64 {
+            2.0 * self.next() - 1.0
+        }
+    }
+
+    #[test]
+    fn random_banded_socps_agree() {
+        for seed in 1..=12u64 {
+            let mut rng = Rng(seed * 7919);
+            let nb = 12 + (rng.next() * 40.0) as usize;
+            let (t, e) = (nb, nb + 1);
+            let n = nb + 2;
+            let mut ip = Problem::new(nb, 2);
+            let mut cl = QpBuilder::new(n);
+            let xs: Vec<f64> = (0..nb).map(|_| rng.sym() * 3.0).collect();
+            let local = |rng: &mut Rng, len: usize| -> Row {
+                let at = (rng.next() * (nb - len) as f64) as usize;
+                (at..at + len).map(|j| (j, rng.sym())).collect()
+            };
+            for _ in 0..nb {
+                let r = local(&mut rng, 3);
+                let (wt, tg) = (0.01 + rng.next(), rng.sym());
+                ip.add_square(&r, wt, tg);
+                cl.add_square(&r, wt, tg);
+            }
+            for j in 0..nb {
+                ip.add_square(&[(j, 1.0)], 1e-3, 0.0);
+                cl.add_square(&[(j, 1.0)], 1e-3, 0.0);
+            }
+            ip.add_linear(t, 1.0);
+            cl.add_linear(t, 1.0);
+            ip.add_linear(e, 50.0);
+            cl.add_linear(e, 50.0);
+            for _ in 0..3 * nb {
+                let len = 2 + (rng.next() * 3.0) as usize;
+                let r = local(&mut rng, len);
+                let at: f64 = r.iter().map(|&(j, v)| v * xs[j]).sum();
+                // Some rows tight at the planted point, some infeasible without e.
+                let (lo, hi) = (at - 0.5 * rng.next(), at + 0.5 * rng.next());
+                let shift = if rng.next() < 0.1 { 1.0 } else { 0.0 };
+                let elastic = rng.next() < 0.5;
+                let lo = if rng.next() < 0.2 {
+                    f64::NEG_INFINITY
+                } else {
+                    lo + shift
+                };
+                let hi = if rng.next() < 0.2 {
+                    f64::INFINITY
+                } else {
+                    hi + shift * 0.5
+                };
+                let el = elastic.then_some(e);
+                let (lo, hi) = if el.is_none() {
+                    (lo - shift, hi)
+                } else {
+                    (lo, hi)
+                };
+                ip.add_pair(&r, lo, hi, el);
+                let mut up = r.clone();
+                let mut dn: Row = r.iter().map(|&(j, v)| (j, -v)).collect();
+                if let Some(e) = el {
+                    up.push((e, -1.0));
+                    dn.push((e, -1.0));
+                }
+                if hi.is_finite() {
+                    cl.add_le(&up, hi);
+                }
+                if lo.is_finite() {
+                    cl.add_le(&dn, -lo);
+                }
+            }
+            ip.add_le(&[(e, -1.0)], 0.0);
+            cl.add_le(&[(e, -1.0)], 0.0);
+            ip.add_le(&[(t, 1.0)], 100.0);
+            cl.add_le(&[(t, 1.0)], 100.0);
+            for _ in 0..nb / 2 {
+                let (u, v) = (local(&mut rng, 4), local(&mut rng, 3));
+                let (bu, bv) = (rng.sym(), rng.sym());
+                let rows: Vec<(Row, f64)> = vec![(vec![(t, -1.0)], 0.0), (u, bu), (v, bv)];
+                let view: Vec<(&[(usize, f64)], f64)> =
+                    rows.iter().map(|(r, b)| (r.as_slice(), *b)).collect();
+                ip.add_soc(&view);
+                cl.add_soc(&rows);
+            }
+            let sol = ip.solve(&IpmSettings::default());
+            assert_eq!(sol.status, IpmStatus::Solved, "seed {seed}");
+            let want = cl
+                .solve(&mut QpStats::default())
+                .expect("clarabel solves it");
+            let objf = |x: &[f64]| -> (f64, f64) {
+                let mut o: f64 = cl.q.iter().zip(x).map(|(a, b)| a * b).sum();
+                for ((&i, &j), &v) in cl.h_rows.iter().zip(&cl.h_cols).zip(&cl.h_vals) {
+                    o += if i == j {
+                        0.5 * v * x[i] * x[i]
+                    } else {
+                        v * x[i] * x[j]
+                    };
+                }
+                let mut viol: f64 = 0.0;
+                for (row, rhs) in &cl.le {
+                    let g: f64 = row.iter().map(|&(j, v)| v * x[j]).sum();
+                    viol = viol.max(g - rhs);
+                }
+                for b in &cl.soc {
+                    let sv: Vec<f64> = b
+                        .iter()
+                        .map(|(row, rhs)| rhs - row.iter().map(|&(j, v)| v * x[j]).sum::<f64>())
+                        .collect();
+                    viol = viol.max((sv[1] * sv[1] + sv[2] * sv[2]).sqrt() - sv[0]);
+                }
+                (o, viol)
+            };
+            let ((on, vn), (oc, vc)) = (objf(&sol.x), objf(&want));
+            assert!(vn < 1e-7 && vc < 1e-6, "seed {seed}: violations {vn} {vc}");
+            assert!(
+                (on - oc).abs() < 1e-5 * (1.0 + oc.abs()),
+                "seed {seed}: {on} vs {oc}"
+            );
+        }
     }
 }

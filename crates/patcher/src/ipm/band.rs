@@ -7,13 +7,6 @@
 
 use super::inf_norm;
 
-/// Where one unknown of the KKT system lives.
-#[derive(Clone, Copy)]
-pub(super) enum Slot {
-    Band(usize),
-    Border(usize),
-}
-
 /// A symmetric matrix: banded `nb × nb` (half-bandwidth `w`, lower part stored by
 /// diagonals), a dense border `C` (`k × nb`) and corner `E` (`k × k`), factored in place.
 pub(super) struct BorderedBand {
@@ -48,12 +41,22 @@ impl BorderedBand {
         }
     }
 
-    /// Add `v` at (a, b) and (b, a) of the symmetric matrix (once on the diagonal).
-    pub(super) fn add(&mut self, a: Slot, b: Slot, v: f64) {
-        let mut at = Vec::with_capacity(2);
-        self.dsts(a, b, &mut at);
-        for i in at {
-            self.add_flat(i, v);
+    /// Add `v` at `(i, j)` and `(j, i)` of the symmetric matrix (once on the diagonal);
+    /// `i`, `j` are unknown indices: `nb + r` is border row r.
+    pub(super) fn add_sym(&mut self, i: usize, j: usize, v: f64) {
+        let (nb, k, w) = (self.nb, self.k, self.w);
+        let (i, j) = if i >= j { (i, j) } else { (j, i) };
+        if j >= nb {
+            let (a, b) = (i - nb, j - nb);
+            self.corner[a * k + b] += v;
+            if a != b {
+                self.corner[b * k + a] += v;
+            }
+        } else if i >= nb {
+            self.border[(i - nb) * nb + j] += v;
+        } else {
+            debug_assert!(i - j <= w, "({i}, {j}) outside the band");
+            self.band[i * (w + 1) + j + w - i] += v;
         }
     }
 
@@ -234,43 +237,6 @@ impl BorderedBand {
 }
 
 impl BorderedBand {
-    /// The flat storage indices (band, then border, then corner) at which [`BorderedBand::add`]
-    /// adds a value at `(a, b)`.
-    pub(super) fn dsts(&self, a: Slot, b: Slot, out: &mut Vec<u32>) {
-        let nbw = self.band.len();
-        let nbo = self.border.len();
-        let idx = match (a, b) {
-            (Slot::Band(i), Slot::Band(j)) => {
-                let (i, j) = if i >= j { (i, j) } else { (j, i) };
-                i * (self.w + 1) + (j + self.w - i)
-            }
-            (Slot::Border(r), Slot::Band(i)) | (Slot::Band(i), Slot::Border(r)) => {
-                nbw + r * self.nb + i
-            }
-            (Slot::Border(r), Slot::Border(q)) => {
-                if r != q {
-                    out.push((nbw + nbo + q * self.k + r) as u32);
-                }
-                nbw + nbo + r * self.k + q
-            }
-        };
-        out.push(idx as u32);
-    }
-
-    /// Add `v` at the flat storage index `i` ([`BorderedBand::dsts`]).
-    #[inline]
-    pub(super) fn add_flat(&mut self, i: u32, v: f64) {
-        let i = i as usize;
-        let nbw = self.band.len();
-        if i < nbw {
-            self.band[i] += v;
-        } else if i < nbw + self.border.len() {
-            self.border[i - nbw] += v;
-        } else {
-            self.corner[i - nbw - self.border.len()] += v;
-        }
-    }
-
     /// Copy another matrix of the same shape.
     pub(super) fn copy_from(&mut self, o: &BorderedBand) {
         self.band.copy_from_slice(&o.band);
@@ -328,16 +294,16 @@ mod tests {
         };
         for i in 0..nb {
             let sign = if i % 5 == 4 { -1.0 } else { 1.0 };
-            m.add(Slot::Band(i), Slot::Band(i), sign * (4.0 + rnd()));
+            m.add_sym(i, i, sign * (4.0 + rnd()));
             for d in 1..=w.min(i) {
-                m.add(Slot::Band(i), Slot::Band(i - d), 0.3 * rnd());
+                m.add_sym(i, i - d, 0.3 * rnd());
             }
             for r in 0..k {
-                m.add(Slot::Border(r), Slot::Band(i), 0.2 * rnd());
+                m.add_sym(nb + r, i, 0.2 * rnd());
             }
         }
         for r in 0..k {
-            m.add(Slot::Border(r), Slot::Border(r), 6.0);
+            m.add_sym(nb + r, nb + r, 6.0);
         }
         let x: Vec<f64> = (0..nb + k).map(|_| rnd()).collect();
         let mut b = vec![0.0; nb + k];

@@ -4,19 +4,50 @@
 // Index loops mirror the formulas (cone entries).
 #![allow(clippy::needless_range_loop)]
 
-/// The largest second-order cone (rows) [`super::Banded::solve`] takes.
+/// The largest second-order cone (rows) [`super::Problem::solve`] takes.
 pub const MAX_CONE: usize = 8;
 
-/// Nesterov–Todd scaling of one second-order cone block at `(s, z)` (both interior):
-/// `W` (symmetric, q × q, row-major) with `W·z = W⁻¹·s = λ`, its inverse, and `λ`
-/// (Vandenberghe, "The CVXOPT linear and quadratic cone program solvers", §4.2).
+/// Nesterov–Todd scaling of one second-order cone at `(s, z)` (both interior), kept as
+/// `η` and the unit hyperbolic vector `w̄` (Vandenberghe, "The CVXOPT linear and
+/// quadratic cone program solvers", §4.2):
+///
+/// ```text
+/// W  = η·[ w̄0   w̄1ᵀ                 ]      W·z = W⁻¹·s = λ
+///        [ w̄1   I + w̄1·w̄1ᵀ/(1 + w̄0) ]
+/// W⁻¹ = (1/η)·[ w̄0   −w̄1ᵀ ; −w̄1   I + w̄1·w̄1ᵀ/(1 + w̄0) ]
+/// ```
+///
+/// so that applying `W` or `W⁻¹` costs O(q).
+#[derive(Debug, Clone, Copy)]
 pub(super) struct SocScaling {
-    /// `W`, q × q row-major (first q² entries used).
-    pub(super) w: [f64; MAX_CONE * MAX_CONE],
-    /// `W⁻¹`, likewise.
-    pub(super) winv: [f64; MAX_CONE * MAX_CONE],
-    /// `λ` (first q entries).
-    pub(super) lambda: [f64; MAX_CONE],
+    pub(super) eta: f64,
+    pub(super) wbar: [f64; MAX_CONE],
+}
+
+impl SocScaling {
+    /// `out = W·v` (q = `v.len()`).
+    pub(super) fn apply(&self, v: &[f64], out: &mut [f64]) {
+        let q = v.len();
+        let wb = &self.wbar;
+        let dot: f64 = (1..q).map(|i| wb[i] * v[i]).sum();
+        let f = dot / (1.0 + wb[0]);
+        out[0] = self.eta * (wb[0] * v[0] + dot);
+        for i in 1..q {
+            out[i] = self.eta * (v[i] + wb[i] * (v[0] + f));
+        }
+    }
+
+    /// `out = W⁻¹·v`.
+    pub(super) fn apply_inv(&self, v: &[f64], out: &mut [f64]) {
+        let q = v.len();
+        let wb = &self.wbar;
+        let dot: f64 = (1..q).map(|i| wb[i] * v[i]).sum();
+        let f = dot / (1.0 + wb[0]);
+        out[0] = (wb[0] * v[0] - dot) / self.eta;
+        for i in 1..q {
+            out[i] = (v[i] + wb[i] * (f - v[0])) / self.eta;
+        }
+    }
 }
 
 pub(super) fn soc_norm(v: &[f64]) -> f64 {
@@ -24,7 +55,8 @@ pub(super) fn soc_norm(v: &[f64]) -> f64 {
     r.max(0.0).sqrt()
 }
 
-pub(super) fn soc_scaling(s: &[f64], z: &[f64]) -> SocScaling {
+/// The scaling at `(s, z)` and `λ = W·z` (into `lambda`).
+pub(super) fn soc_scaling(s: &[f64], z: &[f64], lambda: &mut [f64]) -> SocScaling {
     let q = s.len();
     let (sn, zn) = (soc_norm(s), soc_norm(z));
     let (mut sb, mut zb) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
@@ -33,32 +65,17 @@ pub(super) fn soc_scaling(s: &[f64], z: &[f64]) -> SocScaling {
         zb[i] = z[i] / zn;
     }
     let gamma = ((1.0 + (0..q).map(|i| sb[i] * zb[i]).sum::<f64>()) / 2.0).sqrt();
-    let mut wb = [0.0; MAX_CONE];
-    wb[0] = (sb[0] + zb[0]) / (2.0 * gamma);
+    let mut wbar = [0.0; MAX_CONE];
+    wbar[0] = (sb[0] + zb[0]) / (2.0 * gamma);
     for i in 1..q {
-        wb[i] = (sb[i] - zb[i]) / (2.0 * gamma);
+        wbar[i] = (sb[i] - zb[i]) / (2.0 * gamma);
     }
-    let eta = (sn / zn).sqrt();
-    let mut w = [0.0; MAX_CONE * MAX_CONE];
-    let mut winv = [0.0; MAX_CONE * MAX_CONE];
-    w[0] = eta * wb[0];
-    winv[0] = wb[0] / eta;
-    for i in 1..q {
-        w[i] = eta * wb[i];
-        w[i * q] = eta * wb[i];
-        winv[i] = -wb[i] / eta;
-        winv[i * q] = -wb[i] / eta;
-        for j in 1..q {
-            let m = f64::from(u8::from(i == j)) + wb[i] * wb[j] / (1.0 + wb[0]);
-            w[i * q + j] = eta * m;
-            winv[i * q + j] = m / eta;
-        }
-    }
-    let mut lambda = [0.0; MAX_CONE];
-    for i in 0..q {
-        lambda[i] = (0..q).map(|j| w[i * q + j] * z[j]).sum();
-    }
-    SocScaling { w, winv, lambda }
+    let sc = SocScaling {
+        eta: (sn / zn).sqrt(),
+        wbar,
+    };
+    sc.apply(z, lambda);
+    sc
 }
 
 /// `u ∘ v` of the second-order cone's Jordan algebra: `(uᵀv, u0·v1 + v0·u1)`.
@@ -114,7 +131,7 @@ mod tests {
     use super::*;
 
     /// Nesterov–Todd scaling: `W·z = W⁻¹·s = λ`, `W·W⁻¹ = I`, on random interior points;
-    /// Jordan division inverts the product.
+    /// Jordan division inverts the product; the cone step lands on the boundary.
     #[test]
     fn nesterov_todd_scaling_identities() {
         let mut seed = 7u64;
@@ -124,54 +141,56 @@ mod tests {
                 .wrapping_add(1442695040888963407);
             ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
         };
-        for _ in 0..50 {
-            let mut s = [0.0, rnd(), rnd()];
-            let mut z = [0.0, rnd(), rnd()];
-            s[0] = (s[1] * s[1] + s[2] * s[2]).sqrt() + 0.1 + rnd().abs();
-            z[0] = (z[1] * z[1] + z[2] * z[2]).sqrt() + 0.1 + rnd().abs();
-            let sc = soc_scaling(&s, &z);
-            let mul = |m: &[f64], v: &[f64]| -> Vec<f64> {
-                (0..3)
-                    .map(|a| (0..3).map(|b| m[a * 3 + b] * v[b]).sum())
-                    .collect()
-            };
-            let (wz, wis) = (mul(&sc.w, &z), mul(&sc.winv, &s));
-            for a in 0..3 {
-                assert!(
-                    (wz[a] - sc.lambda[a]).abs() < 1e-10,
-                    "{wz:?} {:?}",
-                    sc.lambda
-                );
-                assert!(
-                    (wis[a] - sc.lambda[a]).abs() < 1e-10,
-                    "{wis:?} {:?}",
-                    sc.lambda
-                );
-                for b in 0..3 {
-                    let id: f64 = (0..3).map(|m| sc.w[a * 3 + m] * sc.winv[m * 3 + b]).sum();
-                    assert!((id - f64::from(u8::from(a == b))).abs() < 1e-10);
+        for q in [3usize, 5] {
+            for _ in 0..50 {
+                let (mut s, mut z) = (vec![0.0; q], vec![0.0; q]);
+                for i in 1..q {
+                    s[i] = rnd();
+                    z[i] = rnd();
+                }
+                s[0] = soc_norm_tail(&s) + 0.1 + rnd().abs();
+                z[0] = soc_norm_tail(&z) + 0.1 + rnd().abs();
+                let mut lambda = vec![0.0; q];
+                let sc = soc_scaling(&s, &z, &mut lambda);
+                let (mut wz, mut wis) = (vec![0.0; q], vec![0.0; q]);
+                sc.apply(&z, &mut wz);
+                sc.apply_inv(&s, &mut wis);
+                for a in 0..q {
+                    assert!((wz[a] - lambda[a]).abs() < 1e-10, "{wz:?} {lambda:?}");
+                    assert!((wis[a] - lambda[a]).abs() < 1e-10, "{wis:?} {lambda:?}");
+                }
+                for b in 0..q {
+                    let mut e = vec![0.0; q];
+                    e[b] = 1.0;
+                    let (mut we, mut back) = (vec![0.0; q], vec![0.0; q]);
+                    sc.apply(&e, &mut we);
+                    sc.apply_inv(&we, &mut back);
+                    for a in 0..q {
+                        assert!((back[a] - e[a]).abs() < 1e-10);
+                    }
+                }
+                let r: Vec<f64> = (0..q).map(|_| rnd()).collect();
+                let mut u = vec![0.0; q];
+                soc_div(&lambda, &r, &mut u);
+                let mut back = vec![0.0; q];
+                soc_prod(&lambda, &u, &mut back);
+                for a in 0..q {
+                    assert!((back[a] - r[a]).abs() < 1e-9);
+                }
+                // The cone step lands on the boundary (or is not limited).
+                let d: Vec<f64> = (0..q).map(|_| rnd() * 5.0).collect();
+                let al = soc_step(&s, &d, 1e6);
+                let v: Vec<f64> = (0..q).map(|a| s[a] + al * d[a]).collect();
+                assert!(v[0] >= -1e-9 && v[0] - soc_norm_tail(&v) >= -1e-7 * (1.0 + v[0]));
+                if al < 1e6 {
+                    let w: Vec<f64> = (0..q).map(|a| s[a] + 1.001 * al * d[a]).collect();
+                    assert!(w[0] < soc_norm_tail(&w));
                 }
             }
-            let r = [rnd(), rnd(), rnd()];
-            let mut u = [0.0; 3];
-            soc_div(&sc.lambda[..3], &r, &mut u);
-            let mut back = [0.0; 3];
-            soc_prod(&sc.lambda[..3], &u, &mut back);
-            for a in 0..3 {
-                assert!((back[a] - r[a]).abs() < 1e-9);
-            }
-            // The cone step lands on the boundary (or is not limited).
-            let d = [rnd() * 5.0, rnd() * 5.0, rnd() * 5.0];
-            let al = soc_step(&s, &d, 1e6);
-            let v: Vec<f64> = (0..3).map(|a| s[a] + al * d[a]).collect();
-            assert!(
-                v[0] >= -1e-9
-                    && v[0] * v[0] - v[1] * v[1] - v[2] * v[2] >= -1e-7 * (1.0 + v[0] * v[0])
-            );
-            if al < 1e6 {
-                let w: Vec<f64> = (0..3).map(|a| s[a] + 1.001 * al * d[a]).collect();
-                assert!(w[0] < 0.0 || w[0] * w[0] - w[1] * w[1] - w[2] * w[2] < 0.0);
-            }
         }
+    }
+
+    fn soc_norm_tail(v: &[f64]) -> f64 {
+        v[1..].iter().map(|x| x * x).sum::<f64>().sqrt()
     }
 }

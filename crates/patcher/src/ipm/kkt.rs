@@ -1,295 +1,287 @@
-//! The KKT matrix of one problem: the unknowns' order along the path (the band), its
-//! shape, and the assembly of `H + Gᵀ·V·G` and `A` from a pattern computed once per
-//! solve.
+//! The KKT system of one problem: the products with `G` and `Gᵀ` and the assembly of
+//! `H + Gᵀ·V·G` into the bordered band matrix, from the problem's rows as they are
+//! (each pair's band row once for both its sides).
+//!
+//! Slack order: pair p's upper side at `2p`, its lower side at `2p + 1`, then the
+//! one-sided rows, then every cone's rows.
 
 // Index loops mirror the assembly's formulas.
 #![allow(clippy::needless_range_loop)]
 
-use super::Banded;
-use super::band::{BorderedBand, Slot};
+use super::band::BorderedBand;
+use super::cones::{MAX_CONE, SocScaling};
+use super::problem::Problem;
 
-/// The unknowns' order and the matrix shape, fixed for a problem.
-pub(super) struct Layout {
-    /// Band index of each variable (`None`: border).
-    pub(super) var_band: Vec<Option<usize>>,
-    /// Border index of each border variable.
-    pub(super) var_border: Vec<Option<usize>>,
-    /// Band index of each equality's multiplier.
-    pub(super) eq_band: Vec<usize>,
-    /// Band size, half-bandwidth, border size.
+/// One cone's rows gathered densely over the unknowns they touch.
+pub(super) struct ConeRows {
+    /// First slack index and number of rows.
+    pub(super) b0: usize,
+    pub(super) q: usize,
+    /// The band unknowns the rows touch (sorted).
+    vars: Vec<u32>,
+    /// `g[a·(nv + k) + j]`: row a's coefficient of `vars[j]` (j < nv) or of border
+    /// unknown `j − nv`.
+    g: Vec<f64>,
+}
+
+/// The structure of one (equilibrated) problem's KKT system.
+pub(super) struct Kkt<'a> {
+    pub(super) p: &'a Problem,
     pub(super) nb: usize,
-    pub(super) w: usize,
     pub(super) k: usize,
+    /// Slacks of the pairs (2 each) and of the one-sided rows: the linear part.
+    pub(super) ml: usize,
+    /// All slacks.
+    pub(super) mi: usize,
+    pub(super) cones: Vec<ConeRows>,
+    /// The right-hand sides of all slacks (`h`).
+    pub(super) h: Vec<f64>,
 }
 
-impl Layout {
-    pub(super) fn new(p: &Banded) -> Layout {
-        let n = p.n;
-        // Sort keys: a variable by its position; a multiplier right after the largest
-        // position of its row's banded variables (or at the front when it has none).
-        let mut keys: Vec<(f64, u8, usize)> = Vec::with_capacity(n + p.eq.len());
-        let mut var_border = vec![None; n];
-        let mut k = 0;
-        for (j, pos) in p.position.iter().enumerate() {
-            match pos {
-                Some(v) => keys.push((*v, 0, j)),
-                None => {
-                    var_border[j] = Some(k);
-                    k += 1;
+impl<'a> Kkt<'a> {
+    pub(super) fn new(p: &'a Problem) -> Kkt<'a> {
+        let (nb, k) = (p.nb, p.k);
+        let ml = 2 * p.pairs() + p.ones();
+        let mut cones = Vec::with_capacity(p.cones());
+        for c in 0..p.cones() {
+            let (r0, r1) = (p.cone_ptr[c] as usize, p.cone_ptr[c + 1] as usize);
+            let q = r1 - r0;
+            let mut vars: Vec<u32> =
+                p.crow_idx[p.crow_ptr[r0] as usize..p.crow_ptr[r1] as usize].to_vec();
+            vars.sort_unstable();
+            vars.dedup();
+            let nt = vars.len() + k;
+            let mut g = vec![0.0; q * nt];
+            for (a, r) in (r0..r1).enumerate() {
+                for e in p.crow_ptr[r] as usize..p.crow_ptr[r + 1] as usize {
+                    let j = vars.binary_search(&p.crow_idx[e]).unwrap_or(0);
+                    g[a * nt + j] += p.crow_val[e];
+                }
+                for b in 0..k {
+                    g[a * nt + vars.len() + b] += p.crow_border[r * k + b];
                 }
             }
+            cones.push(ConeRows {
+                b0: ml + r0,
+                q,
+                vars,
+                g,
+            });
         }
-        for (r, (row, _)) in p.eq.iter().enumerate() {
-            let at = row
-                .iter()
-                .filter_map(|&(j, _)| p.position[j])
-                .fold(f64::NEG_INFINITY, f64::max);
-            keys.push((at, 1, r));
+        let mut h = Vec::with_capacity(ml + p.crow_rhs.len());
+        for q in 0..p.pairs() {
+            h.push(p.pair_hi[q]);
+            h.push(-p.pair_lo[q]);
         }
-        keys.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
-        let mut var_band = vec![None; n];
-        let mut eq_band = vec![0; p.eq.len()];
-        for (i, &(_, kind, idx)) in keys.iter().enumerate() {
-            if kind == 0 {
-                var_band[idx] = Some(i);
-            } else {
-                eq_band[idx] = i;
-            }
-        }
-        let nb = keys.len();
-        let mut l = Layout {
-            var_band,
-            var_border,
-            eq_band,
+        h.extend_from_slice(&p.one_rhs);
+        h.extend_from_slice(&p.crow_rhs);
+        Kkt {
+            p,
             nb,
-            w: 0,
             k,
-        };
-        // Half-bandwidth: the widest spread of band indices any block of the matrix
-        // couples.
-        let mut w = 0usize;
-        let spread = |idx: &mut dyn Iterator<Item = usize>| {
-            let (mut lo, mut hi) = (usize::MAX, 0usize);
-            for i in idx {
-                lo = lo.min(i);
-                hi = hi.max(i);
-            }
-            if lo == usize::MAX { 0 } else { hi - lo }
-        };
-        for &(i, j, _) in &p.h {
-            if let (Some(a), Some(b)) = (l.var_band[i], l.var_band[j]) {
-                w = w.max(a.abs_diff(b));
-            }
-        }
-        for (row, _) in &p.le {
-            w = w.max(spread(&mut row.iter().filter_map(|&(j, _)| l.var_band[j])));
-        }
-        for cone in &p.soc {
-            w = w.max(spread(
-                &mut cone
-                    .iter()
-                    .flat_map(|(row, _)| row.iter())
-                    .filter_map(|&(j, _)| l.var_band[j]),
-            ));
-        }
-        for (r, (row, _)) in p.eq.iter().enumerate() {
-            let m = l.eq_band[r];
-            w = w.max(spread(
-                &mut row
-                    .iter()
-                    .filter_map(|&(j, _)| l.var_band[j])
-                    .chain(std::iter::once(m)),
-            ));
-        }
-        l.w = w;
-        l
-    }
-
-    pub(super) fn var_slot(&self, j: usize) -> Slot {
-        match self.var_band[j] {
-            Some(b) => Slot::Band(b),
-            None => Slot::Border(self.var_border[j].unwrap_or(0)),
-        }
-    }
-}
-
-/// One entry of a row with its place in the KKT system.
-#[derive(Clone, Copy)]
-pub(super) struct Entry {
-    pub(super) var: usize,
-    pub(super) slot: Slot,
-    pub(super) v: f64,
-}
-
-/// The fixed shape of the KKT matrix of one problem, computed once per solve: where each
-/// product of [`Banded::solve`]'s iteration matrix lands (flat indices into the
-/// [`BorderedBand`]'s storage), so that an iteration only multiplies and adds.
-pub(super) struct Assembler {
-    /// `H` and `A` (the parts that do not change), unregularised.
-    pub(super) base: BorderedBand,
-    /// Linear row r's pairs `lp_ptr[r]..lp_ptr[r + 1]`: where `d_r·g_a·g_b` is added.
-    pub(super) lp_ptr: Vec<usize>,
-    pub(super) lp_dst: Vec<u32>,
-    pub(super) lp_coef: Vec<f64>,
-    /// Per cone block: its variables' count, `G_c` (q × nv, row-major) and, for every
-    /// pair `i ≤ j` of its variables in order, where `(G_cᵀ·V·G_c)_ij` is added
-    /// (`pair_ptr` into `pair_dst`).
-    pub(super) cones: Vec<ConePattern>,
-    /// The diagonal entries that get `+δ` (variables) and `−δ` (multipliers).
-    pub(super) reg_plus: Vec<u32>,
-    pub(super) reg_minus: Vec<u32>,
-}
-
-pub(super) struct ConePattern {
-    pub(super) nv: usize,
-    pub(super) g: Vec<f64>,
-    pub(super) pair_ptr: Vec<usize>,
-    pub(super) pair_dst: Vec<u32>,
-}
-
-impl Assembler {
-    pub(super) fn new(
-        p: &Banded,
-        lay: &Layout,
-        entries: &[Vec<Entry>],
-        blocks: &[(usize, usize)],
-    ) -> Self {
-        let mut base = BorderedBand::new(lay.nb, lay.w, lay.k);
-        for &(i, j, v) in &p.h {
-            base.add(lay.var_slot(i), lay.var_slot(j), v);
-        }
-        for (r, (row, _)) in p.eq.iter().enumerate() {
-            for &(j, v) in row {
-                base.add(Slot::Band(lay.eq_band[r]), lay.var_slot(j), v);
-            }
-        }
-        let ml = entries.len() - blocks.iter().map(|b| b.1).sum::<usize>();
-        let mut d = Vec::new();
-        let (mut lp_ptr, mut lp_dst, mut lp_coef) = (vec![0], Vec::new(), Vec::new());
-        for row in &entries[..ml] {
-            for (a, ea) in row.iter().enumerate() {
-                for eb in &row[a..] {
-                    d.clear();
-                    base.dsts(ea.slot, eb.slot, &mut d);
-                    for &i in &d {
-                        lp_dst.push(i);
-                        lp_coef.push(ea.v * eb.v);
-                    }
-                }
-            }
-            lp_ptr.push(lp_dst.len());
-        }
-        let cones = blocks
-            .iter()
-            .map(|&(b0, q)| {
-                let mut vars: Vec<Entry> = Vec::new();
-                for r in b0..b0 + q {
-                    for e in &entries[r] {
-                        if !vars.iter().any(|c| c.var == e.var) {
-                            vars.push(*e);
-                        }
-                    }
-                }
-                let nv = vars.len();
-                let mut g = vec![0.0; q * nv];
-                for (a, r) in (b0..b0 + q).enumerate() {
-                    for e in &entries[r] {
-                        let c = vars.iter().position(|c| c.var == e.var).unwrap_or(0);
-                        g[a * nv + c] += e.v;
-                    }
-                }
-                let (mut pair_ptr, mut pair_dst) = (vec![0], Vec::new());
-                for i in 0..nv {
-                    for j in i..nv {
-                        base.dsts(vars[i].slot, vars[j].slot, &mut pair_dst);
-                        pair_ptr.push(pair_dst.len());
-                    }
-                }
-                ConePattern {
-                    nv,
-                    g,
-                    pair_ptr,
-                    pair_dst,
-                }
-            })
-            .collect();
-        let (mut reg_plus, mut reg_minus) = (Vec::new(), Vec::new());
-        for j in 0..p.n {
-            let sl = lay.var_slot(j);
-            base.dsts(sl, sl, &mut reg_plus);
-        }
-        for r in 0..p.eq.len() {
-            let sl = Slot::Band(lay.eq_band[r]);
-            base.dsts(sl, sl, &mut reg_minus);
-        }
-        Assembler {
-            base,
-            lp_ptr,
-            lp_dst,
-            lp_coef,
+            ml,
+            mi: h.len(),
             cones,
-            reg_plus,
-            reg_minus,
+            h,
         }
     }
 
-    /// The KKT matrix `[H + Gᵀ·V·G, Aᵀ; A, 0]` into `unreg`, and regularised (`±δ`) into
-    /// `kkt`: `V` is `d_lp` on the linear rows, `v_cone[b]` (q × q) on cone block b.
+    /// `out = G·x`.
+    pub(super) fn g_mul(&self, x: &[f64], out: &mut [f64]) {
+        let p = self.p;
+        let (nb, k) = (self.nb, self.k);
+        let xe = p.elastic.map_or(0.0, |e| x[nb + e]);
+        let (pairs, rest) = out.split_at_mut(2 * p.pairs());
+        for (q, o) in pairs.chunks_exact_mut(2).enumerate() {
+            let (a, b) = (p.pair_ptr[q] as usize, p.pair_ptr[q + 1] as usize);
+            let ax: f64 = p.pair_val[a..b]
+                .iter()
+                .zip(&p.pair_idx[a..b])
+                .map(|(v, &j)| v * x[j as usize])
+                .sum();
+            let el = p.pair_el[q] * xe;
+            o[0] = ax - el;
+            o[1] = -ax - el;
+        }
+        let xb = &x[nb..];
+        let (ones, cones) = rest.split_at_mut(p.ones());
+        let row = |ptr: &[u32], idx: &[u32], val: &[f64], border: &[f64], r: usize| {
+            let (a, b) = (ptr[r] as usize, ptr[r + 1] as usize);
+            let mut g: f64 = val[a..b]
+                .iter()
+                .zip(&idx[a..b])
+                .map(|(v, &j)| v * x[j as usize])
+                .sum();
+            for (bv, xv) in border[r * k..(r + 1) * k].iter().zip(xb) {
+                g += bv * xv;
+            }
+            g
+        };
+        for (r, o) in ones.iter_mut().enumerate() {
+            *o = row(&p.one_ptr, &p.one_idx, &p.one_val, &p.one_border, r);
+        }
+        for (r, o) in cones.iter_mut().enumerate() {
+            *o = row(&p.crow_ptr, &p.crow_idx, &p.crow_val, &p.crow_border, r);
+        }
+    }
+
+    /// `out += Gᵀ·z`.
+    pub(super) fn gt_mul_add(&self, z: &[f64], out: &mut [f64]) {
+        let p = self.p;
+        let (nb, k) = (self.nb, self.k);
+        let (pairs, rest) = z.split_at(2 * p.pairs());
+        let mut ze = 0.0;
+        for (q, zz) in pairs.chunks_exact(2).enumerate() {
+            let (a, b) = (p.pair_ptr[q] as usize, p.pair_ptr[q + 1] as usize);
+            let zd = zz[0] - zz[1];
+            for (v, &j) in p.pair_val[a..b].iter().zip(&p.pair_idx[a..b]) {
+                out[j as usize] += v * zd;
+            }
+            ze += p.pair_el[q] * (zz[0] + zz[1]);
+        }
+        if let Some(e) = p.elastic {
+            out[nb + e] -= ze;
+        }
+        let (ones, cones) = rest.split_at(p.ones());
+        let mut add_row =
+            |ptr: &[u32], idx: &[u32], val: &[f64], border: &[f64], r: usize, zr: f64| {
+                let (a, b) = (ptr[r] as usize, ptr[r + 1] as usize);
+                for (v, &j) in val[a..b].iter().zip(&idx[a..b]) {
+                    out[j as usize] += v * zr;
+                }
+                for (bi, bv) in border[r * k..(r + 1) * k].iter().enumerate() {
+                    out[nb + bi] += bv * zr;
+                }
+            };
+        for (r, &zr) in ones.iter().enumerate() {
+            add_row(&p.one_ptr, &p.one_idx, &p.one_val, &p.one_border, r, zr);
+        }
+        for (r, &zr) in cones.iter().enumerate() {
+            add_row(&p.crow_ptr, &p.crow_idx, &p.crow_val, &p.crow_border, r, zr);
+        }
+    }
+
+    /// `H` alone as a bordered band matrix of half-bandwidth `w`.
+    pub(super) fn h_matrix(&self, w: usize) -> BorderedBand {
+        let mut m = BorderedBand::new(self.nb, w, self.k);
+        for &(i, j, v) in &self.p.h {
+            m.add_sym(i as usize, j as usize, v);
+        }
+        m
+    }
+
+    /// `unreg = H + Gᵀ·V·G` (`V = d` on the linear slacks, `W⁻¹·W⁻¹` of `scal[c]` on cone
+    /// c), and `kkt = unreg + δ·I`.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn assemble(
         &self,
-        d_lp: &[f64],
-        v_cone: &[Vec<f64>],
+        hmat: &BorderedBand,
+        d: &[f64],
+        scal: &[SocScaling],
+        y: &mut Vec<f64>,
         delta: f64,
-        kkt: &mut BorderedBand,
         unreg: &mut BorderedBand,
-        vg: &mut Vec<f64>,
+        kkt: &mut BorderedBand,
     ) {
-        unreg.copy_from(&self.base);
-        for (r, &d) in d_lp.iter().enumerate() {
-            let (a, b) = (self.lp_ptr[r], self.lp_ptr[r + 1]);
-            for (&i, &c) in self.lp_dst[a..b].iter().zip(&self.lp_coef[a..b]) {
-                unreg.add_flat(i, d * c);
-            }
-        }
-        for (cp, v) in self.cones.iter().zip(v_cone) {
-            let nv = cp.nv;
-            let q = cp.g.len() / nv.max(1);
-            // V·G_c (q × nv), then G_cᵀ·(V·G_c) on the pairs i ≤ j.
-            vg.clear();
-            vg.resize(q * nv, 0.0);
-            for a in 0..q {
-                for b in 0..q {
-                    let vab = v[a * q + b];
-                    if vab == 0.0 {
-                        continue;
-                    }
-                    for j in 0..nv {
-                        vg[a * nv + j] += vab * cp.g[b * nv + j];
-                    }
+        let p = self.p;
+        let (nb, k) = (self.nb, self.k);
+        let w = unreg.w;
+        let wp = w + 1;
+        unreg.copy_from(hmat);
+        let mut corner_e = 0.0;
+        let npairs = p.pairs();
+        for q in 0..npairs {
+            let (a0, a1) = (p.pair_ptr[q] as usize, p.pair_ptr[q + 1] as usize);
+            let (du, dl) = (d[2 * q], d[2 * q + 1]);
+            let dq = du + dl;
+            let idx = &p.pair_idx[a0..a1];
+            let val = &p.pair_val[a0..a1];
+            for (a, (&ia, &va)) in idx.iter().zip(val).enumerate() {
+                let i = ia as usize;
+                let row = &mut unreg.band[i * wp + w - i..i * wp + wp];
+                let s = dq * va;
+                for (&jb, &vb) in idx[..=a].iter().zip(&val[..=a]) {
+                    row[jb as usize] += s * vb;
                 }
             }
-            let mut pair = 0;
-            for i in 0..nv {
-                for j in i..nv {
+            let el = p.pair_el[q];
+            if el != 0.0 {
+                let e = p.elastic.unwrap_or(0);
+                let cross = el * (dl - du);
+                let border = &mut unreg.border[e * nb..(e + 1) * nb];
+                for (&ia, &va) in idx.iter().zip(val) {
+                    border[ia as usize] += cross * va;
+                }
+                corner_e += el * el * dq;
+            }
+        }
+        if let Some(e) = p.elastic {
+            unreg.corner[e * k + e] += corner_e;
+        }
+        for r in 0..p.ones() {
+            let dr = d[2 * npairs + r];
+            let (a0, a1) = (p.one_ptr[r] as usize, p.one_ptr[r + 1] as usize);
+            let idx = &p.one_idx[a0..a1];
+            let val = &p.one_val[a0..a1];
+            let bor = &p.one_border[r * k..(r + 1) * k];
+            for (a, (&ia, &va)) in idx.iter().zip(val).enumerate() {
+                let i = ia as usize;
+                for (&jb, &vb) in idx[..=a].iter().zip(&val[..=a]) {
+                    unreg.band[i * wp + jb as usize + w - i] += dr * va * vb;
+                }
+                for (b, &bv) in bor.iter().enumerate() {
+                    unreg.border[b * nb + i] += dr * bv * va;
+                }
+            }
+            for (b, &bv) in bor.iter().enumerate() {
+                for (c, &cv) in bor.iter().enumerate() {
+                    unreg.corner[b * k + c] += dr * bv * cv;
+                }
+            }
+        }
+        let mut col = [0.0; MAX_CONE];
+        let mut out = [0.0; MAX_CONE];
+        for (c, cr) in self.cones.iter().enumerate() {
+            let (q, nv) = (cr.q, cr.vars.len());
+            let nt = nv + k;
+            // Y = W⁻¹·G (q × nt, by columns), then Gᵀ·V·G = Yᵀ·Y.
+            y.resize(q * nt, 0.0);
+            for j in 0..nt {
+                for a in 0..q {
+                    col[a] = cr.g[a * nt + j];
+                }
+                scal[c].apply_inv(&col[..q], &mut out[..q]);
+                for a in 0..q {
+                    y[a * nt + j] = out[a];
+                }
+            }
+            for i in 0..nt {
+                for j in 0..=i {
                     let mut acc = 0.0;
                     for a in 0..q {
-                        acc += cp.g[a * nv + i] * vg[a * nv + j];
+                        acc += y[a * nt + i] * y[a * nt + j];
                     }
-                    if acc != 0.0 {
-                        for &dst in &cp.pair_dst[cp.pair_ptr[pair]..cp.pair_ptr[pair + 1]] {
-                            unreg.add_flat(dst, acc);
+                    if i < nv {
+                        let (gi, gj) = (cr.vars[i] as usize, cr.vars[j] as usize);
+                        unreg.band[gi * wp + gj + w - gi] += acc;
+                    } else if j < nv {
+                        unreg.border[(i - nv) * nb + cr.vars[j] as usize] += acc;
+                    } else {
+                        let (bi, bj) = (i - nv, j - nv);
+                        unreg.corner[bi * k + bj] += acc;
+                        if bi != bj {
+                            unreg.corner[bj * k + bi] += acc;
                         }
                     }
-                    pair += 1;
                 }
             }
         }
         kkt.copy_from(unreg);
-        for &i in &self.reg_plus {
-            kkt.add_flat(i, delta);
+        for i in 0..nb {
+            kkt.band[i * wp + w] += delta;
         }
-        for &i in &self.reg_minus {
-            kkt.add_flat(i, -delta);
+        for b in 0..k {
+            kkt.corner[b * k + b] += delta;
         }
     }
 }

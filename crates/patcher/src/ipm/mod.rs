@@ -1,35 +1,41 @@
-//! A primal–dual interior-point method for the patcher's convex QPs, exploiting their
-//! structure: every row of the Hermite forms touches the variables of two or three
-//! neighbouring CL points, so with the variables ordered along the path the KKT matrix is
-//! **banded**, apart from a few variables every row may touch (the epigraph `t` of the
+//! A primal–dual interior-point method for the joint patch's convex QPs, exploiting their
+//! structure: every row of the Hermite forms touches the unknowns of two or three
+//! neighbouring CL points, so with the unknowns ordered along the path the KKT matrix is
+//! **banded**, apart from a few unknowns every row may touch (the epigraph `t` of the
 //! largest deviation, the elastic `e`), kept as a dense **border**.
+//!
+//! The module is split the way Clarabel's solver is: [`Problem`] (`problem.rs`: the data,
+//! its builders and equilibration), [`IpmSettings`] (`settings.rs`), the bordered band
+//! `L·D·Lᵀ` and iterative refinement (`band.rs`), the second-order cone's algebra
+//! (`cones.rs`), the KKT system's products and assembly (`kkt.rs`) and the loop
+//! (`solver.rs`).
 //!
 //! # The problem
 //!
 //! ```text
 //! minimise    ½·xᵀ·H·x + cᵀ·x
-//! subject to  A·x = b          (equalities)
-//!             G·x + s = h,  s ∈ K = ℝ₊^m × Q^{q_1} × … × Q^{q_p}
+//! subject to  G·x + s = h,  s ∈ K = ℝ₊^m × Q^{q_1} × … × Q^{q_p}
 //! ```
 //!
 //! with H positive semidefinite and `Q^q = {(s_0, s_1) : s_0 ≥ ‖s_1‖}` second-order cones
-//! (the minimax of orientation changes: `‖r_i‖ ≤ t`). Each variable has a position along the path
-//! ([`Banded::position`]; `None` for a border variable).
+//! (the minimax of orientation changes: `‖r_i‖ ≤ t`). The linear rows come mostly as
+//! **pairs** `lo ≤ a·x ≤ hi` (the limit rows `|f| ≤ b` and the trust region): one band row
+//! for both sides, so each pair costs one row in every product and in the assembly. There
+//! are no equalities: the joint patch eliminates its own (`crate::hermite`'s reduced
+//! form), so the KKT matrix is positive definite and its band about half as wide.
 //!
 //! # The method (Mehrotra's predictor–corrector with Nesterov–Todd scaling)
 //!
 //! As in CVXOPT's `coneqp` (Vandenberghe, "The CVXOPT linear and quadratic cone program
-//! solvers", 2010). With slacks `s ∈ K`, multipliers `y`, `z ∈ K`, residuals
-//! `r_d = H·x + c + Aᵀ·y + Gᵀ·z`, `r_p = A·x − b`, `r_g = G·x + s − h`, `μ = sᵀz/ν` (ν: one
-//! per linear row and per cone), and the scaling `W` with `W·z = W⁻ᵀ·s = λ` (diagonal
-//! `√(s/z)` on the linear rows, the Nesterov–Todd matrix on a cone), each iteration solves
-//! the Newton system twice with one factorisation, eliminating `ds` and `dz`
-//! (`V = W⁻¹·W⁻ᵀ`, `u = λ \ (−r_c)` in the cone's Jordan algebra, `w = V·r_g + W⁻¹·u`):
+//! solvers", 2010). With slacks `s ∈ K`, multipliers `z ∈ K`, residuals
+//! `r_d = H·x + c + Gᵀ·z`, `r_g = G·x + s − h`, `μ = sᵀz/ν` (ν: one per linear row and per
+//! cone), and the scaling `W` with `W·z = W⁻ᵀ·s = λ` (diagonal `√(s/z)` on the linear rows,
+//! the Nesterov–Todd matrix on a cone), each iteration solves the Newton system twice with
+//! one factorisation, eliminating `ds` and `dz` (`V = W⁻¹·W⁻ᵀ`, `u = λ \ (−r_c)` in the
+//! cone's Jordan algebra, `w = V·r_g + W⁻¹·u`):
 //!
 //! ```text
-//! [ H + Gᵀ·V·G   Aᵀ ] [dx]   [ −r_d − Gᵀ·w ]
-//! [ A             0 ] [dy] = [ −r_p         ]
-//! dz = V·G·dx + w,    ds = −r_g − G·dx
+//! (H + Gᵀ·V·G)·dx = −r_d − Gᵀ·w,     dz = V·G·dx + w,    ds = −r_g − G·dx
 //! ```
 //!
 //! first with `r_c = λ∘λ` (the affine step), then with
@@ -38,30 +44,25 @@
 //!
 //! # The linear algebra
 //!
-//! The unknowns `(x, y)` are ordered by position (each equality's multiplier right after
-//! the last variable it touches), which makes the matrix above banded of half-bandwidth
-//! `w` (about ten for the joint patch), plus `k` border rows and columns. It is regularised
-//! (`+δ` on the variables, `−δ` on the multipliers: quasi-definite, so `L·D·Lᵀ` exists in any
-//! order without pivoting), factored as a banded `L·D·Lᵀ` in `O(n·w²)` with the border by
-//! its Schur complement, and every solve is refined against the unregularised matrix
-//! ([`IpmSettings::refinement_steps`]). An iteration costs `O(n·w² + nnz(G)·r)` for `r` the
-//! largest row length: linear in the number of CL points, where a general sparse solver
-//! pays for its ordering and symbolic analysis on every call.
-
-// Index loops mirror the factorisation's formulas (rows, columns, band offsets).
-#![allow(clippy::needless_range_loop)]
+//! The caller orders the band unknowns along the path (the joint patch interleaves the two
+//! axes' coefficients), which makes `H + Gᵀ·V·G` banded of half-bandwidth `w` (six for
+//! the joint patch), plus `k` border rows and columns. It is regularised (`+δ` on the
+//! diagonal), factored as a banded `L·D·Lᵀ` in `O(n·w²)` with the border by its Schur
+//! complement, and every solve is refined against the unregularised matrix
+//! ([`IpmSettings::refinement_steps`]). An iteration costs `O(n·w² + nnz(G))`: linear in
+//! the number of CL points, where a general sparse solver pays for its ordering and
+//! symbolic analysis on every call.
 
 mod band;
 mod cones;
 mod kkt;
+mod problem;
 mod settings;
 mod solver;
 
 pub use cones::MAX_CONE;
+pub use problem::Problem;
 pub use settings::IpmSettings;
-
-/// A sparse linear form: `Σ coeff · x[var]` over `(var, coeff)`.
-pub type Row = Vec<(usize, f64)>;
 
 /// How a solve ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -77,65 +78,12 @@ pub enum IpmStatus {
 /// A solve's result.
 #[derive(Debug, Clone, PartialEq)]
 pub struct IpmSolution {
-    /// The primal solution.
+    /// The primal solution (every unknown, band then border).
     pub x: Vec<f64>,
     /// Status.
     pub status: IpmStatus,
     /// Iterations made.
     pub iterations: u32,
-}
-
-/// A QP with variables placed along the path (module docs).
-#[derive(Debug, Clone, Default)]
-pub struct Banded {
-    n: usize,
-    /// Position of each variable along the path; `None`: a border variable.
-    pub position: Vec<Option<f64>>,
-    /// Upper-or-lower triangle entries of H (`(i, j, v)`, each pair once; `i == j` on the
-    /// diagonal).
-    pub h: Vec<(usize, usize, f64)>,
-    /// Linear objective.
-    pub c: Vec<f64>,
-    /// Equality rows `row·x = rhs`.
-    pub eq: Vec<(Row, f64)>,
-    /// Inequality rows `row·x ≤ rhs`.
-    pub le: Vec<(Row, f64)>,
-    /// Second-order cones: each block of rows `(row_k, rhs_k)` says
-    /// `‖(rhs_k − row_k·x)_{k≥1}‖₂ ≤ rhs_0 − row_0·x` (at most [`MAX_CONE`] rows).
-    pub soc: Vec<Vec<(Row, f64)>>,
-}
-
-impl Banded {
-    /// An empty problem in `n` variables, all in the band at position 0.
-    pub fn new(n: usize) -> Banded {
-        Banded {
-            n,
-            position: vec![Some(0.0); n],
-            h: Vec::new(),
-            c: vec![0.0; n],
-            eq: Vec::new(),
-            le: Vec::new(),
-            soc: Vec::new(),
-        }
-    }
-
-    /// Number of variables.
-    pub fn vars(&self) -> usize {
-        self.n
-    }
-
-    pub(super) fn h_mul(&self, x: &[f64], out: &mut [f64]) {
-        for &(i, j, v) in &self.h {
-            out[i] += v * x[j];
-            if i != j {
-                out[j] += v * x[i];
-            }
-        }
-    }
-}
-
-pub(super) fn dot(row: &Row, x: &[f64]) -> f64 {
-    row.iter().map(|&(j, v)| v * x[j]).sum()
 }
 
 pub(super) fn inf_norm(v: &[f64]) -> f64 {

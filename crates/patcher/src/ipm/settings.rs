@@ -1,6 +1,6 @@
 //! The interior-point method's settings (Clarabel's `DefaultSettings` manner).
 
-/// Settings of [`super::Banded::solve`]. Plain struct: public fields, documented defaults.
+/// Settings of [`super::Problem::solve`]. Plain struct: public fields, documented defaults.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IpmSettings {
     /// Most iterations. Default 60.

@@ -4,153 +4,66 @@
 // Index loops mirror the method's formulas (rows, cones).
 #![allow(clippy::needless_range_loop)]
 
-use super::band::{BorderedBand, Slot, refine};
+use super::band::{BorderedBand, refine};
 use super::cones::{MAX_CONE, SocScaling, soc_div, soc_prod, soc_scaling, soc_step};
-use super::kkt::{Assembler, Entry, Layout};
-use super::{Banded, IpmSettings, IpmSolution, IpmStatus, Row, dot, inf_norm};
+use super::kkt::Kkt;
+use super::problem::Problem;
+use super::{IpmSettings, IpmSolution, IpmStatus, inf_norm};
 
-impl Banded {
-    /// Solve from the primal point `x0` (any point; feasibility is not required).
-    ///
-    /// The problem is equilibrated first: every row (every cone's rows together) divided
-    /// by its largest coefficient, the objective by its largest one. Neither changes the
-    /// solution, and the tolerances then mean the same on every row.
-    pub fn solve(&self, x0: &[f64], st: &IpmSettings) -> IpmSolution {
-        let scale_row = |(row, rhs): &(Row, f64)| -> (Row, f64) {
-            let m = row.iter().fold(0.0f64, |m, e| m.max(e.1.abs()));
-            if m > 0.0 && m.is_finite() {
-                (row.iter().map(|&(j, v)| (j, v / m)).collect(), rhs / m)
-            } else {
-                (row.clone(), *rhs)
-            }
-        };
-        let obj = self
-            .c
-            .iter()
-            .map(|v| v.abs())
-            .chain(self.h.iter().map(|e| e.2.abs()))
-            .fold(0.0f64, f64::max);
-        let obj = if obj > 0.0 && obj.is_finite() {
-            obj
-        } else {
-            1.0
-        };
-        let scaled = Banded {
-            n: self.n,
-            position: self.position.clone(),
-            h: self.h.iter().map(|&(i, j, v)| (i, j, v / obj)).collect(),
-            c: self.c.iter().map(|v| v / obj).collect(),
-            eq: self.eq.iter().map(scale_row).collect(),
-            le: self.le.iter().map(scale_row).collect(),
-            soc: self
-                .soc
-                .iter()
-                .map(|cone| {
-                    let m = cone
-                        .iter()
-                        .flat_map(|(row, _)| row.iter())
-                        .fold(0.0f64, |m, e| m.max(e.1.abs()));
-                    let m = if m > 0.0 && m.is_finite() { m } else { 1.0 };
-                    cone.iter()
-                        .map(|(row, rhs)| (row.iter().map(|&(j, v)| (j, v / m)).collect(), rhs / m))
-                        .collect()
-                })
-                .collect(),
-        };
-        scaled.solve_scaled(x0, st)
+impl Problem {
+    /// Solve (module docs of [`super`]): Mehrotra's predictor–corrector with
+    /// Nesterov–Todd scaling from CVXOPT's start, on the equilibrated problem.
+    pub fn solve(&self, st: &IpmSettings) -> IpmSolution {
+        self.equilibrated().solve_scaled(st)
     }
 
-    fn solve_scaled(&self, x0: &[f64], st: &IpmSettings) -> IpmSolution {
-        assert!(
-            self.soc.iter().all(|c| (2..=MAX_CONE).contains(&c.len())),
-            "second-order cones have 2 to {MAX_CONE} rows"
-        );
-        let n = self.n;
-        let me = self.eq.len();
-        let ml = self.le.len();
-        // Every cone row after the linear rows: rows[ml..], blocks of `soc` sizes.
-        let rows: Vec<&(Row, f64)> = self.le.iter().chain(self.soc.iter().flatten()).collect();
-        let mi = rows.len();
-        let mut blocks: Vec<(usize, usize)> = Vec::with_capacity(self.soc.len());
-        let mut at = ml;
-        for cone in &self.soc {
-            blocks.push((at, cone.len()));
-            at += cone.len();
-        }
-        let degree = (ml + blocks.len()).max(1) as f64;
-        let lay = Layout::new(self);
-        let nk = lay.nb + lay.k;
-        let slot_index = |sl: Slot| match sl {
-            Slot::Band(i) => i,
-            Slot::Border(r) => lay.nb + r,
-        };
-        let entries: Vec<Vec<Entry>> = rows
-            .iter()
-            .map(|(row, _)| {
-                row.iter()
-                    .map(|&(j, v)| Entry {
-                        var: j,
-                        slot: lay.var_slot(j),
-                        v,
-                    })
-                    .collect()
-            })
-            .collect();
-        let x_at: Vec<usize> = (0..n).map(|j| slot_index(lay.var_slot(j))).collect();
-        let mut kkt = BorderedBand::new(lay.nb, lay.w, lay.k);
-        let mut unreg = BorderedBand::new(lay.nb, lay.w, lay.k);
+    fn solve_scaled(&self, st: &IpmSettings) -> IpmSolution {
+        let sys = Kkt::new(self);
+        let (nb, k) = (self.nb, self.k);
+        let n = nb + k;
+        let (ml, mi) = (sys.ml, sys.mi);
+        let hv = &sys.h;
+        let degree = (ml + sys.cones.len()).max(1) as f64;
+        let w = self.half_bandwidth();
+        let hmat = sys.h_matrix(w);
+        let mut unreg = BorderedBand::new(nb, w, k);
+        let mut kkt = BorderedBand::new(nb, w, k);
         let delta = st.regularisation;
-        let asm = Assembler::new(self, &lay, &entries, &blocks);
-        // The rows of G flat (compressed rows), for the products with G and Gᵀ.
-        let mut ent_ptr: Vec<usize> = Vec::with_capacity(mi + 1);
-        let (mut ent_var, mut ent_v): (Vec<u32>, Vec<f64>) = (Vec::new(), Vec::new());
-        ent_ptr.push(0);
-        for row in &entries {
-            for e in row {
-                ent_var.push(e.var as u32);
-                ent_v.push(e.v);
-            }
-            ent_ptr.push(ent_var.len());
-        }
-        let mut gtw = vec![0.0; n];
-        let mut vg: Vec<f64> = Vec::new();
-        let mut d_lp = vec![1.0; ml];
+        let blocks: Vec<(usize, usize)> = sys.cones.iter().map(|c| (c.b0, c.q)).collect();
+        let mut d = vec![1.0; ml];
         let mut d_sqrt = vec![1.0; ml];
-        let mut v_cone: Vec<Vec<f64>> = blocks
-            .iter()
-            .map(|&(_, q)| {
-                (0..q * q)
-                    .map(|i| f64::from(u8::from(i % (q + 1) == 0)))
-                    .collect()
-            })
-            .collect();
-        let (mut rhs, mut sol, mut tmp) = (vec![0.0; nk], vec![0.0; nk], vec![0.0; nk]);
-        // Start (CVXOPT's): x̂ minimising ½xᵀHx + cᵀx + ½‖G·x − h‖² with A·x = b, then
-        // ŝ = h − G·x̂ and ẑ = −ŝ, each moved into the cones' interiors.
-        asm.assemble(&d_lp, &v_cone, delta, &mut kkt, &mut unreg, &mut vg);
-        let mut x = x0.to_vec();
+        let ident = SocScaling {
+            eta: 1.0,
+            wbar: {
+                let mut e = [0.0; MAX_CONE];
+                e[0] = 1.0;
+                e
+            },
+        };
+        let mut scal: Vec<SocScaling> = vec![ident; blocks.len()];
+        let mut yscratch: Vec<f64> = Vec::new();
+        let (mut rhs, mut sol, mut tmp) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        // Start (CVXOPT's): x̂ minimising ½xᵀHx + cᵀx + ½‖G·x − h‖², then ŝ = h − G·x̂ and
+        // ẑ = −ŝ, each moved into the cones' interiors.
+        sys.assemble(&hmat, &d, &scal, &mut yscratch, delta, &mut unreg, &mut kkt);
+        let mut x = vec![0.0; n];
         if kkt.factor() {
             for j in 0..n {
-                rhs[x_at[j]] = -self.c[j];
+                rhs[j] = -self.c[j];
             }
-            for (r, (_, h)) in rows.iter().enumerate() {
-                for e in &entries[r] {
-                    rhs[x_at[e.var]] += e.v * h;
-                }
-            }
-            for (r, (_, b)) in self.eq.iter().enumerate() {
-                rhs[lay.eq_band[r]] = *b;
-            }
+            sys.gt_mul_add(hv, &mut rhs);
             sol.copy_from_slice(&rhs);
             kkt.solve(&mut sol);
             refine(&kkt, &unreg, &rhs, &mut sol, &mut tmp, st.refinement_steps);
             if sol.iter().all(|v| v.is_finite()) {
-                x = (0..n).map(|j| sol[x_at[j]]).collect();
+                x.copy_from_slice(&sol);
             }
         }
-        let _ = x0;
-        let mut y = vec![0.0; me];
-        let mut s: Vec<f64> = rows.iter().map(|(row, rhs)| rhs - dot(row, &x)).collect();
+        let mut s = vec![0.0; mi];
+        sys.g_mul(&x, &mut s);
+        for r in 0..mi {
+            s[r] = hv[r] - s[r];
+        }
         let mut z: Vec<f64> = s.iter().map(|v| -v).collect();
         // Shift into the interior: by 1 + the distance outside (the largest violation).
         let outside = |v: &[f64]| -> f64 {
@@ -176,13 +89,9 @@ impl Banded {
                 }
             }
         }
-        let scale_b = 1.0 + self.eq.iter().fold(0.0f64, |m, e| m.max(e.1.abs()));
-        let scale_h = 1.0 + rows.iter().fold(0.0f64, |m, e| m.max(e.1.abs()));
+        let scale_h = 1.0 + inf_norm(hv);
         let scale_c = 1.0 + inf_norm(&self.c);
-        let (mut rd, mut rp, mut rg, mut hx) =
-            (vec![0.0; n], vec![0.0; me], vec![0.0; mi], vec![0.0; n]);
-        // Per-row scaling data: LP rows `V = z/s`, `W⁻¹ = sqrt(z/s)`; cones their matrices.
-        let mut scal: Vec<SocScaling> = Vec::with_capacity(blocks.len());
+        let (mut rd, mut rg, mut hx) = (vec![0.0; n], vec![0.0; mi], vec![0.0; n]);
         let mut lam = vec![0.0; mi];
         let (mut u, mut w_r, mut dz, mut ds, mut gdx) = (
             vec![0.0; mi],
@@ -192,32 +101,19 @@ impl Banded {
             vec![0.0; mi],
         );
         let (mut dz_a, mut ds_a, mut rc) = (vec![0.0; mi], vec![0.0; mi], vec![0.0; mi]);
-        let mut dxy: Vec<f64> = Vec::with_capacity(n + me);
+        let mut dx = vec![0.0; n];
         for it in 0..st.max_iter {
             // Residuals.
             rd.copy_from_slice(&self.c);
             hx.iter_mut().for_each(|v| *v = 0.0);
-            self.h_mul(&x, &mut hx);
+            hmat.mul(&x, &mut hx);
             for j in 0..n {
                 rd[j] += hx[j];
             }
-            for (r, (row, _)) in self.eq.iter().enumerate() {
-                for &(j, v) in row {
-                    rd[j] += v * y[r];
-                }
-            }
+            sys.gt_mul_add(&z, &mut rd);
+            sys.g_mul(&x, &mut rg);
             for r in 0..mi {
-                let mut g = 0.0;
-                let zr = z[r];
-                for k in ent_ptr[r]..ent_ptr[r + 1] {
-                    let (j, v) = (ent_var[k] as usize, ent_v[k]);
-                    g += v * x[j];
-                    rd[j] += v * zr;
-                }
-                rg[r] = g + s[r] - rows[r].1;
-            }
-            for (r, (row, rhs_r)) in self.eq.iter().enumerate() {
-                rp[r] = dot(row, &x) - rhs_r;
+                rg[r] += s[r] - hv[r];
             }
             let mu = s.iter().zip(&z).map(|(a, b)| a * b).sum::<f64>() / degree;
             let obj = 0.5 * hx.iter().zip(&x).map(|(a, b)| a * b).sum::<f64>()
@@ -229,8 +125,7 @@ impl Banded {
                     iterations: it,
                 };
             }
-            if inf_norm(&rp) <= st.tol_feas * scale_b
-                && inf_norm(&rg) <= st.tol_feas * scale_h
+            if inf_norm(&rg) <= st.tol_feas * scale_h
                 && inf_norm(&rd) <= st.tol_feas * scale_c
                 && mu <= st.tol_gap * (1.0 + obj.abs())
             {
@@ -240,32 +135,16 @@ impl Banded {
                     iterations: it,
                 };
             }
-            // Scalings.
+            // Scalings: linear slacks `V = z/s`, `W⁻¹ = sqrt(z/s)`; cones their `W`.
             for r in 0..ml {
                 lam[r] = (s[r] * z[r]).sqrt();
+                d[r] = z[r] / s[r];
+                d_sqrt[r] = d[r].sqrt();
             }
-            scal.clear();
-            for &(b0, q) in &blocks {
-                let sc = soc_scaling(&s[b0..b0 + q], &z[b0..b0 + q]);
-                lam[b0..b0 + q].copy_from_slice(&sc.lambda[..q]);
-                scal.push(sc);
+            for (bi, &(b0, q)) in blocks.iter().enumerate() {
+                scal[bi] = soc_scaling(&s[b0..b0 + q], &z[b0..b0 + q], &mut lam[b0..b0 + q]);
             }
-            // The matrix: H + Gᵀ·V·G on the variables, A and Aᵀ, regularised.
-            for r in 0..ml {
-                d_lp[r] = z[r] / s[r];
-                d_sqrt[r] = d_lp[r].sqrt();
-            }
-            for (bi, &(_, q)) in blocks.iter().enumerate() {
-                // V = W⁻¹·W⁻¹ (symmetric).
-                let wi = &scal[bi].winv;
-                let v = &mut v_cone[bi];
-                for a in 0..q {
-                    for b in 0..q {
-                        v[a * q + b] = (0..q).map(|m| wi[a * q + m] * wi[m * q + b]).sum();
-                    }
-                }
-            }
-            asm.assemble(&d_lp, &v_cone, delta, &mut kkt, &mut unreg, &mut vg);
+            sys.assemble(&hmat, &d, &scal, &mut yscratch, delta, &mut unreg, &mut kkt);
             if !kkt.factor() {
                 return IpmSolution {
                     x,
@@ -274,67 +153,49 @@ impl Banded {
                 };
             }
             // One Newton solve for the complementarity residual `rc` (module docs, with
-            // u = λ \ (−r_c), w = V·r_g + W⁻¹·u): the steps dx, dy, dz, ds.
-            let mut newton = |rc: &[f64], dz: &mut [f64], ds: &mut [f64], dxy: &mut Vec<f64>| {
+            // u = λ \ (−r_c), w = V·r_g + W⁻¹·u): the steps dx, dz, ds.
+            let mut newton = |rc: &[f64], dz: &mut [f64], ds: &mut [f64], dx: &mut [f64]| {
                 for r in 0..ml {
                     u[r] = -rc[r] / lam[r];
                     // V·r_g + W⁻¹·u with V = z/s, W⁻¹ = sqrt(z/s).
-                    w_r[r] = d_lp[r] * rg[r] + d_sqrt[r] * u[r];
+                    w_r[r] = d[r] * rg[r] + d_sqrt[r] * u[r];
                 }
                 for (bi, &(b0, q)) in blocks.iter().enumerate() {
                     let mut neg = [0.0; MAX_CONE];
-                    for (d, v) in neg.iter_mut().zip(&rc[b0..b0 + q]) {
-                        *d = -v;
+                    for (dd, v) in neg.iter_mut().zip(&rc[b0..b0 + q]) {
+                        *dd = -v;
                     }
                     soc_div(&lam[b0..b0 + q], &neg[..q], &mut u[b0..b0 + q]);
-                    let wi = &scal[bi].winv;
                     // W⁻¹·(W⁻¹·r_g + u).
                     let mut t = [0.0; MAX_CONE];
+                    scal[bi].apply_inv(&rg[b0..b0 + q], &mut t[..q]);
                     for a in 0..q {
-                        t[a] = (0..q).map(|m| wi[a * q + m] * rg[b0 + m]).sum::<f64>() + u[b0 + a];
+                        t[a] += u[b0 + a];
                     }
-                    for a in 0..q {
-                        w_r[b0 + a] = (0..q).map(|m| wi[a * q + m] * t[m]).sum();
-                    }
+                    scal[bi].apply_inv(&t[..q], &mut w_r[b0..b0 + q]);
                 }
-                rhs.iter_mut().for_each(|v| *v = 0.0);
-                gtw.iter_mut().for_each(|v| *v = 0.0);
-                for r in 0..mi {
-                    let wr = w_r[r];
-                    for k in ent_ptr[r]..ent_ptr[r + 1] {
-                        gtw[ent_var[k] as usize] += ent_v[k] * wr;
-                    }
-                }
-                for j in 0..n {
-                    rhs[x_at[j]] = -rd[j] - gtw[j];
-                }
-                for r in 0..me {
-                    rhs[lay.eq_band[r]] = -rp[r];
+                rhs.copy_from_slice(&rd);
+                sys.gt_mul_add(&w_r, &mut rhs);
+                for v in rhs.iter_mut() {
+                    *v = -*v;
                 }
                 sol.copy_from_slice(&rhs);
                 kkt.solve(&mut sol);
                 refine(&kkt, &unreg, &rhs, &mut sol, &mut tmp, st.refinement_steps);
-                dxy.clear();
-                dxy.extend((0..n).map(|j| sol[x_at[j]]));
-                dxy.extend((0..me).map(|r| sol[lay.eq_band[r]]));
+                dx.copy_from_slice(&sol);
+                sys.g_mul(dx, &mut gdx);
                 for r in 0..mi {
-                    gdx[r] = (ent_ptr[r]..ent_ptr[r + 1])
-                        .map(|k| ent_v[k] * dxy[ent_var[k] as usize])
-                        .sum();
                     ds[r] = -rg[r] - gdx[r];
                 }
                 for r in 0..ml {
-                    dz[r] = d_lp[r] * gdx[r] + w_r[r];
+                    dz[r] = d[r] * gdx[r] + w_r[r];
                 }
                 for (bi, &(b0, q)) in blocks.iter().enumerate() {
-                    let wi = &scal[bi].winv;
-                    let mut t = [0.0; MAX_CONE];
+                    let (mut t, mut t2) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
+                    scal[bi].apply_inv(&gdx[b0..b0 + q], &mut t[..q]);
+                    scal[bi].apply_inv(&t[..q], &mut t2[..q]);
                     for a in 0..q {
-                        t[a] = (0..q).map(|m| wi[a * q + m] * gdx[b0 + m]).sum();
-                    }
-                    for a in 0..q {
-                        dz[b0 + a] =
-                            (0..q).map(|m| wi[a * q + m] * t[m]).sum::<f64>() + w_r[b0 + a];
+                        dz[b0 + a] = t2[a] + w_r[b0 + a];
                     }
                 }
             };
@@ -359,7 +220,7 @@ impl Banded {
                 l[..q].copy_from_slice(&lam[b0..b0 + q]);
                 soc_prod(&l[..q], &l[..q], &mut rc[b0..b0 + q]);
             }
-            newton(&rc, &mut dz_a, &mut ds_a, &mut dxy);
+            newton(&rc, &mut dz_a, &mut ds_a, &mut dx);
             let a_aff = max_step(&s, &ds_a).min(max_step(&z, &dz_a)).min(1.0);
             let mu_aff = (0..mi)
                 .map(|r| (s[r] + a_aff * ds_a[r]) * (z[r] + a_aff * dz_a[r]))
@@ -375,12 +236,9 @@ impl Banded {
                 rc[r] = lam[r] * lam[r] + ds_a[r] * dz_a[r] - sigma * mu;
             }
             for (bi, &(b0, q)) in blocks.iter().enumerate() {
-                let (w, wi) = (&scal[bi].w, &scal[bi].winv);
                 let (mut sd, mut zd) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
-                for a in 0..q {
-                    sd[a] = (0..q).map(|m| wi[a * q + m] * ds_a[b0 + m]).sum();
-                    zd[a] = (0..q).map(|m| w[a * q + m] * dz_a[b0 + m]).sum();
-                }
+                scal[bi].apply_inv(&ds_a[b0..b0 + q], &mut sd[..q]);
+                scal[bi].apply(&dz_a[b0..b0 + q], &mut zd[..q]);
                 let mut l = [0.0; MAX_CONE];
                 l[..q].copy_from_slice(&lam[b0..b0 + q]);
                 let (mut ll, mut sz) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
@@ -391,9 +249,9 @@ impl Banded {
                 }
                 rc[b0] -= sigma * mu;
             }
-            newton(&rc, &mut dz, &mut ds, &mut dxy);
+            newton(&rc, &mut dz, &mut ds, &mut dx);
             let alpha = (st.step_fraction * max_step(&s, &ds).min(max_step(&z, &dz))).min(1.0);
-            if !(alpha.is_finite() && dxy.iter().all(|v| v.is_finite())) {
+            if !(alpha.is_finite() && dx.iter().all(|v| v.is_finite())) {
                 return IpmSolution {
                     x,
                     status: IpmStatus::NumericalError,
@@ -401,10 +259,7 @@ impl Banded {
                 };
             }
             for j in 0..n {
-                x[j] += alpha * dxy[j];
-            }
-            for r in 0..me {
-                y[r] += alpha * dxy[n + r];
+                x[j] += alpha * dx[j];
             }
             for r in 0..mi {
                 s[r] += alpha * ds[r];
@@ -427,16 +282,15 @@ impl Banded {
 mod tests {
     use super::*;
 
-    /// minimise (x0 − 1)² + (x1 − 2)² s.t. x0 + x1 = 1, x1 ≤ 0.5 → (0.5, 0.5).
+    /// minimise (x0 − 1)² + (x1 − 2)² s.t. 0 ≤ x0 + x1 ≤ 1, x1 ≤ 0.5 → (0.5, 0.5).
     #[test]
-    fn planted_qp_with_equality_and_bound() {
-        let mut p = Banded::new(2);
-        p.position = vec![Some(0.0), Some(1.0)];
-        p.h = vec![(0, 0, 2.0), (1, 1, 2.0)];
-        p.c = vec![-2.0, -4.0];
-        p.eq.push((vec![(0, 1.0), (1, 1.0)], 1.0));
-        p.le.push((vec![(1, 1.0)], 0.5));
-        let r = p.solve(&[0.0, 0.0], &IpmSettings::default());
+    fn planted_qp_with_a_pair_and_a_bound() {
+        let mut p = Problem::new(2, 0);
+        p.add_square(&[(0, 1.0)], 1.0, 1.0);
+        p.add_square(&[(1, 1.0)], 1.0, 2.0);
+        p.add_pair(&[(0, 1.0), (1, 1.0)], 0.0, 1.0, None);
+        p.add_le(&[(1, 1.0)], 0.5);
+        let r = p.solve(&IpmSettings::default());
         assert_eq!(r.status, IpmStatus::Solved);
         assert!(
             (r.x[0] - 0.5).abs() < 1e-7 && (r.x[1] - 0.5).abs() < 1e-7,
@@ -444,55 +298,58 @@ mod tests {
         );
     }
 
-    /// A planted minimax with a border variable: minimise t s.t. |x_i − a_i| ≤ t and a
-    /// chain of equalities x_{i+1} − x_i = 1 along the band: the answer is the half range
-    /// of a_i − i.
+    /// A planted minimax with a border unknown: minimise t s.t. |x_i − a_i| ≤ t, with a
+    /// chain `|x_{i+1} − x_i − 1| ≤ 0.25` along the band: without the chain the answer
+    /// would be 0; with it, x_i = x_0 + i ± … and the answer is checked against a
+    /// brute-force search of the same LP's optimum by bisection on t with a feasibility
+    /// sweep (interval propagation along the chain, exact for this structure).
     #[test]
     fn planted_minimax_with_a_border() {
         let n = 40;
-        let a: Vec<f64> = (0..n).map(|i| i as f64 + (i as f64 * 0.7).sin()).collect();
-        let mut p = Banded::new(n + 1);
-        for i in 0..n {
-            p.position[i] = Some(i as f64);
-        }
-        p.position[n] = None;
-        p.c[n] = 1.0;
+        let a: Vec<f64> = (0..n)
+            .map(|i| i as f64 + 2.0 * (i as f64 * 0.7).sin())
+            .collect();
+        let mut p = Problem::new(n, 1);
+        p.add_linear(n, 1.0);
         for i in 0..n - 1 {
-            p.eq.push((vec![(i + 1, 1.0), (i, -1.0)], 1.0));
+            p.add_pair(&[(i + 1, 1.0), (i, -1.0)], 0.75, 1.25, None);
         }
         for (i, ai) in a.iter().enumerate() {
-            p.le.push((vec![(i, 1.0), (n, -1.0)], *ai));
-            p.le.push((vec![(i, -1.0), (n, -1.0)], -ai));
+            p.add_le(&[(i, 1.0), (n, -1.0)], *ai);
+            p.add_le(&[(i, -1.0), (n, -1.0)], -ai);
         }
-        let r = p.solve(&vec![0.0; n + 1], &IpmSettings::default());
+        let r = p.solve(&IpmSettings::default());
         assert_eq!(r.status, IpmStatus::Solved);
-        let d: Vec<f64> = a.iter().enumerate().map(|(i, v)| v - i as f64).collect();
-        let (lo, hi) = d
-            .iter()
-            .fold((f64::MAX, f64::MIN), |m, v| (m.0.min(*v), m.1.max(*v)));
-        assert!(
-            (r.x[n] - 0.5 * (hi - lo)).abs() < 1e-6,
-            "{} vs {}",
-            r.x[n],
-            0.5 * (hi - lo)
-        );
+        // Feasible for t: intervals [a_i − t, a_i + t] propagated along the chain.
+        let feasible = |t: f64| {
+            let (mut lo, mut hi) = (a[0] - t, a[0] + t);
+            for ai in &a[1..] {
+                lo = (lo + 0.75).max(ai - t);
+                hi = (hi + 1.25).min(ai + t);
+                if lo > hi {
+                    return false;
+                }
+            }
+            true
+        };
+        let (mut lo, mut hi) = (0.0, 10.0);
+        for _ in 0..60 {
+            let m = 0.5 * (lo + hi);
+            if feasible(m) { hi = m } else { lo = m }
+        }
+        assert!((r.x[n] - hi).abs() < 1e-6, "{} vs {hi}", r.x[n]);
         assert!(r.iterations < 40, "{}", r.iterations);
     }
 
-    /// Planted SOCP: minimise t s.t. ‖(x0 − 3, x1 − 4)‖ ≤ t, x0 + x1 = 0 → the distance
-    /// from (3, 4) to the line x0 + x1 = 0 is 7/√2, at (−0.5, 0.5).
+    /// Planted SOCP: minimise t s.t. ‖(x0 − 3, x1 − 4)‖ ≤ t, −1e-9 ≤ x0 + x1 ≤ 1e-9 → the
+    /// distance from (3, 4) to the line x0 + x1 = 0 is 7/√2, at (−0.5, 0.5).
     #[test]
     fn planted_second_order_cone() {
-        let mut p = Banded::new(3);
-        p.position = vec![Some(0.0), Some(0.0), None];
-        p.c[2] = 1.0;
-        p.eq.push((vec![(0, 1.0), (1, 1.0)], 0.0));
-        p.soc.push(vec![
-            (vec![(2, -1.0)], 0.0),
-            (vec![(0, 1.0)], 3.0),
-            (vec![(1, 1.0)], 4.0),
-        ]);
-        let r = p.solve(&[0.0; 3], &IpmSettings::default());
+        let mut p = Problem::new(2, 1);
+        p.add_linear(2, 1.0);
+        p.add_pair(&[(0, 1.0), (1, 1.0)], -1e-9, 1e-9, None);
+        p.add_soc(&[(&[(2, -1.0)], 0.0), (&[(0, 1.0)], 3.0), (&[(1, 1.0)], 4.0)]);
+        let r = p.solve(&IpmSettings::default());
         assert_eq!(r.status, IpmStatus::Solved);
         assert!((r.x[2] - 7.0 / 2f64.sqrt()).abs() < 1e-6, "{r:?}");
         assert!(
@@ -502,9 +359,9 @@ mod tests {
     }
 
     /// A planted minimax of distances in the plane along a band (Weber-like): the point
-    /// chain x_{i+1} − x_i = (1, 0) that comes closest, in the largest Euclidean distance,
-    /// to scattered targets: the answer is the smallest enclosing circle of the targets
-    /// shifted back by i — checked against a brute-force grid search.
+    /// chain (x_i, y_i) = (x0 + i, y0) that comes closest, in the largest Euclidean
+    /// distance, to scattered targets — written with the chain's steps as nearly tight
+    /// pairs (±1e-9) along the band — checked against a brute-force grid search.
     #[test]
     fn planted_chain_minimax_of_distances() {
         let n = 12;
@@ -514,26 +371,26 @@ mod tests {
                 [t + (t * 1.3).sin(), (t * 0.7).cos()]
             })
             .collect();
-        // Variables: (x_i, y_i) interleaved, then t.
-        let mut p = Banded::new(2 * n + 1);
-        for i in 0..n {
-            p.position[2 * i] = Some(i as f64);
-            p.position[2 * i + 1] = Some(i as f64);
-        }
-        p.position[2 * n] = None;
-        p.c[2 * n] = 1.0;
+        // Unknowns: (x_i, y_i) interleaved, then t.
+        let mut p = Problem::new(2 * n, 1);
+        p.add_linear(2 * n, 1.0);
         for i in 0..n - 1 {
-            p.eq.push((vec![(2 * i + 2, 1.0), (2 * i, -1.0)], 1.0));
-            p.eq.push((vec![(2 * i + 3, 1.0), (2 * i + 1, -1.0)], 0.0));
+            p.add_pair(
+                &[(2 * i + 2, 1.0), (2 * i, -1.0)],
+                1.0 - 1e-9,
+                1.0 + 1e-9,
+                None,
+            );
+            p.add_pair(&[(2 * i + 3, 1.0), (2 * i + 1, -1.0)], -1e-9, 1e-9, None);
         }
         for (i, tg) in targets.iter().enumerate() {
-            p.soc.push(vec![
-                (vec![(2 * n, -1.0)], 0.0),
-                (vec![(2 * i, 1.0)], tg[0]),
-                (vec![(2 * i + 1, 1.0)], tg[1]),
+            p.add_soc(&[
+                (&[(2 * n, -1.0)], 0.0),
+                (&[(2 * i, 1.0)], tg[0]),
+                (&[(2 * i + 1, 1.0)], tg[1]),
             ]);
         }
-        let r = p.solve(&vec![0.0; 2 * n + 1], &IpmSettings::default());
+        let r = p.solve(&IpmSettings::default());
         assert_eq!(r.status, IpmStatus::Solved);
         // Brute force over the chain's start (x0, y0).
         let worst = |x0: f64, y0: f64| {
