@@ -1,6 +1,7 @@
 //! Per-zone patch time and deviation on the held-out-like zones (`polepatch_benches::
-//! held_out_zones`) and C17's SING on both machines: each run is patched `REPS` times and
-//! the fastest is kept (wall time, one core), with the number of solves and IPM
+//! held_out_zones`) and C17's SING on both machines: each run is patched `REPS` times
+//! (`ZT_REPS` overrides) and the fastest is kept (wall time, one core, and the thread's CPU
+//! time, which a shared machine's load disturbs less), with the number of solves and IPM
 //! iterations; with `--reference`, each zone's deviation is compared with the bench
 //! reference (`polepatch_patcher::reference::zone_reference`).
 //!
@@ -65,6 +66,7 @@ fn main() {
         }
     }
     let mut times = Vec::new();
+    let mut cpu_times = Vec::new();
     let mut ratios = Vec::new();
     for (label, m, path, pinned, decimals) in &cases {
         if only.as_ref().is_some_and(|o| !label.contains(o.as_str())) {
@@ -78,15 +80,19 @@ fn main() {
             ..PatchOptions::default()
         };
         let mut best = f64::INFINITY;
+        let mut best_cpu = f64::INFINITY;
         let mut res = None;
         let reps = std::env::var("ZT_REPS")
             .ok()
             .and_then(|v| v.parse().ok())
             .unwrap_or(REPS);
         for _ in 0..reps {
-            let t = Instant::now();
+            let (t, c) = (Instant::now(), thread_cpu_s());
             let r = patch_path(path, m, &opts).expect("valid path");
             best = best.min(t.elapsed().as_secs_f64());
+            if let (Some(a), Some(b)) = (c, thread_cpu_s()) {
+                best_cpu = best_cpu.min(b - a);
+            }
             res = Some(r);
         }
         let Some(res) = res else { continue };
@@ -95,16 +101,21 @@ fn main() {
             continue;
         }
         let per_zone = best / res.zones.len() as f64;
+        let cpu_zone = best_cpu / res.zones.len() as f64;
         for z in &res.zones {
             times.push(per_zone * 1e3);
+            if cpu_zone.is_finite() {
+                cpu_times.push(cpu_zone * 1e3);
+            }
             let mut line = format!(
-                "{label}: {:?} {} dev {:.4}° solves {} it {} | {:.3} ms/zone",
+                "{label}: {:?} {} dev {:.4}° solves {} it {} | {:.3} ms/zone (cpu {:.3} ms)",
                 z.outcome,
                 z.reason,
                 z.max_deviation_deg,
                 z.qp.solves,
                 z.qp.iterations,
-                per_zone * 1e3
+                per_zone * 1e3,
+                cpu_zone * 1e3
             );
             if with_ref {
                 let n = path.s_mm.len();
@@ -156,6 +167,15 @@ fn main() {
             q(&mut times, 1.0)
         );
     }
+    if !cpu_times.is_empty() {
+        println!(
+            "{} zones, thread CPU time: median {:.3} ms, p90 {:.3} ms, max {:.3} ms",
+            cpu_times.len(),
+            q(&mut cpu_times, 0.5),
+            q(&mut cpu_times, 0.9),
+            q(&mut cpu_times, 1.0)
+        );
+    }
     if !ratios.is_empty() {
         println!(
             "deviation / reference: median {:.3}, worst {:.3}",
@@ -163,4 +183,12 @@ fn main() {
             q(&mut ratios, 1.0)
         );
     }
+}
+
+/// This thread's CPU time, seconds (Linux: the first field of
+/// `/proc/thread-self/schedstat`, nanoseconds on the CPU), or `None` elsewhere.
+fn thread_cpu_s() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: f64 = text.split_whitespace().next()?.parse().ok()?;
+    Some(ns * 1e-9)
 }

@@ -50,37 +50,6 @@ pub const WINDOW_POINTS: usize = 16;
 /// Points either side of the modified range whose spans are constrained.
 pub const CONSTRAINED_MARGIN_POINTS: usize = 3;
 
-/// Points of the joint solver's Hermite window either side of the modified range (more than
-/// the C-only QP's [`WINDOW_POINTS`]: the joint solver constrains the window's spans to be
-/// no worse than before, which needs the model exact there, see [`EDGE_SPANS`]).
-pub const JOINT_WINDOW_POINTS: usize = 24;
-
-/// Spans at each end of a Hermite window inside the path that [`Hermite::push_limits`]
-/// leaves unconstrained: the fixed end slope is exact only to about 0.27^window of the
-/// change, and next to the end that error enters q''' amplified by 6/h²; 8 spans further
-/// it has decayed by 0.27⁸ ≈ 3·10⁻⁵.
-pub const EDGE_SPANS: usize = 8;
-
-/// Rows per span (plus the current spline's vertex of q') of the "not worse" velocity rows
-/// on a span that exceeded the velocity limit before (`Hermite::push_limits`).
-pub const NOT_WORSE_SAMPLES_PER_SPAN: usize = 8;
-
-/// Relative slack of a "not worse than before" bound (round-off only).
-pub const NOT_WORSE_SLACK: f64 = 1e-9;
-
-/// What the solves of one zone share and need not recompute: the rounding room of each
-/// window they constrain (`Hermite::rounding_room`, a function of the window's knots
-/// and written points only). Create one per zone; it grows by one entry per window.
-#[derive(Debug, Default)]
-pub struct RoundingMemo {
-    /// (window knots, written points relative to the window, room per span for a unit
-    /// rounding error).
-    pub(crate) entries: std::cell::RefCell<Vec<RoomEntry>>,
-}
-
-/// An entry of [`RoundingMemo`].
-pub(crate) type RoomEntry = (Vec<f64>, (usize, usize), Vec<[f64; 3]>);
-
 /// An affine form `Σ coeff·x[var] + c`.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Aff {
@@ -130,17 +99,6 @@ pub(crate) struct Hermite<'a> {
     offset: usize,
     /// Current spline's slope at `lo` / `hi` when that end is inside the path.
     fixed: [Option<f64>; 2],
-    /// In coefficient form ([`Hermite::coefficient_form`]): the window's cubic B-spline
-    /// (clamped knots at every CL point of the window) with the current spline's
-    /// coefficients; the variables are the changes of those coefficients.
-    basis: Option<polepatch_bspline::BSpline>,
-    /// In coefficient form: the value and slope forms at each knot of the window
-    /// (`lo..=hi`), computed once.
-    knot_forms: Vec<[Aff; 2]>,
-    /// In reduced form ([`Hermite::reduced`]): the variables are the free coefficients
-    /// only, variable `r` at index `offset + stride·r`.
-    reduced: bool,
-    stride: usize,
 }
 
 impl<'a> Hermite<'a> {
@@ -194,180 +152,7 @@ impl<'a> Hermite<'a> {
             nd: last - first + 1,
             offset,
             fixed,
-            basis: None,
-            knot_forms: Vec::new(),
-            reduced: false,
-            stride: 1,
         })
-    }
-
-    /// The same window in **coefficient form**: the variables are the `hi − lo + 3`
-    /// coefficients of the cubic B-spline with a knot at every CL point of the window
-    /// (clamped at its ends), numbered from `offset`. Every value and slope is then a
-    /// combination of three neighbouring coefficients, C² continuity holds by
-    /// construction (no rows for it), and the equalities are the fixed points' values and
-    /// the two end conditions. The forms (`d1`, `d2`, `d3`, `b1`, …) and
-    /// [`Hermite::push_limits`] are the same functions of the values and slopes; the
-    /// changes are [`Hermite::delta`]. About a third of the unknowns of the point form and
-    /// a third of its bandwidth: what the banded interior-point method wants
-    /// ([`crate::ipm`]).
-    pub(crate) fn coefficient_form(mut self) -> Result<Hermite<'a>, PatchFailure> {
-        // The current spline on the window: the clamped interpolant with its own end
-        // slopes (it is C² with these values, so it is that spline exactly); the variables
-        // are changes of its coefficients, so a fixed point's value is exact (its row has
-        // right-hand side 0) whatever the solver's tolerance.
-        let (a, b) = (self.lo, self.hi);
-        let sp = self.widened()?;
-        let cl = polepatch_bspline::interpolate_clamped(
-            &self.s[a..=b],
-            &self.c[a..=b],
-            sp.eval_derivs(self.s[a])[1],
-            sp.eval_derivs(self.s[b])[1],
-        )
-        .map_err(|_| PatchFailure::TooShort)?;
-        self.knot_forms = (self.lo..=self.hi)
-            .map(|k| {
-                [
-                    Self::form_at(&cl, self.s[k], self.offset, 0),
-                    Self::form_at(&cl, self.s[k], self.offset, 1),
-                ]
-            })
-            .collect();
-        self.basis = Some(cl);
-        Ok(self)
-    }
-
-    /// The coefficient form with its equalities **eliminated**: the variables are the
-    /// `last − first + 1` free coefficients (as many as the movable points), variable `r`
-    /// at index `offset + stride·r` (two axes interleave with strides 2 and offsets 0, 1).
-    ///
-    /// The fixed points' values and the window's end conditions are linear equalities
-    /// `E·δc = 0` in the coefficient changes. At each end of the window they involve the
-    /// `m` outermost coefficients (as many as the equalities there: the fixed points
-    /// outside the movable range and the end condition) and a few free ones `R` next to
-    /// them; so the outer ones are `δc_M = −E_M⁻¹·E_R·δc_R` (a small dense solve per end;
-    /// for a fixed end slope each outer coefficient is a multiple of the one free
-    /// coefficient at the range's edge, decaying by ≈ 0.27 per knot outwards). Every form
-    /// is rewritten in the free coefficients: the same functions of the values (the
-    /// feasible set and every row are those of the coefficient form), no equality rows,
-    /// and about half the unknowns and band of the coefficient form when the window's
-    /// fixed margins are long.
-    pub(crate) fn reduced(
-        mut self,
-        offset: usize,
-        stride: usize,
-    ) -> Result<Hermite<'a>, PatchFailure> {
-        self.offset = 0;
-        let mut h = self.coefficient_form()?;
-        let nc = h.hi - h.lo + 3;
-        let eqs = h.sided_equalities();
-        let ml = eqs.iter().filter(|e| e.1).count();
-        let mr = eqs.len() - ml;
-        let both_ends = h.fixed == [None, None];
-        if (both_ends && h.hi - h.lo < 3) || ml + mr + h.nd != nc {
-            return Err(PatchFailure::TooShort);
-        }
-        // sub[j]: coefficient j as a combination of the free coefficients ml..nc − mr.
-        let mut sub: Vec<Row> = (0..nc).map(|j| vec![(j, 1.0)]).collect();
-        let free = ml..nc - mr;
-        let outer: Vec<usize> = (0..ml).chain(nc - mr..nc).collect();
-        let mut others: Vec<usize> = eqs
-            .iter()
-            .flat_map(|f| f.0.row.iter().map(|e| e.0))
-            .filter(|j| free.contains(j))
-            .collect();
-        others.sort_unstable();
-        others.dedup();
-        let (m, no) = (outer.len(), others.len());
-        // [E_M | E_R] dense, then E_M⁻¹·E_R by elimination with partial pivoting.
-        let mut a = vec![0.0; m * (m + no)];
-        for (r, (f, _)) in eqs.iter().enumerate() {
-            for &(j, v) in &f.row {
-                let col = if free.contains(&j) {
-                    m + others.binary_search(&j).unwrap_or(0)
-                } else if j < ml {
-                    j
-                } else {
-                    ml + j - (nc - mr)
-                };
-                a[r * (m + no) + col] += v;
-            }
-        }
-        let t = solve_dense(&mut a, m, no).ok_or(PatchFailure::TooShort)?;
-        for (r, &j) in outer.iter().enumerate() {
-            sub[j] = others
-                .iter()
-                .enumerate()
-                .map(|(q, &o)| (o, -t[r * no + q]))
-                .filter(|e| e.1 != 0.0)
-                .collect();
-        }
-        let map = |f: &Aff| -> Aff {
-            let mut row: Row = Vec::with_capacity(f.row.len() + 2);
-            for &(j, v) in &f.row {
-                for &(fj, w) in &sub[j] {
-                    row.push((offset + stride * (fj - ml), v * w));
-                }
-            }
-            Aff {
-                row: crate::qp::compact(&row),
-                c: f.c,
-            }
-        };
-        h.knot_forms = h.knot_forms.iter().map(|[v, d]| [map(v), map(d)]).collect();
-        h.offset = offset;
-        h.stride = stride;
-        h.reduced = true;
-        Ok(h)
-    }
-
-    /// The value (`order` 0) or slope (1) at `t` as an affine form of the changes of the
-    /// coefficients of `b` (numbered from `offset`): the current spline's plus the basis
-    /// row.
-    fn form_at(b: &polepatch_bspline::BSpline, t: f64, offset: usize, order: usize) -> Aff {
-        let r = b.basis_row(t, order);
-        let cur = &b.coeffs()[r.first..];
-        Aff {
-            row: (0..4)
-                .filter(|&j| r.weights[j] != 0.0)
-                .map(|j| (offset + r.first + j, r.weights[j]))
-                .collect(),
-            c: (0..4)
-                .map(|j| r.weights[j] * cur.get(j).copied().unwrap_or(0.0))
-                .sum(),
-        }
-    }
-
-    /// The analysis spline of the current values on the window widened by
-    /// [`WINDOW_POINTS`] or more (where the window's slopes are taken from).
-    fn widened(&self) -> Result<AnalysisSpline, PatchFailure> {
-        let n = self.s.len();
-        let w = (self.hi - self.last)
-            .max(self.first - self.lo)
-            .max(WINDOW_POINTS);
-        let lo2 = self.lo.saturating_sub(w);
-        let hi2 = (self.hi + w).min(n - 1);
-        AnalysisSpline::new(&self.s[lo2..=hi2], &self.c[lo2..=hi2])
-            .map_err(|_| PatchFailure::TooShort)
-    }
-
-    /// The value (`order` 0) or slope (1) at knot `k` of the window, in coefficient form.
-    fn basis_aff(&self, k: usize, order: usize) -> Aff {
-        self.knot_forms[k - self.lo][order].clone()
-    }
-
-    /// The change `δ_i` of the value at point `i` (in `first..=last`): one variable in
-    /// point form, a combination of coefficients minus the current value in coefficient
-    /// form.
-    pub(crate) fn delta(&self, i: usize) -> Aff {
-        match &self.basis {
-            None => Aff::var(self.delta_var(i)),
-            Some(_) => {
-                let mut a = self.basis_aff(i, 0);
-                a.c -= self.c[i];
-                a
-            }
-        }
     }
 
     /// Index of the variable `δ_i` (point `i` in `first..=last`).
@@ -375,13 +160,9 @@ impl<'a> Hermite<'a> {
         self.offset + i - self.first
     }
 
-    /// Number of variables (changes, then slopes; or the coefficients).
+    /// Number of variables (changes, then slopes).
     pub(crate) fn vars(&self) -> usize {
-        match &self.basis {
-            None => self.nd + self.hi - self.lo + 1,
-            Some(_) if self.reduced => self.nd,
-            Some(_) => self.hi - self.lo + 3,
-        }
+        self.nd + self.hi - self.lo + 1
     }
 
     pub(crate) fn h(&self, k: usize) -> f64 {
@@ -390,9 +171,6 @@ impl<'a> Hermite<'a> {
 
     /// Value at path point k.
     fn y(&self, k: usize) -> Aff {
-        if self.basis.is_some() {
-            return self.basis_aff(k, 0);
-        }
         let mut a = Aff::constant(self.c[k]);
         if (self.first..=self.last).contains(&k) {
             a.row.push((self.delta_var(k), 1.0));
@@ -402,10 +180,7 @@ impl<'a> Hermite<'a> {
 
     /// Slope at path knot k (lo ≤ k ≤ hi).
     pub(crate) fn m(&self, k: usize) -> Aff {
-        match &self.basis {
-            None => Aff::var(self.offset + self.nd + k - self.lo),
-            Some(_) => self.basis_aff(k, 1),
-        }
+        Aff::var(self.offset + self.nd + k - self.lo)
     }
 
     fn secant(&self, k: usize) -> Aff {
@@ -462,52 +237,28 @@ impl<'a> Hermite<'a> {
     /// The rows tying the slopes to the values (each `form = 0`): C² continuity at every
     /// interior knot, then the two end conditions (module docs).
     pub(crate) fn equalities(&self) -> Vec<Aff> {
-        self.sided_equalities().into_iter().map(|e| e.0).collect()
-    }
-
-    /// [`Hermite::equalities`], each with the end of the window it belongs to (`true`:
-    /// the `lo` end; C² rows of the point form count as neither and say `false`).
-    fn sided_equalities(&self) -> Vec<(Aff, bool)> {
         let (lo, hi) = (self.lo, self.hi);
         let mut eqs = Vec::with_capacity(hi - lo + 1);
-        if self.reduced {
-            // Eliminated: the fixed points' values and the end conditions hold for every
-            // value of the free coefficients.
-            return eqs;
-        }
-        if self.basis.is_some() {
-            // Coefficient form: C² holds by construction; the fixed points keep their
-            // values.
-            for k in (lo..=hi).filter(|k| !(self.first..=self.last).contains(k)) {
-                eqs.push((
-                    Aff::sum(&[(1.0, &self.y(k)), (-self.c[k], &Aff::constant(1.0))]),
-                    k < self.first,
-                ));
-            }
-        }
-        for k in (lo + 1..hi).filter(|_| self.basis.is_none()) {
+        for k in lo + 1..hi {
             let (ha, hb) = (self.h(k - 1), self.h(k));
             let w = 1.0 / (ha + hb);
-            eqs.push((
-                Aff::sum(&[
-                    (hb * w, &self.m(k - 1)),
-                    (2.0, &self.m(k)),
-                    (ha * w, &self.m(k + 1)),
-                    (-3.0 * hb * w, &self.secant(k - 1)),
-                    (-3.0 * ha * w, &self.secant(k)),
-                ]),
-                false,
-            ));
+            eqs.push(Aff::sum(&[
+                (hb * w, &self.m(k - 1)),
+                (2.0, &self.m(k)),
+                (ha * w, &self.m(k + 1)),
+                (-3.0 * hb * w, &self.secant(k - 1)),
+                (-3.0 * ha * w, &self.secant(k)),
+            ]));
         }
         let nw = hi - lo + 1;
         let both_path_ends = self.fixed == [None, None];
         if both_path_ends && nw <= 3 {
             // A line (2 points) or a parabola (3 points).
             for k in lo..hi {
-                eqs.push((Aff::sum(&[(self.h(k) * self.h(k), &self.c3(k))]), false));
+                eqs.push(Aff::sum(&[(self.h(k) * self.h(k), &self.c3(k))]));
             }
             if nw == 2 {
-                eqs.push((Aff::sum(&[(self.h(lo), &self.c2(lo))]), false));
+                eqs.push(Aff::sum(&[(self.h(lo), &self.c2(lo))]));
             }
             return eqs;
         }
@@ -515,20 +266,14 @@ impl<'a> Hermite<'a> {
             let (ha, hb) = (self.h(a), self.h(a + 1));
             Aff::sum(&[(ha * hb, &self.c3(a)), (-ha * hb, &self.c3(a + 1))])
         };
-        eqs.push((
-            match self.fixed[0] {
-                Some(m) => Aff::sum(&[(1.0, &self.m(lo)), (-m, &Aff::constant(1.0))]),
-                None => not_a_knot(lo),
-            },
-            true,
-        ));
-        eqs.push((
-            match self.fixed[1] {
-                Some(m) => Aff::sum(&[(1.0, &self.m(hi)), (-m, &Aff::constant(1.0))]),
-                None => not_a_knot(hi - 2),
-            },
-            false,
-        ));
+        eqs.push(match self.fixed[0] {
+            Some(m) => Aff::sum(&[(1.0, &self.m(lo)), (-m, &Aff::constant(1.0))]),
+            None => not_a_knot(lo),
+        });
+        eqs.push(match self.fixed[1] {
+            Some(m) => Aff::sum(&[(1.0, &self.m(hi)), (-m, &Aff::constant(1.0))]),
+            None => not_a_knot(hi - 2),
+        });
         eqs
     }
 
@@ -541,208 +286,6 @@ impl<'a> Hermite<'a> {
             .max(self.lo);
         let b = (self.last + CONSTRAINED_MARGIN_POINTS).min(self.hi);
         a..b.max(a + 1).min(self.hi)
-    }
-
-    /// Write the current spline into `x` (the variables of this Hermite): every change 0,
-    /// every knot slope the slope of the analysis spline of the current values (on the
-    /// window widened by [`WINDOW_POINTS`], as the fixed end slopes are).
-    #[cfg(test)]
-    pub(crate) fn write_current(&self, x: &mut [f64]) -> Result<(), PatchFailure> {
-        let n = self.s.len();
-        let w = (self.hi - self.last)
-            .max(self.first - self.lo)
-            .max(WINDOW_POINTS);
-        let lo2 = self.lo.saturating_sub(w);
-        let hi2 = (self.hi + w).min(n - 1);
-        if self.basis.is_some() {
-            // The current spline: no change of its coefficients.
-            for j in 0..self.vars() {
-                x[self.offset + self.stride * j] = 0.0;
-            }
-            return Ok(());
-        }
-        let sp = AnalysisSpline::new(&self.s[lo2..=hi2], &self.c[lo2..=hi2])
-            .map_err(|_| PatchFailure::TooShort)?;
-        for i in self.first..=self.last {
-            x[self.delta_var(i)] = 0.0;
-        }
-        for k in self.lo..=self.hi {
-            x[self.offset + self.nd + k - self.lo] = sp.eval_derivs(self.s[k])[1];
-        }
-        Ok(())
-    }
-
-    /// For every span `k` of the window (`lo..hi`, index `k − lo`), what rounding the
-    /// written values (points `first..=last`, each moved by at most `eps`) can add to the
-    /// span's `|q'|`, `|q''|`, `|q'''|` at the points the bounds are taken (knots and
-    /// middle): `eps·Σ_{i written} |w_i|` over the analysis spline's data rows
-    /// ([`crate::spline::SplineSystem::data_row`], on the window).
-    pub(crate) fn rounding_room(
-        &self,
-        eps: f64,
-        memo: Option<&RoundingMemo>,
-    ) -> Result<Vec<[f64; 3]>, PatchFailure> {
-        let gains = self.rounding_gains(memo)?;
-        Ok(gains
-            .iter()
-            .map(|g| [g[0] * eps, g[1] * eps, g[2] * eps])
-            .collect())
-    }
-
-    /// [`Hermite::rounding_room`] for `eps = 1`. It depends only on the window's knots and
-    /// which of them are written, and one zone's solves (every start, both axes) ask for
-    /// the same window again and again: with a `memo` the results are kept there, keyed
-    /// by exactly those inputs (the knots compared bit for bit).
-    fn rounding_gains(&self, memo: Option<&RoundingMemo>) -> Result<Vec<[f64; 3]>, PatchFailure> {
-        let knots = &self.s[self.lo..=self.hi];
-        let (a, b) = (self.first - self.lo, self.last - self.lo);
-        let same = |k: &[f64]| {
-            k.len() == knots.len() && k.iter().zip(knots).all(|(x, y)| x.to_bits() == y.to_bits())
-        };
-        if let Some(hit) = memo.and_then(|m| {
-            m.entries
-                .borrow()
-                .iter()
-                .find(|e| e.1 == (a, b) && same(&e.0))
-                .map(|e| e.2.clone())
-        }) {
-            return Ok(hit);
-        }
-        let sys = crate::spline::SplineSystem::new(knots).map_err(|_| PatchFailure::TooShort)?;
-        let l1 = |t: f64, order: usize| -> f64 {
-            sys.data_row(t, order)[a..=b]
-                .iter()
-                .map(|w| w.abs())
-                .sum::<f64>()
-        };
-        let gains: Vec<[f64; 3]> = (self.lo..self.hi)
-            .map(|k| {
-                let (x0, x1) = (self.s[k], self.s[k + 1]);
-                let mid = 0.5 * (x0 + x1);
-                [
-                    l1(x0, 1).max(l1(mid, 1)).max(l1(x1, 1)),
-                    l1(x0, 2).max(l1(x1, 2)),
-                    l1(mid, 3),
-                ]
-            })
-            .collect();
-        if let Some(m) = memo {
-            m.entries
-                .borrow_mut()
-                .push((knots.to_vec(), (a, b), gains.clone()));
-        }
-        Ok(gains)
-    }
-
-    /// Push Equation 6's rows for this axis over every span of the window, in convex-hull
-    /// form (the bounds then hold for every s of a span, hence at every sample):
-    /// `|m_k| ≤ v`, `|b1| ≤ v`, `|q''(knot)| ≤ a`, `|q'''| ≤ j`. A span with both knots
-    /// movable, or in `core` (the spans that must reach feed), gets `limit − room`; any
-    /// other span that touches a fixed point gets
-    /// `max(limit, |value before|·(1 + NOT_WORSE_SLACK)) − room` — for q', where the span
-    /// exceeded the velocity limit before, at [`NOT_WORSE_SAMPLES_PER_SPAN`] samples and the
-    /// spline's vertex of q' before (where its exact peak is) against that exact peak
-    /// instead of the hull: it may not get worse, and need not reach
-    /// feed (a fixed neighbour may already exceed the limits, e.g. through the file's own
-    /// rounding). `room[k − lo][r]` ([`Hermite::rounding_room`]) is
-    /// what rounding the written values can add to the (r+1)-th derivative on span k, so
-    /// the bounds still hold on the values as written. "Before" is `before`'s spline (the
-    /// same window; `self` when the values before are the base's): each form's value on
-    /// it is the constant of the same form built on it. Each row `(f, b)` says
-    /// `|f| ≤ b`. The window is constrained but for its last
-    /// [`EDGE_SPANS`] spans at each cut end, so that what lies beyond moves by about
-    /// 0.27^(window − EDGE_SPANS) of the change only.
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn push_limits(
-        &self,
-        before: &Hermite<'_>,
-        out: &mut Vec<(Aff, f64)>,
-        lim: &crate::limits::GeomLimits,
-        room: &[[f64; 3]],
-        core: std::ops::Range<usize>,
-    ) {
-        // Spans next to a window end inside the path are left out: there the fixed end
-        // slope's error (about 0.27^window of the change) enters q''' amplified by 6/h².
-        let n = self.s.len();
-        let a = if self.lo > 0 {
-            self.lo + EDGE_SPANS
-        } else {
-            self.lo
-        };
-        let b = if self.hi < n - 1 {
-            self.hi.saturating_sub(EDGE_SPANS)
-        } else {
-            self.hi
-        };
-        let a = a.min(self.first);
-        let spans = a.min(core.start)..b.max(self.last).max(core.end).max(a + 1).min(self.hi);
-        let mut taus = Vec::new();
-        for k in spans.clone() {
-            let movable = |i: usize| i >= self.first && i <= self.last;
-            let strict = (movable(k) && movable(k + 1)) || core.contains(&k);
-            let room = room.get(k - self.lo).copied().unwrap_or([0.0; 3]);
-            // `now`: the same form's value on the spline before.
-            let bound = |now: f64, limit: f64, r: usize| {
-                let b = if strict {
-                    limit
-                } else {
-                    limit.max(now.abs() * (1.0 + NOT_WORSE_SLACK))
-                };
-                // Never below a sliver of the limit: the row stays well posed.
-                (b - room[r]).max(1e-3 * limit)
-            };
-            let rows = [
-                (self.m(k), before.m(k).c, lim.v, 0),
-                (self.d2(k, 0.0), before.d2(k, 0.0).c, lim.a, 1),
-                (self.d3(k), before.d3(k).c, lim.j, 2),
-            ];
-            let hull_now = [before.m(k), before.b1(k), before.m(k + 1)]
-                .iter()
-                .fold(0.0f64, |m, f| m.max(f.c.abs()));
-            if strict || hull_now <= lim.v {
-                // |q'| ≤ v on the whole span through its Bernstein coefficients (a span
-                // within the limit before may only stay within it: "not worse").
-                let b = (lim.v - room[0]).max(1e-3 * lim.v);
-                out.push((self.b1(k), b));
-            } else {
-                // Beyond the limit before: "not worse" on q' against the span's exact peak
-                // before (the hull overstates the peak, so it cannot stand for it).
-                crate::spline::span_offsets(self.h(k), NOT_WORSE_SAMPLES_PER_SPAN, &mut taus);
-                // Rows at the samples and at the spline's vertex of q' before (its peak
-                // on the span, when inside), against that peak.
-                let d1 = |t: f64| before.d1(k, t).c;
-                let (qa, qm, qb) = (d1(0.0), d1(0.5 * self.h(k)), d1(self.h(k)));
-                // q'(τ) = qa + c1·τ + c2·τ² through the three values.
-                let h = self.h(k);
-                let c2 = 2.0 * (qa - 2.0 * qm + qb) / (h * h);
-                let c1 = (qb - qa) / h - c2 * h;
-                if c2 != 0.0 {
-                    let v = -c1 / (2.0 * c2);
-                    if v > 0.0 && v < h {
-                        taus.push(v);
-                    }
-                }
-                let peak = taus.iter().fold(0.0f64, |m, &t| m.max(d1(t).abs()));
-                let b = (lim.v.max(peak * (1.0 + NOT_WORSE_SLACK)) - room[0]).max(1e-3 * lim.v);
-                for &tau in taus.iter().filter(|&&t| t > 0.0 && t < h) {
-                    out.push((self.d1(k, tau), b));
-                }
-            }
-            for (f, now, l, r) in rows {
-                let b = bound(now, l, r);
-                out.push((f, b));
-            }
-            if k + 1 == spans.end {
-                let h = self.h(k);
-                for (f, now, l, r) in [
-                    (self.m(k + 1), before.m(k + 1).c, lim.v, 0),
-                    (self.d2(k, h), before.d2(k, h).c, lim.a, 1),
-                ] {
-                    let b = bound(now, l, r);
-                    out.push((f, b));
-                }
-            }
-        }
     }
 
     /// Add this Hermite's equalities to `qp`.
@@ -760,46 +303,6 @@ impl<'a> Hermite<'a> {
         }
         qp
     }
-}
-
-/// `A⁻¹·B` for `a = [A | B]` (`m × (m + no)`, row-major), `A` square: Gaussian
-/// elimination with partial pivoting, in place; `None` when a pivot vanishes (relative
-/// to the largest entry of `A`).
-fn solve_dense(a: &mut [f64], m: usize, no: usize) -> Option<Vec<f64>> {
-    let wd = m + no;
-    let scale = a.iter().fold(0.0f64, |x, v| x.max(v.abs()));
-    for col in 0..m {
-        let piv =
-            (col..m).max_by(|&p, &q| a[p * wd + col].abs().total_cmp(&a[q * wd + col].abs()))?;
-        if a[piv * wd + col].abs() <= 1e-12 * scale {
-            return None;
-        }
-        if piv != col {
-            for j in 0..wd {
-                a.swap(piv * wd + j, col * wd + j);
-            }
-        }
-        let d = a[col * wd + col];
-        for r in col + 1..m {
-            let f = a[r * wd + col] / d;
-            if f != 0.0 {
-                for j in col..wd {
-                    a[r * wd + j] -= f * a[col * wd + j];
-                }
-            }
-        }
-    }
-    let mut t = vec![0.0; m * no];
-    for q in 0..no {
-        for r in (0..m).rev() {
-            let mut v = a[r * wd + m + q];
-            for j in r + 1..m {
-                v -= a[r * wd + j] * t[j * no + q];
-            }
-            t[r * no + q] = v / a[r * wd + r];
-        }
-    }
-    Some(t)
 }
 
 /// Push `|f| ≤ bound` (two rows, scaled by 1/bound).
@@ -896,146 +399,6 @@ mod tests {
         for k in hm.lo..=hm.hi {
             let m = sp.eval_derivs(s[k])[1];
             assert!((x[hm.nd + k - hm.lo] - m).abs() < 1e-5, "knot {k}");
-        }
-    }
-
-    /// Coefficient form, the planted response: with the changes of points `first..=last`
-    /// fixed, the coefficients the equalities determine give the analysis spline of the
-    /// changed data — its value, first, second and third derivatives at points of every
-    /// span of the window, through the same forms (`d1`, `d2`, `d3`, `b1`) the limits use
-    /// — on a window inside the path (fixed end slopes) and on the whole path (not-a-knot).
-    #[test]
-    fn coefficient_form_is_the_spline_of_the_changed_data() {
-        let (s, y) = data(60);
-        let cases = [
-            (28, 32, WINDOW_POINTS, false),
-            (1, 58, 60, false),
-            (28, 32, WINDOW_POINTS, true),
-            (1, 58, 60, true),
-            (1, 30, JOINT_WINDOW_POINTS, true),
-            (40, 58, JOINT_WINDOW_POINTS, true),
-            (2, 3, 30, true),
-            (57, 59, JOINT_WINDOW_POINTS, true),
-        ];
-        for (first, last, window, reduce) in cases {
-            let hm = Hermite::new(&s, &y, first, last, window).unwrap();
-            let hm = if reduce {
-                hm.reduced(0, 1)
-                    .unwrap_or_else(|e| panic!("{first}..={last} window {window}: {e:?}"))
-            } else {
-                hm.coefficient_form().unwrap()
-            };
-            let delta: Vec<f64> = (first..=last)
-                .map(|i| (i as f64 * 0.9).sin() * 4.0)
-                .collect();
-            // The equalities and the changes make a square system in the coefficients:
-            // solve it exactly (Gaussian elimination with partial pivoting).
-            let nv = hm.vars();
-            let mut rows: Vec<(Vec<f64>, f64)> = Vec::new();
-            let dense = |f: &Aff| {
-                let mut r = vec![0.0; nv];
-                for &(j, v) in &f.row {
-                    r[j] += v;
-                }
-                r
-            };
-            for e in hm.equalities() {
-                rows.push((dense(&e), -e.c));
-            }
-            for (i, d) in (first..=last).zip(&delta) {
-                let f = hm.delta(i);
-                rows.push((dense(&f), d - f.c));
-            }
-            assert_eq!(rows.len(), nv, "one row per coefficient");
-            if reduce {
-                assert_eq!(
-                    nv,
-                    last - first + 1,
-                    "one free coefficient per movable point"
-                );
-            }
-            for col in 0..nv {
-                let piv = (col..nv)
-                    .max_by(|&a, &b| rows[a].0[col].abs().total_cmp(&rows[b].0[col].abs()))
-                    .unwrap();
-                rows.swap(col, piv);
-                let (head, tail) = rows.split_at_mut(col + 1);
-                let p = &head[col];
-                for r in tail.iter_mut() {
-                    let f = r.0[col] / p.0[col];
-                    for j in col..nv {
-                        r.0[j] -= f * p.0[j];
-                    }
-                    r.1 -= f * p.1;
-                }
-            }
-            let mut x = vec![0.0; nv];
-            for col in (0..nv).rev() {
-                let acc: f64 = (col + 1..nv).map(|j| rows[col].0[j] * x[j]).sum();
-                x[col] = (rows[col].1 - acc) / rows[col].0[col];
-            }
-            let mut y2 = y.clone();
-            for (i, d) in (first..=last).zip(&delta) {
-                y2[i] += d;
-            }
-            let sp = interpolate_not_a_knot(&s, &y2).unwrap();
-            // Inside a window cut from the path the end slopes are fixed: the spline there
-            // differs from the whole path's by what a change propagates (≈ 0.27^16).
-            for k in hm.lo..hm.hi {
-                let h = hm.h(k);
-                for tau in [0.0, 0.37 * h, h] {
-                    // q' and q'' are continuous: at τ = h either span's piece will do.
-                    let d = sp.eval_derivs(s[k] + tau);
-                    assert!((hm.d1(k, tau).at(&x) - d[1]).abs() < 1e-7, "{k}: q'");
-                    assert!((hm.d2(k, tau).at(&x) - d[2]).abs() < 1e-6, "{k}: q''");
-                }
-                assert!((hm.d3(k).at(&x) - sp.eval_derivs(s[k] + 0.5 * h)[3]).abs() < 1e-5);
-                // b1 is the middle Bernstein coefficient of q': its average is the secant.
-                let b1 = hm.b1(k).at(&x);
-                let secant = (y2[k + 1] - y2[k]) / h;
-                let avg = (hm.m(k).at(&x) + b1 + hm.m(k + 1).at(&x)) / 3.0;
-                assert!((avg - secant).abs() < 1e-6, "{k}");
-            }
-            for i in first..=last {
-                assert!((hm.delta(i).at(&x) - delta[i - first]).abs() < 1e-9);
-            }
-            // With no change at all the variables are zero: the current spline.
-            let mut cur = vec![0.0; hm.vars()];
-            hm.write_current(&mut cur).unwrap();
-            assert!(cur.iter().all(|&v| v == 0.0));
-            assert!(
-                (hm.m(first).at(&cur)
-                    - interpolate_not_a_knot(&s, &y)
-                        .unwrap()
-                        .eval_derivs(s[first])[1])
-                    .abs()
-                    < 1e-6
-            );
-        }
-    }
-
-    /// In reduced form with an offset and a stride, free coefficient r is variable
-    /// `offset + stride·r` and nothing else changes.
-    #[test]
-    fn reduced_form_offset_and_stride() {
-        let (s, y) = data(50);
-        let a = Hermite::new(&s, &y, 20, 30, JOINT_WINDOW_POINTS)
-            .unwrap()
-            .reduced(0, 1)
-            .unwrap();
-        let b = Hermite::new(&s, &y, 20, 30, JOINT_WINDOW_POINTS)
-            .unwrap()
-            .reduced(1, 2)
-            .unwrap();
-        assert_eq!(a.vars(), 11);
-        assert!(a.equalities().is_empty());
-        for k in a.lo..a.hi {
-            for (fa, fb) in [(a.d3(k), b.d3(k)), (a.b1(k), b.b1(k)), (a.m(k), b.m(k))] {
-                let fa = crate::qp::compact(&fa.row);
-                let fb = crate::qp::compact(&fb.row);
-                let moved: Row = fa.iter().map(|&(j, v)| (1 + 2 * j, v)).collect();
-                assert_eq!(moved, fb);
-            }
         }
     }
 

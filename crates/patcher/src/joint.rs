@@ -22,7 +22,7 @@
 //! ```text
 //! γ^P_r, γ^C_r      r = 0 … last − first     the free changes of the coefficients of the
 //!                                            analysis splines of P and C on the window
-//!                                            (crate::hermite's reduced form: one per
+//!                                            (crate::window: one per
 //!                                            movable point; the fixed points' values and
 //!                                            the window's end conditions are eliminated),
 //!                                            interleaved P, C along the path
@@ -48,7 +48,7 @@
 //! ```
 //!
 //! with `(v, a, j) = (1 − margin)·(V/F, A/F², J/F³)` per axis ([`GeomLimits`]), less what
-//! rounding the written values can add (`Hermite::rounding_room`). The constraints are
+//! rounding the written values can add (`Window::rounding_room`). The constraints are
 //! linear in the values (hence in δ); the objective is not convex. It is solved by
 //! sequential convex programming: at the iterate `(P̄, C̄) = base + δ̄` the tool axis is
 //! linearised, `fk(P̂ + δP, Ĉ + δC) ≈ ō + a·(δP − δ̄P) + b·(δC − δ̄C)` with `ō = fk(P̄, C̄)`,
@@ -91,16 +91,18 @@
 
 use crate::{
     candidate::PatchFailure,
-    hermite::{Aff, Hermite, JOINT_WINDOW_POINTS},
+    hermite::Aff,
     ipm::{IpmStatus, Problem},
     limits::GeomLimits,
+    qp::Row,
     report::{QpStats, QpStatus},
     settings::SolverSettings,
+    window::{JOINT_WINDOW_POINTS, Window},
 };
 use polepatch_kinematics::{Machine, angle_between_deg, forward, forward_jacobian};
 use std::time::Instant;
 
-pub use crate::hermite::RoundingMemo;
+pub use crate::window::WindowMemo;
 
 /// One joint solve's inputs. Every slice is per point of the whole path.
 #[derive(Debug, Clone)]
@@ -146,7 +148,7 @@ pub struct JointProblem<'a> {
     pub max_solves: u32,
     /// Where the rounding room of a window is kept between the solves of one zone
     /// (`None`: computed each time).
-    pub memo: Option<&'a RoundingMemo>,
+    pub memo: Option<&'a WindowMemo>,
     /// The numerical settings.
     pub settings: &'a SolverSettings,
 }
@@ -212,41 +214,43 @@ struct Model<'a> {
 impl<'a> Model<'a> {
     fn new(pr: &'a JointProblem<'a>) -> Result<Model<'a>, PatchFailure> {
         let (first, last) = (pr.first, pr.last);
-        let reduced = |y: &'a [f64], offset: usize| {
-            Hermite::with_offset(pr.s_mm, y, first, last, JOINT_WINDOW_POINTS, 0)?
-                .reduced(offset, 2)
+        let n = pr.s_mm.len();
+        let owned;
+        let win: &Window = match pr.memo {
+            Some(m) => {
+                owned = m.get(pr.s_mm, first, last)?;
+                &owned
+            }
+            None => {
+                owned = std::rc::Rc::new(Window::new(pr.s_mm, first, last, JOINT_WINDOW_POINTS)?);
+                &owned
+            }
         };
-        let (hp, hc) = (reduced(pr.p_deg, 0)?, reduced(pr.c_deg, 1)?);
-        let nb = 2 * (last - first + 1);
-        // The spline before (what "not worse" compares with): the base's, or the
-        // reference's on the same window.
-        let before = |y: &'a [f64]| {
-            Hermite::with_offset(pr.s_mm, y, first, last, JOINT_WINDOW_POINTS, 0)?
-                .coefficient_form()
-        };
-        let refs = match pr.reference {
-            None => None,
-            Some((rp, rc)) => Some((before(rp)?, before(rc)?)),
-        };
-        let (bp, bc) = match &refs {
-            None => (&hp, &hc),
-            Some((a, b)) => (a, b),
-        };
-        let (rp, rc) = (
-            hp.rounding_room(pr.round_p_deg, pr.memo)?,
-            hc.rounding_room(pr.round_c_deg, pr.memo)?,
+        let nb = 2 * win.unknowns();
+        // The start's splines (the unknowns are changes of their coefficients) and the
+        // splines before (what "not worse" compares with): the start's, or the reference's.
+        let (cp, cc) = (
+            win.coeffs(pr.s_mm, pr.p_deg)?,
+            win.coeffs(pr.s_mm, pr.c_deg)?,
         );
-        let mut rows: Vec<(Aff, f64)> = Vec::new();
-        hp.push_limits(bp, &mut rows, &pr.lim_p, &rp, pr.core.clone());
-        hc.push_limits(bc, &mut rows, &pr.lim_c, &rc, pr.core.clone());
+        let (bp, bc) = match pr.reference {
+            None => (cp.clone(), cc.clone()),
+            Some((rp, rc)) => (win.coeffs(pr.s_mm, rp)?, win.coeffs(pr.s_mm, rc)?),
+        };
+        let mut rows: Vec<(Row, f64, f64)> = Vec::new();
+        // P's unknowns at even indices, C's at odd ones: interleaved along the path.
+        for (c, b, lim, round, offset) in [
+            (&cp, &bp, &pr.lim_p, pr.round_p_deg, 0),
+            (&cc, &bc, &pr.lim_c, pr.round_c_deg, 1),
+        ] {
+            let room = win.rounding_room(round);
+            win.limit_rows(n, c, b, lim, &room, pr.core.clone(), offset, 2, &mut rows);
+        }
         let limits = rows
             .into_iter()
-            .map(|(f, b)| Aff {
-                row: crate::qp::compact(&f.row)
-                    .into_iter()
-                    .map(|(j, v)| (j, v / b))
-                    .collect(),
-                c: f.c / b,
+            .map(|(row, c, b)| Aff {
+                row: row.into_iter().map(|(j, v)| (j, v / b)).collect(),
+                c: c / b,
             })
             .collect();
         // The machine's ranges as bounds on each point's changes; the trust region
@@ -265,10 +269,9 @@ impl<'a> Model<'a> {
             .collect();
         let deltas = (first..=last)
             .map(|i| {
-                let (mut a, mut b) = (hp.delta(i), hc.delta(i));
-                a.row = crate::qp::compact(&a.row);
-                b.row = crate::qp::compact(&b.row);
-                (a, b)
+                let (rp, kp) = win.delta(i, &cp, pr.p_deg[i], 0, 2);
+                let (rc, kc) = win.delta(i, &cc, pr.c_deg[i], 1, 2);
+                (Aff { row: rp, c: kp }, Aff { row: rc, c: kc })
             })
             .collect();
         Ok(Model {

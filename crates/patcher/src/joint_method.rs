@@ -108,7 +108,7 @@ impl Proposer for JointMethod {
                 .max(z.first.saturating_sub(e0))
                 .max(e1.saturating_sub(z.last));
         }
-        let memo = crate::joint::RoundingMemo::default();
+        let memo = crate::joint::WindowMemo::default();
         loop {
             let Some((first, last)) = Self::range(ctx, extra) else {
                 return;
@@ -132,7 +132,7 @@ impl JointMethod {
     fn solve_range(
         ctx: &ZoneCtx<'_>,
         sink: &mut dyn Sink,
-        memo: &crate::joint::RoundingMemo,
+        memo: &crate::joint::WindowMemo,
         first: usize,
         last: usize,
         last_try: bool,

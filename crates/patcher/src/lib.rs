@@ -27,6 +27,7 @@ pub mod spline;
 #[cfg(test)]
 mod testutil;
 pub mod verify;
+pub(crate) mod window;
 
 pub use analysis::{AnalysisOptions, RunAnalysis, Sample, Zone, ZoneKind, analyze_path};
 pub use candidate::{Candidate, PatchFailure};

@@ -48,8 +48,8 @@ impl Problem {
         sys.assemble(&hmat, &d, &scal, &mut yscratch, delta, &mut unreg, &mut kkt);
         let mut x = vec![0.0; n];
         if kkt.factor() {
-            for j in 0..n {
-                rhs[j] = -self.c[j];
+            for (r, c) in rhs.iter_mut().zip(&self.c) {
+                *r = -c;
             }
             sys.gt_mul_add(hv, &mut rhs);
             sol.copy_from_slice(&rhs);
@@ -61,16 +61,13 @@ impl Problem {
         }
         let mut s = vec![0.0; mi];
         sys.g_mul(&x, &mut s);
-        for r in 0..mi {
-            s[r] = hv[r] - s[r];
+        for (sr, hr) in s.iter_mut().zip(hv) {
+            *sr = hr - *sr;
         }
         let mut z: Vec<f64> = s.iter().map(|v| -v).collect();
         // Shift into the interior: by 1 + the distance outside (the largest violation).
         let outside = |v: &[f64]| -> f64 {
-            let mut a = f64::NEG_INFINITY;
-            for r in 0..ml {
-                a = a.max(-v[r]);
-            }
+            let mut a = v[..ml].iter().fold(f64::NEG_INFINITY, |a, x| a.max(-x));
             for &(b0, q) in &blocks {
                 let tail = v[b0 + 1..b0 + q].iter().map(|t| t * t).sum::<f64>().sqrt();
                 a = a.max(tail - v[b0]);
@@ -81,9 +78,7 @@ impl Problem {
             let a = outside(v);
             if a >= -1e-8 || !a.is_finite() {
                 let shift = if a.is_finite() { 1.0 + a } else { 1.0 };
-                for r in 0..ml {
-                    v[r] += shift;
-                }
+                v[..ml].iter_mut().for_each(|x| *x += shift);
                 for &(b0, _) in &blocks {
                     v[b0] += shift;
                 }
@@ -93,31 +88,23 @@ impl Problem {
         let scale_c = 1.0 + inf_norm(&self.c);
         let (mut rd, mut rg, mut hx) = (vec![0.0; n], vec![0.0; mi], vec![0.0; n]);
         let mut lam = vec![0.0; mi];
-        let (mut u, mut w_r, mut dz, mut ds, mut gdx) = (
-            vec![0.0; mi],
-            vec![0.0; mi],
-            vec![0.0; mi],
-            vec![0.0; mi],
-            vec![0.0; mi],
-        );
+        let (mut w_r, mut dz, mut ds, mut gdx) =
+            (vec![0.0; mi], vec![0.0; mi], vec![0.0; mi], vec![0.0; mi]);
         let (mut dz_a, mut ds_a, mut rc) = (vec![0.0; mi], vec![0.0; mi], vec![0.0; mi]);
         let mut dx = vec![0.0; n];
         for it in 0..st.max_iter {
             // Residuals.
-            rd.copy_from_slice(&self.c);
-            hx.iter_mut().for_each(|v| *v = 0.0);
             hmat.mul(&x, &mut hx);
-            for j in 0..n {
-                rd[j] += hx[j];
+            for ((r, c), h) in rd.iter_mut().zip(&self.c).zip(&hx) {
+                *r = c + h;
             }
             sys.gt_mul_add(&z, &mut rd);
             sys.g_mul(&x, &mut rg);
-            for r in 0..mi {
-                rg[r] += s[r] - hv[r];
+            for ((r, sr), hr) in rg.iter_mut().zip(&s).zip(hv) {
+                *r += sr - hr;
             }
-            let mu = s.iter().zip(&z).map(|(a, b)| a * b).sum::<f64>() / degree;
-            let obj = 0.5 * hx.iter().zip(&x).map(|(a, b)| a * b).sum::<f64>()
-                + self.c.iter().zip(&x).map(|(a, b)| a * b).sum::<f64>();
+            let mu = dot(&s, &z) / degree;
+            let obj = 0.5 * dot(&hx, &x) + dot(&self.c, &x);
             if !(obj.is_finite() && mu.is_finite()) {
                 return IpmSolution {
                     x,
@@ -136,10 +123,16 @@ impl Problem {
                 };
             }
             // Scalings: linear slacks `V = z/s`, `W⁻¹ = sqrt(z/s)`; cones their `W`.
-            for r in 0..ml {
-                lam[r] = (s[r] * z[r]).sqrt();
-                d[r] = z[r] / s[r];
-                d_sqrt[r] = d[r].sqrt();
+            for ((((l, dr), dq), sr), zr) in lam[..ml]
+                .iter_mut()
+                .zip(d.iter_mut())
+                .zip(d_sqrt.iter_mut())
+                .zip(&s[..ml])
+                .zip(&z[..ml])
+            {
+                *l = (sr * zr).sqrt();
+                *dr = zr / sr;
+                *dq = dr.sqrt();
             }
             for (bi, &(b0, q)) in blocks.iter().enumerate() {
                 scal[bi] = soc_scaling(&s[b0..b0 + q], &z[b0..b0 + q], &mut lam[b0..b0 + q]);
@@ -155,22 +148,28 @@ impl Problem {
             // One Newton solve for the complementarity residual `rc` (module docs, with
             // u = λ \ (−r_c), w = V·r_g + W⁻¹·u): the steps dx, dz, ds.
             let mut newton = |rc: &[f64], dz: &mut [f64], ds: &mut [f64], dx: &mut [f64]| {
-                for r in 0..ml {
-                    u[r] = -rc[r] / lam[r];
-                    // V·r_g + W⁻¹·u with V = z/s, W⁻¹ = sqrt(z/s).
-                    w_r[r] = d[r] * rg[r] + d_sqrt[r] * u[r];
+                // Linear slacks: u = −r_c/λ, w = V·r_g + W⁻¹·u with V = z/s, W⁻¹ = √(z/s).
+                for (((((wr, rcr), l), dr), dq), g) in w_r[..ml]
+                    .iter_mut()
+                    .zip(&rc[..ml])
+                    .zip(&lam[..ml])
+                    .zip(&d)
+                    .zip(&d_sqrt)
+                    .zip(&rg[..ml])
+                {
+                    *wr = dr * g + dq * (-rcr / l);
                 }
                 for (bi, &(b0, q)) in blocks.iter().enumerate() {
-                    let mut neg = [0.0; MAX_CONE];
+                    let (mut neg, mut u) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
                     for (dd, v) in neg.iter_mut().zip(&rc[b0..b0 + q]) {
                         *dd = -v;
                     }
-                    soc_div(&lam[b0..b0 + q], &neg[..q], &mut u[b0..b0 + q]);
+                    soc_div(&lam[b0..b0 + q], &neg[..q], &mut u[..q]);
                     // W⁻¹·(W⁻¹·r_g + u).
                     let mut t = [0.0; MAX_CONE];
                     scal[bi].apply_inv(&rg[b0..b0 + q], &mut t[..q]);
                     for a in 0..q {
-                        t[a] += u[b0 + a];
+                        t[a] += u[a];
                     }
                     scal[bi].apply_inv(&t[..q], &mut w_r[b0..b0 + q]);
                 }
@@ -184,11 +183,11 @@ impl Problem {
                 refine(&kkt, &unreg, &rhs, &mut sol, &mut tmp, st.refinement_steps);
                 dx.copy_from_slice(&sol);
                 sys.g_mul(dx, &mut gdx);
-                for r in 0..mi {
-                    ds[r] = -rg[r] - gdx[r];
+                for ((dsr, g), gd) in ds.iter_mut().zip(&rg).zip(&gdx) {
+                    *dsr = -g - gd;
                 }
-                for r in 0..ml {
-                    dz[r] = d[r] * gdx[r] + w_r[r];
+                for (((dzr, dr), gd), wr) in dz[..ml].iter_mut().zip(&d).zip(&gdx[..ml]).zip(&w_r) {
+                    *dzr = dr * gd + wr;
                 }
                 for (bi, &(b0, q)) in blocks.iter().enumerate() {
                     let (mut t, mut t2) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
@@ -201,9 +200,9 @@ impl Problem {
             };
             let max_step = |v: &[f64], dv: &[f64]| -> f64 {
                 let mut a = f64::INFINITY;
-                for r in 0..ml {
-                    if dv[r] < 0.0 {
-                        a = a.min(-v[r] / dv[r]);
+                for (vr, dr) in v[..ml].iter().zip(&dv[..ml]) {
+                    if *dr < 0.0 {
+                        a = a.min(-vr / dr);
                     }
                 }
                 for &(b0, q) in &blocks {
@@ -212,8 +211,8 @@ impl Problem {
                 a
             };
             // Predictor: r_c = λ∘λ.
-            for r in 0..ml {
-                rc[r] = lam[r] * lam[r];
+            for (r, l) in rc[..ml].iter_mut().zip(&lam[..ml]) {
+                *r = l * l;
             }
             for &(b0, q) in &blocks {
                 let mut l = [0.0; MAX_CONE];
@@ -222,8 +221,11 @@ impl Problem {
             }
             newton(&rc, &mut dz_a, &mut ds_a, &mut dx);
             let a_aff = max_step(&s, &ds_a).min(max_step(&z, &dz_a)).min(1.0);
-            let mu_aff = (0..mi)
-                .map(|r| (s[r] + a_aff * ds_a[r]) * (z[r] + a_aff * dz_a[r]))
+            let mu_aff = s
+                .iter()
+                .zip(&ds_a)
+                .zip(z.iter().zip(&dz_a))
+                .map(|((sr, dsr), (zr, dzr))| (sr + a_aff * dsr) * (zr + a_aff * dzr))
                 .sum::<f64>()
                 / degree;
             let sigma = if mu > 0.0 {
@@ -232,8 +234,14 @@ impl Problem {
                 0.0
             };
             // Corrector: r_c = λ∘λ + (W⁻ᵀ·ds_a)∘(W·dz_a) − σ·μ·e.
-            for r in 0..ml {
-                rc[r] = lam[r] * lam[r] + ds_a[r] * dz_a[r] - sigma * mu;
+            let smu = sigma * mu;
+            for (((r, l), dsr), dzr) in rc[..ml]
+                .iter_mut()
+                .zip(&lam[..ml])
+                .zip(&ds_a[..ml])
+                .zip(&dz_a[..ml])
+            {
+                *r = l * l + dsr * dzr - smu;
             }
             for (bi, &(b0, q)) in blocks.iter().enumerate() {
                 let (mut sd, mut zd) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
@@ -247,7 +255,7 @@ impl Problem {
                 for a in 0..q {
                     rc[b0 + a] = ll[a] + sz[a];
                 }
-                rc[b0] -= sigma * mu;
+                rc[b0] -= smu;
             }
             newton(&rc, &mut dz, &mut ds, &mut dx);
             let alpha = (st.step_fraction * max_step(&s, &ds).min(max_step(&z, &dz))).min(1.0);
@@ -258,16 +266,16 @@ impl Problem {
                     iterations: it,
                 };
             }
-            for j in 0..n {
-                x[j] += alpha * dx[j];
+            for (xj, dj) in x.iter_mut().zip(&dx) {
+                *xj += alpha * dj;
             }
-            for r in 0..mi {
-                s[r] += alpha * ds[r];
-                z[r] += alpha * dz[r];
+            for ((sr, dsr), (zr, dzr)) in s.iter_mut().zip(&ds).zip(z.iter_mut().zip(&dz)) {
+                *sr += alpha * dsr;
+                *zr += alpha * dzr;
             }
-            for r in 0..ml {
-                s[r] = s[r].max(1e-300);
-                z[r] = z[r].max(1e-300);
+            for (sr, zr) in s[..ml].iter_mut().zip(z[..ml].iter_mut()) {
+                *sr = sr.max(1e-300);
+                *zr = zr.max(1e-300);
             }
         }
         IpmSolution {
@@ -276,6 +284,10 @@ impl Problem {
             iterations: st.max_iter,
         }
     }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 #[cfg(test)]
