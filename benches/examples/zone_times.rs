@@ -38,6 +38,7 @@ fn main() {
                 "joint_range_zone_factor" => solver.joint_range_zone_factor = f,
                 "scp_max_solves" => solver.scp_max_solves = f as u32,
                 "screen_solves" => solver.screen_solves = f as u32,
+                "screen_keep" => solver.screen_keep = f as usize,
                 "scp_rel_tol" => solver.scp_rel_tol = f,
                 "ipm_tol" => {
                     solver.ipm.tol_feas = f;

@@ -15,9 +15,12 @@
 //!   the range is wide enough to hold the cone stretch;
 //!   FREEZE's and LINEARIZE's rules across the cone (C held at its entry value, or linear
 //!   in s, P on C's meridian: [`crate::peers`]) pass through the pole inside the range; the
-//!   program's own values are the last start. Each start gets
-//!   [`SolverSettings::screen_solves`] solves; the better (less excess over the limits, then
-//!   smaller deviation) goes on warm for the rest of [`SolverSettings::scp_max_solves`].
+//!   program's own values are the last start. Every start gets one solve; the
+//!   [`SolverSettings::screen_keep`] best (less excess over the limits, then smaller
+//!   deviation) go on for the rest of [`SolverSettings::screen_solves`], and the best of
+//!   those for the rest of [`SolverSettings::scp_max_solves`]. A start's later solves go on
+//!   from its solution and compare "not worse" with what its first did (the program's
+//!   values, or for the other branch its own).
 //! - **Proposals.** The refined solution, then the other start's; and, with
 //!   `max_deviation_deg` when nothing within it passed, the capped solve from each start
 //!   that keeps every tool axis — the program's values and the other branch (the least
@@ -214,9 +217,10 @@ impl JointMethod {
         let lim_p = GeomLimits::of(ctx.machine, Axis::Primary, ctx.feed_mm_min, ctx.margin);
         let lim_c = GeomLimits::of(ctx.machine, Axis::C, ctx.feed_mm_min, ctx.margin);
         let round_deg = 0.5 * 10f64.powi(-(ctx.opts.max_decimals as i32));
+        // `before`: what "not worse" compares with (None: the start's own values).
         let problem = |sp: &'_ [f64],
                        sc: &'_ [f64],
-                       rule: bool,
+                       before: Option<(&'_ [f64], &'_ [f64])>,
                        cap: Option<f64>,
                        warm: bool,
                        solves: u32| {
@@ -233,7 +237,7 @@ impl JointMethod {
                 core: ctx.core.clone(),
                 round_p_deg: round_deg,
                 round_c_deg: round_deg,
-                reference: rule.then_some((p, c)),
+                reference: before,
                 cap_deg: cap,
                 warm,
                 max_solves: solves,
@@ -242,16 +246,56 @@ impl JointMethod {
             };
             solve_joint(&pr)
         };
-        // Screen every start, then refine the best.
+        // More solves from a start's solution, with the same "before" as its first solves:
+        // the program's values for a rule's start, else the start's own values.
+        let go_on = |s0: &Start, sol: &JointSolution, solves: u32| {
+            let (mut wp, mut wc) = (s0.p.clone(), s0.c.clone());
+            wp[first..=last].copy_from_slice(&sol.p_deg);
+            wc[first..=last].copy_from_slice(&sol.c_deg);
+            let warm = sol.excess <= st.elastic_tol;
+            let before = if s0.rule {
+                (p, c)
+            } else {
+                (s0.p.as_slice(), s0.c.as_slice())
+            };
+            problem(&wp, &wc, Some(before), None, warm, solves)
+        };
+        // Within the limits first (by deviation), then the least excess.
+        let key = |s: &JointSolution| {
+            if s.excess <= st.elastic_tol {
+                (0u8, s.max_deviation_deg)
+            } else {
+                (1u8, s.excess)
+            }
+        };
+        let rank = |v: &mut Vec<(usize, JointSolution)>| {
+            v.sort_by(|a, b| {
+                key(&a.1)
+                    .partial_cmp(&key(&b.1))
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            })
+        };
+        // Add `more` (solves from `sol`) to `sol` when it is better; its solves count.
+        let keep_better = |sol: &mut JointSolution, more: JointSolution| {
+            let mut qp = sol.qp.clone();
+            crate::qp::add_stats(&mut qp, &more.qp);
+            if key(&more) < key(sol) {
+                *sol = JointSolution { qp, ..more };
+            } else {
+                sol.qp = qp;
+            }
+        };
+        // Screen: one solve from every start; the `screen_keep` best go on for the rest of
+        // `screen_solves`; then the best is refined up to `scp_max_solves`.
         let screen = st.screen_solves.min(st.scp_max_solves).max(1);
         let mut screened: Vec<(usize, JointSolution)> = Vec::new();
         for (i, s0) in starts.iter().enumerate() {
             let solves = if starts.len() == 1 {
                 st.scp_max_solves
             } else {
-                screen
+                1
             };
-            match problem(&s0.p, &s0.c, s0.rule, None, false, solves) {
+            match problem(&s0.p, &s0.c, s0.rule.then_some((p, c)), None, false, solves) {
                 Ok(sol) => {
                     let perfect = sol.excess <= st.elastic_tol && sol.max_deviation_deg <= 1e-9;
                     screened.push((i, sol));
@@ -263,37 +307,24 @@ impl JointMethod {
                 Err(_) => {}
             }
         }
-        // Within the limits first (by deviation), then the least excess.
-        let key = |s: &JointSolution| {
-            if s.excess <= st.elastic_tol {
-                (0u8, s.max_deviation_deg)
-            } else {
-                (1u8, s.excess)
-            }
-        };
-        screened.sort_by(|a, b| {
-            key(&a.1)
-                .partial_cmp(&key(&b.1))
-                .unwrap_or(std::cmp::Ordering::Equal)
-        });
-        if starts.len() > 1
-            && let Some((i, sol)) = screened.first_mut()
-            && st.scp_max_solves > screen
-        {
-            let s0 = &starts[*i];
-            let (mut wp, mut wc) = (s0.p.clone(), s0.c.clone());
-            wp[first..=last].copy_from_slice(&sol.p_deg);
-            wc[first..=last].copy_from_slice(&sol.c_deg);
-            let warm = sol.excess <= st.elastic_tol;
-            if let Ok(refined) = problem(&wp, &wc, s0.rule, None, warm, st.scp_max_solves - screen)
-            {
-                let mut qp = sol.qp.clone();
-                crate::qp::add_stats(&mut qp, &refined.qp);
-                if key(&refined) < key(sol) {
-                    *sol = JointSolution { qp, ..refined };
-                } else {
-                    sol.qp = qp;
+        rank(&mut screened);
+        let perfect = screened
+            .first()
+            .is_some_and(|(_, s)| s.excess <= st.elastic_tol && s.max_deviation_deg <= 1e-9);
+        if starts.len() > 1 && !perfect {
+            if screen > 1 {
+                for (i, sol) in screened.iter_mut().take(st.screen_keep.max(1)) {
+                    if let Ok(more) = go_on(&starts[*i], sol, screen - 1) {
+                        keep_better(sol, more);
+                    }
                 }
+                rank(&mut screened);
+            }
+            if let Some((i, sol)) = screened.first_mut()
+                && st.scp_max_solves > screen
+                && let Ok(more) = go_on(&starts[*i], sol, st.scp_max_solves - screen)
+            {
+                keep_better(sol, more);
             }
         }
         // The best solution's values (whole path) and its start's tail, for a capped solve.
@@ -349,7 +380,14 @@ impl JointMethod {
                 .map(|b| (b, true))
                 .chain(starts.iter().filter(|s0| !s0.rule).map(|s0| (s0, false)));
             for (s0, warm) in capped {
-                match problem(&s0.p, &s0.c, s0.rule, Some(cap), warm, st.scp_max_solves) {
+                match problem(
+                    &s0.p,
+                    &s0.c,
+                    s0.rule.then_some((p, c)),
+                    Some(cap),
+                    warm,
+                    st.scp_max_solves,
+                ) {
                     Ok(sol) => {
                         sink.offer(Proposal {
                             method: Method::Joint,

@@ -30,10 +30,13 @@ pub struct SolverSettings {
     pub joint_range_zone_factor: f64,
     /// Most SCP solves from the chosen start. Default 6.
     pub scp_max_solves: u32,
-    /// Solves each start gets when several are screened (the best then goes on): one
-    /// solve from a start far outside the limits does not rank the starts well (on the
-    /// held-out-like zones one gave 1.47× the reference, two 1.11×). Default 2.
+    /// Solves a start gets when several are screened (the best then goes on): the first
+    /// from every start, the rest only for the [`SolverSettings::screen_keep`] best after
+    /// one (one solve from a start far outside the limits does not rank the starts well
+    /// enough to keep only one). Default 2.
     pub screen_solves: u32,
+    /// Starts that go on screening after their first solve. Default 2.
+    pub screen_keep: usize,
     /// An accepted step that lowers the exact largest deviation by less than this fraction
     /// ends the SCP. Default 0.01.
     pub scp_rel_tol: f64,
@@ -89,6 +92,7 @@ impl Default for SolverSettings {
             joint_range_zone_factor: 1.0,
             scp_max_solves: 6,
             screen_solves: 2,
+            screen_keep: 2,
             scp_rel_tol: 0.01,
             first_trust_p_deg: 15.0,
             first_trust_c_deg: 180.0,
