@@ -201,11 +201,17 @@ impl Machine {
                 builtins: Machine::builtin_names().join(", "),
             });
         }
+        Machine::from_file(path)
+    }
+    /// A machine file at `path` (never a built-in name), read as [`Machine::load`] reads
+    /// it: at most [`MAX_MACHINE_FILE_BYTES`].
+    pub fn from_file(path: &std::path::Path) -> Result<Machine, MachineError> {
+        let name = path.display().to_string();
         let text = read_bounded(path).map_err(|cause| MachineError::Io {
-            path: name_or_path.to_string(),
+            path: name.clone(),
             cause,
         })?;
-        Machine::from_toml_str(&text, name_or_path)
+        Machine::from_toml_str(&text, &name)
     }
     /// Letter of the primary axis in NC words (`'A'` or `'B'`).
     pub fn primary_letter(&self) -> char {

@@ -13,12 +13,13 @@
 //! | `LN …` | 3D-compensated line with normal vectors: a move that ends runs |
 //! | `TOOL CALL 5 Z S12000` | tool change; `TOOL DEF`: ends runs |
 //! | `BLK FORM 0.1 Z X+0 Y+0 Z-40` | blank definition: not a move |
-//! | `CYCL DEF 7.x` (datum shift), `247` (datum setting), `8`, `10`, `11`, `19`, `26` | frame changes (positions unknown after) |
+//! | `CYCL DEF 7.x` (datum shift), `247` (datum setting), `8`, `10`, `11`, `19`, `26` | frame changes (positions unknown after); `8.1`, `10.1`, `11.1`, `19.1`, `26.1` switch a mirror image, rotation or scaling on, or off where their values are the identity ([`crate::modal::transform`]) |
 //! | `CYCL DEF` (other), `CYCL CALL`, `M99` | cycle definition ends runs; a cycle call moves the tool (positions unknown after) |
-//! | `LBL n`, `CALL LBL n`, `CALL PGM` | a label may be reached by a jump, a call runs other blocks: positions unknown after |
-//! | `FN 0..8`, `Q1 = …` | parameter arithmetic: ends runs; `FN 9..12` (jumps): positions unknown after |
+//! | `LBL n`, `LBL "NAME"`, `LBL 0`, `CALL LBL n [REP m]`, `CALL PGM`, `SEL PGM` | labels, returns and calls ([`crate::flow`]): positions unknown after; TCPM as the file's flow settles it |
+//! | `FN 0..8`, `Q1 = …` | parameter arithmetic: ends runs; `FN 9..12: IF … GOTO LBL n` (conditional jumps, [`crate::flow`]): positions unknown after |
+//! | `TRANS MIRROR/ROTATION/SCALE/DATUM …` (`… RESET`) | TNC7 frames: frame changes, transformations on (off) |
 //! | `FUNCTION TCPM …`, `FUNCTION RESET TCPM`, `M128`, `M129` | TCPM on / off |
-//! | `PLANE …` | tilted working plane: a frame change (positions unknown after) |
+//! | `PLANE …` | tilted working plane: a frame change and a rotation (positions unknown after); `PLANE RESET` ends the rotation |
 //! | `STOP`, `TCH PROBE`, anything else | ends runs; lines polepatch does not model leave positions unknown and are flagged |
 //! | `* - text`, `; text` | comments |
 //!
@@ -26,8 +27,10 @@
 //! analysable (positions unknown after it), never the file.
 
 use crate::error::ParseError;
+use crate::flow::{Key, Stmt};
 use crate::interp::{Interpreter, Scan, function};
 use crate::lexer::parse_number;
+use crate::modal::transform;
 use crate::modal::{A, AXES, B, C, Motion};
 use crate::program::{Flags, Word};
 use crate::tcpm::code10;
@@ -335,10 +338,15 @@ pub(crate) fn lex(
         b"CYCL" => {
             if second == b"DEF" {
                 let number = rest.get(1).map(|t| upper(bytes, t)).unwrap_or_default();
-                let major = number.split(|&c| c == b'.').next().unwrap_or_default();
+                let mut parts = number.split(|&c| c == b'.');
+                let major = parts.next().unwrap_or_default();
+                let minor = parts.next().unwrap_or_default();
                 if matches!(major, b"7" | b"247" | b"8" | b"10" | b"11" | b"19" | b"26") {
                     s.datum_shift = true;
                     s.unknown_after = true;
+                    if minor == b"1" {
+                        cycle_transform(major, &upper_tokens(bytes, &rest[2..]), &mut s);
+                    }
                 } else {
                     s.no_move = true;
                 }
@@ -347,9 +355,53 @@ pub(crate) fn lex(
             }
             s.breaks = true;
         }
-        b"LBL" | b"CALL" | b"TCH" => {
+        b"TCH" => {
             s.unknown_after = true;
             s.breaks = true;
+        }
+        b"LBL" => {
+            let name = rest
+                .first()
+                .map(|t| label_name(bytes, t))
+                .unwrap_or_default();
+            s.flow = Some(if name == "0" {
+                Stmt::Return {
+                    falls_through: true,
+                }
+            } else {
+                Stmt::Label(Key::Label(name))
+            });
+        }
+        b"CALL" => {
+            s.flow = Some(if second == b"LBL" {
+                let name = rest
+                    .get(1)
+                    .map(|t| label_name(bytes, t))
+                    .unwrap_or_default();
+                if name.starts_with('Q') {
+                    Stmt::Opaque
+                } else {
+                    let rep = rest.iter().position(|t| upper(bytes, t) == b"REP");
+                    let times = rep
+                        .and_then(|k| rest.get(k + 1))
+                        .map(|t| upper(bytes, t))
+                        .and_then(|t| crate::lexer::parse_number(&t));
+                    Stmt::Call {
+                        key: Key::Label(name),
+                        repeats: rep.is_some() && times != Some(0.0),
+                    }
+                }
+            } else {
+                // CALL PGM, CALL SELECTED PGM: a program outside the file.
+                Stmt::External
+            });
+        }
+        b"SEL" => {
+            if second == b"PGM" {
+                s.flow = Some(Stmt::External);
+            } else {
+                s.breaks = true;
+            }
         }
         b"FN" => {
             let n = rest
@@ -364,7 +416,18 @@ pub(crate) fn lex(
                 })
                 .unwrap_or(0);
             if (9..=12).contains(&n) {
-                s.unknown_after = true;
+                // `FN 9: IF +Q1 EQU +0 GOTO LBL 5`: a conditional jump.
+                let goto = rest.iter().position(|t| upper(bytes, t) == b"GOTO");
+                let name = goto
+                    .and_then(|k| rest.get(k + 2))
+                    .map(|t| label_name(bytes, t));
+                s.flow = Some(match name {
+                    Some(name) if !name.starts_with('Q') && !name.is_empty() => Stmt::Jump {
+                        key: Key::Label(name),
+                        cond: true,
+                    },
+                    _ => Stmt::Opaque,
+                });
             }
             s.breaks = true;
         }
@@ -374,6 +437,32 @@ pub(crate) fn lex(
             s.datum_shift = true;
             s.unknown_after = true;
             s.breaks = true;
+            // A tilted working plane rotates the frame; `PLANE RESET` ends it.
+            if second == b"RESET" {
+                s.transform_off |= transform::ROTATION;
+            } else {
+                s.transform_on |= transform::ROTATION;
+            }
+        }
+        b"TRANS" => {
+            // TNC7 frames: `TRANS DATUM …`, `TRANS MIRROR …`, `TRANS ROTATION …`,
+            // `TRANS SCALE …`; `… RESET` ends them.
+            s.datum_shift = true;
+            s.unknown_after = true;
+            s.breaks = true;
+            let reset = rest.iter().any(|t| upper(bytes, t) == b"RESET");
+            let bit = match second.as_slice() {
+                b"MIRROR" => transform::MIRROR,
+                b"ROTATION" => transform::ROTATION,
+                b"SCALE" | b"SCALING" => transform::SCALING,
+                b"DATUM" => 0,
+                _ => transform::ALL,
+            };
+            if reset {
+                s.transform_off |= bit;
+            } else {
+                s.transform_on |= bit;
+            }
         }
         b"STOP" => {
             s.breaks = true;
@@ -388,11 +477,69 @@ pub(crate) fn lex(
             s.breaks = true;
         }
     }
-    if s.axes_expr != 0 || s.feed_expr {
-        s.flags.set(Flags::NOT_ANALYSABLE);
-        s.breaks = true;
-    }
+    crate::interp::after_lex(bytes, &span, &mut s);
     Ok(s)
+}
+
+/// A label's name as `LBL` and `CALL LBL` write it: a number, or a quoted name (upper case).
+fn label_name(bytes: &[u8], t: &Range<usize>) -> String {
+    let text = upper(bytes, t);
+    let text = text.strip_prefix(b"\"").unwrap_or(&text);
+    let text = text.strip_suffix(b"\"").unwrap_or(text);
+    String::from_utf8_lossy(text).into_owned()
+}
+
+/// The upper-case text of tokens.
+fn upper_tokens(bytes: &[u8], toks: &[Range<usize>]) -> Vec<Vec<u8>> {
+    toks.iter().map(|t| upper(bytes, t)).collect()
+}
+
+/// What the `.1` line of a frame cycle does (`CYCL DEF 8.1 X Y`, `10.1 ROT+30`,
+/// `11.1 SCL 0.8`, `26.1 X1.5 CCX+0`, `19.1 A+0 B+45`): a transformation on, or off where
+/// its values are the identity.
+fn cycle_transform(major: &[u8], toks: &[Vec<u8>], s: &mut Scan) {
+    let number_after = |t: &[u8], k: usize| crate::lexer::parse_number(&t[k..]);
+    let (bit, identity) = match major {
+        // Mirror image: the axes named (none: off).
+        b"8" => (transform::MIRROR, toks.is_empty()),
+        b"10" => (
+            transform::ROTATION,
+            toks.iter()
+                .filter(|t| t.starts_with(b"ROT"))
+                .all(|t| number_after(t, 3) == Some(0.0)),
+        ),
+        b"11" => {
+            // `SCL 0.8` or `SCL0.8`.
+            let v = toks.iter().enumerate().find_map(|(k, t)| {
+                t.strip_prefix(b"SCL").and_then(|r| {
+                    if r.is_empty() {
+                        toks.get(k + 1).and_then(|n| crate::lexer::parse_number(n))
+                    } else {
+                        crate::lexer::parse_number(r)
+                    }
+                })
+            });
+            (transform::SCALING, v == Some(1.0))
+        }
+        b"26" => (
+            transform::SCALING,
+            toks.iter()
+                .filter(|t| matches!(t.first(), Some(b'X' | b'Y' | b'Z')))
+                .all(|t| number_after(t, 1) == Some(1.0)),
+        ),
+        b"19" => (
+            transform::ROTATION,
+            toks.iter()
+                .filter(|t| matches!(t.first(), Some(b'A' | b'B' | b'C')))
+                .all(|t| number_after(t, 1) == Some(0.0)),
+        ),
+        _ => (0, true),
+    };
+    if identity {
+        s.transform_off |= bit;
+    } else {
+        s.transform_on |= bit;
+    }
 }
 
 #[cfg(test)]

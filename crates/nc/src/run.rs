@@ -39,6 +39,9 @@ pub struct Run {
     /// TCPM state during the run (only [`crate::Tcpm::On`] allows changing rotary words
     /// alone).
     pub tcpm: crate::Tcpm,
+    /// Frame transformations in force during the run (bits of [`crate::modal::transform`]:
+    /// rotation, scaling, mirror image); 0 where none.
+    pub transform: u8,
     /// Why the run ended.
     pub ended_by: RunBreak,
 }
@@ -120,6 +123,7 @@ impl RunBuilder {
             feed_mode: st.feed_mode,
             block_feed_mm_min: Vec::new(),
             tcpm: st.tcpm,
+            transform: st.transform,
             ended_by: RunBreak::End,
         }
     }
@@ -147,12 +151,15 @@ impl RunBuilder {
                         self.cur = Some(Self::start(i, st));
                     } else {
                         if let Some(r) = &mut self.cur
-                            && (r.feed_mm_min != st.feed_mm_min || r.tcpm != st.tcpm)
+                            && (r.feed_mm_min != st.feed_mm_min
+                                || r.tcpm != st.tcpm
+                                || r.transform != st.transform)
                         {
                             if r.len() == 1 {
                                 r.feed_mm_min = st.feed_mm_min;
                                 r.feed_mode = st.feed_mode;
                                 r.tcpm = st.tcpm;
+                                r.transform = st.transform;
                             } else {
                                 self.finish_run(RunBreak::FeedChange, emit);
                             }
@@ -163,6 +170,7 @@ impl RunBuilder {
                             r.feed_mm_min = st.feed_mm_min;
                             r.feed_mode = st.feed_mode;
                             r.tcpm = st.tcpm;
+                            r.transform = st.transform;
                             r
                         });
                         // A rotary axis first programmed by this move: its motion over the

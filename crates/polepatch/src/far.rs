@@ -71,7 +71,7 @@ pub fn far_from_pole(
     let read = crate::program::read_options(machine)?;
     let mut notes = crate::notes::Notes::new();
     let mut prev = polepatch_nc::modal::initial(&read.controller);
-    scan_blocks_with(bytes, &read, |s| {
+    let settled = scan_blocks_with(bytes, &read, |s| {
         let (block, st) = (s.block, s.state);
         notes.push(block, s.words, &prev, st);
         prev = *st;
@@ -87,7 +87,9 @@ pub fn far_from_pole(
         }
     })
     .map_err(|e| crate::Error::Parse(e.with_path(&opts.name)))?;
-    if near {
+    // Program flow settles TCPM only on a second read: the full path does it (whether a
+    // point is near the pole does not depend on it, but the report's notes may).
+    if near || matches!(settled, polepatch_nc::Settled::Again(_)) {
         return Ok(None);
     }
     builder.finish(&mut |run| take(run, &mut seen));

@@ -310,6 +310,26 @@ pub enum UntouchedReason {
     FeedTooLow,
     /// A rotary axis moves while its value at some point is unknown.
     UnknownRotary,
+    /// The file does not settle whether TCPM is on (after a call of code outside it, where
+    /// a jump, a label or a loop joins different states, after `TRACON`/`G43.8`:
+    /// [`polepatch_nc::flow`]): X Y Z may be machine coordinates.
+    TcpmUnknown,
+    /// A rotation, scaling or mirror image of the frame is in force (`G68`, `G51`, `G51.1`,
+    /// Heidenhain `G73`/`G72`/`G28`, `CYCL DEF 8/10/11/19/26`, `PLANE`, Sinumerik
+    /// `ROT`/`SCALE`/`MIRROR`, `CYCLE800`): the program's X Y Z and tool axis are not the
+    /// frame polepatch computes in.
+    FrameTransformed,
+}
+
+impl UntouchedReason {
+    /// The reason a zone of such a run reports, where it says more than `not_patched`.
+    pub fn zone_reason(self) -> Option<&'static str> {
+        match self {
+            UntouchedReason::TcpmUnknown => Some("tcpm_unknown"),
+            UntouchedReason::FrameTransformed => Some("frame_transformed"),
+            _ => None,
+        }
+    }
 }
 
 /// A run left byte-identical, and why.
@@ -412,7 +432,9 @@ impl FileReport {
             .filter(|u| {
                 matches!(
                     u.reason,
-                    UntouchedReason::NoTcpm | UntouchedReason::TcpmUncertain
+                    UntouchedReason::NoTcpm
+                        | UntouchedReason::TcpmUncertain
+                        | UntouchedReason::TcpmUnknown
                 ) && u.zones > 0
             })
             .count()
@@ -508,7 +530,23 @@ pub fn patch_program(
             .as_ref()
             .and_then(|ch| machine_frame::run_datum(lp, r, lp.work_offset_mm).map(|d| (ch, d)));
         let inch = rp.run.blocks.iter().any(|&b| program.state(b).inch);
-        let leave = if rp.run.tcpm == Tcpm::Uncertain {
+        let leave = if rp.run.transform != 0 {
+            Some((
+                UntouchedReason::FrameTransformed,
+                "a rotation, scaling or mirror image of the frame is in force (G68, G51, G51.1, \
+                 G73/G72/G28 in Heidenhain ISO, CYCL DEF 8/10/11/19/26, PLANE, ROT/SCALE/MIRROR, \
+                 CYCLE800): the program's X Y Z and tool axis are not in the frame polepatch \
+                 computes in, so the run is left as it is",
+            ))
+        } else if rp.run.tcpm == Tcpm::Unknown {
+            Some((
+                UntouchedReason::TcpmUnknown,
+                "whether TCPM is on here is not settled by the file: the run follows a call of \
+                 code outside it, a label or a jump where ways with different TCPM states meet, \
+                 or a code whose effect on TCPM polepatch does not know (TRACON, G43.8); X Y Z \
+                 may be machine coordinates, so the run is left as it is",
+            ))
+        } else if rp.run.tcpm == Tcpm::Uncertain {
             Some((
                 UntouchedReason::TcpmUncertain,
                 "TCPM is switched by a block that block delete (`/`) may skip: whether X Y Z are \
@@ -546,9 +584,13 @@ pub fn patch_program(
             match report_unpatched(path, machine, &opts) {
                 Ok(zones) => {
                     if !zones.is_empty() {
-                        report
-                            .zones
-                            .extend(zones.iter().map(|z| ZoneRow::new(lp, r, z)));
+                        report.zones.extend(zones.iter().map(|z| {
+                            let mut row = ZoneRow::new(lp, r, z);
+                            if let Some(why) = reason.zone_reason() {
+                                row.reason = why;
+                            }
+                            row
+                        }));
                         report.untouched_runs.push(untouched(
                             lp,
                             r,

@@ -72,6 +72,7 @@ pub fn read_options(machine: &Machine) -> Result<polepatch_nc::ReadOptions, Erro
             off: codes("tcpm_off", &machine.controller.tcpm_off)?,
             always: machine.controller.tcpm_always,
         },
+        flow: None,
     })
 }
 

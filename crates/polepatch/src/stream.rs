@@ -136,6 +136,8 @@ impl EndRec {
 /// The first read's findings.
 struct Survey {
     dialect: Dialect,
+    /// How the file is read: the dialect found and its program flow settled.
+    read: polepatch_nc::ReadOptions,
     runs: Vec<RunRec>,
     /// Some run point has a value for X Y Z A B C.
     uses: [bool; 6],
@@ -220,8 +222,29 @@ struct Reading<'a> {
     chord_tolerance_mm: f64,
 }
 
-/// The first read (module docs, step 1).
+/// The first read (module docs, step 1), read again when the file's program flow must
+/// settle the TCPM states ([`polepatch_nc::flow`]).
 fn survey(bytes: &[u8], opts: &Reading<'_>) -> Result<Survey, Error> {
+    let mut read = opts.read.clone();
+    loop {
+        let (mut sv, settled) = survey_once(bytes, opts, &read)?;
+        match settled {
+            polepatch_nc::Settled::Done(dialect) => {
+                sv.dialect = dialect;
+                read.dialect = dialect;
+                sv.read = read;
+                return Ok(sv);
+            }
+            polepatch_nc::Settled::Again(settled) => read = settled,
+        }
+    }
+}
+
+fn survey_once(
+    bytes: &[u8],
+    opts: &Reading<'_>,
+    read: &polepatch_nc::ReadOptions,
+) -> Result<(Survey, polepatch_nc::Settled), Error> {
     let mut sv = Surveying {
         cone_deg: opts.cone_deg,
         fallback: opts.fallback,
@@ -238,7 +261,7 @@ fn survey(bytes: &[u8], opts: &Reading<'_>) -> Result<Survey, Error> {
     let mut builder = RunBuilder::default();
     let mut prev = polepatch_nc::modal::initial(&opts.read.controller);
     let mut i = 0usize;
-    let dialect = scan_blocks_with(bytes, &opts.read, |s: Scanned<'_>| {
+    let settled = scan_blocks_with(bytes, read, |s: Scanned<'_>| {
         style.add_block(bytes, s.words);
         notes.push(s.block, s.words, &prev, s.state);
         if let Some(d) = s.stated_datum {
@@ -282,13 +305,17 @@ fn survey(bytes: &[u8], opts: &Reading<'_>) -> Result<Survey, Error> {
             }
         }
     }
-    Ok(Survey {
-        dialect,
-        runs: sv.runs,
-        uses: sv.uses,
-        style: style.style(),
-        notes,
-    })
+    Ok((
+        Survey {
+            dialect: read.dialect,
+            read: read.clone(),
+            runs: sv.runs,
+            uses: sv.uses,
+            style: style.style(),
+            notes,
+        },
+        settled,
+    ))
 }
 
 /// A stretch to parse in full: blocks `first_block..=last_block`, runs `runs` (numbers in
@@ -689,11 +716,9 @@ fn each_stretch<T: Send>(
             h.runs.push(run);
         }
     };
-    let read = polepatch_nc::ReadOptions {
-        dialect: sv.dialect,
-        ..rd.read.clone()
-    };
-    scan_blocks_with(bytes, &read, |s: Scanned<'_>| {
+    // The survey's options: the dialect found and the program flow settled, so this read
+    // ends `Done`.
+    let _ = scan_blocks_with(bytes, &sv.read, |s: Scanned<'_>| {
         if let Some(h) = &mut building {
             h.program.push(&s);
             if h.stretch.last_block == i {

@@ -3,6 +3,8 @@ ValueError naming them; a panic InternalError — never a crash."""
 
 from __future__ import annotations
 
+import os
+
 import pytest
 
 import polepatch
@@ -105,6 +107,14 @@ def test_a_machine_from_toml_is_used_like_a_built_in(tmp_path) -> None:
     path = tmp_path / "shop.toml"
     path.write_text(MACHINE_TOML)
     assert polepatch.Machine.from_file(path).limits == m.limits
+
+
+def test_a_machine_file_is_read_to_a_bound() -> None:
+    # Issue 26: `/dev/zero` was read without limit.
+    if not os.path.exists("/dev/zero"):
+        pytest.skip("no /dev/zero on this system")
+    with pytest.raises(polepatch.MachineError, match="longer than"):
+        polepatch.Machine.from_file("/dev/zero")
     out, report = polepatch.patch_nc(read("fixtures/c17/SING.I"), m)
     assert report["machine"] == "shop-ac" and report["zones"]
 

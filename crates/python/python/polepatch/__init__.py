@@ -91,9 +91,10 @@ class Machine:
 
     @classmethod
     def from_file(cls, path: Union[str, os.PathLike[str]]) -> Machine:
-        """A machine from a machine TOML file (UTF-8), as :meth:`from_toml`."""
-        with open(path, encoding="utf-8") as f:
-            return cls.from_toml(f.read(), origin=str(path))
+        """A machine from a machine TOML file (UTF-8), as :meth:`from_toml`. At most
+        1 MiB is read: a longer file, or a device such as ``/dev/zero``, raises
+        :class:`MachineError`."""
+        return cls(_native.NativeMachine.from_file(os.fspath(path)))
 
     @staticmethod
     def builtin_names() -> List[str]:
