@@ -232,6 +232,8 @@ def patch_nc(
             (with ``line``), an empty program or one without G1 motion or rotary words.
         MachineError: an unknown built-in name.
         ValueError: an option out of range (named).
+        KeyboardInterrupt: Ctrl-C (SIGINT) during the call: the patch stops at its next
+            stretch near the pole (it looks for signals every 50 ms), nothing is returned.
     """
     options = _options(locals(), "data", "machine")
     out, report = _native.patch_nc(_bytes(data, "data"), _machine(machine), options)
