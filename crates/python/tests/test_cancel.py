@@ -47,3 +47,4 @@ def test_ctrl_c_stops_a_long_patch_before_it_ends() -> None:
     assert stopped < delay + 0.5 * (full - delay), f"stopped after {stopped:.2f} s of {full:.2f} s"
     # The package still works after an interrupted call.
     assert polepatch.patch_nc(read("fixtures/c17/SING.I"), "mikron-ucp710")[1]["zones"]
+

@@ -414,7 +414,9 @@ def cl_to_joints(
         (no copy was made to return it).
 
     Raises:
-        InputError: a value that is not finite or a zero tool axis (``index``: the row).
+        InputError: a value that is not finite, a zero tool axis, or a joint value
+            outside the machine's range on the branch picked (e.g. A = 180° where A ends
+            at 120°) (``index``: the row).
         ValueError: a wrong shape or branch name.
     """
     arr = _rows(xyzijk, 6, "xyzijk")
