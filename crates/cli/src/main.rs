@@ -1,6 +1,6 @@
 //! The `polepatch` command line.
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use polepatch::kinematics::{Axis, Machine};
 use polepatch::patcher::{AnalysisOptions, PatchOptions};
@@ -42,6 +42,26 @@ enum Command {
     /// Quality suite: analyze and patch every program × machine, compare the deviation
     /// with the best possible for C-only changes, and print one table.
     Bench(bench_cmd::BenchArgs),
+    /// LinuxCNC program filter ([FILTER] in the INI): the patched program on standard
+    /// output, FILTER_PROGRESS=N and the summary on standard error (docs/linuxcnc.md).
+    Filter(filter_cmd::FilterArgs),
+}
+
+/// Exit status with `--strict` when a zone stays below feed or something near the pole
+/// could not be analysed.
+pub(crate) const STRICT_EXIT: u8 = 2;
+/// Exit status of a usage error (an unknown option, a missing or bad value): 64, as
+/// sysexits.h's `EX_USAGE`, apart from `--strict`'s 2 and bad input's 1.
+pub(crate) const USAGE_EXIT: u8 = 64;
+
+/// A usage error (exit [`USAGE_EXIT`]).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub(crate) struct Usage(String);
+
+/// A usage error with this message.
+pub(crate) fn usage(message: impl Into<String>) -> anyhow::Error {
+    Usage(message.into()).into()
 }
 
 #[derive(clap::Args)]
@@ -114,7 +134,7 @@ pub(crate) struct PatchArgs {
     /// Work offset X,Y,Z (mm, machine coordinates of the program's zero) for a machine
     /// with a kinematic chain, where the program only names it (G54); default: the
     /// program's datum shift (Heidenhain G54 X Y Z).
-    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z")]
+    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z", allow_hyphen_values = true)]
     pub(crate) work_offset: Option<[f64; 3]>,
     /// With a kinematic chain, for runs without TCPM: how far the tool tip may leave the
     /// programmed line between two points of a rewritten block, mm (the controller
@@ -142,7 +162,7 @@ struct AnalyzeArgs {
     #[arg(long)]
     json: bool,
     /// Work offset X,Y,Z (mm) for a machine with a kinematic chain (see `patch`).
-    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z")]
+    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z", allow_hyphen_values = true)]
     work_offset: Option<[f64; 3]>,
     /// Exit with status 2 when a run or lines could not be analysed (no feed, expressions,
     /// arcs or skippable blocks near the pole, …).
@@ -167,7 +187,19 @@ pub(crate) fn parse_xyz(text: &str) -> Result<[f64; 3], String> {
 
 fn main() -> ExitCode {
     polepatch_cli::outputs::remove_temporaries_on_signal();
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            // Help and version are printed to standard output and exit 0; a usage error
+            // exits USAGE_EXIT (not clap's 2, which is --strict's).
+            let _ = e.print();
+            return if e.use_stderr() {
+                ExitCode::from(USAGE_EXIT)
+            } else {
+                ExitCode::SUCCESS
+            };
+        }
+    };
     let result = match cli.command {
         Command::Analyze(args) => analyze(args),
         Command::Patch(args) => patch::run(args),
@@ -175,12 +207,17 @@ fn main() -> ExitCode {
         Command::Reorient(args) => reorient_cmd::run(args),
         Command::Post(args) => post_cmd::run(args),
         Command::Simulate(args) => simulate_cmd::run(args),
+        Command::Filter(args) => filter_cmd::run(args),
     };
     match result {
         Ok(code) => code,
         Err(e) => {
             eprintln!("polepatch: error: {}", message(&e));
-            ExitCode::from(1)
+            if e.downcast_ref::<Usage>().is_some() {
+                ExitCode::from(USAGE_EXIT)
+            } else {
+                ExitCode::from(1)
+            }
         }
     }
 }
@@ -202,6 +239,8 @@ fn message(e: &anyhow::Error) -> String {
 }
 
 mod bench_cmd;
+mod filter_cmd;
+mod lcnc_planner;
 mod patch;
 mod post_cmd;
 mod reorient_cmd;
@@ -214,7 +253,7 @@ pub(crate) fn machine(name: &str) -> Result<Machine> {
 /// `--tcy-ms` within the range a machine file accepts (`kinematics::machine::TCY_MS_RANGE`).
 pub(crate) fn check_tcy_ms(v: Option<f64>) -> Result<()> {
     if let Some(v) = v {
-        polepatch::kinematics::machine::check_tcy_ms("--tcy-ms", v).map_err(anyhow::Error::msg)?;
+        polepatch::kinematics::machine::check_tcy_ms("--tcy-ms", v).map_err(usage)?;
     }
     Ok(())
 }
@@ -223,7 +262,7 @@ pub(crate) fn check_positive(name: &str, v: Option<f64>) -> Result<()> {
     if let Some(v) = v
         && !(v.is_finite() && v > 0.0)
     {
-        bail!("{name} must be a positive number, got {v}");
+        return Err(usage(format!("{name} must be a positive number, got {v}")));
     }
     Ok(())
 }
@@ -317,7 +356,7 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
     let failures = failed.len() + report.not_analysed.len();
     Ok(if args_strict && failures > 0 {
         eprintln!("polepatch: {failures} run(s) or line range(s) not analysed (--strict)");
-        ExitCode::from(2)
+        ExitCode::from(crate::STRICT_EXIT)
     } else {
         ExitCode::SUCCESS
     })

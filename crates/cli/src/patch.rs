@@ -1,12 +1,12 @@
 //! `polepatch patch`: one file or a batch.
 
-use crate::{PatchArgs, check_positive, machine};
+use crate::{PatchArgs, check_positive, machine, usage};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use polepatch::patcher::{PatchAxes, PatchOptions};
 use polepatch::{FileReport, ZoneRow};
 use polepatch_cli::files::{JobError, patch_to};
-use polepatch_cli::outputs::{Input, Output, plan};
+use polepatch_cli::outputs::{Input, Output, is_std, plan};
 use rayon::prelude::*;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -17,18 +17,23 @@ fn options(args: &PatchArgs) -> Result<PatchOptions> {
     if let Some(d) = args.max_deviation
         && !(d.is_finite() && d >= 0.0)
     {
-        bail!("--max-deviation must be an angle ≥ 0°, got {d}");
+        return Err(usage(format!(
+            "--max-deviation must be an angle ≥ 0°, got {d}"
+        )));
     }
     check_positive("--feed", args.feed)?;
     check_positive("--max-patch-length", args.max_patch_length)?;
     if !(0.0..0.5).contains(&args.margin) {
-        bail!("--margin must be in [0, 0.5), got {}", args.margin);
+        return Err(usage(format!(
+            "--margin must be in [0, 0.5), got {}",
+            args.margin
+        )));
     }
     if args.max_decimals > 9 {
-        bail!(
+        return Err(usage(format!(
             "--max-decimals must be at most 9, got {}",
             args.max_decimals
-        );
+        )));
     }
     Ok(PatchOptions {
         cone_deg: args.cone,
@@ -117,33 +122,43 @@ pub(crate) fn machine_input(name: &str) -> Vec<Input> {
     }
 }
 
-pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
+/// The library's options for `args` (checked: a bad value is a usage error).
+pub(crate) fn file_options(args: &PatchArgs) -> Result<polepatch::PatchOptions> {
     check_positive("--chord-tolerance", Some(args.chord_tolerance))?;
-    let opts = polepatch::PatchOptions {
-        patch: options(&args)?,
+    Ok(polepatch::PatchOptions {
+        patch: options(args)?,
         feed_fallback_mm_min: args.feed,
         work_offset_mm: args.work_offset,
         chord_tolerance_mm: args.chord_tolerance,
         ..polepatch::PatchOptions::default()
-    };
+    })
+}
+
+pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
+    let opts = file_options(&args)?;
     let machine = machine(&args.machine)?;
     // Every file this command reads and writes, checked together before anything is
     // written (crate::outputs, docs/output-paths.md).
     let files: Vec<(PathBuf, PathBuf)> = match (&args.output, &args.out_dir) {
         (Some(_), None) => {
-            if args.inputs.len() != 1 || args.inputs[0].is_dir() {
-                bail!("-o/--output takes one input file; use --out-dir for several or a folder");
+            if args.inputs.len() != 1 || (!is_std(&args.inputs[0]) && args.inputs[0].is_dir()) {
+                return Err(usage(
+                    "-o/--output takes one input file; use --out-dir for several or a folder",
+                ));
             }
             vec![(args.inputs[0].clone(), PathBuf::new())]
         }
         (None, Some(dir)) => {
+            if args.inputs.iter().any(|p| is_std(p)) {
+                return Err(usage("- (standard input) takes -o OUTPUT, not --out-dir"));
+            }
             let files = expand(&args.inputs, Some(dir))?;
             if files.is_empty() {
                 bail!("no input files");
             }
             files
         }
-        _ => bail!("give either -o OUTPUT (one input) or --out-dir DIR"),
+        _ => return Err(usage("give either -o OUTPUT (one input) or --out-dir DIR")),
     };
     let mut inputs: Vec<Input> = files
         .iter()
@@ -164,6 +179,13 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
         }
     }
     let targets = plan(&inputs, planned)?;
+    // With an output on standard output, everything else printed goes to standard error.
+    let to_stdout = targets.iter().any(|t| t.is_stdout());
+    let mut table: Box<dyn std::io::Write> = if to_stdout {
+        Box::new(std::io::stderr())
+    } else {
+        Box::new(std::io::stdout())
+    };
     let names: Vec<PathBuf> = files.iter().map(|(input, _)| input.clone()).collect();
     let reports: Vec<Result<FileReport, JobError>> = if files.len() == 1 && args.output.is_some() {
         vec![patch_to(&files[0].0, &targets[0], &machine, &opts)]
@@ -202,7 +224,7 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
 
     let mut reports = reports;
     if args.simulate {
-        simulate_both(&mut reports, &names, &machine, &opts);
+        simulate_both(&mut reports, &names, &machine, &opts, &mut table);
     }
     let mut ok: Vec<&FileReport> = Vec::new();
     let mut failed = 0;
@@ -216,7 +238,7 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
         }
     }
     if failed < reports.len() {
-        print_summary(&names, &reports);
+        print_summary(&names, &reports, &mut table).context("printing the summary")?;
     }
     for rep in &ok {
         for w in &rep.warnings {
@@ -282,7 +304,7 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
                  analysed (see the warnings above): whether they reach feed is unknown (--strict)"
             );
         }
-        return Ok(ExitCode::from(2));
+        return Ok(ExitCode::from(crate::STRICT_EXIT));
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -304,11 +326,16 @@ fn csv_rows(reports: &[&FileReport]) -> Result<Vec<u8>> {
 
 /// One line per input file, in input order; a file that failed says so (its error is
 /// printed on standard error).
-fn print_summary(inputs: &[PathBuf], reports: &[Result<FileReport, JobError>]) {
-    println!(
+fn print_summary(
+    inputs: &[PathBuf],
+    reports: &[Result<FileReport, JobError>],
+    out: &mut dyn std::io::Write,
+) -> std::io::Result<()> {
+    writeln!(
+        out,
         "{:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8} {:>6} {:>8}",
         "file", "zones", "reached", "C ratio", "overall", "time s", "dev °", "points", "words"
-    );
+    )?;
     for (input, r) in inputs.iter().zip(reports) {
         let rep = match r {
             Ok(rep) => rep,
@@ -316,7 +343,7 @@ fn print_summary(inputs: &[PathBuf], reports: &[Result<FileReport, JobError>]) {
                 let name = input.file_name().map_or(input.display().to_string(), |n| {
                     n.to_string_lossy().into_owned()
                 });
-                println!("{name:<40} failed, not written (see the error above)");
+                writeln!(out, "{name:<40} failed, not written (see the error above)")?;
                 continue;
             }
         };
@@ -328,13 +355,15 @@ fn print_summary(inputs: &[PathBuf], reports: &[Result<FileReport, JobError>]) {
             .file_name()
             .map_or(rep.file.clone(), |n| n.to_string_lossy().into_owned());
         if rep.zones.is_empty() {
-            println!(
+            writeln!(
+                out,
                 "{name:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8} {:>6} {:>8}",
                 0, "-", "-", "-", "-", "-", 0, rep.words_changed
-            );
+            )?;
             continue;
         }
-        println!(
+        writeln!(
+            out,
             "{:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8.3} {:>6} {:>8}",
             name,
             rep.zones.len(),
@@ -360,7 +389,7 @@ fn print_summary(inputs: &[PathBuf], reports: &[Result<FileReport, JobError>]) {
                 .fold(0.0, f64::max),
             rep.zones.iter().map(|z| z.points_modified).sum::<usize>(),
             rep.words_changed,
-        );
+        )?;
         // Why each zone ended as it did (a fixed set, docs/user-guide.md), counted.
         let counts: Vec<String> = polepatch::patcher::Reason::ALL
             .iter()
@@ -369,7 +398,7 @@ fn print_summary(inputs: &[PathBuf], reports: &[Result<FileReport, JobError>]) {
                 (k > 0).then(|| format!("{} {k}", r.name()))
             })
             .collect();
-        println!("  reasons: {}", counts.join(", "));
+        writeln!(out, "  reasons: {}", counts.join(", "))?;
         for (letter, written, file) in [
             ("C", rep.written_c_decimals, rep.file_c_decimals),
             (
@@ -381,12 +410,14 @@ fn print_summary(inputs: &[PathBuf], reports: &[Result<FileReport, JobError>]) {
             if let (Some(written), Some(file)) = (written, file)
                 && written > file
             {
-                println!(
+                writeln!(
+                    out,
                     "  note: {letter} written with {written} decimals (the file uses {file}) so that Equation 6 holds on the written values"
-                );
+                )?;
             }
         }
     }
+    Ok(())
 }
 
 /// `--simulate`: the simulated times of every input and its output, into the reports
@@ -396,9 +427,17 @@ fn simulate_both(
     names: &[PathBuf],
     machine: &polepatch::kinematics::Machine,
     opts: &polepatch::PatchOptions,
+    out: &mut dyn std::io::Write,
 ) {
     for (rep, input) in reports.iter_mut().zip(names) {
         let Ok(rep) = rep else { continue };
+        if is_std(input) || rep.output.as_deref() == Some("<stdout>") {
+            eprintln!(
+                "polepatch: warning: {}: not simulated: standard input and output cannot be read again",
+                rep.file
+            );
+            continue;
+        }
         let Some(output) = rep.output.clone() else {
             continue;
         };
@@ -418,7 +457,8 @@ fn simulate_both(
         match (sim(input), sim(Path::new(&output))) {
             (Ok(b), Ok(a)) => {
                 let t = polepatch::simulate::compare(&b, &a);
-                println!(
+                let _ = writeln!(
+                    out,
                     "{}: simulated {:.3} s → {:.3} s ({:+.1} %), Equation 6 {:.3} s → {:.3} s",
                     rep.file,
                     t.before_s,

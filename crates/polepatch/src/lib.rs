@@ -29,6 +29,7 @@ pub use polepatch_simulate as sim;
 pub mod end_pose;
 pub mod error;
 pub mod far;
+pub mod hooks;
 pub mod joints;
 pub mod machine_frame;
 pub mod notes;
@@ -41,6 +42,7 @@ pub mod simulate;
 pub mod stream;
 
 pub use error::Error;
+pub use hooks::Hooks;
 pub use patch::{FileReport, UntouchedReason, UntouchedRun, ZoneRow, patch_loaded, patch_program};
 pub use report::AnalyzeReport;
 pub use simulate::{SimulateOptions, SimulateReport, simulate_nc, simulate_nc_with};
@@ -232,12 +234,28 @@ pub fn patch_nc_to(
     opts: &PatchOptions,
     out: &mut dyn std::io::Write,
 ) -> Result<FileReport, Error> {
+    patch_nc_hooked(bytes, machine, opts, out, Hooks::NONE)
+}
+
+/// [`patch_nc_to`] with [`Hooks`]: progress as the output is written, and a cancellation
+/// check between stretches (a cancelled patch ends with [`Error::Cancelled`]).
+pub fn patch_nc_hooked(
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &PatchOptions,
+    out: &mut dyn std::io::Write,
+    hooks: Hooks<'_>,
+) -> Result<FileReport, Error> {
     let cl_instead = |e| program::or_cl_file(e, bytes, &opts.name);
+    if (hooks.cancelled)() {
+        return Err(Error::Cancelled);
+    }
     if let Some(report) = far::far_from_pole(bytes, machine, opts).map_err(cl_instead)? {
         out.write_all(bytes).map_err(Error::Output)?;
+        (hooks.progress)(bytes.len(), bytes.len());
         return Ok(report);
     }
-    stream::patch_nc_to(bytes, machine, opts, out).map_err(cl_instead)
+    stream::patch_nc_hooked(bytes, machine, opts, out, hooks).map_err(cl_instead)
 }
 
 /// Equation 6 along every run of an NC program held in memory (what `polepatch analyze`

@@ -434,6 +434,19 @@ pub fn patch_nc_to(
     opts: &crate::PatchOptions,
     out: &mut dyn Write,
 ) -> Result<FileReport, Error> {
+    patch_nc_hooked(bytes, machine, opts, out, crate::Hooks::NONE)
+}
+
+/// [`patch_nc_to`] with [`crate::Hooks`]: `progress` after each batch of stretches is
+/// written (and at the end), `cancelled` before each stretch is patched and before each
+/// batch is written ([`Error::Cancelled`]).
+pub fn patch_nc_hooked(
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &crate::PatchOptions,
+    out: &mut dyn Write,
+    hooks: crate::Hooks<'_>,
+) -> Result<FileReport, Error> {
     opts.check()?;
     let rd = Reading {
         name: &opts.name,
@@ -446,7 +459,11 @@ pub fn patch_nc_to(
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
         Begun::Whole(lp) => {
             let (output, report) = patch_loaded(&lp, machine, &opts.patch);
+            if (hooks.cancelled)() {
+                return Err(Error::Cancelled);
+            }
             out.write_all(&output).map_err(Error::Output)?;
+            (hooks.progress)(bytes.len(), bytes.len());
             return Ok(report);
         }
         Begun::Nothing { sv, p_idx, why } => {
@@ -459,6 +476,7 @@ pub fn patch_nc_to(
             report.not_analysed = not_analysed;
             report.warnings.extend(warnings);
             out.write_all(bytes).map_err(Error::Output)?;
+            (hooks.progress)(bytes.len(), bytes.len());
             return Ok(report);
         }
         Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx),
@@ -475,13 +493,29 @@ pub fn patch_nc_to(
     report.warnings.extend(warnings);
     let todo = stretches(&sv.runs, l, |rec| rec.near[l] || rec.feedless[l]);
     let mut copied_to = 0usize;
-    each_stretch(
+    // Set when a stretch was skipped because the caller cancelled: its part is not
+    // written, and the patch ends with `Error::Cancelled`.
+    let stopped = std::sync::atomic::AtomicBool::new(false);
+    let cancelled = || {
+        let c = stopped.load(std::sync::atomic::Ordering::Relaxed) || (hooks.cancelled)();
+        if c {
+            stopped.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+        c
+    };
+    let result = each_stretch(
         bytes,
         &sv,
         &todo,
         l,
         &rd,
         |lp| {
+            if cancelled() {
+                return (
+                    Vec::new(),
+                    FileReport::unchanged(&opts.name, machine, Vec::new()),
+                );
+            }
             let (edits, part) = patch_program(&lp, machine, &opts.patch);
             let output = if edits.is_empty() {
                 lp.program.bytes
@@ -491,6 +525,9 @@ pub fn patch_nc_to(
             (output, part)
         },
         |(output, part), replaced| {
+            if cancelled() {
+                return Err(std::io::Error::other("cancelled"));
+            }
             // A stretch that starts at the block the previous one ended at: that block was
             // written with the previous stretch (a run never changes its first point).
             let shared = copied_to.saturating_sub(replaced.start);
@@ -502,10 +539,16 @@ pub fn patch_nc_to(
             out.write_all(&output[shared..])?;
             copied_to = replaced.end;
             merge(&mut report, part);
+            (hooks.progress)(copied_to, bytes.len());
             Ok(())
         },
-    )?;
+    );
+    if stopped.load(std::sync::atomic::Ordering::Relaxed) {
+        return Err(Error::Cancelled);
+    }
+    result?;
     out.write_all(&bytes[copied_to..]).map_err(Error::Output)?;
+    (hooks.progress)(bytes.len(), bytes.len());
     Ok(report)
 }
 

@@ -12,7 +12,7 @@ mod errors;
 mod machine;
 mod options;
 
-use errors::{Failure, detached};
+use errors::{Failure, detached, detached_cancellable};
 use machine::NativeMachine;
 use numpy::ndarray::Array2;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
@@ -41,9 +41,15 @@ fn patch_nc<'py>(
     let f: FileKw = options.extract()?;
     let opts = f.patch(&p);
     let m = &machine.0;
-    let (out, report) = detached(py, || {
-        polepatch::patch_nc(&data, m, &opts)
-            .map(|(out, report)| (out, json(&report)))
+    // Ctrl-C stops the patch between stretches (`detached_cancellable`).
+    let (out, report) = detached_cancellable(py, |cancelled| {
+        let mut out = Vec::new();
+        let hooks = polepatch::Hooks {
+            progress: &|_, _| {},
+            cancelled,
+        };
+        polepatch::patch_nc_hooked(&data, m, &opts, &mut out, hooks)
+            .map(|report| (out, json(&report)))
             .map_err(Failure::library(f.named()))
     })?;
     Ok((PyBytes::new(py, &out), report))

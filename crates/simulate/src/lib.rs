@@ -54,6 +54,7 @@
 pub mod caps;
 pub mod error;
 pub mod grid;
+pub mod linuxcnc;
 mod pass;
 pub mod tolerances;
 

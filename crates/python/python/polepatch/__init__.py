@@ -233,6 +233,8 @@ def patch_nc(
             (with ``line``), an empty program or one without G1 motion or rotary words.
         MachineError: an unknown built-in name.
         ValueError: an option out of range (named).
+        KeyboardInterrupt: Ctrl-C (SIGINT) during the call: the patch stops at its next
+            stretch near the pole (it looks for signals every 50 ms), nothing is returned.
     """
     options = _options(locals(), "data", "machine")
     out, report = _native.patch_nc(_bytes(data, "data"), _machine(machine), options)
@@ -413,7 +415,9 @@ def cl_to_joints(
         (no copy was made to return it).
 
     Raises:
-        InputError: a value that is not finite or a zero tool axis (``index``: the row).
+        InputError: a value that is not finite, a zero tool axis, or a joint value
+            outside the machine's range on the branch picked (e.g. A = 180° where A ends
+            at 120°) (``index``: the row).
         ValueError: a wrong shape or branch name.
     """
     arr = _rows(xyzijk, 6, "xyzijk")
