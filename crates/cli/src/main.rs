@@ -142,6 +142,25 @@ pub(crate) struct PatchArgs {
     /// original block — keeps its values.
     #[arg(long, value_name = "MM", default_value_t = polepatch::machine_frame::CHORD_TOLERANCE_MM)]
     pub(crate) chord_tolerance: f64,
+    /// The cutter for the whole program: ball:D, flat:D or bull:D,R (diameter and corner
+    /// radius, mm). Default: per run, from --tools or the program (TOOL DEF, CAM tool
+    /// comments); a ball programmed at its tip keeps its centre (X Y Z rewritten), a flat or
+    /// bull-nose cutter's orientation change is capped by --surface-tolerance.
+    #[arg(long, value_parser = polepatch::tool::Tool::parse, value_name = "KIND:D[,R]")]
+    pub(crate) tool: Option<polepatch::tool::Tool>,
+    /// A tool table (TOML: [tool.5] kind = "ball", diameter_mm = 10, corner_radius_mm = …),
+    /// looked up by the number or name of the tool each run uses.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) tools: Option<PathBuf>,
+    /// Which point of the tool the program's X Y Z are: tip or centre (of a ball).
+    /// Default: the machine file's [controller] tool_point, else the TCPM code's (M128 and
+    /// FUNCTION TCPM … REFPNT CENTER-CENTER: centre; the others: tip).
+    #[arg(long, value_parser = polepatch::tool::ToolPoint::parse, value_name = "tip|centre")]
+    pub(crate) tool_point: Option<polepatch::tool::ToolPoint>,
+    /// How far a flat or bull-nose cutter's surface may move at a CL point when the patch
+    /// turns it about its tip, mm.
+    #[arg(long, value_name = "MM", default_value_t = polepatch::tool::SURFACE_TOLERANCE_MM)]
+    pub(crate) surface_tolerance: f64,
 }
 
 #[derive(clap::Args)]

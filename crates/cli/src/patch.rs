@@ -125,11 +125,28 @@ pub(crate) fn machine_input(name: &str) -> Vec<Input> {
 /// The library's options for `args` (checked: a bad value is a usage error).
 pub(crate) fn file_options(args: &PatchArgs) -> Result<polepatch::PatchOptions> {
     check_positive("--chord-tolerance", Some(args.chord_tolerance))?;
+    check_positive("--surface-tolerance", Some(args.surface_tolerance))?;
+    let table = match &args.tools {
+        Some(path) => {
+            let bytes = crate::files::read(path)?;
+            let text = String::from_utf8(bytes)
+                .map_err(|_| anyhow::anyhow!("tool table {}: not UTF-8 text", path.display()))?;
+            polepatch::tool::ToolTable::from_toml_str(&text, &path.display().to_string())
+                .map_err(|e| anyhow::anyhow!("{e}"))?
+        }
+        None => polepatch::tool::ToolTable::default(),
+    };
     Ok(polepatch::PatchOptions {
         patch: options(args)?,
         feed_fallback_mm_min: args.feed,
         work_offset_mm: args.work_offset,
         chord_tolerance_mm: args.chord_tolerance,
+        tool: polepatch::tool::ToolOptions {
+            tool: args.tool,
+            table,
+            point: args.tool_point,
+            surface_tolerance_mm: args.surface_tolerance,
+        },
         ..polepatch::PatchOptions::default()
     })
 }
@@ -165,6 +182,9 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
         .map(|(input, _)| Input::new("the input", input))
         .collect();
     inputs.extend(machine_input(&args.machine));
+    if let Some(t) = &args.tools {
+        inputs.push(Input::new("the tool table", t));
+    }
     let mut planned: Vec<Output> = Vec::new();
     for (input, rel) in &files {
         planned.push(match (&args.output, &args.out_dir) {
@@ -333,8 +353,8 @@ fn print_summary(
 ) -> std::io::Result<()> {
     writeln!(
         out,
-        "{:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8} {:>6} {:>8}",
-        "file", "zones", "reached", "C ratio", "overall", "time s", "dev °", "points", "words"
+        "{:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8} {:>6} {:>8}  tool",
+        "file", "zones", "reached", "C ratio", "overall", "time s", "dev °", "points", "words",
     )?;
     for (input, r) in inputs.iter().zip(reports) {
         let rep = match r {
@@ -357,14 +377,27 @@ fn print_summary(
         if rep.zones.is_empty() {
             writeln!(
                 out,
-                "{name:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8} {:>6} {:>8}",
+                "{name:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8} {:>6} {:>8}  -",
                 0, "-", "-", "-", "-", "-", 0, rep.words_changed
             )?;
             continue;
         }
+        // The tools the changed zones were patched for (`-`: none changed).
+        let mut tools: Vec<String> = Vec::new();
+        for z in rep.zones.iter().filter(|z| z.tool != "-") {
+            let t = format!("{} at {}", z.tool, z.tool_point);
+            if !tools.contains(&t) {
+                tools.push(t);
+            }
+        }
+        let tools = if tools.is_empty() {
+            "-".to_string()
+        } else {
+            tools.join(", ")
+        };
         writeln!(
             out,
-            "{:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8.3} {:>6} {:>8}",
+            "{:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8.3} {:>6} {:>8}  {}",
             name,
             rep.zones.len(),
             reached,
@@ -389,13 +422,24 @@ fn print_summary(
                 .fold(0.0, f64::max),
             rep.zones.iter().map(|z| z.points_modified).sum::<usize>(),
             rep.words_changed,
+            tools,
         )?;
-        // Why each zone ended as it did (a fixed set, docs/user-guide.md), counted.
-        let counts: Vec<String> = polepatch::patcher::Reason::ALL
+        // Why each zone ended as it did (a fixed set, docs/user-guide.md), counted: the
+        // patcher's reasons in their order, then the library's (tcpm_unknown, …).
+        let mut names: Vec<&str> = polepatch::patcher::Reason::ALL
             .iter()
-            .filter_map(|r| {
-                let k = rep.zones.iter().filter(|z| z.reason == r.name()).count();
-                (k > 0).then(|| format!("{} {k}", r.name()))
+            .map(|r| r.name())
+            .collect();
+        for z in &rep.zones {
+            if !names.contains(&z.reason) {
+                names.push(z.reason);
+            }
+        }
+        let counts: Vec<String> = names
+            .iter()
+            .filter_map(|name| {
+                let k = rep.zones.iter().filter(|z| z.reason == *name).count();
+                (k > 0).then(|| format!("{name} {k}"))
             })
             .collect();
         writeln!(out, "  reasons: {}", counts.join(", "))?;

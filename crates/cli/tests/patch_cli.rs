@@ -19,6 +19,9 @@ fn one_file_with_report() {
         "--report",
         report.to_str().unwrap(),
         "--strict",
+        // An M128 program: X Y Z are the ball's centre (--strict needs the tool known).
+        "--tool",
+        "ball:10",
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(stdout.contains("SING.I"), "{stdout}");

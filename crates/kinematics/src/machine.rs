@@ -95,6 +95,11 @@ pub struct Controller {
     /// Always TCP. Default false.
     #[serde(default)]
     pub tcpm_always: bool,
+    /// Which point of the tool the programs' X Y Z state under TCPM, where the shop set
+    /// the tool lengths so: `"tip"` or `"centre"` (of a ball). Default: each TCPM code's
+    /// own (M128: centre; the others: tip).
+    #[serde(default)]
+    pub tool_point: Option<String>,
 }
 
 /// Errors of machine loading.
@@ -169,6 +174,8 @@ impl Machine {
     /// tcpm_on = ["M428"]               # added to the dialect's (M128, TRAORI, G43.4, …)
     /// tcpm_off = ["M429", "M430"]
     /// tcpm_always = false              # true: kinematics always TCP
+    /// tool_point = "tip"               # optional: X Y Z under TCPM are the tool tip or
+    ///                                  # the ball's "centre" (default: the TCPM code's)
     /// ```
     ///
     /// Every limit must lie within [`LIMIT_MIN`, `LIMIT_MAX`] = 0.001 to 10⁶ in the file's
@@ -505,6 +512,16 @@ impl MachineFile {
                              \"M428\" or \"G43.4\", or a word such as \"TRAORI\")"
                         ));
                     }
+                }
+                if let Some(p) = &self.controller.tool_point
+                    && !matches!(
+                        p.trim().to_ascii_lowercase().as_str(),
+                        "tip" | "centre" | "center"
+                    )
+                {
+                    return Err(format!(
+                        "controller.tool_point: '{p}' is not \"tip\" or \"centre\""
+                    ));
                 }
                 self.controller
             },

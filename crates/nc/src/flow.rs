@@ -11,7 +11,7 @@
 //!
 //! | dialect | label | call | return | jump | structured (any keyword reaches any other of its statement) |
 //! |---|---|---|---|---|---|
-//! | Fanuc, Haas | `O2000` (program number), `N100` (a `GOTO`/`M97` target) | `M98 P2000 [L3]`, `M98 P32000`, `M97 P100`, `G65 P9001` (in the file or outside), `M198`, `M6` (a tool-change macro): outside | `M99` | `GOTO 100`, `IF […] GOTO 100` | `WHILE […] DO 1` … `END 1` |
+//! | Fanuc, Haas | `O2000` (program number), `N100` (a `GOTO`/`M97` target) | `M98 P2000 [L3]`, `M98 P32000`, `M97 P100`, `G65 P9001` (in the file or outside), `M198`: outside; `M6` (a tool-change macro: may end TCPM, never starts it) | `M99` | `GOTO 100`, `IF […] GOTO 100` | `WHILE […] DO 1` … `END 1` |
 //! | LinuxCNC | `o100 sub` … `o100 endsub` (skipped in file order) | `o100 call`, `o<name> call` | `o100 return`, `endsub` | — | `o100 if/elseif/else/endif/while/endwhile/do/repeat/endrepeat/break/continue` |
 //! | Sinumerik | `NAME:`, `N100` (a jump target) | `L123`, `CALL`, `PCALL`, `EXTCALL`, a subprogram's name: outside | `RET`, `M17` | `GOTOF`, `GOTOB`, `GOTO`, `GOTOC` (also after `IF`) | `IF/ELSE/ENDIF`, `WHILE/ENDWHILE`, `FOR/ENDFOR`, `LOOP/ENDLOOP`, `REPEAT/UNTIL` |
 //! | Heidenhain ISO | `G98 L1` | `L1,0` (`L1,3`: repeated), `%NAME`: outside | `G98 L0` | — | — |
@@ -101,6 +101,9 @@ pub(crate) enum Stmt {
     },
     /// A call of code outside the file: the state after it is unknown.
     External,
+    /// A tool change that may run a macro (Fanuc `M6`): it may end TCPM but does not
+    /// start it, so TCPM on becomes unknown and off stays off.
+    ToolChange,
     /// A jump to `key`; `cond`: it may also go on in file order.
     Jump {
         /// Where to.
@@ -126,7 +129,10 @@ impl Stmt {
     /// Whether the statement needs the whole file's flow to settle the state (anything but
     /// a call of code that is certainly outside the file).
     pub(crate) fn is_global(&self) -> bool {
-        !matches!(self, Stmt::External)
+        // A call of code outside the file acts on the block after it only; a label only
+        // matters where something jumps or calls (which is global itself): a Fanuc
+        // program's `O1000` line alone is read once.
+        !matches!(self, Stmt::External | Stmt::ToolChange | Stmt::Label(_))
     }
 }
 
@@ -158,6 +164,7 @@ enum Kind {
     /// The block after a call: where its returns arrive.
     AfterCall,
     External,
+    ToolChange,
     Jump {
         key: Key,
         cond: bool,
@@ -289,6 +296,7 @@ impl Recorder {
                 self.push(line + 1, Kind::AfterCall);
             }
             Some(Stmt::External) => self.push(line, Kind::External),
+            Some(Stmt::ToolChange) => self.push(line, Kind::ToolChange),
             Some(Stmt::Jump { key, cond }) => {
                 if let Key::Block(n) = key {
                     self.block_targets.insert(*n);
@@ -450,6 +458,7 @@ impl Recorder {
                     None => send(&mut state, &mut work, next, Tcpm::Unknown),
                 },
                 Kind::External => send(&mut state, &mut work, next, Tcpm::Unknown),
+                Kind::ToolChange => send(&mut state, &mut work, next, s.after_tool_change()),
                 Kind::Jump { key, cond } => {
                     for &j in &labels[key] {
                         send(&mut state, &mut work, j, s);
@@ -1279,8 +1288,11 @@ pub(crate) fn read_iso(
             if g(66.0) || g(66.1) {
                 return Some(Stmt::Opaque);
             }
-            if m(198.0) || m(6.0) {
+            if m(198.0) {
                 return Some(Stmt::External);
+            }
+            if m(6.0) {
+                return Some(Stmt::ToolChange);
             }
             None
         }

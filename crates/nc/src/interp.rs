@@ -57,6 +57,9 @@ pub(crate) struct Scan {
     pub(crate) flow: Option<crate::flow::Stmt>,
     /// The block's number (`N…`), when it is a whole number.
     pub(crate) number: Option<u64>,
+    /// A TCPM-on code that refers X Y Z to the centre of a ball (Heidenhain `M128`, `FUNCTION
+    /// TCPM … REFPNT CENTER-CENTER`) rather than to the tool tip.
+    pub(crate) tcpm_centre: bool,
     /// Heidenhain ISO `G73`, `G72` or `G28` (× 10): the frame code whose values the block
     /// gives.
     pub(crate) heidenhain_frame: Option<i64>,
@@ -320,6 +323,10 @@ impl Interpreter {
         let sw = code.and_then(|c| self.controller.m(self.dialect, c));
         if let Some(sw) = sw {
             s.tcpm = Some(sw);
+            // M128: the tool length refers to the ball's centre (Heidenhain's manuals).
+            s.tcpm_centre = sw == Switch::On
+                && code == Some(1280)
+                && matches!(self.dialect, Dialect::Heidenhain | Dialect::Conversational);
         }
         match code {
             // Spindle and coolant.
@@ -688,14 +695,18 @@ impl Interpreter {
             if !always {
                 m.tcpm = m.tcpm.switched(sw.state(), flags.has(Flags::SKIPPABLE));
             }
+            if sw == Switch::On {
+                m.tcpm_centre = s.tcpm_centre;
+            }
             breaks = true;
         }
         if !always {
             match &s.flow {
                 // Code outside the file runs: it may switch TCPM.
                 Some(crate::flow::Stmt::External) => m.tcpm = Tcpm::Unknown,
+                Some(crate::flow::Stmt::ToolChange) => m.tcpm = m.tcpm.after_tool_change(),
                 // Flow that joins paths, on a read without its plan: unknown until solved.
-                Some(_) if self.plan.is_none() => m.tcpm = Tcpm::Unknown,
+                Some(st) if self.plan.is_none() && st.is_global() => m.tcpm = Tcpm::Unknown,
                 _ => {}
             }
             if self.plan.as_ref().is_some_and(|p| p.all_unknown()) {
@@ -840,6 +851,14 @@ pub(crate) fn function(text: &[u8], s: &mut Scan) {
     let first = words.next().unwrap_or_default();
     let second = words.next().unwrap_or_default();
     let sw = if first.eq_ignore_ascii_case(b"TCPM") {
+        // `REFPNT TIP-TIP` (the default), `TIP-CENTER`: X Y Z are the tip; `CENTER-CENTER`:
+        // the centre of the ball.
+        let mut rest = words.clone();
+        s.tcpm_centre = std::iter::once(second)
+            .chain(&mut rest)
+            .skip_while(|w| !w.eq_ignore_ascii_case(b"REFPNT"))
+            .nth(1)
+            .is_some_and(|w| w.len() >= 6 && w[..6].eq_ignore_ascii_case(b"CENTER"));
         Some(Switch::On)
     } else if first.eq_ignore_ascii_case(b"RESET") && second.eq_ignore_ascii_case(b"TCPM") {
         Some(Switch::Off)

@@ -73,6 +73,15 @@ pub enum Tcpm {
 }
 
 impl Tcpm {
+    /// The state after a tool change that may run a macro (Fanuc `M6`): such a macro may
+    /// end TCPM (`G49`) but never starts it.
+    pub fn after_tool_change(self) -> Tcpm {
+        match self {
+            Tcpm::On => Tcpm::Unknown,
+            other => other,
+        }
+    }
+
     /// Whether TCPM is certainly on.
     pub fn is_on(self) -> bool {
         self == Tcpm::On
@@ -185,6 +194,10 @@ pub struct Modal {
     /// Frame transformations in force beyond a shift ([`transform`] bits: rotation,
     /// scaling, mirror image), 0 where none.
     pub transform: u8,
+    /// The code that switched TCPM on last refers X Y Z to the centre of a ball
+    /// (Heidenhain `M128`, `FUNCTION TCPM … REFPNT CENTER-CENTER`); false: to the tool tip
+    /// (`FUNCTION TCPM` by default, `TRAORI`, `G43.4`, `G234`, a machine's own codes).
+    pub tcpm_centre: bool,
 }
 
 impl Default for Modal {
@@ -200,6 +213,7 @@ impl Default for Modal {
             incremental: false,
             inch: false,
             transform: 0,
+            tcpm_centre: false,
         }
     }
 }
@@ -232,7 +246,7 @@ pub(crate) struct PackedModal {
     /// bit 6 TCPM uncertain; bit 7 canned cycle.
     flags: u8,
     /// Bits 0–1: feed mode (0 G94, 1 G93, 2 G95); bits 2–4: [`transform`] bits; bit 5:
-    /// TCPM unknown.
+    /// TCPM unknown; bit 6: TCPM refers to the ball's centre.
     feed_mode: u8,
 }
 
@@ -281,7 +295,8 @@ impl PackedModal {
                 FeedMode::InverseTime => 1,
                 FeedMode::PerRevolution => 2,
             } | (m.transform & transform::ALL) << 2
-                | u8::from(m.tcpm == Tcpm::Unknown) << 5,
+                | u8::from(m.tcpm == Tcpm::Unknown) << 5
+                | u8::from(m.tcpm_centre) << 6,
         }
     }
 
@@ -313,6 +328,7 @@ impl PackedModal {
                 Tcpm::Off
             },
             transform: (self.feed_mode >> 2) & transform::ALL,
+            tcpm_centre: self.feed_mode & 64 != 0,
             incremental: self.flags & 16 != 0,
             inch: self.flags & 32 != 0,
             canned_cycle: self.flags & 128 != 0,
@@ -351,6 +367,7 @@ mod tests {
             ][k % 3];
             m.tcpm = [Tcpm::Off, Tcpm::On, Tcpm::Uncertain, Tcpm::Unknown][k % 4];
             m.transform = (k as u8 * 3) & transform::ALL;
+            m.tcpm_centre = k % 2 == 1;
             m.canned_cycle = k % 2 == 0;
             m.incremental = k % 3 == 1;
             m.inch = k >= 3;

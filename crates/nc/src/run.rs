@@ -42,6 +42,9 @@ pub struct Run {
     /// Frame transformations in force during the run (bits of [`crate::modal::transform`]:
     /// rotation, scaling, mirror image); 0 where none.
     pub transform: u8,
+    /// The TCPM code in force refers X Y Z to the centre of a ball
+    /// ([`crate::Modal::tcpm_centre`]).
+    pub tcpm_centre: bool,
     /// Why the run ended.
     pub ended_by: RunBreak,
 }
@@ -124,6 +127,7 @@ impl RunBuilder {
             block_feed_mm_min: Vec::new(),
             tcpm: st.tcpm,
             transform: st.transform,
+            tcpm_centre: st.tcpm_centre,
             ended_by: RunBreak::End,
         }
     }
@@ -160,6 +164,7 @@ impl RunBuilder {
                                 r.feed_mode = st.feed_mode;
                                 r.tcpm = st.tcpm;
                                 r.transform = st.transform;
+                                r.tcpm_centre = st.tcpm_centre;
                             } else {
                                 self.finish_run(RunBreak::FeedChange, emit);
                             }
@@ -171,6 +176,7 @@ impl RunBuilder {
                             r.feed_mode = st.feed_mode;
                             r.tcpm = st.tcpm;
                             r.transform = st.transform;
+                            r.tcpm_centre = st.tcpm_centre;
                             r
                         });
                         // A rotary axis first programmed by this move: its motion over the

@@ -61,6 +61,11 @@ pub struct PatchOptions {
     /// then carries the offset, and the move after the run has to turn C the extra
     /// revolution back, so it is off by default. Default false.
     pub allow_c_offset: bool,
+    /// Keep a ball-end mill's centre where X Y Z are its tip: the tip of every point whose
+    /// orientation changes is rewritten, `tip′ = tip + R·(o − o′)` ([`crate::centre`]), and
+    /// verified with the rotary axes. `None`: X Y Z never change (they are the centre, or
+    /// the tool is not a ball). Default `None`.
+    pub keep_centre: Option<crate::centre::KeepCentre>,
     /// Numerical settings ([`SolverSettings`]). Default [`SolverSettings::default`].
     pub solver: SolverSettings,
 }
@@ -81,6 +86,7 @@ impl Default for PatchOptions {
             max_patch_length_mm: None,
             keep_last_point: false,
             allow_c_offset: false,
+            keep_centre: None,
             solver: SolverSettings::default(),
         }
     }
@@ -119,6 +125,17 @@ impl PatchOptions {
             && !(d.is_finite() && d >= 0.0)
         {
             return bad(&format!("the largest deviation must be ≥ 0°, got {d}°"));
+        }
+        if let Some(k) = &self.keep_centre
+            && !(k.radius_mm.is_finite()
+                && k.radius_mm > 0.0
+                && k.unit_mm.is_finite()
+                && k.unit_mm > 0.0)
+        {
+            return bad(&format!(
+                "keeping a ball's centre needs a positive radius and unit, got {} mm and {} mm",
+                k.radius_mm, k.unit_mm
+            ));
         }
         if let Some(l) = self.max_patch_length_mm
             && !(l.is_finite() && l > 0.0)

@@ -40,6 +40,7 @@ pub mod reorient;
 pub mod report;
 pub mod simulate;
 pub mod stream;
+pub mod tool;
 
 pub use error::Error;
 pub use hooks::Hooks;
@@ -67,8 +68,13 @@ pub struct PatchOptions {
     /// With a kinematic chain, for runs without TCPM: how far the tool tip may leave the
     /// programmed line between two points when the rewritten block's axes are
     /// interpolated linearly, mm (never more than the original block did, either).
-    /// Default [`machine_frame::CHORD_TOLERANCE_MM`] (0.005 mm).
+    /// Default [`machine_frame::CHORD_TOLERANCE_MM`] (0.005 mm). Also how far the centre
+    /// of a ball programmed at its tip may leave its original path between two points
+    /// ([`tool`]).
     pub chord_tolerance_mm: f64,
+    /// The cutting tool and the point X Y Z state ([`tool`]). Default: from the program
+    /// and the TCPM codes.
+    pub tool: tool::ToolOptions,
 }
 
 impl Default for PatchOptions {
@@ -79,6 +85,7 @@ impl Default for PatchOptions {
             name: "input".to_string(),
             work_offset_mm: None,
             chord_tolerance_mm: machine_frame::CHORD_TOLERANCE_MM,
+            tool: tool::ToolOptions::default(),
         }
     }
 }
@@ -175,6 +182,7 @@ impl PatchOptions {
     /// caller need not; a front end checks earlier only to name its own flags.
     pub fn check(&self) -> Result<(), Error> {
         check_patcher_options(&self.patch)?;
+        self.tool.check()?;
         check_common(self.feed_fallback_mm_min, self.work_offset_mm)
     }
 }

@@ -659,6 +659,21 @@ pub fn post_items(
     Ok(p.items)
 }
 
+/// The tool of a posted program where the caller did not say it: the CL file's `CUTTER/` or
+/// `TLDATA/` ([`crate::tool::cl_tool`]), and the tool tip as the point (APT's `GOTO/` states
+/// the tip). The patch then keeps a ball's centre and caps a flat or bull-nose cutter's
+/// orientation change ([`crate::tool`]). `cl_bytes` are the CL file's bytes, `cl` as read.
+pub fn tool_from_cl(cl_bytes: &[u8], cl: &ClProgram, opts: &mut PostOptions) {
+    let t = &mut opts.patch_options.tool;
+    if t.tool.is_none() {
+        let unit_mm = if cl.units == Units::Inch { 25.4 } else { 1.0 };
+        t.tool = crate::tool::cl_tool(cl_bytes, unit_mm).map(|(tool, _)| tool);
+    }
+    if t.point.is_none() {
+        t.point = Some(crate::tool::ToolPoint::Tip);
+    }
+}
+
 /// Post a CL program for `machine`: the NC bytes and, when patched, the patch report
 /// (`None` with `patch: false`, or when the program has no G1 run for the patch to look at:
 /// holes and rapids only).

@@ -83,6 +83,8 @@ pub struct RunPath {
     pub run: Run,
     /// The path (axes X Y Z P C), or why there is none.
     pub path: Result<Path, RunProblem>,
+    /// What the program says of the tool in use ([`crate::tool::Tracker`]).
+    pub found_tool: crate::tool::FoundTool,
 }
 
 /// A parsed program with its runs as paths for a machine.
@@ -112,6 +114,8 @@ pub struct LoadedProgram {
     /// What the reader carried through without analysing ([`crate::notes`]); empty for a
     /// stretch (the stream lists it once for the file).
     pub notes: crate::notes::Notes,
+    /// The caller's tool options ([`crate::PatchOptions::tool`]).
+    pub tool: crate::tool::ToolOptions,
 }
 
 /// What a stretch of a file ([`LoadedProgram::window`]) needs from the rest of the file,
@@ -333,7 +337,11 @@ pub(crate) fn run_path(
         axes: run.axes5(p_idx),
         feed_mm_min: feed,
     });
-    RunPath { run, path }
+    RunPath {
+        run,
+        path,
+        found_tool: crate::tool::FoundTool::default(),
+    }
 }
 
 /// The path parameter of an inverse-time (G93) run whose blocks have different feeds,
@@ -461,12 +469,29 @@ pub fn load(
         .into_iter()
         .collect();
     let mut notes = crate::notes::Notes::new();
+    // The tool of each run: the program's as it stands at the run's last block (a tool
+    // change ends runs, so the state there is the run's).
+    let mut tracker = crate::tool::Tracker::default();
+    let mut found = Vec::with_capacity(runs.len());
+    let mut next_run = 0;
     for b in 0..program.blocks.len() {
         notes.push(
             &program.blocks[b],
             program.block_words(b),
             &program.state_before(b),
             &program.state(b),
+        );
+        while next_run < runs.len() && runs[next_run].blocks.last() == Some(&b) {
+            found.push(tracker.found());
+            next_run += 1;
+        }
+        let blk = &program.blocks[b];
+        tracker.block(
+            program.dialect,
+            blk.line,
+            &program.bytes[blk.span()],
+            program.block_words(b),
+            program.state(b).inch,
         );
     }
     let has = |idx: usize| runs.iter().any(|r| r.uses(idx));
@@ -476,11 +501,15 @@ pub fn load(
             primary: machine.primary_letter(),
         });
     }
+    found.resize(runs.len(), tracker.found());
     let runs = runs
         .into_iter()
-        .map(|run| {
+        .zip(found)
+        .map(|(run, found)| {
             let line = program.blocks[run.blocks[0]].line;
-            run_path(run, p_idx, feed_fallback_mm_min, line)
+            let mut rp = run_path(run, p_idx, feed_fallback_mm_min, line);
+            rp.found_tool = found;
+            rp
         })
         .collect();
     Ok(LoadedProgram {
@@ -493,5 +522,6 @@ pub fn load(
         chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
         window: None,
         notes,
+        tool: crate::tool::ToolOptions::default(),
     })
 }

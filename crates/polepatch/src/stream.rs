@@ -89,6 +89,8 @@ struct RunRec {
     end: [EndRec; 2],
     /// Work offset for this run ([`crate::machine_frame::datum_at`]).
     datum_mm: Option<[f64; 3]>,
+    /// The program's tool for this run: an index into [`Survey::tools`].
+    tool: usize,
 }
 
 /// The end pose of a run as the survey finds it ([`crate::end_pose`]).
@@ -144,6 +146,8 @@ struct Survey {
     style: FileStyle,
     /// What the reader carried through without analysing.
     notes: crate::notes::Notes,
+    /// The program's tools as the runs found them ([`RunRec::tool`]), one per change.
+    tools: Vec<crate::tool::FoundTool>,
 }
 
 /// The first read in progress.
@@ -160,6 +164,11 @@ struct Surveying {
     /// The end pose of the open run so far, from the blocks after its last block, per
     /// letter.
     first_after: [EndRec; 2],
+    /// The tool in use ([`crate::tool`]).
+    tracker: crate::tool::Tracker,
+    /// The tools found so far, and the tracker's revision of the last.
+    tools: Vec<crate::tool::FoundTool>,
+    tools_revision: Option<u64>,
 }
 
 impl Surveying {
@@ -176,6 +185,10 @@ impl Surveying {
         }
         let first_block = run.blocks[0];
         let r = self.runs.len();
+        if self.tools_revision != Some(self.tracker.revision()) {
+            self.tools.push(self.tracker.found());
+            self.tools_revision = Some(self.tracker.revision());
+        }
         for (l, rec) in self.first_after.iter().enumerate() {
             if rec.decided.is_none() {
                 self.pending[l].push(r);
@@ -193,6 +206,7 @@ impl Surveying {
                 first_block,
                 self.work_offset_mm,
             ),
+            tool: self.tools.len() - 1,
         });
     }
 
@@ -220,6 +234,8 @@ struct Reading<'a> {
     read: polepatch_nc::ReadOptions,
     /// Chord tolerance for the chain path, mm.
     chord_tolerance_mm: f64,
+    /// The caller's tool options.
+    tool: crate::tool::ToolOptions,
 }
 
 /// The first read (module docs, step 1), read again when the file's program flow must
@@ -255,6 +271,13 @@ fn survey_once(
         frame_changes: Vec::new(),
         pending: [Vec::new(), Vec::new()],
         first_after: [EndRec::default(), EndRec::default()],
+        tracker: crate::tool::Tracker::default(),
+        tools: Vec::new(),
+        tools_revision: None,
+    };
+    let dialect = match read.dialect {
+        Dialect::Auto => polepatch_nc::program::detect(bytes),
+        d => d,
     };
     let mut style = StyleEvidence::default();
     let mut notes = crate::notes::Notes::new();
@@ -279,6 +302,14 @@ fn survey_once(
         };
         sv.decide(&after, i, s.block.line);
         builder.push(i, s.block, s.state, &mut |run| sv.take(run));
+        // After the runs this block ends: a tool change is the next run's.
+        sv.tracker.block(
+            dialect,
+            s.block.line,
+            &bytes[s.block.span()],
+            s.words,
+            s.state.inch,
+        );
         // Deciding blocks count from the open run's last block on: when this block
         // extended it, or no run is open, the verdicts seen so far are spent.
         if builder.open_run_last_block().is_none_or(|last| last == i) {
@@ -313,6 +344,7 @@ fn survey_once(
             uses: sv.uses,
             style: style.style(),
             notes,
+            tools: sv.tools,
         },
         settled,
     ))
@@ -415,6 +447,7 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
         };
         lp.work_offset_mm = rd.work_offset_mm;
         lp.chord_tolerance_mm = rd.chord_tolerance_mm;
+        lp.tool = rd.tool.clone();
         return Ok(Begun::Whole(Box::new(lp)));
     }
     Ok(Begun::Stretches {
@@ -455,6 +488,7 @@ pub fn patch_nc_hooked(
         work_offset_mm: opts.work_offset_mm,
         read: crate::program::read_options(machine)?,
         chord_tolerance_mm: opts.chord_tolerance_mm,
+        tool: opts.tool.clone(),
     };
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
         Begun::Whole(lp) => {
@@ -549,6 +583,7 @@ pub fn patch_nc_hooked(
     result?;
     out.write_all(&bytes[copied_to..]).map_err(Error::Output)?;
     (hooks.progress)(bytes.len(), bytes.len());
+    report.warn_unknown_tool();
     Ok(report)
 }
 
@@ -611,6 +646,7 @@ fn analyze_each(
         work_offset_mm: opts.work_offset_mm,
         read: crate::program::read_options(machine)?,
         chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
+        tool: crate::tool::ToolOptions::default(),
     };
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
         Begun::Whole(lp) => {
@@ -690,6 +726,7 @@ pub(crate) fn each_run<T: Send>(
         work_offset_mm,
         read: crate::program::read_options(machine)?,
         chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
+        tool: crate::tool::ToolOptions::default(),
     };
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
         Begun::Whole(lp) => {
@@ -825,18 +862,21 @@ fn loaded(bytes: &[u8], hand: InHand, sv: &Survey, l: usize, rd: &Reading<'_>) -
     let program = hand.program.finish(bytes[base..end].to_vec(), sv.dialect);
     let first = hand.stretch.first_block;
     let p_idx = if l == 0 { A } else { B };
+    let recs = &sv.runs[hand.stretch.runs.clone()];
     let runs: Vec<RunPath> = hand
         .runs
         .into_iter()
-        .map(|mut run| {
+        .zip(recs)
+        .map(|(mut run, rec)| {
             for b in &mut run.blocks {
                 *b -= first;
             }
             let line = program.blocks[run.blocks[0]].line;
-            run_path(run, p_idx, rd.fallback, line)
+            let mut rp = run_path(run, p_idx, rd.fallback, line);
+            rp.found_tool = sv.tools[rec.tool].clone();
+            rp
         })
         .collect();
-    let recs = &sv.runs[hand.stretch.runs.clone()];
     LoadedProgram {
         name: rd.name.to_string(),
         program,
@@ -852,6 +892,7 @@ fn loaded(bytes: &[u8], hand: InHand, sv: &Survey, l: usize, rd: &Reading<'_>) -
             datum_mm: recs.iter().map(|r| r.datum_mm).collect(),
         }),
         notes: crate::notes::Notes::new(),
+        tool: rd.tool.clone(),
     }
 }
 

@@ -27,6 +27,8 @@ fn linuxcnc() -> Machine {
         tcpm_on: vec!["M428".into()],
         tcpm_off: vec!["M429".into()],
         tcpm_always: false,
+
+        ..Default::default()
     };
     m
 }

@@ -29,6 +29,8 @@ fn linuxcnc(always: bool) -> Machine {
             vec!["M429".into(), "M430".into()]
         },
         tcpm_always: always,
+
+        ..Default::default()
     };
     m
 }
