@@ -756,3 +756,457 @@ fn kinstype_of(ngc: &str, dirs: &[PathBuf]) -> Result<Option<i64>, String> {
     }
     Ok(None)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Axis, forward};
+
+    fn config(rel: &str) -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/linuxcnc")
+            .join(rel)
+    }
+
+    fn load(rel: &str) -> Machine {
+        Machine::load(config(rel).to_str().unwrap()).unwrap()
+    }
+
+    /// The HAL pins of the trt and tdr modules.
+    #[derive(Clone, Copy, Default)]
+    struct Pins {
+        rot: [f64; 3],
+        dx: f64,
+        dy: f64,
+        dz: f64,
+        /// conventional-directions: +1 set, −1 not (trt only).
+        con: f64,
+    }
+
+    /// `xyzacKinematicsInverse` of trtfuncs.c, transcribed (tool offset 0): world → joints.
+    fn xyzac_inverse(pins: Pins, pos: [f64; 3], a_deg: f64, c_deg: f64) -> [f64; 3] {
+        let [xr, yr, zr] = pins.rot;
+        let (dy, dz, con) = (pins.dy, pins.dz, pins.con);
+        let (sa, ca) = a_deg.to_radians().sin_cos();
+        let (sc, cc) = c_deg.to_radians().sin_cos();
+        let (x, y, z) = (pos[0], pos[1], pos[2]);
+        [
+            cc * (x - xr) + con * sc * (y - yr) + xr,
+            -con * sc * ca * (x - xr) + cc * ca * (y - yr) + con * sa * (z - zr)
+                - ca * dy
+                - con * sa * dz
+                + dy
+                + yr,
+            sc * sa * (x - xr) - con * cc * sa * (y - yr) + ca * (z - zr) + con * sa * dy - ca * dz
+                + dz
+                + zr,
+        ]
+    }
+
+    /// `xyzbcKinematicsInverse` of trtfuncs.c, transcribed (tool offset 0).
+    fn xyzbc_inverse(pins: Pins, pos: [f64; 3], b_deg: f64, c_deg: f64) -> [f64; 3] {
+        let [xr, yr, zr] = pins.rot;
+        let (dx, dz, con) = (pins.dx, pins.dz, pins.con);
+        let (sb, cb) = b_deg.to_radians().sin_cos();
+        let (sc, cc) = c_deg.to_radians().sin_cos();
+        let dpx = -cb * dx + sb * dz + dx;
+        let dpz = -sb * dx - cb * dz + dz;
+        let (x, y, z) = (pos[0], pos[1], pos[2]);
+        [
+            cc * cb * (x - xr) + con * sc * cb * (y - yr) - con * sb * (z - zr) + dpx + xr,
+            -con * sc * (x - xr) + cc * (y - yr) + yr,
+            con * cc * sb * (x - xr) + sc * sb * (y - yr) + cb * (z - zr) + dpz + zr,
+        ]
+    }
+
+    /// `kinematicsInverse` type 1 of xyzab_tdr_kins.comp, transcribed (tool offset 0).
+    fn xyzab_tdr_inverse(pins: Pins, pos: [f64; 3], a_deg: f64, b_deg: f64) -> [f64; 3] {
+        let [xr, yr, zr] = pins.rot;
+        let (dx, dz) = (pins.dx, pins.dz);
+        let (sa, ca) = a_deg.to_radians().sin_cos();
+        let (sb, cb) = b_deg.to_radians().sin_cos();
+        let qx = pos[0] - xr - dx;
+        let qy = pos[1] - yr;
+        let qz = pos[2] - zr - dz;
+        [
+            cb * qx + sa * sb * qy - ca * sb * qz + cb * dx - sb * dz + xr,
+            ca * qy + sa * qz + yr,
+            sb * qx - sa * cb * qy + ca * cb * qz + sb * dx + cb * dz + zr,
+        ]
+    }
+
+    fn close(a: [f64; 3], b: [f64; 3], tol: f64) -> bool {
+        (0..3).all(|k| (a[k] - b[k]).abs() <= tol)
+    }
+
+    /// Each module's conventions, from its source: moving the world point along
+    /// `forward(P, C)` moves the joints along machine Z only (the tool is Z), and the chain
+    /// gives the module's joints for every world point and angle.
+    fn check_against_source(
+        m: &Machine,
+        inverse: impl Fn([f64; 3], f64, f64) -> [f64; 3],
+        with_chain: bool,
+    ) {
+        let mut rng = crate::testutil::SplitMix64(21);
+        for _ in 0..500 {
+            let (p, c) = (rng.uniform(-90.0, 50.0), rng.uniform(-400.0, 400.0));
+            let pos = [
+                rng.uniform(-80.0, 80.0),
+                rng.uniform(-80.0, 80.0),
+                rng.uniform(-60.0, 60.0),
+            ];
+            let o = forward(m, p, c);
+            let j0 = inverse(pos, p, c);
+            let j1 = inverse(
+                [
+                    pos[0] + 10.0 * o[0],
+                    pos[1] + 10.0 * o[1],
+                    pos[2] + 10.0 * o[2],
+                ],
+                p,
+                c,
+            );
+            let d = [j1[0] - j0[0], j1[1] - j0[1], j1[2] - j0[2]];
+            assert!(
+                close(d, [0.0, 0.0, 10.0], 1e-9),
+                "{}: {d:?} at P={p} C={c}",
+                m.name
+            );
+            if with_chain {
+                let chain = m.chain.expect("a chain");
+                let datum = [3.0, -7.0, 12.0];
+                // The part point x_W is the world point pos − datum (G54 = datum).
+                let x =
+                    chain.program_xyz(m, datum, p, c, [pos[0] - 3.0, pos[1] + 7.0, pos[2] - 12.0]);
+                let x_m = [x[0] + 3.0, x[1] - 7.0, x[2] + 12.0];
+                assert!(close(x_m, j0, 1e-9), "{}: {x_m:?} vs {j0:?}", m.name);
+            }
+        }
+    }
+
+    #[test]
+    fn xyzac_trt_follows_trtfuncs_and_the_ini() {
+        let m = load("xyzac-trt/xyzac-trt.ini");
+        assert_eq!(m.name, "test-xyzac-trt (switchkins)");
+        assert_eq!((m.primary_letter(), m.c_letter()), ('A', 'C'));
+        // conventional-directions 0: j = +cos C · sin A (C17's senses), the opposite of the
+        // UCP710's j = −cos C · sin A.
+        assert_eq!((m.primary_sense, m.c_sense), (-1.0, -1.0));
+        let (a, c) = (25f64.to_radians(), 40f64.to_radians());
+        let o = forward(&m, 25.0, 40.0);
+        assert!(close(
+            o,
+            [c.sin() * a.sin(), c.cos() * a.sin(), a.cos()],
+            1e-15
+        ));
+        let ucp = Machine::builtin("mikron-ucp710").unwrap();
+        assert!((forward(&ucp, 25.0, 40.0)[1] + c.cos() * a.sin()).abs() < 1e-15);
+        let pins = Pins {
+            rot: [5.0, -3.0, -40.0],
+            dx: 0.0,
+            dy: 20.0,
+            dz: 10.0,
+            con: -1.0,
+        };
+        check_against_source(&m, |pos, p, c| xyzac_inverse(pins, pos, p, c), true);
+        // conventional-directions 1: G16's senses, and still the source's joints.
+        let text = std::fs::read_to_string(config("xyzac-trt/xyzac-trt.ini"))
+            .unwrap()
+            .replace("conventional-directions 0", "conventional-directions 1");
+        let dir = config("xyzac-trt");
+        let m1 = machine_from_ini_text(&text, "conv.ini", Some(&dir)).unwrap();
+        assert_eq!((m1.primary_sense, m1.c_sense), (1.0, 1.0));
+        let pins1 = Pins { con: 1.0, ..pins };
+        check_against_source(&m1, |pos, p, c| xyzac_inverse(pins1, pos, p, c), true);
+    }
+
+    #[test]
+    fn xyzac_trt_ini_has_the_limits_of_the_equivalent_toml() {
+        let ini = load("xyzac-trt/xyzac-trt.ini");
+        let toml = Machine::load(config("xyzac-trt/xyzac-trt.toml").to_str().unwrap()).unwrap();
+        for axis in Axis::ALL {
+            let (a, b) = (ini.limit(axis), toml.limit(axis));
+            for (x, y, what) in [(a.v, b.v, "v"), (a.a, b.a, "a"), (a.j, b.j, "j")] {
+                assert!(
+                    (x - y).abs() <= 1e-12 * y,
+                    "{axis:?} {what}: INI {x} TOML {y}"
+                );
+            }
+        }
+        // X's joint is slower than its axis: the joint counts (18 mm/s); Z's joint jerk.
+        assert!((ini.limit(Axis::X).v - 18.0).abs() < 1e-12);
+        assert_eq!(ini.limit(Axis::Z).j, 5000.0);
+        assert_eq!(ini.primary_range_deg, toml.primary_range_deg);
+        assert_eq!(ini.primary_range_deg, (-90.0, 50.0));
+        assert_eq!(ini.c_range_deg, toml.c_range_deg);
+        assert_eq!(ini.tcy_s, toml.tcy_s);
+        assert_eq!(ini.rotary, toml.rotary);
+        assert_eq!(
+            (ini.primary_sense, ini.c_sense),
+            (toml.primary_sense, toml.c_sense)
+        );
+        assert_eq!(ini.chain, toml.chain);
+        assert_eq!(ini.controller, toml.controller);
+        // The one assumption said: the jerk of the axes without MAX_JERK.
+        assert_eq!(ini.warnings.len(), 1, "{:?}", ini.warnings);
+        assert!(
+            ini.warnings[0].contains("no MAX_JERK for X Y A C")
+                && ini.warnings[0].contains("MAX_ACCELERATION / SERVO_PERIOD (1 ms)"),
+            "{:?}",
+            ini.warnings
+        );
+    }
+
+    #[test]
+    fn switchkins_remaps_are_the_tcpm_codes() {
+        let m = load("xyzac-trt/xyzac-trt.ini");
+        // sparm=identityfirst: type 1 is the TCP kinematics. M6's remap switches nothing.
+        assert_eq!(m.controller.tcpm_on, ["M428"]);
+        assert_eq!(m.controller.tcpm_off, ["M429", "M430"]);
+        assert!(!m.controller.tcpm_always);
+        // Without sparm, type 0 is TCP: M429 (type 0) switches it on, and the kinematics
+        // start as TCP (said in a warning).
+        let text = std::fs::read_to_string(config("xyzac-trt/xyzac-trt.ini"))
+            .unwrap()
+            .replace(" sparm=identityfirst", "");
+        let dir = config("xyzac-trt");
+        let m = machine_from_ini_text(&text, "t.ini", Some(&dir)).unwrap();
+        assert_eq!(m.controller.tcpm_on, ["M429"]);
+        assert_eq!(m.controller.tcpm_off, ["M428", "M430"]);
+        assert!(
+            m.warnings.iter().any(|w| w.contains("start as TCP")),
+            "{:?}",
+            m.warnings
+        );
+        // Not switched at all: always TCP.
+        let text: String = text
+            .lines()
+            .filter(|l| !l.contains("REMAP"))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let m = machine_from_ini_text(&text, "t.ini", Some(&dir)).unwrap();
+        assert!(m.controller.tcpm_always);
+        assert!(m.controller.tcpm_on.is_empty() && m.controller.tcpm_off.is_empty());
+        // A remap whose subroutine cannot be found: taken as ending TCP, with a warning.
+        let text = std::fs::read_to_string(config("xyzac-trt/xyzac-trt.ini"))
+            .unwrap()
+            .replace("ngc=430remap", "ngc=431remap");
+        let m = machine_from_ini_text(&text, "t.ini", Some(&dir)).unwrap();
+        assert_eq!(m.controller.tcpm_off, ["M429", "M430"]);
+        assert!(
+            m.warnings
+                .iter()
+                .any(|w| w.contains("REMAP M430") && w.contains("431remap.ngc")),
+            "{:?}",
+            m.warnings
+        );
+    }
+
+    #[test]
+    fn xyzbc_trt_follows_trtfuncs_with_pins_from_a_hal_file() {
+        let m = load("xyzbc-trt/xyzbc-trt.ini");
+        assert_eq!((m.primary_letter(), m.c_letter()), ('B', 'C'));
+        assert_eq!((m.primary_sense, m.c_sense), (1.0, 1.0));
+        // Not switched: always TCP.
+        assert!(m.controller.tcpm_always);
+        // Inch: 2 in/s = 50.8 mm/s; the rot point and offsets in mm; half a ms servo.
+        assert!((m.limit(Axis::X).v - 50.8).abs() < 1e-12);
+        assert!((m.limit(Axis::Z).j - 200.0 * 25.4).abs() < 1e-9);
+        assert_eq!(m.limit(Axis::C).j, 20_000.0);
+        assert!((m.limit(Axis::Primary).j - 900.0 / 5e-4).abs() < 1e-6);
+        assert_eq!(m.tcy_s, 5e-4);
+        assert_eq!(m.c_range_deg, None, "WRAPPED_ROTARY");
+        assert_eq!(m.primary_range_deg, (-120.0, 120.0));
+        let mm = |v: f64| v * 25.4;
+        let pins = Pins {
+            rot: [mm(1.5), mm(-0.5), mm(-2.0)],
+            dx: mm(-0.8),
+            dy: 0.0,
+            dz: mm(-0.6),
+            con: 1.0,
+        };
+        check_against_source(&m, |pos, p, c| xyzbc_inverse(pins, pos, p, c), true);
+        // The postgui file that is not there is said.
+        assert!(
+            m.warnings.iter().any(|w| w.contains("missing_postgui.hal")),
+            "{:?}",
+            m.warnings
+        );
+        // conventional-directions 0 with offsets: the source turns its offsets the other way
+        // than the table (dpx, dpz carry no `con`), which no pair of fixed axes does: the
+        // orientation is still the source's, but no chain is taken, with a warning.
+        let dir = config("xyzbc-trt");
+        let hal = std::fs::read_to_string(dir.join("xyzbc-pivot.hal"))
+            .unwrap()
+            .replace("conventional-directions 1", "conventional-directions 0");
+        let tmp = std::env::temp_dir().join(format!("polepatch-lcnc-{}", std::process::id()));
+        std::fs::create_dir_all(&tmp).unwrap();
+        std::fs::write(tmp.join("xyzbc-pivot.hal"), hal).unwrap();
+        let text = std::fs::read_to_string(dir.join("xyzbc-trt.ini")).unwrap();
+        let m0 = machine_from_ini_text(&text, "t.ini", Some(&tmp)).unwrap();
+        assert_eq!((m0.primary_sense, m0.c_sense), (-1.0, -1.0));
+        assert_eq!(m0.chain, None);
+        assert!(
+            m0.warnings.iter().any(|w| w.contains("dpx/dpz")),
+            "{:?}",
+            m0.warnings
+        );
+        let pins0 = Pins { con: -1.0, ..pins };
+        check_against_source(&m0, |pos, p, c| xyzbc_inverse(pins0, pos, p, c), false);
+        // Without offsets it is a chain again, and the source's joints.
+        let text0 = text
+            .replace("X_OFFSET = -0.8", "X_OFFSET = 0")
+            .replace("Z_OFFSET = -0.6", "Z_OFFSET = 0");
+        let m0 = machine_from_ini_text(&text0, "t.ini", Some(&tmp)).unwrap();
+        let pins0 = Pins {
+            dx: 0.0,
+            dz: 0.0,
+            ..pins0
+        };
+        check_against_source(&m0, |pos, p, c| xyzbc_inverse(pins0, pos, p, c), true);
+        std::fs::remove_dir_all(&tmp).unwrap();
+    }
+
+    #[test]
+    fn xyzab_tdr_has_its_pole_along_x() {
+        let m = load("xyzab-tdr/xyzab-tdr.ini");
+        // The A table (the pole axis, next to the part) along X, carried by B along Y.
+        assert_eq!((m.primary_letter(), m.c_letter()), ('B', 'A'));
+        assert_eq!(m.pole_direction(), [1.0, 0.0, 0.0]);
+        // Its source's tool axis: (sin B, −sin A cos B, cos A cos B).
+        let (a, b) = (30f64.to_radians(), 20f64.to_radians());
+        let o = forward(&m, 20.0, 30.0);
+        assert!(close(
+            o,
+            [b.sin(), -a.sin() * b.cos(), a.cos() * b.cos()],
+            1e-15
+        ));
+        // The pole is B = ±90°: there A cannot change the tool axis.
+        let pole = m.pole_p_deg().unwrap();
+        assert!((pole.abs() - 90.0).abs() < 1e-12, "{pole}");
+        assert!(close(
+            forward(&m, 90.0, 17.0),
+            forward(&m, 90.0, -140.0),
+            1e-15
+        ));
+        assert!((m.pole_tilt_deg(80.0) - 10.0).abs() < 1e-12);
+        let pins = Pins {
+            rot: [-50.0, -50.0, -100.0],
+            dx: -20.0,
+            dy: 0.0,
+            dz: -10.0,
+            con: 1.0,
+        };
+        check_against_source(&m, |pos, p, c| xyzab_tdr_inverse(pins, pos, c, p), true);
+        assert_eq!(m.controller.tcpm_on, ["M428"]);
+        assert_eq!(m.controller.tcpm_off, ["M429"]);
+        assert_eq!(m.c_range_deg, Some((-3600.0, 3600.0)));
+        assert_eq!(m.primary_range_deg, (-180.0, 180.0));
+        assert_eq!(m.limit(Axis::C).v, 30.0);
+    }
+
+    #[test]
+    fn bad_inis_are_refused_by_name() {
+        let good = std::fs::read_to_string(config("xyzab-tdr/xyzab-tdr.ini")).unwrap();
+        let cases: &[(&str, &str, &str)] = &[
+            (
+                "KINEMATICS = xyzab_tdr_kins",
+                "KINEMATICS = trivkins coordinates=xyzab",
+                "[KINS] KINEMATICS = trivkins: polepatch reads the 5-axis modules",
+            ),
+            ("KINEMATICS = xyzab_tdr_kins", "", "no [KINS] KINEMATICS"),
+            (
+                "    MAX_VELOCITY =   20\nMAX_ACCELERATION =  300\n\n[AXIS_Y]",
+                "MAX_ACCELERATION =  300\n\n[AXIS_Y]",
+                "no MAX_VELOCITY for axis X in [AXIS_X] or [JOINT_0]",
+            ),
+            (
+                "    MAX_VELOCITY =    30\nMAX_ACCELERATION =   300\n\n[AXIS_B]",
+                "    MAX_VELOCITY =    3O\nMAX_ACCELERATION =   300\n\n[AXIS_B]",
+                "[AXIS_A] MAX_VELOCITY = 3O: not a number",
+            ),
+            (
+                "       MIN_LIMIT =   -180\n",
+                "",
+                "axis B tilts the tool and needs a travel",
+            ),
+            (
+                "LINEAR_UNITS = mm",
+                "LINEAR_UNITS = furlong",
+                "not mm or inch",
+            ),
+            (
+                "[EMCMOT]",
+                "[EMCMOT\n",
+                "a section header must end with ']'",
+            ),
+            (
+                "SERVO_PERIOD = 1000000",
+                "SERVO_PERIOD = 1000",
+                "SERVO_PERIOD (as ms) must be a cycle time from 0.1 to 100 ms, got 0.001",
+            ),
+            (
+                "    MAX_VELOCITY =   20\nMAX_ACCELERATION =  300\n\n[AXIS_Y]",
+                "    MAX_VELOCITY =   1e-9\nMAX_ACCELERATION =  300\n\n[AXIS_Y]",
+                "is outside the accepted range",
+            ),
+        ];
+        for (from, to, want) in cases {
+            assert!(good.contains(from), "edit {from:?} does not apply");
+            let text = good.replacen(from, to, 1);
+            let err = machine_from_ini_text(&text, "bad.ini", None)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("bad.ini") && err.contains(want),
+                "{to:?}: {err}"
+            );
+        }
+        // A signal with no value and no other pin is HAL's 0 (a chain); one a GUI slider
+        // drives at run time gives no chain, said.
+        let text = good.replace("HALCMD = sets :x-offset     -20\n", "");
+        let m = machine_from_ini_text(&text, "t.ini", None).unwrap();
+        assert_eq!(m.chain.unwrap().c_axis_point_mm, [-50.0, -50.0, -110.0]);
+        let text = good.replace(
+            "HALCMD = sets :x-offset     -20\n",
+            "HALCMD = net :x-offset => pyvcp.x-offset-f\n",
+        );
+        let m = machine_from_ini_text(&text, "t.ini", None).unwrap();
+        assert_eq!(m.chain, None);
+        assert!(
+            m.warnings
+                .iter()
+                .any(|w| w.contains("xyzab_tdr_kins.x-offset is netted to :x-offset")),
+            "{:?}",
+            m.warnings
+        );
+        // Without a directory the remap subroutines are not read: said, taken as ending TCP.
+        assert!(m.controller.tcpm_on.is_empty());
+        assert!(
+            m.warnings.iter().any(|w| w.contains("REMAP M428")),
+            "{:?}",
+            m.warnings
+        );
+    }
+
+    #[test]
+    fn ini_syntax_as_linuxcnc_reads_it() {
+        let ini = Ini::parse(
+            "# comment\n; other comment\n[A]\nK = 1\n  K = 2\nL=x = y\n[B]\nK = 3\n",
+            "t",
+        )
+        .unwrap();
+        assert_eq!(ini.get("A", "K"), Some("1"));
+        assert_eq!(ini.all("A", "K").collect::<Vec<_>>(), ["1", "2"]);
+        assert_eq!(ini.get("A", "L"), Some("x = y"));
+        assert_eq!(ini.get("B", "K"), Some("3"));
+        assert_eq!(ini.get("C", "K"), None);
+        let err = Ini::parse("[A]\nnonsense\n", "t.ini")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("line 2") && err.contains("KEY = VALUE"),
+            "{err}"
+        );
+    }
+}
