@@ -85,6 +85,8 @@ struct Entry {
 #[derive(Debug, Default)]
 pub struct Ini {
     entries: Vec<Entry>,
+    /// `#INCLUDE` lines (expanded by LinuxCNC's start script, not here): 1-based lines.
+    includes: Vec<usize>,
 }
 
 impl Ini {
@@ -92,8 +94,12 @@ impl Ini {
     pub fn parse(text: &str, origin: &str) -> Result<Ini, MachineError> {
         let mut section = String::new();
         let mut entries = Vec::new();
+        let mut includes = Vec::new();
         for (n, raw) in text.lines().enumerate() {
             let line = raw.trim();
+            if line.starts_with("#INCLUDE") {
+                includes.push(n + 1);
+            }
             if line.is_empty() || line.starts_with('#') || line.starts_with(';') {
                 continue;
             }
@@ -120,7 +126,7 @@ impl Ini {
                 line: n + 1,
             });
         }
-        Ok(Ini { entries })
+        Ok(Ini { entries, includes })
     }
 
     /// The first value of `key` in `[section]`.
@@ -339,6 +345,12 @@ pub fn machine_from_ini_text(
     let ini = Ini::parse(text, origin)?;
     let err = |m: String| invalid(origin, m);
     let mut warnings = Vec::new();
+    if let Some(line) = ini.includes.first() {
+        warnings.push(format!(
+            "{origin}: line {line}: #INCLUDE is expanded by LinuxCNC's start script, not read \
+             here: keys in the included file are missing"
+        ));
+    }
 
     // [KINS] KINEMATICS = module params...
     let kins = ini.entry("KINS", "KINEMATICS").ok_or_else(|| {
@@ -1201,6 +1213,9 @@ mod tests {
         assert_eq!(ini.get("A", "L"), Some("x = y"));
         assert_eq!(ini.get("B", "K"), Some("3"));
         assert_eq!(ini.get("C", "K"), None);
+        assert_eq!(ini.includes, Vec::<usize>::new());
+        let with = Ini::parse("[A]\n#INCLUDE joints.inc\nK = 1\n", "t").unwrap();
+        assert_eq!(with.includes, [2]);
         let err = Ini::parse("[A]\nnonsense\n", "t.ini")
             .unwrap_err()
             .to_string();
