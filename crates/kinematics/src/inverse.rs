@@ -741,6 +741,114 @@ mod tests {
         assert_eq!(unwrap_near_deg(-1e-20, 0.0), -1e-20);
     }
 
+    /// A pair whose pole is not at P = 0: LinuxCNC's xyzab_tdr layout, the A table along X
+    /// (the pole axis) carried by B along Y, tool along Z. The pole is B = ±90°.
+    fn tdr() -> Machine {
+        crate::testutil::pair_machine([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], 1.0, 1.0)
+    }
+
+    /// A 45° nutating table: B at 45° between +Y and +Z carrying C; it reaches 0° to 90°
+    /// from its C axis.
+    fn nutating() -> Machine {
+        let mut m = crate::testutil::pair_machine(
+            [0.0, 0.0, 1.0],
+            crate::testutil::unit([0.0, 1.0, 1.0]),
+            [0.0, 0.0, 1.0],
+            1.0,
+            1.0,
+        );
+        m.primary_range_deg = (-5.0, 185.0);
+        m
+    }
+
+    /// A planted pass 1.15° beside the pole of a pair whose pole is at B = 90°: every rule
+    /// gives joints whose FK is the tool axis; Nearest and the constant-sign rules stay
+    /// continuous (C unwrapped), the domain rule keeps |C| the smaller of the two.
+    #[test]
+    fn paths_on_a_pair_whose_pole_is_not_at_zero() {
+        let m = tdr();
+        assert!(m.standard_form().is_none());
+        // The tool axis passes 0.02 rad beside +X while its y component crosses 0.
+        let o: Vec<[f64; 3]> = (-10..=10)
+            .map(|n| {
+                let (y, z) = (f64::from(n) * 0.01, 0.02);
+                [(1.0 - y * y - z * z).sqrt(), y, z]
+            })
+            .collect();
+        for rule in [
+            BranchRule::Nearest,
+            BranchRule::DomainRule,
+            BranchRule::PreferPositive,
+            BranchRule::PreferNegative,
+        ] {
+            let path = inverse_path(&m, &o, rule);
+            for (s, o) in path.iter().zip(&o) {
+                assert!(
+                    dist(forward(&m, s.p_deg, s.c_deg), *o) < 1e-12,
+                    "{rule:?}: {s:?}"
+                );
+                // Within 5.85° of the pole (the pass's ends: hypot(0.1, 0.02) rad), B is
+                // within 5.85° of ±90°.
+                assert!((s.p_deg.abs() - 90.0).abs() < 5.9, "{rule:?}: {s:?}");
+            }
+            if rule == BranchRule::DomainRule {
+                for (s, o) in path.iter().zip(&o) {
+                    let [a, b] = inverse(&m, *o).unwrap();
+                    assert!(s.c_deg.abs() <= a.c_deg.abs().min(b.c_deg.abs()) + 1e-12);
+                }
+            } else {
+                // A continuous C sweep: no step above 30°.
+                let max_step = path
+                    .windows(2)
+                    .map(|w| (w[1].c_deg - w[0].c_deg).abs())
+                    .fold(0.0, f64::max);
+                assert!(max_step < 30.0, "{rule:?}: {max_step}");
+            }
+        }
+        // On the pole: B at the pole, C held; the opposite pole: the other B.
+        let path = inverse_path(
+            &m,
+            &[forward(&m, 80.0, 33.0), [1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]],
+            BranchRule::Nearest,
+        );
+        assert!(
+            (path[1].p_deg - m.pole_p_deg().unwrap()).abs() < 1e-12,
+            "{path:?}"
+        );
+        assert!((path[1].p_deg.abs() - 90.0).abs() < 1e-12);
+        assert_eq!(path[1].c_deg, path[0].c_deg);
+        assert!(dist(forward(&m, path[2].p_deg, path[2].c_deg), [-1.0, 0.0, 0.0]) < 1e-12);
+        assert_eq!(path[2].c_deg, path[0].c_deg);
+    }
+
+    /// A tool axis a nutating table cannot reach is a NaN point, and the path goes on from
+    /// the last point it could.
+    #[test]
+    fn an_unreachable_tool_axis_is_a_nan_point_on_the_path() {
+        let m = nutating();
+        let o = [
+            forward(&m, 60.0, 10.0),
+            [1.0, 0.0, -0.2],
+            forward(&m, 61.0, 11.0),
+        ];
+        let path = inverse_path(&m, &o, BranchRule::Nearest);
+        assert!(path[1].p_deg.is_nan() && path[1].c_deg.is_nan());
+        assert!((path[0].p_deg - 60.0).abs() < 1e-9 && (path[2].p_deg - 61.0).abs() < 1e-9);
+        assert!((path[2].c_deg - 11.0).abs() < 1e-9);
+        match solve_ik(&m, o[1]) {
+            Ik::Unreachable {
+                angle_deg,
+                reach_deg,
+            } => {
+                assert!(angle_deg > 90.0 && (reach_deg.1 - 90.0).abs() < 1e-9)
+            }
+            other => panic!("{other:?}"),
+        }
+        // The range check picks the solution within B's travel: (−B) is out of it.
+        let s = inverse_path(&m, &[forward(&m, 60.0, 10.0)], BranchRule::PreferNegative)[0];
+        assert!((s.p_deg - 60.0).abs() < 1e-9, "{s:?}");
+    }
+
     mod prop {
         use super::*;
         use proptest::prelude::*;
