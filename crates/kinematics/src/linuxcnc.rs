@@ -418,39 +418,29 @@ pub fn machine_from_ini_text(
     let read_axis = |letter: char| -> Result<AxisIni, MachineError> {
         let mut sections = vec![format!("AXIS_{letter}")];
         sections.extend(joints_of(letter).into_iter().map(|n| format!("JOINT_{n}")));
-        let value = |key: &str| -> Result<Option<f64>, MachineError> {
-            let mut best: Option<f64> = None;
-            for s in &sections {
-                if let Some(e) = ini.entry(s, key) {
-                    let v = number(&e.value).ok_or_else(|| {
-                        err(format!(
-                            "line {}: [{s}] {key} = {}: not a number",
-                            e.line, e.value
-                        ))
-                    })?;
-                    best = Some(best.map_or(v, |b: f64| b.min(v)));
+        // The values of `key` over the axis and its joints, combined by `pick` (the smaller
+        // limit, the larger MIN_LIMIT).
+        let combined =
+            |key: &str, pick: fn(f64, f64) -> f64| -> Result<Option<f64>, MachineError> {
+                let mut best: Option<f64> = None;
+                for s in &sections {
+                    if let Some(e) = ini.entry(s, key) {
+                        let v = number(&e.value).ok_or_else(|| {
+                            err(format!(
+                                "line {}: [{s}] {key} = {}: not a number",
+                                e.line, e.value
+                            ))
+                        })?;
+                        best = Some(best.map_or(v, |b| pick(b, v)));
+                    }
                 }
-            }
-            Ok(best)
-        };
-        let mut lo: Option<f64> = None;
-        let mut hi: Option<f64> = None;
-        for s in &sections {
-            for (key, slot, pick) in [
-                ("MIN_LIMIT", &mut lo, f64::max as fn(f64, f64) -> f64),
-                ("MAX_LIMIT", &mut hi, f64::min as fn(f64, f64) -> f64),
-            ] {
-                if let Some(e) = ini.entry(s, key) {
-                    let v = number(&e.value).ok_or_else(|| {
-                        err(format!(
-                            "line {}: [{s}] {key} = {}: not a number",
-                            e.line, e.value
-                        ))
-                    })?;
-                    *slot = Some(slot.map_or(v, |b| pick(b, v)));
-                }
-            }
-        }
+                Ok(best)
+            };
+        let value = |key: &str| combined(key, f64::min);
+        let (lo, hi) = (
+            combined("MIN_LIMIT", f64::max)?,
+            combined("MAX_LIMIT", f64::min)?,
+        );
         Ok(AxisIni {
             v: value("MAX_VELOCITY")?,
             a: value("MAX_ACCELERATION")?,
