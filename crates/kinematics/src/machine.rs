@@ -249,8 +249,15 @@ impl Machine {
                 builtins: Machine::builtin_names().join(", "),
             });
         }
+        Machine::from_file(path)
+    }
+    /// A machine file at `path` (never a built-in name), read as [`Machine::load`] reads
+    /// it: at most [`MAX_MACHINE_FILE_BYTES`]; a LinuxCNC INI when the name ends in `.ini`
+    /// (any case), else TOML.
+    pub fn from_file(path: &std::path::Path) -> Result<Machine, MachineError> {
+        let name = path.display().to_string();
         let text = read_bounded(path).map_err(|cause| MachineError::Io {
-            path: name_or_path.to_string(),
+            path: name.clone(),
             cause,
         })?;
         let is_ini = path
@@ -259,7 +266,7 @@ impl Machine {
         if is_ini {
             crate::linuxcnc::machine_from_ini(&text, path)
         } else {
-            Machine::from_toml_str(&text, name_or_path)
+            Machine::from_toml_str(&text, &name)
         }
     }
     /// Letter of the primary (tilting) axis in NC words (`'A'` or `'B'` on the built-ins).
