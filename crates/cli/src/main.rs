@@ -266,7 +266,12 @@ mod reorient_cmd;
 mod simulate_cmd;
 
 pub(crate) fn machine(name: &str) -> Result<Machine> {
-    Ok(Machine::load(name)?)
+    let machine = Machine::load(name)?;
+    // What the loader assumed (a LinuxCNC INI without jerk limits, …).
+    for w in &machine.warnings {
+        eprintln!("polepatch: warning: {w}");
+    }
+    Ok(machine)
 }
 
 /// `--tcy-ms` within the range a machine file accepts (`kinematics::machine::TCY_MS_RANGE`).
