@@ -122,6 +122,11 @@ pub(crate) struct PatchArgs {
     /// original block — keeps its values.
     #[arg(long, value_name = "MM", default_value_t = polepatch::machine_frame::CHORD_TOLERANCE_MM)]
     pub(crate) chord_tolerance: f64,
+    /// Units of a program that states none (no G20/G21, G70/G71, BEGIN PGM … MM|INCH):
+    /// nothing in the file tells inches from mm, so say it (default mm; the report says
+    /// which was assumed).
+    #[arg(long, value_enum)]
+    pub(crate) units: Option<post_cmd::UnitsArg>,
 }
 
 #[derive(clap::Args)]
@@ -148,6 +153,9 @@ struct AnalyzeArgs {
     /// arcs or skippable blocks near the pole, …).
     #[arg(long)]
     strict: bool,
+    /// Units of a program that states none (see `patch`). Default mm.
+    #[arg(long, value_enum)]
+    units: Option<post_cmd::UnitsArg>,
 }
 
 /// `X,Y,Z` as three finite numbers.
@@ -241,6 +249,7 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
         feed_fallback_mm_min: args.feed,
         name: name.clone(),
         work_offset_mm: args.work_offset,
+        inch: args.units == Some(post_cmd::UnitsArg::Inch),
     };
     let bytes = files::read(&args.file)?;
     let args_strict = args.strict;
@@ -330,9 +339,9 @@ fn print_run(
     primary_letter: u8,
 ) -> std::io::Result<()> {
     {
-        let feed = r
-            .feed_mm_min
-            .map_or("no F".to_string(), |f| format!("F{f}"));
+        let feed = r.feed_mm_min.map_or("no F".to_string(), |f| {
+            format!("F{}", polepatch::report::feed_text(f))
+        });
         writeln!(
             out,
             "\nrun {}: lines {}–{}, {} points, {:.3} mm at {}",

@@ -124,6 +124,7 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
         feed_fallback_mm_min: args.feed,
         work_offset_mm: args.work_offset,
         chord_tolerance_mm: args.chord_tolerance,
+        inch: args.units == Some(crate::post_cmd::UnitsArg::Inch),
         ..polepatch::PatchOptions::default()
     };
     let machine = machine(&args.machine)?;

@@ -4,7 +4,7 @@
 //!
 //! | line | read as |
 //! |---|---|
-//! | `BEGIN PGM NAME MM` / `INCH` | program start; INCH: lengths ×25.4, F in 1/10 inch/min ×2.54 |
+//! | `BEGIN PGM NAME MM` / `INCH` (`IN`, as NX's posts write it) | program start; INCH: lengths ×25.4, F in 1/10 inch/min ×2.54 |
 //! | `END PGM NAME` | program end (TCPM off) |
 //! | `L X+10 Y-5 Z+0 A+0 C+90 R0 F2000 M3` | linear move; `FMAX` a rapid for this block only; `FAUTO`, `FU`, `FZ` no feed per minute; `IX+5` incremental for this block (the block is never changed and ends runs); `RL`/`RR`/`R+`/`R-` radius compensation ends runs |
 //! | `C`, `CR`, `CT` (arcs), `CP`, `LP` (polar), `APPR`, `DEP` | moves polepatch does not follow: they end runs (`LP`, `CP`, `APPR`, `DEP` leave X Y Z unknown) |
@@ -88,11 +88,37 @@ impl Words<'_> {
     ) -> Result<(), ParseError> {
         let b = self.bytes;
         let mut seen = [false; 7];
-        for t in toks {
+        let mut k = 0;
+        while k < toks.len() {
+            let t = &toks[k];
+            k += 1;
             let text = &b[t.clone()];
             let letters = text.iter().take_while(|c| c.is_ascii_alphabetic()).count();
             let name = text[..letters].to_ascii_uppercase();
-            let value = t.start + letters..t.end;
+            let mut value = t.start + letters..t.end;
+            // `L Z 25.000 FMAX` (an APT post's output): a blank between an axis letter (or
+            // F) and its number, read as the word — the blank stays in the file; a letter
+            // left without a number says the blank is what is wrong.
+            let lone = value.is_empty()
+                && matches!(name.as_slice(), [l] | [b'I', l] if axis_index(*l).is_some() || *l == b'F');
+            if lone {
+                match toks.get(k) {
+                    Some(next) if parse_number(&b[next.clone()]).is_some() => {
+                        value = next.clone();
+                        k += 1;
+                    }
+                    _ => {
+                        return Err(self.err(
+                            t.start,
+                            format!(
+                                "{} word has no number (a blank after the letter is read only when \
+                                 a number follows it)",
+                                String::from_utf8_lossy(&name)
+                            ),
+                        ));
+                    }
+                }
+            }
             let value_text = &b[value.clone()];
             // An axis word, possibly incremental (`IX+5`).
             let (incremental, axis) = match name.as_slice() {
@@ -265,9 +291,11 @@ pub(crate) fn lex(
     match key.as_slice() {
         k if k.first() == Some(&b'*') => {}
         b"BEGIN" => {
+            // `INCH` (NX's Heidenhain posts write `IN`) or `MM`; anything else states no
+            // units.
             if let Some(unit) = rest.last() {
                 let u = upper(bytes, unit);
-                if u == b"INCH" {
+                if u == b"INCH" || u == b"IN" {
                     s.inch = Some(true);
                 } else if u == b"MM" {
                     s.inch = Some(false);

@@ -113,7 +113,7 @@ impl Interpreter {
         Interpreter {
             dialect,
             controller: opts.controller.clone(),
-            modal: crate::modal::initial(&opts.controller),
+            modal: opts.initial(),
             stated_datum: None,
             frame_changed: false,
         }
@@ -123,6 +123,9 @@ impl Interpreter {
         let heidenhain = self.dialect == Dialect::Heidenhain;
         if let Some(sw) = code.and_then(|c| self.controller.g(self.dialect, c)) {
             s.tcpm = Some(sw);
+            return;
+        }
+        if self.dialect == Dialect::MillPlus && crate::millplus::g(code, s) {
             return;
         }
         match code {
@@ -348,6 +351,9 @@ impl Interpreter {
                         s.breaks = true;
                     }
                 }
+                Token::Indexed { letter, .. } => {
+                    crate::millplus::indexed(self.dialect, letter, &mut s)
+                }
                 Token::Percent { span } => {
                     for w in bytes[span].split(|b| b.is_ascii_whitespace()) {
                         if w.eq_ignore_ascii_case(b"G70") {
@@ -413,6 +419,7 @@ impl Interpreter {
         }
         if let Some(inch) = s.inch {
             m.inch = inch;
+            flags.set(Flags::UNITS);
         }
         if let Some(sw) = s.tcpm {
             if !always {

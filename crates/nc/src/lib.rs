@@ -15,6 +15,7 @@ pub mod error;
 mod interp;
 pub mod lexer;
 pub mod lines;
+pub mod millplus;
 pub mod modal;
 pub mod plan;
 pub mod program;

@@ -17,6 +17,7 @@
 //! | Heidenhain (ISO and conversational) | `M128`, `FUNCTION TCPM …` | `M129`, `FUNCTION RESET TCPM`, `M2`, `M30`, `END PGM` |
 //! | Sinumerik | `TRAORI` | `TRAFOOF`, `TRANSMIT`, `TRACYL`, `TRAANG`, `M2`, `M30` |
 //! | Fanuc, Haas, LinuxCNC and other ISO | `G43.4`, `G43.5`, `G234` (Haas TCPC) | `G49`, `G43`, `G44` (group 8 replaces G43.4), `G43.1`, `G43.7`, `M2`, `M30` |
+//! | MillPlus | `G141` (3D tool correction with the tool orientation) | `G40`, `M2`, `M30` |
 //!
 //! A machine adds its own codes (`tcpm_on = ["M428"]`, `tcpm_off = ["M429", "M430"]` for
 //! LinuxCNC's switchable kinematics), or says its kinematics are always TCP
@@ -137,6 +138,12 @@ impl ControllerCodes {
                 490 | 430 | 440 | 431 | 437 => Some(Switch::Off),
                 _ => None,
             },
+            // MillPlus: G141 3D tool correction with the tool orientation; G40 ends it.
+            Dialect::MillPlus => match g {
+                1410 => Some(Switch::On),
+                400 => Some(Switch::Off),
+                _ => None,
+            },
             Dialect::Sinumerik | Dialect::Heidenhain | Dialect::Conversational => None,
         }
     }
@@ -178,21 +185,35 @@ impl ControllerCodes {
     }
 }
 
-/// How to read a program: its dialect and the machine's TCPM codes.
+/// How to read a program: its dialect, the machine's TCPM codes, and the units of a
+/// program that does not state them.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct ReadOptions {
     /// Dialect (default: detected).
     pub dialect: Dialect,
     /// The machine's own TCPM codes (default: none beyond the dialect's).
     pub controller: ControllerCodes,
+    /// Read lengths (and feeds) in inches until the program states its units (G20/G21,
+    /// G70/G71, G700/G710, `%NAME G71`, `BEGIN PGM … MM|INCH`): what a controller set to
+    /// inches does with a program that states none. Default false: mm.
+    pub inch: bool,
 }
 
 impl ReadOptions {
-    /// Read as `dialect` with the built-in codes only.
+    /// Read as `dialect` with the built-in codes only, in mm.
     pub fn dialect(dialect: Dialect) -> Self {
         ReadOptions {
             dialect,
             controller: ControllerCodes::default(),
+            inch: false,
+        }
+    }
+
+    /// The modal state at the start of a program read this way.
+    pub fn initial(&self) -> crate::Modal {
+        crate::Modal {
+            inch: self.inch,
+            ..crate::modal::initial(&self.controller)
         }
     }
 }

@@ -68,9 +68,9 @@ pub fn far_from_pole(
         }
     };
     let mut i = 0usize;
-    let read = crate::program::read_options(machine)?;
+    let read = crate::program::read_options_with(machine, opts.inch)?;
     let mut notes = crate::notes::Notes::new();
-    let mut prev = polepatch_nc::modal::initial(&read.controller);
+    let mut prev = read.initial();
     scan_blocks_with(bytes, &read, |s| {
         let (block, st) = (s.block, s.state);
         notes.push(block, s.words, &prev, st);

@@ -67,6 +67,10 @@ pub struct PatchOptions {
     /// interpolated linearly, mm (never more than the original block did, either).
     /// Default [`machine_frame::CHORD_TOLERANCE_MM`] (0.005 mm).
     pub chord_tolerance_mm: f64,
+    /// Read a program that states no length units (no G20/G21, G70/G71, G700/G710,
+    /// `%NAME G71`, `BEGIN PGM … MM|INCH`) in inches, as a control set to inches does
+    /// (`--units inch`). Default false: mm. The report's warnings say which was assumed.
+    pub inch: bool,
 }
 
 impl Default for PatchOptions {
@@ -77,6 +81,7 @@ impl Default for PatchOptions {
             name: "input".to_string(),
             work_offset_mm: None,
             chord_tolerance_mm: machine_frame::CHORD_TOLERANCE_MM,
+            inch: false,
         }
     }
 }
@@ -92,6 +97,9 @@ pub struct AnalyzeOptions {
     pub name: String,
     /// Work offset for a machine with a kinematic chain (as [`PatchOptions::work_offset_mm`]).
     pub work_offset_mm: Option<[f64; 3]>,
+    /// Read a program that states no length units in inches (as [`PatchOptions::inch`]).
+    /// Default false: mm.
+    pub inch: bool,
 }
 
 impl Default for AnalyzeOptions {
@@ -101,6 +109,7 @@ impl Default for AnalyzeOptions {
             feed_fallback_mm_min: None,
             name: "input".to_string(),
             work_offset_mm: None,
+            inch: false,
         }
     }
 }

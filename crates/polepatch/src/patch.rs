@@ -310,6 +310,8 @@ pub enum UntouchedReason {
     FeedTooLow,
     /// A rotary axis moves while its value at some point is unknown.
     UnknownRotary,
+    /// The run turns a tilting axis the machine does not have (or holds it away from 0).
+    OtherRotary,
 }
 
 /// A run left byte-identical, and why.
@@ -874,6 +876,7 @@ fn problem_reason(p: &RunProblem) -> UntouchedReason {
         RunProblem::NoFeed => UntouchedReason::NoFeed,
         RunProblem::FeedTooLow { .. } => UntouchedReason::FeedTooLow,
         RunProblem::UnknownRotary { .. } => UntouchedReason::UnknownRotary,
+        RunProblem::OtherRotary { .. } => UntouchedReason::OtherRotary,
     }
 }
 

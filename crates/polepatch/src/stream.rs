@@ -51,7 +51,7 @@
 use crate::end_pose::{After, EndPose, Scan, Step};
 use crate::error::Error;
 use crate::patch::{FileReport, patch_loaded, patch_program};
-use crate::program::{LoadedProgram, RunPath, Window, load_nc, primary_mismatch_warning, run_path};
+use crate::program::{LoadedProgram, RunPath, Window, primary_mismatch_warning, run_path};
 use crate::report::{AnalyzeReport, RunReport};
 use polepatch_kinematics::Machine;
 use polepatch_nc::modal::{A, B, C};
@@ -236,7 +236,7 @@ fn survey(bytes: &[u8], opts: &Reading<'_>) -> Result<Survey, Error> {
     let mut style = StyleEvidence::default();
     let mut notes = crate::notes::Notes::new();
     let mut builder = RunBuilder::default();
-    let mut prev = polepatch_nc::modal::initial(&opts.read.controller);
+    let mut prev = opts.read.initial();
     let mut i = 0usize;
     let dialect = scan_blocks_with(bytes, &opts.read, |s: Scanned<'_>| {
         style.add_block(bytes, s.words);
@@ -375,7 +375,13 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
     let sv = survey(bytes, rd)?;
     let p_idx = tilting_index(&sv, machine);
     if sv.runs.is_empty() || (!sv.uses[p_idx] && !sv.uses[C]) {
-        let mut lp = match load_nc(bytes.to_vec(), rd.name, machine, rd.fallback) {
+        let mut lp = match crate::program::load_nc_with(
+            bytes.to_vec(),
+            rd.name,
+            machine,
+            rd.fallback,
+            &rd.read,
+        ) {
             Ok(lp) => lp,
             Err(why) if why.is_nothing_to_analyse() => {
                 return Ok(Begun::Nothing {
@@ -413,7 +419,7 @@ pub fn patch_nc_to(
         cone_deg: opts.patch.cone_deg,
         fallback: opts.feed_fallback_mm_min,
         work_offset_mm: opts.work_offset_mm,
-        read: crate::program::read_options(machine)?,
+        read: crate::program::read_options_with(machine, opts.inch)?,
         chord_tolerance_mm: opts.chord_tolerance_mm,
     };
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
@@ -539,7 +545,7 @@ fn analyze_each(
         cone_deg: opts.analysis.cone_deg,
         fallback: opts.feed_fallback_mm_min,
         work_offset_mm: opts.work_offset_mm,
-        read: crate::program::read_options(machine)?,
+        read: crate::program::read_options_with(machine, opts.inch)?,
         chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
     };
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
@@ -656,7 +662,7 @@ fn each_stretch<T: Send>(
     let mut failure: Option<Error> = None;
     let mut builder = RunBuilder::default();
     let mut run_no = 0usize;
-    let mut prev = polepatch_nc::modal::initial(&rd.read.controller);
+    let mut prev = rd.read.initial();
     let mut i = 0usize;
     let mut ready: Vec<InHand> = Vec::new();
     let mut ready_bytes = 0usize;
