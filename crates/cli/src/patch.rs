@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 fn options(args: &PatchArgs) -> Result<PatchOptions> {
-    check_positive("--cone", Some(args.cone))?;
+    let (cone_deg, pole_reach_deg) = crate::cone_and_reach(args.cone, args.pole_reach)?;
     if let Some(d) = args.max_deviation
         && !(d.is_finite() && d >= 0.0)
     {
@@ -31,7 +31,8 @@ fn options(args: &PatchArgs) -> Result<PatchOptions> {
         );
     }
     Ok(PatchOptions {
-        cone_deg: args.cone,
+        cone_deg,
+        pole_reach_deg,
         max_deviation_deg: args.max_deviation,
         margin: args.margin,
         third_derivative_continuity: !args.no_jerk_continuity,

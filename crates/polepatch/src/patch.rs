@@ -432,7 +432,9 @@ pub fn patch_program(
 ) -> (Vec<Edit>, FileReport) {
     let program = &lp.program;
     let mut report = FileReport::unchanged(&lp.name, machine, lp.warnings.clone());
-    let (not_analysed, warnings) = lp.notes.finish(lp.primary_index(), opts.cone_deg, &lp.name);
+    let (not_analysed, warnings) = lp
+        .notes
+        .finish(lp.primary_index(), opts.reach_deg(), &lp.name);
     report.not_analysed = not_analysed;
     report.warnings.extend(warnings);
     // The file's number style is only needed when some run comes near the pole; reading
@@ -441,7 +443,7 @@ pub fn patch_program(
     let near_pole = lp.runs.iter().any(|r| {
         r.path
             .as_ref()
-            .is_ok_and(|p| p.axes.iter().any(|q| q[pi].abs() <= opts.cone_deg))
+            .is_ok_and(|p| p.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg()))
     });
     if !near_pole {
         for (r, rp) in lp.runs.iter().enumerate() {
@@ -452,7 +454,7 @@ pub fn patch_program(
                     problem_reason(problem),
                     0,
                     problem.to_string(),
-                    opts.cone_deg,
+                    opts.reach_deg(),
                 ));
             }
         }
@@ -489,14 +491,14 @@ pub fn patch_program(
                     problem_reason(problem),
                     0,
                     problem.to_string(),
-                    opts.cone_deg,
+                    opts.reach_deg(),
                 ));
                 continue;
             }
         };
         // A zone needs a point in the cone (`detect_zones`): a run with none has nothing to
         // patch or report, and its analysis is skipped.
-        if !path.axes.iter().any(|q| q[pi].abs() <= opts.cone_deg) {
+        if !path.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg()) {
             continue;
         }
         let incremental = rp
@@ -557,7 +559,7 @@ pub fn patch_program(
                             reason,
                             zones.len(),
                             message.to_string(),
-                            opts.cone_deg,
+                            opts.reach_deg(),
                         ));
                     }
                 }
@@ -567,7 +569,7 @@ pub fn patch_program(
                     UntouchedReason::Invalid,
                     0,
                     e.to_string(),
-                    opts.cone_deg,
+                    opts.reach_deg(),
                 )),
             }
             continue;
@@ -601,7 +603,7 @@ pub fn patch_program(
                     UntouchedReason::Invalid,
                     0,
                     e.to_string(),
-                    opts.cone_deg,
+                    opts.reach_deg(),
                 ));
                 continue;
             }
@@ -648,7 +650,7 @@ pub fn patch_program(
                         UntouchedReason::MachineFrame,
                         result.zones.len(),
                         why,
-                        opts.cone_deg,
+                        opts.reach_deg(),
                     ));
                     continue;
                 }
@@ -841,6 +843,7 @@ fn through_chain(
     }
     let aopts = polepatch_patcher::AnalysisOptions {
         cone_deg: opts.cone_deg,
+        pole_reach_deg: opts.pole_reach_deg,
         tcy_s: opts.tcy_s,
         keep_samples: false,
     };

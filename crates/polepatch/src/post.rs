@@ -664,8 +664,8 @@ pub fn post_items(
 }
 
 /// The CL file's `INSERT` records in the patch report: each one where it was written (a
-/// warning), and those between two moves with the primary axis within the cone
-/// `cone_deg` (either side) as lines not analysed — the text is the user's, polepatch does
+/// warning), and those between two moves with the primary axis within `cone_deg` on
+/// either side (the reach of the pole) as lines not analysed — the text is the user's, polepatch does
 /// not read what it does to the motion there.
 fn list_inserts(
     cl: &ClProgram,
@@ -697,11 +697,11 @@ fn list_inserts(
         };
         let before = items[..k].iter().rev().find_map(p);
         let after = items[k + 1..].iter().find_map(p);
+        // Text before the first move or after the last cuts no run.
         near.push(
-            [before, after]
-                .iter()
-                .flatten()
-                .any(|v| v.abs() <= cone_deg),
+            before
+                .zip(after)
+                .is_some_and(|(b, a)| b.abs().min(a.abs()) <= cone_deg),
         );
     }
     // Program lines of the raw lines, in order.
@@ -811,7 +811,7 @@ pub fn post_cl(
                 cl,
                 &items,
                 &out,
-                opts.patch_options.patch.cone_deg,
+                opts.patch_options.patch.reach_deg(),
                 &mut report,
             );
             Ok((out, Some(report)))

@@ -137,6 +137,8 @@ pub struct AnalyzeReport {
     pub machine: String,
     /// Singular cone used, degrees.
     pub cone_deg: f64,
+    /// Pole reach used, degrees ([`polepatch_patcher::pole_dominates`]).
+    pub pole_reach_deg: f64,
     /// The tilting letter the program uses as the primary axis (`A` or `B`).
     pub primary: String,
     /// Notes for the user.
@@ -278,11 +280,13 @@ pub fn analyze_program(
         })
         .collect();
     let (not_analysed, notes_warnings) =
-        lp.notes.finish(lp.primary_index(), opts.cone_deg, &lp.name);
+        lp.notes
+            .finish(lp.primary_index(), opts.reach_deg(), &lp.name);
     AnalyzeReport {
         file: lp.name.clone(),
         machine: machine.name.clone(),
         cone_deg: opts.cone_deg,
+        pole_reach_deg: opts.pole_reach_deg,
         primary: (lp.primary_letter as char).to_string(),
         warnings: lp.warnings.iter().cloned().chain(notes_warnings).collect(),
         not_analysed,

@@ -211,6 +211,7 @@ impl Surveying {
 /// What both reads need to know of the caller's options.
 struct Reading<'a> {
     name: &'a str,
+    /// How far from the pole a zone can lie (the cone, or the pole reach beyond it).
     cone_deg: f64,
     fallback: Option<f64>,
     work_offset_mm: Option<[f64; 3]>,
@@ -416,7 +417,7 @@ pub fn patch_nc_to(
     opts.check()?;
     let rd = Reading {
         name: &opts.name,
-        cone_deg: opts.patch.cone_deg,
+        cone_deg: opts.patch.reach_deg(),
         fallback: opts.feed_fallback_mm_min,
         work_offset_mm: opts.work_offset_mm,
         read: crate::program::read_options_with(machine, opts.inch)?,
@@ -542,7 +543,7 @@ fn analyze_each(
     opts.check()?;
     let rd = Reading {
         name: &opts.name,
-        cone_deg: opts.analysis.cone_deg,
+        cone_deg: opts.analysis.reach_deg(),
         fallback: opts.feed_fallback_mm_min,
         work_offset_mm: opts.work_offset_mm,
         read: crate::program::read_options_with(machine, opts.inch)?,
@@ -565,6 +566,7 @@ fn analyze_each(
                 file: opts.name.clone(),
                 machine: machine.name.clone(),
                 cone_deg: opts.analysis.cone_deg,
+                pole_reach_deg: opts.analysis.pole_reach_deg,
                 primary: (LETTERS[l] as char).to_string(),
                 warnings: std::iter::once(format!("{why}: no run analysed"))
                     .chain(warnings)
@@ -582,6 +584,7 @@ fn analyze_each(
         file: opts.name.clone(),
         machine: machine.name.clone(),
         cone_deg: opts.analysis.cone_deg,
+        pole_reach_deg: opts.analysis.pole_reach_deg,
         primary: (LETTERS[l] as char).to_string(),
         warnings: primary_mismatch_warning(&opts.name, machine, p_idx)
             .into_iter()
@@ -621,7 +624,7 @@ pub(crate) fn each_run<T: Send>(
 ) -> Result<(char, Vec<String>), Error> {
     let rd = Reading {
         name,
-        cone_deg: polepatch_patcher::AnalysisOptions::default().cone_deg,
+        cone_deg: polepatch_patcher::AnalysisOptions::default().reach_deg(),
         fallback,
         work_offset_mm,
         read: crate::program::read_options(machine)?,

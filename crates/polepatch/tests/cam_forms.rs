@@ -261,8 +261,8 @@ fn millplus_is_read_as_millplus() {
         .find(|&b| String::from_utf8_lossy(&p.bytes[p.blocks[b].span()]).ends_with("G40"))
         .unwrap();
     assert_eq!(p.state(g40).tcpm, Tcpm::Off);
-    let pass = block("X1. B8.981");
-    assert_eq!(p.state(pass).pos[C], Some(173.66));
+    let pass = block("X1. B9.562");
+    assert_eq!(p.state(pass).pos[C], Some(174.053));
     assert_eq!(p.state(pass).feed_mm_min, Some(1500.0));
     patches_rotary_words_only("millplus", &bytes, &hsm600(), &opts("millplus"));
     // The indexed addresses are not listed as expressions.
@@ -400,4 +400,31 @@ fn insert_records_are_written_and_listed() {
         e.contains("INSERT/X: its text, written as it is at line"),
         "{e}"
     );
+}
+
+/// Item 12: corners at B ≈ 6.4° (a Haas UMC program's, redrawn), where C slows the feed
+/// because the tool passes near the pole, are zones by default on both machines and reach
+/// feed; the old fixed 5° cone does not see them.
+#[test]
+fn corners_near_the_pole_are_zones_by_default() {
+    let bytes = cam("haas-umc-corners-b6.nc");
+    for m in [ucp710(), hsm600()] {
+        let (_, report) = patch_nc(&bytes, &m, &opts("corners")).unwrap();
+        assert!(!report.zones.is_empty(), "{}", m.name);
+        for z in &report.zones {
+            assert_eq!(z.outcome, "reached", "{}: {z:?}", m.name);
+            assert!(z.min_abs_primary_deg > 5.0, "{z:?}");
+        }
+        patches_rotary_words_only("corners", &bytes, &m, &opts("corners"));
+        let fixed = PatchOptions {
+            patch: polepatch::patcher::PatchOptions {
+                pole_reach_deg: 5.0,
+                ..polepatch::patcher::PatchOptions::default()
+            },
+            ..opts("corners")
+        };
+        let (out, report) = patch_nc(&bytes, &m, &fixed).unwrap();
+        assert!(report.zones.is_empty(), "{}: {:?}", m.name, report.zones);
+        assert_eq!(out, bytes);
+    }
 }
