@@ -107,6 +107,14 @@ impl Words<'_> {
                         value = next.clone();
                         k += 1;
                     }
+                    // `F MAX` (older TNC listings, NX's posts for them): `FMAX`.
+                    Some(next) if name == b"F" && b[next.clone()].eq_ignore_ascii_case(b"MAX") => {
+                        s.rapid_once = true;
+                        k += 1;
+                        continue;
+                    }
+                    // An empty `F` field (`L R F M30`, older TNC listings): no feed given.
+                    _ if name == b"F" => continue,
                     _ => {
                         return Err(self.err(
                             t.start,
@@ -203,6 +211,9 @@ impl Words<'_> {
                 }
                 b"FMAX" => s.rapid_once = true,
                 b"FAUTO" | b"FU" | b"FZ" => s.feed_unknown = true,
+                // `M` alone: no miscellaneous function (older TNC listings write the empty
+                // dialog field).
+                b"M" if value_text.is_empty() => {}
                 b"M" => {
                     let v = parse_number(value_text)
                         .filter(|v| v.is_finite())
@@ -468,6 +479,43 @@ mod tests {
         let w = p.word(9, b'C').unwrap();
         assert_eq!(&p.bytes[w.value_span()], b"+140.1");
         assert_eq!(crate::write(&p, &[]), PGM.as_bytes());
+    }
+
+    /// Issue 30 item 7: blanks after the letter, as APT posts and older TNC listings
+    /// write them.
+    #[test]
+    fn blanks_after_the_letter() {
+        let p = parse(
+            b"0 BEGIN PGM T MM\n1 L Z 25.000 FMAX\n2 L X1.9685 Y-.3937 M3 F MAX\n3 L X 2 Y -1 A +1 C 5 F 900\n".to_vec(),
+            Dialect::Auto,
+        )
+        .unwrap();
+        assert_eq!(p.state(1).pos[Z], Some(25.0));
+        assert_eq!(p.state(1).motion, Motion::Rapid);
+        assert_eq!(p.state(2).motion, Motion::Rapid, "F MAX");
+        // Empty `M` and `F` fields, as older TNC listings write them: nothing.
+        assert!(
+            parse(
+                b"0 BEGIN PGM T MM\n1 L X+0 Y+0 Z+0 F9.8 M\n2 L X+1 M\n3 L R F M30\n".to_vec(),
+                Dialect::Auto
+            )
+            .is_ok()
+        );
+        assert_eq!(p.state(3).pos[C], Some(5.0));
+        assert_eq!(p.state(3).feed_mm_min, Some(900.0));
+        // The value keeps its bytes; the word starts at its letter.
+        let w = p.word(3, b'A').unwrap();
+        assert_eq!(&p.bytes[w.value_span()], b"+1");
+        assert_eq!(crate::write(&p, &[]), p.bytes.as_slice());
+        for (line, col) in [("1 L Z FMAX", 5), ("1 L X+1 C", 9)] {
+            let e = parse(
+                format!("0 BEGIN PGM T MM\n{line}\n").into_bytes(),
+                Dialect::Auto,
+            )
+            .unwrap_err();
+            assert_eq!((e.line, e.column), (2, col), "{line}");
+            assert!(e.message.contains("a blank after the letter"), "{e}");
+        }
     }
 
     #[test]
