@@ -29,9 +29,15 @@ pub(crate) struct FilterArgs {
     /// Feed in mm/min for runs with no F in force.
     #[arg(long)]
     feed: Option<f64>,
-    /// Singular cone, degrees: a zone needs a point with |primary| within it.
-    #[arg(long, default_value_t = PatchOptions::default().cone_deg)]
-    cone: f64,
+    /// Singular cone, degrees (as `patch`). Default: a 5° cone and the pole reach.
+    #[arg(long)]
+    cone: Option<f64>,
+    /// Pole reach, degrees (as `patch`). Default 10; with --cone, the cone.
+    #[arg(long)]
+    pole_reach: Option<f64>,
+    /// Units of a program that states none (as `patch`): mm unless said.
+    #[arg(long, value_enum)]
+    units: Option<crate::post_cmd::UnitsArg>,
     /// Largest orientation change allowed at any point, degrees (as `patch`).
     #[arg(long)]
     max_deviation: Option<f64>,
@@ -75,6 +81,8 @@ impl FilterArgs {
             strict: self.strict,
             feed: self.feed,
             cone: self.cone,
+            pole_reach: self.pole_reach,
+            units: self.units,
             max_deviation: self.max_deviation,
             margin: PatchOptions::default().margin,
             max_decimals: PatchOptions::default().max_decimals,

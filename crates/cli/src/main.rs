@@ -92,9 +92,15 @@ pub(crate) struct PatchArgs {
     /// Feed in mm/min for runs with no F in force.
     #[arg(long)]
     pub(crate) feed: Option<f64>,
-    /// Singular cone, degrees: a zone needs a point with |primary| within it.
-    #[arg(long, default_value_t = PatchOptions::default().cone_deg)]
-    pub(crate) cone: f64,
+    /// A fixed singular cone, degrees: a stretch where C is below feed is a zone when its
+    /// primary axis comes within it, and no other. Default: a 5° cone, and out to
+    /// --pole-reach the stretches whose slowdown the pole dominates (docs/method.md).
+    #[arg(long)]
+    pub(crate) cone: Option<f64>,
+    /// Pole reach, degrees: out to here a stretch where C is below feed is a zone when the
+    /// pole accounts for at least half its slowdown. Default 10; with --cone, the cone.
+    #[arg(long)]
+    pub(crate) pole_reach: Option<f64>,
     /// Largest orientation change allowed at any point, degrees, on the exact angle of the
     /// written words (default: no limit; the change is always minimised). A cap at or above
     /// what the default achieves changes nothing.
@@ -161,6 +167,11 @@ pub(crate) struct PatchArgs {
     /// turns it about its tip, mm.
     #[arg(long, value_name = "MM", default_value_t = polepatch::tool::SURFACE_TOLERANCE_MM)]
     pub(crate) surface_tolerance: f64,
+    /// Units of a program that states none (no G20/G21, G70/G71, BEGIN PGM … MM|INCH):
+    /// nothing in the file tells inches from mm, so say it (default mm; the report says
+    /// which was assumed).
+    #[arg(long, value_enum)]
+    pub(crate) units: Option<post_cmd::UnitsArg>,
 }
 
 #[derive(clap::Args)]
@@ -174,9 +185,12 @@ struct AnalyzeArgs {
     /// Feed in mm/min for runs with no F in force.
     #[arg(long)]
     feed: Option<f64>,
-    /// Singular cone, degrees: a zone needs a point with |primary| within it.
-    #[arg(long, default_value_t = AnalysisOptions::default().cone_deg)]
-    cone: f64,
+    /// A fixed singular cone, degrees (see `patch`). Default: a 5° cone and the pole reach.
+    #[arg(long)]
+    cone: Option<f64>,
+    /// Pole reach, degrees (see `patch`). Default 10; with --cone, the cone.
+    #[arg(long)]
+    pole_reach: Option<f64>,
     /// Print one JSON document instead of the table.
     #[arg(long)]
     json: bool,
@@ -187,6 +201,9 @@ struct AnalyzeArgs {
     /// arcs or skippable blocks near the pole, …).
     #[arg(long)]
     strict: bool,
+    /// Units of a program that states none (see `patch`). Default mm.
+    #[arg(long, value_enum)]
+    units: Option<post_cmd::UnitsArg>,
 }
 
 /// `X,Y,Z` as three finite numbers.
@@ -282,6 +299,22 @@ pub(crate) fn check_tcy_ms(v: Option<f64>) -> Result<()> {
     Ok(())
 }
 
+/// The cone and the pole reach of `--cone` and `--pole-reach`: the defaults, or a fixed
+/// cone (the reach equal to it) unless the reach is given too.
+pub(crate) fn cone_and_reach(cone: Option<f64>, reach: Option<f64>) -> Result<(f64, f64)> {
+    check_positive("--cone", cone)?;
+    if let Some(r) = reach
+        && !(r.is_finite() && (0.0..=90.0).contains(&r))
+    {
+        return Err(usage(format!(
+            "--pole-reach must be an angle from 0° to 90°, got {r}"
+        )));
+    }
+    let d = AnalysisOptions::default();
+    let c = cone.unwrap_or(d.cone_deg);
+    Ok((c, reach.or(cone).unwrap_or(d.pole_reach_deg)))
+}
+
 pub(crate) fn check_positive(name: &str, v: Option<f64>) -> Result<()> {
     if let Some(v) = v
         && !(v.is_finite() && v > 0.0)
@@ -293,17 +326,19 @@ pub(crate) fn check_positive(name: &str, v: Option<f64>) -> Result<()> {
 
 fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
     check_positive("--feed", args.feed)?;
-    check_positive("--cone", Some(args.cone))?;
+    let (cone_deg, pole_reach_deg) = cone_and_reach(args.cone, args.pole_reach)?;
     let machine = machine(&args.machine)?;
     let name = args.file.display().to_string();
     let opts = polepatch::AnalyzeOptions {
         analysis: AnalysisOptions {
-            cone_deg: args.cone,
+            cone_deg,
+            pole_reach_deg,
             ..AnalysisOptions::default()
         },
         feed_fallback_mm_min: args.feed,
         name: name.clone(),
         work_offset_mm: args.work_offset,
+        inch: args.units == Some(post_cmd::UnitsArg::Inch),
     };
     let bytes = files::read(&args.file)?;
     let args_strict = args.strict;
@@ -325,8 +360,8 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
             } else {
                 writeln!(
                     out,
-                    "{} on {} (singular cone {}°)",
-                    h.file, h.machine, h.cone_deg
+                    "{} on {} (singular cone {}°, pole reach {}°)",
+                    h.file, h.machine, h.cone_deg, h.pole_reach_deg
                 )
             }
         }
@@ -393,9 +428,9 @@ fn print_run(
     primary_letter: u8,
 ) -> std::io::Result<()> {
     {
-        let feed = r
-            .feed_mm_min
-            .map_or("no F".to_string(), |f| format!("F{f}"));
+        let feed = r.feed_mm_min.map_or("no F".to_string(), |f| {
+            format!("F{}", polepatch::report::feed_text(f))
+        });
         writeln!(
             out,
             "\nrun {}: lines {}–{}, {} points, {:.3} mm at {}",

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 fn options(args: &PatchArgs) -> Result<PatchOptions> {
-    check_positive("--cone", Some(args.cone))?;
+    let (cone_deg, pole_reach_deg) = crate::cone_and_reach(args.cone, args.pole_reach)?;
     if let Some(d) = args.max_deviation
         && !(d.is_finite() && d >= 0.0)
     {
@@ -36,7 +36,8 @@ fn options(args: &PatchArgs) -> Result<PatchOptions> {
         )));
     }
     Ok(PatchOptions {
-        cone_deg: args.cone,
+        cone_deg,
+        pole_reach_deg,
         max_deviation_deg: args.max_deviation,
         margin: args.margin,
         third_derivative_continuity: !args.no_jerk_continuity,
@@ -147,6 +148,7 @@ pub(crate) fn file_options(args: &PatchArgs) -> Result<polepatch::PatchOptions> 
             point: args.tool_point,
             surface_tolerance_mm: args.surface_tolerance,
         },
+        inch: args.units == Some(crate::post_cmd::UnitsArg::Inch),
         ..polepatch::PatchOptions::default()
     })
 }

@@ -18,8 +18,8 @@ enum DialectArg {
     Fanuc,
 }
 
-#[derive(Clone, Copy, clap::ValueEnum)]
-enum UnitsArg {
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum UnitsArg {
     /// Millimetres (G21, G71, G71).
     Mm,
     /// Inches (G20, G700; not for Heidenhain).

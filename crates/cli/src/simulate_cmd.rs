@@ -312,7 +312,9 @@ fn print_report(out: &mut impl Write, r: &SimulateReport) -> std::io::Result<()>
     )?;
     for run in &r.runs {
         let lines = format!("{}–{}", run.lines[0], run.lines[1]);
-        let feed = run.feed_mm_min.map_or("no F".into(), |f| format!("{f}"));
+        let feed = run
+            .feed_mm_min
+            .map_or("no F".into(), polepatch::report::feed_text);
         if let Some(e) = &run.error {
             writeln!(
                 out,

@@ -4,7 +4,7 @@
 //!
 //! | line | read as |
 //! |---|---|
-//! | `BEGIN PGM NAME MM` / `INCH` | program start; INCH: lengths ×25.4, F in 1/10 inch/min ×2.54 |
+//! | `BEGIN PGM NAME MM` / `INCH` (`IN`, as NX's posts write it) | program start; INCH: lengths ×25.4, F in 1/10 inch/min ×2.54 |
 //! | `END PGM NAME` | program end (TCPM off) |
 //! | `L X+10 Y-5 Z+0 A+0 C+90 R0 F2000 M3` | linear move; `FMAX` a rapid for this block only; `FAUTO`, `FU`, `FZ` no feed per minute; `IX+5` incremental for this block (the block is never changed and ends runs); `RL`/`RR`/`R+`/`R-` radius compensation ends runs |
 //! | `C`, `CR`, `CT` (arcs), `CP`, `LP` (polar), `APPR`, `DEP` | moves polepatch does not follow: they end runs (`LP`, `CP`, `APPR`, `DEP` leave X Y Z unknown) |
@@ -91,11 +91,45 @@ impl Words<'_> {
     ) -> Result<(), ParseError> {
         let b = self.bytes;
         let mut seen = [false; 7];
-        for t in toks {
+        let mut k = 0;
+        while k < toks.len() {
+            let t = &toks[k];
+            k += 1;
             let text = &b[t.clone()];
             let letters = text.iter().take_while(|c| c.is_ascii_alphabetic()).count();
             let name = text[..letters].to_ascii_uppercase();
-            let value = t.start + letters..t.end;
+            let mut value = t.start + letters..t.end;
+            // `L Z 25.000 FMAX` (an APT post's output): a blank between an axis letter (or
+            // F) and its number, read as the word — the blank stays in the file; a letter
+            // left without a number says the blank is what is wrong.
+            let lone = value.is_empty()
+                && matches!(name.as_slice(), [l] | [b'I', l] if axis_index(*l).is_some() || *l == b'F');
+            if lone {
+                match toks.get(k) {
+                    Some(next) if parse_number(&b[next.clone()]).is_some() => {
+                        value = next.clone();
+                        k += 1;
+                    }
+                    // `F MAX` (older TNC listings, NX's posts for them): `FMAX`.
+                    Some(next) if name == b"F" && b[next.clone()].eq_ignore_ascii_case(b"MAX") => {
+                        s.rapid_once = true;
+                        k += 1;
+                        continue;
+                    }
+                    // An empty `F` field (`L R F M30`, older TNC listings): no feed given.
+                    _ if name == b"F" => continue,
+                    _ => {
+                        return Err(self.err(
+                            t.start,
+                            format!(
+                                "{} word has no number (a blank after the letter is read only when \
+                                 a number follows it)",
+                                String::from_utf8_lossy(&name)
+                            ),
+                        ));
+                    }
+                }
+            }
             let value_text = &b[value.clone()];
             // An axis word, possibly incremental (`IX+5`).
             let (incremental, axis) = match name.as_slice() {
@@ -180,6 +214,9 @@ impl Words<'_> {
                 }
                 b"FMAX" => s.rapid_once = true,
                 b"FAUTO" | b"FU" | b"FZ" => s.feed_unknown = true,
+                // `M` alone: no miscellaneous function (older TNC listings write the empty
+                // dialog field).
+                b"M" if value_text.is_empty() => {}
                 b"M" => {
                     let v = parse_number(value_text)
                         .filter(|v| v.is_finite())
@@ -268,9 +305,11 @@ pub(crate) fn lex(
     match key.as_slice() {
         k if k.first() == Some(&b'*') => {}
         b"BEGIN" => {
+            // `INCH` (NX's Heidenhain posts write `IN`) or `MM`; anything else states no
+            // units.
             if let Some(unit) = rest.last() {
                 let u = upper(bytes, unit);
-                if u == b"INCH" {
+                if u == b"INCH" || u == b"IN" {
                     s.inch = Some(true);
                 } else if u == b"MM" {
                     s.inch = Some(false);
@@ -587,6 +626,43 @@ mod tests {
         let w = p.word(9, b'C').unwrap();
         assert_eq!(&p.bytes[w.value_span()], b"+140.1");
         assert_eq!(crate::write(&p, &[]), PGM.as_bytes());
+    }
+
+    /// Issue 30 item 7: blanks after the letter, as APT posts and older TNC listings
+    /// write them.
+    #[test]
+    fn blanks_after_the_letter() {
+        let p = parse(
+            b"0 BEGIN PGM T MM\n1 L Z 25.000 FMAX\n2 L X1.9685 Y-.3937 M3 F MAX\n3 L X 2 Y -1 A +1 C 5 F 900\n".to_vec(),
+            Dialect::Auto,
+        )
+        .unwrap();
+        assert_eq!(p.state(1).pos[Z], Some(25.0));
+        assert_eq!(p.state(1).motion, Motion::Rapid);
+        assert_eq!(p.state(2).motion, Motion::Rapid, "F MAX");
+        // Empty `M` and `F` fields, as older TNC listings write them: nothing.
+        assert!(
+            parse(
+                b"0 BEGIN PGM T MM\n1 L X+0 Y+0 Z+0 F9.8 M\n2 L X+1 M\n3 L R F M30\n".to_vec(),
+                Dialect::Auto
+            )
+            .is_ok()
+        );
+        assert_eq!(p.state(3).pos[C], Some(5.0));
+        assert_eq!(p.state(3).feed_mm_min, Some(900.0));
+        // The value keeps its bytes; the word starts at its letter.
+        let w = p.word(3, b'A').unwrap();
+        assert_eq!(&p.bytes[w.value_span()], b"+1");
+        assert_eq!(crate::write(&p, &[]), p.bytes.as_slice());
+        for (line, col) in [("1 L Z FMAX", 5), ("1 L X+1 C", 9)] {
+            let e = parse(
+                format!("0 BEGIN PGM T MM\n{line}\n").into_bytes(),
+                Dialect::Auto,
+            )
+            .unwrap_err();
+            assert_eq!((e.line, e.column), (2, col), "{line}");
+            assert!(e.message.contains("a blank after the letter"), "{e}");
+        }
     }
 
     #[test]

@@ -807,9 +807,10 @@ fn toks(bytes: &[u8], span: std::ops::Range<usize>) -> Vec<Tok> {
                 let _ = letter;
                 out.push(Tok::Other(bytes[span.start + 1..span.end].to_vec()));
             }
-            Token::Other { span } | Token::Param { span } | Token::Percent { span } => {
-                out.push(Tok::Other(bytes[span].to_vec()))
-            }
+            Token::Other { span }
+            | Token::Param { span }
+            | Token::Percent { span }
+            | Token::Indexed { span, .. } => out.push(Tok::Other(bytes[span].to_vec())),
             Token::Comment { .. } | Token::BlockEnd { .. } | Token::Slash { .. } => {}
         }
     }

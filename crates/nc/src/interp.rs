@@ -216,7 +216,7 @@ impl Interpreter {
         Interpreter {
             dialect,
             controller: opts.controller.clone(),
-            modal: crate::modal::initial(&opts.controller),
+            modal: opts.initial(),
             plan: opts.flow.clone().filter(|_| !always),
             cursor: crate::flow::Cursor::default(),
             // Kinematics that are always TCP: flow cannot change it.
@@ -236,6 +236,9 @@ impl Interpreter {
         let heidenhain = self.dialect == Dialect::Heidenhain;
         if let Some(sw) = code.and_then(|c| self.controller.g(self.dialect, c)) {
             s.tcpm = Some(sw);
+            return;
+        }
+        if self.dialect == Dialect::MillPlus && crate::millplus::g(code, s) {
             return;
         }
         match code {
@@ -525,6 +528,9 @@ impl Interpreter {
                         s.breaks = true;
                     }
                 }
+                Token::Indexed { letter, .. } => {
+                    crate::millplus::indexed(self.dialect, letter, &mut s)
+                }
                 Token::Percent { span } => {
                     for w in bytes[span].split(|b| b.is_ascii_whitespace()) {
                         if w.eq_ignore_ascii_case(b"G70") {
@@ -689,6 +695,7 @@ impl Interpreter {
         }
         if let Some(inch) = s.inch {
             m.inch = inch;
+            flags.set(Flags::UNITS);
         }
         m.transform = (m.transform & !s.transform_off) | s.transform_on;
         if let Some(sw) = s.tcpm {

@@ -16,6 +16,7 @@ pub mod flow;
 mod interp;
 pub mod lexer;
 pub mod lines;
+pub mod millplus;
 pub mod modal;
 pub mod plan;
 pub mod program;

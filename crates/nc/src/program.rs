@@ -26,6 +26,10 @@ pub enum Dialect {
     Sinumerik,
     /// Fanuc and the ISO controllers like it (Haas, LinuxCNC, grblHAL, Mazak ISO, …).
     Fanuc,
+    /// Heidenhain (Philips) MillPlus: ISO words with its own G codes (`G7` tilted plane,
+    /// `G93` datum shift, `G141` TCPM, `G81`… cycle definitions) and indexed addresses
+    /// (`A5=15.`); see [`crate::millplus`].
+    MillPlus,
 }
 
 /// What a block does beyond moving: a set of bits ([`Flags::has`]).
@@ -53,6 +57,9 @@ impl Flags {
     /// A conversational line polepatch does not model, which may move the machine: carried
     /// through, positions unknown after it.
     pub const NOT_MODELLED: Flags = Flags(128);
+    /// The block states the length units (G20/G21, G70/G71, G700/G710, a `%NAME G71`
+    /// header, `BEGIN PGM … MM|INCH`).
+    pub const UNITS: Flags = Flags(256);
 
     /// Whether every bit of `other` is set.
     pub fn has(self, other: Flags) -> bool {
@@ -199,7 +206,7 @@ pub fn parse(bytes: Vec<u8>, dialect: Dialect) -> Result<Program, ParseError> {
 pub fn parse_with(bytes: Vec<u8>, opts: &ReadOptions) -> Result<Program, ParseError> {
     let mut opts = opts.clone();
     loop {
-        let mut builder = ProgramBuilder::new(0, &crate::modal::initial(&opts.controller));
+        let mut builder = ProgramBuilder::new(0, &opts.initial());
         // Reserved from the size: lines of NC code are rarely shorter than 24 bytes or words
         // than 6; untouched capacity costs address space only, a reallocation a copy. A
         // machine that cannot give the memory gets an error, not an abort.
@@ -346,6 +353,7 @@ fn scan_with(
         dialect,
         controller: opts.controller.clone(),
         flow: Some(std::sync::Arc::new(plan)),
+        inch: opts.inch,
     }))
 }
 
@@ -663,6 +671,10 @@ pub fn detect(bytes: &[u8]) -> Dialect {
         {
             return Dialect::Heidenhain;
         }
+    }
+    // MillPlus: `G141`, `G174`, `G7` with indexed addresses, a `%PM` header.
+    if lines().any(crate::millplus::looks_like) {
+        return Dialect::MillPlus;
     }
     // M128 as a word (not M1280): Heidenhain's TCPM code.
     let m128 = head.windows(5).enumerate().any(|(k, w)| {
@@ -1133,6 +1145,7 @@ mod tests {
                     dialect: Dialect::Auto,
                     controller: c.clone(),
                     flow: None,
+                    inch: false,
                 },
             )
             .unwrap();

@@ -17,6 +17,7 @@
 //! | Heidenhain (ISO and conversational) | `M128`, `FUNCTION TCPM …` | `M129`, `FUNCTION RESET TCPM`, `M2`, `M30`, `END PGM` |
 //! | Sinumerik | `TRAORI` | `TRAFOOF`, `TRANSMIT`, `TRACYL`, `TRAANG`, `M2`, `M30` |
 //! | Fanuc, Haas, LinuxCNC and other ISO | `G43.4`, `G43.5`, `G234` (Haas TCPC) | `G49`, `G43`, `G44` (group 8 replaces G43.4), `G43.1`, `G43.7`, `M2`, `M30` |
+//! | MillPlus | `G141` (3D tool correction with the tool orientation) | `G40`, `M2`, `M30` |
 //!
 //! Codes whose effect the reader does not know leave the state [`crate::Tcpm::Unknown`]
 //! (never patched) until a code of the table settles it: Sinumerik `TRACON`, Fanuc
@@ -159,6 +160,12 @@ impl ControllerCodes {
                 438 | 439 => Some(Switch::Unknown),
                 _ => None,
             },
+            // MillPlus: G141 3D tool correction with the tool orientation; G40 ends it.
+            Dialect::MillPlus => match g {
+                1410 => Some(Switch::On),
+                400 => Some(Switch::Off),
+                _ => None,
+            },
             Dialect::Sinumerik | Dialect::Heidenhain | Dialect::Conversational => None,
         }
     }
@@ -204,8 +211,8 @@ impl ControllerCodes {
     }
 }
 
-/// How to read a program: its dialect, the machine's TCPM codes, and how the file's program
-/// flow settles TCPM.
+/// How to read a program: its dialect, the machine's TCPM codes, how the file's program
+/// flow settles TCPM, and the units of a program that does not state them.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct ReadOptions {
     /// Dialect (default: detected).
@@ -215,15 +222,28 @@ pub struct ReadOptions {
     /// How program flow settles TCPM (default `None`: not known yet; a read that finds
     /// flow returns the plan in [`crate::Settled::Again`]).
     pub flow: Option<std::sync::Arc<crate::flow::FlowPlan>>,
+    /// Read lengths (and feeds) in inches until the program states its units (G20/G21,
+    /// G70/G71, G700/G710, `%NAME G71`, `BEGIN PGM … MM|INCH`): what a controller set to
+    /// inches does with a program that states none. Default false: mm.
+    pub inch: bool,
 }
 
 impl ReadOptions {
-    /// Read as `dialect` with the built-in codes only.
+    /// Read as `dialect` with the built-in codes only, in mm.
     pub fn dialect(dialect: Dialect) -> Self {
         ReadOptions {
             dialect,
             controller: ControllerCodes::default(),
             flow: None,
+            inch: false,
+        }
+    }
+
+    /// The modal state at the start of a program read this way.
+    pub fn initial(&self) -> crate::Modal {
+        crate::Modal {
+            inch: self.inch,
+            ..crate::modal::initial(&self.controller)
         }
     }
 }

@@ -572,6 +572,7 @@ impl PatchResult {
 pub(crate) fn analysis_options(opts: &PatchOptions) -> AnalysisOptions {
     AnalysisOptions {
         cone_deg: opts.cone_deg,
+        pole_reach_deg: opts.pole_reach_deg,
         tcy_s: opts.tcy_s,
         keep_samples: false,
     }
@@ -836,7 +837,7 @@ fn patch_on(
     opts.validate()?;
     let n = path.s_mm.len();
     let (pi, ci) = (Axis::Primary.index(), Axis::C.index());
-    if !path.axes.iter().any(|q| q[pi].abs() <= opts.cone_deg) {
+    if !path.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg()) {
         return Ok(PatchResult::unchanged(path, opts));
     }
     let st = &opts.solver;
@@ -1184,7 +1185,7 @@ pub fn report_unpatched(
 ) -> Result<Vec<ZoneReport>, PathError> {
     validate(path)?;
     let pi = Axis::Primary.index();
-    if !path.axes.iter().any(|q| q[pi].abs() <= opts.cone_deg) {
+    if !path.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg()) {
         return Ok(Vec::new());
     }
     let n = path.s_mm.len();
@@ -1386,14 +1387,15 @@ mod tests {
         let res = patch_path(&pole, &m, &PatchOptions::default()).unwrap();
         check_both(&pole, &m, &res, "exact pole");
     }
-    /// No point within the cone: nothing changes, with either method, and no spline work
-    /// is needed (no zone reported).
+    /// No point within reach of the pole (the cone, or the pole reach beyond it): nothing
+    /// changes, with either method, and no spline work is needed (no zone reported).
     #[test]
     fn no_point_in_cone_is_unchanged() {
         let m = machine("mikron-hsm600");
         let mut path = planted(41, 1.0, 8.0, false, 2000.0);
+        let reach = PatchOptions::default().reach_deg();
         for q in &mut path.axes {
-            q[3] = q[3].abs().max(6.0);
+            q[3] = q[3].abs().max(reach + 1.0);
         }
         for axes in [PatchAxes::Both, PatchAxes::OnlyC] {
             let opts = PatchOptions {

@@ -561,7 +561,11 @@ impl<'a> Hermite<'a> {
             self.hi
         };
         let a = a.min(self.first);
-        let spans = a.min(core.start)..b.max(self.last).max(core.end).max(a + 1).min(self.hi);
+        // Only the window's spans have rows here: a core that reaches past the window's
+        // ends (a zone wider than the range being solved) is clipped to it — the points
+        // beyond are fixed in this solve, and verification judges the whole zone.
+        let spans =
+            a.min(core.start).max(self.lo)..b.max(self.last).max(core.end).max(a + 1).min(self.hi);
         let mut taus = Vec::new();
         for k in spans.clone() {
             let movable = |i: usize| i >= self.first && i <= self.last;
@@ -850,6 +854,31 @@ mod tests {
     }
 
     /// With an offset, the same rows move to the offset's variables.
+    /// Regression (issue 30, a real Haas UMC program with `--cone 7.5`): a core wider
+    /// than the window — spans before its first knot — panicked with an index below the
+    /// window; its rows are those of the window's spans only.
+    #[test]
+    fn a_core_wider_than_the_window_is_clipped_to_it() {
+        let (s, y) = data(60);
+        for form in [false, true] {
+            let mut hm = Hermite::new(&s, &y, 28, 32, 3).unwrap();
+            if form {
+                hm = hm.coefficient_form().unwrap();
+            }
+            let mut current = vec![0.0; hm.vars()];
+            hm.write_current(&mut current).unwrap();
+            let room = vec![[0.0; 3]; hm.hi - hm.lo + 1];
+            let lim = crate::limits::GeomLimits {
+                v: 1.0,
+                a: 1.0,
+                j: 1.0,
+            };
+            let mut qp = QpBuilder::new(hm.vars());
+            hm.push_limits(&mut qp, &lim, &current, &room, 0..59);
+            assert!(qp.le_len() > 0);
+        }
+    }
+
     #[test]
     fn offset_shifts_every_variable() {
         let (s, y) = data(12);

@@ -29,7 +29,10 @@ pub mod spline;
 mod testutil;
 pub mod verify;
 
-pub use analysis::{AnalysisOptions, RunAnalysis, Sample, Zone, ZoneKind, analyze_path};
+pub use analysis::{
+    AnalysisOptions, CONE_DEG, POLE_REACH_DEG, RunAnalysis, Sample, Zone, ZoneKind, analyze_path,
+    pole_dominates,
+};
 pub use candidate::{Candidate, PatchFailure};
 pub use centre::KeepCentre;
 pub use driver::{PatchResult, patch_path, report_unpatched};

@@ -17,8 +17,14 @@ pub enum PatchAxes {
 /// Options of [`crate::patch_path`]. Plain struct: every field public, documented default.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PatchOptions {
-    /// Singular cone, degrees: a zone needs a point with |primary| ≤ this. Default 5.
+    /// Singular cone, degrees: a stretch below feed with a point with |primary| ≤ this is a
+    /// zone; the cone stretch of FREEZE and LINEARIZE. Default
+    /// [`crate::analysis::CONE_DEG`] (5).
     pub cone_deg: f64,
+    /// Pole reach, degrees: out to here a stretch below feed is a zone when the pole
+    /// dominates its slowdown ([`crate::analysis::pole_dominates`]); at or below `cone_deg`
+    /// only the cone counts. Default [`crate::analysis::POLE_REACH_DEG`] (10).
+    pub pole_reach_deg: f64,
     /// Which rotary axes may change. Default [`PatchAxes::Both`].
     pub axes: PatchAxes,
     /// polepatch's method, or a peer's rule for comparison ([`crate::peers`]). Default
@@ -73,7 +79,8 @@ pub struct PatchOptions {
 impl Default for PatchOptions {
     fn default() -> Self {
         PatchOptions {
-            cone_deg: 5.0,
+            cone_deg: crate::analysis::CONE_DEG,
+            pole_reach_deg: crate::analysis::POLE_REACH_DEG,
             axes: PatchAxes::Both,
             strategy: crate::peers::Strategy::Polepatch,
             max_deviation_deg: None,
@@ -93,6 +100,12 @@ impl Default for PatchOptions {
 }
 
 impl PatchOptions {
+    /// How far from the pole a zone can lie, degrees: the larger of the cone and the pole
+    /// reach. A path with no point this close holds no zone.
+    pub fn reach_deg(&self) -> f64 {
+        self.cone_deg.max(self.pole_reach_deg)
+    }
+
     /// Refuse options that would mean nothing: G16's join options with the default
     /// method, a cone, margin or cap out of range.
     pub fn validate(&self) -> Result<(), PathError> {
@@ -113,6 +126,12 @@ impl PatchOptions {
             return bad(&format!(
                 "the singular cone must be a positive angle, got {}°",
                 self.cone_deg
+            ));
+        }
+        if !(self.pole_reach_deg.is_finite() && (0.0..=90.0).contains(&self.pole_reach_deg)) {
+            return bad(&format!(
+                "the pole reach must be an angle from 0° to 90°, got {}°",
+                self.pole_reach_deg
             ));
         }
         if !(0.0..1.0).contains(&self.margin) {

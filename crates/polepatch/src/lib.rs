@@ -75,6 +75,10 @@ pub struct PatchOptions {
     /// The cutting tool and the point X Y Z state ([`tool`]). Default: from the program
     /// and the TCPM codes.
     pub tool: tool::ToolOptions,
+    /// Read a program that states no length units (no G20/G21, G70/G71, G700/G710,
+    /// `%NAME G71`, `BEGIN PGM … MM|INCH`) in inches, as a control set to inches does
+    /// (`--units inch`). Default false: mm. The report's warnings say which was assumed.
+    pub inch: bool,
 }
 
 impl Default for PatchOptions {
@@ -86,6 +90,7 @@ impl Default for PatchOptions {
             work_offset_mm: None,
             chord_tolerance_mm: machine_frame::CHORD_TOLERANCE_MM,
             tool: tool::ToolOptions::default(),
+            inch: false,
         }
     }
 }
@@ -101,6 +106,9 @@ pub struct AnalyzeOptions {
     pub name: String,
     /// Work offset for a machine with a kinematic chain (as [`PatchOptions::work_offset_mm`]).
     pub work_offset_mm: Option<[f64; 3]>,
+    /// Read a program that states no length units in inches (as [`PatchOptions::inch`]).
+    /// Default false: mm.
+    pub inch: bool,
 }
 
 impl Default for AnalyzeOptions {
@@ -110,6 +118,7 @@ impl Default for AnalyzeOptions {
             feed_fallback_mm_min: None,
             name: "input".to_string(),
             work_offset_mm: None,
+            inch: false,
         }
     }
 }

@@ -378,6 +378,8 @@ pub enum UntouchedReason {
     /// `ROT`/`SCALE`/`MIRROR`, `CYCLE800`): the program's X Y Z and tool axis are not the
     /// frame polepatch computes in.
     FrameTransformed,
+    /// The run turns a tilting axis the machine does not have (or holds it away from 0).
+    OtherRotary,
 }
 
 impl UntouchedReason {
@@ -544,7 +546,9 @@ pub fn patch_program(
 ) -> (Vec<Edit>, FileReport) {
     let program = &lp.program;
     let mut report = FileReport::unchanged(&lp.name, machine, lp.warnings.clone());
-    let (not_analysed, warnings) = lp.notes.finish(lp.primary_index(), opts.cone_deg, &lp.name);
+    let (not_analysed, warnings) = lp
+        .notes
+        .finish(lp.primary_index(), opts.reach_deg(), &lp.name);
     report.not_analysed = not_analysed;
     report.warnings.extend(warnings);
     // The file's number style is only needed when some run comes near the pole; reading
@@ -553,7 +557,7 @@ pub fn patch_program(
     let near_pole = lp.runs.iter().any(|r| {
         r.path
             .as_ref()
-            .is_ok_and(|p| p.axes.iter().any(|q| q[pi].abs() <= opts.cone_deg))
+            .is_ok_and(|p| p.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg()))
     });
     if !near_pole {
         for (r, rp) in lp.runs.iter().enumerate() {
@@ -564,7 +568,7 @@ pub fn patch_program(
                     problem_reason(problem),
                     0,
                     problem.to_string(),
-                    opts.cone_deg,
+                    opts.reach_deg(),
                 ));
             }
         }
@@ -609,14 +613,14 @@ pub fn patch_program(
                     problem_reason(problem),
                     0,
                     problem.to_string(),
-                    opts.cone_deg,
+                    opts.reach_deg(),
                 ));
                 continue;
             }
         };
         // A zone needs a point in the cone (`detect_zones`): a run with none has nothing to
         // patch or report, and its analysis is skipped.
-        if !path.axes.iter().any(|q| q[pi].abs() <= opts.cone_deg) {
+        if !path.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg()) {
             continue;
         }
         let incremental = rp
@@ -697,7 +701,7 @@ pub fn patch_program(
                             reason,
                             zones.len(),
                             message.to_string(),
-                            opts.cone_deg,
+                            opts.reach_deg(),
                         ));
                     }
                 }
@@ -707,7 +711,7 @@ pub fn patch_program(
                     UntouchedReason::Invalid,
                     0,
                     e.to_string(),
-                    opts.cone_deg,
+                    opts.reach_deg(),
                 )),
             }
             continue;
@@ -773,7 +777,7 @@ pub fn patch_program(
                     UntouchedReason::Invalid,
                     0,
                     e.to_string(),
-                    opts.cone_deg,
+                    opts.reach_deg(),
                 ));
                 continue;
             }
@@ -853,7 +857,7 @@ pub fn patch_program(
                         UntouchedReason::MachineFrame,
                         result.zones.len(),
                         why,
-                        opts.cone_deg,
+                        opts.reach_deg(),
                     ));
                     continue;
                 }
@@ -1075,6 +1079,7 @@ fn through_chain(
     }
     let aopts = polepatch_patcher::AnalysisOptions {
         cone_deg: opts.cone_deg,
+        pole_reach_deg: opts.pole_reach_deg,
         tcy_s: opts.tcy_s,
         keep_samples: false,
     };
@@ -1248,6 +1253,7 @@ fn problem_reason(p: &RunProblem) -> UntouchedReason {
         RunProblem::NoFeed => UntouchedReason::NoFeed,
         RunProblem::FeedTooLow { .. } => UntouchedReason::FeedTooLow,
         RunProblem::UnknownRotary { .. } => UntouchedReason::UnknownRotary,
+        RunProblem::OtherRotary { .. } => UntouchedReason::OtherRotary,
     }
 }
 

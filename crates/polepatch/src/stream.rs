@@ -51,7 +51,7 @@
 use crate::end_pose::{After, EndPose, Scan, Step};
 use crate::error::Error;
 use crate::patch::{FileReport, patch_loaded, patch_program};
-use crate::program::{LoadedProgram, RunPath, Window, load_nc, primary_mismatch_warning, run_path};
+use crate::program::{LoadedProgram, RunPath, Window, primary_mismatch_warning, run_path};
 use crate::report::{AnalyzeReport, RunReport};
 use polepatch_kinematics::Machine;
 use polepatch_nc::modal::{A, B, C};
@@ -227,6 +227,7 @@ impl Surveying {
 /// What both reads need to know of the caller's options.
 struct Reading<'a> {
     name: &'a str,
+    /// How far from the pole a zone can lie (the cone, or the pole reach beyond it).
     cone_deg: f64,
     fallback: Option<f64>,
     work_offset_mm: Option<[f64; 3]>,
@@ -282,7 +283,7 @@ fn survey_once(
     let mut style = StyleEvidence::default();
     let mut notes = crate::notes::Notes::new();
     let mut builder = RunBuilder::default();
-    let mut prev = polepatch_nc::modal::initial(&opts.read.controller);
+    let mut prev = opts.read.initial();
     let mut i = 0usize;
     let settled = scan_blocks_with(bytes, read, |s: Scanned<'_>| {
         style.add_block(bytes, s.words);
@@ -434,7 +435,13 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
     let sv = survey(bytes, rd)?;
     let p_idx = tilting_index(&sv, machine);
     if sv.runs.is_empty() || (!sv.uses[p_idx] && !sv.uses[C]) {
-        let mut lp = match load_nc(bytes.to_vec(), rd.name, machine, rd.fallback) {
+        let mut lp = match crate::program::load_nc_with(
+            bytes.to_vec(),
+            rd.name,
+            machine,
+            rd.fallback,
+            &rd.read,
+        ) {
             Ok(lp) => lp,
             Err(why) if why.is_nothing_to_analyse() => {
                 return Ok(Begun::Nothing {
@@ -483,10 +490,10 @@ pub fn patch_nc_hooked(
     opts.check()?;
     let rd = Reading {
         name: &opts.name,
-        cone_deg: opts.patch.cone_deg,
+        cone_deg: opts.patch.reach_deg(),
         fallback: opts.feed_fallback_mm_min,
         work_offset_mm: opts.work_offset_mm,
-        read: crate::program::read_options(machine)?,
+        read: crate::program::read_options_with(machine, opts.inch)?,
         chord_tolerance_mm: opts.chord_tolerance_mm,
         tool: opts.tool.clone(),
     };
@@ -641,10 +648,10 @@ fn analyze_each(
     opts.check()?;
     let rd = Reading {
         name: &opts.name,
-        cone_deg: opts.analysis.cone_deg,
+        cone_deg: opts.analysis.reach_deg(),
         fallback: opts.feed_fallback_mm_min,
         work_offset_mm: opts.work_offset_mm,
-        read: crate::program::read_options(machine)?,
+        read: crate::program::read_options_with(machine, opts.inch)?,
         chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
         tool: crate::tool::ToolOptions::default(),
     };
@@ -665,6 +672,7 @@ fn analyze_each(
                 file: opts.name.clone(),
                 machine: machine.name.clone(),
                 cone_deg: opts.analysis.cone_deg,
+                pole_reach_deg: opts.analysis.pole_reach_deg,
                 primary: (LETTERS[l] as char).to_string(),
                 warnings: std::iter::once(format!("{why}: no run analysed"))
                     .chain(warnings)
@@ -682,6 +690,7 @@ fn analyze_each(
         file: opts.name.clone(),
         machine: machine.name.clone(),
         cone_deg: opts.analysis.cone_deg,
+        pole_reach_deg: opts.analysis.pole_reach_deg,
         primary: (LETTERS[l] as char).to_string(),
         warnings: primary_mismatch_warning(&opts.name, machine, p_idx)
             .into_iter()
@@ -721,7 +730,7 @@ pub(crate) fn each_run<T: Send>(
 ) -> Result<(char, Vec<String>), Error> {
     let rd = Reading {
         name,
-        cone_deg: polepatch_patcher::AnalysisOptions::default().cone_deg,
+        cone_deg: polepatch_patcher::AnalysisOptions::default().reach_deg(),
         fallback,
         work_offset_mm,
         read: crate::program::read_options(machine)?,
@@ -763,7 +772,7 @@ fn each_stretch<T: Send>(
     let mut failure: Option<Error> = None;
     let mut builder = RunBuilder::default();
     let mut run_no = 0usize;
-    let mut prev = polepatch_nc::modal::initial(&rd.read.controller);
+    let mut prev = rd.read.initial();
     let mut i = 0usize;
     let mut ready: Vec<InHand> = Vec::new();
     let mut ready_bytes = 0usize;

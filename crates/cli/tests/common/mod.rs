@@ -490,12 +490,19 @@ pub fn reachable_bound_deg(lp: &LoadedProgram, r: usize, machine: &Machine) -> O
     let p: Vec<f64> = path.axes.iter().map(|q| q[Axis::Primary.index()]).collect();
     let c: Vec<f64> = path.axes.iter().map(|q| q[Axis::C.index()]).collect();
     let lim = CLimits::new(machine, path.feed_mm_min, 0.0);
+    // A run whose end is pinned (`polepatch::end_pose`) keeps its last point, as the
+    // patch does.
+    let end = if polepatch::end_pose::end_pose_is_free(lp, r) {
+        n - 1
+    } else {
+        n - 2
+    };
     deviation_bound_zone(
         &path.s_mm,
         &p,
         &c,
         1,
-        n - 1,
+        end,
         zone,
         &lim,
         polepatch::patcher::direct::BOUND_SAMPLES_PER_SPAN,

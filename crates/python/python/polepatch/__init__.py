@@ -209,7 +209,9 @@ def patch_nc(
         data: the program's bytes (any encoding; non-UTF-8 bytes pass through).
         machine: a :class:`Machine` or a built-in name.
         only_c: change C only (G16's method); default both rotary axes may change.
-        cone_deg: singular cone, degrees: a zone needs a point with |primary| ≤ this.
+        cone_deg: singular cone, degrees: a stretch where C is below feed with a point
+            with |primary| ≤ this is a zone; out to the pole reach (10°) beyond it, a
+            stretch is a zone where the pole dominates its slowdown (docs/method.md).
         max_deviation_deg: largest change of tool orientation allowed, degrees
             (``None``: no limit; the deviation is minimised anyway).
         tcy_ms: interpolation cycle time, ms (``None``: the machine's). Accepted for
