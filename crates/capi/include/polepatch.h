@@ -33,6 +33,11 @@ typedef enum PpStatus {
    A bug in polepatch (a caught panic); the message says where.
    */
   PP_INTERNAL = 4,
+  /*
+   A joint value outside the machine's range ([`pp_cl_to_joints`]); the message names
+   the point, the axis, the value and the range.
+   */
+  PP_OUT_OF_RANGE = 5,
 } PpStatus;
 
 /*
@@ -265,7 +270,9 @@ enum PpStatus pp_simulate_nc(const struct PpMachine *m,
  Joints for CL points: `cl_xyzijk` holds `n` points of x y z i j k (mm; a tool axis,
  normalised here, must not be zero); `out_xyzpc` gets `n` points of x y z p c (x y z as
  given, the tool tip in the part frame for a TCPM program; p and c in degrees, C
- continuous). `branch_rule` is a `PpBranchRule`.
+ continuous). `branch_rule` is a `PpBranchRule`. A point whose joint value on the branch
+ the rule picks lies outside the machine's range (primary, or a bounded C) is
+ `PP_OUT_OF_RANGE`, and nothing is written to `out_xyzpc`.
 
  # Safety
  `m` is a live machine; `cl_xyzijk` points to `6·n` readable doubles; `out_xyzpc` to

@@ -37,6 +37,9 @@ pub enum PpStatus {
     PpIo = 3,
     /// A bug in polepatch (a caught panic); the message says where.
     PpInternal = 4,
+    /// A joint value outside the machine's range ([`pp_cl_to_joints`]); the message names
+    /// the point, the axis, the value and the range.
+    PpOutOfRange = 5,
 }
 
 /// Branch rule of the inverse kinematics ([`pp_cl_to_joints`]).
@@ -486,7 +489,9 @@ fn branch_rule_of(rule: i32) -> Result<BranchRule, Fail> {
 /// Joints for CL points: `cl_xyzijk` holds `n` points of x y z i j k (mm; a tool axis,
 /// normalised here, must not be zero); `out_xyzpc` gets `n` points of x y z p c (x y z as
 /// given, the tool tip in the part frame for a TCPM program; p and c in degrees, C
-/// continuous). `branch_rule` is a `PpBranchRule`.
+/// continuous). `branch_rule` is a `PpBranchRule`. A point whose joint value on the branch
+/// the rule picks lies outside the machine's range (primary, or a bounded C) is
+/// `PP_OUT_OF_RANGE`, and nothing is written to `out_xyzpc`.
 ///
 /// # Safety
 /// `m` is a live machine; `cl_xyzijk` points to `6·n` readable doubles; `out_xyzpc` to
@@ -513,8 +518,10 @@ pub unsafe extern "C" fn pp_cl_to_joints(
         let out = unsafe { slice_mut(out_xyzpc.cast::<[f64; 5]>(), n, "out_xyzpc") }?;
         // SAFETY: non-NULL, a live machine (header contract).
         let machine = unsafe { &(*m).0 };
-        let joints =
-            polepatch::joints::cl_to_joints(machine, cl, rule).map_err(|e| bad(e.to_string()))?;
+        let joints = polepatch::joints::cl_to_joints(machine, cl, rule).map_err(|e| match e {
+            polepatch::Error::OutOfRange { .. } => Fail(PpStatus::PpOutOfRange, e.to_string()),
+            e => bad(e.to_string()),
+        })?;
         out.copy_from_slice(&joints);
         Ok(())
     })

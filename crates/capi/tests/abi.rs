@@ -185,6 +185,54 @@ fn cl_to_joints_normalises_huge_axes() {
     unsafe { pp_machine_free(m) };
 }
 
+/// Issue 26 item 4: a tool axis pointing down needs A = 180° on the UCP710, whose A ends at
+/// 120°: `PP_OUT_OF_RANGE` naming the point, the value and the range (it was `PP_OK`), and
+/// nothing written. The same axis on a machine whose range holds it is `PP_OK`.
+#[test]
+fn cl_to_joints_refuses_a_primary_angle_outside_the_range() {
+    let m = machine("mikron-ucp710");
+    let cl = [0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, -1.0];
+    let mut out = [7.0; 10];
+    for rule in [
+        PpBranchRule::PpBranchNearest,
+        PpBranchRule::PpBranchPositive,
+    ] {
+        let status = unsafe { pp_cl_to_joints(m, cl.as_ptr(), 2, rule as i32, out.as_mut_ptr()) };
+        assert_eq!(status, PpStatus::PpOutOfRange, "{rule:?}: {}", last_error());
+        let e = last_error();
+        assert!(
+            e.contains("point 1") && e.contains("180") && e.contains("120"),
+            "{e}"
+        );
+        assert_eq!(out, [7.0; 10], "nothing written");
+    }
+    unsafe { pp_machine_free(m) };
+    let toml =
+        std::fs::read_to_string(root().join("crates/kinematics/machines/mikron-ucp710.toml"))
+            .unwrap()
+            .replace("range_deg = [-100.0, 120.0]", "range_deg = [-100.0, 180.0]");
+    let text = std::ffi::CString::new(toml).unwrap();
+    let mut wide: *mut PpMachine = std::ptr::null_mut();
+    assert_eq!(
+        unsafe { pp_machine_from_toml(text.as_ptr(), &mut wide) },
+        PpStatus::PpOk,
+        "{}",
+        last_error()
+    );
+    let status = unsafe {
+        pp_cl_to_joints(
+            wide,
+            cl.as_ptr(),
+            2,
+            PpBranchRule::PpBranchPositive as i32,
+            out.as_mut_ptr(),
+        )
+    };
+    assert_eq!(status, PpStatus::PpOk, "{}", last_error());
+    assert!((out[8] - 180.0).abs() < 1e-9, "{out:?}");
+    unsafe { pp_machine_free(wide) };
+}
+
 #[test]
 fn patch_joints_is_the_patcher_on_the_arrays() {
     // SING's long TCPM run, as a CAM plugin would hold it.

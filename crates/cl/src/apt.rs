@@ -1,11 +1,14 @@
 //! APT CLDATA, the text form CAM post-processors read: one record per line, `$` at the end
-//! of a line continues the record on the next, `$$` starts a comment. Each record is a
+//! of a line continues the record on the next, `$$` starts a comment (a comment that ends
+//! with `$` continues on the next line, as Creo writes its `$$-> CSYS / …  $`). Each record is a
 //! major word, optionally `/` and comma-separated values and minor words. The table of
 //! records and what becomes of each is in `docs/post.md`; in short:
 //!
 //! - posted: `GOTO`, `FROM`, `GOHOME`, `GODLTA`, `RAPID`, `FEDRAT`, `CIRCLE`, `MOVARC`,
 //!   `CYCLE`, `LOADTL`/`LOAD/TOOL`, `SPINDL`, `COOLNT`, `CUTCOM`, `DELAY`, `STOP`, `OPSTOP`,
-//!   `TLAXIS`, `UNITS`/`UNIT`, `PARTNO`/`PPRINT`/`TPRINT` (comments);
+//!   `TLAXIS`, `UNITS`/`UNIT`, `PARTNO`/`PPRINT`/`TPRINT` (comments), `INSERT` (its text
+//!   written into the program as it is, and listed in [`ClProgram::notes`]; it can still be
+//!   skipped with `--ignore INSERT`);
 //! - read, no effect on the motion (counted): [`PASSIVE`];
 //! - `CSYS/[R|t]` (CAMWorks): the values that follow are given in that frame and are
 //!   converted to the part frame (world = R·v + t, 3-value GOTOs along its Z);
@@ -98,13 +101,22 @@ impl Record {
 }
 
 /// The records of `text`: `$` continuation joined, `$$` comments removed, blank records
-/// dropped.
+/// dropped. A `$$` comment that ends with `$` continues on the next line, which is comment
+/// too (Creo: `$$-> CSYS / 1.0, 0.0, 0.0, 0.0,  $` and two lines of numbers).
 fn records(text: &str) -> Result<Vec<Record>, ClError> {
     let mut out = Vec::new();
     let mut cur: Option<Record> = None;
     let mut line_no = 0;
+    let mut comment_continues = false;
     for raw in crate::lines(text) {
         line_no += 1;
+        if comment_continues {
+            comment_continues = raw.trim_end().ends_with('$');
+            continue;
+        }
+        if let Some(p) = raw.find("$$") {
+            comment_continues = raw[p + 2..].trim_end().ends_with('$');
+        }
         let code = raw.find("$$").map_or(raw, |p| &raw[..p]);
         let trimmed = code.trim_end();
         let (body, continued) = match trimmed.strip_suffix('$') {
@@ -182,6 +194,26 @@ struct Reader<'o> {
     spindle_dir: Option<SpindleDir>,
     /// `CUTCOM/ON` waiting for its side.
     cutcom_on: Option<At>,
+}
+
+/// Whether `w` can be an APT major word: a letter, then letters, digits, `_`, `-` or
+/// blanks (`GOTO`, `LOAD`, `CSI_SET_FLUTE_LENGTH`, `TOOL PATH`, `END-OF-PATH`).
+fn is_record_word(w: &str) -> bool {
+    let mut c = w.chars();
+    c.next().is_some_and(|f| f.is_ascii_alphabetic())
+        && c.all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | ' '))
+}
+
+/// The error for a record that does not start with a major word (`0.0, 1.0, …`): most
+/// often the continuation of a line that does not end with `$`.
+fn no_record_word(text: &str, at: At) -> ClError {
+    let shown: String = text.chars().take(40).collect();
+    e(
+        at,
+        format!(
+            "'{shown}' does not start with an APT record word (GOTO/, FEDRAT/, …): values without a record, as a continuation line is when the line before it does not end with '$'"
+        ),
+    )
 }
 
 /// A finite number in a field (mm or whatever `what` is), with its column for errors.
@@ -315,6 +347,7 @@ impl Reader<'_> {
         for w in &words {
             match w.as_str() {
                 "RAPID" => self.rapid_next = true,
+                other if !is_record_word(other) => return Err(no_record_word(&rec.text, at0)),
                 other => {
                     return Err(e(
                         at0,
@@ -324,6 +357,9 @@ impl Reader<'_> {
                     ));
                 }
             }
+        }
+        if !is_record_word(&word) {
+            return Err(no_record_word(&rec.text, at0));
         }
         // Records without '/' but with blanks: `PARTNO NAME`, `PPRINT text`.
         let (word, args_from) = match args_from {
@@ -620,6 +656,25 @@ impl Reader<'_> {
                     .notes
                     .push(format!("line {}: {word} {text}", at0.line));
                 self.prog.items.push(ClItem::Comment(text));
+            }
+            "INSERT" => {
+                // Text for the NC program, written there as it is (every APT post does);
+                // listed for the user.
+                let text = args.trim_end().to_string();
+                if let Some(c) = text.chars().find(|c| c.is_control()) {
+                    return Err(e(
+                        at0,
+                        format!(
+                            "INSERT text holds the control character {:?}; it cannot be written into an NC program",
+                            c
+                        ),
+                    ));
+                }
+                self.prog.notes.push(format!(
+                    "line {}: INSERT/{text} is written into the program as it is",
+                    at0.line
+                ));
+                self.prog.items.push(ClItem::Insert { text, at: at0 });
             }
             "TRNTYP" => {
                 // CAMWorks: TRNTYP/WORLD,0,0,0 (no transformation) is read; any other is not.
@@ -1280,6 +1335,7 @@ mod tests {
                 ClItem::Dwell { seconds, .. } => format!("dwell {seconds}"),
                 ClItem::Stop { optional, .. } => format!("stop {optional}"),
                 ClItem::Comment(c) => c.clone(),
+                ClItem::Insert { text, .. } => format!("insert {text}"),
                 ClItem::Move(_) => unreachable!(),
             })
             .collect();
@@ -1341,6 +1397,69 @@ mod tests {
         );
     }
 
+    /// Issue 30 item 3: a `$$` comment ending with `$` continues on the next line, as
+    /// comment (Creo's CSYS comment); a line of values without a record word is refused
+    /// naming that, and no `--ignore` is suggested for a number.
+    #[test]
+    fn a_comment_continues_as_comment() {
+        let text = "$$-> CSYS / 1.0000000000, 0.0000000000, 0.0000000000, 0.0000000000,  $\n\
+                    \x20           0.0000000000, 1.0000000000, 0.0000000000, 0.0000000000,  $\n\
+                    \x20           0.0000000000, 0.0000000000, 1.0000000000, 0.0000000000\n\
+                    MULTAX / ON\n\
+                    GOTO / 1.0, 2.0, 3.0,  $\n\
+                    0.0, 0.0, 1.0\n";
+        let p = parse(text.as_bytes()).unwrap();
+        assert_eq!(p.point_count(), 1);
+        assert_eq!(p.points().next().unwrap().pos_mm, [1.0, 2.0, 3.0]);
+        // Without the comment, the same lines are values without a record.
+        let bare = text.replacen(
+            "$$-> CSYS / 1.0000000000, 0.0000000000, 0.0000000000, 0.0000000000,  $",
+            "$$-> CSYS",
+            1,
+        );
+        let e = parse(bare.as_bytes()).unwrap_err();
+        assert_eq!(e.line, 2, "{e}");
+        assert!(
+            e.message.contains("does not start with an APT record word"),
+            "{e}"
+        );
+        assert!(!e.message.contains("--ignore"), "{e}");
+    }
+
+    /// Issue 30 item 4: `INSERT/` text is kept for the program, in file order, and listed.
+    #[test]
+    fn insert_records_are_kept_and_listed() {
+        let p = parse(b"UNIT/MM\nINSERT/14MM CRB 4FL 32 LOC  \nGOTO/0,0,0\nINSERT/M88\n").unwrap();
+        let inserts: Vec<_> = p
+            .items
+            .iter()
+            .filter_map(|i| match i {
+                ClItem::Insert { text, at } => Some((text.as_str(), at.line)),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(inserts, [("14MM CRB 4FL 32 LOC", 2), ("M88", 4)]);
+        assert_eq!(p.records["INSERT"], 2);
+        assert!(
+            p.notes
+                .iter()
+                .any(|n| n.contains("line 2: INSERT/14MM CRB 4FL 32 LOC")),
+            "{:?}",
+            p.notes
+        );
+        // Still skippable on request.
+        let q = parse_with(
+            b"INSERT/M88\nGOTO/0,0,0\n",
+            &ParseOptions {
+                ignore: vec!["INSERT".into()],
+                ..ParseOptions::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(q.skipped["INSERT"], 1);
+        assert_eq!(q.items.len(), 1);
+    }
+
     /// Issue 16 §6: a record nobody handles stops the read naming it, unless skipped.
     #[test]
     fn unknown_records_stop_the_read_unless_ignored() {
@@ -1362,7 +1481,6 @@ mod tests {
         assert_eq!(p.records["THREAD"], 2);
         for w in [
             "AUXFUN/10",
-            "INSERT/M88",
             "TURRET/2",
             "TRNTYP/1",
             "PREFUN/54",

@@ -1,26 +1,54 @@
-//! CSV cutter locations: `x,y,z,i,j,k[,f]` per line (mm, mm/min), straight moves, with or
-//! without a header line; blank lines and lines starting with `#` are skipped; a missing
-//! `f` carries the previous feed on.
+//! Cutter locations as text columns: `x,y,z,i,j,k[,f]` per line (mm, mm/min), straight
+//! moves. The values are separated by commas, by semicolons, or — on a line without
+//! either — by blanks (`113.560775   7.735266 -2.209314 -0.107258 0.624902 0.773300`, as
+//! research data sets and CAM exports write them). Blank lines and lines starting with `#`
+//! are skipped; the first other line is a header when none of its values is a number
+//! (`x,y,z,i,j,k,f`, `X Y Z I J K`), and a point otherwise (an error then points at it);
+//! a missing `f` carries the previous feed on.
 
 use crate::apt::{coordinate, number};
 use crate::records::{At, ClItem, ClPoint, ClProgram};
 use crate::{ClError, MAX_FEED_MM_MIN, err, unit_axis};
 
-/// Split `s` at commas: (field, byte offset of the field in `s`).
+/// Split `s` into its values (module docs): (value, byte offset of the value in `s`).
 fn fields(s: &str) -> Vec<(&str, usize)> {
+    let sep = if s.contains(',') {
+        Some(',')
+    } else if s.contains(';') {
+        Some(';')
+    } else {
+        None
+    };
     let mut out = Vec::new();
-    let mut start = 0;
-    for (i, c) in s.char_indices() {
-        if c == ',' {
-            out.push((&s[start..i], start));
-            start = i + 1;
+    match sep {
+        Some(sep) => {
+            let mut start = 0;
+            for (i, c) in s.char_indices() {
+                if c == sep {
+                    out.push((&s[start..i], start));
+                    start = i + 1;
+                }
+            }
+            out.push((&s[start..], start));
+        }
+        None => {
+            let mut start = None;
+            for (i, c) in s.char_indices().chain(std::iter::once((s.len(), ' '))) {
+                match (c.is_whitespace(), start) {
+                    (true, Some(b)) => {
+                        out.push((&s[b..i], b));
+                        start = None;
+                    }
+                    (false, None) => start = Some(i),
+                    _ => {}
+                }
+            }
         }
     }
-    out.push((&s[start..], start));
     out
 }
 
-/// Read CSV `x,y,z,i,j,k[,f]` (module docs).
+/// Read cutter locations as text columns (module docs).
 pub fn parse_csv(text: &str) -> Result<ClProgram, ClError> {
     let mut prog = ClProgram::default();
     let mut first_data = true;
@@ -37,8 +65,8 @@ pub fn parse_csv(text: &str) -> Result<ClProgram, ClError> {
             line,
             column: col0 + off,
         };
-        if first_data && f[0].0.trim().parse::<f64>().is_err() {
-            // A header line.
+        if first_data && f.iter().all(|(v, _)| v.trim().parse::<f64>().is_err()) {
+            // A header line: no value in it is a number.
             first_data = false;
             prog.notes.push(format!("line {line}: header '{t}'"));
             continue;
@@ -112,6 +140,28 @@ mod tests {
         // And an APT file with a mark is still APT.
         let a = parse(b"\xEF\xBB\xBFGOTO/1,2,3\n").unwrap();
         assert_eq!(a.points().next().unwrap().pos_mm, [1.0, 2.0, 3.0]);
+    }
+
+    /// Issue 30 item 8: values separated by blanks, no header; a header is told by its
+    /// content, not by being first.
+    #[test]
+    fn blank_separated_columns_and_headers_by_content() {
+        let text = "113.560775   7.735266    -2.209314   -0.107258 0.624902  0.773300\n\
+                    117.864949 -10.950074   -0.974065   -0.003002 0.653008  0.757345   \n";
+        let p = parse(text.as_bytes()).unwrap();
+        assert_eq!(p.point_count(), 2);
+        let first = p.points().next().unwrap();
+        assert_eq!(first.pos_mm, [113.560775, 7.735266, -2.209314]);
+        assert!(p.notes.is_empty(), "{:?}", p.notes);
+        // Semicolons, tabs, a header in words.
+        let p = parse(b"X\tY\tZ\tI\tJ\tK\n1\t2\t3\t0\t0\t1\n").unwrap();
+        assert_eq!((p.point_count(), p.notes.len()), (1, 1));
+        let p = parse(b"1;2;3;0;0;1;1500\n").unwrap();
+        assert_eq!(p.points().next().unwrap().feed_mm_min, Some(1500.0));
+        // A first line with a bad value is a point with an error, not a header.
+        let e = parse(b"1 2 x 0 0 1\n4 5 6 0 0 1\n").unwrap_err();
+        assert_eq!((e.line, e.column), (1, 5));
+        assert!(e.message.contains("'x'"), "{e}");
     }
 
     #[test]

@@ -175,6 +175,13 @@ pub enum ClItem {
     },
     /// `PPRINT`/`PARTNO`/`TPRINT` text, written as a comment.
     Comment(String),
+    /// `INSERT/text`: text for the NC program, written there as it is (a line of its own).
+    Insert {
+        /// The text after `INSERT/`, trailing blanks removed.
+        text: String,
+        /// Where the record is.
+        at: At,
+    },
 }
 
 /// A CL file read.

@@ -362,6 +362,7 @@ pub fn bench_file(
 fn analysis_zones(lp: &LoadedProgram, machine: &Machine, opts: &PatchOptions) -> Vec<Vec<Zone>> {
     let aopts = AnalysisOptions {
         cone_deg: opts.cone_deg,
+        pole_reach_deg: opts.pole_reach_deg,
         tcy_s: opts.tcy_s,
         keep_samples: false,
     };
@@ -386,6 +387,7 @@ pub fn bench_program(
 ) -> Result<Vec<BenchCase>, Error> {
     let aopts = AnalysisOptions {
         cone_deg: opts.patch.cone_deg,
+        pole_reach_deg: opts.patch.pole_reach_deg,
         tcy_s: opts.patch.tcy_s,
         keep_samples: false,
     };
@@ -656,6 +658,7 @@ fn plot_data(
     let hi = (last + half).min(n - 1);
     let aopts = AnalysisOptions {
         cone_deg: opts.cone_deg,
+        pole_reach_deg: opts.pole_reach_deg,
         tcy_s: opts.tcy_s,
         keep_samples: true,
     };

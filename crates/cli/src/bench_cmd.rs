@@ -36,9 +36,12 @@ pub(crate) struct BenchArgs {
     /// Feed in mm/min for runs with no F in force.
     #[arg(long)]
     feed: Option<f64>,
-    /// Singular cone, degrees.
-    #[arg(long, default_value_t = PatchOptions::default().cone_deg)]
-    cone: f64,
+    /// A fixed singular cone, degrees (see `patch`). Default: a 5° cone and the pole reach.
+    #[arg(long)]
+    cone: Option<f64>,
+    /// Pole reach, degrees (see `patch`). Default 10; with --cone, the cone.
+    #[arg(long)]
+    pole_reach: Option<f64>,
     /// Safety margin on the rotary axes' limits the patch aims at, as a fraction.
     #[arg(long, default_value_t = PatchOptions::default().margin)]
     margin: f64,
@@ -92,7 +95,7 @@ fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
 
 pub(crate) fn run(args: BenchArgs) -> Result<ExitCode> {
     check_positive("--feed", args.feed)?;
-    check_positive("--cone", Some(args.cone))?;
+    let (cone_deg, pole_reach_deg) = crate::cone_and_reach(args.cone, args.pole_reach)?;
     if !(0.0..0.5).contains(&args.margin) {
         bail!("--margin must be in [0, 0.5), got {}", args.margin);
     }
@@ -155,7 +158,8 @@ pub(crate) fn run(args: BenchArgs) -> Result<ExitCode> {
     strategies.dedup();
     let opts = BenchOptions {
         patch: PatchOptions {
-            cone_deg: args.cone,
+            cone_deg,
+            pole_reach_deg,
             margin: args.margin,
             ..PatchOptions::default()
         },

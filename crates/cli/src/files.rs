@@ -34,12 +34,27 @@ pub enum JobError {
     Path(#[from] PathError),
 }
 
-/// Read a file's bytes.
+/// Read a file's bytes; `-` reads standard input to its end.
 pub fn read(path: &FsPath) -> Result<Vec<u8>, JobError> {
-    std::fs::read(path).map_err(|cause| JobError::Read {
-        path: path.display().to_string(),
+    let err = |cause| JobError::Read {
+        path: shown(path),
         cause,
-    })
+    };
+    if outputs::is_std(path) {
+        let mut bytes = Vec::new();
+        std::io::Read::read_to_end(&mut std::io::stdin().lock(), &mut bytes).map_err(err)?;
+        return Ok(bytes);
+    }
+    std::fs::read(path).map_err(err)
+}
+
+/// An input's name in messages and reports: `<stdin>` for `-`, else the path.
+pub fn shown(path: &FsPath) -> String {
+    if outputs::is_std(path) {
+        "<stdin>".to_string()
+    } else {
+        path.display().to_string()
+    }
 }
 
 /// Read, patch and write one file to `output` (checked against the input by the output
@@ -66,7 +81,7 @@ pub fn patch_to(
     machine: &Machine,
     opts: &polepatch::PatchOptions,
 ) -> Result<FileReport, JobError> {
-    let name = input.display().to_string();
+    let name = shown(input);
     let bytes = read(input)?;
     let write_err = |cause| JobError::Write {
         path: target.path.display().to_string(),
@@ -76,7 +91,8 @@ pub fn patch_to(
         name,
         ..opts.clone()
     };
-    let mut sink = target.create(Some(input)).map_err(write_err)?;
+    let like = (!outputs::is_std(input)).then_some(input);
+    let mut sink = target.create(like).map_err(write_err)?;
     let mut report = {
         let mut w = std::io::BufWriter::with_capacity(1 << 20, &mut sink);
         let report = match polepatch::patch_nc_to(&bytes, machine, &opts, &mut w) {
@@ -87,6 +103,10 @@ pub fn patch_to(
         report
     };
     sink.commit().map_err(write_err)?;
-    report.output = Some(target.path.display().to_string());
+    report.output = Some(if target.is_stdout() {
+        "<stdout>".to_string()
+    } else {
+        target.path.display().to_string()
+    });
     Ok(report)
 }

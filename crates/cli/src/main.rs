@@ -1,6 +1,6 @@
 //! The `polepatch` command line.
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use polepatch::kinematics::{Axis, Machine};
 use polepatch::patcher::{AnalysisOptions, PatchOptions};
@@ -42,6 +42,26 @@ enum Command {
     /// Quality suite: analyze and patch every program × machine, compare the deviation
     /// with the best possible for C-only changes, and print one table.
     Bench(bench_cmd::BenchArgs),
+    /// LinuxCNC program filter ([FILTER] in the INI): the patched program on standard
+    /// output, FILTER_PROGRESS=N and the summary on standard error (docs/linuxcnc.md).
+    Filter(filter_cmd::FilterArgs),
+}
+
+/// Exit status with `--strict` when a zone stays below feed or something near the pole
+/// could not be analysed.
+pub(crate) const STRICT_EXIT: u8 = 2;
+/// Exit status of a usage error (an unknown option, a missing or bad value): 64, as
+/// sysexits.h's `EX_USAGE`, apart from `--strict`'s 2 and bad input's 1.
+pub(crate) const USAGE_EXIT: u8 = 64;
+
+/// A usage error (exit [`USAGE_EXIT`]).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub(crate) struct Usage(String);
+
+/// A usage error with this message.
+pub(crate) fn usage(message: impl Into<String>) -> anyhow::Error {
+    Usage(message.into()).into()
 }
 
 #[derive(clap::Args)]
@@ -72,9 +92,15 @@ pub(crate) struct PatchArgs {
     /// Feed in mm/min for runs with no F in force.
     #[arg(long)]
     pub(crate) feed: Option<f64>,
-    /// Singular cone, degrees: a zone needs a point with |primary| within it.
-    #[arg(long, default_value_t = PatchOptions::default().cone_deg)]
-    pub(crate) cone: f64,
+    /// A fixed singular cone, degrees: a stretch where C is below feed is a zone when its
+    /// primary axis comes within it, and no other. Default: a 5° cone, and out to
+    /// --pole-reach the stretches whose slowdown the pole dominates (docs/method.md).
+    #[arg(long)]
+    pub(crate) cone: Option<f64>,
+    /// Pole reach, degrees: out to here a stretch where C is below feed is a zone when the
+    /// pole accounts for at least half its slowdown. Default 10; with --cone, the cone.
+    #[arg(long)]
+    pub(crate) pole_reach: Option<f64>,
     /// Largest orientation change allowed at any point, degrees, on the exact angle of the
     /// written words (default: no limit; the change is always minimised). A cap at or above
     /// what the default achieves changes nothing.
@@ -114,7 +140,7 @@ pub(crate) struct PatchArgs {
     /// Work offset X,Y,Z (mm, machine coordinates of the program's zero) for a machine
     /// with a kinematic chain, where the program only names it (G54); default: the
     /// program's datum shift (Heidenhain G54 X Y Z).
-    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z")]
+    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z", allow_hyphen_values = true)]
     pub(crate) work_offset: Option<[f64; 3]>,
     /// With a kinematic chain, for runs without TCPM: how far the tool tip may leave the
     /// programmed line between two points of a rewritten block, mm (the controller
@@ -122,6 +148,30 @@ pub(crate) struct PatchArgs {
     /// original block — keeps its values.
     #[arg(long, value_name = "MM", default_value_t = polepatch::machine_frame::CHORD_TOLERANCE_MM)]
     pub(crate) chord_tolerance: f64,
+    /// The cutter for the whole program: ball:D, flat:D or bull:D,R (diameter and corner
+    /// radius, mm). Default: per run, from --tools or the program (TOOL DEF, CAM tool
+    /// comments); a ball programmed at its tip keeps its centre (X Y Z rewritten), a flat or
+    /// bull-nose cutter's orientation change is capped by --surface-tolerance.
+    #[arg(long, value_parser = polepatch::tool::Tool::parse, value_name = "KIND:D[,R]")]
+    pub(crate) tool: Option<polepatch::tool::Tool>,
+    /// A tool table (TOML: [tool.5] kind = "ball", diameter_mm = 10, corner_radius_mm = …),
+    /// looked up by the number or name of the tool each run uses.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) tools: Option<PathBuf>,
+    /// Which point of the tool the program's X Y Z are: tip or centre (of a ball).
+    /// Default: the machine file's [controller] tool_point, else the TCPM code's (M128 and
+    /// FUNCTION TCPM … REFPNT CENTER-CENTER: centre; the others: tip).
+    #[arg(long, value_parser = polepatch::tool::ToolPoint::parse, value_name = "tip|centre")]
+    pub(crate) tool_point: Option<polepatch::tool::ToolPoint>,
+    /// How far a flat or bull-nose cutter's surface may move at a CL point when the patch
+    /// turns it about its tip, mm.
+    #[arg(long, value_name = "MM", default_value_t = polepatch::tool::SURFACE_TOLERANCE_MM)]
+    pub(crate) surface_tolerance: f64,
+    /// Units of a program that states none (no G20/G21, G70/G71, BEGIN PGM … MM|INCH):
+    /// nothing in the file tells inches from mm, so say it (default mm; the report says
+    /// which was assumed).
+    #[arg(long, value_enum)]
+    pub(crate) units: Option<post_cmd::UnitsArg>,
 }
 
 #[derive(clap::Args)]
@@ -135,19 +185,25 @@ struct AnalyzeArgs {
     /// Feed in mm/min for runs with no F in force.
     #[arg(long)]
     feed: Option<f64>,
-    /// Singular cone, degrees: a zone needs a point with |primary| within it.
-    #[arg(long, default_value_t = AnalysisOptions::default().cone_deg)]
-    cone: f64,
+    /// A fixed singular cone, degrees (see `patch`). Default: a 5° cone and the pole reach.
+    #[arg(long)]
+    cone: Option<f64>,
+    /// Pole reach, degrees (see `patch`). Default 10; with --cone, the cone.
+    #[arg(long)]
+    pole_reach: Option<f64>,
     /// Print one JSON document instead of the table.
     #[arg(long)]
     json: bool,
     /// Work offset X,Y,Z (mm) for a machine with a kinematic chain (see `patch`).
-    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z")]
+    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z", allow_hyphen_values = true)]
     work_offset: Option<[f64; 3]>,
     /// Exit with status 2 when a run or lines could not be analysed (no feed, expressions,
     /// arcs or skippable blocks near the pole, …).
     #[arg(long)]
     strict: bool,
+    /// Units of a program that states none (see `patch`). Default mm.
+    #[arg(long, value_enum)]
+    units: Option<post_cmd::UnitsArg>,
 }
 
 /// `X,Y,Z` as three finite numbers.
@@ -167,7 +223,19 @@ pub(crate) fn parse_xyz(text: &str) -> Result<[f64; 3], String> {
 
 fn main() -> ExitCode {
     polepatch_cli::outputs::remove_temporaries_on_signal();
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            // Help and version are printed to standard output and exit 0; a usage error
+            // exits USAGE_EXIT (not clap's 2, which is --strict's).
+            let _ = e.print();
+            return if e.use_stderr() {
+                ExitCode::from(USAGE_EXIT)
+            } else {
+                ExitCode::SUCCESS
+            };
+        }
+    };
     let result = match cli.command {
         Command::Analyze(args) => analyze(args),
         Command::Patch(args) => patch::run(args),
@@ -175,12 +243,17 @@ fn main() -> ExitCode {
         Command::Reorient(args) => reorient_cmd::run(args),
         Command::Post(args) => post_cmd::run(args),
         Command::Simulate(args) => simulate_cmd::run(args),
+        Command::Filter(args) => filter_cmd::run(args),
     };
     match result {
         Ok(code) => code,
         Err(e) => {
             eprintln!("polepatch: error: {}", message(&e));
-            ExitCode::from(1)
+            if e.downcast_ref::<Usage>().is_some() {
+                ExitCode::from(USAGE_EXIT)
+            } else {
+                ExitCode::from(1)
+            }
         }
     }
 }
@@ -202,45 +275,70 @@ fn message(e: &anyhow::Error) -> String {
 }
 
 mod bench_cmd;
+mod filter_cmd;
+mod lcnc_planner;
 mod patch;
 mod post_cmd;
 mod reorient_cmd;
 mod simulate_cmd;
 
 pub(crate) fn machine(name: &str) -> Result<Machine> {
-    Ok(Machine::load(name)?)
+    let machine = Machine::load(name)?;
+    // What the loader assumed (a LinuxCNC INI without jerk limits, …).
+    for w in &machine.warnings {
+        eprintln!("polepatch: warning: {w}");
+    }
+    Ok(machine)
 }
 
 /// `--tcy-ms` within the range a machine file accepts (`kinematics::machine::TCY_MS_RANGE`).
 pub(crate) fn check_tcy_ms(v: Option<f64>) -> Result<()> {
     if let Some(v) = v {
-        polepatch::kinematics::machine::check_tcy_ms("--tcy-ms", v).map_err(anyhow::Error::msg)?;
+        polepatch::kinematics::machine::check_tcy_ms("--tcy-ms", v).map_err(usage)?;
     }
     Ok(())
+}
+
+/// The cone and the pole reach of `--cone` and `--pole-reach`: the defaults, or a fixed
+/// cone (the reach equal to it) unless the reach is given too.
+pub(crate) fn cone_and_reach(cone: Option<f64>, reach: Option<f64>) -> Result<(f64, f64)> {
+    check_positive("--cone", cone)?;
+    if let Some(r) = reach
+        && !(r.is_finite() && (0.0..=90.0).contains(&r))
+    {
+        return Err(usage(format!(
+            "--pole-reach must be an angle from 0° to 90°, got {r}"
+        )));
+    }
+    let d = AnalysisOptions::default();
+    let c = cone.unwrap_or(d.cone_deg);
+    Ok((c, reach.or(cone).unwrap_or(d.pole_reach_deg)))
 }
 
 pub(crate) fn check_positive(name: &str, v: Option<f64>) -> Result<()> {
     if let Some(v) = v
         && !(v.is_finite() && v > 0.0)
     {
-        bail!("{name} must be a positive number, got {v}");
+        return Err(usage(format!("{name} must be a positive number, got {v}")));
     }
     Ok(())
 }
 
 fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
     check_positive("--feed", args.feed)?;
-    check_positive("--cone", Some(args.cone))?;
+    let (cone_deg, pole_reach_deg) = cone_and_reach(args.cone, args.pole_reach)?;
     let machine = machine(&args.machine)?;
     let name = args.file.display().to_string();
     let opts = polepatch::AnalyzeOptions {
         analysis: AnalysisOptions {
-            cone_deg: args.cone,
+            cone_deg,
+            pole_reach_deg,
             ..AnalysisOptions::default()
         },
         feed_fallback_mm_min: args.feed,
         name: name.clone(),
         work_offset_mm: args.work_offset,
+        inch: args.units == Some(post_cmd::UnitsArg::Inch),
     };
     let bytes = files::read(&args.file)?;
     let args_strict = args.strict;
@@ -262,8 +360,8 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
             } else {
                 writeln!(
                     out,
-                    "{} on {} (singular cone {}°)",
-                    h.file, h.machine, h.cone_deg
+                    "{} on {} (singular cone {}°, pole reach {}°)",
+                    h.file, h.machine, h.cone_deg, h.pole_reach_deg
                 )
             }
         }
@@ -317,7 +415,7 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
     let failures = failed.len() + report.not_analysed.len();
     Ok(if args_strict && failures > 0 {
         eprintln!("polepatch: {failures} run(s) or line range(s) not analysed (--strict)");
-        ExitCode::from(2)
+        ExitCode::from(crate::STRICT_EXIT)
     } else {
         ExitCode::SUCCESS
     })
@@ -330,9 +428,9 @@ fn print_run(
     primary_letter: u8,
 ) -> std::io::Result<()> {
     {
-        let feed = r
-            .feed_mm_min
-            .map_or("no F".to_string(), |f| format!("F{f}"));
+        let feed = r.feed_mm_min.map_or("no F".to_string(), |f| {
+            format!("F{}", polepatch::report::feed_text(f))
+        });
         writeln!(
             out,
             "\nrun {}: lines {}–{}, {} points, {:.3} mm at {}",

@@ -18,7 +18,9 @@
 //!    folder, named `.<name>.polepatch-tmp-XXXXXX`, synced, given the permissions of the
 //!    file it replaces (else of the input it derives from, else rw-r--r--), and renamed
 //!    over the output on success. A failed job deletes it; so does SIGINT, SIGTERM or
-//!    SIGHUP ([`remove_temporaries_on_signal`]).
+//!    SIGHUP ([`remove_temporaries_on_signal`]). A run killed outright leaves it; the next
+//!    run that writes the same output removes it ([`remove_stale`]: not locked, older than
+//!    [`STALE_AFTER`]).
 //! 6. **Anything else that exists is written through**: a character device (`/dev/null`,
 //!    a terminal), a FIFO or a socket is opened and written, never replaced by a rename.
 //!    A character device is a stream, not a file: it may take several outputs and may
@@ -27,6 +29,8 @@
 //!    replaced (through a temporary file in that file's folder) and the link stays; a link
 //!    to an input is refused by rule 1; a dangling link is refused (its target is not
 //!    created).
+//! 8. **`-` is standard output** (and, as an input, standard input): written through,
+//!    never a file named `-`; at most one output may be `-`.
 
 use std::fs;
 use std::io::{self, Write};
@@ -195,6 +199,13 @@ pub struct Target {
     file: PathBuf,
     /// An existing non-regular file (device, FIFO, socket): opened and written.
     through: bool,
+    /// `-`: standard output (written through).
+    stdout: bool,
+}
+
+/// `-`: standard input as an input, standard output as an output (rule 8).
+pub fn is_std(path: &Path) -> bool {
+    path.as_os_str() == "-"
 }
 
 /// Identity of an existing file: device and inode on Unix.
@@ -272,6 +283,9 @@ fn find(path: &Path) -> io::Result<Found> {
 pub fn plan(inputs: &[Input], outputs: Vec<Output>) -> Result<Vec<Target>, PathError> {
     let mut input_ids: Vec<(Option<Id>, PathBuf, &Input)> = Vec::new();
     for input in inputs {
+        if is_std(&input.path) {
+            continue;
+        }
         if let Ok(found) = find(&input.path)
             && let Some(m) = &found.meta
             && !m.is_dir()
@@ -282,6 +296,32 @@ pub fn plan(inputs: &[Input], outputs: Vec<Output>) -> Result<Vec<Target>, PathE
     }
     let mut targets: Vec<(Target, Found)> = Vec::with_capacity(outputs.len());
     for out in outputs {
+        if out.under.is_none() && is_std(&out.path) {
+            if let Some((other, _)) = targets.iter().find(|(t, _)| t.stdout) {
+                return Err(PathError::Clash {
+                    what: other.what.clone(),
+                    path: "- (standard output)".into(),
+                    other_what: out.what,
+                    other: "- (standard output)".into(),
+                });
+            }
+            let target = Target {
+                what: out.what,
+                shown: "standard output".into(),
+                path: out.path,
+                file: PathBuf::new(),
+                through: true,
+                stdout: true,
+            };
+            targets.push((
+                target,
+                Found {
+                    key: PathBuf::new(),
+                    meta: None,
+                },
+            ));
+            continue;
+        }
         let shown = out.shown.clone();
         let io_err = |cause| PathError::Io {
             what: out.what.clone(),
@@ -358,6 +398,7 @@ pub fn plan(inputs: &[Input], outputs: Vec<Output>) -> Result<Vec<Target>, PathE
             path: out.path,
             file: found.key.clone(),
             through,
+            stdout: false,
         };
         targets.push((target, found));
     }
@@ -371,10 +412,22 @@ impl Target {
         self.through
     }
 
+    /// Whether the output is standard output (`-`).
+    pub fn is_stdout(&self) -> bool {
+        self.stdout
+    }
+
     /// Start writing the output: a temporary file beside the file it replaces (its folders
     /// created), or the device or FIFO opened for writing. `like` is the input whose
     /// permissions a new file takes.
     pub fn create(&self, like: Option<&Path>) -> io::Result<Sink> {
+        if self.stdout {
+            return Ok(Sink {
+                inner: SinkInner::Stdout(io::stdout()),
+                file: PathBuf::new(),
+                like: None,
+            });
+        }
         if self.through {
             let file = fs::OpenOptions::new().write(true).open(&self.path)?;
             return Ok(Sink {
@@ -418,6 +471,7 @@ pub struct Sink {
 enum SinkInner {
     Temp(Staged),
     Through(fs::File),
+    Stdout(io::Stdout),
 }
 
 impl Sink {
@@ -426,6 +480,7 @@ impl Sink {
     pub fn commit(self) -> io::Result<()> {
         match self.inner {
             SinkInner::Through(mut f) => f.flush(),
+            SinkInner::Stdout(mut f) => f.flush(),
             SinkInner::Temp(mut staged) => {
                 let perms = fs::metadata(&self.file)
                     .or_else(|e| self.like.as_deref().map_or(Err(e), fs::metadata))
@@ -442,9 +497,10 @@ impl Sink {
         }
     }
 
-    fn file(&mut self) -> &mut fs::File {
+    fn writer(&mut self) -> &mut dyn Write {
         match &mut self.inner {
             SinkInner::Through(f) => f,
+            SinkInner::Stdout(f) => f,
             SinkInner::Temp(s) => s.file(),
         }
     }
@@ -452,13 +508,13 @@ impl Sink {
 
 impl Write for Sink {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        self.file().write(buf)
+        self.writer().write(buf)
     }
     fn write_all(&mut self, buf: &[u8]) -> io::Result<()> {
-        self.file().write_all(buf)
+        self.writer().write_all(buf)
     }
     fn flush(&mut self) -> io::Result<()> {
-        self.file().flush()
+        self.writer().flush()
     }
 }
 
@@ -483,6 +539,56 @@ fn live() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
 /// Marker in the name of every temporary file: `.<name>.polepatch-tmp-XXXXXX`.
 pub const TEMP_MARKER: &str = ".polepatch-tmp-";
 
+/// A temporary file older than this whose writer is gone is removed by the next run that
+/// writes the same output ([`remove_stale`]).
+pub const STALE_AFTER: std::time::Duration = std::time::Duration::from_secs(10);
+
+/// Remove the temporary files that a run killed outright (SIGKILL, a power cut: no
+/// clean-up could run) left for the output `name` in `dir`: those named
+/// `.<name>.polepatch-tmp-*`, last written more than [`STALE_AFTER`] ago, and not locked.
+/// Every run holds an exclusive `flock` on its temporary file while it writes, which the
+/// system releases when the process ends however it ends: a lock that can be taken means
+/// no process is writing the file. Returns the paths removed. Without Unix file locks it
+/// removes nothing.
+pub fn remove_stale(dir: &Path, name: &str) -> Vec<PathBuf> {
+    let mut removed = Vec::new();
+    #[cfg(unix)]
+    {
+        let prefix = format!(".{name}{TEMP_MARKER}");
+        let Ok(entries) = fs::read_dir(dir) else {
+            return removed;
+        };
+        for e in entries.flatten() {
+            if !e.file_name().to_string_lossy().starts_with(&prefix) {
+                continue;
+            }
+            let path = e.path();
+            let old = fs::symlink_metadata(&path).is_ok_and(|m| {
+                m.is_file()
+                    && m.modified()
+                        .ok()
+                        .and_then(|t| t.elapsed().ok())
+                        .is_some_and(|age| age > STALE_AFTER)
+            });
+            if !old {
+                continue;
+            }
+            let Ok(file) = fs::File::open(&path) else {
+                continue;
+            };
+            if rustix::fs::flock(&file, rustix::fs::FlockOperation::NonBlockingLockExclusive)
+                .is_ok()
+                && fs::remove_file(&path).is_ok()
+            {
+                removed.push(path);
+            }
+        }
+    }
+    #[cfg(not(unix))]
+    let _ = (dir, name);
+    removed
+}
+
 /// A temporary file registered for removal on a signal; deleted when dropped.
 struct Staged {
     tmp: Option<tempfile::NamedTempFile>,
@@ -490,11 +596,24 @@ struct Staged {
 
 impl Staged {
     fn new(dir: &Path, name: &str) -> io::Result<Staged> {
+        for p in remove_stale(dir, name) {
+            eprintln!(
+                "polepatch: removed {}, the temporary file of a run that was killed before it finished",
+                p.display()
+            );
+        }
         let mut registry = live();
         let tmp = tempfile::Builder::new()
             .prefix(&format!(".{name}{TEMP_MARKER}"))
             .rand_bytes(6)
             .tempfile_in(dir)?;
+        // Held until the file is renamed or removed, and released by the system if the
+        // process dies: how the next run tells a live temporary file from a stale one.
+        #[cfg(unix)]
+        rustix::fs::flock(
+            tmp.as_file(),
+            rustix::fs::FlockOperation::NonBlockingLockExclusive,
+        )?;
         registry.push(tmp.path().to_path_buf());
         Ok(Staged { tmp: Some(tmp) })
     }
@@ -613,5 +732,62 @@ mod tests {
         assert!(!live().iter().any(|p| p.starts_with(&d)));
         assert_eq!(fs::read_dir(&d).unwrap().count(), 1);
         fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// Issue 26 item 4: a patch killed outright (SIGKILL) leaves its temporary file; the
+    /// next run writing the same output removes it, but never one that a live run holds.
+    #[cfg(unix)]
+    #[test]
+    fn a_stale_temporary_file_is_removed_by_the_next_run_and_a_live_one_kept() {
+        let d = dir("stale");
+        let old = std::time::SystemTime::now() - 2 * STALE_AFTER;
+        let stale = d.join(".x.I.polepatch-tmp-AAAAAA");
+        fs::File::create(&stale).unwrap().set_modified(old).unwrap();
+        let held = d.join(".x.I.polepatch-tmp-BBBBBB");
+        let holder = fs::File::create(&held).unwrap();
+        holder.set_modified(old).unwrap();
+        rustix::fs::flock(
+            &holder,
+            rustix::fs::FlockOperation::NonBlockingLockExclusive,
+        )
+        .unwrap();
+        let young = d.join(".x.I.polepatch-tmp-CCCCCC");
+        fs::File::create(&young).unwrap();
+        let other = d.join(".y.I.polepatch-tmp-DDDDDD");
+        fs::File::create(&other).unwrap().set_modified(old).unwrap();
+        let target = &plan(&[], vec![Output::new("-o", d.join("x.I"))]).unwrap()[0];
+        target.write(b"x", None).unwrap();
+        assert!(!stale.exists(), "the stale temporary file is removed");
+        assert!(
+            held.exists(),
+            "a locked temporary file belongs to a live run"
+        );
+        assert!(
+            young.exists(),
+            "a recent one may be a run that has not locked it yet"
+        );
+        assert!(
+            other.exists(),
+            "another output's temporary file is not this run's business"
+        );
+        assert_eq!(fs::read(d.join("x.I")).unwrap(), b"x");
+        drop(holder);
+        fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn dash_is_standard_output_and_only_once() {
+        let t = plan(
+            &[Input::new("the input", "-")],
+            vec![Output::new("-o", "-")],
+        )
+        .unwrap();
+        assert!(t[0].is_stdout() && t[0].is_written_through());
+        let e = plan(
+            &[],
+            vec![Output::new("-o", "-"), Output::new("--report", "-")],
+        )
+        .unwrap_err();
+        assert!(matches!(e, PathError::Clash { .. }), "{e}");
     }
 }

@@ -1,37 +1,43 @@
 //! `polepatch patch`: one file or a batch.
 
-use crate::{PatchArgs, check_positive, machine};
+use crate::{PatchArgs, check_positive, machine, usage};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use polepatch::patcher::{PatchAxes, PatchOptions};
 use polepatch::{FileReport, ZoneRow};
 use polepatch_cli::files::{JobError, patch_to};
-use polepatch_cli::outputs::{Input, Output, plan};
+use polepatch_cli::outputs::{Input, Output, is_std, plan};
 use rayon::prelude::*;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 fn options(args: &PatchArgs) -> Result<PatchOptions> {
-    check_positive("--cone", Some(args.cone))?;
+    let (cone_deg, pole_reach_deg) = crate::cone_and_reach(args.cone, args.pole_reach)?;
     if let Some(d) = args.max_deviation
         && !(d.is_finite() && d >= 0.0)
     {
-        bail!("--max-deviation must be an angle ≥ 0°, got {d}");
+        return Err(usage(format!(
+            "--max-deviation must be an angle ≥ 0°, got {d}"
+        )));
     }
     check_positive("--feed", args.feed)?;
     check_positive("--max-patch-length", args.max_patch_length)?;
     if !(0.0..0.5).contains(&args.margin) {
-        bail!("--margin must be in [0, 0.5), got {}", args.margin);
+        return Err(usage(format!(
+            "--margin must be in [0, 0.5), got {}",
+            args.margin
+        )));
     }
     if args.max_decimals > 9 {
-        bail!(
+        return Err(usage(format!(
             "--max-decimals must be at most 9, got {}",
             args.max_decimals
-        );
+        )));
     }
     Ok(PatchOptions {
-        cone_deg: args.cone,
+        cone_deg,
+        pole_reach_deg,
         max_deviation_deg: args.max_deviation,
         margin: args.margin,
         third_derivative_continuity: !args.no_jerk_continuity,
@@ -117,39 +123,70 @@ pub(crate) fn machine_input(name: &str) -> Vec<Input> {
     }
 }
 
-pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
+/// The library's options for `args` (checked: a bad value is a usage error).
+pub(crate) fn file_options(args: &PatchArgs) -> Result<polepatch::PatchOptions> {
     check_positive("--chord-tolerance", Some(args.chord_tolerance))?;
-    let opts = polepatch::PatchOptions {
-        patch: options(&args)?,
+    check_positive("--surface-tolerance", Some(args.surface_tolerance))?;
+    let table = match &args.tools {
+        Some(path) => {
+            let bytes = crate::files::read(path)?;
+            let text = String::from_utf8(bytes)
+                .map_err(|_| anyhow::anyhow!("tool table {}: not UTF-8 text", path.display()))?;
+            polepatch::tool::ToolTable::from_toml_str(&text, &path.display().to_string())
+                .map_err(|e| anyhow::anyhow!("{e}"))?
+        }
+        None => polepatch::tool::ToolTable::default(),
+    };
+    Ok(polepatch::PatchOptions {
+        patch: options(args)?,
         feed_fallback_mm_min: args.feed,
         work_offset_mm: args.work_offset,
         chord_tolerance_mm: args.chord_tolerance,
+        tool: polepatch::tool::ToolOptions {
+            tool: args.tool,
+            table,
+            point: args.tool_point,
+            surface_tolerance_mm: args.surface_tolerance,
+        },
+        inch: args.units == Some(crate::post_cmd::UnitsArg::Inch),
         ..polepatch::PatchOptions::default()
-    };
+    })
+}
+
+pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
+    let opts = file_options(&args)?;
     let machine = machine(&args.machine)?;
     // Every file this command reads and writes, checked together before anything is
     // written (crate::outputs, docs/output-paths.md).
     let files: Vec<(PathBuf, PathBuf)> = match (&args.output, &args.out_dir) {
         (Some(_), None) => {
-            if args.inputs.len() != 1 || args.inputs[0].is_dir() {
-                bail!("-o/--output takes one input file; use --out-dir for several or a folder");
+            if args.inputs.len() != 1 || (!is_std(&args.inputs[0]) && args.inputs[0].is_dir()) {
+                return Err(usage(
+                    "-o/--output takes one input file; use --out-dir for several or a folder",
+                ));
             }
             vec![(args.inputs[0].clone(), PathBuf::new())]
         }
         (None, Some(dir)) => {
+            if args.inputs.iter().any(|p| is_std(p)) {
+                return Err(usage("- (standard input) takes -o OUTPUT, not --out-dir"));
+            }
             let files = expand(&args.inputs, Some(dir))?;
             if files.is_empty() {
                 bail!("no input files");
             }
             files
         }
-        _ => bail!("give either -o OUTPUT (one input) or --out-dir DIR"),
+        _ => return Err(usage("give either -o OUTPUT (one input) or --out-dir DIR")),
     };
     let mut inputs: Vec<Input> = files
         .iter()
         .map(|(input, _)| Input::new("the input", input))
         .collect();
     inputs.extend(machine_input(&args.machine));
+    if let Some(t) = &args.tools {
+        inputs.push(Input::new("the tool table", t));
+    }
     let mut planned: Vec<Output> = Vec::new();
     for (input, rel) in &files {
         planned.push(match (&args.output, &args.out_dir) {
@@ -164,6 +201,13 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
         }
     }
     let targets = plan(&inputs, planned)?;
+    // With an output on standard output, everything else printed goes to standard error.
+    let to_stdout = targets.iter().any(|t| t.is_stdout());
+    let mut table: Box<dyn std::io::Write> = if to_stdout {
+        Box::new(std::io::stderr())
+    } else {
+        Box::new(std::io::stdout())
+    };
     let names: Vec<PathBuf> = files.iter().map(|(input, _)| input.clone()).collect();
     let reports: Vec<Result<FileReport, JobError>> = if files.len() == 1 && args.output.is_some() {
         vec![patch_to(&files[0].0, &targets[0], &machine, &opts)]
@@ -202,7 +246,7 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
 
     let mut reports = reports;
     if args.simulate {
-        simulate_both(&mut reports, &names, &machine, &opts);
+        simulate_both(&mut reports, &names, &machine, &opts, &mut table);
     }
     let mut ok: Vec<&FileReport> = Vec::new();
     let mut failed = 0;
@@ -216,7 +260,7 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
         }
     }
     if failed < reports.len() {
-        print_summary(&names, &reports);
+        print_summary(&names, &reports, &mut table).context("printing the summary")?;
     }
     for rep in &ok {
         for w in &rep.warnings {
@@ -282,7 +326,7 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
                  analysed (see the warnings above): whether they reach feed is unknown (--strict)"
             );
         }
-        return Ok(ExitCode::from(2));
+        return Ok(ExitCode::from(crate::STRICT_EXIT));
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -304,11 +348,16 @@ fn csv_rows(reports: &[&FileReport]) -> Result<Vec<u8>> {
 
 /// One line per input file, in input order; a file that failed says so (its error is
 /// printed on standard error).
-fn print_summary(inputs: &[PathBuf], reports: &[Result<FileReport, JobError>]) {
-    println!(
-        "{:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8} {:>6} {:>8}",
-        "file", "zones", "reached", "C ratio", "overall", "time s", "dev °", "points", "words"
-    );
+fn print_summary(
+    inputs: &[PathBuf],
+    reports: &[Result<FileReport, JobError>],
+    out: &mut dyn std::io::Write,
+) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "{:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8} {:>6} {:>8}  tool",
+        "file", "zones", "reached", "C ratio", "overall", "time s", "dev °", "points", "words",
+    )?;
     for (input, r) in inputs.iter().zip(reports) {
         let rep = match r {
             Ok(rep) => rep,
@@ -316,7 +365,7 @@ fn print_summary(inputs: &[PathBuf], reports: &[Result<FileReport, JobError>]) {
                 let name = input.file_name().map_or(input.display().to_string(), |n| {
                     n.to_string_lossy().into_owned()
                 });
-                println!("{name:<40} failed, not written (see the error above)");
+                writeln!(out, "{name:<40} failed, not written (see the error above)")?;
                 continue;
             }
         };
@@ -328,14 +377,29 @@ fn print_summary(inputs: &[PathBuf], reports: &[Result<FileReport, JobError>]) {
             .file_name()
             .map_or(rep.file.clone(), |n| n.to_string_lossy().into_owned());
         if rep.zones.is_empty() {
-            println!(
-                "{name:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8} {:>6} {:>8}",
+            writeln!(
+                out,
+                "{name:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8} {:>6} {:>8}  -",
                 0, "-", "-", "-", "-", "-", 0, rep.words_changed
-            );
+            )?;
             continue;
         }
-        println!(
-            "{:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8.3} {:>6} {:>8}",
+        // The tools the changed zones were patched for (`-`: none changed).
+        let mut tools: Vec<String> = Vec::new();
+        for z in rep.zones.iter().filter(|z| z.tool != "-") {
+            let t = format!("{} at {}", z.tool, z.tool_point);
+            if !tools.contains(&t) {
+                tools.push(t);
+            }
+        }
+        let tools = if tools.is_empty() {
+            "-".to_string()
+        } else {
+            tools.join(", ")
+        };
+        writeln!(
+            out,
+            "{:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8.3} {:>6} {:>8}  {}",
             name,
             rep.zones.len(),
             reached,
@@ -360,16 +424,27 @@ fn print_summary(inputs: &[PathBuf], reports: &[Result<FileReport, JobError>]) {
                 .fold(0.0, f64::max),
             rep.zones.iter().map(|z| z.points_modified).sum::<usize>(),
             rep.words_changed,
-        );
-        // Why each zone ended as it did (a fixed set, docs/user-guide.md), counted.
-        let counts: Vec<String> = polepatch::patcher::Reason::ALL
+            tools,
+        )?;
+        // Why each zone ended as it did (a fixed set, docs/user-guide.md), counted: the
+        // patcher's reasons in their order, then the library's (tcpm_unknown, …).
+        let mut names: Vec<&str> = polepatch::patcher::Reason::ALL
             .iter()
-            .filter_map(|r| {
-                let k = rep.zones.iter().filter(|z| z.reason == r.name()).count();
-                (k > 0).then(|| format!("{} {k}", r.name()))
+            .map(|r| r.name())
+            .collect();
+        for z in &rep.zones {
+            if !names.contains(&z.reason) {
+                names.push(z.reason);
+            }
+        }
+        let counts: Vec<String> = names
+            .iter()
+            .filter_map(|name| {
+                let k = rep.zones.iter().filter(|z| z.reason == *name).count();
+                (k > 0).then(|| format!("{name} {k}"))
             })
             .collect();
-        println!("  reasons: {}", counts.join(", "));
+        writeln!(out, "  reasons: {}", counts.join(", "))?;
         for (letter, written, file) in [
             ("C", rep.written_c_decimals, rep.file_c_decimals),
             (
@@ -381,12 +456,14 @@ fn print_summary(inputs: &[PathBuf], reports: &[Result<FileReport, JobError>]) {
             if let (Some(written), Some(file)) = (written, file)
                 && written > file
             {
-                println!(
+                writeln!(
+                    out,
                     "  note: {letter} written with {written} decimals (the file uses {file}) so that Equation 6 holds on the written values"
-                );
+                )?;
             }
         }
     }
+    Ok(())
 }
 
 /// `--simulate`: the simulated times of every input and its output, into the reports
@@ -396,9 +473,17 @@ fn simulate_both(
     names: &[PathBuf],
     machine: &polepatch::kinematics::Machine,
     opts: &polepatch::PatchOptions,
+    out: &mut dyn std::io::Write,
 ) {
     for (rep, input) in reports.iter_mut().zip(names) {
         let Ok(rep) = rep else { continue };
+        if is_std(input) || rep.output.as_deref() == Some("<stdout>") {
+            eprintln!(
+                "polepatch: warning: {}: not simulated: standard input and output cannot be read again",
+                rep.file
+            );
+            continue;
+        }
         let Some(output) = rep.output.clone() else {
             continue;
         };
@@ -418,7 +503,8 @@ fn simulate_both(
         match (sim(input), sim(Path::new(&output))) {
             (Ok(b), Ok(a)) => {
                 let t = polepatch::simulate::compare(&b, &a);
-                println!(
+                let _ = writeln!(
+                    out,
                     "{}: simulated {:.3} s → {:.3} s ({:+.1} %), Equation 6 {:.3} s → {:.3} s",
                     rep.file,
                     t.before_s,

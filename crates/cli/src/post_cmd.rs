@@ -18,8 +18,8 @@ enum DialectArg {
     Fanuc,
 }
 
-#[derive(Clone, Copy, clap::ValueEnum)]
-enum UnitsArg {
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum UnitsArg {
     /// Millimetres (G21, G71, G71).
     Mm,
     /// Inches (G20, G700; not for Heidenhain).
@@ -110,8 +110,9 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
     if let Err(m) = parse.check() {
         bail!("{m}");
     }
-    let cl = read_cl_with(&read(&args.cl)?, &name, &parse)?;
-    let opts = PostOptions {
+    let cl_bytes = read(&args.cl)?;
+    let cl = read_cl_with(&cl_bytes, &name, &parse)?;
+    let mut opts = PostOptions {
         dialect: match args.dialect {
             DialectArg::Heidenhain => Dialect::Heidenhain,
             DialectArg::Sinumerik => Dialect::Sinumerik,
@@ -138,6 +139,7 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
         linearize: args.linearize,
         arc_tolerance_mm: args.arc_tolerance,
     };
+    polepatch::post::tool_from_cl(&cl_bytes, &cl, &mut opts);
     let (bytes, report) = post_cl(&cl, &machine, &opts)?;
     targets[0]
         .write(&bytes, None)

@@ -40,8 +40,13 @@ pub(crate) struct SimulateArgs {
     #[arg(long)]
     tcy_ms: Option<f64>,
     /// Work offset X,Y,Z (mm) for a machine with a kinematic chain (see `patch`).
-    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z")]
+    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z", allow_hyphen_values = true)]
     work_offset: Option<[f64; 3]>,
+    /// The planner: `jerk` (a jerk-limited controller, the default) or `linuxcnc` (a
+    /// model of LinuxCNC 2.9's planner: V and A only, each line stopping within itself at
+    /// half the acceleration; docs/linuxcnc.md, docs/validation.md).
+    #[arg(long, value_enum, default_value_t = crate::lcnc_planner::Planner::Jerk)]
+    planner: crate::lcnc_planner::Planner,
 }
 
 /// Largest number of bins of the plot along s (the bins double in width when full, so
@@ -109,6 +114,21 @@ impl Binned {
 pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
     check_positive("--feed", args.feed)?;
     crate::check_tcy_ms(args.tcy_ms)?;
+    if args.planner == crate::lcnc_planner::Planner::Linuxcnc {
+        if args.trajectory.is_some() || args.plot.is_some() {
+            return Err(crate::usage(
+                "--planner linuxcnc gives times only: no --trajectory or --plot",
+            ));
+        }
+        let tcy_s = args.tcy_ms.map(|ms| ms / 1000.0);
+        return crate::lcnc_planner::run(
+            &args.programs,
+            &args.machine,
+            args.feed,
+            tcy_s,
+            args.json,
+        );
+    }
     if args.trajectory.is_some() && args.programs.len() > 1 {
         bail!("--trajectory writes one program's trajectory: give one program");
     }
@@ -292,7 +312,9 @@ fn print_report(out: &mut impl Write, r: &SimulateReport) -> std::io::Result<()>
     )?;
     for run in &r.runs {
         let lines = format!("{}–{}", run.lines[0], run.lines[1]);
-        let feed = run.feed_mm_min.map_or("no F".into(), |f| format!("{f}"));
+        let feed = run
+            .feed_mm_min
+            .map_or("no F".into(), polepatch::report::feed_text);
         if let Some(e) = &run.error {
             writeln!(
                 out,

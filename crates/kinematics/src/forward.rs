@@ -1,5 +1,12 @@
 //! Forward kinematics: rotary angles (degrees) → tool axis in the workpiece frame.
 //!
+//! Every machine: `o_wp = R(a, sc·C)·R(b, sp·P)·t0` ([`crate::rotary`]). The machines of the
+//! **standard form** — the pole axis along ±Z, the tilting axis along ±X (A) or ±Y (B), the
+//! tool along +Z: the built-ins and every `[primary]`/`[c]` file — are computed with the
+//! written-out formulas below (exact zeros; the values are bit for bit those polepatch
+//! always gave), every other pair with the general formula of [`crate::rotary`]. A test
+//! keeps the two equal on the standard form.
+//!
 //! ```text
 //! o_wp = Rz(sc·C) · Rp(sp·P) · ẑ
 //!   A (Rp = Rx):  o_wp = ( sp·sin P · sin(sc·C), −sp·sin P · cos(sc·C), cos P )
@@ -10,15 +17,69 @@
 //! k = cos A`; with `sp = sc = −1` it is C17 eq. 2: `i = sin C sin A, j = cos C sin A`.
 
 use crate::machine::{Machine, PrimaryAxis};
+use crate::rotary::{coordinate_axis, forward_general, jacobian_general};
 
-/// Tool axis `o_wp = Rz(sc·C)·Rp(sp·P)·ẑ` (unit vector) for primary angle `p_deg` and
-/// `c_deg`, both degrees.
+/// A machine of the standard form (module docs): which coordinate axis the tilting axis
+/// turns about, and the senses with the signs of the directions folded in (a pole axis
+/// along −Z with sense +1 is one along +Z with sense −1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StandardForm {
+    /// A (about ±X) or B (about ±Y).
+    pub primary: PrimaryAxis,
+    /// Effective sense of the tilting axis about +X or +Y, ±1.
+    pub sp: f64,
+    /// Effective sense of the pole axis about +Z, ±1.
+    pub sc: f64,
+}
+
+impl Machine {
+    /// The standard form of this machine's pair, if it has it (module docs): then the two
+    /// joint solutions of every tool axis are (P, C) and (−P, C + 180°), the pole is P = 0,
+    /// and the tilt from the pole is |P|.
+    pub fn standard_form(&self) -> Option<StandardForm> {
+        let r = &self.rotary;
+        if r.tool_direction != [0.0, 0.0, 1.0] {
+            return None;
+        }
+        let (2, c_sign) = coordinate_axis(r.c.direction)? else {
+            return None;
+        };
+        let (k, p_sign) = coordinate_axis(r.primary.direction)?;
+        let primary = match k {
+            0 => PrimaryAxis::A,
+            1 => PrimaryAxis::B,
+            _ => return None,
+        };
+        Some(StandardForm {
+            primary,
+            sp: self.primary_sense * p_sign,
+            sc: self.c_sense * c_sign,
+        })
+    }
+}
+
+/// Tool axis (unit vector, part frame) for primary angle `p_deg` and `c_deg`, both degrees:
+/// `R(a, sc·C)·R(b, sp·P)·t0`; for the built-ins `Rz(sc·C)·Rp(sp·P)·ẑ`.
 pub fn forward(machine: &Machine, p_deg: f64, c_deg: f64) -> [f64; 3] {
+    match machine.standard_form() {
+        Some(f) => forward_standard(f, p_deg, c_deg),
+        None => forward_general(
+            &machine.rotary,
+            machine.primary_sense,
+            machine.c_sense,
+            p_deg,
+            c_deg,
+        ),
+    }
+}
+
+/// [`forward`] of the standard form, written out.
+fn forward_standard(f: StandardForm, p_deg: f64, c_deg: f64) -> [f64; 3] {
     let (sin_p, cos_p) = p_deg.to_radians().sin_cos();
-    let (sin_c, cos_c) = (machine.c_sense * c_deg).to_radians().sin_cos();
+    let (sin_c, cos_c) = (f.sc * c_deg).to_radians().sin_cos();
     // Horizontal length of Rp(sp·P)·ẑ, signed by the primary sense.
-    let h = machine.primary_sense * sin_p;
-    match machine.primary {
+    let h = f.sp * sin_p;
+    match f.primary {
         // Rx(a)·ẑ = (0, −sin a, cos a), then Rz(γ) gives (sin γ·sin a, −cos γ·sin a, cos a).
         PrimaryAxis::A => [h * sin_c, -h * cos_c, cos_p],
         // Ry(b)·ẑ = (sin b, 0, cos b), then Rz(γ) gives (cos γ·sin b, sin γ·sin b, cos b).
@@ -27,7 +88,9 @@ pub fn forward(machine: &Machine, p_deg: f64, c_deg: f64) -> [f64; 3] {
 }
 
 /// The tool axis and its partial derivatives with respect to the primary angle and C,
-/// per **degree**: `(o_wp, ∂o_wp/∂P, ∂o_wp/∂C)`. With `h = sp·sin P`, `γ = sc·C`:
+/// per **degree**: `(o_wp, ∂o_wp/∂P, ∂o_wp/∂C)`. In general `∂o/∂P = sp·R(a, sc·C)·(b × v)`
+/// with `v = R(b, sp·P)·t0`, `∂o/∂C = sc·(a × o)` (times π/180); for the standard form, with
+/// `h = sp·sin P`, `γ = sc·C`:
 ///
 /// ```text
 /// A:  ∂o/∂P = (sp cos P sin γ, −sp cos P cos γ, −sin P)·π/180
@@ -36,16 +99,25 @@ pub fn forward(machine: &Machine, p_deg: f64, c_deg: f64) -> [f64; 3] {
 ///     ∂o/∂C = sc·(−h sin γ, h cos γ, 0)·π/180
 /// ```
 ///
-/// `∂o/∂P` is a unit vector (per radian) and `∂o/∂C` has length `|sin P|` (per radian),
-/// orthogonal to it: near the pole C barely moves the tool.
+/// `∂o/∂C` has length `sin ∠(a, v)` per radian (`|sin P|` on the built-ins): near the pole C
+/// barely moves the tool. `∂o/∂P` has length `sin ∠(b, t0)` (1 on the built-ins).
 pub fn forward_jacobian(machine: &Machine, p_deg: f64, c_deg: f64) -> [[f64; 3]; 3] {
+    let Some(f) = machine.standard_form() else {
+        return jacobian_general(
+            &machine.rotary,
+            machine.primary_sense,
+            machine.c_sense,
+            p_deg,
+            c_deg,
+        );
+    };
     let (sin_p, cos_p) = p_deg.to_radians().sin_cos();
-    let sp = machine.primary_sense;
-    let sc = machine.c_sense;
+    let sp = f.sp;
+    let sc = f.sc;
     let (sin_c, cos_c) = (sc * c_deg).to_radians().sin_cos();
     let h = sp * sin_p;
     let k = std::f64::consts::PI / 180.0;
-    match machine.primary {
+    match f.primary {
         PrimaryAxis::A => [
             [h * sin_c, -h * cos_c, cos_p],
             [k * sp * cos_p * sin_c, -k * sp * cos_p * cos_c, -k * sin_p],

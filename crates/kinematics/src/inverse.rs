@@ -1,7 +1,10 @@
 //! Inverse kinematics: tool axis → (primary, C) in degrees, both solutions, branch choice.
 //!
-//! Off the pole every unit tool axis `o_wp = (i, j, k)` has exactly two joint solutions
-//! (see [`crate::forward::forward`] for the model):
+//! Every machine: the closed form of [`crate::rotary`] ([`solve_ik`]). For the standard form
+//! ([`crate::forward::StandardForm`], the built-ins) the written-out formulas below are
+//! used, bit for bit what polepatch always computed; a test keeps the two equal. Off the
+//! pole every unit tool axis `o_wp = (i, j, k)` the standard form reaches has exactly two
+//! joint solutions:
 //!
 //! ```text
 //! P1 = atan2(√(i² + j²), k) ∈ [0°, 180°]          (= acos k, but accurate near the pole)
@@ -13,41 +16,89 @@
 //! On the pole (`|sin P| < POLE_SIN_TOL`, k ≈ ±1) C does not change the tool axis and is
 //! undefined. k ≈ +1 is the singular pole of G16 and C17 (P = 0); k ≈ −1 (P = ±180°, the
 //! tool pointing straight up at the table) is the same degeneracy, reported the same way
-//! by [`inverse`] and resolved by [`inverse_path`] as P = ±180° with C held.
+//! by [`inverse`] and resolved by [`inverse_path`] as P = ±180° with C held. On other pairs
+//! the pole is the tool along the pole axis (the C slot), P there is
+//! [`Machine::pole_p_deg`], and the two solutions are not in general (P, C) and
+//! (−P, C + 180°) ([`Machine::other_solution`]).
 
+use crate::forward::StandardForm;
 use crate::machine::{Machine, PrimaryAxis};
+use crate::rotary::{Ik, inverse_general, pole_p_general, pole_tilt_general};
 use crate::tolerances::POLE_SIN_TOL;
 
 /// One joint solution, degrees.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IkSolution {
-    /// Primary angle (A or B), degrees.
+    /// Primary angle (the tilting axis: A or B on the built-ins), degrees.
     pub p_deg: f64,
-    /// C angle, degrees, in (−180, 180] before unwrapping.
+    /// C angle (the pole axis), degrees, in (−180, 180] before unwrapping.
     pub c_deg: f64,
 }
 
-/// How [`inverse_path`] picks between the two solutions (P, C) and (−P, C+180°).
+/// How [`inverse_path`] picks between the two solutions ((P, C) and (−P, C+180°) on the
+/// built-ins).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BranchRule {
     /// The solution nearest to the previous point (max of |ΔP| and |ΔC| after unwrapping);
-    /// the first point prefers positive P.
+    /// the first point prefers the larger P (P ≥ 0 on the built-ins).
     Nearest,
-    /// G16 Table 1: the branch is chosen by the sign of j (flips P near the pole).
+    /// G16 Table 1: the solution whose C lies in [−90°, 90°] (on the built-ins the branch is
+    /// chosen by the sign of j, which flips P near the pole); on other pairs the solution
+    /// with the smaller |C|.
     DomainRule,
-    /// Always P ≥ 0.
+    /// Always the larger P (P ≥ 0 on the built-ins).
     PreferPositive,
-    /// Always P ≤ 0.
+    /// Always the smaller P (P ≤ 0 on the built-ins).
     PreferNegative,
 }
 
-/// Both solutions for a unit tool axis `o_wp`. Returns `None` on the pole (|sin P| below
-/// [`crate::tolerances::POLE_SIN_TOL`]): C is undefined there. The first solution has
-/// P ≥ 0. Both P lie within (−180, 180].
+/// Both solutions for a tool axis `o_wp`, any machine ([`crate::rotary`]); the pole, an
+/// orientation the pair cannot reach and bad input each say so.
+pub fn solve_ik(machine: &Machine, o_wp: [f64; 3]) -> Ik {
+    match machine.standard_form() {
+        Some(f) => match inverse_standard(f, o_wp) {
+            Some(s) if s[0].p_deg.is_nan() => Ik::Invalid,
+            Some(s) => Ik::Two(s),
+            None => Ik::Pole {
+                p_deg: if o_wp[2] < 0.0 { 180.0 } else { 0.0 },
+                opposite: o_wp[2] < 0.0,
+            },
+        },
+        None => inverse_general(
+            &machine.rotary,
+            machine.primary_sense,
+            machine.c_sense,
+            o_wp,
+        ),
+    }
+}
+
+/// Both solutions for a unit tool axis `o_wp`. Returns `None` on the pole (the tool along
+/// the pole axis or against it, within [`crate::tolerances::POLE_SIN_TOL`]): C is undefined
+/// there. The first solution has the larger P (P ≥ 0 on the built-ins). Both P lie within
+/// (−180, 180].
 ///
 /// `o_wp` need not be normalised. A zero or non-finite `o_wp` gives NaN solutions (never
-/// `None`), so bad input is not mistaken for the pole.
+/// `None`), so bad input is not mistaken for the pole; so does an orientation the machine's
+/// pair cannot reach (only on pairs other than the standard form; [`solve_ik`] tells them
+/// apart).
 pub fn inverse(machine: &Machine, o_wp: [f64; 3]) -> Option<[IkSolution; 2]> {
+    let nan = IkSolution {
+        p_deg: f64::NAN,
+        c_deg: f64::NAN,
+    };
+    match machine.standard_form() {
+        Some(f) => inverse_standard(f, o_wp),
+        None => match solve_ik(machine, o_wp) {
+            Ik::Two(s) => Some(s),
+            Ik::Pole { .. } => None,
+            Ik::Unreachable { .. } | Ik::Invalid => Some([nan, nan]),
+        },
+    }
+}
+
+/// [`inverse`] of the standard form, written out (module docs).
+fn inverse_standard(f: StandardForm, o_wp: [f64; 3]) -> Option<[IkSolution; 2]> {
     // Scaled to the largest component first: (f64::MAX, 0, f64::MAX) has a direction, but
     // its length overflows.
     let m = o_wp[0].abs().max(o_wp[1].abs()).max(o_wp[2].abs());
@@ -69,8 +120,8 @@ pub fn inverse(machine: &Machine, o_wp: [f64; 3]) -> Option<[IkSolution; 2]> {
         return None;
     }
     let p_deg = h.atan2(k).to_degrees();
-    let (sp, sc) = (machine.primary_sense, machine.c_sense);
-    let theta_deg = match machine.primary {
+    let (sp, sc) = (f.sp, f.sc);
+    let theta_deg = match f.primary {
         PrimaryAxis::A => atan2_deg(sp * i, -sp * j),
         PrimaryAxis::B => atan2_deg(sp * j, sp * i),
     };
@@ -82,6 +133,66 @@ pub fn inverse(machine: &Machine, o_wp: [f64; 3]) -> Option<[IkSolution; 2]> {
             c_deg: wrap_deg(c_deg + 180.0),
         },
     ])
+}
+
+impl Machine {
+    /// The primary angle at which the tool lies along the pole axis, degrees: 0 on the
+    /// built-ins and on every pair whose tool at zero lies along the pole axis; `None` when
+    /// the pair cannot reach the pole (then it has no singularity to patch).
+    pub fn pole_p_deg(&self) -> Option<f64> {
+        match self.standard_form() {
+            Some(_) => Some(0.0),
+            None => pole_p_general(&self.rotary, self.primary_sense),
+        }
+    }
+    /// The angle between the tool and the pole when the primary axis is at `p_deg`,
+    /// degrees in [0, 180] (C turns the tool about the pole at this angle): `|P|` (folded
+    /// into [0, 180]) on the built-ins. The distance from the pole is this angle; a change
+    /// ΔC moves the tool by `2·asin(sin(tilt)·|sin(ΔC/2)|)`.
+    pub fn pole_tilt_deg(&self, p_deg: f64) -> f64 {
+        match self.standard_form() {
+            Some(_) => wrap_deg(p_deg).abs(),
+            None => pole_tilt_general(&self.rotary, self.primary_sense, p_deg),
+        }
+    }
+    /// The other joint solution of the tool axis at (`p_deg`, `c_deg`): `(−P, C + 180°)`
+    /// on the standard form (exactly, C not wrapped); on other pairs the inverse kinematics'
+    /// other solution with C unwrapped to within 180° of `c_deg + 180°`. On the pole, or
+    /// where the two coincide, it is the same posture (P, C); `None` only for non-finite
+    /// input.
+    pub fn other_solution(&self, p_deg: f64, c_deg: f64) -> Option<IkSolution> {
+        if !(p_deg.is_finite() && c_deg.is_finite()) {
+            return None;
+        }
+        if self.standard_form().is_some() {
+            return Some(IkSolution {
+                p_deg: -p_deg,
+                c_deg: c_deg + 180.0,
+            });
+        }
+        let o = crate::forward::forward(self, p_deg, c_deg);
+        match solve_ik(self, o) {
+            Ik::Two(sols) => {
+                // The one that is not (p, c): the farther in P, or in C when P ties.
+                let far = |s: &IkSolution| {
+                    (
+                        wrap_deg(s.p_deg - p_deg).abs(),
+                        wrap_deg(s.c_deg - c_deg).abs(),
+                    )
+                };
+                let s = if far(&sols[0]) > far(&sols[1]) {
+                    sols[0]
+                } else {
+                    sols[1]
+                };
+                Some(IkSolution {
+                    p_deg: unwrap_near_deg(s.p_deg, p_deg),
+                    c_deg: unwrap_near_deg(s.c_deg, c_deg + 180.0),
+                })
+            }
+            _ => Some(IkSolution { p_deg, c_deg }),
+        }
+    }
 }
 
 /// An angle in degrees wrapped to (−180, 180].
@@ -117,16 +228,24 @@ fn atan2_deg(y: f64, x: f64) -> f64 {
 
 /// G16 Table 1, generalised to both senses and to B machines: index (0 or 1) of the
 /// solution of [`inverse`] whose C, in (−180, 180], lies in [−90°, 90°]; at exactly ±90°
-/// the one with P > 0 (index 0).
+/// the one with P > 0 (index 0). On pairs other than the standard form: the solution with
+/// the smaller |C| (index 0 on a tie), which is the same rule where the solutions are
+/// (P, C) and (−P, C + 180°).
 ///
-/// cos C1 has the sign of `−sp·j` (A) or `sp·i` (B), so the choice is made on that sign,
-/// exactly, and not on a rounded C. For the UCP710 (A, sp = +1) this is G16's rule:
-/// j ≤ 0 → A = acos k; j > 0 → A = −acos k.
+/// For the standard form cos C1 has the sign of `−sp·j` (A) or `sp·i` (B), so the choice
+/// is made on that sign, exactly, and not on a rounded C. For the UCP710 (A, sp = +1) this
+/// is G16's rule: j ≤ 0 → A = acos k; j > 0 → A = −acos k.
 pub fn domain_rule_index(machine: &Machine, o_wp: [f64; 3]) -> usize {
+    let Some(f) = machine.standard_form() else {
+        return match inverse(machine, o_wp) {
+            Some([s0, s1]) if s1.c_deg.abs() < s0.c_deg.abs() => 1,
+            _ => 0,
+        };
+    };
     let [i, j, _] = o_wp;
-    let cos_c1_sign = match machine.primary {
-        PrimaryAxis::A => -machine.primary_sense * j,
-        PrimaryAxis::B => machine.primary_sense * i,
+    let cos_c1_sign = match f.primary {
+        PrimaryAxis::A => -f.sp * j,
+        PrimaryAxis::B => f.sp * i,
     };
     if cos_c1_sign < 0.0 { 1 } else { 0 }
 }
@@ -149,8 +268,12 @@ pub fn domain_rule_index(machine: &Machine, o_wp: [f64; 3]) -> usize {
 /// On the pole (k ≈ +1) the output is P = 0 with C held. On the opposite pole (k ≈ −1) it
 /// is P = 180° (P = −180° for `PreferNegative`, or for `Nearest` when the previous P is
 /// negative) with C held, subject to the same range check; it is usually out of range.
+/// On other pairs the pole gives P = [`Machine::pole_p_deg`] with C held (and the opposite
+/// pole the P that points the tool against the pole axis). "P ≥ 0" and "P ≤ 0" above read
+/// "the larger P" and "the smaller P" there.
 /// C's own range (`c_range_deg`) is not checked here. A zero or non-finite tool axis gives
-/// a NaN point, and the next point continues from the last finite one.
+/// a NaN point, and the next point continues from the last finite one; so does an
+/// orientation the pair cannot reach (never on the standard form; [`solve_ik`] says why).
 pub fn inverse_path(machine: &Machine, o_wp: &[[f64; 3]], rule: BranchRule) -> Vec<IkSolution> {
     inverse_path_from(machine, o_wp, rule, None)
 }
@@ -167,20 +290,35 @@ pub fn inverse_path_from(
     let in_range = |s: &IkSolution| p_lo <= s.p_deg && s.p_deg <= p_hi;
     let mut out = Vec::with_capacity(o_wp.len());
     let mut prev: Option<IkSolution> = start.filter(|s| s.p_deg.is_finite() && s.c_deg.is_finite());
+    let standard = machine.standard_form().is_some();
+    let nan = IkSolution {
+        p_deg: f64::NAN,
+        c_deg: f64::NAN,
+    };
     for &o in o_wp {
         let held_c = prev.map_or(0.0, |p| p.c_deg);
-        let solutions = inverse(machine, o);
+        let (solutions, pole_p_deg) = match standard {
+            // Opposite pole: ±180°, two names of one posture; pole: 0° twice.
+            true => (inverse(machine, o), if o[2] < 0.0 { 180.0 } else { 0.0 }),
+            false => match solve_ik(machine, o) {
+                Ik::Two(s) => (Some(s), 0.0),
+                Ik::Pole { p_deg, .. } => (None, p_deg),
+                Ik::Unreachable { .. } | Ik::Invalid => (Some([nan; 2]), 0.0),
+            },
+        };
         let on_pole = solutions.is_none();
         let mut cands = solutions.unwrap_or_else(|| {
-            // Opposite pole: ±180°, two names of one posture; pole: 0° twice.
-            let p_deg = if o[2] < 0.0 { 180.0 } else { 0.0 };
             [
                 IkSolution {
-                    p_deg,
+                    p_deg: pole_p_deg,
                     c_deg: held_c,
                 },
                 IkSolution {
-                    p_deg: if p_deg == 0.0 { 0.0 } else { -p_deg },
+                    p_deg: if pole_p_deg.abs() == 180.0 {
+                        -pole_p_deg
+                    } else {
+                        pole_p_deg
+                    },
                     c_deg: held_c,
                 },
             ]
@@ -271,7 +409,7 @@ mod tests {
                     assert!(
                         dist(back, o) < 4e-16 * 8.0,
                         "{:?} P={p} C={c}: {s:?}",
-                        m.primary
+                        m.primary_letter()
                     );
                 }
                 // One of the two is (p, c) itself, up to a turn of C; C is only as
@@ -409,7 +547,7 @@ mod tests {
                 assert!(
                     (-90.0..=90.0).contains(&s.c_deg),
                     "{:?} {o:?}: {s:?}",
-                    m.primary
+                    m.primary_letter()
                 );
                 assert!(dist(forward(&m, s.p_deg, s.c_deg), o) < 1e-14);
             }
@@ -601,6 +739,114 @@ mod tests {
         assert_eq!(unwrap_near_deg(-170.0, 170.0), 190.0);
         assert_eq!(unwrap_near_deg(10.0, 725.0), 730.0);
         assert_eq!(unwrap_near_deg(-1e-20, 0.0), -1e-20);
+    }
+
+    /// A pair whose pole is not at P = 0: LinuxCNC's xyzab_tdr layout, the A table along X
+    /// (the pole axis) carried by B along Y, tool along Z. The pole is B = ±90°.
+    fn tdr() -> Machine {
+        crate::testutil::pair_machine([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], 1.0, 1.0)
+    }
+
+    /// A 45° nutating table: B at 45° between +Y and +Z carrying C; it reaches 0° to 90°
+    /// from its C axis.
+    fn nutating() -> Machine {
+        let mut m = crate::testutil::pair_machine(
+            [0.0, 0.0, 1.0],
+            crate::testutil::unit([0.0, 1.0, 1.0]),
+            [0.0, 0.0, 1.0],
+            1.0,
+            1.0,
+        );
+        m.primary_range_deg = (-5.0, 185.0);
+        m
+    }
+
+    /// A planted pass 1.15° beside the pole of a pair whose pole is at B = 90°: every rule
+    /// gives joints whose FK is the tool axis; Nearest and the constant-sign rules stay
+    /// continuous (C unwrapped), the domain rule keeps |C| the smaller of the two.
+    #[test]
+    fn paths_on_a_pair_whose_pole_is_not_at_zero() {
+        let m = tdr();
+        assert!(m.standard_form().is_none());
+        // The tool axis passes 0.02 rad beside +X while its y component crosses 0.
+        let o: Vec<[f64; 3]> = (-10..=10)
+            .map(|n| {
+                let (y, z) = (f64::from(n) * 0.01, 0.02);
+                [(1.0 - y * y - z * z).sqrt(), y, z]
+            })
+            .collect();
+        for rule in [
+            BranchRule::Nearest,
+            BranchRule::DomainRule,
+            BranchRule::PreferPositive,
+            BranchRule::PreferNegative,
+        ] {
+            let path = inverse_path(&m, &o, rule);
+            for (s, o) in path.iter().zip(&o) {
+                assert!(
+                    dist(forward(&m, s.p_deg, s.c_deg), *o) < 1e-12,
+                    "{rule:?}: {s:?}"
+                );
+                // Within 5.85° of the pole (the pass's ends: hypot(0.1, 0.02) rad), B is
+                // within 5.85° of ±90°.
+                assert!((s.p_deg.abs() - 90.0).abs() < 5.9, "{rule:?}: {s:?}");
+            }
+            if rule == BranchRule::DomainRule {
+                for (s, o) in path.iter().zip(&o) {
+                    let [a, b] = inverse(&m, *o).unwrap();
+                    assert!(s.c_deg.abs() <= a.c_deg.abs().min(b.c_deg.abs()) + 1e-12);
+                }
+            } else {
+                // A continuous C sweep: no step above 30°.
+                let max_step = path
+                    .windows(2)
+                    .map(|w| (w[1].c_deg - w[0].c_deg).abs())
+                    .fold(0.0, f64::max);
+                assert!(max_step < 30.0, "{rule:?}: {max_step}");
+            }
+        }
+        // On the pole: B at the pole, C held; the opposite pole: the other B.
+        let path = inverse_path(
+            &m,
+            &[forward(&m, 80.0, 33.0), [1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]],
+            BranchRule::Nearest,
+        );
+        assert!(
+            (path[1].p_deg - m.pole_p_deg().unwrap()).abs() < 1e-12,
+            "{path:?}"
+        );
+        assert!((path[1].p_deg.abs() - 90.0).abs() < 1e-12);
+        assert_eq!(path[1].c_deg, path[0].c_deg);
+        assert!(dist(forward(&m, path[2].p_deg, path[2].c_deg), [-1.0, 0.0, 0.0]) < 1e-12);
+        assert_eq!(path[2].c_deg, path[0].c_deg);
+    }
+
+    /// A tool axis a nutating table cannot reach is a NaN point, and the path goes on from
+    /// the last point it could.
+    #[test]
+    fn an_unreachable_tool_axis_is_a_nan_point_on_the_path() {
+        let m = nutating();
+        let o = [
+            forward(&m, 60.0, 10.0),
+            [1.0, 0.0, -0.2],
+            forward(&m, 61.0, 11.0),
+        ];
+        let path = inverse_path(&m, &o, BranchRule::Nearest);
+        assert!(path[1].p_deg.is_nan() && path[1].c_deg.is_nan());
+        assert!((path[0].p_deg - 60.0).abs() < 1e-9 && (path[2].p_deg - 61.0).abs() < 1e-9);
+        assert!((path[2].c_deg - 11.0).abs() < 1e-9);
+        match solve_ik(&m, o[1]) {
+            Ik::Unreachable {
+                angle_deg,
+                reach_deg,
+            } => {
+                assert!(angle_deg > 90.0 && (reach_deg.1 - 90.0).abs() < 1e-9)
+            }
+            other => panic!("{other:?}"),
+        }
+        // The range check picks the solution within B's travel: (−B) is out of it.
+        let s = inverse_path(&m, &[forward(&m, 60.0, 10.0)], BranchRule::PreferNegative)[0];
+        assert!((s.p_deg - 60.0).abs() < 1e-9, "{s:?}");
     }
 
     mod prop {

@@ -11,19 +11,28 @@
 //!   linear axis, °/mm, °/mm², °/mm³ for a rotary axis.
 //!
 //! # Frames and senses
-//! The tool axis `o_wp = (i, j, k)` is expressed in the workpiece frame. A machine's
-//! primary rotary axis tilts about X (A) or Y (B); the secondary C turns the table about
-//! Z and rides on the primary. With senses `sp`, `sc` = ±1 from the machine definition:
-//! `o_wp = Rz(sc·C) · Rp(sp·P) · ẑ`, where `Rp` is `Rx` for A and `Ry` for B.
+//! The tool axis `o_wp = (i, j, k)` is expressed in the workpiece frame. A machine's two
+//! rotary axes form a chain ([`rotary`]): the pole axis (slot [`Axis::C`]) next to the part,
+//! the tilting axis (slot [`Axis::Primary`]) next to the tool, each turning the table or
+//! the head about its own direction, with its own letter. With senses `sp`, `sc` = ±1:
+//! `o_wp = R(a, sc·C) · R(b, sp·P) · t0`. On the built-ins (a table-table A-C and B-C) this
+//! is `o_wp = Rz(sc·C) · Rp(sp·P) · ẑ`, where `Rp` is `Rx` for A and `Ry` for B.
 //! G16 eq. 1 is `sp = sc = +1` with A (`i = sin C sin A, j = −cos C sin A, k = cos A`);
 //! C17 eq. 2 is `sp = sc = −1` (`i = sin C sin A, j = cos C sin A, k = cos A`).
+//!
+//! # Machine sources
+//! A built-in name, a TOML file in either form ([`Machine::from_toml_str`]), or a
+//! LinuxCNC INI file ([`linuxcnc`]), all through [`Machine::load`].
 
 pub mod chain;
 pub mod feed;
 pub mod forward;
 pub mod inverse;
+pub mod linuxcnc;
 pub mod machine;
+mod machine_file;
 pub mod reorient;
+pub mod rotary;
 pub mod tolerances;
 
 #[cfg(test)]
@@ -31,10 +40,11 @@ mod testutil;
 
 pub use chain::Chain;
 pub use feed::{AxisBound, FeedBound, LimitKind, axis_feed_bound, axis_feed_ratio, feed_bound};
-pub use forward::{angle_between_deg, forward, forward_jacobian};
+pub use forward::{StandardForm, angle_between_deg, forward, forward_jacobian};
 pub use inverse::{
-    BranchRule, IkSolution, domain_rule_index, inverse, inverse_path, inverse_path_from,
+    BranchRule, IkSolution, domain_rule_index, inverse, inverse_path, inverse_path_from, solve_ik,
     unwrap_near_deg, wrap_deg,
 };
 pub use machine::{Axis, AxisLimits, Controller, Machine, MachineError, PrimaryAxis};
 pub use reorient::JigRotation;
+pub use rotary::{Carrier, Ik, Layout, Rotaries, RotaryAxis};

@@ -1,9 +1,12 @@
-//! Machine model: axes, senses, ranges, kinematic limits, interpolation cycle time.
+//! Machine model: the two rotary axes as a chain, senses, ranges, kinematic limits,
+//! interpolation cycle time; loading a machine (built-in, TOML file, LinuxCNC INI).
 
+use crate::rotary::{Layout, Rotaries};
 use serde::{Deserialize, Serialize};
 
-/// The five axes of a table-table machine, in the fixed order used by every per-axis
-/// array in polepatch: X, Y, Z, primary rotary (A or B), C.
+/// The five axes of a 5-axis machine, in the fixed order used by every per-axis array in
+/// polepatch: X, Y, Z, then the two rotary axes by their role (whatever their letters, see
+/// [`crate::rotary`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub enum Axis {
     /// Linear X.
@@ -12,9 +15,11 @@ pub enum Axis {
     Y,
     /// Linear Z.
     Z,
-    /// Primary rotary axis (A about X or B about Y), the tilting one.
+    /// The rotary axis next to the tool in the chain, which tilts the tool relative to the
+    /// pole axis (A or B on a table-table A-C or B-C machine).
     Primary,
-    /// Secondary rotary axis C about Z (the table), riding on the primary.
+    /// The rotary axis next to the part in the chain: the pole axis, whose rotation cannot
+    /// change a tool axis along it (C on a table-table machine, whatever its letter).
     C,
 }
 
@@ -31,7 +36,8 @@ impl Axis {
     }
 }
 
-/// Which physical rotation the primary rotary axis performs.
+/// The tilting axis of the built-in form (the `[primary]` letter of a table-table file):
+/// which coordinate axis it turns about.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum PrimaryAxis {
     /// A: tilts about X.
@@ -52,31 +58,43 @@ pub struct AxisLimits {
     pub j: f64,
 }
 
-/// A table-table 5-axis machine. See the crate docs for units and senses.
+/// The letters a rotary axis may have: A B C, and the addresses that no dialect polepatch
+/// reads gives another meaning (E U V W; D F G H I J K L M N O P Q R S T X Y Z are taken).
+pub const ROTARY_LETTERS: &str = "ABCEUVW";
+
+/// A 5-axis machine: three linear axes and two rotary axes in a chain. See the crate docs
+/// for units and [`crate::rotary`] for the chain, its senses and its kinematics.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Machine {
     /// Short name, e.g. `mikron-ucp710`.
     pub name: String,
-    /// Primary rotary axis kind (A about X or B about Y).
-    pub primary: PrimaryAxis,
-    /// Sense of the primary rotation, +1 or −1 (see crate docs).
+    /// The two rotary axes: letters, what each turns, directions at zero, and the tool
+    /// direction at zero.
+    pub rotary: Rotaries,
+    /// Sense of the primary (tilting) axis, +1 or −1 (ISO 841 when +1, see
+    /// [`crate::rotary`]).
     pub primary_sense: f64,
-    /// Sense of the C rotation, +1 or −1 (see crate docs).
+    /// Sense of the C (pole) axis, +1 or −1.
     pub c_sense: f64,
     /// Allowed range of the primary axis, degrees (min, max).
     pub primary_range_deg: (f64, f64),
-    /// Allowed range of C, degrees (min, max); `None` = endless rotary axis.
+    /// Allowed range of the C (pole) axis, degrees (min, max); `None` = endless.
     pub c_range_deg: Option<(f64, f64)>,
     /// Interpolation cycle time Tcy, seconds (default 0.001).
     pub tcy_s: f64,
     /// Limits per axis in [`Axis`] order, internal units.
     pub limits: [AxisLimits; 5],
-    /// Where the rotary axes sit in the machine frame (`[chain]`, optional): needed to
-    /// patch programs without TCPM and to analyse the linear axes in the machine frame.
+    /// Points on the two rotary axes (`[chain]`, or `point_mm` of each `[[rotary]]`;
+    /// optional): needed to patch programs without TCPM and to analyse the linear axes in
+    /// the machine frame.
     pub chain: Option<crate::chain::Chain>,
     /// How the controller switches TCPM beyond its dialect's codes (`[controller]`,
     /// optional).
     pub controller: Controller,
+    /// What the loader assumed where the source did not say (a LinuxCNC INI without jerk
+    /// limits, a HAL pin it could not follow, …), one sentence each, for the caller to
+    /// print. Empty for TOML files.
+    pub warnings: Vec<String>,
 }
 
 /// `[controller]`: the machine's own TCPM codes, as NC words (`"M428"`, `"G43.4"`,
@@ -95,6 +113,11 @@ pub struct Controller {
     /// Always TCP. Default false.
     #[serde(default)]
     pub tcpm_always: bool,
+    /// Which point of the tool the programs' X Y Z state under TCPM, where the shop set
+    /// the tool lengths so: `"tip"` or `"centre"` (of a ball). Default: each TCPM code's
+    /// own (M128: centre; the others: tip).
+    #[serde(default)]
+    pub tool_point: Option<String>,
 }
 
 /// Errors of machine loading.
@@ -139,23 +162,53 @@ impl Machine {
     }
     /// Parse a machine from TOML text; `origin` names the source in errors.
     ///
-    /// The format (every field required unless marked optional; unknown fields are errors):
+    /// Two forms (every field required unless marked optional; unknown fields are errors).
+    /// **The chain form**, any layout — the two rotary axes from the part to the tool:
     ///
     /// ```toml
-    /// name = "mikron-ucp710"
+    /// name = "head-table-bc"
     /// description = "free text"        # optional, not kept
     /// tcy_ms = 1.0                     # optional, interpolation cycle time, default 1 ms
+    /// tool_direction = [0.0, 0.0, 1.0] # optional, tip → spindle at zero, default [0, 0, 1]
     /// [x]                              # also [y] and [z]
     /// v_m_min = 30.0                   # max velocity, m/min
     /// a_m_s2 = 2.5                     # max acceleration, m/s²
     /// j_m_s3 = 5.0                     # max jerk, m/s³
+    /// [[rotary]]                       # first: the axis next to the part (the pole axis)
+    /// letter = "C"                     # its NC address: A B C, or E U V W
+    /// moves = "table"                  # "table" or "head"
+    /// direction = [0.0, 0.0, 1.0]      # at zero, machine frame (any length; 45° is fine)
+    /// sense = 1                        # optional, default +1: ISO 841 (crate::rotary)
+    /// # range_deg = [-360.0, 360.0]    # optional for this axis; omitted = endless
+    /// v_rpm = 20.0                     # max velocity, rpm
+    /// a_rev_s2 = 0.83                  # max acceleration, rev/s²
+    /// j_rev_s3 = 50.0                  # max jerk, rev/s³
+    /// # point_mm = [0.0, 0.0, 0.0]     # optional (with the other's): a point on the axis
+    /// [[rotary]]                       # second: the axis next to the tool
+    /// letter = "B"
+    /// moves = "head"
+    /// direction = [0.0, 1.0, 0.0]
+    /// range_deg = [-110.0, 110.0]      # required for this axis
+    /// v_rpm = 15.0
+    /// a_rev_s2 = 0.83
+    /// j_rev_s3 = 5.0
+    /// [controller]                     # optional: the machine's own TCPM codes
+    /// tcpm_on = ["M428"]               # added to the dialect's (M128, TRAORI, G43.4, …)
+    /// tcpm_off = ["M429", "M430"]
+    /// tcpm_always = false              # true: kinematics always TCP
+    /// ```
+    ///
+    /// **The table-table form** (today's files, read as the chain C table `[0, 0, 1]` then
+    /// A table `[1, 0, 0]` or B table `[0, 1, 0]`, tool `[0, 0, 1]`):
+    ///
+    /// ```toml
     /// [primary]
     /// letter = "A"                     # "A" tilts about X, "B" about Y
     /// sense = 1                        # +1 or -1, sp in o = Rz(sc·C)·Rp(sp·P)·ẑ
     /// range_deg = [-100.0, 120.0]      # travel, degrees
-    /// v_rpm = 15.0                     # max velocity, rpm
-    /// a_rev_s2 = 0.83                  # max acceleration, rev/s²
-    /// j_rev_s3 = 5.0                   # max jerk, rev/s³
+    /// v_rpm = 15.0
+    /// a_rev_s2 = 0.83
+    /// j_rev_s3 = 5.0
     /// [c]
     /// sense = 1                        # +1 or -1, sc
     /// range_deg = [-360.0, 360.0]      # optional; omitted = endless
@@ -169,11 +222,15 @@ impl Machine {
     /// tcpm_on = ["M428"]               # added to the dialect's (M128, TRAORI, G43.4, …)
     /// tcpm_off = ["M429", "M430"]
     /// tcpm_always = false              # true: kinematics always TCP
+    /// tool_point = "tip"               # optional: X Y Z under TCPM are the tool tip or
+    ///                                  # the ball's "centre" (default: the TCPM code's)
     /// ```
     ///
     /// Every limit must lie within [`LIMIT_MIN`, `LIMIT_MAX`] = 0.001 to 10⁶ in the file's
     /// units, `tcy_ms` within [`TCY_MS_RANGE`] = 0.1 to 100 ms, a `range_deg` must have
-    /// exactly two values and a chain point exactly three (an error names the field).
+    /// exactly two values and a direction or point exactly three (an error names the
+    /// field). The two rotary axes must have different letters, the table axes come first,
+    /// and the second axis may lie neither along the first nor along the tool.
     ///
     /// Limits are converted once to internal units: m/min → mm/s ×1000/60, m/s² → mm/s²
     /// ×1000, m/s³ → mm/s³ ×1000, rpm → °/s ×6, rev/s² → °/s² ×360, rev/s³ → °/s³ ×360.
@@ -182,10 +239,12 @@ impl Machine {
             path: origin.to_string(),
             message,
         };
-        let file: MachineFile = toml::from_str(text).map_err(|e| invalid(e.to_string()))?;
+        let file: crate::machine_file::MachineFile =
+            toml::from_str(text).map_err(|e| invalid(e.to_string()))?;
         file.into_machine().map_err(invalid)
     }
-    /// A built-in name or a path to a TOML file.
+    /// A built-in name, a path to a TOML file, or a path to a LinuxCNC INI file (a name
+    /// ending in `.ini`, any case: [`crate::linuxcnc`]).
     ///
     /// Built-in names win over files of the same name in the working directory. At most
     /// [`MAX_MACHINE_FILE_BYTES`] are read (a device such as `/dev/zero` or a FIFO is read
@@ -201,22 +260,69 @@ impl Machine {
                 builtins: Machine::builtin_names().join(", "),
             });
         }
+        Machine::from_file(path)
+    }
+    /// A machine file at `path` (never a built-in name), read as [`Machine::load`] reads
+    /// it: at most [`MAX_MACHINE_FILE_BYTES`]; a LinuxCNC INI when the name ends in `.ini`
+    /// (any case), else TOML.
+    pub fn from_file(path: &std::path::Path) -> Result<Machine, MachineError> {
+        let name = path.display().to_string();
         let text = read_bounded(path).map_err(|cause| MachineError::Io {
-            path: name_or_path.to_string(),
+            path: name.clone(),
             cause,
         })?;
-        Machine::from_toml_str(&text, name_or_path)
+        let is_ini = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("ini"));
+        if is_ini {
+            crate::linuxcnc::machine_from_ini(&text, path)
+        } else {
+            Machine::from_toml_str(&text, &name)
+        }
     }
-    /// Letter of the primary axis in NC words (`'A'` or `'B'`).
+    /// Letter of the primary (tilting) axis in NC words (`'A'` or `'B'` on the built-ins).
     pub fn primary_letter(&self) -> char {
-        match self.primary {
-            PrimaryAxis::A => 'A',
-            PrimaryAxis::B => 'B',
+        self.rotary.primary.letter
+    }
+    /// Letter of the C (pole) axis in NC words (`'C'` on the built-ins; `'B'` on an A-B
+    /// trunnion whose platter is B).
+    pub fn c_letter(&self) -> char {
+        self.rotary.c.letter
+    }
+    /// The NC letter of an axis: X, Y, Z, or the file's own rotary letters.
+    pub fn letter(&self, axis: Axis) -> char {
+        match axis {
+            Axis::X => 'X',
+            Axis::Y => 'Y',
+            Axis::Z => 'Z',
+            Axis::Primary => self.primary_letter(),
+            Axis::C => self.c_letter(),
+        }
+    }
+    /// The slot of a rotary letter (`Axis::Primary` or `Axis::C`), or `None` when the
+    /// machine has no rotary axis of that letter (case-insensitive).
+    pub fn rotary_axis_of(&self, letter: char) -> Option<Axis> {
+        let l = letter.to_ascii_uppercase();
+        if l == self.primary_letter() {
+            Some(Axis::Primary)
+        } else if l == self.c_letter() {
+            Some(Axis::C)
+        } else {
+            None
         }
     }
     /// Limits of one axis.
     pub fn limit(&self, axis: Axis) -> &AxisLimits {
         &self.limits[axis.index()]
+    }
+    /// Table-table, head-table or head-head.
+    pub fn layout(&self) -> Layout {
+        self.rotary.layout()
+    }
+    /// The pole: the tool axis (unit, part frame) along the C (pole) axis, where turning C
+    /// does not change the tool axis. `[0, 0, 1]` on the built-ins.
+    pub fn pole_direction(&self) -> [f64; 3] {
+        self.rotary.c.direction
     }
 }
 
@@ -247,7 +353,7 @@ pub const TCY_MS_RANGE: (f64, f64) = (0.1, 100.0);
 
 /// The whole file at `path`, as text, reading at most [`MAX_MACHINE_FILE_BYTES`] + 1
 /// bytes: more is an error, as is text that is not UTF-8.
-fn read_bounded(path: &std::path::Path) -> std::io::Result<String> {
+pub(crate) fn read_bounded(path: &std::path::Path) -> std::io::Result<String> {
     use std::io::Read;
     let mut bytes = Vec::new();
     std::fs::File::open(path)?
@@ -272,7 +378,7 @@ fn read_bounded(path: &std::path::Path) -> std::io::Result<String> {
 
 /// A number for a message: the shortest form that reads back as the value (`1e-300`, not
 /// three hundred digits), without a trailing `.0`.
-fn num(v: f64) -> String {
+pub(crate) fn num(v: f64) -> String {
     let text = format!("{v:?}");
     text.strip_suffix(".0").map_or(text.clone(), str::to_string)
 }
@@ -287,222 +393,6 @@ pub fn check_tcy_ms(name: &str, tcy_ms: f64) -> Result<f64, String> {
             "{name} must be a cycle time from {lo} to {hi} ms, got {}",
             num(tcy_ms)
         ))
-    }
-}
-
-/// mm/s per m/min.
-const MM_S_PER_M_MIN: f64 = 1000.0 / 60.0;
-/// mm per m (for m/s² and m/s³).
-const MM_PER_M: f64 = 1000.0;
-/// °/s per rpm.
-const DEG_S_PER_RPM: f64 = 6.0;
-/// Degrees per revolution (for rev/s² and rev/s³).
-const DEG_PER_REV: f64 = 360.0;
-
-/// The TOML file as written (units of the machine tables).
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct MachineFile {
-    name: String,
-    #[allow(dead_code)]
-    description: Option<String>,
-    tcy_ms: Option<f64>,
-    x: LinearFile,
-    y: LinearFile,
-    z: LinearFile,
-    primary: PrimaryFile,
-    c: CFile,
-    chain: Option<ChainFile>,
-    #[serde(default)]
-    controller: Controller,
-}
-
-/// `[chain]` as written: arrays of any length, checked for three values each (a fixed-size
-/// array would be filled from the first three values and the rest ignored).
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ChainFile {
-    primary_axis_point_mm: Vec<f64>,
-    c_axis_point_mm: Vec<f64>,
-}
-
-impl ChainFile {
-    fn into_chain(self) -> Result<crate::chain::Chain, String> {
-        let chain = crate::chain::Chain {
-            primary_axis_point_mm: exactly(
-                "chain.primary_axis_point_mm",
-                &self.primary_axis_point_mm,
-            )?,
-            c_axis_point_mm: exactly("chain.c_axis_point_mm", &self.c_axis_point_mm)?,
-        };
-        chain.validate()?;
-        Ok(chain)
-    }
-}
-
-/// The `N` values of an array field, or an error naming it when it has another length.
-fn exactly<const N: usize>(field: &str, values: &[f64]) -> Result<[f64; N], String> {
-    values.try_into().map_err(|_| {
-        format!(
-            "{field} must have {N} values, got {}: {values:?}",
-            values.len()
-        )
-    })
-}
-
-/// `[x]`, `[y]`, `[z]`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct LinearFile {
-    v_m_min: f64,
-    a_m_s2: f64,
-    j_m_s3: f64,
-}
-
-/// `[primary]`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct PrimaryFile {
-    letter: PrimaryAxis,
-    sense: f64,
-    range_deg: Vec<f64>,
-    v_rpm: f64,
-    a_rev_s2: f64,
-    j_rev_s3: f64,
-}
-
-/// `[c]`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct CFile {
-    sense: f64,
-    range_deg: Option<Vec<f64>>,
-    v_rpm: f64,
-    a_rev_s2: f64,
-    j_rev_s3: f64,
-}
-
-/// A limit must be positive, finite and within [`LIMIT_MIN`, `LIMIT_MAX`] (file units);
-/// `field` is its dotted TOML name.
-fn positive(field: &str, value: f64) -> Result<f64, String> {
-    if !(value.is_finite() && value > 0.0) {
-        return Err(format!(
-            "{field} must be positive and finite, got {}",
-            num(value)
-        ));
-    }
-    if !(LIMIT_MIN..=LIMIT_MAX).contains(&value) {
-        return Err(format!(
-            "{field} = {} is outside the accepted range {} to {} (in the file's units; a \
-             unit mistake?)",
-            num(value),
-            num(LIMIT_MIN),
-            num(LIMIT_MAX)
-        ));
-    }
-    Ok(value)
-}
-
-/// A sense must be exactly +1 or −1.
-fn sense(field: &str, value: f64) -> Result<f64, String> {
-    if value == 1.0 || value == -1.0 {
-        Ok(value)
-    } else {
-        Err(format!("{field} must be +1 or -1, got {}", num(value)))
-    }
-}
-
-/// A range must be two finite values with min < max.
-fn range(field: &str, r: &[f64]) -> Result<(f64, f64), String> {
-    let [lo, hi] = exactly(field, r)?;
-    if !(lo.is_finite() && hi.is_finite()) {
-        return Err(format!(
-            "{field} must be finite, got [{}, {}]",
-            num(lo),
-            num(hi)
-        ));
-    }
-    if lo >= hi {
-        return Err(format!(
-            "{field}: min must be below max, got [{}, {}]",
-            num(lo),
-            num(hi)
-        ));
-    }
-    Ok((lo, hi))
-}
-
-impl LinearFile {
-    fn limits(&self, axis: &str) -> Result<AxisLimits, String> {
-        Ok(AxisLimits {
-            v: positive(&format!("{axis}.v_m_min"), self.v_m_min)? * MM_S_PER_M_MIN,
-            a: positive(&format!("{axis}.a_m_s2"), self.a_m_s2)? * MM_PER_M,
-            j: positive(&format!("{axis}.j_m_s3"), self.j_m_s3)? * MM_PER_M,
-        })
-    }
-}
-
-/// Rotary limits from rpm, rev/s², rev/s³.
-fn rotary_limits(
-    axis: &str,
-    v_rpm: f64,
-    a_rev_s2: f64,
-    j_rev_s3: f64,
-) -> Result<AxisLimits, String> {
-    Ok(AxisLimits {
-        v: positive(&format!("{axis}.v_rpm"), v_rpm)? * DEG_S_PER_RPM,
-        a: positive(&format!("{axis}.a_rev_s2"), a_rev_s2)? * DEG_PER_REV,
-        j: positive(&format!("{axis}.j_rev_s3"), j_rev_s3)? * DEG_PER_REV,
-    })
-}
-
-impl MachineFile {
-    /// Validate and convert to internal units; the error names the field.
-    fn into_machine(self) -> Result<Machine, String> {
-        let tcy_ms = check_tcy_ms("tcy_ms", self.tcy_ms.unwrap_or(1.0))?;
-        let p = &self.primary;
-        let c = &self.c;
-        Ok(Machine {
-            name: self.name,
-            primary: p.letter,
-            primary_sense: sense("primary.sense", p.sense)?,
-            c_sense: sense("c.sense", c.sense)?,
-            primary_range_deg: range("primary.range_deg", &p.range_deg)?,
-            c_range_deg: c
-                .range_deg
-                .as_deref()
-                .map(|r| range("c.range_deg", r))
-                .transpose()?,
-            tcy_s: tcy_ms / 1000.0,
-            limits: [
-                self.x.limits("x")?,
-                self.y.limits("y")?,
-                self.z.limits("z")?,
-                rotary_limits("primary", p.v_rpm, p.a_rev_s2, p.j_rev_s3)?,
-                rotary_limits("c", c.v_rpm, c.a_rev_s2, c.j_rev_s3)?,
-            ],
-            chain: self.chain.map(ChainFile::into_chain).transpose()?,
-            controller: {
-                for (field, codes) in [
-                    ("controller.tcpm_on", &self.controller.tcpm_on),
-                    ("controller.tcpm_off", &self.controller.tcpm_off),
-                ] {
-                    if let Some(bad) = codes.iter().find(|c| {
-                        c.trim().is_empty()
-                            || !c
-                                .trim()
-                                .bytes()
-                                .all(|b| b.is_ascii_alphanumeric() || b == b'.' || b == b'_')
-                    }) {
-                        return Err(format!(
-                            "{field}: '{bad}' is not an NC code (write a G or M code such as \
-                             \"M428\" or \"G43.4\", or a word such as \"TRAORI\")"
-                        ));
-                    }
-                }
-                self.controller
-            },
-        })
     }
 }
 
@@ -527,7 +417,7 @@ mod tests {
     fn ucp710_has_the_figures_of_g16_table_2_in_internal_units() {
         let m = Machine::builtin("mikron-ucp710").unwrap();
         assert_eq!(m.name, "mikron-ucp710");
-        assert_eq!(m.primary, PrimaryAxis::A);
+        assert_eq!(m.standard_form().unwrap().primary, PrimaryAxis::A);
         assert_eq!(m.primary_letter(), 'A');
         assert_eq!((m.primary_sense, m.c_sense), (1.0, 1.0));
         assert_eq!(m.primary_range_deg, (-100.0, 120.0));
@@ -547,7 +437,7 @@ mod tests {
     fn hsm600_has_the_figures_of_g16_table_3_in_internal_units() {
         let m = Machine::builtin("mikron-hsm600").unwrap();
         assert_eq!(m.name, "mikron-hsm600");
-        assert_eq!(m.primary, PrimaryAxis::B);
+        assert_eq!(m.standard_form().unwrap().primary, PrimaryAxis::B);
         assert_eq!(m.primary_letter(), 'B');
         assert_eq!((m.primary_sense, m.c_sense), (1.0, 1.0));
         assert_eq!(m.primary_range_deg, (-120.0, 120.0));
@@ -627,7 +517,7 @@ j_rev_s3 = 1
     fn user_machine_with_integers_negative_senses_and_c_range() {
         let m = Machine::from_toml_str(GOOD, "good.toml").unwrap();
         assert_eq!(m.name, "test-bc");
-        assert_eq!(m.primary, PrimaryAxis::B);
+        assert_eq!(m.standard_form().unwrap().primary, PrimaryAxis::B);
         assert_eq!((m.primary_sense, m.c_sense), (-1.0, -1.0));
         assert_eq!(m.primary_range_deg, (-30.0, 110.0));
         assert_eq!(m.c_range_deg, Some((-360.0, 360.0)));

@@ -5,7 +5,10 @@ use crate::machine::{Machine, PrimaryAxis};
 /// The UCP710 limits with another primary kind, senses and primary range.
 pub(crate) fn machine(primary: PrimaryAxis, sp: f64, sc: f64, range_deg: (f64, f64)) -> Machine {
     let mut m = Machine::builtin("mikron-ucp710").unwrap();
-    m.primary = primary;
+    m.rotary = crate::rotary::Rotaries::table_table(match primary {
+        PrimaryAxis::A => 'A',
+        PrimaryAxis::B => 'B',
+    });
     m.primary_sense = sp;
     m.c_sense = sc;
     m.primary_range_deg = range_deg;
@@ -46,4 +49,34 @@ impl SplitMix64 {
     pub(crate) fn pick<T: Copy>(&mut self, items: &[T]) -> T {
         items[(self.next_u64() % items.len() as u64) as usize]
     }
+}
+
+/// The UCP710 limits with any pair: pole axis `a` (letter C), tilting axis `b` (letter B),
+/// tool `t0` (unit vectors), senses, both table axes, primary range (−180, 180].
+pub(crate) fn pair_machine(a: [f64; 3], b: [f64; 3], t0: [f64; 3], sp: f64, sc: f64) -> Machine {
+    use crate::rotary::{Carrier, Rotaries, RotaryAxis};
+    let mut m = Machine::builtin("mikron-ucp710").unwrap();
+    m.rotary = Rotaries {
+        primary: RotaryAxis {
+            letter: 'B',
+            carrier: Carrier::Table,
+            direction: b,
+        },
+        c: RotaryAxis {
+            letter: 'C',
+            carrier: Carrier::Table,
+            direction: a,
+        },
+        tool_direction: t0,
+    };
+    m.primary_sense = sp;
+    m.c_sense = sc;
+    m.primary_range_deg = (-180.0, 180.0);
+    m
+}
+
+/// A unit vector from three numbers (not all near zero).
+pub(crate) fn unit(v: [f64; 3]) -> [f64; 3] {
+    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    [v[0] / n, v[1] / n, v[2] / n]
 }

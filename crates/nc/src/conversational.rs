@@ -4,7 +4,7 @@
 //!
 //! | line | read as |
 //! |---|---|
-//! | `BEGIN PGM NAME MM` / `INCH` | program start; INCH: lengths ×25.4, F in 1/10 inch/min ×2.54 |
+//! | `BEGIN PGM NAME MM` / `INCH` (`IN`, as NX's posts write it) | program start; INCH: lengths ×25.4, F in 1/10 inch/min ×2.54 |
 //! | `END PGM NAME` | program end (TCPM off) |
 //! | `L X+10 Y-5 Z+0 A+0 C+90 R0 F2000 M3` | linear move; `FMAX` a rapid for this block only; `FAUTO`, `FU`, `FZ` no feed per minute; `IX+5` incremental for this block (the block is never changed and ends runs); `RL`/`RR`/`R+`/`R-` radius compensation ends runs |
 //! | `C`, `CR`, `CT` (arcs), `CP`, `LP` (polar), `APPR`, `DEP` | moves polepatch does not follow: they end runs (`LP`, `CP`, `APPR`, `DEP` leave X Y Z unknown) |
@@ -13,12 +13,13 @@
 //! | `LN …` | 3D-compensated line with normal vectors: a move that ends runs |
 //! | `TOOL CALL 5 Z S12000` | tool change; `TOOL DEF`: ends runs |
 //! | `BLK FORM 0.1 Z X+0 Y+0 Z-40` | blank definition: not a move |
-//! | `CYCL DEF 7.x` (datum shift), `247` (datum setting), `8`, `10`, `11`, `19`, `26` | frame changes (positions unknown after) |
+//! | `CYCL DEF 7.x` (datum shift), `247` (datum setting), `8`, `10`, `11`, `19`, `26` | frame changes (positions unknown after); `8.1`, `10.1`, `11.1`, `19.1`, `26.1` switch a mirror image, rotation or scaling on, or off where their values are the identity ([`crate::modal::transform`]) |
 //! | `CYCL DEF` (other), `CYCL CALL`, `M99` | cycle definition ends runs; a cycle call moves the tool (positions unknown after) |
-//! | `LBL n`, `CALL LBL n`, `CALL PGM` | a label may be reached by a jump, a call runs other blocks: positions unknown after |
-//! | `FN 0..8`, `Q1 = …` | parameter arithmetic: ends runs; `FN 9..12` (jumps): positions unknown after |
+//! | `LBL n`, `LBL "NAME"`, `LBL 0`, `CALL LBL n [REP m]`, `CALL PGM`, `SEL PGM` | labels, returns and calls ([`crate::flow`]): positions unknown after; TCPM as the file's flow settles it |
+//! | `FN 0..8`, `Q1 = …` | parameter arithmetic: ends runs; `FN 9..12: IF … GOTO LBL n` (conditional jumps, [`crate::flow`]): positions unknown after |
+//! | `TRANS MIRROR/ROTATION/SCALE/DATUM …` (`… RESET`) | TNC7 frames: frame changes, transformations on (off) |
 //! | `FUNCTION TCPM …`, `FUNCTION RESET TCPM`, `M128`, `M129` | TCPM on / off |
-//! | `PLANE …` | tilted working plane: a frame change (positions unknown after) |
+//! | `PLANE …` | tilted working plane: a frame change and a rotation (positions unknown after); `PLANE RESET` ends the rotation |
 //! | `STOP`, `TCH PROBE`, anything else | ends runs; lines polepatch does not model leave positions unknown and are flagged |
 //! | `* - text`, `; text` | comments |
 //!
@@ -26,8 +27,10 @@
 //! analysable (positions unknown after it), never the file.
 
 use crate::error::ParseError;
+use crate::flow::{Key, Stmt};
 use crate::interp::{Interpreter, Scan, function};
 use crate::lexer::parse_number;
+use crate::modal::transform;
 use crate::modal::{A, AXES, B, C, Motion};
 use crate::program::{Flags, Word};
 use crate::tcpm::code10;
@@ -88,11 +91,45 @@ impl Words<'_> {
     ) -> Result<(), ParseError> {
         let b = self.bytes;
         let mut seen = [false; 7];
-        for t in toks {
+        let mut k = 0;
+        while k < toks.len() {
+            let t = &toks[k];
+            k += 1;
             let text = &b[t.clone()];
             let letters = text.iter().take_while(|c| c.is_ascii_alphabetic()).count();
             let name = text[..letters].to_ascii_uppercase();
-            let value = t.start + letters..t.end;
+            let mut value = t.start + letters..t.end;
+            // `L Z 25.000 FMAX` (an APT post's output): a blank between an axis letter (or
+            // F) and its number, read as the word — the blank stays in the file; a letter
+            // left without a number says the blank is what is wrong.
+            let lone = value.is_empty()
+                && matches!(name.as_slice(), [l] | [b'I', l] if axis_index(*l).is_some() || *l == b'F');
+            if lone {
+                match toks.get(k) {
+                    Some(next) if parse_number(&b[next.clone()]).is_some() => {
+                        value = next.clone();
+                        k += 1;
+                    }
+                    // `F MAX` (older TNC listings, NX's posts for them): `FMAX`.
+                    Some(next) if name == b"F" && b[next.clone()].eq_ignore_ascii_case(b"MAX") => {
+                        s.rapid_once = true;
+                        k += 1;
+                        continue;
+                    }
+                    // An empty `F` field (`L R F M30`, older TNC listings): no feed given.
+                    _ if name == b"F" => continue,
+                    _ => {
+                        return Err(self.err(
+                            t.start,
+                            format!(
+                                "{} word has no number (a blank after the letter is read only when \
+                                 a number follows it)",
+                                String::from_utf8_lossy(&name)
+                            ),
+                        ));
+                    }
+                }
+            }
             let value_text = &b[value.clone()];
             // An axis word, possibly incremental (`IX+5`).
             let (incremental, axis) = match name.as_slice() {
@@ -177,6 +214,9 @@ impl Words<'_> {
                 }
                 b"FMAX" => s.rapid_once = true,
                 b"FAUTO" | b"FU" | b"FZ" => s.feed_unknown = true,
+                // `M` alone: no miscellaneous function (older TNC listings write the empty
+                // dialog field).
+                b"M" if value_text.is_empty() => {}
                 b"M" => {
                     let v = parse_number(value_text)
                         .filter(|v| v.is_finite())
@@ -265,9 +305,11 @@ pub(crate) fn lex(
     match key.as_slice() {
         k if k.first() == Some(&b'*') => {}
         b"BEGIN" => {
+            // `INCH` (NX's Heidenhain posts write `IN`) or `MM`; anything else states no
+            // units.
             if let Some(unit) = rest.last() {
                 let u = upper(bytes, unit);
-                if u == b"INCH" {
+                if u == b"INCH" || u == b"IN" {
                     s.inch = Some(true);
                 } else if u == b"MM" {
                     s.inch = Some(false);
@@ -335,10 +377,15 @@ pub(crate) fn lex(
         b"CYCL" => {
             if second == b"DEF" {
                 let number = rest.get(1).map(|t| upper(bytes, t)).unwrap_or_default();
-                let major = number.split(|&c| c == b'.').next().unwrap_or_default();
+                let mut parts = number.split(|&c| c == b'.');
+                let major = parts.next().unwrap_or_default();
+                let minor = parts.next().unwrap_or_default();
                 if matches!(major, b"7" | b"247" | b"8" | b"10" | b"11" | b"19" | b"26") {
                     s.datum_shift = true;
                     s.unknown_after = true;
+                    if minor == b"1" {
+                        cycle_transform(major, &upper_tokens(bytes, &rest[2..]), &mut s);
+                    }
                 } else {
                     s.no_move = true;
                 }
@@ -347,9 +394,53 @@ pub(crate) fn lex(
             }
             s.breaks = true;
         }
-        b"LBL" | b"CALL" | b"TCH" => {
+        b"TCH" => {
             s.unknown_after = true;
             s.breaks = true;
+        }
+        b"LBL" => {
+            let name = rest
+                .first()
+                .map(|t| label_name(bytes, t))
+                .unwrap_or_default();
+            s.flow = Some(if name == "0" {
+                Stmt::Return {
+                    falls_through: true,
+                }
+            } else {
+                Stmt::Label(Key::Label(name))
+            });
+        }
+        b"CALL" => {
+            s.flow = Some(if second == b"LBL" {
+                let name = rest
+                    .get(1)
+                    .map(|t| label_name(bytes, t))
+                    .unwrap_or_default();
+                if name.starts_with('Q') {
+                    Stmt::Opaque
+                } else {
+                    let rep = rest.iter().position(|t| upper(bytes, t) == b"REP");
+                    let times = rep
+                        .and_then(|k| rest.get(k + 1))
+                        .map(|t| upper(bytes, t))
+                        .and_then(|t| crate::lexer::parse_number(&t));
+                    Stmt::Call {
+                        key: Key::Label(name),
+                        repeats: rep.is_some() && times != Some(0.0),
+                    }
+                }
+            } else {
+                // CALL PGM, CALL SELECTED PGM: a program outside the file.
+                Stmt::External
+            });
+        }
+        b"SEL" => {
+            if second == b"PGM" {
+                s.flow = Some(Stmt::External);
+            } else {
+                s.breaks = true;
+            }
         }
         b"FN" => {
             let n = rest
@@ -364,7 +455,18 @@ pub(crate) fn lex(
                 })
                 .unwrap_or(0);
             if (9..=12).contains(&n) {
-                s.unknown_after = true;
+                // `FN 9: IF +Q1 EQU +0 GOTO LBL 5`: a conditional jump.
+                let goto = rest.iter().position(|t| upper(bytes, t) == b"GOTO");
+                let name = goto
+                    .and_then(|k| rest.get(k + 2))
+                    .map(|t| label_name(bytes, t));
+                s.flow = Some(match name {
+                    Some(name) if !name.starts_with('Q') && !name.is_empty() => Stmt::Jump {
+                        key: Key::Label(name),
+                        cond: true,
+                    },
+                    _ => Stmt::Opaque,
+                });
             }
             s.breaks = true;
         }
@@ -374,6 +476,32 @@ pub(crate) fn lex(
             s.datum_shift = true;
             s.unknown_after = true;
             s.breaks = true;
+            // A tilted working plane rotates the frame; `PLANE RESET` ends it.
+            if second == b"RESET" {
+                s.transform_off |= transform::ROTATION;
+            } else {
+                s.transform_on |= transform::ROTATION;
+            }
+        }
+        b"TRANS" => {
+            // TNC7 frames: `TRANS DATUM …`, `TRANS MIRROR …`, `TRANS ROTATION …`,
+            // `TRANS SCALE …`; `… RESET` ends them.
+            s.datum_shift = true;
+            s.unknown_after = true;
+            s.breaks = true;
+            let reset = rest.iter().any(|t| upper(bytes, t) == b"RESET");
+            let bit = match second.as_slice() {
+                b"MIRROR" => transform::MIRROR,
+                b"ROTATION" => transform::ROTATION,
+                b"SCALE" | b"SCALING" => transform::SCALING,
+                b"DATUM" => 0,
+                _ => transform::ALL,
+            };
+            if reset {
+                s.transform_off |= bit;
+            } else {
+                s.transform_on |= bit;
+            }
         }
         b"STOP" => {
             s.breaks = true;
@@ -388,11 +516,69 @@ pub(crate) fn lex(
             s.breaks = true;
         }
     }
-    if s.axes_expr != 0 || s.feed_expr {
-        s.flags.set(Flags::NOT_ANALYSABLE);
-        s.breaks = true;
-    }
+    crate::interp::after_lex(bytes, &span, &mut s);
     Ok(s)
+}
+
+/// A label's name as `LBL` and `CALL LBL` write it: a number, or a quoted name (upper case).
+fn label_name(bytes: &[u8], t: &Range<usize>) -> String {
+    let text = upper(bytes, t);
+    let text = text.strip_prefix(b"\"").unwrap_or(&text);
+    let text = text.strip_suffix(b"\"").unwrap_or(text);
+    String::from_utf8_lossy(text).into_owned()
+}
+
+/// The upper-case text of tokens.
+fn upper_tokens(bytes: &[u8], toks: &[Range<usize>]) -> Vec<Vec<u8>> {
+    toks.iter().map(|t| upper(bytes, t)).collect()
+}
+
+/// What the `.1` line of a frame cycle does (`CYCL DEF 8.1 X Y`, `10.1 ROT+30`,
+/// `11.1 SCL 0.8`, `26.1 X1.5 CCX+0`, `19.1 A+0 B+45`): a transformation on, or off where
+/// its values are the identity.
+fn cycle_transform(major: &[u8], toks: &[Vec<u8>], s: &mut Scan) {
+    let number_after = |t: &[u8], k: usize| crate::lexer::parse_number(&t[k..]);
+    let (bit, identity) = match major {
+        // Mirror image: the axes named (none: off).
+        b"8" => (transform::MIRROR, toks.is_empty()),
+        b"10" => (
+            transform::ROTATION,
+            toks.iter()
+                .filter(|t| t.starts_with(b"ROT"))
+                .all(|t| number_after(t, 3) == Some(0.0)),
+        ),
+        b"11" => {
+            // `SCL 0.8` or `SCL0.8`.
+            let v = toks.iter().enumerate().find_map(|(k, t)| {
+                t.strip_prefix(b"SCL").and_then(|r| {
+                    if r.is_empty() {
+                        toks.get(k + 1).and_then(|n| crate::lexer::parse_number(n))
+                    } else {
+                        crate::lexer::parse_number(r)
+                    }
+                })
+            });
+            (transform::SCALING, v == Some(1.0))
+        }
+        b"26" => (
+            transform::SCALING,
+            toks.iter()
+                .filter(|t| matches!(t.first(), Some(b'X' | b'Y' | b'Z')))
+                .all(|t| number_after(t, 1) == Some(1.0)),
+        ),
+        b"19" => (
+            transform::ROTATION,
+            toks.iter()
+                .filter(|t| matches!(t.first(), Some(b'A' | b'B' | b'C')))
+                .all(|t| number_after(t, 1) == Some(0.0)),
+        ),
+        _ => (0, true),
+    };
+    if identity {
+        s.transform_off |= bit;
+    } else {
+        s.transform_on |= bit;
+    }
 }
 
 #[cfg(test)]
@@ -440,6 +626,43 @@ mod tests {
         let w = p.word(9, b'C').unwrap();
         assert_eq!(&p.bytes[w.value_span()], b"+140.1");
         assert_eq!(crate::write(&p, &[]), PGM.as_bytes());
+    }
+
+    /// Issue 30 item 7: blanks after the letter, as APT posts and older TNC listings
+    /// write them.
+    #[test]
+    fn blanks_after_the_letter() {
+        let p = parse(
+            b"0 BEGIN PGM T MM\n1 L Z 25.000 FMAX\n2 L X1.9685 Y-.3937 M3 F MAX\n3 L X 2 Y -1 A +1 C 5 F 900\n".to_vec(),
+            Dialect::Auto,
+        )
+        .unwrap();
+        assert_eq!(p.state(1).pos[Z], Some(25.0));
+        assert_eq!(p.state(1).motion, Motion::Rapid);
+        assert_eq!(p.state(2).motion, Motion::Rapid, "F MAX");
+        // Empty `M` and `F` fields, as older TNC listings write them: nothing.
+        assert!(
+            parse(
+                b"0 BEGIN PGM T MM\n1 L X+0 Y+0 Z+0 F9.8 M\n2 L X+1 M\n3 L R F M30\n".to_vec(),
+                Dialect::Auto
+            )
+            .is_ok()
+        );
+        assert_eq!(p.state(3).pos[C], Some(5.0));
+        assert_eq!(p.state(3).feed_mm_min, Some(900.0));
+        // The value keeps its bytes; the word starts at its letter.
+        let w = p.word(3, b'A').unwrap();
+        assert_eq!(&p.bytes[w.value_span()], b"+1");
+        assert_eq!(crate::write(&p, &[]), p.bytes.as_slice());
+        for (line, col) in [("1 L Z FMAX", 5), ("1 L X+1 C", 9)] {
+            let e = parse(
+                format!("0 BEGIN PGM T MM\n{line}\n").into_bytes(),
+                Dialect::Auto,
+            )
+            .unwrap_err();
+            assert_eq!((e.line, e.column), (2, col), "{line}");
+            assert!(e.message.contains("a blank after the letter"), "{e}");
+        }
     }
 
     #[test]

@@ -176,9 +176,17 @@ pub enum Item {
     Dwell(f64),
     /// Program stop (`true`: optional, M1).
     Stop(bool),
+    /// A line written as it is (APT `INSERT/` text): no block number, no `*`, no
+    /// comment delimiters. The writer forgets what it knows of the modal state after it
+    /// (the next move states G1, F and every axis again), since the text may change any
+    /// of it.
+    Raw(String),
     /// A comment line.
     Comment(String),
 }
+
+/// Marks a body line written as it is ([`Item::Raw`]) until the frame writes it.
+const RAW: char = '\u{1}';
 
 impl From<EmitPoint> for Item {
     fn from(p: EmitPoint) -> Self {
@@ -189,7 +197,8 @@ impl From<EmitPoint> for Item {
 /// How to write the program.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EmitOptions {
-    /// Dialect (`Auto` is taken as Heidenhain).
+    /// Dialect (`Auto` is taken as Heidenhain; MillPlus is not written — `polepatch`'s post
+    /// refuses it — and gets the Fanuc form here).
     pub dialect: Dialect,
     /// Program name (Heidenhain `%NAME`, Fanuc comment, Sinumerik comment).
     pub name: String,
@@ -207,13 +216,14 @@ pub struct EmitOptions {
 
 fn style(dialect: Dialect) -> NumberStyle {
     match dialect {
-        Dialect::Fanuc => NumberStyle {
+        Dialect::Fanuc | Dialect::MillPlus => NumberStyle {
             plus_sign: false,
             decimals: 3,
             strip_trailing_zeros: true,
             trailing_point: true,
             leading_zero: true,
             equals: false,
+            zero: None,
         },
         Dialect::Sinumerik => NumberStyle {
             plus_sign: false,
@@ -222,6 +232,7 @@ fn style(dialect: Dialect) -> NumberStyle {
             trailing_point: false,
             leading_zero: true,
             equals: false,
+            zero: None,
         },
         Dialect::Heidenhain | Dialect::Conversational | Dialect::Auto => NumberStyle {
             plus_sign: true,
@@ -230,6 +241,7 @@ fn style(dialect: Dialect) -> NumberStyle {
             trailing_point: false,
             leading_zero: true,
             equals: false,
+            zero: None,
         },
     }
 }
@@ -321,7 +333,7 @@ impl Writer<'_> {
         let h = self.length_offset;
         self.push(match self.o.dialect {
             Dialect::Sinumerik => "TRAORI".to_string(),
-            Dialect::Fanuc => format!("G43.4 H{h}"),
+            Dialect::Fanuc | Dialect::MillPlus => format!("G43.4 H{h}"),
             _ => "M128".to_string(),
         });
         self.tcpm = Tcpm::On;
@@ -333,7 +345,7 @@ impl Writer<'_> {
         if self.tcpm == Tcpm::On {
             self.push(match self.o.dialect {
                 Dialect::Sinumerik => "TRAFOOF",
-                Dialect::Fanuc => "G49",
+                Dialect::Fanuc | Dialect::MillPlus => "G49",
                 _ => "M129",
             });
             self.tcpm = Tcpm::Off;
@@ -499,7 +511,7 @@ impl Writer<'_> {
         let f = self.feed_word(h.feed_mm_min);
         let ms = (h.dwell_s * 1000.0).round();
         match self.o.dialect {
-            Dialect::Fanuc => {
+            Dialect::Fanuc | Dialect::MillPlus => {
                 let (g, extra) = match h.kind {
                     HoleKind::Drill if h.dwell_s > 0.0 => ("G82", format!(" P{ms}")),
                     HoleKind::Drill => ("G81", String::new()),
@@ -661,7 +673,7 @@ pub fn emit(items: &[Item], o: &EmitOptions) -> Vec<u8> {
                         w.push(format!("T{tool} M6"));
                         w.push("D1");
                     }
-                    Dialect::Fanuc => {
+                    Dialect::Fanuc | Dialect::MillPlus => {
                         if w.length_comp {
                             w.push("G49");
                         }
@@ -691,7 +703,7 @@ pub fn emit(items: &[Item], o: &EmitOptions) -> Vec<u8> {
             Item::Dwell(s) => {
                 let t = w.plain(*s, 3);
                 w.push(match o.dialect {
-                    Dialect::Fanuc => format!("G04 X{t}"),
+                    Dialect::Fanuc | Dialect::MillPlus => format!("G04 X{t}"),
                     Dialect::Sinumerik => format!("G4 F{t}"),
                     _ => format!("G04 F{t}"),
                 });
@@ -701,10 +713,17 @@ pub fn emit(items: &[Item], o: &EmitOptions) -> Vec<u8> {
                 w.push(if *optional { "M01" } else { "M00" });
                 w.motion = None;
             }
+            Item::Raw(text) => {
+                w.push(format!("{RAW}{text}"));
+                w.motion = None;
+                w.feed = None;
+                w.pos = None;
+                w.rotary = None;
+            }
             Item::Comment(c) => {
                 let c = clean(c);
                 w.push(match o.dialect {
-                    Dialect::Fanuc => format!("({c})"),
+                    Dialect::Fanuc | Dialect::MillPlus => format!("({c})"),
                     _ => format!("; {c}"),
                 });
             }
@@ -732,6 +751,11 @@ fn frame(body: &[String], o: &EmitOptions) -> Vec<u8> {
                 .chain(std::iter::once("M30".to_string()))
                 .collect::<Vec<_>>();
             for (k, b) in lines.iter().enumerate() {
+                if let Some(raw) = b.strip_prefix(RAW) {
+                    out.push_str(raw);
+                    out.push('\n');
+                    continue;
+                }
                 // A cycle definition's parameter lines (`Q200=…`) continue its block: no
                 // N, and the block's `*` after the last one.
                 if b.starts_with('Q') {
@@ -752,19 +776,19 @@ fn frame(body: &[String], o: &EmitOptions) -> Vec<u8> {
             }
             out.push_str(if o.inch { "G90 G700\n" } else { "G90 G71\n" });
             for b in body {
-                out.push_str(b);
+                out.push_str(b.strip_prefix(RAW).unwrap_or(b));
                 out.push('\n');
             }
             out.push_str("M30\n");
         }
-        Dialect::Fanuc => {
+        Dialect::Fanuc | Dialect::MillPlus => {
             out.push_str(&format!("%\nO1000 ({name})\n"));
             for c in &o.comments {
                 out.push_str(&format!("({})\n", clean(c)));
             }
             out.push_str(if o.inch { "G90 G20\n" } else { "G90 G21\n" });
             for b in body {
-                out.push_str(b);
+                out.push_str(b.strip_prefix(RAW).unwrap_or(b));
                 out.push('\n');
             }
             out.push_str("M30\n%\n");

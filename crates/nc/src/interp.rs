@@ -51,12 +51,33 @@ pub(crate) struct Scan {
     pub(crate) breaks: bool,
     /// Flags for the block.
     pub(crate) flags: Flags,
+    /// The block may hold a flow statement ([`crate::flow`]): read it after lexing.
+    pub(crate) maybe_flow: bool,
+    /// Its flow statement.
+    pub(crate) flow: Option<crate::flow::Stmt>,
+    /// The block's number (`N…`), when it is a whole number.
+    pub(crate) number: Option<u64>,
+    /// A TCPM-on code that refers X Y Z to the centre of a ball (Heidenhain `M128`, `FUNCTION
+    /// TCPM … REFPNT CENTER-CENTER`) rather than to the tool tip.
+    pub(crate) tcpm_centre: bool,
+    /// Heidenhain ISO `G73`, `G72` or `G28` (× 10): the frame code whose values the block
+    /// gives.
+    pub(crate) heidenhain_frame: Option<i64>,
+    /// Frame transformations the block switches on (bits of [`crate::modal::transform`]).
+    pub(crate) transform_on: u8,
+    /// … and off.
+    pub(crate) transform_off: u8,
 }
 
 pub(crate) struct Interpreter {
     pub(crate) dialect: Dialect,
     pub(crate) controller: ControllerCodes,
     pub(crate) modal: Modal,
+    /// How program flow settles TCPM (`None` on a first read: see [`crate::flow`]).
+    plan: Option<std::sync::Arc<crate::flow::FlowPlan>>,
+    cursor: crate::flow::Cursor,
+    /// The flow events of a first read.
+    pub(crate) recorder: Option<crate::flow::Recorder>,
     /// The datum the last block stated (Heidenhain `G54 X Y Z`), taken by the caller.
     pub(crate) stated_datum: Option<[f64; 3]>,
     /// The last block changed the frame without stating it, taken by the caller.
@@ -95,6 +116,87 @@ const FLOW: &[&[u8]] = &[
     b"MCALL",
 ];
 
+/// Sinumerik frame instructions (a shift, rotation, scaling or mirror of the programmable
+/// frame).
+pub(crate) fn is_sinumerik_frame(name: &[u8]) -> bool {
+    [
+        &b"TRANS"[..],
+        b"ATRANS",
+        b"CTRANS",
+        b"ROT",
+        b"AROT",
+        b"CROT",
+        b"RPL",
+        b"SCALE",
+        b"ASCALE",
+        b"CSCALE",
+        b"MIRROR",
+        b"AMIRROR",
+        b"CMIRROR",
+        b"TOFRAME",
+        b"TOROT",
+        b"TOROTOF",
+        b"PAROT",
+        b"PAROTOF",
+    ]
+    .iter()
+    .any(|n| name.eq_ignore_ascii_case(n))
+}
+
+/// What a Sinumerik frame instruction does to the transformation bits, given whether the
+/// block states values (axis words, `RPL=`): (switched on, switched off).
+fn sinumerik_frame_transform(name: &[u8], with_values: bool) -> (u8, u8) {
+    use crate::modal::transform::{ALL, MIRROR, ROTATION, SCALING};
+    let up = name.to_ascii_uppercase();
+    let core = |r: &[u8]| matches!(r, b"TRANS" | b"ROT" | b"SCALE" | b"MIRROR");
+    // `A…`: additive (needs values); `C…`: the same as the plain form.
+    let (base, additive): (&[u8], bool) = match up.as_slice() {
+        [b'A', r @ ..] if core(r) => (r, true),
+        [b'C', r @ ..] if core(r) => (r, false),
+        r => (r, false),
+    };
+    match base {
+        // Without values, TRANS, ROT, SCALE and MIRROR delete the programmable frame.
+        b"TRANS" | b"ROT" | b"SCALE" | b"MIRROR" if !with_values && !additive => (0, ALL),
+        b"TRANS" => (0, 0),
+        b"ROT" | b"RPL" | b"TOFRAME" | b"TOROT" | b"PAROT" => (ROTATION, 0),
+        b"TOROTOF" | b"PAROTOF" => (0, ROTATION),
+        b"SCALE" => (SCALING, 0),
+        b"MIRROR" => (MIRROR, 0),
+        _ => (0, 0),
+    }
+}
+
+/// Whether a Sinumerik `CYCLE800(…)` call (`args`: its parenthesised argument list) swivels
+/// the frame: its rotation angles (arguments 8–10, `_A _B _C`, after retract, carrier,
+/// state, mode and the shift `_X0 _Y0 _Z0`) are not all zero. `CYCLE800()` and a call with
+/// zero angles (posts write one to align the table before `TRAORI`) do not; angles that are
+/// not plain numbers may.
+pub(crate) fn cycle800_rotates(args: &[u8]) -> bool {
+    let inner = args
+        .iter()
+        .position(|&c| c == b'(')
+        .map_or(&args[..0], |k| &args[k + 1..]);
+    let inner = inner.strip_suffix(b")").unwrap_or(inner);
+    let mut fields = Vec::new();
+    let (mut start, mut quoted) = (0, false);
+    for (k, &c) in inner.iter().enumerate() {
+        match c {
+            b'"' => quoted = !quoted,
+            b',' if !quoted => {
+                fields.push(&inner[start..k]);
+                start = k + 1;
+            }
+            _ => {}
+        }
+    }
+    fields.push(&inner[start..]);
+    fields.iter().skip(7).take(3).any(|f| {
+        let f = f.trim_ascii();
+        !f.is_empty() && crate::lexer::parse_number(f) != Some(0.0)
+    })
+}
+
 /// Bit of axis index `i` in [`Scan::axes_expr`].
 fn bit(i: usize) -> u8 {
     1 << i
@@ -110,19 +212,33 @@ fn looks_like_axis_words(text: &[u8]) -> bool {
 
 impl Interpreter {
     pub(crate) fn new(opts: &ReadOptions, dialect: Dialect) -> Self {
+        let always = opts.controller.always;
         Interpreter {
             dialect,
             controller: opts.controller.clone(),
-            modal: crate::modal::initial(&opts.controller),
+            modal: opts.initial(),
+            plan: opts.flow.clone().filter(|_| !always),
+            cursor: crate::flow::Cursor::default(),
+            // Kinematics that are always TCP: flow cannot change it.
+            recorder: (opts.flow.is_none() && !always).then(crate::flow::Recorder::default),
             stated_datum: None,
             frame_changed: false,
         }
     }
 
+    /// Record block labels numbered `targets` too (a second pass).
+    pub(crate) fn record_block_labels(&mut self, targets: std::collections::HashSet<u64>) {
+        self.recorder = Some(crate::flow::Recorder::with_block_labels(targets));
+    }
+
     fn g(&self, code: Option<i64>, s: &mut Scan) {
+        use crate::modal::transform::{MIRROR, ROTATION, SCALING};
         let heidenhain = self.dialect == Dialect::Heidenhain;
         if let Some(sw) = code.and_then(|c| self.controller.g(self.dialect, c)) {
             s.tcpm = Some(sw);
+            return;
+        }
+        if self.dialect == Dialect::MillPlus && crate::millplus::g(code, s) {
             return;
         }
         match code {
@@ -130,6 +246,14 @@ impl Interpreter {
             Some(10) => s.motion = Some(Motion::Linear),
             Some(20) => s.motion = Some(Motion::ArcCw),
             Some(30) => s.motion = Some(Motion::ArcCcw),
+            // Heidenhain ISO: G73 rotates the frame (`G73 G90 H+30`), G72 scales it
+            // (`G72 F0.8`), G28 mirrors it (`G28 X`); their values are read after the words
+            // ([`Interpreter::lex`]).
+            Some(c @ (730 | 720 | 280)) if heidenhain => {
+                s.datum_shift = true;
+                s.breaks = true;
+                s.heidenhain_frame = Some(c);
+            }
             // Canned cycles (Fanuc, Haas, LinuxCNC; Heidenhain ISO uses G2xx + G79).
             Some(730 | 740 | 760 | 810..=890) if !heidenhain => {
                 s.cycle = Some(true);
@@ -156,16 +280,43 @@ impl Interpreter {
             }
             Some(530) if heidenhain => s.datum_shift = true,
             Some(540..=590 | 5000 | 5050..=5990) => s.work_offset = true,
-            Some(920 | 100 | 520 | 500 | 510 | 680 | 681 | 690) => s.datum_shift = true,
+            // Fanuc: G68 rotation (G68.1–G68.4: tilted working planes), G69 its end; G51
+            // scaling, G50 its end; G51.1 mirror image, G50.1 its end.
+            Some(680..=684) => {
+                s.datum_shift = true;
+                s.transform_on |= ROTATION;
+            }
+            Some(690) => {
+                s.datum_shift = true;
+                s.transform_off |= ROTATION;
+            }
+            Some(510) => {
+                s.datum_shift = true;
+                s.transform_on |= SCALING;
+            }
+            Some(500) => {
+                s.datum_shift = true;
+                s.transform_off |= SCALING;
+            }
+            Some(511) => {
+                s.datum_shift = true;
+                s.transform_on |= MIRROR;
+            }
+            Some(501) => {
+                s.datum_shift = true;
+                s.transform_off |= MIRROR;
+            }
+            Some(920 | 100 | 520) => s.datum_shift = true,
             Some(530 | 280 | 300) => s.reference = true,
             Some(40) => {
                 s.no_move = true;
                 s.breaks = true;
             }
-            Some(650 | 660) => {
+            Some(650 | 660 | 661) => {
                 s.no_move = true;
                 s.unknown_after = true;
                 s.breaks = true;
+                s.maybe_flow = true;
             }
             _ => s.breaks = true,
         }
@@ -175,6 +326,10 @@ impl Interpreter {
         let sw = code.and_then(|c| self.controller.m(self.dialect, c));
         if let Some(sw) = sw {
             s.tcpm = Some(sw);
+            // M128: the tool length refers to the ball's centre (Heidenhain's manuals).
+            s.tcpm_centre = sw == Switch::On
+                && code == Some(1280)
+                && matches!(self.dialect, Dialect::Heidenhain | Dialect::Conversational);
         }
         match code {
             // Spindle and coolant.
@@ -182,15 +337,18 @@ impl Interpreter {
             Some(60) => {
                 s.flags.set(Flags::TOOL_CHANGE);
                 s.breaks = true;
+                // Fanuc-style controls run M6 as a macro ([`crate::flow`]).
+                s.maybe_flow = matches!(self.dialect, Dialect::Fanuc | Dialect::Auto);
             }
             Some(20 | 300) => {
                 s.flags.set(Flags::PROGRAM_END);
                 s.breaks = true;
             }
             // Subprogram call and return, cycle call (Heidenhain M99): other blocks run.
-            Some(980 | 990) => {
+            Some(980 | 990 | 970 | 1980 | 170) => {
                 s.unknown_after = true;
                 s.breaks = true;
+                s.maybe_flow = self.dialect != Dialect::Heidenhain;
             }
             // A TCPM switch (breaks through the state change).
             _ if sw.is_some() => {}
@@ -206,21 +364,7 @@ impl Interpreter {
         }
         let is = |n: &[u8]| name.eq_ignore_ascii_case(n);
         if is(b"MSG") {
-        } else if [
-            &b"TRANS"[..],
-            b"ATRANS",
-            b"CTRANS",
-            b"ROT",
-            b"AROT",
-            b"CROT",
-            b"SCALE",
-            b"ASCALE",
-            b"MIRROR",
-            b"AMIRROR",
-        ]
-        .iter()
-        .any(|n| is(n))
-        {
+        } else if is_sinumerik_frame(name) {
             s.datum_shift = true;
         } else if is(b"SUPA") {
             s.reference = true;
@@ -229,8 +373,11 @@ impl Interpreter {
             // ones before it, so positions are unknown after it.
             s.unknown_after = true;
             s.breaks = true;
+            s.maybe_flow = true;
         } else {
             s.breaks = true;
+            // Sinumerik: a label, or a subprogram called by its name; Fanuc: `END 1`.
+            s.maybe_flow |= self.dialect == Dialect::Sinumerik || is(b"END");
         }
     }
 
@@ -281,6 +428,13 @@ impl Interpreter {
             }
             Ok(())
         };
+        // Values the frame codes read after the words: Heidenhain ISO G73's H, LinuxCNC
+        // G10's R; the Sinumerik frame instruction and CYCLE800's argument list.
+        let mut h_word: Option<f64> = None;
+        let mut r_word: Option<f64> = None;
+        let mut sinumerik_frame: Option<Range<usize>> = None;
+        let mut cycle800_level: Option<bool> = None;
+        let mut rpl = false;
         for token in Lexer::new(bytes, span.clone()) {
             let token =
                 token.map_err(|e| ParseError::at(line, e.at - span.start + 1, e.message))?;
@@ -306,13 +460,28 @@ impl Interpreter {
                             s.flags.set(Flags::TOOL_CHANGE);
                             s.breaks = true;
                         }
-                        // Block number, spindle, arc centre and radius, program number;
-                        // extruder and auxiliary axes are carried through (listed by the
-                        // caller).
-                        b'N' | b'S' | b'I' | b'J' | b'K' | b'R' | b'O' | b'E' | b'U' | b'V'
-                        | b'W' => {}
+                        b'N' => {
+                            s.number = (value >= 0.0 && value.fract() == 0.0 && value < 1e15)
+                                .then_some(value as u64);
+                        }
+                        b'R' => r_word = Some(value),
+                        // Spindle, arc centre, program number; extruder and auxiliary axes
+                        // are carried through (listed by the caller).
+                        b'S' | b'I' | b'J' | b'K' | b'E' | b'U' | b'V' | b'W' => {}
+                        // A program number or LinuxCNC o-word, a label or subprogram call.
+                        b'O' | b'L' => {
+                            s.maybe_flow = true;
+                            if letter == b'L' {
+                                s.breaks = true;
+                            }
+                        }
                         // D/H offsets, P Q L parameters.
-                        _ => s.breaks = true,
+                        _ => {
+                            if letter == b'H' {
+                                h_word = Some(value);
+                            }
+                            s.breaks = true
+                        }
                     }
                     // Offsets fit: files are at most 4 GiB.
                     words.push(Word {
@@ -329,7 +498,17 @@ impl Interpreter {
                         function(&bytes[ispan.start..span.end], &mut s);
                         break;
                     }
-                    self.ident(&bytes[name], &mut s)
+                    let n = &bytes[name.clone()];
+                    if self.dialect == Dialect::Sinumerik {
+                        if n.eq_ignore_ascii_case(b"CYCLE800") {
+                            cycle800_level = Some(!cycle800_rotates(&bytes[name.end..ispan.end]));
+                        } else if n.eq_ignore_ascii_case(b"RPL") {
+                            rpl = true;
+                        } else if is_sinumerik_frame(n) {
+                            sinumerik_frame = Some(name.clone());
+                        }
+                    }
+                    self.ident(n, &mut s)
                 }
                 Token::Assign {
                     letter,
@@ -344,9 +523,13 @@ impl Interpreter {
                         // `o<name> call`, `o<name> sub`: LinuxCNC program flow.
                         s.unknown_after = true;
                         s.breaks = true;
+                        s.maybe_flow = true;
                     } else if !matches!(letter, b'R' | b'S') {
                         s.breaks = true;
                     }
+                }
+                Token::Indexed { letter, .. } => {
+                    crate::millplus::indexed(self.dialect, letter, &mut s)
                 }
                 Token::Percent { span } => {
                     for w in bytes[span].split(|b| b.is_ascii_whitespace()) {
@@ -356,6 +539,8 @@ impl Interpreter {
                             s.inch = Some(false);
                         }
                     }
+                    // `%NAME` in a Heidenhain ISO block calls another program.
+                    s.maybe_flow |= self.dialect == Dialect::Heidenhain;
                 }
                 Token::Slash { .. } => {
                     s.flags.set(Flags::SKIPPABLE);
@@ -376,13 +561,85 @@ impl Interpreter {
                 Token::BlockEnd { .. } | Token::Other { .. } => {}
             }
         }
-        if s.axes_expr != 0 || s.feed_expr {
-            s.flags.set(Flags::NOT_ANALYSABLE);
-            s.breaks = true;
+        self.frames_after_words(
+            &mut s,
+            h_word,
+            r_word,
+            sinumerik_frame.map(|r| &bytes[r]),
+            rpl,
+            cycle800_level,
+        );
+        if s.maybe_flow {
+            s.flow = crate::flow::read_iso(self.dialect, bytes, span.clone());
         }
+        after_lex(bytes, &span, &mut s);
         Ok(s)
     }
 
+    /// The frame transformations of a block, once its words are read.
+    fn frames_after_words(
+        &self,
+        s: &mut Scan,
+        h_word: Option<f64>,
+        r_word: Option<f64>,
+        sinumerik_frame: Option<&[u8]>,
+        rpl: bool,
+        cycle800_level: Option<bool>,
+    ) {
+        use crate::modal::transform::{MIRROR, ROTATION, SCALING};
+        let has_axes = s.axes.iter().any(Option::is_some) || s.axes_expr != 0;
+        match self.dialect {
+            Dialect::Heidenhain => match s.heidenhain_frame {
+                // G73 H…: a rotation (H0 ends it).
+                Some(730) => {
+                    if h_word == Some(0.0) {
+                        s.transform_off |= ROTATION;
+                    } else {
+                        s.transform_on |= ROTATION;
+                    }
+                }
+                // G72 F…: a scaling factor, not a feed (F1 ends it).
+                Some(720) => {
+                    if s.feed == Some(1.0) {
+                        s.transform_off |= SCALING;
+                    } else {
+                        s.transform_on |= SCALING;
+                    }
+                    s.feed = None;
+                }
+                // G28 X Y: a mirror image of the named axes (none: it ends).
+                Some(280) => {
+                    if has_axes {
+                        s.transform_on |= MIRROR;
+                    } else {
+                        s.transform_off |= MIRROR;
+                    }
+                }
+                _ => {}
+            },
+            Dialect::Sinumerik => {
+                if let Some(name) = sinumerik_frame {
+                    let (on, off) = sinumerik_frame_transform(name, has_axes || rpl);
+                    s.transform_on |= on;
+                    s.transform_off |= off;
+                }
+                match cycle800_level {
+                    Some(true) => s.transform_off |= ROTATION,
+                    Some(false) => s.transform_on |= ROTATION,
+                    None => {}
+                }
+                if cycle800_level.is_some() {
+                    s.datum_shift = true;
+                }
+            }
+            _ => {
+                // LinuxCNC `G10 L2 P1 R30`: the coordinate system is rotated.
+                if s.datum_shift && r_word.is_some_and(|r| r != 0.0) {
+                    s.transform_on |= ROTATION;
+                }
+            }
+        }
+    }
     /// Update the modal state; the block's `state` index is set by the caller.
     pub(crate) fn apply(
         &mut self,
@@ -392,6 +649,31 @@ impl Interpreter {
         words: Range<usize>,
     ) -> Block {
         let always = self.controller.always;
+        // Before the block: what program flow settles ([`crate::flow`]).
+        if let Some(plan) = &self.plan {
+            let (tcpm, join) = self.cursor.at(plan, line);
+            if let Some(t) = tcpm {
+                self.modal.tcpm = t;
+            }
+            if join {
+                self.modal.pos = [None; 6];
+            }
+        }
+        if let Some(r) = &mut self.recorder
+            && (s.flow.is_some()
+                || s.tcpm.is_some()
+                || s.flags.has(Flags::PROGRAM_END)
+                || (s.number.is_some() && r.wants_block_labels()))
+        {
+            r.block(&crate::flow::BlockFlow {
+                line,
+                stmt: s.flow.as_ref(),
+                switch: s.tcpm.filter(|_| !always).map(Switch::state),
+                skippable: s.flags.has(Flags::SKIPPABLE),
+                program_end: s.flags.has(Flags::PROGRAM_END),
+                number: s.number,
+            });
+        }
         let m = &mut self.modal;
         let mut breaks = s.breaks;
         let mut flags = s.flags;
@@ -413,20 +695,30 @@ impl Interpreter {
         }
         if let Some(inch) = s.inch {
             m.inch = inch;
+            flags.set(Flags::UNITS);
         }
+        m.transform = (m.transform & !s.transform_off) | s.transform_on;
         if let Some(sw) = s.tcpm {
             if !always {
-                let target = match sw {
-                    Switch::On => Tcpm::On,
-                    Switch::Off => Tcpm::Off,
-                };
-                m.tcpm = if flags.has(Flags::SKIPPABLE) && m.tcpm != target {
-                    Tcpm::Uncertain
-                } else {
-                    target
-                };
+                m.tcpm = m.tcpm.switched(sw.state(), flags.has(Flags::SKIPPABLE));
+            }
+            if sw == Switch::On {
+                m.tcpm_centre = s.tcpm_centre;
             }
             breaks = true;
+        }
+        if !always {
+            match &s.flow {
+                // Code outside the file runs: it may switch TCPM.
+                Some(crate::flow::Stmt::External) => m.tcpm = Tcpm::Unknown,
+                Some(crate::flow::Stmt::ToolChange) => m.tcpm = m.tcpm.after_tool_change(),
+                // Flow that joins paths, on a read without its plan: unknown until solved.
+                Some(st) if self.plan.is_none() && st.is_global() => m.tcpm = Tcpm::Unknown,
+                _ => {}
+            }
+            if self.plan.as_ref().is_some_and(|p| p.all_unknown()) {
+                m.tcpm = Tcpm::Unknown;
+            }
         }
         if let Some(fm) = s.feed_mode
             && fm != m.feed_mode
@@ -532,6 +824,30 @@ impl Interpreter {
     }
 }
 
+/// What every dialect's reading of a line ends with: expressions flag the block; a flow
+/// statement ends runs and leaves positions unknown; a lone CR inside the line, with text
+/// after it, may be a line end to the control (hiding what follows in a comment, or showing
+/// a comment's text as a block), so the block's effect on TCPM and positions is unknown.
+pub(crate) fn after_lex(bytes: &[u8], span: &Range<usize>, s: &mut Scan) {
+    if s.axes_expr != 0 || s.feed_expr {
+        s.flags.set(Flags::NOT_ANALYSABLE);
+        s.breaks = true;
+    }
+    if s.flow.is_some() {
+        s.unknown_after = true;
+        s.breaks = true;
+    }
+    let line = &bytes[span.clone()];
+    if let Some(cr) = line.iter().position(|&b| b == b'\r')
+        && line[cr + 1..].iter().any(|b| !b.is_ascii_whitespace())
+    {
+        s.tcpm = Some(Switch::Unknown);
+        s.flags.set(Flags::NOT_MODELLED);
+        s.unknown_after = true;
+        s.breaks = true;
+    }
+}
+
 /// A Heidenhain `FUNCTION …` line (`text` from the word `FUNCTION` on): `FUNCTION TCPM …`
 /// switches TCPM on, `FUNCTION RESET TCPM` off; any other function breaks runs.
 pub(crate) fn function(text: &[u8], s: &mut Scan) {
@@ -542,6 +858,14 @@ pub(crate) fn function(text: &[u8], s: &mut Scan) {
     let first = words.next().unwrap_or_default();
     let second = words.next().unwrap_or_default();
     let sw = if first.eq_ignore_ascii_case(b"TCPM") {
+        // `REFPNT TIP-TIP` (the default), `TIP-CENTER`: X Y Z are the tip; `CENTER-CENTER`:
+        // the centre of the ball.
+        let mut rest = words.clone();
+        s.tcpm_centre = std::iter::once(second)
+            .chain(&mut rest)
+            .skip_while(|w| !w.eq_ignore_ascii_case(b"REFPNT"))
+            .nth(1)
+            .is_some_and(|w| w.len() >= 6 && w[..6].eq_ignore_ascii_case(b"CENTER"));
         Some(Switch::On)
     } else if first.eq_ignore_ascii_case(b"RESET") && second.eq_ignore_ascii_case(b"TCPM") {
         Some(Switch::Off)

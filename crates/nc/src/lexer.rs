@@ -11,10 +11,15 @@
 //!   `G01`, `X10.`); followed by `=` it is a Sinumerik word (`X=12.5`); blanks may stand
 //!   between the letter and its number and between a sign and its digits (`X  6.302`,
 //!   `Y -11.56`, `Z- 5`: RS274/NGC and Fanuc accept them), and belong to the word;
-//! - a letter whose value is not a plain number (`A#<a>`, `X=R1+2`, `X+Q5`, `F=FGREF(5)`)
-//!   is an [`Token::Assign`]: the reader marks such a block as not analysable;
-//! - a letter followed by a letter or `_` starts an identifier (`TRAORI`, `CYCLE800(…)`,
-//!   `MSG("…")`), which takes a following `(…)`/`[…]` and `=expression` along;
+//! - a letter whose value is not a plain number (`A#<a>`, `X=R1+2`, `X+Q5`, `F=FGREF(5)`,
+//!   `Z=_Z_HOME`: Sinumerik user variables start with `_`) is an [`Token::Assign`]: the
+//!   reader marks such a block as not analysable;
+//! - a letter, an index and `=` (`A5=15.`, `B7=254`, `L1=1`, `R1=5`, Sinumerik's `A3=` of
+//!   an orientation vector) is an indexed address, [`Token::Indexed`]: a parameter, not the
+//!   letter's word (two of them with one letter are not "the word twice");
+//! - a letter followed by a letter or `_`, or a `_` followed by a letter or digit, starts an
+//!   identifier (`TRAORI`, `CYCLE800(…)`, `MSG("…")`, `_X_HOME=-365.`), which takes a
+//!   following `(…)`/`[…]` and `=expression` along;
 //! - `/` with optional level digits is the block-delete marker;
 //! - `#` starts a parameter (`#12`, `#<name>`, `#[expr]`);
 //! - anything else up to the next blank, letter, `;` or `(` is an unknown token.
@@ -55,6 +60,15 @@ pub enum Token {
         /// Upper-case letter.
         letter: u8,
         /// The whole token.
+        span: Range<usize>,
+    },
+    /// An indexed address and its value: a letter, an index and `=` (`A5=15.`, `B7=254`,
+    /// `L1=1`, `R1=R2*3`, `A3=0.5`). What it means depends on the dialect (MillPlus
+    /// parameters, Sinumerik R parameters and orientation vectors): the reader decides.
+    Indexed {
+        /// Upper-case letter.
+        letter: u8,
+        /// The whole token, from the letter to the end of the value.
         span: Range<usize>,
     },
     /// `;` comment to the end of the line, or `( … )` comment.
@@ -142,15 +156,16 @@ fn is_non_finite_name(text: &[u8]) -> bool {
 }
 
 /// Whether a value that is not a plain number reads as an expression or a variable: after
-/// an optional sign, a variable (`#1`, `#<name>`, `R1`, `Q5`, `$P_X`), a bracket (`[…]`,
-/// `(…)`), `<`, or a function name (`IC(5)`).
+/// an optional sign, a variable (`#1`, `#<name>`, `R1`, `Q5`, `$P_X`, a Sinumerik user
+/// variable `_XH`), a bracket (`[…]`, `(…)`), `<`, or a function name (`IC(5)`).
 fn is_expression_start(text: &[u8]) -> bool {
     let t = match text.first() {
         Some(b'+' | b'-') => &text[1..],
         _ => text,
     };
-    t.first()
-        .is_some_and(|&c| c.is_ascii_alphabetic() || matches!(c, b'#' | b'[' | b'(' | b'<' | b'$'))
+    t.first().is_some_and(|&c| {
+        c.is_ascii_alphabetic() || matches!(c, b'#' | b'[' | b'(' | b'<' | b'$' | b'_')
+    })
 }
 
 /// Exact powers of ten representable in f64.
@@ -476,10 +491,17 @@ impl<'a> Lexer<'a> {
             );
         }
         if !eq && e < self.end && b[e] == b'=' {
-            // Parameter assignment such as `R1=5`.
+            // An indexed address (`A5=15.`, `R1=5`) when the index is an unsigned whole
+            // number written right after the letter; any other number before `=` is an
+            // assignment the reader cannot read either.
             let x = self.skip_expr(e + 1);
             self.pos = x;
-            return Some(Ok(Token::Assign { letter, span: p..x }));
+            let index = &b[q..e];
+            return Some(Ok(if index.iter().all(u8::is_ascii_digit) {
+                Token::Indexed { letter, span: p..x }
+            } else {
+                Token::Assign { letter, span: p..x }
+            }));
         }
         self.pos = e;
         Some(Ok(Token::Word {
@@ -543,6 +565,10 @@ impl Iterator for Lexer<'_> {
                 } else {
                     self.word(p, c.to_ascii_uppercase())
                 }
+            }
+            // A Sinumerik user variable or name: `_X_HOME=-365.`, `_camtolerance=.02`.
+            b'_' if p + 1 < self.end && (b[p + 1].is_ascii_alphanumeric() || b[p + 1] == b'_') => {
+                self.ident(p)
             }
             b';' => {
                 self.pos = self.end;
@@ -752,7 +778,7 @@ mod tests {
         assert!(matches!(t[3], Token::Ident { .. }));
         assert!(matches!(&t[4], Token::Ident { span, .. } if span.end == 40));
         assert!(matches!(&t[5], Token::Ident { span, .. } if span.len() == 10));
-        assert!(matches!(t[6], Token::Assign { letter: b'R', .. }));
+        assert!(matches!(t[6], Token::Indexed { letter: b'R', .. }));
         assert!(matches!(t[7], Token::Assign { letter: b'T', .. }));
         assert!(matches!(t[8], Token::Comment { .. }));
     }
@@ -795,6 +821,51 @@ mod tests {
         assert_eq!(lex_err("G1 X+ Y1").message, "X value '+' is not a number");
         let huge = format!("X{}", "9".repeat(400));
         assert!(lex_err(&huge).message.ends_with("is not a finite number"));
+    }
+
+    /// Issue 30 item 1: Sinumerik user variables start with `_` (`SUPA G0 Z=_Z_HOME D0`),
+    /// and are read like any other variable; assigning one is an identifier.
+    #[test]
+    fn sinumerik_user_variables_are_variables() {
+        for text in ["X=_XH", "Z=_Z_HOME", "X=-_XH", "F=_F_CUTTING"] {
+            assert!(
+                matches!(lex(text)[0], Token::Assign { .. }),
+                "{text}: {:?}",
+                lex(text)
+            );
+        }
+        let t = lex("N120 _X_HOME=-365. _Y_HOME=224. _Z_HOME=610.");
+        assert_eq!(t.len(), 4, "{t:?}");
+        assert!(t[1..].iter().all(|t| matches!(t, Token::Ident { .. })));
+        assert!(matches!(&t[1], Token::Ident { span, .. } if span.len() == 13));
+        // `_` alone is not a name.
+        assert!(matches!(lex("G1 _ X1")[1], Token::Other { .. }));
+    }
+
+    /// Issue 30 item 6: an indexed address is its own token (MillPlus `A5=15. B7=254`,
+    /// `L1=1`, `F2=15000.`; Sinumerik `R1=5`, `A3=0.5`), not the letter's word.
+    #[test]
+    fn indexed_addresses() {
+        let t = lex("N3780 G7 A5=15. B5=0.0 C5=210. B7=254 C7=255 L1=1");
+        let indexed: Vec<u8> = t
+            .iter()
+            .filter_map(|t| match t {
+                Token::Indexed { letter, .. } => Some(*letter),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(indexed, b"ABCBCL");
+        assert!(matches!(&t[2], Token::Indexed { span, .. } if span.len() == 6));
+        assert!(matches!(
+            lex("R1=R2*3")[0],
+            Token::Indexed { letter: b'R', .. }
+        ));
+        assert!(matches!(
+            lex("F2=15000.")[0],
+            Token::Indexed { letter: b'F', .. }
+        ));
+        // A number that is not an index before `=` is not one.
+        assert!(matches!(lex("X1.5=3")[0], Token::Assign { .. }));
     }
 
     #[test]

@@ -12,9 +12,11 @@
 pub mod conversational;
 pub mod emit;
 pub mod error;
+pub mod flow;
 mod interp;
 pub mod lexer;
 pub mod lines;
+pub mod millplus;
 pub mod modal;
 pub mod plan;
 pub mod program;
@@ -24,12 +26,13 @@ pub mod tcpm;
 pub mod writer;
 
 pub use error::ParseError;
+pub use flow::FlowPlan;
 pub use lines::LineEnds;
 pub use modal::{FeedMode, Modal, Motion, Tcpm};
 pub use plan::restore_modal;
 pub use program::{
-    Block, Dialect, Flags, Program, ProgramBuilder, Scanned, Word, parse, parse_with, scan,
-    scan_blocks, scan_blocks_with,
+    Block, Dialect, Flags, Program, ProgramBuilder, Scanned, Settled, Word, parse, parse_with,
+    scan, scan_blocks, scan_blocks_with,
 };
 pub use run::{Run, RunBreak, RunBuilder, primary_in_use, primary_of, runs};
 pub use style::{FileStyle, NumberStyle, StyleEvidence};

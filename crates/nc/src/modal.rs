@@ -65,12 +65,77 @@ pub enum Tcpm {
     /// Depends on whether block delete (`/`) skipped a block that switches it: treated
     /// as off by every caller (never patched), and reported.
     Uncertain,
+    /// The file does not settle it: after a call of code outside the file, where a jump,
+    /// a label or a loop joins paths with different states ([`crate::flow`]), or after a
+    /// code whose effect on TCPM the reader does not know (`TRACON`, `G43.8`). Never
+    /// patched, and reported.
+    Unknown,
 }
 
 impl Tcpm {
+    /// The state after a tool change that may run a macro (Fanuc `M6`): such a macro may
+    /// end TCPM (`G49`) but never starts it.
+    pub fn after_tool_change(self) -> Tcpm {
+        match self {
+            Tcpm::On => Tcpm::Unknown,
+            other => other,
+        }
+    }
+
     /// Whether TCPM is certainly on.
     pub fn is_on(self) -> bool {
         self == Tcpm::On
+    }
+
+    /// The state after a block that switches TCPM to `to` (`On`, `Off` or `Unknown`), from
+    /// `self`: a block that block delete (`/`) may skip (`skippable`) leaves it
+    /// [`Tcpm::Uncertain`] where the switch would change it — or [`Tcpm::Unknown`] where it
+    /// was unknown already. One rule for the reader and for [`crate::flow`]'s solver.
+    pub fn switched(self, to: Tcpm, skippable: bool) -> Tcpm {
+        if !skippable || self == to {
+            to
+        } else if self == Tcpm::Unknown || to == Tcpm::Unknown {
+            Tcpm::Unknown
+        } else {
+            Tcpm::Uncertain
+        }
+    }
+
+    /// Where two ways into a block meet: their common state, or [`Tcpm::Unknown`] where
+    /// they differ.
+    pub fn join(self, other: Tcpm) -> Tcpm {
+        if self == other { self } else { Tcpm::Unknown }
+    }
+}
+
+/// Transformations of the programmed frame that are more than a shift: while one is in
+/// force the program's X Y Z (and the tool axis as the part sees it) are not the frame
+/// polepatch computes in, so no run is rewritten ([`Modal::transform`]).
+pub mod transform {
+    /// A rotation (Fanuc `G68`, `G68.2`; Heidenhain ISO `G73`; conversational
+    /// `CYCL DEF 10`, `19`, `PLANE`; Sinumerik `ROT`, `AROT`, `CYCLE800(…)`; LinuxCNC
+    /// `G10 L2 … R`).
+    pub const ROTATION: u8 = 1;
+    /// A scaling (Fanuc `G51`; Heidenhain ISO `G72`; conversational `CYCL DEF 11`, `26`;
+    /// Sinumerik `SCALE`, `ASCALE`).
+    pub const SCALING: u8 = 2;
+    /// A mirror image (Fanuc `G51.1`; Heidenhain ISO `G28` in its own meaning;
+    /// conversational `CYCL DEF 8`; Sinumerik `MIRROR`, `AMIRROR`).
+    pub const MIRROR: u8 = 4;
+    /// All of them.
+    pub const ALL: u8 = ROTATION | SCALING | MIRROR;
+
+    /// Names for people, in bit order.
+    pub fn names(bits: u8) -> Vec<&'static str> {
+        [
+            (ROTATION, "rotation"),
+            (SCALING, "scaling"),
+            (MIRROR, "mirror image"),
+        ]
+        .into_iter()
+        .filter(|(b, _)| bits & b != 0)
+        .map(|(_, n)| n)
+        .collect()
     }
 }
 
@@ -126,6 +191,13 @@ pub struct Modal {
     pub incremental: bool,
     /// Inch units (G20 / G70): values are converted to mm on read.
     pub inch: bool,
+    /// Frame transformations in force beyond a shift ([`transform`] bits: rotation,
+    /// scaling, mirror image), 0 where none.
+    pub transform: u8,
+    /// The code that switched TCPM on last refers X Y Z to the centre of a ball
+    /// (Heidenhain `M128`, `FUNCTION TCPM … REFPNT CENTER-CENTER`); false: to the tool tip
+    /// (`FUNCTION TCPM` by default, `TRAORI`, `G43.4`, `G234`, a machine's own codes).
+    pub tcpm_centre: bool,
 }
 
 impl Default for Modal {
@@ -140,6 +212,8 @@ impl Default for Modal {
             canned_cycle: false,
             incremental: false,
             inch: false,
+            transform: 0,
+            tcpm_centre: false,
         }
     }
 }
@@ -171,7 +245,8 @@ pub(crate) struct PackedModal {
     /// Bits 0–2: motion (0 none … 4 G3); bit 3 TCPM on; bit 4 incremental; bit 5 inch;
     /// bit 6 TCPM uncertain; bit 7 canned cycle.
     flags: u8,
-    /// Feed mode: 0 G94, 1 G93, 2 G95.
+    /// Bits 0–1: feed mode (0 G94, 1 G93, 2 G95); bits 2–4: [`transform`] bits; bit 5:
+    /// TCPM unknown; bit 6: TCPM refers to the ball's centre.
     feed_mode: u8,
 }
 
@@ -219,7 +294,9 @@ impl PackedModal {
                 FeedMode::PerMinute => 0,
                 FeedMode::InverseTime => 1,
                 FeedMode::PerRevolution => 2,
-            },
+            } | (m.transform & transform::ALL) << 2
+                | u8::from(m.tcpm == Tcpm::Unknown) << 5
+                | u8::from(m.tcpm_centre) << 6,
         }
     }
 
@@ -236,7 +313,7 @@ impl PackedModal {
             pos: std::array::from_fn(|i| bit(i as u32).then_some(self.pos[i])),
             feed_mm_min: bit(6).then_some(self.feed),
             inverse_time_per_min: bit(7).then_some(self.feed),
-            feed_mode: match self.feed_mode {
+            feed_mode: match self.feed_mode & 3 {
                 0 => FeedMode::PerMinute,
                 1 => FeedMode::InverseTime,
                 _ => FeedMode::PerRevolution,
@@ -245,9 +322,13 @@ impl PackedModal {
                 Tcpm::On
             } else if self.flags & 64 != 0 {
                 Tcpm::Uncertain
+            } else if self.feed_mode & 32 != 0 {
+                Tcpm::Unknown
             } else {
                 Tcpm::Off
             },
+            transform: (self.feed_mode >> 2) & transform::ALL,
+            tcpm_centre: self.feed_mode & 64 != 0,
             incremental: self.flags & 16 != 0,
             inch: self.flags & 32 != 0,
             canned_cycle: self.flags & 128 != 0,
@@ -284,7 +365,9 @@ mod tests {
                 FeedMode::InverseTime,
                 FeedMode::PerRevolution,
             ][k % 3];
-            m.tcpm = [Tcpm::Off, Tcpm::On, Tcpm::Uncertain][k % 3];
+            m.tcpm = [Tcpm::Off, Tcpm::On, Tcpm::Uncertain, Tcpm::Unknown][k % 4];
+            m.transform = (k as u8 * 3) & transform::ALL;
+            m.tcpm_centre = k % 2 == 1;
             m.canned_cycle = k % 2 == 0;
             m.incremental = k % 3 == 1;
             m.inch = k >= 3;

@@ -26,6 +26,10 @@ pub enum Dialect {
     Sinumerik,
     /// Fanuc and the ISO controllers like it (Haas, LinuxCNC, grblHAL, Mazak ISO, …).
     Fanuc,
+    /// Heidenhain (Philips) MillPlus: ISO words with its own G codes (`G7` tilted plane,
+    /// `G93` datum shift, `G141` TCPM, `G81`… cycle definitions) and indexed addresses
+    /// (`A5=15.`); see [`crate::millplus`].
+    MillPlus,
 }
 
 /// What a block does beyond moving: a set of bits ([`Flags::has`]).
@@ -53,6 +57,9 @@ impl Flags {
     /// A conversational line polepatch does not model, which may move the machine: carried
     /// through, positions unknown after it.
     pub const NOT_MODELLED: Flags = Flags(128);
+    /// The block states the length units (G20/G21, G70/G71, G700/G710, a `%NAME G71`
+    /// header, `BEGIN PGM … MM|INCH`).
+    pub const UNITS: Flags = Flags(256);
 
     /// Whether every bit of `other` is set.
     pub fn has(self, other: Flags) -> bool {
@@ -197,25 +204,53 @@ pub fn parse(bytes: Vec<u8>, dialect: Dialect) -> Result<Program, ParseError> {
 
 /// [`parse`] with the machine's TCPM codes.
 pub fn parse_with(bytes: Vec<u8>, opts: &ReadOptions) -> Result<Program, ParseError> {
-    let mut builder = ProgramBuilder::new(0, &crate::modal::initial(&opts.controller));
-    // Reserved from the size: lines of NC code are rarely shorter than 24 bytes or words
-    // than 6; untouched capacity costs address space only, a reallocation a copy. A
-    // machine that cannot give the memory gets an error, not an abort.
-    builder.reserve(bytes.len()).map_err(|what| {
-        ParseError::at(
-            1,
-            1,
-            format!(
-                "not enough memory to read a program of {} bytes ({what})",
-                bytes.len()
-            ),
-        )
-    })?;
-    let dialect = scan_blocks_with(&bytes, opts, |s| {
-        builder.push(&s);
-        std::ops::ControlFlow::Continue(())
-    })?;
-    Ok(builder.finish(bytes, dialect))
+    let mut opts = opts.clone();
+    loop {
+        let mut builder = ProgramBuilder::new(0, &opts.initial());
+        // Reserved from the size: lines of NC code are rarely shorter than 24 bytes or words
+        // than 6; untouched capacity costs address space only, a reallocation a copy. A
+        // machine that cannot give the memory gets an error, not an abort.
+        builder.reserve(bytes.len()).map_err(|what| {
+            ParseError::at(
+                1,
+                1,
+                format!(
+                    "not enough memory to read a program of {} bytes ({what})",
+                    bytes.len()
+                ),
+            )
+        })?;
+        match scan_blocks_with(&bytes, &opts, |s| {
+            builder.push(&s);
+            std::ops::ControlFlow::Continue(())
+        })? {
+            Settled::Done(dialect) => return Ok(builder.finish(bytes, dialect)),
+            Settled::Again(settled) => opts = settled,
+        }
+    }
+}
+
+/// How a read ended ([`scan_blocks_with`]).
+#[must_use = "a read that found program flow must be read again with its plan"]
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Settled {
+    /// The states given were final; the dialect used.
+    Done(Dialect),
+    /// The file has program flow that joins paths ([`crate::flow`]): the TCPM states given
+    /// were provisional. Read it again with these options (the dialect and the flow plan
+    /// set), which then ends [`Settled::Done`].
+    Again(ReadOptions),
+}
+
+impl Settled {
+    /// The dialect of a read that ended [`Settled::Done`], or the options to read again
+    /// with.
+    pub fn done(self) -> Result<Dialect, ReadOptions> {
+        match self {
+            Settled::Done(d) => Ok(d),
+            Settled::Again(o) => Err(o),
+        }
+    }
 }
 
 /// Read `bytes` block by block without building a [`Program`]: `visit` gets each block
@@ -224,12 +259,13 @@ pub fn parse_with(bytes: Vec<u8>, opts: &ReadOptions) -> Result<Program, ParseEr
 /// block's words. Same rules and the same errors, in the same order, as [`parse`] (which
 /// reads the whole file and so also reports an error after a point where `visit` stopped).
 ///
-/// Returns the dialect used (`Dialect::Auto` is detected as in [`parse`]).
+/// Returns the dialect used (`Dialect::Auto` is detected as in [`parse`]), or that the
+/// file must be read again with the plan of its program flow ([`Settled`]).
 pub fn scan(
     bytes: &[u8],
     dialect: Dialect,
     mut visit: impl FnMut(&Block, &[Word], &Modal) -> std::ops::ControlFlow<()>,
-) -> Result<Dialect, ParseError> {
+) -> Result<Settled, ParseError> {
     scan_blocks(bytes, dialect, |s| visit(s.block, s.words, s.state))
 }
 
@@ -255,16 +291,20 @@ pub fn scan_blocks(
     bytes: &[u8],
     dialect: Dialect,
     visit: impl FnMut(Scanned<'_>) -> std::ops::ControlFlow<()>,
-) -> Result<Dialect, ParseError> {
+) -> Result<Settled, ParseError> {
     scan_blocks_with(bytes, &ReadOptions::dialect(dialect), visit)
 }
 
 /// [`scan_blocks`] with the machine's TCPM codes: the one reader.
+///
+/// Where `opts` has no flow plan and the file has program flow that joins paths (labels,
+/// jumps, calls of its own subprograms: [`crate::flow`]), the states given to `visit` are
+/// provisional and the result is [`Settled::Again`] with the plan: read again with it.
 pub fn scan_blocks_with(
     bytes: &[u8],
     opts: &ReadOptions,
     visit: impl FnMut(Scanned<'_>) -> std::ops::ControlFlow<()>,
-) -> Result<Dialect, ParseError> {
+) -> Result<Settled, ParseError> {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
     scan_with(bytes, opts, threads, visit)
 }
@@ -274,8 +314,8 @@ fn scan_with(
     bytes: &[u8],
     opts: &ReadOptions,
     threads: usize,
-    mut visit: impl FnMut(Scanned<'_>) -> std::ops::ControlFlow<()>,
-) -> Result<Dialect, ParseError> {
+    visit: impl FnMut(Scanned<'_>) -> std::ops::ControlFlow<()>,
+) -> Result<Settled, ParseError> {
     if u32::try_from(bytes.len()).is_err() {
         return Err(too_big(bytes.len()));
     }
@@ -283,8 +323,48 @@ fn scan_with(
         Dialect::Auto => detect(bytes),
         d => d,
     };
-    let ends = LineEnds::of(bytes);
     let mut interp = Interpreter::new(opts, dialect);
+    let completed = read(bytes, threads, &mut interp, visit)?;
+    let Some(mut flow) = interp.recorder.take() else {
+        return Ok(Settled::Done(dialect));
+    };
+    if !completed {
+        // The visit stopped early: whether the rest of the file has flow is still to see.
+        let mut whole = Interpreter::new(opts, dialect);
+        read(bytes, threads, &mut whole, |_| {
+            std::ops::ControlFlow::Continue(())
+        })?;
+        flow = whole.recorder.take().unwrap_or_default();
+    }
+    if !flow.global {
+        return Ok(Settled::Done(dialect));
+    }
+    if flow.needs_block_labels() {
+        // Jumps name block numbers: find those blocks.
+        let mut again = Interpreter::new(opts, dialect);
+        again.record_block_labels(flow.block_targets.clone());
+        read(bytes, threads, &mut again, |_| {
+            std::ops::ControlFlow::Continue(())
+        })?;
+        flow = again.recorder.take().unwrap_or_default();
+    }
+    let plan = flow.solve(crate::modal::initial(&opts.controller).tcpm);
+    Ok(Settled::Again(ReadOptions {
+        dialect,
+        controller: opts.controller.clone(),
+        flow: Some(std::sync::Arc::new(plan)),
+        inch: opts.inch,
+    }))
+}
+
+/// One read of the file with `interp`: whether `visit` took every block.
+fn read(
+    bytes: &[u8],
+    threads: usize,
+    interp: &mut Interpreter,
+    mut visit: impl FnMut(Scanned<'_>) -> std::ops::ControlFlow<()>,
+) -> Result<bool, ParseError> {
+    let ends = LineEnds::of(bytes);
     let mut give = |interp: &mut Interpreter, block: &Block, words: &[Word]| {
         visit(Scanned {
             block,
@@ -300,11 +380,11 @@ fn scan_with(
         for (span, line) in ends.lines_from(bytes, 0) {
             words.clear();
             let block = interp.block(bytes, span, line, &mut words)?;
-            if give(&mut interp, &block, &words).is_break() {
-                break;
+            if give(interp, &block, &words).is_break() {
+                return Ok(false);
             }
         }
-        return Ok(dialect);
+        return Ok(true);
     }
     // Windows of about SCAN_WINDOW_BYTES, each cut at line ends into one part per thread;
     // the parts are lexed side by side (lexing needs only the dialect), then applied to
@@ -322,7 +402,7 @@ fn scan_with(
             cuts.push(c.max(*cuts.last().unwrap_or(&from)));
         }
         cuts.push(to);
-        let interp_ref = &interp;
+        let interp_ref = &*interp;
         std::thread::scope(|sc| {
             let (first, rest) = parts.split_at_mut(1);
             let handles: Vec<_> = cuts
@@ -344,8 +424,8 @@ fn scan_with(
                 let line = line_offset + k + 1;
                 let ws = &part.words[words];
                 let block = interp.apply(scan, line, span, 0..ws.len());
-                if give(&mut interp, &block, ws).is_break() {
-                    return Ok(dialect);
+                if give(interp, &block, ws).is_break() {
+                    return Ok(false);
                 }
             }
             line_offset += part.line_count;
@@ -356,7 +436,7 @@ fn scan_with(
         }
         from = to;
     }
-    Ok(dialect)
+    Ok(true)
 }
 
 /// A [`Program`] for a stretch of a larger file, built from the blocks [`scan_blocks`]
@@ -591,6 +671,10 @@ pub fn detect(bytes: &[u8]) -> Dialect {
         {
             return Dialect::Heidenhain;
         }
+    }
+    // MillPlus: `G141`, `G174`, `G7` with indexed addresses, a `%PM` header.
+    if lines().any(crate::millplus::looks_like) {
+        return Dialect::MillPlus;
     }
     // M128 as a word (not M1280): Heidenhain's TCPM code.
     let m128 = head.windows(5).enumerate().any(|(k, w)| {
@@ -844,7 +928,7 @@ mod tests {
 
     fn scanned(bytes: &[u8], threads: usize) -> Result<Visited, ParseError> {
         let mut v = Vec::new();
-        scan_with(bytes, &ReadOptions::default(), threads, |s| {
+        let settled = scan_with(bytes, &ReadOptions::default(), threads, |s| {
             let b = s.block;
             v.push((
                 b.line,
@@ -858,6 +942,7 @@ mod tests {
             ));
             std::ops::ControlFlow::Continue(())
         })?;
+        assert!(matches!(settled, Settled::Done(_)), "no program flow");
         Ok(v)
     }
 
@@ -901,7 +986,7 @@ mod tests {
             let base = prog.blocks[from].span().start;
             let mut builder = ProgramBuilder::new(base, &prog.state_before(from));
             let mut i = 0;
-            scan_with(&bytes, &ReadOptions::default(), 2, |s| {
+            let settled = scan_with(&bytes, &ReadOptions::default(), 2, |s| {
                 if (from..to).contains(&i) {
                     builder.push(&s);
                 }
@@ -909,6 +994,7 @@ mod tests {
                 std::ops::ControlFlow::Continue(())
             })
             .unwrap();
+            assert!(matches!(settled, Settled::Done(_)));
             let end = prog.blocks[to - 1].span().end;
             let sub = builder.finish(bytes[base..end].to_vec(), prog.dialect);
             assert_eq!(sub.blocks.len(), to - from);
@@ -1058,6 +1144,8 @@ mod tests {
                 &ReadOptions {
                     dialect: Dialect::Auto,
                     controller: c.clone(),
+                    flow: None,
+                    inch: false,
                 },
             )
             .unwrap();
@@ -1189,5 +1277,158 @@ mod tests {
             p("%P G71 *\nN1 G01 X0 Y0 Z0 F1 *\nN2 G79 *\n").state(2).pos[X],
             None
         );
+    }
+
+    /// Issue 26: rotations, scalings and mirror images of the frame, in every dialect's
+    /// forms, and their ends.
+    #[test]
+    fn frame_transformations() {
+        use crate::modal::transform::{ALL, MIRROR, ROTATION, SCALING};
+        let after = |text: &str| {
+            let prog = p(text);
+            prog.state(prog.blocks.len() - 1).transform
+        };
+        for (text, want) in [
+            ("(F)\nG68 X0 Y0 R30\n", ROTATION),
+            ("(F)\nG68 X0 Y0 R30\nG69\n", 0),
+            ("(F)\nG68.2 X0 Y0 Z0 I0 J30 K0\n", ROTATION),
+            ("(F)\nG51 X0 Y0 P0.5\n", SCALING),
+            ("(F)\nG51 X0 Y0 P0.5\nG50\n", 0),
+            ("(F)\nG51.1 X0\n", MIRROR),
+            ("(F)\nG51.1 X0\nG50.1 X0\n", 0),
+            ("(F)\nG10 L2 P1 X0 Y0 R15\n", ROTATION),
+            ("(F)\nG10 L2 P1 X0 Y0 Z0\n", 0),
+            ("%P G71 *\nN10 G73 G90 H+30 *\n", ROTATION),
+            ("%P G71 *\nN10 G73 G90 H+30 *\nN20 G73 G90 H+0 *\n", 0),
+            ("%P G71 *\nN10 G72 F0.8 *\n", SCALING),
+            ("%P G71 *\nN10 G72 F0.8 *\nN20 G72 F1 *\n", 0),
+            ("%P G71 *\nN10 G28 X+0 *\n", MIRROR),
+            ("%P G71 *\nN10 G28 X+0 *\nN20 G28 *\n", 0),
+            ("N10 TRAORI\nN20 ROT Z30\n", ROTATION),
+            ("N10 TRAORI\nN20 AROT RPL=30\n", ROTATION),
+            ("N10 TRAORI\nN20 ROT Z30\nN30 ROT\n", 0),
+            (
+                "N10 TRAORI\nN20 SCALE X2 Y2\nN30 MIRROR X0\n",
+                SCALING | MIRROR,
+            ),
+            ("N10 TRAORI\nN20 SCALE X2\nN30 MIRROR X0\nN40 TRANS\n", 0),
+            ("N10 TRAORI\nN20 ATRANS X10\n", 0),
+            (
+                "N10 TRAORI\nN20 CYCLE800(1,\"TC1\",0,57,0,0,0,30,0,0,0,0,0,-1)\n",
+                ROTATION,
+            ),
+            (
+                "N10 TRAORI\nN20 CYCLE800(1,\"TC1\",0,57,0,0,0,0,0,R1,0,0,0,-1)\n",
+                ROTATION,
+            ),
+            (
+                "N10 CYCLE800(0,\"TC1\",200000,57,0,0,0,0,0,0,0,0,0,-1,100,1)\n",
+                0,
+            ),
+            (
+                "N10 TRAORI\nN20 CYCLE800(1,\"TC1\",0,57,0,0,0,30)\nN30 CYCLE800()\n",
+                0,
+            ),
+            (
+                "0 BEGIN PGM T MM\n1 CYCL DEF 10.0 ROTATION\n2 CYCL DEF 10.1 ROT+30\n",
+                ROTATION,
+            ),
+            (
+                "0 BEGIN PGM T MM\n1 CYCL DEF 10.0 ROTATION\n2 CYCL DEF 10.1 ROT+0\n",
+                0,
+            ),
+            (
+                "0 BEGIN PGM T MM\n1 CYCL DEF 11.0 SCALING\n2 CYCL DEF 11.1 SCL 0.8\n",
+                SCALING,
+            ),
+            (
+                "0 BEGIN PGM T MM\n1 CYCL DEF 11.0 SCALING\n2 CYCL DEF 11.1 SCL 1\n",
+                0,
+            ),
+            (
+                "0 BEGIN PGM T MM\n1 CYCL DEF 8.0 MIRROR IMAGE\n2 CYCL DEF 8.1 X\n",
+                MIRROR,
+            ),
+            (
+                "0 BEGIN PGM T MM\n1 CYCL DEF 8.0 MIRROR IMAGE\n2 CYCL DEF 8.1\n",
+                0,
+            ),
+            (
+                "0 BEGIN PGM T MM\n1 CYCL DEF 26.0 AXIS-SPECIFIC SCALING\n2 CYCL DEF 26.1 X1.5 CCX+0\n",
+                SCALING,
+            ),
+            (
+                "0 BEGIN PGM T MM\n1 CYCL DEF 19.0 WORKING PLANE\n2 CYCL DEF 19.1 A+0 B+45 C+0\n",
+                ROTATION,
+            ),
+            (
+                "0 BEGIN PGM T MM\n1 CYCL DEF 19.0 WORKING PLANE\n2 CYCL DEF 19.1 A+0 B+0 C+0\n",
+                0,
+            ),
+            (
+                "0 BEGIN PGM T MM\n1 PLANE SPATIAL SPA+0 SPB+45 SPC+0 STAY\n",
+                ROTATION,
+            ),
+            (
+                "0 BEGIN PGM T MM\n1 PLANE SPATIAL SPA+0 SPB+45 SPC+0 STAY\n2 PLANE RESET STAY\n",
+                0,
+            ),
+        ] {
+            assert_eq!(after(text), want, "{text}");
+        }
+        // A run under a transformation carries it; every code also ends the known frame.
+        let prog = p("(F)\nG68 X0 Y0 R30\nG1 X0 Y0 Z0 A1 C0 F100\nX1 A2\n");
+        let r = crate::runs(&prog);
+        assert_eq!(r[0].transform, ROTATION);
+        assert!(prog.frame_changes.contains(&1));
+        assert_eq!(ALL, 7);
+    }
+
+    /// Issue 26: TCPM through calls, labels and jumps — the reader's side (the patch's is
+    /// in crates/polepatch/tests/flow.rs): a read that meets flow says so, and the read with
+    /// its plan settles the states.
+    #[test]
+    fn program_flow_settles_tcpm() {
+        let text =
+            "(F)\nG43.4 H1\nM98 P2000\nG1 X0 Y0 Z0 A1 C0 F100\nX1 A2\nM30\nO2000\nG49\nM99\n";
+        let first = scan(text.as_bytes(), Dialect::Auto, |_, _, _| {
+            std::ops::ControlFlow::Continue(())
+        })
+        .unwrap();
+        let Settled::Again(opts) = first else {
+            panic!("flow found")
+        };
+        assert!(opts.flow.is_some());
+        assert_eq!(opts.dialect, Dialect::Fanuc);
+        let prog = parse_with(text.as_bytes().to_vec(), &opts).unwrap();
+        assert_eq!(prog.state(1).tcpm, Tcpm::On);
+        assert_eq!(prog.state(3).tcpm, Tcpm::Off, "settled by O2000's G49");
+        assert_eq!(prog.state(4).tcpm, Tcpm::Off);
+        assert_eq!(prog.state(7).tcpm, Tcpm::Off, "G49 in the subprogram");
+        // parse settles by itself; a file without flow is read once.
+        assert_eq!(p(text).state(3).tcpm, Tcpm::Off);
+        let plain = "(F)\nG43.4 H1\nG1 X0 Y0 Z0 A1 C0 F100\n";
+        assert!(matches!(
+            scan(plain.as_bytes(), Dialect::Auto, |_, _, _| {
+                std::ops::ControlFlow::Continue(())
+            }),
+            Ok(Settled::Done(Dialect::Fanuc))
+        ));
+        // Code outside the file: unknown after the call, settled by the next switch.
+        let ext = p("(F)\nG43.4 H1\nG65 P9001\nG1 X0\nG43.4 H1\nG1 X1\n");
+        assert_eq!(ext.state(3).tcpm, Tcpm::Unknown);
+        assert_eq!(ext.state(5).tcpm, Tcpm::On);
+        // Codes whose effect is not known.
+        assert_eq!(p("N1 TRAORI\nN2 TRACON(1)\n").state(1).tcpm, Tcpm::Unknown);
+        assert_eq!(p("(F)\nG43.4 H1\nG43.8 H1\n").state(2).tcpm, Tcpm::Unknown);
+        // An early stop of the visit still finds flow later in the file.
+        let mut seen = 0;
+        let early = scan(text.as_bytes(), Dialect::Auto, |_, _, _| {
+            seen += 1;
+            std::ops::ControlFlow::Break(())
+        })
+        .unwrap();
+        assert_eq!(seen, 1);
+        assert!(matches!(early, Settled::Again(_)));
     }
 }

@@ -39,6 +39,12 @@ pub struct Run {
     /// TCPM state during the run (only [`crate::Tcpm::On`] allows changing rotary words
     /// alone).
     pub tcpm: crate::Tcpm,
+    /// Frame transformations in force during the run (bits of [`crate::modal::transform`]:
+    /// rotation, scaling, mirror image); 0 where none.
+    pub transform: u8,
+    /// The TCPM code in force refers X Y Z to the centre of a ball
+    /// ([`crate::Modal::tcpm_centre`]).
+    pub tcpm_centre: bool,
     /// Why the run ended.
     pub ended_by: RunBreak,
 }
@@ -120,6 +126,8 @@ impl RunBuilder {
             feed_mode: st.feed_mode,
             block_feed_mm_min: Vec::new(),
             tcpm: st.tcpm,
+            transform: st.transform,
+            tcpm_centre: st.tcpm_centre,
             ended_by: RunBreak::End,
         }
     }
@@ -147,12 +155,16 @@ impl RunBuilder {
                         self.cur = Some(Self::start(i, st));
                     } else {
                         if let Some(r) = &mut self.cur
-                            && (r.feed_mm_min != st.feed_mm_min || r.tcpm != st.tcpm)
+                            && (r.feed_mm_min != st.feed_mm_min
+                                || r.tcpm != st.tcpm
+                                || r.transform != st.transform)
                         {
                             if r.len() == 1 {
                                 r.feed_mm_min = st.feed_mm_min;
                                 r.feed_mode = st.feed_mode;
                                 r.tcpm = st.tcpm;
+                                r.transform = st.transform;
+                                r.tcpm_centre = st.tcpm_centre;
                             } else {
                                 self.finish_run(RunBreak::FeedChange, emit);
                             }
@@ -163,6 +175,8 @@ impl RunBuilder {
                             r.feed_mm_min = st.feed_mm_min;
                             r.feed_mode = st.feed_mode;
                             r.tcpm = st.tcpm;
+                            r.transform = st.transform;
+                            r.tcpm_centre = st.tcpm_centre;
                             r
                         });
                         // A rotary axis first programmed by this move: its motion over the

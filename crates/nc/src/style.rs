@@ -20,6 +20,34 @@ pub struct NumberStyle {
     pub leading_zero: bool,
     /// `=` between letter and number (`C=12.5`, Sinumerik).
     pub equals: bool,
+    /// How a zero is written when the file writes it its own way (NX posts: `B0.0` beside
+    /// `B.387` and `B15.`); `None`: like any other value.
+    pub zero: Option<ZeroStyle>,
+}
+
+/// How a file writes the value zero (the first zero of the letter, or of the axis words).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ZeroStyle {
+    /// A `0` before the point (`0.0`, not `.0`).
+    pub leading_zero: bool,
+    /// A point (`0.`, `0.0`).
+    pub point: bool,
+    /// Zeros after the point.
+    pub decimals: u8,
+}
+
+impl ZeroStyle {
+    fn render(self) -> String {
+        let mut s = String::with_capacity(3 + usize::from(self.decimals));
+        if self.leading_zero || !self.point || self.decimals == 0 {
+            s.push('0');
+        }
+        if self.point {
+            s.push('.');
+            s.extend(std::iter::repeat_n('0', usize::from(self.decimals)));
+        }
+        s
+    }
 }
 
 /// What the words of one letter show about their style.
@@ -40,6 +68,9 @@ struct Evidence {
     equals: usize,
     /// Values whose last decimal is a `0` (`12.500`): evidence against stripping.
     trailing_zero: usize,
+    /// The first zero written (a zero is evidence of its own form only: `B0.0` says
+    /// nothing about how `B.387` is written).
+    zero_form: Option<ZeroStyle>,
 }
 
 impl Evidence {
@@ -82,6 +113,14 @@ impl Evidence {
             None => (0, false),
         };
         e.max_decimals = e.max_decimals.max(decimals);
+        if body.iter().all(|&b| b == b'0' || b == b'.') {
+            e.zero_form.get_or_insert(ZeroStyle {
+                leading_zero: body.first() == Some(&b'0'),
+                point: has_point,
+                decimals: decimals.min(usize::from(u8::MAX)) as u8,
+            });
+            return;
+        }
         e.min_decimals = e.min_decimals.min(decimals);
         if decimals > 0 && body.last() == Some(&b'0') {
             e.trailing_zero += 1;
@@ -121,7 +160,9 @@ impl NumberStyle {
     ///
     /// - `plus_sign`: a non-negative value of the letter is written with `+` (if the
     ///   letter has no non-negative value: one of the axis words X Y Z A B C is);
-    /// - `decimals`: the most decimals written;
+    /// - `decimals`: the most decimals written (a zero — `0`, `0.`, `0.0`, `.000` — counts
+    ///   for `decimals` and `plus_sign` only: posts often write it their own way, which
+    ///   `zero` keeps: letter, else axis words);
     /// - `strip_trailing_zeros`: some value is written with fewer decimals than that and
     ///   none ends in a decimal `0` (letter; if its words all have the same decimals,
     ///   the axis words decide; else false);
@@ -162,6 +203,7 @@ impl NumberStyle {
             trailing_point: point.point > 0,
             leading_zero: !(zero.no_zero > 0 && zero.zero == 0),
             equals: main.equals > 0,
+            zero: main.zero_form.or(axes.zero_form),
         }
     }
 
@@ -172,11 +214,18 @@ impl NumberStyle {
     /// zeros are stripped (and the point unless `trailing_point`) if
     /// `strip_trailing_zeros`, else a whole number gets a point if `trailing_point`; a
     /// leading `0` before the point is dropped unless `leading_zero`; `+` is put before a
-    /// non-negative value if `plus_sign`.
+    /// non-negative value if `plus_sign`. A value that rounds to zero is written in the
+    /// file's `zero` form when it has one.
     pub fn render(&self, value: f64, decimals: usize) -> String {
         let mut s = format!("{:.*}", decimals, value);
         if s.starts_with('-') && s[1..].bytes().all(|b| b == b'0' || b == b'.') {
             s.remove(0);
+        }
+        if let Some(z) = self.zero
+            && s.bytes().all(|b| b == b'0' || b == b'.')
+        {
+            let z = z.render();
+            return if self.plus_sign { format!("+{z}") } else { z };
         }
         if s.contains('.') {
             if self.strip_trailing_zeros {
@@ -326,6 +375,11 @@ mod tests {
         trailing_point: false,
         leading_zero: true,
         equals: false,
+        zero: Some(ZeroStyle {
+            leading_zero: true,
+            point: false,
+            decimals: 0,
+        }),
     };
 
     #[test]
@@ -381,6 +435,7 @@ mod tests {
             trailing_point: false,
             leading_zero: true,
             equals: false,
+            zero: None,
         };
         for v in [0.0005, 0.0015, 2.675, -1.0005, 123456.789, 1e-9, -1e-9] {
             let f = format!("{:.3}", v);
@@ -391,6 +446,32 @@ mod tests {
             };
             assert_eq!(st.render(v, 3), expected, "{v}");
         }
+    }
+
+    /// Issue 30 item 9: NX writes zero `B0.0` and every other value without trailing zeros
+    /// or a leading zero (`B.387`, `B1.8`, `B15.`): a rewritten word keeps that style.
+    #[test]
+    fn a_zero_written_its_own_way_is_no_evidence_for_the_others() {
+        let src = "N15 G00 B0.0\nN16 G00 C0.0\nN480 G01 X.9857 Y.9845 B.387 C9.03 F9.8\n\
+                   N481 X.987 B1.8 C17.521\nN482 B15. C25.815\n";
+        let st = style(src, b'B');
+        assert!(
+            !st.leading_zero && st.strip_trailing_zeros && st.trailing_point,
+            "{st:?}"
+        );
+        assert_eq!(st.decimals, 3);
+        assert_eq!(st.render(0.059, 3), ".059");
+        assert_eq!(st.render(0.42, 3), ".42");
+        assert_eq!(st.render(-0.5, 3), "-.5");
+        assert_eq!(st.render(12.0, 3), "12.");
+        assert_eq!(st.render(0.0001, 3), "0.0", "zero as the file writes it");
+        assert_eq!(st.render(-0.0001, 3), "0.0");
+        assert_eq!(st.rounded(0.0004, 3), 0.0);
+        // A fixed-decimals file keeps its zeros and its trailing zeros.
+        let st = style("N10 G1 X=10.000 A=0.000 C=30.000\n", b'A');
+        assert!(!st.strip_trailing_zeros);
+        assert_eq!(st.render(2.5, 3), "2.500");
+        assert_eq!(st.render(0.0, 3), "0.000");
     }
 
     /// The file style gathered block by block is each letter's [`NumberStyle::of`], and the

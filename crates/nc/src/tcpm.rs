@@ -17,6 +17,12 @@
 //! | Heidenhain (ISO and conversational) | `M128`, `FUNCTION TCPM …` | `M129`, `FUNCTION RESET TCPM`, `M2`, `M30`, `END PGM` |
 //! | Sinumerik | `TRAORI` | `TRAFOOF`, `TRANSMIT`, `TRACYL`, `TRAANG`, `M2`, `M30` |
 //! | Fanuc, Haas, LinuxCNC and other ISO | `G43.4`, `G43.5`, `G234` (Haas TCPC) | `G49`, `G43`, `G44` (group 8 replaces G43.4), `G43.1`, `G43.7`, `M2`, `M30` |
+//! | MillPlus | `G141` (3D tool correction with the tool orientation) | `G40`, `M2`, `M30` |
+//!
+//! Codes whose effect the reader does not know leave the state [`crate::Tcpm::Unknown`]
+//! (never patched) until a code of the table settles it: Sinumerik `TRACON`, Fanuc
+//! `G43.8`/`G43.9`. So do calls, labels and jumps the file does not settle
+//! ([`crate::flow`]).
 //!
 //! A machine adds its own codes (`tcpm_on = ["M428"]`, `tcpm_off = ["M429", "M430"]` for
 //! LinuxCNC's switchable kinematics), or says its kinematics are always TCP
@@ -113,6 +119,20 @@ pub struct ControllerCodes {
 pub(crate) enum Switch {
     On,
     Off,
+    /// A code whose effect on TCPM the reader does not know (`TRACON` after `TRAORI`,
+    /// `G43.8`): the state after it is [`crate::Tcpm::Unknown`] until a code settles it.
+    Unknown,
+}
+
+impl Switch {
+    /// The state the switch sets.
+    pub(crate) fn state(self) -> crate::Tcpm {
+        match self {
+            Switch::On => crate::Tcpm::On,
+            Switch::Off => crate::Tcpm::Off,
+            Switch::Unknown => crate::Tcpm::Unknown,
+        }
+    }
 }
 
 impl ControllerCodes {
@@ -135,6 +155,15 @@ impl ControllerCodes {
             Dialect::Fanuc | Dialect::Auto => match g {
                 434 | 435 | 2340 => Some(Switch::On),
                 490 | 430 | 440 | 431 | 437 => Some(Switch::Off),
+                // Tool-length compensation forms whose TCPM meaning differs by controller
+                // (Fanuc's cutting-point and tool-centre-point variants): not guessed.
+                438 | 439 => Some(Switch::Unknown),
+                _ => None,
+            },
+            // MillPlus: G141 3D tool correction with the tool orientation; G40 ends it.
+            Dialect::MillPlus => match g {
+                1410 => Some(Switch::On),
+                400 => Some(Switch::Off),
                 _ => None,
             },
             Dialect::Sinumerik | Dialect::Heidenhain | Dialect::Conversational => None,
@@ -169,6 +198,10 @@ impl ControllerCodes {
                     Some(Switch::On)
                 } else if is(b"TRAFOOF") || is(b"TRANSMIT") || is(b"TRACYL") || is(b"TRAANG") {
                     Some(Switch::Off)
+                } else if is(b"TRACON") {
+                    // A cascade of transformations: whether TRAORI's tool-tip frame holds
+                    // depends on the cascade, which the reader does not follow.
+                    Some(Switch::Unknown)
                 } else {
                     None
                 }
@@ -178,21 +211,39 @@ impl ControllerCodes {
     }
 }
 
-/// How to read a program: its dialect and the machine's TCPM codes.
+/// How to read a program: its dialect, the machine's TCPM codes, how the file's program
+/// flow settles TCPM, and the units of a program that does not state them.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct ReadOptions {
     /// Dialect (default: detected).
     pub dialect: Dialect,
     /// The machine's own TCPM codes (default: none beyond the dialect's).
     pub controller: ControllerCodes,
+    /// How program flow settles TCPM (default `None`: not known yet; a read that finds
+    /// flow returns the plan in [`crate::Settled::Again`]).
+    pub flow: Option<std::sync::Arc<crate::flow::FlowPlan>>,
+    /// Read lengths (and feeds) in inches until the program states its units (G20/G21,
+    /// G70/G71, G700/G710, `%NAME G71`, `BEGIN PGM … MM|INCH`): what a controller set to
+    /// inches does with a program that states none. Default false: mm.
+    pub inch: bool,
 }
 
 impl ReadOptions {
-    /// Read as `dialect` with the built-in codes only.
+    /// Read as `dialect` with the built-in codes only, in mm.
     pub fn dialect(dialect: Dialect) -> Self {
         ReadOptions {
             dialect,
             controller: ControllerCodes::default(),
+            flow: None,
+            inch: false,
+        }
+    }
+
+    /// The modal state at the start of a program read this way.
+    pub fn initial(&self) -> crate::Modal {
+        crate::Modal {
+            inch: self.inch,
+            ..crate::modal::initial(&self.controller)
         }
     }
 }

@@ -36,11 +36,26 @@ pub const TIME_REL_TOL: f64 = 1e-3;
 /// Most bisections of a span for its time (at most `2^TIME_MAX_DEPTH` pieces).
 pub const TIME_MAX_DEPTH: u32 = 6;
 
+/// Default singular cone, degrees: every stretch where C is below feed and the primary
+/// axis comes this close to the pole is a zone ([`detect_zones`]).
+pub const CONE_DEG: f64 = 5.0;
+
+/// Default pole reach, degrees: out to this distance from the pole, a stretch where C is
+/// below feed is a zone when the pole accounts for at least half its slowdown
+/// ([`pole_dominates`]).
+pub const POLE_REACH_DEG: f64 = 10.0;
+
 /// Options of [`analyze_path`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct AnalysisOptions {
-    /// Singular cone: a zone needs a point with |primary| ≤ this, degrees. Default 5.
+    /// Singular cone: a stretch below feed with a point with |primary| ≤ this is a zone,
+    /// degrees. Default [`CONE_DEG`] (5).
     pub cone_deg: f64,
+    /// Pole reach, degrees: a stretch below feed whose closest point to the pole lies
+    /// between the cone and this is a zone when the pole dominates its slowdown
+    /// ([`pole_dominates`]); at or below `cone_deg`, only the cone counts. Default
+    /// [`POLE_REACH_DEG`] (10).
+    pub pole_reach_deg: f64,
     /// Interpolation cycle time override, seconds; `None` uses the machine's `tcy_s`. It
     /// does not change any figure: Equation 6 is bounded exactly over every span, which is
     /// at least as strict as sampling every F·Tcy for any Tcy (module docs). Kept for the
@@ -53,10 +68,19 @@ pub struct AnalysisOptions {
 impl Default for AnalysisOptions {
     fn default() -> Self {
         AnalysisOptions {
-            cone_deg: 5.0,
+            cone_deg: CONE_DEG,
+            pole_reach_deg: POLE_REACH_DEG,
             tcy_s: None,
             keep_samples: false,
         }
+    }
+}
+
+impl AnalysisOptions {
+    /// How far from the pole a zone can lie, degrees: the larger of the cone and the pole
+    /// reach. A run with no point this close holds no zone.
+    pub fn reach_deg(&self) -> f64 {
+        self.cone_deg.max(self.pole_reach_deg)
     }
 }
 
@@ -246,7 +270,7 @@ fn run_analysis(
         }
     }
     let (mut analysis, below) = acc.finish(path);
-    analysis.zones = detect_zones(path, &below, opts.cone_deg);
+    analysis.zones = detect_zones(path, &below, opts.cone_deg, opts.pole_reach_deg);
     Ok(analysis)
 }
 
@@ -259,6 +283,8 @@ pub struct BelowFeed {
     pub last_span: usize,
     /// Lowest C ratio in the stretch.
     pub min_ratio: f64,
+    /// C's limit that binds that lowest ratio (velocity, acceleration or jerk).
+    pub kind: LimitKind,
 }
 
 /// Equation 6 at one point of a span: `d[axis] = [q', q'', q''']`.
@@ -394,17 +420,22 @@ impl Accumulator {
         self.time_s += time_s;
         self.time_error_s += time_error_s;
         let rc = axis_ratio[Axis::C.index()];
+        let kc = axis_kind[Axis::C.index()];
         if rc < 1.0 - RATIO_TOL {
             match &mut self.open {
                 Some(b) => {
                     b.last_span = k;
-                    b.min_ratio = b.min_ratio.min(rc);
+                    if rc < b.min_ratio {
+                        b.min_ratio = rc;
+                        b.kind = kc;
+                    }
                 }
                 None => {
                     self.open = Some(BelowFeed {
                         first_span: k,
                         last_span: k,
                         min_ratio: rc,
+                        kind: kc,
                     })
                 }
             }
@@ -485,28 +516,68 @@ impl Accumulator {
     }
 }
 
+/// Whether the pole dominates the slowdown of a stretch where C's lowest ratio is
+/// `c_ratio`, bound by C's limit `kind`, and the primary axis comes within `min_abs_deg` of
+/// the pole (SPEC §3 step 2; docs/method.md, "What a zone is").
+///
+/// Near the pole C turns the tool axis' azimuth: for a given motion of the tool axis, C's
+/// derivatives of every order are those of the tool axis' own angular motion times
+/// 1/sin|P| (C17 eq. 5, Ċ = Θ̇/sin A). Equation 6's bound on C scales as the e-th root of
+/// the derivative it limits (e = 1 velocity, 2 acceleration, 3 jerk), so the pole alone
+/// multiplies C's feed bound by sin(|P|)^(1/e), and C's lowest ratio is
+/// `c_ratio = sin(|P|)^(1/e) · rest`, `rest` being what the tool axis' own motion would
+/// allow on an axis with C's limits. The pole dominates when its factor is at most the
+/// rest — it accounts for at least half of the slowdown, in ratio:
+/// `sin(|P|)^(1/e) ≤ c_ratio / sin(|P|)^(1/e)`, i.e. `sin(|P|)^(2/e) ≤ c_ratio`. Both
+/// sides follow from the machine's C limits and the program's feed (which limit binds,
+/// and how far below feed), none from a chosen angle.
+pub fn pole_dominates(min_abs_deg: f64, c_ratio: f64, kind: LimitKind) -> bool {
+    let e = match kind {
+        LimitKind::Velocity => 1.0,
+        LimitKind::Acceleration => 2.0,
+        LimitKind::Jerk => 3.0,
+        LimitKind::Feed => return false,
+    };
+    let s = min_abs_deg.to_radians().sin().abs();
+    s.powf(2.0 / e) <= c_ratio
+}
+
 /// Zones from the stretches where C is below feed: each stretch covers the points of its
 /// spans; overlapping or touching stretches merge; a stretch is a zone when a point in it
-/// has |primary| ≤ `cone_deg`.
-pub fn detect_zones(path: &Path, below: &[BelowFeed], cone_deg: f64) -> Vec<Zone> {
+/// has |primary| ≤ `cone_deg`, or — out to `pole_reach_deg` — when the pole dominates its
+/// slowdown ([`pole_dominates`], on the stretch's lowest C ratio and the limit binding it).
+/// A stretch admitted by the reach and the zone before it are one zone when the primary
+/// axis stays within the reach between them (one pass by the pole); zones the cone
+/// admits are never joined to each other here (the driver merges close ones).
+pub fn detect_zones(
+    path: &Path,
+    below: &[BelowFeed],
+    cone_deg: f64,
+    pole_reach_deg: f64,
+) -> Vec<Zone> {
     let p = |i: usize| path.axes[i][Axis::Primary.index()];
-    let mut merged: Vec<(usize, usize, f64)> = Vec::new();
+    let mut merged: Vec<(usize, usize, f64, LimitKind)> = Vec::new();
     for b in below {
         let (first, last) = (b.first_span, b.last_span + 1);
         match merged.last_mut() {
             Some(m) if first <= m.1 => {
                 m.1 = m.1.max(last);
-                m.2 = m.2.min(b.min_ratio);
+                if b.min_ratio < m.2 {
+                    m.2 = b.min_ratio;
+                    m.3 = b.kind;
+                }
             }
-            _ => merged.push((first, last, b.min_ratio)),
+            _ => merged.push((first, last, b.min_ratio, b.kind)),
         }
     }
-    let mut zones = Vec::new();
-    for (first, last, c_ratio_min) in merged {
+    let mut zones: Vec<Zone> = Vec::new();
+    for (first, last, c_ratio_min, kind) in merged {
         let min_abs = (first..=last)
             .map(|i| p(i).abs())
             .fold(f64::INFINITY, f64::min);
-        if min_abs > cone_deg {
+        let in_cone = min_abs <= cone_deg;
+        let dominated = min_abs <= pole_reach_deg && pole_dominates(min_abs, c_ratio_min, kind);
+        if !(in_cone || dominated) {
             continue;
         }
         // A flip: the primary changes sign between two points (or passes through 0 with
@@ -532,14 +603,37 @@ pub fn detect_zones(path: &Path, below: &[BelowFeed], cone_deg: f64) -> Vec<Zone
             Some(j) => (ZoneKind::AFlip, j),
             None => (ZoneKind::CSwing, least),
         };
-        zones.push(Zone {
+        let zone = Zone {
             first,
             last,
             singular,
             kind,
             min_abs_primary_deg: min_abs,
             c_ratio_min,
-        });
+        };
+        // One pass by the pole is one zone: a stretch the reach admits joins the zone
+        // before it (and a zone joins such a stretch) when the primary axis stays within
+        // the reach between them — the same pass, patched in one go.
+        if let Some(prev) = zones.last_mut()
+            && (!in_cone || prev.min_abs_primary_deg > cone_deg)
+            && (prev.last..=zone.first).all(|i| p(i).abs() <= pole_reach_deg.max(cone_deg))
+        {
+            let keep_prev = prev.min_abs_primary_deg <= zone.min_abs_primary_deg;
+            *prev = Zone {
+                first: prev.first,
+                last: zone.last,
+                singular: if keep_prev {
+                    prev.singular
+                } else {
+                    zone.singular
+                },
+                kind: if keep_prev { prev.kind } else { zone.kind },
+                min_abs_primary_deg: prev.min_abs_primary_deg.min(zone.min_abs_primary_deg),
+                c_ratio_min: prev.c_ratio_min.min(zone.c_ratio_min),
+            };
+            continue;
+        }
+        zones.push(zone);
     }
     zones
 }
@@ -707,6 +801,7 @@ mod tests {
         // The same swing with a cone of 0.5°: C still crawls, but no point is in the cone.
         let narrow = AnalysisOptions {
             cone_deg: 0.5,
+            pole_reach_deg: 0.5,
             ..AnalysisOptions::default()
         };
         let a = analyze_path(&swing, &m, &narrow).unwrap();
@@ -724,25 +819,90 @@ mod tests {
                 first_span: 10,
                 last_span: 14,
                 min_ratio: 0.5,
+                kind: LimitKind::Velocity,
             },
             BelowFeed {
                 first_span: 15,
                 last_span: 22,
                 min_ratio: 0.2,
+                kind: LimitKind::Jerk,
             },
             BelowFeed {
                 first_span: 30,
                 last_span: 31,
                 min_ratio: 0.9,
+                kind: LimitKind::Acceleration,
             },
         ];
-        let zones = detect_zones(&path, &below, 50.0);
+        let zones = detect_zones(&path, &below, 50.0, 50.0);
         assert_eq!(zones.len(), 2, "{zones:?}");
         assert_eq!((zones[0].first, zones[0].last), (10, 23));
         assert_eq!(zones[0].c_ratio_min, 0.2);
         assert_eq!((zones[1].first, zones[1].last), (30, 32));
         // With a 0.1° cone neither has a point in it.
-        assert!(detect_zones(&path, &below, 0.1).is_empty());
+        assert!(detect_zones(&path, &below, 0.1, 0.1).is_empty());
+    }
+
+    /// Issue 30 item 12: out to the pole reach, a stretch is a zone where the pole's factor
+    /// sin(|P|)^(1/e) on C's bound is at most the rest of its slowdown.
+    #[test]
+    fn the_pole_dominates_near_it_and_not_far() {
+        use LimitKind::{Acceleration, Jerk, Velocity};
+        // The corners of a real Haas UMC program at B ≈ 6.3° (UCP710: C's acceleration,
+        // ratio 0.30; HSM600: jerk, 0.73) and the table turning round a part at 58°–81°
+        // (0.03–0.19): the first are the pole's, the second the program's.
+        assert!(pole_dominates(6.311, 0.302, Acceleration));
+        assert!(pole_dominates(6.311, 0.732, Jerk));
+        assert!(!pole_dominates(58.3, 0.177, Acceleration));
+        assert!(!pole_dominates(81.7, 0.031, Acceleration));
+        // A branch flip 20° from the pole (C jumps 180° at once: V, ratio 0.008) is not.
+        assert!(!pole_dominates(20.0, 0.008, Velocity));
+        // The boundary: sin(P)^(2/e) = ratio.
+        for (e, kind) in [(1.0, Velocity), (2.0, Acceleration), (3.0, Jerk)] {
+            let p = 10.0f64;
+            let r = p.to_radians().sin().powf(2.0 / e);
+            assert!(pole_dominates(p, r * 1.001, kind));
+            assert!(!pole_dominates(p, r * 0.999, kind));
+        }
+        // At the pole any slowdown is the pole's; a limit that is not C's never is.
+        assert!(pole_dominates(0.0, 1e-6, Jerk));
+        assert!(!pole_dominates(0.0, 0.5, LimitKind::Feed));
+    }
+
+    /// A stretch between the cone and the reach is a zone only when the pole dominates.
+    #[test]
+    fn the_reach_keeps_dominated_stretches_only() {
+        let mut path = planted(41, 1.0, 1.0, false, 1000.0);
+        for q in &mut path.axes {
+            q[3] = q[3].abs() + 9.0;
+        }
+        let below = |r: f64| {
+            [BelowFeed {
+                first_span: 10,
+                last_span: 14,
+                min_ratio: r,
+                kind: LimitKind::Acceleration,
+            }]
+        };
+        // min |P| is 9° + the planted pass's own least |P|.
+        let least = (10..=15)
+            .map(|i| path.axes[i][3])
+            .fold(f64::INFINITY, f64::min);
+        let threshold = least.to_radians().sin();
+        assert_eq!(
+            detect_zones(&path, &below(threshold * 1.01), 5.0, 15.0).len(),
+            1
+        );
+        assert!(detect_zones(&path, &below(threshold * 0.99), 5.0, 15.0).is_empty());
+        assert!(
+            detect_zones(&path, &below(0.99), 5.0, 5.0).is_empty(),
+            "beyond the reach"
+        );
+        assert_eq!(
+            detect_zones(&path, &below(0.01), 12.0, 12.0).len(),
+            1,
+            "in the cone"
+        );
     }
 
     /// Bad paths are errors, never a panic or a silent result.

@@ -53,10 +53,21 @@ use crate::{
     qp::add_stats,
     report::{Method, Outcome, QpStats, Reason, ZoneFigures, ZoneReport},
     settings::SolverSettings,
-    verify::{AxisChange, Verdict, verify_change_with_core},
+    verify::{AxisChange, Verdict, verify_change_on, verify_change_with_core},
 };
 use polepatch_kinematics::{Axis, LimitKind, Machine, angle_between_deg, forward};
 use std::ops::Range;
+
+/// Narrowing a patch that slowed a linear axis away from its zone ([`patch_with`], a
+/// ball's centre kept) moves its bound at least this fraction of the way to the zone.
+const NARROW_STEP_DIV: usize = 4;
+
+/// Tries at scaling a change that reaches feed beyond `max_deviation_deg` into the cap
+/// (the best improvement within it).
+const SCALE_TRIES: usize = 4;
+/// Each try aims this fraction of the cap (the deviation is nearly, not exactly, linear in
+/// the scale; rounding adds a little).
+const SCALE_SAFETY: f64 = 0.98;
 
 /// Points of unchanged path either side of a candidate's change and its zone that the
 /// candidate check verifies (the whole run is verified again at the end).
@@ -189,6 +200,8 @@ struct Checked {
 /// The driver's [`Sink`] for one zone: checks proposals and keeps the best.
 struct Selection<'a> {
     s: &'a [f64],
+    /// The path's axis values (the tips the program states).
+    axes: &'a [[f64; 5]],
     target: &'a [[f64; 3]],
     machine: &'a Machine,
     opts: &'a PatchOptions,
@@ -260,6 +273,21 @@ impl Selection<'_> {
         let hi = (changed_hi.max(self.zone.last) + CHECK_MARGIN_POINTS).min(n - 1);
         let (bp, bc) = (&self.p[lo..=hi], &self.c[lo..=hi]);
         let axes = self.axes();
+        // With a ball's centre kept the tips move with the orientation, and the tip path's
+        // length with them: before and after each on its own (unrounded: the whole-run
+        // check picks the decimals).
+        let tip_s = |wp: &[f64], wc: &[f64]| -> Option<Vec<f64>> {
+            let keep = self.opts.keep_centre.filter(|k| k.s_is_length)?;
+            let tips: Vec<[f64; 3]> = (lo..=hi)
+                .map(|i| {
+                    let q = &self.axes[i];
+                    let o0 = self.target[i];
+                    let o1 = forward(self.machine, wp[i - lo], wc[i - lo]);
+                    std::array::from_fn(|j| q[j] + keep.radius_mm * (o0[j] - o1[j]))
+                })
+                .collect();
+            Some(crate::centre::tip_length(self.s[lo], &tips))
+        };
         let verify = |wp: &[f64], wc: &[f64]| {
             let ch: Vec<AxisChange> = axes
                 .iter()
@@ -269,14 +297,23 @@ impl Selection<'_> {
                     after: if axis == Axis::C { wc } else { wp },
                 })
                 .collect();
-            verify_change_with_core(
-                &self.s[lo..=hi],
-                &ch,
+            let (changed, core) = (
                 (first - lo, changed_hi - lo),
                 (self.zone.first.max(lo) - lo, self.zone.last.min(hi) - lo),
-                self.machine,
-                self.feed_mm_s,
-            )
+            );
+            match (tip_s(bp, bc), tip_s(wp, wc)) {
+                (Some(sb), Some(sa)) => {
+                    verify_change_on(&sb, &sa, &ch, changed, core, self.machine, self.feed_mm_s)
+                }
+                _ => verify_change_with_core(
+                    &self.s[lo..=hi],
+                    &ch,
+                    changed,
+                    core,
+                    self.machine,
+                    self.feed_mm_s,
+                ),
+            }
         };
         let deviation = |wp: &[f64], wc: &[f64]| {
             (first..=last)
@@ -331,6 +368,47 @@ impl Selection<'_> {
         last_checked.map(|l| (l, false))
     }
 
+    /// Keep `ck` as the best improvement so far when it improves the zone more.
+    fn consider_improved(&mut self, ck: Checked) {
+        if ck.verdict.improves()
+            && ck.verdict.core_min_after > 0.0
+            && self
+                .improved
+                .as_ref()
+                .is_none_or(|b| ck.verdict.core_min_after > b.verdict.core_min_after + RATIO_TOL)
+        {
+            self.improved = Some(ck);
+        }
+    }
+
+    /// `prop`'s change from the current values scaled by λ < 1 so that its deviation
+    /// (`dev_deg` unscaled) is within the cap, checked as written; λ shrinks by the ratio of
+    /// cap to deviation until it fits (a few tries: the deviation is nearly linear in λ).
+    /// `None` for a change that moves the points after it (a re-selected tail is not a
+    /// change to scale) or that does not fit.
+    fn scaled_into_cap(&self, prop: &Proposal, dev_deg: f64) -> Option<Checked> {
+        let cap = self.opts.max_deviation_deg?;
+        if !matches!(prop.tail, Tail::Keep) || cap <= 0.0 {
+            return None;
+        }
+        let mut lambda = 1.0;
+        let mut dev = dev_deg;
+        for _ in 0..SCALE_TRIES {
+            lambda *= (cap / dev) * SCALE_SAFETY;
+            let mut scaled = prop.clone();
+            for (k, i) in (prop.first..=prop.last).enumerate() {
+                scaled.p[k] = self.p[i] + lambda * (prop.p[k] - self.p[i]);
+                scaled.c[k] = self.c[i] + lambda * (prop.c[k] - self.c[i]);
+            }
+            let (ck, _) = self.check(&scaled)?;
+            if self.within_cap(ck.deviation_deg) {
+                return Some(ck);
+            }
+            dev = ck.deviation_deg;
+        }
+        None
+    }
+
     fn within_cap(&self, dev: f64) -> bool {
         self.opts
             .max_deviation_deg
@@ -357,6 +435,14 @@ impl Sink for Selection<'_> {
                     .map_or(ck.deviation_deg, |d| d.min(ck.deviation_deg)),
             );
         }
+        if !in_cap {
+            // The best improvement within the cap: the change scaled down until its
+            // deviation as written fits (issue 26: a cap below what the zone needs gave
+            // nothing; a solve capped at the limit can exceed it by its rounding).
+            if let Some(scaled) = self.scaled_into_cap(&prop, ck.deviation_deg) {
+                self.consider_improved(scaled);
+            }
+        }
         if passes && in_cap {
             if self
                 .passed
@@ -365,15 +451,8 @@ impl Sink for Selection<'_> {
             {
                 self.passed = Some(ck);
             }
-        } else if in_cap
-            && ck.verdict.improves()
-            && ck.verdict.core_min_after > 0.0
-            && self
-                .improved
-                .as_ref()
-                .is_none_or(|b| ck.verdict.core_min_after > b.verdict.core_min_after + RATIO_TOL)
-        {
-            self.improved = Some(ck);
+        } else if in_cap {
+            self.consider_improved(ck);
         }
         Some(out)
     }
@@ -433,6 +512,8 @@ struct Done {
     over_cap_deg: Option<f64>,
     /// The zone's patch was put back by the whole-run verification.
     reverted: bool,
+    /// The first and last point its patch could change.
+    bounds: (usize, usize),
 }
 
 /// Result of patching one path: the values of both rotary axes as they must be written.
@@ -452,6 +533,14 @@ pub struct PatchResult {
     pub c_changed: Vec<bool>,
     /// Decimal places to write the changed C values with (≥ `opts.c_decimals`).
     pub c_decimals: usize,
+    /// X Y Z per point, mm, as they must be written: the input values, except where
+    /// [`PatchOptions::keep_centre`] rewrote a tip (rounded as written).
+    pub xyz_mm: Vec<[f64; 3]>,
+    /// Which points' X, Y, Z changed.
+    pub xyz_changed: Vec<[bool; 3]>,
+    /// Decimal places to write the changed X Y Z with, in the file's unit (≥ those of
+    /// [`PatchOptions::keep_centre`]); 0 when none changed.
+    pub xyz_decimals: usize,
     /// One row per zone.
     pub zones: Vec<ZoneReport>,
 }
@@ -467,6 +556,9 @@ impl PatchResult {
             c_deg: path.axes.iter().map(|q| q[Axis::C.index()]).collect(),
             c_changed: vec![false; n],
             c_decimals: opts.c_decimals,
+            xyz_mm: path.axes.iter().map(|q| [q[0], q[1], q[2]]).collect(),
+            xyz_changed: vec![[false; 3]; n],
+            xyz_decimals: 0,
             zones: Vec::new(),
         }
     }
@@ -480,6 +572,7 @@ impl PatchResult {
 pub(crate) fn analysis_options(opts: &PatchOptions) -> AnalysisOptions {
     AnalysisOptions {
         cone_deg: opts.cone_deg,
+        pole_reach_deg: opts.pole_reach_deg,
         tcy_s: opts.tcy_s,
         keep_samples: false,
     }
@@ -537,6 +630,20 @@ pub fn figures_over(spans: &[SpanFigures], range: Range<usize>) -> ZoneFigures {
     f
 }
 
+/// Spans on which the machine is slower after than before: the overall ratio (every axis
+/// and the feed) below [`crate::verify::not_worse_floor`] of the ratio before. Where a
+/// patch moves the tips (a ball's centre kept), a linear axis may take over a span's limit
+/// from a rotary axis the patch freed — what counts is that the span gets no slower.
+pub fn whole_run_slower(before: &[SpanFigures], after: &[SpanFigures]) -> Vec<usize> {
+    before
+        .iter()
+        .zip(after)
+        .enumerate()
+        .filter(|(_, (b, a))| a.bound.ratio < crate::verify::not_worse_floor(b.bound.ratio))
+        .map(|(k, _)| k)
+        .collect()
+}
+
 /// Spans of `axes` on which `after` is worse than `before`: its ratio below
 /// [`crate::verify::not_worse_floor`] of the ratio before (the verification's rule).
 pub fn whole_run_worse(before: &[SpanFigures], after: &[SpanFigures], axes: &[Axis]) -> Vec<usize> {
@@ -554,14 +661,99 @@ pub fn whole_run_worse(before: &[SpanFigures], after: &[SpanFigures], axes: &[Ax
         .collect()
 }
 
-/// The path with the rotary values `p`, `c`.
-fn with_values(path: &Path, p: &[f64], c: &[f64]) -> Path {
-    let mut out = path.clone();
-    for (q, (pv, cv)) in out.axes.iter_mut().zip(p.iter().zip(c)) {
-        q[Axis::Primary.index()] = *pv;
-        q[Axis::C.index()] = *cv;
+/// What stays the same for every zone of a path.
+struct Fixed<'a> {
+    path: &'a Path,
+    /// The path length the methods solve on: the path's, or with a ball's centre kept the
+    /// length of the tips the last solve wrote ([`patch_with`]).
+    s: &'a [f64],
+    machine: &'a Machine,
+    opts: &'a PatchOptions,
+    /// The program's tool axes.
+    target: &'a [[f64; 3]],
+    verify: bool,
+}
+
+/// Ask every method for `zone` (points `lower..=end` may change, from the current values
+/// `cur_p`, `cur_c`), down the margin ladder; the best proposal kept.
+fn solve_zone(
+    f: &Fixed<'_>,
+    methods: &mut [Box<dyn Proposer>],
+    zone: Zone,
+    cur_p: &[f64],
+    cur_c: &[f64],
+    lower: usize,
+    end: usize,
+) -> Done {
+    let (path, opts, st) = (f.path, f.opts, &f.opts.solver);
+    let n = path.s_mm.len();
+    let core = zone_core(&zone, n, st.core_margin_points);
+    let mut sel = Selection {
+        s: f.s,
+        axes: &path.axes,
+        target: f.target,
+        machine: f.machine,
+        opts,
+        zone: &zone,
+        p: cur_p,
+        c: cur_c,
+        lower,
+        end,
+        feed_mm_s: path.feed_mm_min / 60.0,
+        verify: f.verify,
+        stats: QpStats::default(),
+        passed: None,
+        improved: None,
+        over_cap_deg: None,
+        as_is: None,
+    };
+    for (rung, factor) in st.margin_ladder.iter().enumerate() {
+        let ctx = ZoneCtx {
+            s: f.s,
+            target: f.target,
+            machine: f.machine,
+            opts,
+            settings: st,
+            feed_mm_min: path.feed_mm_min,
+            zone: &zone,
+            core: core.clone(),
+            lower,
+            end,
+            p: cur_p,
+            c: cur_c,
+            margin: opts.margin * factor,
+            rung,
+        };
+        for m in methods.iter_mut() {
+            m.propose(&ctx, &mut sel);
+            // Re-selection keeps every tool axis (its deviation is the rounding's):
+            // nothing can do better.
+            if sel
+                .passed
+                .as_ref()
+                .is_some_and(|c| c.prop.method == Method::Reselect)
+            {
+                break;
+            }
+        }
+        if sel.passed.is_some() || !f.verify || opts.margin == 0.0 {
+            break;
+        }
     }
-    out
+    let kept = if f.verify {
+        sel.passed.take().or(sel.improved.take())
+    } else {
+        sel.as_is.take()
+    };
+    let (stats, over_cap_deg) = (sel.stats.clone(), sel.over_cap_deg);
+    Done {
+        zone,
+        kept,
+        stats,
+        over_cap_deg,
+        reverted: false,
+        bounds: (lower, end),
+    }
 }
 
 /// Patch every singular zone of `path` with the methods of `opts`' strategy (module
@@ -577,6 +769,12 @@ pub fn patch_path(
 
 /// [`patch_path`] with the given methods (asked in order) and whether their proposals are
 /// verified.
+///
+/// Keeping a ball's centre ([`PatchOptions::keep_centre`]) moves the tips, so the tip
+/// path's length s — Equation 6's parameter — depends on the solution: the zones are
+/// solved again on the length of the tips the last solve wrote, until the lengths agree
+/// within [`CENTRE_S_TOL`] (a fixed point: a few solves), and the solve that reaches feed
+/// on most zones is kept. Every solve is verified on the path as written, with its own s.
 pub fn patch_with(
     path: &Path,
     machine: &Machine,
@@ -584,11 +782,62 @@ pub fn patch_with(
     mut methods: Vec<Box<dyn Proposer>>,
     verify: bool,
 ) -> Result<PatchResult, PathError> {
+    let mut best = patch_on(path, &path.s_mm, machine, opts, &mut methods, verify)?;
+    if opts.keep_centre.is_none_or(|k| !k.s_is_length) {
+        return Ok(best);
+    }
+    let reached = |r: &PatchResult| {
+        r.zones
+            .iter()
+            .filter(|z| z.outcome == Outcome::Reached)
+            .count()
+    };
+    let mut last = best.clone();
+    let mut solve_s = path.s_mm.clone();
+    for _ in 0..CENTRE_S_ITERATIONS {
+        if reached(&best) == best.zones.len() {
+            break;
+        }
+        let s = crate::centre::tip_length(path.s_mm[0], &last.xyz_mm);
+        let moved = s
+            .windows(2)
+            .zip(solve_s.windows(2))
+            .map(|(a, b)| ((a[1] - a[0]) - (b[1] - b[0])).abs() / (b[1] - b[0]))
+            .fold(0.0, f64::max);
+        if moved.is_nan()
+            || moved <= CENTRE_S_TOL
+            || s.windows(2).any(|w| w[1].is_nan() || w[1] <= w[0])
+        {
+            break;
+        }
+        solve_s = s;
+        last = patch_on(path, &solve_s, machine, opts, &mut methods, verify)?;
+        if reached(&last) > reached(&best) {
+            best = last.clone();
+        }
+    }
+    Ok(best)
+}
+
+/// Solves of a path whose tips move to keep a ball's centre, at most ([`patch_with`]).
+const CENTRE_S_ITERATIONS: usize = 4;
+/// Relative change of a block's length below which the tip path's length has settled.
+const CENTRE_S_TOL: f64 = 1e-3;
+
+/// [`patch_with`] with the methods solving on the path length `solve_s`.
+fn patch_on(
+    path: &Path,
+    solve_s: &[f64],
+    machine: &Machine,
+    opts: &PatchOptions,
+    methods: &mut [Box<dyn Proposer>],
+    verify: bool,
+) -> Result<PatchResult, PathError> {
     validate(path)?;
     opts.validate()?;
     let n = path.s_mm.len();
     let (pi, ci) = (Axis::Primary.index(), Axis::C.index());
-    if !path.axes.iter().any(|q| q[pi].abs() <= opts.cone_deg) {
+    if !path.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg()) {
         return Ok(PatchResult::unchanged(path, opts));
     }
     let st = &opts.solver;
@@ -608,95 +857,89 @@ pub fn patch_with(
     let end = if opts.keep_last_point { n - 2 } else { n - 1 };
     let mut lower = 1;
     let mut done: Vec<Done> = Vec::new();
+    let fixed = Fixed {
+        path,
+        s: solve_s,
+        machine,
+        opts,
+        target: &target,
+        verify,
+    };
     for zone in merge_zones(&analysis.zones, st.merge_gap_points) {
-        let core = zone_core(&zone, n, st.core_margin_points);
-        let mut sel = Selection {
-            s: &path.s_mm,
-            target: &target,
-            machine,
-            opts,
-            zone: &zone,
-            p: &cur_p,
-            c: &cur_c,
-            lower,
-            end,
-            feed_mm_s: path.feed_mm_min / 60.0,
-            verify,
-            stats: QpStats::default(),
-            passed: None,
-            improved: None,
-            over_cap_deg: None,
-            as_is: None,
-        };
-        for (rung, factor) in st.margin_ladder.iter().enumerate() {
-            let ctx = ZoneCtx {
-                s: &path.s_mm,
-                target: &target,
-                machine,
-                opts,
-                settings: st,
-                feed_mm_min: path.feed_mm_min,
-                zone: &zone,
-                core: core.clone(),
-                lower,
-                end,
-                p: &cur_p,
-                c: &cur_c,
-                margin: opts.margin * factor,
-                rung,
-            };
-            for m in methods.iter_mut() {
-                m.propose(&ctx, &mut sel);
-                // Re-selection keeps every tool axis (its deviation is the rounding's):
-                // nothing can do better.
-                if sel
-                    .passed
-                    .as_ref()
-                    .is_some_and(|c| c.prop.method == Method::Reselect)
-                {
-                    break;
-                }
-            }
-            if sel.passed.is_some() || !verify || opts.margin == 0.0 {
-                break;
-            }
-        }
-        let kept = if verify {
-            sel.passed.take().or(sel.improved.take())
-        } else {
-            sel.as_is.take()
-        };
-        let (stats, over_cap_deg) = (sel.stats.clone(), sel.over_cap_deg);
-        if let Some(k) = &kept {
+        let d = solve_zone(&fixed, methods, zone, &cur_p, &cur_c, lower, end);
+        if let Some(k) = &d.kept {
             let (p, c) = materialize(&cur_p, &cur_c, &k.prop, 0, n - 1, Some(k.decimals));
             (cur_p, cur_c) = (p, c);
             lower = k.prop.last + 1;
         } else {
-            lower = lower.max(zone.last + 1);
+            lower = lower.max(d.zone.last + 1);
         }
-        done.push(Done {
-            zone,
-            kept,
-            stats,
-            over_cap_deg,
-            reverted: false,
-        });
+        done.push(d);
     }
 
     // Verify what is written, whole: the run analysed again; a zone whose patch made a
     // span of a checked axis worse is put back.
+    // Keeping a ball's centre rewrites X Y Z with the rotary values: they are checked too.
+    // The tips are written with the file's decimals, and more where their rounding would
+    // slow the run (the rounding of a tip moves the path's length s, and jitter in s eats
+    // the rotary axes' jerk budget: at 0.5 mm spacing, 0.5 µm of it takes a third of the
+    // UCP710's A budget at F3000) — up to `max_decimals`, as for the rotary words.
+    let mut keep_written = opts.keep_centre;
     let checked_axes: &[Axis] = match opts.axes {
         PatchAxes::Both => &[Axis::Primary, Axis::C],
         PatchAxes::OnlyC => &[Axis::C],
     };
     let mut spans_after;
+    let mut after_path;
     loop {
-        let after_path = with_values(path, &cur_p, &cur_c);
-        spans_after = analyze_spans(&after_path, machine, &aopts)?.1;
-        if !verify {
-            break;
+        let keep = keep_written.as_ref();
+        // Written tips that do not make a path (two on one spot) count as worse at the
+        // first span.
+        let written = crate::centre::written_path(path, &cur_p, &cur_c, machine, keep);
+        let worse = match &written {
+            Some(w) => {
+                spans_after = analyze_spans(w, machine, &aopts)?.1;
+                if !verify {
+                    after_path = written;
+                    break;
+                }
+                let mut w = whole_run_worse(&spans_before, &spans_after, checked_axes);
+                if keep.is_some() {
+                    // The linear axes the tips moved: the machine may not get slower there.
+                    w.extend(whole_run_slower(&spans_before, &spans_after));
+                    w.sort_unstable();
+                    w.dedup();
+                }
+                w
+            }
+            None => {
+                spans_after = spans_before.clone();
+                vec![0]
+            }
+        };
+        after_path = written;
+        // The tips' rounding may also keep a zone the candidate brought to feed below it:
+        // more decimals first.
+        let short_of_feed = || {
+            done.iter()
+                .filter(|d| d.kept.is_some() && !d.reverted)
+                .any(|d| {
+                    let f =
+                        figures_over(&spans_after, zone_core(&d.zone, n, st.core_margin_points));
+                    let worst = match opts.axes {
+                        PatchAxes::Both => f.c_ratio.min(f.primary_ratio),
+                        PatchAxes::OnlyC => f.c_ratio,
+                    };
+                    worst < 1.0 - RATIO_TOL
+                })
+        };
+        if let Some(kw) = keep_written.as_mut()
+            && kw.decimals < opts.max_decimals
+            && (!worse.is_empty() || short_of_feed())
+        {
+            kw.decimals += 1;
+            continue;
         }
-        let worse = whole_run_worse(&spans_before, &spans_after, checked_axes);
         let Some(&k) = worse.first() else { break };
         // The kept zone whose change lies nearest the worse span.
         let culprit = done
@@ -716,7 +959,14 @@ pub fn patch_with(
                 }
             })
             .map(|(i, _)| i);
-        let Some(i) = culprit else { break };
+        let Some(i) = culprit else {
+            // Nothing left to put back (only possible with written tips that are not a
+            // path): every value as it was.
+            (cur_p, cur_c) = (p0.clone(), c0.clone());
+            after_path = Some(path.clone());
+            spans_after = spans_before.clone();
+            break;
+        };
         // Put it back: its points (and a re-selected or offset tail) as they were.
         let d = &mut done[i];
         let prop = &d.kept.as_ref().map(|c| c.prop.clone());
@@ -730,6 +980,44 @@ pub fn patch_with(
             cur_c[prop.first..=hi].copy_from_slice(&c0[prop.first..=hi]);
         }
         d.reverted = true;
+        // Keeping a ball's centre moves the tips wherever the orientation changes, and a
+        // wide patch may slow a linear axis at a corner far from the zone: narrow the patch
+        // so that span keeps its values, and solve the zone again ("narrow the patch").
+        if let Some(kw) = keep_written.as_mut() {
+            // Start the decimals over for the narrowed patch.
+            kw.decimals = opts.keep_centre.map_or(kw.decimals, |k| k.decimals);
+            let core = zone_core(&d.zone, n, st.core_margin_points);
+            let (lo, hi) = d.bounds;
+            // The analysis spline is not local: a change a few points away still reaches
+            // the span, so each narrowing also steps a quarter of the way to the zone.
+            let narrowed = if k + 1 < core.start {
+                let step = (d.zone.first.saturating_sub(lo) / NARROW_STEP_DIV).max(1);
+                Some(((lo + step).max(k + 2).min(d.zone.first), hi))
+            } else if k >= core.end {
+                let step = (hi.saturating_sub(d.zone.last) / NARROW_STEP_DIV).max(1);
+                Some((
+                    lo,
+                    hi.saturating_sub(step)
+                        .min(k.saturating_sub(1))
+                        .max(d.zone.last),
+                ))
+            } else {
+                None
+            };
+            if let Some((lo2, hi2)) = narrowed
+                && (lo2, hi2) != (lo, hi)
+                && lo2 <= d.zone.first
+                && hi2 >= d.zone.last
+            {
+                let zone = d.zone.clone();
+                let again = solve_zone(&fixed, methods, zone, &cur_p, &cur_c, lo2, hi2);
+                if let Some(kept) = &again.kept {
+                    (cur_p, cur_c) =
+                        materialize(&cur_p, &cur_c, &kept.prop, 0, n - 1, Some(kept.decimals));
+                }
+                done[i] = again;
+            }
+        }
     }
 
     let mut reports = Vec::with_capacity(done.len());
@@ -834,11 +1122,27 @@ pub fn patch_with(
                 Tail::COffset { deg } => deg,
                 _ => 0.0,
             }),
+            needed_deviation_deg: d.over_cap_deg.filter(|_| reason == Reason::DeviationCap),
         });
     }
     let p_changed: Vec<bool> = cur_p.iter().zip(&p0).map(|(a, b)| a != b).collect();
     let c_changed: Vec<bool> = cur_c.iter().zip(&c0).map(|(a, b)| a != b).collect();
+    let xyz_mm: Vec<[f64; 3]> = after_path
+        .as_ref()
+        .unwrap_or(path)
+        .axes
+        .iter()
+        .map(|q| [q[0], q[1], q[2]])
+        .collect();
+    let xyz_changed = xyz_mm
+        .iter()
+        .zip(&path.axes)
+        .map(|(w, q)| std::array::from_fn(|i| w[i] != q[i]))
+        .collect();
     Ok(PatchResult {
+        xyz_mm,
+        xyz_changed,
+        xyz_decimals: keep_written.map_or(0, |k| k.decimals),
         p_decimals: if p_changed.iter().any(|&x| x) {
             decimals.0
         } else {
@@ -881,7 +1185,7 @@ pub fn report_unpatched(
 ) -> Result<Vec<ZoneReport>, PathError> {
     validate(path)?;
     let pi = Axis::Primary.index();
-    if !path.axes.iter().any(|q| q[pi].abs() <= opts.cone_deg) {
+    if !path.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg()) {
         return Ok(Vec::new());
     }
     let n = path.s_mm.len();
@@ -913,6 +1217,7 @@ pub fn report_unpatched(
                 decimals: opts.c_decimals,
                 p_decimals: opts.p_decimals,
                 c_offset_deg: 0.0,
+                needed_deviation_deg: None,
             }
         })
         .collect())
@@ -1082,14 +1387,15 @@ mod tests {
         let res = patch_path(&pole, &m, &PatchOptions::default()).unwrap();
         check_both(&pole, &m, &res, "exact pole");
     }
-    /// No point within the cone: nothing changes, with either method, and no spline work
-    /// is needed (no zone reported).
+    /// No point within reach of the pole (the cone, or the pole reach beyond it): nothing
+    /// changes, with either method, and no spline work is needed (no zone reported).
     #[test]
     fn no_point_in_cone_is_unchanged() {
         let m = machine("mikron-hsm600");
         let mut path = planted(41, 1.0, 8.0, false, 2000.0);
+        let reach = PatchOptions::default().reach_deg();
         for q in &mut path.axes {
-            q[3] = q[3].abs().max(6.0);
+            q[3] = q[3].abs().max(reach + 1.0);
         }
         for axes in [PatchAxes::Both, PatchAxes::OnlyC] {
             let opts = PatchOptions {

@@ -7,6 +7,7 @@
 pub mod analysis;
 pub mod c_only;
 pub mod candidate;
+pub mod centre;
 pub mod direct;
 pub mod driver;
 pub mod g16;
@@ -29,8 +30,12 @@ mod testutil;
 pub mod verify;
 pub(crate) mod window;
 
-pub use analysis::{AnalysisOptions, RunAnalysis, Sample, Zone, ZoneKind, analyze_path};
+pub use analysis::{
+    AnalysisOptions, CONE_DEG, POLE_REACH_DEG, RunAnalysis, Sample, Zone, ZoneKind, analyze_path,
+    pole_dominates,
+};
 pub use candidate::{Candidate, PatchFailure};
+pub use centre::KeepCentre;
 pub use driver::{PatchResult, patch_path, report_unpatched};
 pub use limits::{CLimits, GeomLimits};
 pub use options::{PatchAxes, PatchOptions};

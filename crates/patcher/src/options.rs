@@ -17,8 +17,14 @@ pub enum PatchAxes {
 /// Options of [`crate::patch_path`]. Plain struct: every field public, documented default.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PatchOptions {
-    /// Singular cone, degrees: a zone needs a point with |primary| ≤ this. Default 5.
+    /// Singular cone, degrees: a stretch below feed with a point with |primary| ≤ this is a
+    /// zone; the cone stretch of FREEZE and LINEARIZE. Default
+    /// [`crate::analysis::CONE_DEG`] (5).
     pub cone_deg: f64,
+    /// Pole reach, degrees: out to here a stretch below feed is a zone when the pole
+    /// dominates its slowdown ([`crate::analysis::pole_dominates`]); at or below `cone_deg`
+    /// only the cone counts. Default [`crate::analysis::POLE_REACH_DEG`] (10).
+    pub pole_reach_deg: f64,
     /// Which rotary axes may change. Default [`PatchAxes::Both`].
     pub axes: PatchAxes,
     /// polepatch's method, or a peer's rule for comparison ([`crate::peers`]). Default
@@ -61,6 +67,11 @@ pub struct PatchOptions {
     /// then carries the offset, and the move after the run has to turn C the extra
     /// revolution back, so it is off by default. Default false.
     pub allow_c_offset: bool,
+    /// Keep a ball-end mill's centre where X Y Z are its tip: the tip of every point whose
+    /// orientation changes is rewritten, `tip′ = tip + R·(o − o′)` ([`crate::centre`]), and
+    /// verified with the rotary axes. `None`: X Y Z never change (they are the centre, or
+    /// the tool is not a ball). Default `None`.
+    pub keep_centre: Option<crate::centre::KeepCentre>,
     /// Numerical settings ([`SolverSettings`]). Default [`SolverSettings::default`].
     pub solver: SolverSettings,
 }
@@ -68,7 +79,8 @@ pub struct PatchOptions {
 impl Default for PatchOptions {
     fn default() -> Self {
         PatchOptions {
-            cone_deg: 5.0,
+            cone_deg: crate::analysis::CONE_DEG,
+            pole_reach_deg: crate::analysis::POLE_REACH_DEG,
             axes: PatchAxes::Both,
             strategy: crate::peers::Strategy::Polepatch,
             max_deviation_deg: None,
@@ -81,12 +93,19 @@ impl Default for PatchOptions {
             max_patch_length_mm: None,
             keep_last_point: false,
             allow_c_offset: false,
+            keep_centre: None,
             solver: SolverSettings::default(),
         }
     }
 }
 
 impl PatchOptions {
+    /// How far from the pole a zone can lie, degrees: the larger of the cone and the pole
+    /// reach. A path with no point this close holds no zone.
+    pub fn reach_deg(&self) -> f64 {
+        self.cone_deg.max(self.pole_reach_deg)
+    }
+
     /// Refuse options that would mean nothing: G16's join options with the default
     /// method, a cone, margin or cap out of range.
     pub fn validate(&self) -> Result<(), PathError> {
@@ -109,6 +128,12 @@ impl PatchOptions {
                 self.cone_deg
             ));
         }
+        if !(self.pole_reach_deg.is_finite() && (0.0..=90.0).contains(&self.pole_reach_deg)) {
+            return bad(&format!(
+                "the pole reach must be an angle from 0° to 90°, got {}°",
+                self.pole_reach_deg
+            ));
+        }
         if !(0.0..1.0).contains(&self.margin) {
             return bad(&format!(
                 "the margin must be in [0, 1), got {}",
@@ -119,6 +144,17 @@ impl PatchOptions {
             && !(d.is_finite() && d >= 0.0)
         {
             return bad(&format!("the largest deviation must be ≥ 0°, got {d}°"));
+        }
+        if let Some(k) = &self.keep_centre
+            && !(k.radius_mm.is_finite()
+                && k.radius_mm > 0.0
+                && k.unit_mm.is_finite()
+                && k.unit_mm > 0.0)
+        {
+            return bad(&format!(
+                "keeping a ball's centre needs a positive radius and unit, got {} mm and {} mm",
+                k.radius_mm, k.unit_mm
+            ));
         }
         if let Some(l) = self.max_patch_length_mm
             && !(l.is_finite() && l > 0.0)

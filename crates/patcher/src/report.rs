@@ -255,4 +255,7 @@ pub struct ZoneReport {
     pub p_decimals: usize,
     /// 360° multiple added to C after the zone (0 when none).
     pub c_offset_deg: f64,
+    /// The smallest orientation change, degrees, of a patch found that reaches feed but
+    /// exceeds `max_deviation_deg` (reason [`Reason::DeviationCap`]); `None` otherwise.
+    pub needed_deviation_deg: Option<f64>,
 }

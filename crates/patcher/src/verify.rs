@@ -152,6 +152,22 @@ pub fn verify_change_with_core(
     machine: &Machine,
     feed_mm_s: f64,
 ) -> Verdict {
+    verify_change_on(s_mm, s_mm, changes, changed, core, machine, feed_mm_s)
+}
+
+/// [`verify_change_with_core`] where the values after run on another path length
+/// `s_after_mm` (same points): a change that moves the tips (a ball's centre kept,
+/// [`crate::centre`]) changes the tip path's length too.
+#[allow(clippy::too_many_arguments)]
+pub fn verify_change_on(
+    s_mm: &[f64],
+    s_after_mm: &[f64],
+    changes: &[AxisChange],
+    changed: (usize, usize),
+    core: (usize, usize),
+    machine: &Machine,
+    feed_mm_s: f64,
+) -> Verdict {
     let n = s_mm.len();
     let first = changed.0.min(core.0);
     let last = changed.1.max(core.1).min(n - 1);
@@ -159,8 +175,17 @@ pub fn verify_change_with_core(
     let hi = (last + 1 + VERIFY_MARGIN_POINTS).min(n - 1);
     let nw = hi - lo + 1;
     let s = &s_mm[lo..=hi];
+    let s_after = &s_after_mm[lo..=hi];
     let Ok(sys) = SplineSystem::new(s) else {
         return Verdict::failed();
+    };
+    let sys_after = if s_after == s {
+        None
+    } else {
+        match SplineSystem::new(s_after) {
+            Ok(x) => Some(x),
+            Err(_) => return Verdict::failed(),
+        }
     };
     let core_lo = core.0.saturating_sub(CORE_MARGIN_POINTS).max(lo) - lo;
     let core_hi = (core.1 + CORE_MARGIN_POINTS).min(hi) - lo; // knot index, exclusive span end
@@ -176,8 +201,12 @@ pub fn verify_change_with_core(
         worse_somewhere: false,
     };
     for ch in changes {
-        let ratios = |y: &[f64]| span_ratios(&sys, s, &y[lo..=hi], machine, ch.axis, feed_mm_s);
-        let (Some(before), Some(after)) = (ratios(ch.before), ratios(ch.after)) else {
+        let before = span_ratios(&sys, s, &ch.before[lo..=hi], machine, ch.axis, feed_mm_s);
+        let after = match &sys_after {
+            None => span_ratios(&sys, s, &ch.after[lo..=hi], machine, ch.axis, feed_mm_s),
+            Some(sa) => span_ratios(sa, s_after, &ch.after[lo..=hi], machine, ch.axis, feed_mm_s),
+        };
+        let (Some(before), Some(after)) = (before, after) else {
             return Verdict::failed();
         };
         for k in 0..nw - 1 {

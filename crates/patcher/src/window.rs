@@ -440,7 +440,12 @@ impl Window {
             self.hi
         };
         let a = a.min(self.first);
-        let spans = a.min(core.start)..b.max(self.last).max(core.end).max(a + 1).min(self.hi);
+        // Only the window's spans have rows here: a core that reaches past the window's
+        // ends (a zone wider than the range being solved) is clipped to it — the points
+        // beyond are fixed in this solve, and verification judges the whole zone (a core
+        // reaching before the window panicked on a real Haas UMC program, issue 30).
+        let spans =
+            a.min(core.start).max(self.lo)..b.max(self.last).max(core.end).max(a + 1).min(self.hi);
         let mut taus = Vec::new();
         let push = |f: &Local, bound: f64, out: &mut Vec<(Row, f64, f64)>| {
             out.push((self.reduce(f, offset, stride), f.at(cur), bound));
@@ -708,5 +713,24 @@ mod tests {
                 assert_eq!(moved, b);
             }
         }
+    }
+
+    /// Regression (issue 30, a real Haas UMC program with `--cone 7.5`): a core wider than
+    /// the window, with spans before its first knot, indexed below the window; its rows are
+    /// those of the window's spans only.
+    #[test]
+    fn a_core_wider_than_the_window_is_clipped_to_it() {
+        let (s, y) = data(60);
+        let win = Window::new(&s, 28, 32, 16).unwrap();
+        let cur = win.coeffs(&s, &y).unwrap();
+        let lim = crate::limits::GeomLimits {
+            v: 1.0,
+            a: 1.0,
+            j: 1.0,
+        };
+        let room = vec![[0.0; 3]; win.hi - win.lo + 1];
+        let mut out = Vec::new();
+        win.limit_rows(s.len(), &cur, &y, &lim, &room, 0..59, 0, 1, &mut out);
+        assert!(!out.is_empty());
     }
 }

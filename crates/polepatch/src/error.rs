@@ -93,6 +93,18 @@ pub enum Error {
     /// that is not positive, …).
     #[error("{0}")]
     Path(#[from] polepatch_patcher::PathError),
+    /// A joint value the machine cannot reach ([`crate::joints::cl_to_joints`]), by the
+    /// point's 0-based index.
+    #[error("point {index}: {message}")]
+    OutOfRange {
+        /// 0-based point index.
+        index: usize,
+        /// Which axis, its value and the range.
+        message: String,
+    },
+    /// The caller's [`crate::Hooks::cancelled`] asked the patch to stop.
+    #[error("cancelled")]
+    Cancelled,
 }
 
 impl Error {

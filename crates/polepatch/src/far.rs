@@ -35,7 +35,8 @@ struct Seen {
     feedless: [bool; 2],
 }
 
-/// The report of a program that is proven to have no run point within `opts.cone_deg`
+/// The report of a program that is proven to have no run point within reach of the pole
+/// (`opts.patch.reach_deg()`: the cone, or the pole reach beyond it)
 /// of the pole (no zone: the output is the input), or `None` when that is not proven and
 /// the full path must run. Errors are bad options ([`crate::PatchOptions::check`]) and the
 /// input's syntax errors, as [`crate::patch_nc`] gives them.
@@ -45,7 +46,8 @@ pub fn far_from_pole(
     opts: &crate::PatchOptions,
 ) -> Result<Option<FileReport>, crate::Error> {
     opts.check()?;
-    let cone_deg = opts.patch.cone_deg;
+    // Where a zone can lie: the cone, or the pole reach beyond it.
+    let cone_deg = opts.patch.reach_deg();
     let fallback = opts.feed_fallback_mm_min;
     let mut seen = Seen {
         min_abs_a_deg: f64::INFINITY,
@@ -68,10 +70,10 @@ pub fn far_from_pole(
         }
     };
     let mut i = 0usize;
-    let read = crate::program::read_options(machine)?;
+    let read = crate::program::read_options_with(machine, opts.inch)?;
     let mut notes = crate::notes::Notes::new();
-    let mut prev = polepatch_nc::modal::initial(&read.controller);
-    scan_blocks_with(bytes, &read, |s| {
+    let mut prev = read.initial();
+    let settled = scan_blocks_with(bytes, &read, |s| {
         let (block, st) = (s.block, s.state);
         notes.push(block, s.words, &prev, st);
         prev = *st;
@@ -87,7 +89,9 @@ pub fn far_from_pole(
         }
     })
     .map_err(|e| crate::Error::Parse(e.with_path(&opts.name)))?;
-    if near {
+    // Program flow settles TCPM only on a second read: the full path does it (whether a
+    // point is near the pole does not depend on it, but the report's notes may).
+    if near || matches!(settled, polepatch_nc::Settled::Again(_)) {
         return Ok(None);
     }
     builder.finish(&mut |run| take(run, &mut seen));

@@ -72,6 +72,33 @@ pub fn cl_to_joints(
             ),
         });
     }
+    // A joint value the machine cannot reach is an error, never a silent result: the
+    // primary axis outside its range on the branch the rule picked (issue 26: A = 180° on
+    // a machine whose range ends at 120°), or C outside a bounded range.
+    let letter = machine.primary_letter();
+    for (index, s) in joints.iter().enumerate() {
+        let (lo, hi) = machine.primary_range_deg;
+        if !(lo..=hi).contains(&s.p_deg) {
+            return Err(Error::OutOfRange {
+                index,
+                message: format!(
+                    "{letter} = {:.6}° is outside the machine's range {lo}° to {hi}°",
+                    s.p_deg
+                ),
+            });
+        }
+        if let Some((lo, hi)) = machine.c_range_deg
+            && !(lo..=hi).contains(&s.c_deg)
+        {
+            return Err(Error::OutOfRange {
+                index,
+                message: format!(
+                    "C = {:.6}° is outside the machine's range {lo}° to {hi}°",
+                    s.c_deg
+                ),
+            });
+        }
+    }
     Ok(cl_xyzijk
         .iter()
         .zip(&joints)

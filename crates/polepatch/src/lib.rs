@@ -29,6 +29,7 @@ pub use polepatch_simulate as sim;
 pub mod end_pose;
 pub mod error;
 pub mod far;
+pub mod hooks;
 pub mod joints;
 pub mod machine_frame;
 pub mod notes;
@@ -39,8 +40,10 @@ pub mod reorient;
 pub mod report;
 pub mod simulate;
 pub mod stream;
+pub mod tool;
 
 pub use error::Error;
+pub use hooks::Hooks;
 pub use patch::{FileReport, UntouchedReason, UntouchedRun, ZoneRow, patch_loaded, patch_program};
 pub use report::AnalyzeReport;
 pub use simulate::{SimulateOptions, SimulateReport, simulate_nc, simulate_nc_with};
@@ -65,8 +68,17 @@ pub struct PatchOptions {
     /// With a kinematic chain, for runs without TCPM: how far the tool tip may leave the
     /// programmed line between two points when the rewritten block's axes are
     /// interpolated linearly, mm (never more than the original block did, either).
-    /// Default [`machine_frame::CHORD_TOLERANCE_MM`] (0.005 mm).
+    /// Default [`machine_frame::CHORD_TOLERANCE_MM`] (0.005 mm). Also how far the centre
+    /// of a ball programmed at its tip may leave its original path between two points
+    /// ([`tool`]).
     pub chord_tolerance_mm: f64,
+    /// The cutting tool and the point X Y Z state ([`tool`]). Default: from the program
+    /// and the TCPM codes.
+    pub tool: tool::ToolOptions,
+    /// Read a program that states no length units (no G20/G21, G70/G71, G700/G710,
+    /// `%NAME G71`, `BEGIN PGM … MM|INCH`) in inches, as a control set to inches does
+    /// (`--units inch`). Default false: mm. The report's warnings say which was assumed.
+    pub inch: bool,
 }
 
 impl Default for PatchOptions {
@@ -77,6 +89,8 @@ impl Default for PatchOptions {
             name: "input".to_string(),
             work_offset_mm: None,
             chord_tolerance_mm: machine_frame::CHORD_TOLERANCE_MM,
+            tool: tool::ToolOptions::default(),
+            inch: false,
         }
     }
 }
@@ -92,6 +106,9 @@ pub struct AnalyzeOptions {
     pub name: String,
     /// Work offset for a machine with a kinematic chain (as [`PatchOptions::work_offset_mm`]).
     pub work_offset_mm: Option<[f64; 3]>,
+    /// Read a program that states no length units in inches (as [`PatchOptions::inch`]).
+    /// Default false: mm.
+    pub inch: bool,
 }
 
 impl Default for AnalyzeOptions {
@@ -101,6 +118,7 @@ impl Default for AnalyzeOptions {
             feed_fallback_mm_min: None,
             name: "input".to_string(),
             work_offset_mm: None,
+            inch: false,
         }
     }
 }
@@ -173,6 +191,7 @@ impl PatchOptions {
     /// caller need not; a front end checks earlier only to name its own flags.
     pub fn check(&self) -> Result<(), Error> {
         check_patcher_options(&self.patch)?;
+        self.tool.check()?;
         check_common(self.feed_fallback_mm_min, self.work_offset_mm)
     }
 }
@@ -232,12 +251,28 @@ pub fn patch_nc_to(
     opts: &PatchOptions,
     out: &mut dyn std::io::Write,
 ) -> Result<FileReport, Error> {
+    patch_nc_hooked(bytes, machine, opts, out, Hooks::NONE)
+}
+
+/// [`patch_nc_to`] with [`Hooks`]: progress as the output is written, and a cancellation
+/// check between stretches (a cancelled patch ends with [`Error::Cancelled`]).
+pub fn patch_nc_hooked(
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &PatchOptions,
+    out: &mut dyn std::io::Write,
+    hooks: Hooks<'_>,
+) -> Result<FileReport, Error> {
     let cl_instead = |e| program::or_cl_file(e, bytes, &opts.name);
+    if (hooks.cancelled)() {
+        return Err(Error::Cancelled);
+    }
     if let Some(report) = far::far_from_pole(bytes, machine, opts).map_err(cl_instead)? {
         out.write_all(bytes).map_err(Error::Output)?;
+        (hooks.progress)(bytes.len(), bytes.len());
         return Ok(report);
     }
-    stream::patch_nc_to(bytes, machine, opts, out).map_err(cl_instead)
+    stream::patch_nc_hooked(bytes, machine, opts, out, hooks).map_err(cl_instead)
 }
 
 /// Equation 6 along every run of an NC program held in memory (what `polepatch analyze`

@@ -11,8 +11,10 @@
 //!   them is not analysed, so a slowdown there would go unseen;
 //! - conversational lines polepatch does not model;
 //! - moves with a feed per revolution (G95), which has no time base;
-//! - and, as warnings: letters carried through without analysis (`E`, `U`, `V`, `W`) and
-//!   `(` comments without `)` that hide what looks like axis words.
+//! - and, as warnings: letters carried through without analysis (`E`, `U`, `V`, `W`),
+//!   `(` comments without `)` that hide what looks like axis words, and the length units
+//!   assumed when the program states none (nothing in a Haas program without `G20` tells
+//!   its inches from mm: the report says which was read, `--units` says which to read).
 //!
 //! `--strict` counts the items (not the warnings) as a failure: the file was read, but
 //! not all of it was analysed.
@@ -35,6 +37,9 @@ pub enum SkipReason {
     NotModelled,
     /// A move with a feed per revolution (G95).
     FeedPerRevolution,
+    /// A posted CL file's `INSERT/` text, written as it is between two moves near the pole
+    /// (`post`): polepatch does not read what it does to the motion.
+    Insert,
 }
 
 /// Lines carried through without analysis, and why.
@@ -64,9 +69,17 @@ pub struct Notes {
     items: Vec<Item>,
     /// First line of each letter carried through (E U V W), in `b"EUVW"` order.
     other_letters: [Option<usize>; 4],
+    /// First line of an A word and of a B word: the tilting letter that is not analysed is
+    /// named once.
+    tilt_first: [Option<usize>; 2],
     /// Lines of unclosed comments that hide axis-like words (the first few).
     unclosed: Vec<usize>,
     unclosed_count: usize,
+    /// The units a program is read in until it states them (`None` before the first
+    /// block): inches when true.
+    default_inch: Option<bool>,
+    /// The first block that states the units: its line and whether they are inches.
+    stated: Option<(usize, bool)>,
 }
 
 /// At most this many lines are named for one kind of warning.
@@ -105,6 +118,10 @@ impl Notes {
         };
         let near = [min_abs(A), min_abs(B)];
         let always = [0.0, 0.0];
+        self.default_inch.get_or_insert(before.inch);
+        if f.has(Flags::UNITS) && self.stated.is_none() {
+            self.stated = Some((line, after.inch));
+        }
         if f.has(Flags::NOT_ANALYSABLE) {
             self.add(line, SkipReason::Expression, always);
         }
@@ -136,6 +153,9 @@ impl Notes {
         for w in words {
             if let Some(k) = b"EUVW".iter().position(|&l| l == w.letter) {
                 self.other_letters[k].get_or_insert(line);
+            }
+            if let Some(k) = b"AB".iter().position(|&l| l == w.letter) {
+                self.tilt_first[k].get_or_insert(line);
             }
         }
     }
@@ -173,6 +193,30 @@ impl Notes {
                  analyses X Y Z, the tilting axis and C)",
                 letters.join(", ")
             ));
+        }
+        // The other tilting letter (B when A is analysed): an axis of another machine.
+        let (own, other) = if l == 0 { ('A', 'B') } else { ('B', 'A') };
+        if let Some(line) = self.tilt_first[1 - l] {
+            warnings.push(format!(
+                "{name}: words {other} (first at line {line}) are of a rotary axis the machine \
+                 does not have (the program is read with {own} and C): they are carried through \
+                 as written, and runs that turn {other} or hold it away from 0 are not analysed"
+            ));
+        }
+        if self.stated.is_none()
+            && let Some(inch) = self.default_inch
+        {
+            warnings.push(if inch {
+                format!(
+                    "{name}: the program states no length units (G20/G21, G70/G71, BEGIN PGM … \
+                     MM|INCH): read in inches, as asked (--units inch)"
+                )
+            } else {
+                format!(
+                    "{name}: the program states no length units (G20/G21, G70/G71, BEGIN PGM … \
+                     MM|INCH): read in mm; if it is written in inches, give --units inch"
+                )
+            });
         }
         if self.unclosed_count > 0 {
             let lines: Vec<String> = self.unclosed.iter().map(|l| l.to_string()).collect();
@@ -220,7 +264,22 @@ fn message(reason: SkipReason, lines: [usize; 2]) -> String {
         SkipReason::FeedPerRevolution => {
             format!("{at}: feed per revolution (G95) has no time base for Equation 6; not analysed")
         }
+        SkipReason::Insert => insert_message(lines[0], 0),
     }
+}
+
+/// The message of an `INSERT` text written at program line `line` from CL line `cl_line`
+/// (0: not known) near the pole.
+pub(crate) fn insert_message(line: usize, cl_line: usize) -> String {
+    let from = if cl_line > 0 {
+        format!(" (CL line {cl_line})")
+    } else {
+        String::new()
+    };
+    format!(
+        "line {line}: INSERT text{from} written as it is between moves near the pole; polepatch \
+         does not read what it does to the motion, so no run is analysed across it"
+    )
 }
 
 #[cfg(test)]
@@ -263,10 +322,64 @@ mod tests {
         assert_eq!(items.len(), 1, "{items:?}");
         assert_eq!(items[0].lines, [2, 3]);
         assert_eq!(items[0].reason, SkipReason::Expression);
-        assert_eq!(warnings.len(), 1);
+        assert_eq!(warnings.len(), 2, "{warnings:?}");
         assert!(
             warnings[0].contains("E (first at line 3), U (first at line 4)"),
             "{warnings:?}"
         );
+        assert!(
+            warnings[1].contains("states no length units"),
+            "{warnings:?}"
+        );
+    }
+
+    /// Issue 30 item 2: the units read are said when the program does not state them; a
+    /// program that states them (anywhere) gets no such warning.
+    #[test]
+    fn units_assumed_are_said() {
+        let (_, w) = notes("G1 X0 Y0 Z0 A2 C0 F100\nX1 C5\n", A);
+        assert!(
+            w.iter()
+                .any(|w| w.contains("read in mm; if it is written in inches, give --units inch")),
+            "{w:?}"
+        );
+        for stated in [
+            "G20\nG1 X0 Y0 Z0 A2 C0 F100\n",
+            "G1 X0 Y0 Z0 A2 C0 F100\nG21\n",
+            "%P G71 *\nN1 G1 X0 A2 C0 F100 *\n",
+        ] {
+            let (_, w) = notes(stated, A);
+            assert!(
+                !w.iter().any(|w| w.contains("length units")),
+                "{stated}: {w:?}"
+            );
+        }
+        let conv = "0 BEGIN PGM PROGRAM IN\n1 L X+.6 Y+4.6 Z+11.9 B+0 C+0 FMAX\n";
+        let (_, w) = notes(conv, B);
+        assert!(!w.iter().any(|w| w.contains("length units")), "{w:?}");
+    }
+
+    /// Issue 30 item 5: the tilting letter that is not analysed is named once, with why.
+    #[test]
+    fn the_other_tilting_letter_is_named() {
+        let text = "G1 X0 Y0 Z0 A0 B225. F10\nX1 A-.274 B279.167\n";
+        let (_, w) = notes(text, A);
+        let other: Vec<_> = w
+            .iter()
+            .filter(|w| w.contains("rotary axis the machine does not have"))
+            .collect();
+        assert_eq!(other.len(), 1, "{w:?}");
+        assert!(
+            other[0].contains("words B (first at line 1)")
+                && other[0].contains("read with A and C"),
+            "{w:?}"
+        );
+        let (_, w) = notes(text, B);
+        assert!(
+            w.iter().any(|w| w.contains("words A (first at line 1)")),
+            "{w:?}"
+        );
+        let (_, w) = notes("G1 X0 Y0 Z0 A2 C0 F100\n", A);
+        assert!(!w.iter().any(|w| w.contains("does not have")), "{w:?}");
     }
 }

@@ -15,8 +15,10 @@
 use crate::machine_frame;
 use crate::program::{LoadedProgram, RunProblem};
 use crate::report::{axis_letter, limit_name, zone_kind_name};
+use crate::tool::{RunTool, ToolKind, ToolPoint};
 use polepatch_kinematics::Machine;
 use polepatch_nc::{Edit, NumberStyle, Tcpm};
+use polepatch_patcher::KeepCentre;
 use polepatch_patcher::{
     Method, Outcome, PatchOptions, QpStatus, ZoneFigures, ZoneReport, patch_path, report_unpatched,
 };
@@ -117,6 +119,32 @@ pub struct ZoneRow {
     /// Feed mode of the run: `G94` (feed per minute) or `G93` (inverse time: each block
     /// keeps its time, F words untouched).
     pub feed_mode: &'static str,
+    /// The tool the run was patched for (`ball D10`, `flat D12`, `bull D10 R2`), `unknown`,
+    /// or `-` for a run that was not patched ([`crate::tool`]).
+    pub tool: String,
+    /// Where the tool was found (`--tool`, `tool table (T5)`, `line 12: TOOL DEF …`), or
+    /// why it is unknown.
+    pub tool_source: String,
+    /// Which point of the tool X Y Z state: `tip`, `centre`, or `-`.
+    pub tool_point: &'static str,
+    /// Why that point (`--tool-point`, the machine file, the TCPM code).
+    pub tool_point_source: String,
+    /// 2·sin(δ/2) for the zone's largest orientation change δ: how far a ball's centre
+    /// moves per mm of its radius when the tool turns about its tip (the figure to read
+    /// when the tool is unknown).
+    pub centre_shift_per_mm_radius: f64,
+    /// The largest displacement of the cutter at a written point, mm: a ball's centre
+    /// (from the written values: 0 within rounding where the centre is kept), the bound
+    /// 2·√(R² + r²)·sin(δ/2) on a flat or bull-nose cutter's end; `None` when the tool is
+    /// unknown.
+    pub max_cutter_shift_mm: Option<f64>,
+    /// A ball programmed at its tip: the largest distance between the centre's path of the
+    /// written blocks and the original's, between the points (the controller moving the
+    /// tip on a line and the rotary axes linearly), mm; `None` otherwise.
+    pub centre_chord_mm: Option<f64>,
+    /// Reason `deviation_cap` or `tool_limited`: the orientation change a patch reaching
+    /// feed needed, degrees.
+    pub needed_deviation_deg: Option<f64>,
 }
 
 /// Report name of a feed mode: `G94`, `G93` or `G95`.
@@ -143,6 +171,9 @@ impl ZoneRow {
         self.reselected_points = 0;
         self.patch_length_mm = 0.0;
         self.c_offset_deg = 0.0;
+        self.centre_shift_per_mm_radius = 0.0;
+        self.max_cutter_shift_mm = self.max_cutter_shift_mm.map(|_| 0.0);
+        self.centre_chord_mm = None;
     }
 }
 
@@ -168,7 +199,7 @@ fn method_name(m: Method) -> &'static str {
 
 impl ZoneRow {
     /// CSV column names of [`ZoneRow::csv_fields`] (the row's fields after `file`).
-    pub const CSV_COLUMNS: [&'static str; 35] = [
+    pub const CSV_COLUMNS: [&'static str; 41] = [
         "run",
         "first_line",
         "last_line",
@@ -204,6 +235,12 @@ impl ZoneRow {
         "primary_decimals",
         "c_offset_deg",
         "feed_mode",
+        "tool",
+        "tool_point",
+        "centre_shift_per_mm_radius",
+        "max_cutter_shift_um",
+        "centre_chord_um",
+        "needed_deviation_deg",
     ];
 
     /// The row as CSV fields, in [`ZoneRow::CSV_COLUMNS`] order.
@@ -251,6 +288,15 @@ impl ZoneRow {
             self.primary_decimals.to_string(),
             format!("{}", self.c_offset_deg),
             self.feed_mode.to_string(),
+            self.tool.clone(),
+            self.tool_point.to_string(),
+            format!("{:.6}", self.centre_shift_per_mm_radius),
+            self.max_cutter_shift_mm
+                .map_or(String::new(), |v| format!("{:.3}", v * 1e3)),
+            self.centre_chord_mm
+                .map_or(String::new(), |v| format!("{:.3}", v * 1e3)),
+            self.needed_deviation_deg
+                .map_or(String::new(), |v| format!("{v:.6}")),
         ]
     }
 
@@ -284,6 +330,16 @@ impl ZoneRow {
             primary_decimals: z.p_decimals,
             c_offset_deg: z.c_offset_deg,
             feed_mode: feed_mode_name(lp.runs[run].run.feed_mode),
+            tool: "-".to_string(),
+            tool_source: String::new(),
+            tool_point: "-",
+            tool_point_source: String::new(),
+            centre_shift_per_mm_radius: crate::tool::centre_shift_per_mm_radius(
+                z.max_deviation_deg,
+            ),
+            max_cutter_shift_mm: None,
+            centre_chord_mm: None,
+            needed_deviation_deg: z.needed_deviation_deg,
         }
     }
 }
@@ -310,6 +366,31 @@ pub enum UntouchedReason {
     FeedTooLow,
     /// A rotary axis moves while its value at some point is unknown.
     UnknownRotary,
+    /// The file does not settle whether TCPM is on (after a call of code outside it, where
+    /// a jump, a label or a loop joins different states, after `TRACON`/`G43.8`:
+    /// [`polepatch_nc::flow`]): X Y Z may be machine coordinates.
+    TcpmUnknown,
+    /// A ball programmed at its tip: keeping its centre at the points would move it off its
+    /// original path between them by more than the chord tolerance ([`crate::tool`]).
+    CentrePath,
+    /// A rotation, scaling or mirror image of the frame is in force (`G68`, `G51`, `G51.1`,
+    /// Heidenhain `G73`/`G72`/`G28`, `CYCL DEF 8/10/11/19/26`, `PLANE`, Sinumerik
+    /// `ROT`/`SCALE`/`MIRROR`, `CYCLE800`): the program's X Y Z and tool axis are not the
+    /// frame polepatch computes in.
+    FrameTransformed,
+    /// The run turns a tilting axis the machine does not have (or holds it away from 0).
+    OtherRotary,
+}
+
+impl UntouchedReason {
+    /// The reason a zone of such a run reports, where it says more than `not_patched`.
+    pub fn zone_reason(self) -> Option<&'static str> {
+        match self {
+            UntouchedReason::TcpmUnknown => Some("tcpm_unknown"),
+            UntouchedReason::FrameTransformed => Some("frame_transformed"),
+            _ => None,
+        }
+    }
 }
 
 /// A run left byte-identical, and why.
@@ -395,7 +476,40 @@ impl FileReport {
     /// low, G93 with differing feeds, an unknown rotary value, invalid values:
     /// [`FileReport::runs_not_analysed`]) and lines carried through without analysis.
     pub fn strict_failures(&self) -> usize {
-        self.zones_below_feed() + self.runs_not_analysed() + self.not_analysed.len()
+        self.zones_below_feed()
+            + self.runs_not_analysed()
+            + self.not_analysed.len()
+            + self.zones_with_unknown_tool()
+    }
+    /// Zones whose tool orientation changed while the tool is unknown: whether the cutter
+    /// stayed on the part cannot be told ([`crate::tool`]).
+    pub fn zones_with_unknown_tool(&self) -> usize {
+        self.zones
+            .iter()
+            .filter(|z| z.tool == "unknown" && z.max_deviation_deg > 0.0)
+            .count()
+    }
+    /// Add, once, the warning a report with [`FileReport::zones_with_unknown_tool`] needs.
+    pub fn warn_unknown_tool(&mut self) {
+        let n = self.zones_with_unknown_tool();
+        if n == 0 {
+            return;
+        }
+        let worst = self
+            .zones
+            .iter()
+            .filter(|z| z.tool == "unknown")
+            .map(|z| z.centre_shift_per_mm_radius)
+            .fold(0.0, f64::max);
+        self.warnings.push(format!(
+            "{}: the tool is not known for {n} changed zone(s): a ball programmed at its tip moves \
+             its centre by up to {:.4} mm per mm of its radius there (the zones' \
+             centre_shift_per_mm_radius), a flat or bull-nose cutter its edge; say the tool \
+             with --tool ball:D, flat:D or bull:D,R, a tool table (--tools FILE), or in the \
+             program (TOOL DEF, the CAM post's tool comments), and the point X Y Z state with \
+             --tool-point tip|centre",
+            self.file, worst
+        ));
     }
     /// Runs that may hold a zone (a point within the cone) but could not be analysed (no
     /// feed, invalid values): whether they reach feed is unknown.
@@ -412,7 +526,9 @@ impl FileReport {
             .filter(|u| {
                 matches!(
                     u.reason,
-                    UntouchedReason::NoTcpm | UntouchedReason::TcpmUncertain
+                    UntouchedReason::NoTcpm
+                        | UntouchedReason::TcpmUncertain
+                        | UntouchedReason::TcpmUnknown
                 ) && u.zones > 0
             })
             .count()
@@ -430,7 +546,9 @@ pub fn patch_program(
 ) -> (Vec<Edit>, FileReport) {
     let program = &lp.program;
     let mut report = FileReport::unchanged(&lp.name, machine, lp.warnings.clone());
-    let (not_analysed, warnings) = lp.notes.finish(lp.primary_index(), opts.cone_deg, &lp.name);
+    let (not_analysed, warnings) = lp
+        .notes
+        .finish(lp.primary_index(), opts.reach_deg(), &lp.name);
     report.not_analysed = not_analysed;
     report.warnings.extend(warnings);
     // The file's number style is only needed when some run comes near the pole; reading
@@ -439,7 +557,7 @@ pub fn patch_program(
     let near_pole = lp.runs.iter().any(|r| {
         r.path
             .as_ref()
-            .is_ok_and(|p| p.axes.iter().any(|q| q[pi].abs() <= opts.cone_deg))
+            .is_ok_and(|p| p.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg()))
     });
     if !near_pole {
         for (r, rp) in lp.runs.iter().enumerate() {
@@ -450,7 +568,7 @@ pub fn patch_program(
                     problem_reason(problem),
                     0,
                     problem.to_string(),
-                    opts.cone_deg,
+                    opts.reach_deg(),
                 ));
             }
         }
@@ -474,6 +592,14 @@ pub fn patch_program(
         ..opts.clone()
     };
     let xyz_decimals = style_of(b'X').decimals.max(machine_frame::MIN_XYZ_DECIMALS);
+    // X Y Z rewritten to keep a ball's centre are written as the file writes them, to a
+    // micrometre at least (a file of round values, `X0.5 Y0 Z-5`, shows no precision).
+    let xyz_file_decimals = [b'X', b'Y', b'Z']
+        .map(|l| style_of(l).decimals)
+        .into_iter()
+        .max()
+        .unwrap_or(0)
+        .max(machine_frame::MIN_XYZ_DECIMALS);
     let mut edits: Vec<Edit> = Vec::new();
     let mut written_c = c_style.decimals;
     let mut written_p = p_style.decimals;
@@ -487,14 +613,14 @@ pub fn patch_program(
                     problem_reason(problem),
                     0,
                     problem.to_string(),
-                    opts.cone_deg,
+                    opts.reach_deg(),
                 ));
                 continue;
             }
         };
         // A zone needs a point in the cone (`detect_zones`): a run with none has nothing to
         // patch or report, and its analysis is skipped.
-        if !path.axes.iter().any(|q| q[pi].abs() <= opts.cone_deg) {
+        if !path.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg()) {
             continue;
         }
         let incremental = rp
@@ -508,7 +634,23 @@ pub fn patch_program(
             .as_ref()
             .and_then(|ch| machine_frame::run_datum(lp, r, lp.work_offset_mm).map(|d| (ch, d)));
         let inch = rp.run.blocks.iter().any(|&b| program.state(b).inch);
-        let leave = if rp.run.tcpm == Tcpm::Uncertain {
+        let leave = if rp.run.transform != 0 {
+            Some((
+                UntouchedReason::FrameTransformed,
+                "a rotation, scaling or mirror image of the frame is in force (G68, G51, G51.1, \
+                 G73/G72/G28 in Heidenhain ISO, CYCL DEF 8/10/11/19/26, PLANE, ROT/SCALE/MIRROR, \
+                 CYCLE800): the program's X Y Z and tool axis are not in the frame polepatch \
+                 computes in, so the run is left as it is",
+            ))
+        } else if rp.run.tcpm == Tcpm::Unknown {
+            Some((
+                UntouchedReason::TcpmUnknown,
+                "whether TCPM is on here is not settled by the file: the run follows a call of \
+                 code outside it, a label or a jump where ways with different TCPM states meet, \
+                 or a code whose effect on TCPM polepatch does not know (TRACON, G43.8); X Y Z \
+                 may be machine coordinates, so the run is left as it is",
+            ))
+        } else if rp.run.tcpm == Tcpm::Uncertain {
             Some((
                 UntouchedReason::TcpmUncertain,
                 "TCPM is switched by a block that block delete (`/`) may skip: whether X Y Z are \
@@ -546,16 +688,20 @@ pub fn patch_program(
             match report_unpatched(path, machine, &opts) {
                 Ok(zones) => {
                     if !zones.is_empty() {
-                        report
-                            .zones
-                            .extend(zones.iter().map(|z| ZoneRow::new(lp, r, z)));
+                        report.zones.extend(zones.iter().map(|z| {
+                            let mut row = ZoneRow::new(lp, r, z);
+                            if let Some(why) = reason.zone_reason() {
+                                row.reason = why;
+                            }
+                            row
+                        }));
                         report.untouched_runs.push(untouched(
                             lp,
                             r,
                             reason,
                             zones.len(),
                             message.to_string(),
-                            opts.cone_deg,
+                            opts.reach_deg(),
                         ));
                     }
                 }
@@ -565,18 +711,50 @@ pub fn patch_program(
                     UntouchedReason::Invalid,
                     0,
                     e.to_string(),
-                    opts.cone_deg,
+                    opts.reach_deg(),
                 )),
             }
             continue;
         }
         let end = crate::end_pose::end_pose(lp, r);
-        let run_opts = PatchOptions {
+        let mut run_opts = PatchOptions {
             // Without TCPM the moves after the run are in machine coordinates: the last
             // point keeps its values (X Y Z included).
             keep_last_point: !rp.run.tcpm.is_on() || !end.free,
             ..opts.clone()
         };
+        // The tool, and what it asks of the patch (crate::tool).
+        let rt = run_tool(lp, r, machine);
+        let mut tool_capped = false;
+        match rt.tool {
+            Some(t) if t.kind == ToolKind::Ball && rt.point == ToolPoint::Tip => {
+                run_opts.keep_centre = Some(KeepCentre {
+                    radius_mm: t.diameter_mm / 2.0,
+                    // Without TCPM the part-frame tips go through the chain, not to the
+                    // file: kept exact there.
+                    decimals: match (rp.run.tcpm.is_on(), inch) {
+                        (false, _) => 9,
+                        (true, false) => xyz_file_decimals,
+                        // 10⁻⁴ inch is 2.5 µm: one more.
+                        (true, true) => xyz_file_decimals.max(MIN_INCH_XYZ_DECIMALS),
+                    },
+                    unit_mm: if inch && rp.run.tcpm.is_on() {
+                        25.4
+                    } else {
+                        1.0
+                    },
+                    s_is_length: rp.run.feed_mode != polepatch_nc::FeedMode::InverseTime,
+                });
+            }
+            Some(t) if t.kind != ToolKind::Ball => {
+                let cap = crate::tool::deviation_cap_deg(&t, lp.tool.surface_tolerance_mm);
+                if run_opts.max_deviation_deg.is_none_or(|c| cap <= c) {
+                    run_opts.max_deviation_deg = Some(cap);
+                    tool_capped = true;
+                }
+            }
+            _ => {}
+        }
         // Without TCPM (and with a chain) the patcher works on the part-frame path.
         let part_path = match (rp.run.tcpm, chain) {
             (Tcpm::Off, Some((ch, d))) => {
@@ -599,7 +777,7 @@ pub fn patch_program(
                     UntouchedReason::Invalid,
                     0,
                     e.to_string(),
-                    opts.cone_deg,
+                    opts.reach_deg(),
                 ));
                 continue;
             }
@@ -607,6 +785,7 @@ pub fn patch_program(
         let first_row = report.zones.len();
         report.zones.extend(result.zones.iter().map(|z| {
             let mut row = ZoneRow::new(lp, r, z);
+            tool_fields(&mut row, &rt, z, work_path, &result, machine, tool_capped);
             row.end_pose = if run_opts.keep_last_point {
                 "pinned"
             } else {
@@ -619,6 +798,38 @@ pub fn patch_program(
             };
             row
         }));
+        // A ball programmed at its tip keeps its centre at the points; between them its
+        // path may not leave the original's line by more than the chord tolerance (where
+        // the original block stayed within it).
+        let chord_limit = lp.chord_tolerance_mm + machine_frame::TIP_TOLERANCE_MM;
+        if let Some(row) = report.zones[first_row..]
+            .iter()
+            .find(|z| z.centre_chord_mm.is_some_and(|c| c > chord_limit))
+        {
+            let why = format!(
+                "between the points of lines {}–{} the ball's centre (X Y Z rewritten to keep it \
+                 at the points) would leave the line between its original positions by {:.3} mm \
+                 with the axes interpolated between the blocks (chord tolerance {} mm; the points \
+                 are too far apart for the orientation change); the run keeps its values",
+                row.lines[0],
+                row.lines[1],
+                row.centre_chord_mm.unwrap_or(0.0),
+                lp.chord_tolerance_mm
+            );
+            for row in &mut report.zones[first_row..] {
+                row.not_written();
+                row.reason = "centre_path";
+            }
+            report.untouched_runs.push(untouched(
+                lp,
+                r,
+                UntouchedReason::CentrePath,
+                result.zones.len(),
+                why,
+                opts.cone_deg,
+            ));
+            continue;
+        }
         let mut run_edits: Vec<Edit> = Vec::new();
         if let Some((ch, d)) = chain {
             match through_chain(
@@ -646,13 +857,44 @@ pub fn patch_program(
                         UntouchedReason::MachineFrame,
                         result.zones.len(),
                         why,
-                        opts.cone_deg,
+                        opts.reach_deg(),
                     ));
                     continue;
                 }
             }
         }
         edits.append(&mut run_edits);
+        // A ball's centre kept under TCPM: the tips the patcher rewrote, in the file's unit
+        // and decimals; blocks after the run that restate its last point follow it.
+        if let (Some(keep), true) = (&run_opts.keep_centre, rp.run.tcpm.is_on()) {
+            let n = rp.run.len();
+            for k in 1..n {
+                for (i, letter) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
+                    if !result.xyz_changed[k][i] {
+                        continue;
+                    }
+                    let value = result.xyz_mm[k][i] / keep.unit_mm;
+                    edits.push(Edit {
+                        block: rp.run.blocks[k],
+                        letter,
+                        value,
+                        decimals: result.xyz_decimals,
+                    });
+                    if k == n - 1 && !run_opts.keep_last_point {
+                        for &b in &end.restate {
+                            if program.block_words(b).iter().any(|w| w.letter == letter) {
+                                edits.push(Edit {
+                                    block: b,
+                                    letter,
+                                    value,
+                                    decimals: result.xyz_decimals,
+                                });
+                            }
+                        }
+                    }
+                }
+            }
+        }
         let letters = [
             (
                 lp.primary_letter,
@@ -701,12 +943,10 @@ pub fn patch_program(
             }
         }
     }
-    let file_decimals = |l: u8| {
-        if l == b'C' {
-            c_style.decimals
-        } else {
-            p_style.decimals
-        }
+    let file_decimals = |l: u8| match l {
+        b'C' => c_style.decimals,
+        b'X' | b'Y' | b'Z' => style_of(l).decimals,
+        _ => p_style.decimals,
     };
     // Inside a run, a point that relied on a modal value keeps it; after a run only the
     // blocks that restate its last values are written: its end point only moves when what
@@ -766,11 +1006,8 @@ fn through_chain(
         if tcpm || !changed(k) {
             continue;
         }
-        let tip = [
-            work_path.axes[k][0],
-            work_path.axes[k][1],
-            work_path.axes[k][2],
-        ];
+        // The part-frame tip as the patch wants it (moved to keep a ball's centre).
+        let tip = result.xyz_mm[k];
         let (p, c) = (result.p_deg[k], result.c_deg[k]);
         let exact = chain.program_xyz(machine, datum_mm, p, c, tip);
         let mut written = exact;
@@ -818,12 +1055,15 @@ fn through_chain(
                     work_path.axes[i][2],
                 ]
             };
-            let tips = [tip(k - 1), tip(k)];
-            let err = |from: &[f64; 5], to: &[f64; 5]| {
+            let err = |from: &[f64; 5], to: &[f64; 5], tips| {
                 machine_frame::chord_error_mm(chain, machine, datum_mm, from, to, tips)
             };
-            let new = err(&after[k - 1], &after[k]);
-            let old = err(&path.axes[k - 1], &path.axes[k]);
+            let new = err(
+                &after[k - 1],
+                &after[k],
+                [result.xyz_mm[k - 1], result.xyz_mm[k]],
+            );
+            let old = err(&path.axes[k - 1], &path.axes[k], [tip(k - 1), tip(k)]);
             // The endpoints themselves may move by the tip tolerance (rounding).
             if new > chord_tolerance_mm.max(old) + machine_frame::TIP_TOLERANCE_MM {
                 return Err(format!(
@@ -839,6 +1079,7 @@ fn through_chain(
     }
     let aopts = polepatch_patcher::AnalysisOptions {
         cone_deg: opts.cone_deg,
+        pole_reach_deg: opts.pole_reach_deg,
         tcy_s: opts.tcy_s,
         keep_samples: false,
     };
@@ -869,11 +1110,150 @@ fn through_chain(
     Ok(edits)
 }
 
+/// Run `r`'s tool and the point its X Y Z state ([`crate::tool::resolve`]).
+fn run_tool(lp: &LoadedProgram, r: usize, machine: &Machine) -> RunTool {
+    let rp = &lp.runs[r];
+    let machine_point = machine
+        .controller
+        .tool_point
+        .as_deref()
+        .and_then(|p| ToolPoint::parse(p).ok());
+    let code = if !rp.run.tcpm.is_on() {
+        "no TCPM: X Y Z through the kinematic chain are the tool tip's"
+    } else if rp.run.tcpm_centre {
+        "M128 or FUNCTION TCPM … REFPNT CENTER-CENTER: the tool length refers to the ball's centre"
+    } else {
+        "the TCPM code in force (FUNCTION TCPM, TRAORI, G43.4, G234, …) refers to the tool tip"
+    };
+    crate::tool::resolve(
+        &lp.tool,
+        &rp.found_tool,
+        machine_point,
+        rp.run.tcpm_centre,
+        code,
+    )
+}
+
+/// Fewest decimals for X Y Z of an inch program rewritten to keep a ball's centre
+/// (5: 0.25 µm per axis).
+const MIN_INCH_XYZ_DECIMALS: usize = 5;
+
+/// Distance from `p` to the segment `a`–`b`, mm.
+fn point_segment_mm(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
+    let ab: [f64; 3] = std::array::from_fn(|i| b[i] - a[i]);
+    let ap: [f64; 3] = std::array::from_fn(|i| p[i] - a[i]);
+    let len2: f64 = ab.iter().map(|v| v * v).sum();
+    let t = if len2 > 0.0 {
+        (ab.iter().zip(&ap).map(|(x, y)| x * y).sum::<f64>() / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (0..3)
+        .map(|i| (ap[i] - t * ab[i]).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// Points sampled inside each block for the centre's path between two points.
+const CENTRE_CHORD_SAMPLES: usize = 8;
+
+/// The tool figures of a patched zone's row (module [`crate::tool`]): the tool and its
+/// point, the cutter's largest displacement at a written point, the centre's path between
+/// the points (a ball at its tip), and `tool_limited` where the tool's cap stopped it.
+#[allow(clippy::too_many_arguments)]
+fn tool_fields(
+    row: &mut ZoneRow,
+    rt: &RunTool,
+    z: &ZoneReport,
+    before: &polepatch_patcher::Path,
+    result: &polepatch_patcher::PatchResult,
+    machine: &Machine,
+    tool_capped: bool,
+) {
+    use polepatch_kinematics::forward;
+    row.tool = rt.tool.map_or("unknown".to_string(), |t| t.describe());
+    row.tool_source = rt.tool_source.clone();
+    row.tool_point = rt.point.name();
+    row.tool_point_source = rt.point_source.clone();
+    if tool_capped && z.reason == polepatch_patcher::Reason::DeviationCap {
+        row.reason = "tool_limited";
+    }
+    let Some(tool) = rt.tool else { return };
+    let at = |k: usize, t: f64| -> ([f64; 3], [f64; 3], [f64; 3], [f64; 3]) {
+        // Tip and tool axis at parameter t of block k (k − 1 → k), before and after.
+        let lerp = |a: f64, b: f64| a + (b - a) * t;
+        let q0: [f64; 5] = std::array::from_fn(|i| lerp(before.axes[k - 1][i], before.axes[k][i]));
+        let x1 = |j: usize| {
+            [
+                result.xyz_mm[j][0],
+                result.xyz_mm[j][1],
+                result.xyz_mm[j][2],
+            ]
+        };
+        let (a, b) = (x1(k - 1), x1(k));
+        let tip1: [f64; 3] = std::array::from_fn(|i| lerp(a[i], b[i]));
+        let p1 = lerp(result.p_deg[k - 1], result.p_deg[k]);
+        let c1 = lerp(result.c_deg[k - 1], result.c_deg[k]);
+        (
+            [q0[0], q0[1], q0[2]],
+            forward(machine, q0[3], q0[4]),
+            tip1,
+            forward(machine, p1, c1),
+        )
+    };
+    let dist = |a: [f64; 3], b: [f64; 3]| (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>().sqrt();
+    match tool.kind {
+        ToolKind::Ball => {
+            let reach = if rt.point == ToolPoint::Tip {
+                tool.diameter_mm / 2.0
+            } else {
+                0.0
+            };
+            let centre = |tip: [f64; 3], o: [f64; 3]| -> [f64; 3] {
+                std::array::from_fn(|i| tip[i] + reach * o[i])
+            };
+            let mut at_points: f64 = 0.0;
+            let mut between: f64 = 0.0;
+            let m = CENTRE_CHORD_SAMPLES;
+            for k in z.first.max(1)..=z.last {
+                let (t0, o0, t1, o1) = at(k, 1.0);
+                at_points = at_points.max(dist(centre(t0, o0), centre(t1, o1)));
+                if rt.point != ToolPoint::Tip {
+                    continue;
+                }
+                // Between the points: how far the centre leaves the line between the
+                // block's original centres (what CAM's chord tolerance bounds), written
+                // against original; only where the written block leaves it more.
+                let (a0, ao, _, _) = at(k, 0.0);
+                let (b0, bo, _, _) = at(k, 1.0);
+                let (a, b) = (centre(a0, ao), centre(b0, bo));
+                let (mut old_dev, mut new_dev): (f64, f64) = (0.0, 0.0);
+                for s in 1..m {
+                    let (t0, o0, t1, o1) = at(k, s as f64 / m as f64);
+                    old_dev = old_dev.max(point_segment_mm(centre(t0, o0), a, b));
+                    new_dev = new_dev.max(point_segment_mm(centre(t1, o1), a, b));
+                }
+                if new_dev > old_dev {
+                    between = between.max(new_dev);
+                }
+            }
+            row.max_cutter_shift_mm = Some(at_points);
+            row.centre_chord_mm = (rt.point == ToolPoint::Tip).then_some(between);
+        }
+        ToolKind::Flat | ToolKind::Bull => {
+            row.max_cutter_shift_mm = Some(
+                tool.end_reach_mm() * crate::tool::centre_shift_per_mm_radius(z.max_deviation_deg),
+            );
+        }
+    }
+}
+
 fn problem_reason(p: &RunProblem) -> UntouchedReason {
     match p {
         RunProblem::NoFeed => UntouchedReason::NoFeed,
         RunProblem::FeedTooLow { .. } => UntouchedReason::FeedTooLow,
         RunProblem::UnknownRotary { .. } => UntouchedReason::UnknownRotary,
+        RunProblem::OtherRotary { .. } => UntouchedReason::OtherRotary,
     }
 }
 
@@ -907,7 +1287,8 @@ pub fn patch_loaded(
     machine: &Machine,
     opts: &PatchOptions,
 ) -> (Vec<u8>, FileReport) {
-    let (edits, report) = patch_program(lp, machine, opts);
+    let (edits, mut report) = patch_program(lp, machine, opts);
+    report.warn_unknown_tool();
     let bytes = if edits.is_empty() {
         lp.program.bytes.clone()
     } else {

@@ -557,6 +557,10 @@ impl Poster<'_> {
                 self.items.push(Item::Comment(c.clone()));
                 Ok(())
             }
+            ClItem::Insert { text, .. } => {
+                self.items.push(Item::Raw(text.clone()));
+                Ok(())
+            }
         }
     }
 
@@ -659,6 +663,106 @@ pub fn post_items(
     Ok(p.items)
 }
 
+/// The tool of a posted program where the caller did not say it: the CL file's `CUTTER/` or
+/// `TLDATA/` ([`crate::tool::cl_tool`]), and the tool tip as the point (APT's `GOTO/` states
+/// the tip). The patch then keeps a ball's centre and caps a flat or bull-nose cutter's
+/// orientation change ([`crate::tool`]). `cl_bytes` are the CL file's bytes, `cl` as read.
+pub fn tool_from_cl(cl_bytes: &[u8], cl: &ClProgram, opts: &mut PostOptions) {
+    let t = &mut opts.patch_options.tool;
+    if t.tool.is_none() {
+        let unit_mm = if cl.units == Units::Inch { 25.4 } else { 1.0 };
+        t.tool = crate::tool::cl_tool(cl_bytes, unit_mm).map(|(tool, _)| tool);
+    }
+    if t.point.is_none() {
+        t.point = Some(crate::tool::ToolPoint::Tip);
+    }
+}
+
+/// The CL file's `INSERT` records in the patch report: each one where it was written (a
+/// warning), and those between two moves with the primary axis within `cone_deg` on
+/// either side (the reach of the pole) as lines not analysed — the text is the user's, polepatch does
+/// not read what it does to the motion there.
+fn list_inserts(
+    cl: &ClProgram,
+    items: &[Item],
+    out: &[u8],
+    cone_deg: f64,
+    report: &mut FileReport,
+) {
+    let texts: Vec<(&str, usize)> = cl
+        .items
+        .iter()
+        .filter_map(|i| match i {
+            ClItem::Insert { text, at } => Some((text.as_str(), at.line)),
+            _ => None,
+        })
+        .collect();
+    if texts.is_empty() {
+        return;
+    }
+    // The primary axis of the moves either side of each raw line, in item order.
+    let mut near = Vec::with_capacity(texts.len());
+    for (k, item) in items.iter().enumerate() {
+        if !matches!(item, Item::Raw(_)) {
+            continue;
+        }
+        let p = |it: &Item| match it {
+            Item::Move(m) => Some(m.p_deg),
+            _ => None,
+        };
+        let before = items[..k].iter().rev().find_map(p);
+        let after = items[k + 1..].iter().find_map(p);
+        // Text before the first move or after the last cuts no run.
+        near.push(
+            before
+                .zip(after)
+                .is_some_and(|(b, a)| b.abs().min(a.abs()) <= cone_deg),
+        );
+    }
+    // Program lines of the raw lines, in order.
+    let mut next = 0;
+    let mut lines = Vec::with_capacity(texts.len());
+    // (The post writes `\n` line ends.)
+    for (n, line) in out.split(|&b| b == b'\n').enumerate() {
+        if next < texts.len() && line == texts[next].0.as_bytes() {
+            lines.push(n + 1);
+            next += 1;
+        }
+    }
+    for (k, &(text, cl_line)) in texts.iter().enumerate() {
+        let Some(&line) = lines.get(k) else { break };
+        report.warnings.push(format!(
+            "{}: line {cl_line}: INSERT/{text} written as it is at line {line} of the program",
+            cl_name(report)
+        ));
+        if near.get(k) == Some(&true) {
+            report.not_analysed.push(crate::notes::NotAnalysed {
+                lines: [line, line],
+                reason: crate::notes::SkipReason::Insert,
+                message: crate::notes::insert_message(line, cl_line),
+            });
+        }
+    }
+    report.not_analysed.sort_by_key(|n| n.lines);
+}
+
+/// The `INSERT` record (text, where) written at program line `line` of `out`, if any.
+fn insert_at<'a>(
+    cl: &'a ClProgram,
+    out: &[u8],
+    line: usize,
+) -> Option<(&'a str, polepatch_cl::At)> {
+    let text = out.split(|&b| b == b'\n').nth(line.checked_sub(1)?)?;
+    cl.items.iter().find_map(|i| match i {
+        ClItem::Insert { text: t, at } if t.as_bytes() == text => Some((t.as_str(), *at)),
+        _ => None,
+    })
+}
+
+fn cl_name(report: &FileReport) -> &str {
+    &report.file
+}
+
 /// Post a CL program for `machine`: the NC bytes and, when patched, the patch report
 /// (`None` with `patch: false`, or when the program has no G1 run for the patch to look at:
 /// holes and rapids only).
@@ -667,6 +771,12 @@ pub fn post_cl(
     machine: &Machine,
     opts: &PostOptions,
 ) -> Result<(Vec<u8>, Option<FileReport>), Error> {
+    if opts.dialect == Dialect::MillPlus {
+        return Err(Error::Options(
+            "MillPlus programs are read, not written: post for heidenhain, sinumerik or fanuc"
+                .into(),
+        ));
+    }
     let inch = opts.units.unwrap_or(cl.units) == Units::Inch;
     if inch
         && matches!(
@@ -711,7 +821,30 @@ pub fn post_cl(
         return Ok((bytes, None));
     }
     match crate::patch_nc(&bytes, machine, &opts.patch_options) {
-        Ok((out, report)) => Ok((out, Some(report))),
+        Ok((out, mut report)) => {
+            list_inserts(
+                cl,
+                &items,
+                &out,
+                opts.patch_options.patch.reach_deg(),
+                &mut report,
+            );
+            Ok((out, Some(report)))
+        }
+        // An INSERT's text the reader cannot read: said at its CL line.
+        Err(Error::Parse(e)) if insert_at(cl, &bytes, e.line).is_some() => {
+            let (text, at) = insert_at(cl, &bytes, e.line).expect("matched");
+            Err(cl_error(
+                &opts.patch_options.name,
+                at.line,
+                at.column,
+                format!(
+                    "INSERT/{text}: its text, written as it is at line {} of the program, is not \
+                     an NC block polepatch can read ({}); skip INSERT records with --ignore INSERT",
+                    e.line, e.message
+                ),
+            ))
+        }
         // A program of holes and rapids only: nothing for the patch to look at.
         Err(Error::NoRuns { .. }) => Ok((bytes, None)),
         Err(e) => Err(e),

@@ -23,6 +23,16 @@ pub enum RunProblem {
         /// The letter.
         letter: char,
     },
+    /// The run turns a tilting axis other than the one analysed (`B` in a program read
+    /// with `A` and `C`: an A-B trunnion's program on an A-C machine), or holds it away
+    /// from 0: the tool axis depends on an axis the machine does not have, so nothing the
+    /// analysis says about the run would be true.
+    OtherRotary {
+        /// The letter the machine does not have.
+        letter: char,
+        /// The letters analysed (`"A and C"`).
+        analysed: String,
+    },
 }
 
 /// The lowest feed polepatch analyses, mm/min. Equation 6 itself has no lower limit, but a
@@ -39,20 +49,36 @@ impl std::fmt::Display for RunProblem {
             }
             RunProblem::FeedTooLow { feed_mm_min, line } => write!(
                 f,
-                "line {line}: feed F{feed_mm_min} mm/min is below polepatch's minimum of \
-                 {MIN_FEED_MM_MIN} mm/min; the run is left as it is"
+                "line {line}: feed F{} mm/min is below polepatch's minimum of \
+                 {MIN_FEED_MM_MIN} mm/min; the run is left as it is",
+                crate::report::feed_text(*feed_mm_min)
             ),
             RunProblem::UnknownRotary { letter } => write!(
                 f,
                 "the rotary axes move in this run but {letter} is unknown at some of its points \
                  (after an expression, a datum change or a call); the run is left as it is"
             ),
+            RunProblem::OtherRotary { letter, analysed } => write!(
+                f,
+                "the run turns {letter} (or holds it away from 0), an axis the machine does not \
+                 have — polepatch analyses {analysed} — so its words are carried through as \
+                 written and the run is left as it is"
+            ),
         }
     }
 }
 
-/// How to read programs for `machine`: the dialect detected, the machine's TCPM codes.
+/// How to read programs for `machine`: the dialect detected, the machine's TCPM codes, mm
+/// when the program states no units.
 pub fn read_options(machine: &Machine) -> Result<polepatch_nc::ReadOptions, Error> {
+    read_options_with(machine, false)
+}
+
+/// [`read_options`], in inches when the program states no units and `inch` is true.
+pub fn read_options_with(
+    machine: &Machine,
+    inch: bool,
+) -> Result<polepatch_nc::ReadOptions, Error> {
     let codes = |field: &str, list: &[String]| {
         list.iter()
             .map(|c| {
@@ -72,6 +98,8 @@ pub fn read_options(machine: &Machine) -> Result<polepatch_nc::ReadOptions, Erro
             off: codes("tcpm_off", &machine.controller.tcpm_off)?,
             always: machine.controller.tcpm_always,
         },
+        flow: None,
+        inch,
     })
 }
 
@@ -82,6 +110,8 @@ pub struct RunPath {
     pub run: Run,
     /// The path (axes X Y Z P C), or why there is none.
     pub path: Result<Path, RunProblem>,
+    /// What the program says of the tool in use ([`crate::tool::Tracker`]).
+    pub found_tool: crate::tool::FoundTool,
 }
 
 /// A parsed program with its runs as paths for a machine.
@@ -111,6 +141,8 @@ pub struct LoadedProgram {
     /// What the reader carried through without analysing ([`crate::notes`]); empty for a
     /// stretch (the stream lists it once for the file).
     pub notes: crate::notes::Notes,
+    /// The caller's tool options ([`crate::PatchOptions::tool`]).
+    pub tool: crate::tool::ToolOptions,
 }
 
 /// What a stretch of a file ([`LoadedProgram::window`]) needs from the rest of the file,
@@ -165,13 +197,22 @@ impl LoadedProgram {
 /// Parse `bytes` named `name` (for messages) as the NC reader reads programs for
 /// `machine` ([`read_options`]).
 pub fn parse_program(bytes: Vec<u8>, name: &str, machine: &Machine) -> Result<Program, Error> {
+    parse_program_with(bytes, name, &read_options(machine)?)
+}
+
+/// [`parse_program`] with the reading options `read` ([`read_options_with`]).
+pub fn parse_program_with(
+    bytes: Vec<u8>,
+    name: &str,
+    read: &polepatch_nc::ReadOptions,
+) -> Result<Program, Error> {
     if bytes.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(Error::Empty {
             path: name.to_string(),
         });
     }
     let cl = cl_file_error(&bytes, name);
-    polepatch_nc::parse_with(bytes, &read_options(machine)?)
+    polepatch_nc::parse_with(bytes, read)
         .map_err(|e| cl.unwrap_or_else(|| Error::Parse(e.with_path(name))))
 }
 
@@ -233,6 +274,22 @@ pub fn load_nc(
 ) -> Result<LoadedProgram, Error> {
     load(
         parse_program(bytes, name, machine)?,
+        name,
+        machine,
+        feed_fallback_mm_min,
+    )
+}
+
+/// [`load_nc`] with the reading options `read` ([`read_options_with`]).
+pub fn load_nc_with(
+    bytes: Vec<u8>,
+    name: &str,
+    machine: &Machine,
+    feed_fallback_mm_min: Option<f64>,
+    read: &polepatch_nc::ReadOptions,
+) -> Result<LoadedProgram, Error> {
+    load(
+        parse_program_with(bytes, name, read)?,
         name,
         machine,
         feed_fallback_mm_min,
@@ -332,7 +389,11 @@ pub(crate) fn run_path(
         axes: run.axes5(p_idx),
         feed_mm_min: feed,
     });
-    RunPath { run, path }
+    RunPath {
+        run,
+        path,
+        found_tool: crate::tool::FoundTool::default(),
+    }
 }
 
 /// The path parameter of an inverse-time (G93) run whose blocks have different feeds,
@@ -369,8 +430,28 @@ pub(crate) fn run_check(
     first_line: usize,
 ) -> Result<f64, RunProblem> {
     let feed = run_feed(run, feed_fallback_mm_min, first_line)?;
+    other_rotary_still(run, p_idx)?;
     rotary_known(run, p_idx)?;
     Ok(feed)
+}
+
+/// The tilting letter that is not analysed (B when the program is read with A, and the
+/// other way round) may appear in a run only parked at 0 (module docs of
+/// [`RunProblem::OtherRotary`]).
+fn other_rotary_still(run: &Run, p_idx: usize) -> Result<(), RunProblem> {
+    let (other, letter) = if p_idx == modal::A {
+        (modal::B, 'B')
+    } else {
+        (modal::A, 'A')
+    };
+    if run.pos.iter().any(|p| p[other].is_some_and(|v| v != 0.0)) {
+        let own = if p_idx == modal::A { 'A' } else { 'B' };
+        return Err(RunProblem::OtherRotary {
+            letter,
+            analysed: format!("{own} and C"),
+        });
+    }
+    Ok(())
 }
 
 /// A run whose rotary axes (the tilting one at `p_idx`, and C) move may not have a point
@@ -460,12 +541,29 @@ pub fn load(
         .into_iter()
         .collect();
     let mut notes = crate::notes::Notes::new();
+    // The tool of each run: the program's as it stands at the run's last block (a tool
+    // change ends runs, so the state there is the run's).
+    let mut tracker = crate::tool::Tracker::default();
+    let mut found = Vec::with_capacity(runs.len());
+    let mut next_run = 0;
     for b in 0..program.blocks.len() {
         notes.push(
             &program.blocks[b],
             program.block_words(b),
             &program.state_before(b),
             &program.state(b),
+        );
+        while next_run < runs.len() && runs[next_run].blocks.last() == Some(&b) {
+            found.push(tracker.found());
+            next_run += 1;
+        }
+        let blk = &program.blocks[b];
+        tracker.block(
+            program.dialect,
+            blk.line,
+            &program.bytes[blk.span()],
+            program.block_words(b),
+            program.state(b).inch,
         );
     }
     let has = |idx: usize| runs.iter().any(|r| r.uses(idx));
@@ -475,11 +573,15 @@ pub fn load(
             primary: machine.primary_letter(),
         });
     }
+    found.resize(runs.len(), tracker.found());
     let runs = runs
         .into_iter()
-        .map(|run| {
+        .zip(found)
+        .map(|(run, found)| {
             let line = program.blocks[run.blocks[0]].line;
-            run_path(run, p_idx, feed_fallback_mm_min, line)
+            let mut rp = run_path(run, p_idx, feed_fallback_mm_min, line);
+            rp.found_tool = found;
+            rp
         })
         .collect();
     Ok(LoadedProgram {
@@ -492,5 +594,6 @@ pub fn load(
         chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
         window: None,
         notes,
+        tool: crate::tool::ToolOptions::default(),
     })
 }

@@ -137,6 +137,8 @@ pub struct AnalyzeReport {
     pub machine: String,
     /// Singular cone used, degrees.
     pub cone_deg: f64,
+    /// Pole reach used, degrees ([`polepatch_patcher::pole_dominates`]).
+    pub pole_reach_deg: f64,
     /// The tilting letter the program uses as the primary axis (`A` or `B`).
     pub primary: String,
     /// Notes for the user.
@@ -252,7 +254,13 @@ pub fn analyze_program(
                 lines: [lp.line_of(r, 0), lp.line_of(r, n - 1)],
                 points: n,
                 length_mm: rp.run.length_mm(),
-                feed_mm_min: rp.path.as_ref().ok().map(|p| p.feed_mm_min),
+                // The run's F also when it is not analysed.
+                feed_mm_min: rp
+                    .path
+                    .as_ref()
+                    .ok()
+                    .map(|p| p.feed_mm_min)
+                    .or(rp.run.feed_mm_min),
                 feed_mode: crate::patch::feed_mode_name(rp.run.feed_mode),
                 error: None,
                 figures: None,
@@ -272,14 +280,39 @@ pub fn analyze_program(
         })
         .collect();
     let (not_analysed, notes_warnings) =
-        lp.notes.finish(lp.primary_index(), opts.cone_deg, &lp.name);
+        lp.notes
+            .finish(lp.primary_index(), opts.reach_deg(), &lp.name);
     AnalyzeReport {
         file: lp.name.clone(),
         machine: machine.name.clone(),
         cone_deg: opts.cone_deg,
+        pole_reach_deg: opts.pole_reach_deg,
         primary: (lp.primary_letter as char).to_string(),
         warnings: lp.warnings.iter().cloned().chain(notes_warnings).collect(),
         not_analysed,
         runs,
+    }
+}
+
+/// A feed for people, mm/min: at most 3 decimals, trailing zeros dropped (`248.92`, not
+/// `248.92000000000002`, the inch feed F9.8 × 25.4 as computed).
+pub fn feed_text(feed_mm_min: f64) -> String {
+    let s = format!("{feed_mm_min:.3}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".into() } else { s.to_string() }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::feed_text;
+
+    /// Issue 30 item 9: feeds are printed rounded for people.
+    #[test]
+    fn feeds_for_people() {
+        assert_eq!(feed_text(9.8 * 25.4), "248.92");
+        assert_eq!(feed_text(2000.0), "2000");
+        assert_eq!(feed_text(78.7 * 2.54), "199.898");
+        assert_eq!(feed_text(0.0004), "0");
+        assert_eq!(feed_text(1500.5), "1500.5");
     }
 }

@@ -152,7 +152,12 @@ fn run_inputs(lp: &LoadedProgram, machine: &Machine, opts: &SimulateOptions) -> 
                 lines: [lp.line_of(r, 0), lp.line_of(r, n - 1)],
                 points: n,
                 length_mm: rp.run.length_mm(),
-                feed_mm_min: rp.path.as_ref().ok().map(|p| p.feed_mm_min),
+                feed_mm_min: rp
+                    .path
+                    .as_ref()
+                    .ok()
+                    .map(|p| p.feed_mm_min)
+                    .or(rp.run.feed_mm_min),
                 error: None,
                 time_s: 0.0,
                 eq6_time_s: 0.0,

@@ -51,7 +51,7 @@
 use crate::end_pose::{After, EndPose, Scan, Step};
 use crate::error::Error;
 use crate::patch::{FileReport, patch_loaded, patch_program};
-use crate::program::{LoadedProgram, RunPath, Window, load_nc, primary_mismatch_warning, run_path};
+use crate::program::{LoadedProgram, RunPath, Window, primary_mismatch_warning, run_path};
 use crate::report::{AnalyzeReport, RunReport};
 use polepatch_kinematics::Machine;
 use polepatch_nc::modal::{A, B, C};
@@ -89,6 +89,8 @@ struct RunRec {
     end: [EndRec; 2],
     /// Work offset for this run ([`crate::machine_frame::datum_at`]).
     datum_mm: Option<[f64; 3]>,
+    /// The program's tool for this run: an index into [`Survey::tools`].
+    tool: usize,
 }
 
 /// The end pose of a run as the survey finds it ([`crate::end_pose`]).
@@ -136,12 +138,16 @@ impl EndRec {
 /// The first read's findings.
 struct Survey {
     dialect: Dialect,
+    /// How the file is read: the dialect found and its program flow settled.
+    read: polepatch_nc::ReadOptions,
     runs: Vec<RunRec>,
     /// Some run point has a value for X Y Z A B C.
     uses: [bool; 6],
     style: FileStyle,
     /// What the reader carried through without analysing.
     notes: crate::notes::Notes,
+    /// The program's tools as the runs found them ([`RunRec::tool`]), one per change.
+    tools: Vec<crate::tool::FoundTool>,
 }
 
 /// The first read in progress.
@@ -158,6 +164,11 @@ struct Surveying {
     /// The end pose of the open run so far, from the blocks after its last block, per
     /// letter.
     first_after: [EndRec; 2],
+    /// The tool in use ([`crate::tool`]).
+    tracker: crate::tool::Tracker,
+    /// The tools found so far, and the tracker's revision of the last.
+    tools: Vec<crate::tool::FoundTool>,
+    tools_revision: Option<u64>,
 }
 
 impl Surveying {
@@ -174,6 +185,10 @@ impl Surveying {
         }
         let first_block = run.blocks[0];
         let r = self.runs.len();
+        if self.tools_revision != Some(self.tracker.revision()) {
+            self.tools.push(self.tracker.found());
+            self.tools_revision = Some(self.tracker.revision());
+        }
         for (l, rec) in self.first_after.iter().enumerate() {
             if rec.decided.is_none() {
                 self.pending[l].push(r);
@@ -191,6 +206,7 @@ impl Surveying {
                 first_block,
                 self.work_offset_mm,
             ),
+            tool: self.tools.len() - 1,
         });
     }
 
@@ -211,6 +227,7 @@ impl Surveying {
 /// What both reads need to know of the caller's options.
 struct Reading<'a> {
     name: &'a str,
+    /// How far from the pole a zone can lie (the cone, or the pole reach beyond it).
     cone_deg: f64,
     fallback: Option<f64>,
     work_offset_mm: Option<[f64; 3]>,
@@ -218,10 +235,33 @@ struct Reading<'a> {
     read: polepatch_nc::ReadOptions,
     /// Chord tolerance for the chain path, mm.
     chord_tolerance_mm: f64,
+    /// The caller's tool options.
+    tool: crate::tool::ToolOptions,
 }
 
-/// The first read (module docs, step 1).
+/// The first read (module docs, step 1), read again when the file's program flow must
+/// settle the TCPM states ([`polepatch_nc::flow`]).
 fn survey(bytes: &[u8], opts: &Reading<'_>) -> Result<Survey, Error> {
+    let mut read = opts.read.clone();
+    loop {
+        let (mut sv, settled) = survey_once(bytes, opts, &read)?;
+        match settled {
+            polepatch_nc::Settled::Done(dialect) => {
+                sv.dialect = dialect;
+                read.dialect = dialect;
+                sv.read = read;
+                return Ok(sv);
+            }
+            polepatch_nc::Settled::Again(settled) => read = settled,
+        }
+    }
+}
+
+fn survey_once(
+    bytes: &[u8],
+    opts: &Reading<'_>,
+    read: &polepatch_nc::ReadOptions,
+) -> Result<(Survey, polepatch_nc::Settled), Error> {
     let mut sv = Surveying {
         cone_deg: opts.cone_deg,
         fallback: opts.fallback,
@@ -232,13 +272,20 @@ fn survey(bytes: &[u8], opts: &Reading<'_>) -> Result<Survey, Error> {
         frame_changes: Vec::new(),
         pending: [Vec::new(), Vec::new()],
         first_after: [EndRec::default(), EndRec::default()],
+        tracker: crate::tool::Tracker::default(),
+        tools: Vec::new(),
+        tools_revision: None,
+    };
+    let dialect = match read.dialect {
+        Dialect::Auto => polepatch_nc::program::detect(bytes),
+        d => d,
     };
     let mut style = StyleEvidence::default();
     let mut notes = crate::notes::Notes::new();
     let mut builder = RunBuilder::default();
-    let mut prev = polepatch_nc::modal::initial(&opts.read.controller);
+    let mut prev = opts.read.initial();
     let mut i = 0usize;
-    let dialect = scan_blocks_with(bytes, &opts.read, |s: Scanned<'_>| {
+    let settled = scan_blocks_with(bytes, read, |s: Scanned<'_>| {
         style.add_block(bytes, s.words);
         notes.push(s.block, s.words, &prev, s.state);
         if let Some(d) = s.stated_datum {
@@ -256,6 +303,14 @@ fn survey(bytes: &[u8], opts: &Reading<'_>) -> Result<Survey, Error> {
         };
         sv.decide(&after, i, s.block.line);
         builder.push(i, s.block, s.state, &mut |run| sv.take(run));
+        // After the runs this block ends: a tool change is the next run's.
+        sv.tracker.block(
+            dialect,
+            s.block.line,
+            &bytes[s.block.span()],
+            s.words,
+            s.state.inch,
+        );
         // Deciding blocks count from the open run's last block on: when this block
         // extended it, or no run is open, the verdicts seen so far are spent.
         if builder.open_run_last_block().is_none_or(|last| last == i) {
@@ -282,13 +337,18 @@ fn survey(bytes: &[u8], opts: &Reading<'_>) -> Result<Survey, Error> {
             }
         }
     }
-    Ok(Survey {
-        dialect,
-        runs: sv.runs,
-        uses: sv.uses,
-        style: style.style(),
-        notes,
-    })
+    Ok((
+        Survey {
+            dialect: read.dialect,
+            read: read.clone(),
+            runs: sv.runs,
+            uses: sv.uses,
+            style: style.style(),
+            notes,
+            tools: sv.tools,
+        },
+        settled,
+    ))
 }
 
 /// A stretch to parse in full: blocks `first_block..=last_block`, runs `runs` (numbers in
@@ -375,7 +435,13 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
     let sv = survey(bytes, rd)?;
     let p_idx = tilting_index(&sv, machine);
     if sv.runs.is_empty() || (!sv.uses[p_idx] && !sv.uses[C]) {
-        let mut lp = match load_nc(bytes.to_vec(), rd.name, machine, rd.fallback) {
+        let mut lp = match crate::program::load_nc_with(
+            bytes.to_vec(),
+            rd.name,
+            machine,
+            rd.fallback,
+            &rd.read,
+        ) {
             Ok(lp) => lp,
             Err(why) if why.is_nothing_to_analyse() => {
                 return Ok(Begun::Nothing {
@@ -388,6 +454,7 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
         };
         lp.work_offset_mm = rd.work_offset_mm;
         lp.chord_tolerance_mm = rd.chord_tolerance_mm;
+        lp.tool = rd.tool.clone();
         return Ok(Begun::Whole(Box::new(lp)));
     }
     Ok(Begun::Stretches {
@@ -407,19 +474,37 @@ pub fn patch_nc_to(
     opts: &crate::PatchOptions,
     out: &mut dyn Write,
 ) -> Result<FileReport, Error> {
+    patch_nc_hooked(bytes, machine, opts, out, crate::Hooks::NONE)
+}
+
+/// [`patch_nc_to`] with [`crate::Hooks`]: `progress` after each batch of stretches is
+/// written (and at the end), `cancelled` before each stretch is patched and before each
+/// batch is written ([`Error::Cancelled`]).
+pub fn patch_nc_hooked(
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &crate::PatchOptions,
+    out: &mut dyn Write,
+    hooks: crate::Hooks<'_>,
+) -> Result<FileReport, Error> {
     opts.check()?;
     let rd = Reading {
         name: &opts.name,
-        cone_deg: opts.patch.cone_deg,
+        cone_deg: opts.patch.reach_deg(),
         fallback: opts.feed_fallback_mm_min,
         work_offset_mm: opts.work_offset_mm,
-        read: crate::program::read_options(machine)?,
+        read: crate::program::read_options_with(machine, opts.inch)?,
         chord_tolerance_mm: opts.chord_tolerance_mm,
+        tool: opts.tool.clone(),
     };
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
         Begun::Whole(lp) => {
             let (output, report) = patch_loaded(&lp, machine, &opts.patch);
+            if (hooks.cancelled)() {
+                return Err(Error::Cancelled);
+            }
             out.write_all(&output).map_err(Error::Output)?;
+            (hooks.progress)(bytes.len(), bytes.len());
             return Ok(report);
         }
         Begun::Nothing { sv, p_idx, why } => {
@@ -432,6 +517,7 @@ pub fn patch_nc_to(
             report.not_analysed = not_analysed;
             report.warnings.extend(warnings);
             out.write_all(bytes).map_err(Error::Output)?;
+            (hooks.progress)(bytes.len(), bytes.len());
             return Ok(report);
         }
         Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx),
@@ -448,13 +534,29 @@ pub fn patch_nc_to(
     report.warnings.extend(warnings);
     let todo = stretches(&sv.runs, l, |rec| rec.near[l] || rec.feedless[l]);
     let mut copied_to = 0usize;
-    each_stretch(
+    // Set when a stretch was skipped because the caller cancelled: its part is not
+    // written, and the patch ends with `Error::Cancelled`.
+    let stopped = std::sync::atomic::AtomicBool::new(false);
+    let cancelled = || {
+        let c = stopped.load(std::sync::atomic::Ordering::Relaxed) || (hooks.cancelled)();
+        if c {
+            stopped.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+        c
+    };
+    let result = each_stretch(
         bytes,
         &sv,
         &todo,
         l,
         &rd,
         |lp| {
+            if cancelled() {
+                return (
+                    Vec::new(),
+                    FileReport::unchanged(&opts.name, machine, Vec::new()),
+                );
+            }
             let (edits, part) = patch_program(&lp, machine, &opts.patch);
             let output = if edits.is_empty() {
                 lp.program.bytes
@@ -464,6 +566,9 @@ pub fn patch_nc_to(
             (output, part)
         },
         |(output, part), replaced| {
+            if cancelled() {
+                return Err(std::io::Error::other("cancelled"));
+            }
             // A stretch that starts at the block the previous one ended at: that block was
             // written with the previous stretch (a run never changes its first point).
             let shared = copied_to.saturating_sub(replaced.start);
@@ -475,10 +580,17 @@ pub fn patch_nc_to(
             out.write_all(&output[shared..])?;
             copied_to = replaced.end;
             merge(&mut report, part);
+            (hooks.progress)(copied_to, bytes.len());
             Ok(())
         },
-    )?;
+    );
+    if stopped.load(std::sync::atomic::Ordering::Relaxed) {
+        return Err(Error::Cancelled);
+    }
+    result?;
     out.write_all(&bytes[copied_to..]).map_err(Error::Output)?;
+    (hooks.progress)(bytes.len(), bytes.len());
+    report.warn_unknown_tool();
     Ok(report)
 }
 
@@ -536,11 +648,12 @@ fn analyze_each(
     opts.check()?;
     let rd = Reading {
         name: &opts.name,
-        cone_deg: opts.analysis.cone_deg,
+        cone_deg: opts.analysis.reach_deg(),
         fallback: opts.feed_fallback_mm_min,
         work_offset_mm: opts.work_offset_mm,
-        read: crate::program::read_options(machine)?,
+        read: crate::program::read_options_with(machine, opts.inch)?,
         chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
+        tool: crate::tool::ToolOptions::default(),
     };
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
         Begun::Whole(lp) => {
@@ -559,6 +672,7 @@ fn analyze_each(
                 file: opts.name.clone(),
                 machine: machine.name.clone(),
                 cone_deg: opts.analysis.cone_deg,
+                pole_reach_deg: opts.analysis.pole_reach_deg,
                 primary: (LETTERS[l] as char).to_string(),
                 warnings: std::iter::once(format!("{why}: no run analysed"))
                     .chain(warnings)
@@ -576,6 +690,7 @@ fn analyze_each(
         file: opts.name.clone(),
         machine: machine.name.clone(),
         cone_deg: opts.analysis.cone_deg,
+        pole_reach_deg: opts.analysis.pole_reach_deg,
         primary: (LETTERS[l] as char).to_string(),
         warnings: primary_mismatch_warning(&opts.name, machine, p_idx)
             .into_iter()
@@ -615,11 +730,12 @@ pub(crate) fn each_run<T: Send>(
 ) -> Result<(char, Vec<String>), Error> {
     let rd = Reading {
         name,
-        cone_deg: polepatch_patcher::AnalysisOptions::default().cone_deg,
+        cone_deg: polepatch_patcher::AnalysisOptions::default().reach_deg(),
         fallback,
         work_offset_mm,
         read: crate::program::read_options(machine)?,
         chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
+        tool: crate::tool::ToolOptions::default(),
     };
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
         Begun::Whole(lp) => {
@@ -656,7 +772,7 @@ fn each_stretch<T: Send>(
     let mut failure: Option<Error> = None;
     let mut builder = RunBuilder::default();
     let mut run_no = 0usize;
-    let mut prev = polepatch_nc::modal::initial(&rd.read.controller);
+    let mut prev = rd.read.initial();
     let mut i = 0usize;
     let mut ready: Vec<InHand> = Vec::new();
     let mut ready_bytes = 0usize;
@@ -689,11 +805,9 @@ fn each_stretch<T: Send>(
             h.runs.push(run);
         }
     };
-    let read = polepatch_nc::ReadOptions {
-        dialect: sv.dialect,
-        ..rd.read.clone()
-    };
-    scan_blocks_with(bytes, &read, |s: Scanned<'_>| {
+    // The survey's options: the dialect found and the program flow settled, so this read
+    // ends `Done`.
+    let _ = scan_blocks_with(bytes, &sv.read, |s: Scanned<'_>| {
         if let Some(h) = &mut building {
             h.program.push(&s);
             if h.stretch.last_block == i {
@@ -757,18 +871,21 @@ fn loaded(bytes: &[u8], hand: InHand, sv: &Survey, l: usize, rd: &Reading<'_>) -
     let program = hand.program.finish(bytes[base..end].to_vec(), sv.dialect);
     let first = hand.stretch.first_block;
     let p_idx = if l == 0 { A } else { B };
+    let recs = &sv.runs[hand.stretch.runs.clone()];
     let runs: Vec<RunPath> = hand
         .runs
         .into_iter()
-        .map(|mut run| {
+        .zip(recs)
+        .map(|(mut run, rec)| {
             for b in &mut run.blocks {
                 *b -= first;
             }
             let line = program.blocks[run.blocks[0]].line;
-            run_path(run, p_idx, rd.fallback, line)
+            let mut rp = run_path(run, p_idx, rd.fallback, line);
+            rp.found_tool = sv.tools[rec.tool].clone();
+            rp
         })
         .collect();
-    let recs = &sv.runs[hand.stretch.runs.clone()];
     LoadedProgram {
         name: rd.name.to_string(),
         program,
@@ -784,6 +901,7 @@ fn loaded(bytes: &[u8], hand: InHand, sv: &Survey, l: usize, rd: &Reading<'_>) -
             datum_mm: recs.iter().map(|r| r.datum_mm).collect(),
         }),
         notes: crate::notes::Notes::new(),
+        tool: rd.tool.clone(),
     }
 }
 

@@ -423,3 +423,56 @@ fn the_work_offset_is_known_or_the_run_is_left() {
     assert_eq!(datum(h, None), Some([1.0, 2.0, 3.0]));
     assert_eq!(datum(h, given), Some([1.0, 2.0, 3.0]));
 }
+
+/// Issue 26 §2: a rotation, scaling or mirror image of the frame before a run without TCPM
+/// (it was rewritten as if the frame were the datum's alone, moving the tool tip 14–60 mm):
+/// the run is left with reason `frame_transformed`, also where the user gives the work
+/// offset; the code's end restores the patch.
+#[test]
+fn a_transformed_frame_leaves_the_run() {
+    let machine = example_machine();
+    let (input, _) = sing_without_tcpm(&machine);
+    let text = String::from_utf8(input).unwrap();
+    let datum = "N60 G54 X-30.489 Y-7.1 Z+38.054 *\n";
+    assert!(text.contains(datum));
+    let opts = PatchOptions {
+        chord_tolerance_mm: 1.0,
+        ..PatchOptions::default()
+    };
+    let given = PatchOptions {
+        work_offset_mm: Some(SING_DATUM),
+        ..opts.clone()
+    };
+    for code in [
+        "N61 G73 G90 H+30 *\n",
+        "N61 G72 F0.9995 *\n",
+        "N61 G28 X+0 *\n",
+        "N61 G68 X+0 Y+0 R+30 *\n",
+    ] {
+        let t = text.replace(datum, &format!("{datum}{code}"));
+        for o in [&opts, &given] {
+            let (out, report) = patch_nc(t.as_bytes(), &machine, o).unwrap();
+            assert_eq!(out, t.as_bytes(), "{code}");
+            let u = &report.untouched_runs[0];
+            assert_eq!(u.reason, UntouchedReason::FrameTransformed, "{code}");
+            assert!(
+                report.zones.iter().all(|z| z.reason == "frame_transformed"),
+                "{code}"
+            );
+        }
+    }
+    // Cancelled before the run: patched as without it.
+    let (baseline, _) = patch_nc(text.as_bytes(), &machine, &opts).unwrap();
+    assert_ne!(baseline, text.as_bytes());
+    let t = text.replace(
+        datum,
+        &format!("N58 G73 G90 H+30 *\nN59 G73 G90 H+0 *\n{datum}"),
+    );
+    let (out, report) = patch_nc(t.as_bytes(), &machine, &opts).unwrap();
+    assert!(
+        report.untouched_runs.is_empty(),
+        "{:?}",
+        report.untouched_runs
+    );
+    assert_ne!(out, t.as_bytes());
+}

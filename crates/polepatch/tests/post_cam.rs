@@ -571,8 +571,13 @@ fn what_is_not_posted_is_refused_naming_the_record() {
             "t.apt:3:3: THREAD records are not posted",
         ),
         (
-            "FEDRAT/100\nGOTO/0,0,0\nINSERT/M88\n",
-            "t.apt:3:1: INSERT records are not posted",
+            "FEDRAT/100\nGOTO/0,0,0\nAUXFUN/88\n",
+            "t.apt:3:1: AUXFUN records are not posted",
+        ),
+        (
+            // A continuation line after a line that does not end with `$`.
+            "FEDRAT/100\nGOTO/0,0,0\n0,0,1\n",
+            "t.apt:3:1: '0,0,1' does not start with an APT record word",
         ),
         (
             "UNITS/INCHES\nFEDRAT/1\nGOTO/0,0,0\n",

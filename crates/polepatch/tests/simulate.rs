@@ -45,6 +45,14 @@ fn check(bytes: &[u8], m: &Machine, what: &str) -> SimulateReport {
                 "{what} run {}: s goes back",
                 run.run
             );
+            // Each state once: time moves on at every state of a run (the end was
+            // written a second time at the same t before 2026-11-25).
+            assert!(
+                w[1].t_s > w[0].t_s,
+                "{what} run {}: two states at t = {} s",
+                run.run,
+                w[0].t_s
+            );
         }
         for s in &st {
             assert!(
@@ -181,4 +189,97 @@ fn the_default_and_the_every_cycle_simulation_agree() {
             );
         }
     }
+}
+
+/// Issue 32's check, as a user's scope would make it: on C17's `%SING` and every program in
+/// `fixtures/` on both built-in machines, the finite differences of the trajectory (every
+/// full cycle of a run) within 1.05× V, 1.10× A and 1.25× J of each axis' limits.
+///
+/// It fails today: where a pass cannot keep the motion under its ceiling it is put on it
+/// (a *clip*), which jumps the speed and the acceleration within one cycle — on `%SING`
+/// (UCP710) C's acceleration reaches 1.27× A and X's jerk 9.4× J. `docs/simulation.md`
+/// ("Jerk at every cycle") says what was tried and what is left. Run:
+/// `cargo test -p polepatch --test simulate -- --ignored --nocapture`.
+#[test]
+#[ignore = "issue 32 item 1 is not done: clips still jump the acceleration (docs/simulation.md)"]
+fn every_fixture_is_within_the_limits_by_finite_differences() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures");
+    let mut files = Vec::new();
+    let mut dirs = vec![root.clone()];
+    while let Some(d) = dirs.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                dirs.push(p);
+            } else if p
+                .extension()
+                .and_then(|x| x.to_str())
+                .is_some_and(|x| ["I", "H", "nc", "mpf", "ngc"].contains(&x))
+            {
+                files.push(p);
+            }
+        }
+    }
+    files.sort();
+    let mut failures = Vec::new();
+    for f in &files {
+        let bytes = std::fs::read(f).unwrap();
+        for name in Machine::builtin_names() {
+            let m = Machine::builtin(name).unwrap();
+            let opts = SimulateOptions {
+                sim: polepatch::sim::SimOptions {
+                    every_cycle: true,
+                    ..Default::default()
+                },
+                ..Default::default()
+            };
+            let mut states: Vec<SimState> = Vec::new();
+            let mut on = |s: &SimState| states.push(*s);
+            if simulate_nc_with(&bytes, &m, &opts, Some(&mut on)).is_err() {
+                continue;
+            }
+            let dt = m.tcy_s;
+            // Largest |difference quotient| / limit for V, A, J over the axes.
+            let mut worst = [0.0f64; 3];
+            for n in 1..=3usize {
+                for w in states.windows(n + 1) {
+                    if w.iter().any(|s| s.run != w[0].run)
+                        || w.windows(2)
+                            .any(|p| (p[1].t_s - p[0].t_s - dt).abs() > 1e-9)
+                    {
+                        continue;
+                    }
+                    for i in 0..5 {
+                        let q: Vec<f64> = w.iter().map(|s| s.axes[i]).collect();
+                        let d = match n {
+                            1 => (q[1] - q[0]) / dt,
+                            2 => (q[2] - 2.0 * q[1] + q[0]) / (dt * dt),
+                            _ => (q[3] - 3.0 * q[2] + 3.0 * q[1] - q[0]) / (dt * dt * dt),
+                        };
+                        let l = m.limits[i];
+                        let lim = [l.v, l.a, l.j][n - 1];
+                        worst[n - 1] = worst[n - 1].max(d.abs() / lim);
+                    }
+                }
+            }
+            let within = worst[0] <= 1.05 && worst[1] <= 1.10 && worst[2] <= 1.25;
+            let rel = f.strip_prefix(&root).unwrap_or(f).display();
+            println!(
+                "{rel} {name}: V {:.3} A {:.3} J {:.3}{}",
+                worst[0],
+                worst[1],
+                worst[2],
+                if within { "" } else { "  OVER" }
+            );
+            if !within {
+                failures.push(format!("{rel} on {name}: {worst:?}"));
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {} runs over: {failures:#?}",
+        failures.len(),
+        2 * files.len()
+    );
 }

@@ -48,6 +48,7 @@ fn same_analysis(bytes: &[u8], machine: &Machine, opts: &PatchOptions, what: &st
         feed_fallback_mm_min: opts.feed_fallback_mm_min,
         name: opts.name.clone(),
         work_offset_mm: opts.work_offset_mm,
+        inch: opts.inch,
     };
     let full = whole(bytes, machine, opts).map(|lp| analyze_program(&lp, machine, &aopts.analysis));
     match (full, analyze_nc_stretches(bytes, machine, &aopts)) {

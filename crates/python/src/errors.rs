@@ -7,7 +7,8 @@
 //! | `Error::Parse`, `Error::Cl` | `InputError` | `path`, `line`, `column` |
 //! | `Error::Unsupported` | `InputError` | `path`, `line` (`column` None) |
 //! | `Error::Empty`, `NoRuns`, `NoRotary` (only where a call needs motion: `reorient`, `simulate`) | `InputError` | `path` |
-//! | `Error::Point` | `InputError` | `index` (the array row) |
+//! | `Error::Point`, `Error::OutOfRange` | `InputError` | `index` (the array row) |
+//! | `Error::Cancelled` (Ctrl-C during the call) | `KeyboardInterrupt` | — |
 //! | `Error::Path` (joint arrays) | `InputError` | — |
 //! | `Error::Options` | `ValueError` | — |
 //! | `MachineError` | `MachineError` | — |
@@ -71,6 +72,55 @@ pub(crate) fn detached<T: Send>(
     }
 }
 
+/// How often a call made with [`detached_cancellable`] looks for a signal (Ctrl-C).
+const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(50);
+
+/// [`detached`] for a long call that can stop: `work` runs on a thread of its own and gets
+/// a `cancelled` flag to hand to the library ([`polepatch::Hooks`]); meanwhile the calling
+/// thread looks for signals every [`SIGNAL_POLL`] (`PyErr_CheckSignals`, which runs
+/// Python's handlers when called from the main thread). A handler that raises (Ctrl-C's
+/// `KeyboardInterrupt`) sets the flag, and once the library has stopped at its next check
+/// (between stretches) its exception is raised, not the library's `Cancelled`.
+pub(crate) fn detached_cancellable<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce(&(dyn Fn() -> bool + Sync)) -> Result<T, Failure> + Send,
+) -> PyResult<T> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let stop = AtomicBool::new(false);
+    let mut raised: Option<PyErr> = None;
+    let result = detached(py, || {
+        std::thread::scope(|scope| {
+            let (tx, rx) = std::sync::mpsc::channel();
+            let stop = &stop;
+            scope.spawn(move || {
+                let cancelled = || stop.load(Ordering::Relaxed);
+                let _ = tx.send(catch_unwind(AssertUnwindSafe(|| work(&cancelled))));
+            });
+            loop {
+                match rx.recv_timeout(SIGNAL_POLL) {
+                    Ok(Ok(r)) => return r,
+                    Ok(Err(panic)) => std::panic::resume_unwind(panic),
+                    Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                        if raised.is_none()
+                            && let Err(e) = Python::attach(|py| py.check_signals())
+                        {
+                            raised = Some(e);
+                            stop.store(true, Ordering::Relaxed);
+                        }
+                    }
+                    Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                        unreachable!("the worker sends before it ends")
+                    }
+                }
+            }
+        })
+    });
+    match raised {
+        Some(e) => Err(e),
+        None => result,
+    }
+}
+
 /// An exception of `polepatch._errors` made with `message` and the keyword arguments
 /// `kwargs` sets (its attributes).
 fn exception(
@@ -129,9 +179,10 @@ pub(crate) fn to_python(py: Python<'_>, failure: Failure) -> PyErr {
                 Error::Empty { path: p }
                 | Error::NoRuns { path: p }
                 | Error::NoRotary { path: p, .. } => input_error(py, message, path(p), None, None),
-                Error::Point { index, .. } => {
+                Error::Point { index, .. } | Error::OutOfRange { index, .. } => {
                     exception(py, "InputError", message, |kw| kw.set_item("index", index))
                 }
+                Error::Cancelled => pyo3::exceptions::PyKeyboardInterrupt::new_err(message),
                 Error::Path(_) => input_error(py, message, None, None, None),
                 Error::Options(_) => PyValueError::new_err(message),
                 Error::Output(_) => PyOSError::new_err(message),

@@ -12,7 +12,7 @@ mod errors;
 mod machine;
 mod options;
 
-use errors::{Failure, detached};
+use errors::{Failure, detached, detached_cancellable};
 use machine::NativeMachine;
 use numpy::ndarray::Array2;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
@@ -41,9 +41,15 @@ fn patch_nc<'py>(
     let f: FileKw = options.extract()?;
     let opts = f.patch(&p);
     let m = &machine.0;
-    let (out, report) = detached(py, || {
-        polepatch::patch_nc(&data, m, &opts)
-            .map(|(out, report)| (out, json(&report)))
+    // Ctrl-C stops the patch between stretches (`detached_cancellable`).
+    let (out, report) = detached_cancellable(py, |cancelled| {
+        let mut out = Vec::new();
+        let hooks = polepatch::Hooks {
+            progress: &|_, _| {},
+            cancelled,
+        };
+        polepatch::patch_nc_hooked(&data, m, &opts, &mut out, hooks)
+            .map(|report| (out, json(&report)))
             .map_err(Failure::library(f.named()))
     })?;
     Ok((PyBytes::new(py, &out), report))
@@ -79,11 +85,12 @@ fn post_cl<'py>(
     let p: PatcherKw = options.extract()?;
     let f: FileKw = options.extract()?;
     let post: PostKw = options.extract()?;
-    let opts = post.post(f.patch(&p))?;
+    let mut opts = post.post(f.patch(&p))?;
     let m = &machine.0;
     let out = detached(py, || {
         let post = || -> Result<Vec<u8>, polepatch::Error> {
             let program = polepatch::post::read_cl(&cl, &opts.patch_options.name)?;
+            polepatch::post::tool_from_cl(&cl, &program, &mut opts);
             polepatch::post::post_cl(&program, m, &opts).map(|(out, _)| out)
         };
         post().map_err(Failure::library(f.named()))

@@ -34,6 +34,15 @@ impl NativeMachine {
             .map_err(|e| to_python(py, Failure::Machine(e)))
     }
 
+    /// A machine file at `path`, read at most 1 MiB (a device such as `/dev/zero` is not
+    /// read without limit).
+    #[staticmethod]
+    fn from_file(py: Python<'_>, path: std::path::PathBuf) -> PyResult<NativeMachine> {
+        Machine::from_file(&path)
+            .map(NativeMachine)
+            .map_err(|e| to_python(py, Failure::Machine(e)))
+    }
+
     /// Names of the built-in machines.
     #[staticmethod]
     fn builtin_names() -> Vec<&'static str> {

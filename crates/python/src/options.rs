@@ -137,6 +137,7 @@ impl FileKw {
             feed_fallback_mm_min: self.feed_fallback_mm_min,
             name: self.name(),
             work_offset_mm: self.work_offset_mm.map(|(x, y, z)| [x, y, z]),
+            inch: false,
         }
     }
 }

@@ -3,6 +3,8 @@ ValueError naming them; a panic InternalError — never a crash."""
 
 from __future__ import annotations
 
+import os
+
 import pytest
 
 import polepatch
@@ -105,6 +107,14 @@ def test_a_machine_from_toml_is_used_like_a_built_in(tmp_path) -> None:
     path = tmp_path / "shop.toml"
     path.write_text(MACHINE_TOML)
     assert polepatch.Machine.from_file(path).limits == m.limits
+
+
+def test_a_machine_file_is_read_to_a_bound() -> None:
+    # Issue 26: `/dev/zero` was read without limit.
+    if not os.path.exists("/dev/zero"):
+        pytest.skip("no /dev/zero on this system")
+    with pytest.raises(polepatch.MachineError, match="longer than"):
+        polepatch.Machine.from_file("/dev/zero")
     out, report = polepatch.patch_nc(read("fixtures/c17/SING.I"), m)
     assert report["machine"] == "shop-ac" and report["zones"]
 
@@ -188,3 +198,14 @@ def test_a_panic_becomes_internal_error_not_a_crash() -> None:
         polepatch._polepatch._panic_for_test("boom 42")
     # The interpreter and the package still work afterwards.
     assert polepatch.Machine.builtin("mikron-ucp710").primary == "A"
+
+
+def test_cl_to_joints_refuses_a_joint_value_outside_the_range() -> None:
+    """Issue 26 item 4: a tool axis pointing down needs A = 180° on the UCP710, whose A
+    ends at 120°: an InputError naming the row, never an out-of-range result."""
+    import numpy as np
+
+    with pytest.raises(polepatch.InputError) as e:
+        polepatch.cl_to_joints(np.array([[0, 0, 0, 0, 0, 1.0], [1, 0, 0, 0, 0, -1.0]]), "mikron-ucp710")
+    assert e.value.index == 1
+    assert "180" in str(e.value) and "120" in str(e.value)

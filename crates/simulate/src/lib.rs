@@ -42,8 +42,11 @@
 //!
 //! Both passes step at Tcy (the controller's cycle), with every limit used at
 //! [`tolerances::LIMIT_USE`] of its value to absorb the change within a cycle, and jump a
-//! cruise at a flat ceiling in one step when no trajectory is asked for (so the work is
-//! bounded by the points and the speed changes, not by the run time). Memory is the
+//! cruise at a flat ceiling in one step — the forward pass only when no trajectory is
+//! asked for, the backward pass always (its profile is a ceiling: the same one for the
+//! report and the trajectory, and nothing recorded per cycle of a long cruise) — so the
+//! work is bounded by the points and the speed changes, not by the run time, and the
+//! memory by the points whatever the mode. Memory is the
 //! spline and the grid (a few words per grid point): bounded by the motion's points.
 //!
 //! On a straight line this is the time-optimal jerk-limited rest-to-rest profile (the
@@ -54,6 +57,7 @@
 pub mod caps;
 pub mod error;
 pub mod grid;
+pub mod linuxcnc;
 mod pass;
 pub mod tolerances;
 
@@ -71,8 +75,9 @@ pub struct SimOptions {
     pub tcy_s: Option<f64>,
     /// Largest number of grid cells per span. Default [`tolerances::MAX_CELLS_PER_SPAN`].
     pub max_cells_per_span: usize,
-    /// Hand out every interpolation cycle (for a trajectory at Tcy); default `false`: a
-    /// cruise at a flat limit is one step.
+    /// Hand out every interpolation cycle of the forward pass, the trajectory (for a
+    /// trajectory at Tcy); default `false`: a cruise at a flat limit is one step. The
+    /// backward pass jumps its cruises either way.
     pub every_cycle: bool,
 }
 
@@ -308,7 +313,10 @@ pub fn simulate(
         forward: false,
         dt: tcy_s,
         use_caps: tolerances::BACKWARD_USE,
-        every_cycle: opts.every_cycle,
+        // The backward profile is a ceiling, not the trajectory: it jumps cruises in both
+        // modes (the same profile for the report and the trajectory, and a long cruise
+        // records nothing per cycle: memory bounded by the points).
+        every_cycle: false,
     };
     let mut store = Store {
         grid: &xb,

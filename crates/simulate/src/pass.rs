@@ -339,6 +339,7 @@ impl Pass<'_> {
                         .is_none_or(|m| m[i] == 0.0 && m[nx] == 0.0)
                     && self.safe(&caps, vmax, xn, st.v, 0.0, i, len)
                 {
+                    let xn = if xn >= len - END_MM { len } else { xn };
                     let to = State {
                         t: st.t + (xn - st.x) / st.v,
                         x: xn,
@@ -459,6 +460,11 @@ impl Pass<'_> {
                 a1 = st.a + j * tm;
                 t1 = st.t + tm;
             }
+            if x1 >= len - END_MM {
+                // Within END_MM of the end: this state is the end (one state, not a
+                // second one at the same time).
+                x1 = len;
+            }
             let (w1, aw1, _) = self.ceiling.at(x1, hint);
             let w1 = w1.min(vmax);
             if v1 > w1 * (1.0 + CEILING_REL) {
@@ -494,7 +500,7 @@ impl Pass<'_> {
             stats.steps += 1;
         }
         if st.x < len {
-            // Within END_MM of the end: the end is reached.
+            // A path shorter than END_MM: its end is reached at once.
             let to = State { x: len, ..st };
             let d = self.geo.derivs(self.s_of(st.x, len));
             sink.step(&st, &to, 0.0, &d, false);

@@ -8,8 +8,9 @@ pub const LIMIT_USE: f64 = 0.998;
 /// Relative slack when comparing a feed with its ceiling (rounding only).
 pub const CEILING_REL: f64 = 1e-9;
 
-/// A pass ends when it is this close to the end of the path, mm. The last point is then
-/// taken as reached (the spline is evaluated there exactly).
+/// A pass ends when it is this close to the end of the path, mm: the state that comes
+/// this close is put at the end (one state, never a second one at the same time). The
+/// last point is then taken as reached (the spline is evaluated there exactly).
 pub const END_MM: f64 = 1e-5;
 
 /// Bisection steps on the jerk of one cycle (the chosen jerk is within 2^-16 of the

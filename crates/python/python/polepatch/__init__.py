@@ -91,9 +91,10 @@ class Machine:
 
     @classmethod
     def from_file(cls, path: Union[str, os.PathLike[str]]) -> Machine:
-        """A machine from a machine TOML file (UTF-8), as :meth:`from_toml`."""
-        with open(path, encoding="utf-8") as f:
-            return cls.from_toml(f.read(), origin=str(path))
+        """A machine from a machine TOML file (UTF-8), as :meth:`from_toml`. At most
+        1 MiB is read: a longer file, or a device such as ``/dev/zero``, raises
+        :class:`MachineError`."""
+        return cls(_native.NativeMachine.from_file(os.fspath(path)))
 
     @staticmethod
     def builtin_names() -> List[str]:
@@ -208,7 +209,9 @@ def patch_nc(
         data: the program's bytes (any encoding; non-UTF-8 bytes pass through).
         machine: a :class:`Machine` or a built-in name.
         only_c: change C only (G16's method); default both rotary axes may change.
-        cone_deg: singular cone, degrees: a zone needs a point with |primary| ≤ this.
+        cone_deg: singular cone, degrees: a stretch where C is below feed with a point
+            with |primary| ≤ this is a zone; out to the pole reach (10°) beyond it, a
+            stretch is a zone where the pole dominates its slowdown (docs/method.md).
         max_deviation_deg: largest change of tool orientation allowed, degrees
             (``None``: no limit; the deviation is minimised anyway).
         tcy_ms: interpolation cycle time, ms (``None``: the machine's). Accepted for
@@ -232,6 +235,8 @@ def patch_nc(
             (with ``line``), an empty program or one without G1 motion or rotary words.
         MachineError: an unknown built-in name.
         ValueError: an option out of range (named).
+        KeyboardInterrupt: Ctrl-C (SIGINT) during the call: the patch stops at its next
+            stretch near the pole (it looks for signals every 50 ms), nothing is returned.
     """
     options = _options(locals(), "data", "machine")
     out, report = _native.patch_nc(_bytes(data, "data"), _machine(machine), options)
@@ -412,7 +417,9 @@ def cl_to_joints(
         (no copy was made to return it).
 
     Raises:
-        InputError: a value that is not finite or a zero tool axis (``index``: the row).
+        InputError: a value that is not finite, a zero tool axis, or a joint value
+            outside the machine's range on the branch picked (e.g. A = 180° where A ends
+            at 120°) (``index``: the row).
         ValueError: a wrong shape or branch name.
     """
     arr = _rows(xyzijk, 6, "xyzijk")

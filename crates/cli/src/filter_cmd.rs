@@ -1,0 +1,218 @@
+//! `polepatch filter`: a LinuxCNC program filter ([docs/linuxcnc.md](../../../docs/linuxcnc.md)).
+//!
+//! LinuxCNC's GUIs run the `[FILTER]` program of a file's extension on every program the
+//! operator opens, as `sh -c "PROGRAM 'FILE'"`, load what it prints on standard output,
+//! show `FILTER_PROGRESS=N` lines (percent) of its standard error as a progress bar, and on
+//! a non-zero exit show the operator its standard error instead of loading anything. So:
+//! the patched program (byte-identical except the rotary words that change) on standard
+//! output, written only once the whole file is patched; progress, the summary and the
+//! warnings on standard error; exit 1 on a program or machine polepatch refuses, 2 with
+//! `--strict` when a zone stays below feed or a run near the pole could not be analysed.
+
+use crate::{PatchArgs, machine, parse_xyz};
+use anyhow::{Context, Result};
+use polepatch::patcher::PatchOptions;
+use polepatch_cli::files;
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Mutex;
+
+#[derive(clap::Args)]
+#[command(allow_negative_numbers = true)]
+pub(crate) struct FilterArgs {
+    /// The NC program LinuxCNC opens (appended by LinuxCNC); `-` for standard input.
+    file: PathBuf,
+    /// Machine: a built-in name (mikron-ucp710, mikron-hsm600) or a TOML file.
+    #[arg(long, short)]
+    machine: String,
+    /// Feed in mm/min for runs with no F in force.
+    #[arg(long)]
+    feed: Option<f64>,
+    /// Singular cone, degrees (as `patch`). Default: a 5° cone and the pole reach.
+    #[arg(long)]
+    cone: Option<f64>,
+    /// Pole reach, degrees (as `patch`). Default 10; with --cone, the cone.
+    #[arg(long)]
+    pole_reach: Option<f64>,
+    /// Units of a program that states none (as `patch`): mm unless said.
+    #[arg(long, value_enum)]
+    units: Option<crate::post_cmd::UnitsArg>,
+    /// Largest orientation change allowed at any point, degrees (as `patch`).
+    #[arg(long)]
+    max_deviation: Option<f64>,
+    /// Change C only, never the primary axis (G16's method).
+    #[arg(long)]
+    only_c: bool,
+    /// Work offset X,Y,Z (mm) for a machine with a kinematic chain (as `patch`).
+    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    work_offset: Option<[f64; 3]>,
+    /// Refuse the program (exit 2, nothing loaded) if a zone stays below feed or a run
+    /// near the pole could not be analysed.
+    #[arg(long)]
+    strict: bool,
+    /// Also write the per-zone report as JSON to this file (replaced on every open).
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// The cutter (as `patch`): ball:D, flat:D or bull:D,R.
+    #[arg(long, value_parser = polepatch::tool::Tool::parse, value_name = "KIND:D[,R]")]
+    tool: Option<polepatch::tool::Tool>,
+    /// A tool table (as `patch`).
+    #[arg(long, value_name = "FILE")]
+    tools: Option<PathBuf>,
+    /// Which point of the tool X Y Z are (as `patch`): tip or centre.
+    #[arg(long, value_parser = polepatch::tool::ToolPoint::parse, value_name = "tip|centre")]
+    tool_point: Option<polepatch::tool::ToolPoint>,
+    /// How far a flat or bull-nose cutter's surface may move, mm (as `patch`).
+    #[arg(long, value_name = "MM", default_value_t = polepatch::tool::SURFACE_TOLERANCE_MM)]
+    surface_tolerance: f64,
+}
+
+impl FilterArgs {
+    /// The `patch` arguments these stand for (every other option at its default).
+    fn patch_args(&self) -> PatchArgs {
+        PatchArgs {
+            inputs: vec![self.file.clone()],
+            output: Some(PathBuf::from("-")),
+            out_dir: None,
+            machine: self.machine.clone(),
+            report: self.report.clone(),
+            csv: None,
+            strict: self.strict,
+            feed: self.feed,
+            cone: self.cone,
+            pole_reach: self.pole_reach,
+            units: self.units,
+            max_deviation: self.max_deviation,
+            margin: PatchOptions::default().margin,
+            max_decimals: PatchOptions::default().max_decimals,
+            max_patch_length: None,
+            only_c: self.only_c,
+            no_jerk_continuity: false,
+            c_offset: false,
+            jobs: None,
+            simulate: false,
+            work_offset: self.work_offset,
+            chord_tolerance: polepatch::machine_frame::CHORD_TOLERANCE_MM,
+            tool: self.tool,
+            tools: self.tools.clone(),
+            tool_point: self.tool_point,
+            surface_tolerance: self.surface_tolerance,
+        }
+    }
+}
+
+pub(crate) fn run(args: FilterArgs) -> Result<ExitCode> {
+    let pa = args.patch_args();
+    let opts = crate::patch::file_options(&pa)?;
+    let machine = machine(&args.machine)?;
+    let mut inputs = vec![polepatch_cli::outputs::Input::new("the input", &args.file)];
+    inputs.extend(crate::patch::machine_input(&args.machine));
+    if let Some(t) = &args.tools {
+        inputs.push(polepatch_cli::outputs::Input::new("the tool table", t));
+    }
+    let report_target = match &args.report {
+        Some(p) => Some(
+            polepatch_cli::outputs::plan(
+                &inputs,
+                vec![polepatch_cli::outputs::Output::new("--report", p)],
+            )?
+            .remove(0),
+        ),
+        None => None,
+    };
+    let name = files::shown(&args.file);
+    let bytes = files::read(&args.file)?;
+    let opts = polepatch::PatchOptions { name, ..opts };
+    // Progress in whole percent, each value once, as LinuxCNC reads it.
+    let last = Mutex::new(None::<usize>);
+    let progress = |done: usize, total: usize| {
+        let pct = (done * 100).checked_div(total).unwrap_or(100).min(100);
+        let mut last = last.lock().unwrap_or_else(|p| p.into_inner());
+        if *last != Some(pct) {
+            *last = Some(pct);
+            eprintln!("FILTER_PROGRESS={pct}");
+        }
+    };
+    progress(0, 1);
+    let hooks = polepatch::Hooks {
+        progress: &progress,
+        cancelled: &|| false,
+    };
+    // The whole output first: a program refused half-way prints nothing.
+    let mut output = Vec::with_capacity(bytes.len());
+    let report = polepatch::patch_nc_hooked(&bytes, &machine, &opts, &mut output, hooks)?;
+    let mut stdout = std::io::stdout().lock();
+    stdout
+        .write_all(&output)
+        .and_then(|()| stdout.flush())
+        .context("writing the patched program to standard output")?;
+    summary(&report);
+    if let Some(target) = report_target {
+        let doc = serde_json::to_string_pretty(&report)?;
+        target
+            .write(doc.as_bytes(), None)
+            .with_context(|| format!("cannot write {}", target.path.display()))?;
+    }
+    let below = report.zones_below_feed();
+    let unanalysed = report.strict_failures() - below;
+    if args.strict && below + unanalysed > 0 {
+        eprintln!(
+            "polepatch: {}: refused (--strict): {below} zone(s) stay below feed, {unanalysed} run(s) or line range(s) near the pole could not be analysed",
+            report.file
+        );
+        return Ok(ExitCode::from(crate::STRICT_EXIT));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// What the operator's terminal shows: one line for the file, then every warning.
+fn summary(rep: &polepatch::FileReport) {
+    if rep.zones.is_empty() {
+        eprintln!(
+            "polepatch: {}: no singular zone on {}; program unchanged",
+            rep.file, rep.machine
+        );
+    } else {
+        let reached = rep.zones.iter().filter(|z| z.outcome == "reached").count();
+        let before: f64 = rep.zones.iter().map(|z| z.before.time_s).sum();
+        let after: f64 = rep.zones.iter().map(|z| z.after.time_s).sum();
+        let dev = rep
+            .zones
+            .iter()
+            .map(|z| z.max_deviation_deg)
+            .fold(0.0, f64::max);
+        eprintln!(
+            "polepatch: {}: {} singular zone(s) on {}, {reached} reach the programmed feed; \
+             estimated time over them {before:.3} s → {after:.3} s; largest change of tool \
+             orientation {dev:.3}°; {} word(s) changed",
+            rep.file,
+            rep.zones.len(),
+            rep.machine,
+            rep.words_changed
+        );
+    }
+    for w in &rep.warnings {
+        eprintln!("polepatch: warning: {w}");
+    }
+    for u in &rep.untouched_runs {
+        eprintln!(
+            "polepatch: warning: {}: run {}, lines {}–{}: {}",
+            rep.file, u.run, u.lines[0], u.lines[1], u.message
+        );
+    }
+    for n in &rep.not_analysed {
+        eprintln!(
+            "polepatch: warning: {}: not analysed: {}",
+            rep.file, n.message
+        );
+    }
+    let no_tcpm = rep.runs_left_without_tcpm();
+    if no_tcpm > 0 {
+        eprintln!(
+            "polepatch: {no_tcpm} run(s) with singular zones left as they are: no TCPM active, \
+             X Y Z are machine coordinates (a LinuxCNC machine whose kinematics are always TCP \
+             says `tcpm_always = true` under [controller]; docs/linuxcnc.md)"
+        );
+    }
+}

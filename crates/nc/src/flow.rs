@@ -1,0 +1,1320 @@
+//! Program flow and the TCPM state: calls, labels, jumps and loops.
+//!
+//! With TCPM on, X Y Z are tool-tip positions in the part frame and a rotary word may change
+//! alone; with it off they are machine positions and it may not. The reader follows the
+//! state block by block — but a block that control reaches other than from the block before
+//! it (a label, a jump's target, a subprogram's first block, the block after a call) has the
+//! state of every way in. Where the ways in disagree, or one of them is code outside the
+//! file, the state there is [`Tcpm::Unknown`], and such a run is never rewritten.
+//!
+//! # The statements ([`Stmt`], read with each block)
+//!
+//! | dialect | label | call | return | jump | structured (any keyword reaches any other of its statement) |
+//! |---|---|---|---|---|---|
+//! | Fanuc, Haas | `O2000` (program number), `N100` (a `GOTO`/`M97` target) | `M98 P2000 [L3]`, `M98 P32000`, `M97 P100`, `G65 P9001` (in the file or outside), `M198`: outside; `M6` (a tool-change macro: may end TCPM, never starts it) | `M99` | `GOTO 100`, `IF […] GOTO 100` | `WHILE […] DO 1` … `END 1` |
+//! | LinuxCNC | `o100 sub` … `o100 endsub` (skipped in file order) | `o100 call`, `o<name> call` | `o100 return`, `endsub` | — | `o100 if/elseif/else/endif/while/endwhile/do/repeat/endrepeat/break/continue` |
+//! | Sinumerik | `NAME:`, `N100` (a jump target) | `L123`, `CALL`, `PCALL`, `EXTCALL`, a subprogram's name: outside | `RET`, `M17` | `GOTOF`, `GOTOB`, `GOTO`, `GOTOC` (also after `IF`) | `IF/ELSE/ENDIF`, `WHILE/ENDWHILE`, `FOR/ENDFOR`, `LOOP/ENDLOOP`, `REPEAT/UNTIL` |
+//! | Heidenhain ISO | `G98 L1` | `L1,0` (`L1,3`: repeated), `%NAME`: outside | `G98 L0` | — | — |
+//! | conversational | `LBL 1`, `LBL "NAME"` | `CALL LBL 1 [REP 2]`, `CALL PGM`, `SEL PGM`: outside | `LBL 0` | `FN 9`…`FN 12: IF … GOTO LBL 1` | — |
+//!
+//! A jump whose target is computed (`GOTO #1`, `GOTO LBL QS1`), a modal macro (`G66`,
+//! Sinumerik `MCALL` of a subprogram), a section repeat (`REPEAT A B P=3`), `M99 P…`, or a
+//! jump to a label the file does not hold: control may reach any block, so TCPM is
+//! unknown in the whole file.
+//!
+//! # How the state is settled
+//!
+//! The file is read once as it would be without flow; when that read meets a statement
+//! above that joins paths (anything but a call of code outside the file, whose effect is
+//! local: the state after it is unknown), the reader records the flow statements, the
+//! TCPM switches and the program ends, and solves the state at each of them: a data-flow
+//! problem on the lattice ⊥ < {off, on, uncertain} < unknown (join: equal states stay,
+//! different ones are unknown), over these edges —
+//! - each statement to the next in file order, except after a program end, an
+//!   unconditional jump, a return (Heidenhain's `LBL 0`/`G98 L0` also fall through: the
+//!   control ignores them where no call is active), and a LinuxCNC `sub` (to its `endsub`);
+//! - a jump to every label of its name; a keyword of a structured statement to every other;
+//! - a call to its subprogram's first block, and each return of that subprogram (the
+//!   returns after its label, up to the next label that is called) back to the block after
+//!   every call of it — and, for a repeated call, to the first block again;
+//!   a call of a name the file does not hold gives `unknown` after it;
+//! - a switch maps the state as the reader does ([`Tcpm::switched`]).
+//!
+//! Blocks no way reaches (code after the end that nothing calls) are `unknown`. The
+//! solution is handed to the reader as a [`FlowPlan`]: the state to take before given
+//! lines, where positions are also unknown at labels (any way in may come from anywhere).
+//! The reader then reads the file again with it ([`crate::Settled::Again`]). Work: the
+//! statements only, a few per subprogram; the file is lexed twice when it has flow (three
+//! times when a jump targets block numbers, whose blocks are found in a second pass).
+
+use crate::modal::Tcpm;
+use std::collections::{HashMap, HashSet};
+
+/// What a jump, a call or a label names.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub(crate) enum Key {
+    /// A named or numbered label (conversational `LBL`, Heidenhain ISO `G98 L`, Sinumerik
+    /// `NAME:`, LinuxCNC `o100`/`o<name>` subroutines), upper case.
+    Label(String),
+    /// A Fanuc program number (`O2000`, `M98 P2000`, `G65 P9001`).
+    Program(u64),
+    /// A block number (`N100`, as `GOTO 100` and `M97 P100` name it).
+    Block(u64),
+    /// The keywords of one structured statement (LinuxCNC by its o-word; Sinumerik and
+    /// Fanuc by nesting, numbered by the recorder).
+    Group(String),
+}
+
+/// Role of a keyword of a structured statement whose keywords are matched by nesting.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Nest {
+    /// `IF`, `WHILE`, `FOR`, `LOOP`, `REPEAT`, Fanuc `DO m`.
+    Open,
+    /// `ELSE`.
+    Middle,
+    /// `ENDIF`, `ENDWHILE`, `ENDFOR`, `ENDLOOP`, `UNTIL`, Fanuc `END m`.
+    Close,
+}
+
+/// What a block says about program flow (module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Stmt {
+    /// A label.
+    Label(Key),
+    /// LinuxCNC `oN sub`: a definition that flow in file order skips.
+    SubStart(Key),
+    /// LinuxCNC `oN endsub`: the end of the definition, a return.
+    SubEnd(Key),
+    /// A return to the caller; `falls_through`: the control goes on in file order where
+    /// no call is active (Heidenhain `LBL 0`, `G98 L0`).
+    Return {
+        /// Falls through when not called.
+        falls_through: bool,
+    },
+    /// A call of `key` (a subprogram in the file, or outside it if the file holds none of
+    /// that name); `repeats`: more than once.
+    Call {
+        /// What is called.
+        key: Key,
+        /// Called more than once in a row.
+        repeats: bool,
+    },
+    /// A call of code outside the file: the state after it is unknown.
+    External,
+    /// A tool change that may run a macro (Fanuc `M6`): it may end TCPM but does not
+    /// start it, so TCPM on becomes unknown and off stays off.
+    ToolChange,
+    /// A jump to `key`; `cond`: it may also go on in file order.
+    Jump {
+        /// Where to.
+        key: Key,
+        /// Conditional.
+        cond: bool,
+    },
+    /// A keyword of a structured statement named by the file (LinuxCNC o-words).
+    Group(Key),
+    /// A keyword of a structured statement matched by nesting; `tag` keeps Fanuc's `DO m`
+    /// and `END m` numbers apart.
+    Nested {
+        /// Its role.
+        role: Nest,
+        /// Fanuc's loop number, if any.
+        tag: u32,
+    },
+    /// Flow the reader cannot follow: TCPM is unknown in the whole file.
+    Opaque,
+}
+
+impl Stmt {
+    /// Whether the statement needs the whole file's flow to settle the state (anything but
+    /// a call of code that is certainly outside the file).
+    pub(crate) fn is_global(&self) -> bool {
+        // A call of code outside the file acts on the block after it only; a label only
+        // matters where something jumps or calls (which is global itself): a Fanuc
+        // program's `O1000` line alone is read once.
+        !matches!(self, Stmt::External | Stmt::ToolChange | Stmt::Label(_))
+    }
+}
+
+/// One recorded event, in file order.
+#[derive(Debug, Clone, PartialEq)]
+enum Kind {
+    /// The program's start (line 1).
+    Start,
+    Switch {
+        to: Tcpm,
+        skippable: bool,
+    },
+    End,
+    Label(Key),
+    /// LinuxCNC `sub`: in file order, flow goes to after the matching `endsub`.
+    SubSkip(Key),
+    /// The first block of a LinuxCNC subroutine (reached by calls only).
+    SubBody(Key),
+    SubEnd(Key),
+    /// The block after a LinuxCNC `endsub`: where flow in file order goes on.
+    AfterSub(Key),
+    Return {
+        falls_through: bool,
+    },
+    Call {
+        key: Key,
+        repeats: bool,
+    },
+    /// The block after a call: where its returns arrive.
+    AfterCall,
+    External,
+    ToolChange,
+    Jump {
+        key: Key,
+        cond: bool,
+    },
+    Group(Key),
+}
+
+#[derive(Debug, Clone)]
+struct Node {
+    /// The line before whose block the node's in-state holds.
+    line: u32,
+    kind: Kind,
+}
+
+/// Records the flow events of a read ([`crate::program`] feeds it block by block, in file
+/// order) and solves them into a [`FlowPlan`].
+#[derive(Debug, Default)]
+pub(crate) struct Recorder {
+    nodes: Vec<Node>,
+    /// A statement that needs the whole file's flow was seen.
+    pub(crate) global: bool,
+    /// Flow that cannot be followed was seen.
+    opaque: bool,
+    /// Block numbers that jumps and calls name.
+    pub(crate) block_targets: HashSet<u64>,
+    /// Block numbers to record as labels (the second pass, once the targets are known).
+    label_blocks: Option<HashSet<u64>>,
+    /// Open nested statements: (group number, Fanuc tag).
+    stack: Vec<(u32, u32)>,
+    next_group: u32,
+}
+
+/// What one block gives the recorder.
+pub(crate) struct BlockFlow<'a> {
+    pub(crate) line: usize,
+    pub(crate) stmt: Option<&'a Stmt>,
+    pub(crate) switch: Option<Tcpm>,
+    pub(crate) skippable: bool,
+    pub(crate) program_end: bool,
+    /// The block's number (`N…`), if it has one.
+    pub(crate) number: Option<u64>,
+}
+
+impl Recorder {
+    /// A recorder for a second pass that also records blocks numbered `targets` as labels.
+    pub(crate) fn with_block_labels(targets: HashSet<u64>) -> Self {
+        Recorder {
+            label_blocks: Some(targets),
+            ..Recorder::default()
+        }
+    }
+
+    fn push(&mut self, line: usize, kind: Kind) {
+        let line = u32::try_from(line).unwrap_or(u32::MAX);
+        self.nodes.push(Node { line, kind });
+    }
+
+    /// Take one block.
+    pub(crate) fn block(&mut self, b: &BlockFlow<'_>) {
+        if self.nodes.is_empty() {
+            self.push(1, Kind::Start);
+        }
+        let line = b.line;
+        if let (Some(n), Some(labels)) = (b.number, &self.label_blocks)
+            && labels.contains(&n)
+        {
+            self.push(line, Kind::Label(Key::Block(n)));
+        }
+        // Labels first: the block's own switch applies after the ways in meet.
+        match b.stmt {
+            Some(Stmt::Label(k)) => self.push(line, Kind::Label(k.clone())),
+            Some(Stmt::Group(k)) => self.push(line, Kind::Group(k.clone())),
+            Some(Stmt::Nested { role, tag }) => {
+                let group = match role {
+                    Nest::Open => {
+                        self.next_group += 1;
+                        self.stack.push((self.next_group, *tag));
+                        Some(self.next_group)
+                    }
+                    Nest::Middle => self.stack.last().map(|&(g, _)| g),
+                    Nest::Close => {
+                        let at = self.stack.iter().rposition(|&(_, t)| t == *tag);
+                        at.map(|k| self.stack.drain(k..).next().map_or(0, |(g, _)| g))
+                    }
+                };
+                match group {
+                    Some(g) => self.push(line, Kind::Group(Key::Group(format!("#{g}")))),
+                    // A closing keyword without its opening: not followed.
+                    None => self.opaque = true,
+                }
+            }
+            Some(Stmt::SubStart(k)) => {
+                self.push(line, Kind::SubSkip(k.clone()));
+                self.push(line + 1, Kind::SubBody(k.clone()));
+            }
+            _ => {}
+        }
+        if let Some(to) = b.switch {
+            self.push(
+                line,
+                Kind::Switch {
+                    to,
+                    skippable: b.skippable,
+                },
+            );
+        }
+        match b.stmt {
+            Some(Stmt::SubEnd(k)) => {
+                self.push(line, Kind::SubEnd(k.clone()));
+                self.push(line + 1, Kind::AfterSub(k.clone()));
+            }
+            Some(Stmt::Return { falls_through }) => self.push(
+                line,
+                Kind::Return {
+                    falls_through: *falls_through,
+                },
+            ),
+            Some(Stmt::Call { key, repeats }) => {
+                if let Key::Block(n) = key {
+                    self.block_targets.insert(*n);
+                }
+                self.push(
+                    line,
+                    Kind::Call {
+                        key: key.clone(),
+                        repeats: *repeats,
+                    },
+                );
+                self.push(line + 1, Kind::AfterCall);
+            }
+            Some(Stmt::External) => self.push(line, Kind::External),
+            Some(Stmt::ToolChange) => self.push(line, Kind::ToolChange),
+            Some(Stmt::Jump { key, cond }) => {
+                if let Key::Block(n) = key {
+                    self.block_targets.insert(*n);
+                }
+                self.push(
+                    line,
+                    Kind::Jump {
+                        key: key.clone(),
+                        cond: *cond,
+                    },
+                );
+            }
+            Some(Stmt::Opaque) => self.opaque = true,
+            _ => {}
+        }
+        if let Some(s) = b.stmt
+            && s.is_global()
+        {
+            self.global = true;
+        }
+        if b.program_end {
+            self.push(line, Kind::End);
+        }
+    }
+
+    /// Whether this pass records numbered blocks as labels.
+    pub(crate) fn wants_block_labels(&self) -> bool {
+        self.label_blocks.is_some()
+    }
+
+    /// Whether a second pass must find the blocks that jumps name by number.
+    pub(crate) fn needs_block_labels(&self) -> bool {
+        self.label_blocks.is_none() && !self.block_targets.is_empty() && !self.opaque
+    }
+
+    /// Solve the recorded flow from the state `initial` (module docs).
+    pub(crate) fn solve(&self, initial: Tcpm) -> FlowPlan {
+        if self.opaque {
+            return FlowPlan {
+                entries: Vec::new(),
+                all_unknown: true,
+            };
+        }
+        let nodes = &self.nodes;
+        let n = nodes.len();
+        let mut labels: HashMap<&Key, Vec<usize>> = HashMap::new();
+        for (i, node) in nodes.iter().enumerate() {
+            match &node.kind {
+                Kind::Label(k) | Kind::SubBody(k) | Kind::Group(k) => {
+                    labels.entry(k).or_default().push(i)
+                }
+                _ => {}
+            }
+        }
+        // A jump to a label the file does not hold: control may go anywhere.
+        let unresolved = nodes.iter().any(|node| match &node.kind {
+            Kind::Jump { key, .. } => !labels.contains_key(key),
+            _ => false,
+        });
+        if unresolved {
+            return FlowPlan {
+                entries: Vec::new(),
+                all_unknown: true,
+            };
+        }
+        // Calls per called key, and the owner (called label) of every return.
+        let mut calls: HashMap<&Key, Vec<usize>> = HashMap::new();
+        for (i, node) in nodes.iter().enumerate() {
+            if let Kind::Call { key, .. } = &node.kind
+                && labels.contains_key(key)
+            {
+                calls.entry(key).or_default().push(i);
+            }
+        }
+        let mut owner: Vec<Option<&Key>> = vec![None; n];
+        let mut current: Option<&Key> = None;
+        for (i, node) in nodes.iter().enumerate() {
+            match &node.kind {
+                Kind::Label(k) | Kind::SubBody(k) if calls.contains_key(k) => current = Some(k),
+                Kind::Return { .. } => owner[i] = current,
+                Kind::SubEnd(k) => owner[i] = Some(k),
+                _ => {}
+            }
+        }
+        let mut state: Vec<Option<Tcpm>> = vec![None; n];
+        let mut work: Vec<usize> = Vec::new();
+        let send = |state: &mut Vec<Option<Tcpm>>, work: &mut Vec<usize>, to: usize, t: Tcpm| {
+            if to >= n {
+                return;
+            }
+            let joined = state[to].map_or(t, |s| s.join(t));
+            if state[to] != Some(joined) {
+                state[to] = Some(joined);
+                work.push(to);
+            }
+        };
+        send(&mut state, &mut work, 0, initial);
+        while let Some(i) = work.pop() {
+            let Some(s) = state[i] else { continue };
+            let next = i + 1;
+            match &nodes[i].kind {
+                Kind::Start
+                | Kind::Label(_)
+                | Kind::SubBody(_)
+                | Kind::AfterCall
+                | Kind::AfterSub(_) => send(&mut state, &mut work, next, s),
+                Kind::Switch { to, skippable } => {
+                    send(&mut state, &mut work, next, s.switched(*to, *skippable))
+                }
+                Kind::End => {}
+                Kind::Group(k) => {
+                    send(&mut state, &mut work, next, s);
+                    for &j in &labels[k] {
+                        send(&mut state, &mut work, j, s);
+                    }
+                }
+                Kind::SubSkip(k) => {
+                    // In file order the definition is skipped (one without its end: what
+                    // follows it is not reached in order).
+                    let after = Kind::AfterSub(k.clone());
+                    if let Some(p) = nodes[next..].iter().position(|nd| nd.kind == after) {
+                        send(&mut state, &mut work, next + p, s);
+                    }
+                }
+                Kind::SubEnd(_) | Kind::Return { .. } => {
+                    let falls = matches!(
+                        nodes[i].kind,
+                        Kind::Return {
+                            falls_through: true
+                        }
+                    );
+                    match owner[i] {
+                        Some(k) => {
+                            for &c in calls.get(k).map_or(&[][..], Vec::as_slice) {
+                                send(&mut state, &mut work, c + 1, s);
+                                if matches!(nodes[c].kind, Kind::Call { repeats: true, .. }) {
+                                    for &j in &labels[k] {
+                                        send(&mut state, &mut work, j, s);
+                                    }
+                                }
+                            }
+                            if falls {
+                                send(&mut state, &mut work, next, s);
+                            }
+                        }
+                        // A return where no call is active: Heidenhain's label 0 goes on;
+                        // Fanuc's M99 in the main program starts it again.
+                        None if falls => send(&mut state, &mut work, next, s),
+                        None => send(&mut state, &mut work, 0, s),
+                    }
+                }
+                Kind::Call { key, .. } => match labels.get(key) {
+                    Some(entries) => {
+                        for &j in entries {
+                            send(&mut state, &mut work, j, s);
+                        }
+                    }
+                    // Nothing of that name in the file: code outside it.
+                    None => send(&mut state, &mut work, next, Tcpm::Unknown),
+                },
+                Kind::External => send(&mut state, &mut work, next, Tcpm::Unknown),
+                Kind::ToolChange => send(&mut state, &mut work, next, s.after_tool_change()),
+                Kind::Jump { key, cond } => {
+                    for &j in &labels[key] {
+                        send(&mut state, &mut work, j, s);
+                    }
+                    if *cond {
+                        send(&mut state, &mut work, next, s);
+                    }
+                }
+            }
+        }
+        // The plan: every node's state before its line (⊥, no way in: unknown), and after a
+        // node that does not fall through, the state of the lines up to the next node.
+        let mut entries = Vec::with_capacity(2 * n);
+        for (i, node) in nodes.iter().enumerate() {
+            let join = matches!(
+                node.kind,
+                Kind::Label(_) | Kind::SubBody(_) | Kind::Group(_)
+            );
+            entries.push(Entry {
+                line: node.line,
+                tcpm: state[i].unwrap_or(Tcpm::Unknown),
+                join,
+            });
+            let stops = match &node.kind {
+                Kind::End | Kind::SubSkip(_) => true,
+                Kind::Jump { cond, .. } => !cond,
+                Kind::Return { falls_through } => !falls_through,
+                Kind::SubEnd(_) => true,
+                _ => false,
+            };
+            if stops {
+                // Reached by no way until the next node (whose own entry, at the same
+                // line or later, comes after this one).
+                entries.push(Entry {
+                    line: node.line.saturating_add(1),
+                    tcpm: Tcpm::Unknown,
+                    join: false,
+                });
+            }
+        }
+        // In line order; at one line, in node order (the last one read wins).
+        entries.sort_by_key(|e| e.line);
+        FlowPlan {
+            entries,
+            all_unknown: false,
+        }
+    }
+}
+
+/// One entry of a [`FlowPlan`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Entry {
+    line: u32,
+    tcpm: Tcpm,
+    /// Ways in meet here: positions are unknown.
+    join: bool,
+}
+
+/// How program flow settles the TCPM state of a file (module docs): the state to take
+/// before given lines. Made by the reader ([`crate::Settled::Again`]) and handed back to it
+/// in [`crate::ReadOptions::flow`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FlowPlan {
+    entries: Vec<Entry>,
+    /// Flow the reader cannot follow: TCPM is unknown everywhere.
+    all_unknown: bool,
+}
+
+impl FlowPlan {
+    /// The plan of a file without flow that joins paths: nothing to change.
+    pub fn none() -> Self {
+        FlowPlan {
+            entries: Vec::new(),
+            all_unknown: false,
+        }
+    }
+
+    /// Whether TCPM is unknown in the whole file (flow the reader cannot follow).
+    pub fn all_unknown(&self) -> bool {
+        self.all_unknown
+    }
+}
+
+/// The reader's place in a [`FlowPlan`] (lines come in increasing order).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Cursor {
+    next: usize,
+}
+
+impl Cursor {
+    /// What the plan says before the block on `line`: the TCPM state to take (if any) and
+    /// whether ways in meet there.
+    pub(crate) fn at(&mut self, plan: &FlowPlan, line: usize) -> (Option<Tcpm>, bool) {
+        if plan.all_unknown {
+            return (Some(Tcpm::Unknown), false);
+        }
+        let line = u32::try_from(line).unwrap_or(u32::MAX);
+        let e = &plan.entries;
+        while self.next < e.len() && e[self.next].line < line {
+            self.next += 1;
+        }
+        let mut out = (None, false);
+        while self.next < e.len() && e[self.next].line == line {
+            out.0 = Some(e[self.next].tcpm);
+            out.1 |= e[self.next].join;
+            self.next += 1;
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rec(blocks: &[(usize, Option<Stmt>, Option<Tcpm>, bool)]) -> Recorder {
+        let mut r = Recorder::default();
+        for (line, stmt, switch, end) in blocks {
+            r.block(&BlockFlow {
+                line: *line,
+                stmt: stmt.as_ref(),
+                switch: *switch,
+                skippable: false,
+                program_end: *end,
+                number: None,
+            });
+        }
+        r
+    }
+
+    fn at(plan: &FlowPlan, line: usize) -> Option<Tcpm> {
+        Cursor::default().at(plan, line).0
+    }
+
+    #[test]
+    fn a_call_is_settled_by_its_subprogram() {
+        // 2 TCPM on, 3 call 2000, 4 the zone, 5 M30; 6 O2000, 7 off, 8 M99.
+        let call = Stmt::Call {
+            key: Key::Program(2000),
+            repeats: false,
+        };
+        let r = rec(&[
+            (2, None, Some(Tcpm::On), false),
+            (3, Some(call.clone()), None, false),
+            (5, None, Some(Tcpm::Off), true),
+            (6, Some(Stmt::Label(Key::Program(2000))), None, false),
+            (7, None, Some(Tcpm::Off), false),
+            (
+                8,
+                Some(Stmt::Return {
+                    falls_through: false,
+                }),
+                None,
+                false,
+            ),
+        ]);
+        assert!(r.global);
+        let plan = r.solve(Tcpm::Off);
+        assert_eq!(at(&plan, 4), Some(Tcpm::Off), "the subprogram ends TCPM");
+        assert_eq!(at(&plan, 6), Some(Tcpm::On), "called with it on");
+        // Without the G49 in the subprogram: on after the call.
+        let r = rec(&[
+            (2, None, Some(Tcpm::On), false),
+            (3, Some(call), None, false),
+            (5, None, Some(Tcpm::Off), true),
+            (6, Some(Stmt::Label(Key::Program(2000))), None, false),
+            (
+                8,
+                Some(Stmt::Return {
+                    falls_through: false,
+                }),
+                None,
+                false,
+            ),
+        ]);
+        assert_eq!(at(&r.solve(Tcpm::Off), 4), Some(Tcpm::On));
+    }
+
+    #[test]
+    fn a_call_of_code_outside_the_file_is_unknown() {
+        let r = rec(&[
+            (2, None, Some(Tcpm::On), false),
+            (
+                3,
+                Some(Stmt::Call {
+                    key: Key::Program(9001),
+                    repeats: false,
+                }),
+                None,
+                false,
+            ),
+        ]);
+        assert_eq!(at(&r.solve(Tcpm::Off), 4), Some(Tcpm::Unknown));
+    }
+
+    #[test]
+    fn a_jump_over_a_switch_joins_two_states() {
+        let r = rec(&[
+            (
+                2,
+                Some(Stmt::Jump {
+                    key: Key::Block(100),
+                    cond: true,
+                }),
+                None,
+                false,
+            ),
+            (3, None, Some(Tcpm::On), false),
+        ]);
+        assert!(r.needs_block_labels());
+        let mut r2 = Recorder::with_block_labels(r.block_targets.clone());
+        for (line, stmt, switch, number) in [
+            (
+                2,
+                Some(Stmt::Jump {
+                    key: Key::Block(100),
+                    cond: true,
+                }),
+                None,
+                None,
+            ),
+            (3, None, Some(Tcpm::On), None),
+            (4, None, None, Some(100)),
+        ] {
+            r2.block(&BlockFlow {
+                line,
+                stmt: stmt.as_ref(),
+                switch,
+                skippable: false,
+                program_end: false,
+                number,
+            });
+        }
+        let plan = r2.solve(Tcpm::Off);
+        assert_eq!(Cursor::default().at(&plan, 4), (Some(Tcpm::Unknown), true));
+        // Unconditional: the switch is never reached; the target has the jump's state.
+        let r = rec(&[
+            (
+                2,
+                Some(Stmt::Jump {
+                    key: Key::Label("SKIP".into()),
+                    cond: false,
+                }),
+                None,
+                false,
+            ),
+            (3, None, Some(Tcpm::On), false),
+            (4, Some(Stmt::Label(Key::Label("SKIP".into()))), None, false),
+        ]);
+        let plan = r.solve(Tcpm::Off);
+        assert_eq!(at(&plan, 4), Some(Tcpm::Off));
+        assert_eq!(at(&plan, 3), Some(Tcpm::Unknown), "not reached");
+    }
+
+    #[test]
+    fn loops_and_unfollowable_flow() {
+        // A switch inside a loop body: the loop's keywords join before and after.
+        let open = Stmt::Nested {
+            role: Nest::Open,
+            tag: 0,
+        };
+        let close = Stmt::Nested {
+            role: Nest::Close,
+            tag: 0,
+        };
+        let r = rec(&[
+            (2, None, Some(Tcpm::On), false),
+            (3, Some(open), None, false),
+            (4, None, Some(Tcpm::Off), false),
+            (5, Some(close), None, false),
+        ]);
+        let plan = r.solve(Tcpm::Off);
+        assert_eq!(at(&plan, 3), Some(Tcpm::Unknown));
+        assert_eq!(at(&plan, 5), Some(Tcpm::Unknown));
+        // A jump to a label that is not in the file, or a computed one: unknown everywhere.
+        let r = rec(&[(
+            2,
+            Some(Stmt::Jump {
+                key: Key::Label("NOWHERE".into()),
+                cond: true,
+            }),
+            None,
+            false,
+        )]);
+        assert!(r.solve(Tcpm::Off).all_unknown());
+        assert!(
+            rec(&[(2, Some(Stmt::Opaque), None, false)])
+                .solve(Tcpm::On)
+                .all_unknown()
+        );
+    }
+
+    #[test]
+    fn linuxcnc_subroutines_are_skipped_in_file_order() {
+        let k = Key::Label("O200".into());
+        let r = rec(&[
+            (1, Some(Stmt::SubStart(k.clone())), None, false),
+            (2, None, Some(Tcpm::Off), false),
+            (3, Some(Stmt::SubEnd(k.clone())), None, false),
+            (4, None, Some(Tcpm::On), false),
+            (
+                5,
+                Some(Stmt::Call {
+                    key: k,
+                    repeats: false,
+                }),
+                None,
+                false,
+            ),
+        ]);
+        let plan = r.solve(Tcpm::Off);
+        assert_eq!(at(&plan, 2), Some(Tcpm::On), "the body runs when called");
+        assert_eq!(at(&plan, 6), Some(Tcpm::Off), "after the call");
+        assert_eq!(at(&plan, 4), Some(Tcpm::Off), "the definition is skipped");
+    }
+}
+
+/// A token of a line as the statement reader sees it.
+#[derive(Debug, Clone, PartialEq)]
+enum Tok {
+    /// An address word with a number (`M98`, `P2000`, `O100`, `N10`).
+    Word(u8, f64),
+    /// An identifier, upper case (`GOTOF`, `CALL`, `SUB1`).
+    Ident(String),
+    /// Any other token's text (`:`, `,0`, `100`, `[#1 EQ 1]`, `<name>`).
+    Other(Vec<u8>),
+}
+
+/// The tokens of a line (comments and block ends dropped).
+fn toks(bytes: &[u8], span: std::ops::Range<usize>) -> Vec<Tok> {
+    use crate::lexer::{Lexer, Token};
+    let mut out = Vec::new();
+    for t in Lexer::new(bytes, span).flatten() {
+        match t {
+            Token::Word { letter, value, .. } => out.push(Tok::Word(letter, value)),
+            Token::Ident { name, span } => {
+                out.push(Tok::Ident(
+                    String::from_utf8_lossy(&bytes[name.clone()]).to_ascii_uppercase(),
+                ));
+                if span.end > name.end {
+                    out.push(Tok::Other(bytes[name.end..span.end].to_vec()));
+                }
+            }
+            Token::Assign { letter, span } => {
+                out.push(Tok::Other(bytes[span.start..span.start + 1].to_vec()));
+                let _ = letter;
+                out.push(Tok::Other(bytes[span.start + 1..span.end].to_vec()));
+            }
+            Token::Other { span }
+            | Token::Param { span }
+            | Token::Percent { span }
+            | Token::Indexed { span, .. } => out.push(Tok::Other(bytes[span].to_vec())),
+            Token::Comment { .. } | Token::BlockEnd { .. } | Token::Slash { .. } => {}
+        }
+    }
+    out
+}
+
+/// A whole number from a word value or token text (`100`, `2000.`), if it is one.
+fn whole(v: f64) -> Option<u64> {
+    (v >= 0.0 && v.fract() == 0.0 && v < 1e15).then_some(v as u64)
+}
+
+fn whole_text(t: &[u8]) -> Option<u64> {
+    let t = t.strip_suffix(b".").unwrap_or(t);
+    (!t.is_empty() && t.iter().all(u8::is_ascii_digit))
+        .then(|| std::str::from_utf8(t).ok()?.parse().ok())
+        .flatten()
+}
+
+/// Sinumerik identifiers that are statements, not subprogram calls (the predefined
+/// instructions a CAM post writes). Any other identifier standing as a statement is read as
+/// the call of a subprogram (outside the file).
+const SINUMERIK_INSTRUCTIONS: &[&str] = &[
+    "MSG",
+    "DEF",
+    "DEFINE",
+    "PROC",
+    "EXTERN",
+    "STOPRE",
+    "FNORM",
+    "FLIN",
+    "FCUB",
+    "FCUT",
+    "COMPOF",
+    "COMPON",
+    "COMPCURV",
+    "COMPCAD",
+    "COMPSURF",
+    "SOFT",
+    "SOFTA",
+    "BRISK",
+    "BRISKA",
+    "DRIVE",
+    "DRIVEA",
+    "FFWON",
+    "FFWOF",
+    "CFC",
+    "CFTCP",
+    "CFIN",
+    "CDON",
+    "CDOF",
+    "CDOF2",
+    "CUT2D",
+    "CUT2DF",
+    "CUT3DC",
+    "CUT3DF",
+    "CUT3DFS",
+    "CUT3DFF",
+    "CUT3DCC",
+    "CUT3DCCD",
+    "ORIWKS",
+    "ORIMKS",
+    "ORIAXES",
+    "ORIVECT",
+    "ORIEULER",
+    "ORIRPY",
+    "ORIRPY2",
+    "ORIVIRT1",
+    "ORIVIRT2",
+    "ORIAXPOS",
+    "ORIPLANE",
+    "ORICONCW",
+    "ORICONCCW",
+    "ORICONIO",
+    "ORICONTO",
+    "ORICURVE",
+    "ORIPATH",
+    "ORIPATHS",
+    "ORIROTA",
+    "ORIROTR",
+    "ORIROTT",
+    "ORIROTC",
+    "ORISON",
+    "ORISOF",
+    "UPATH",
+    "SPATH",
+    "OFFN",
+    "ACC",
+    "VELOLIM",
+    "JERKLIM",
+    "SPOS",
+    "SPOSA",
+    "WAITM",
+    "WAITS",
+    "WAITE",
+    "SETAL",
+    "SAVE",
+    "DISPLOF",
+    "DISPLON",
+    "PRLOC",
+    "FGROUP",
+    "FGREF",
+    "FL",
+    "OST",
+    "TRAILON",
+    "TRAILOF",
+    "WORKPIECE",
+    "TOFRAME",
+    "TOROT",
+    "TOROTOF",
+    "TCARR",
+    "PAROT",
+    "PAROTOF",
+    "TCOABS",
+    "TCOFR",
+    "FA",
+    "FPR",
+    "FPRAON",
+    "FPRAOF",
+    "POS",
+    "POSA",
+    "STOPFIFO",
+    "STARTFIFO",
+    "FIFOCTRL",
+    "IPTRLOCK",
+    "IPTRUNLOCK",
+    "G_GROUP",
+    "SETMS",
+    "SPCON",
+    "SPCOF",
+    "SUPA",
+    "MCALL",
+    "DIAMON",
+    "DIAMOF",
+    "DIAM90",
+    "CHR",
+    "RND",
+    "RNDM",
+    "CHF",
+    "ASPLINE",
+    "BSPLINE",
+    "CSPLINE",
+    "POLY",
+    "PO",
+    "PL",
+    "BAUTO",
+    "BNAT",
+    "BTAN",
+    "EAUTO",
+    "ENAT",
+    "ETAN",
+    "OMA1",
+    "OMA2",
+    "OMA3",
+    "OMA4",
+    "OMA5",
+    "TLIFT",
+    "WALIMON",
+    "WALIMOF",
+    "G_GROUP",
+    "AX",
+    "FXS",
+    "FXST",
+    "FXSW",
+    "FOCON",
+    "FOCOF",
+    "LIMS",
+    "CPRECON",
+    "CPRECOF",
+    "CTOL",
+    "OTOL",
+    "ATOL",
+    "STOLF",
+    "G642",
+    "G643",
+    "G644",
+    "G645",
+    "CYCLE832",
+    "ANG",
+    "AR",
+    "AP",
+    "RP",
+    "CR",
+    "TURN",
+    "CIP",
+    "CT",
+    "IC",
+    "AC",
+    "DC",
+    "ACP",
+    "ACN",
+    "CAC",
+    "CIC",
+    "CDC",
+    "CACP",
+    "CACN",
+];
+
+/// The flow statement of an ISO-style line (Fanuc, Haas, LinuxCNC, Sinumerik, Heidenhain
+/// ISO), if it has one (module docs' table).
+pub(crate) fn read_iso(
+    dialect: crate::Dialect,
+    bytes: &[u8],
+    span: std::ops::Range<usize>,
+) -> Option<Stmt> {
+    use crate::Dialect;
+    let t = toks(bytes, span);
+    // Skip a block number.
+    let body: &[Tok] = match t.first() {
+        Some(Tok::Word(b'N', _)) => &t[1..],
+        _ => &t,
+    };
+    let word = |l: u8| {
+        body.iter().find_map(|x| match x {
+            Tok::Word(c, v) if *c == l => Some(*v),
+            _ => None,
+        })
+    };
+    let ident_at = |name: &str| {
+        body.iter()
+            .position(|x| matches!(x, Tok::Ident(s) if s == name || (s.starts_with(name) && s[name.len()..].bytes().all(|b| b.is_ascii_digit()))))
+    };
+    let m = |code: f64| {
+        body.iter()
+            .any(|x| matches!(x, Tok::Word(b'M', v) if (*v - code).abs() < 1e-9))
+    };
+    let g = |code: f64| {
+        body.iter()
+            .any(|x| matches!(x, Tok::Word(b'G', v) if (*v - code).abs() < 1e-9))
+    };
+    // A jump's target: a number (block), `N100`, or a label name.
+    let target_after = |i: usize, name_len: usize| -> Option<Key> {
+        if let Some(Tok::Ident(s)) = body.get(i)
+            && s.len() > name_len
+        {
+            return whole_text(&s.as_bytes()[name_len..]).map(Key::Block);
+        }
+        match body.get(i + 1) {
+            Some(Tok::Other(o)) => whole_text(o).map(Key::Block),
+            Some(Tok::Word(b'N', v)) => whole(*v).map(Key::Block),
+            Some(Tok::Ident(s)) => Some(Key::Label(s.clone())),
+            _ => None,
+        }
+    };
+    match dialect {
+        Dialect::Heidenhain => {
+            // `G98 L1` label, `G98 L0` return; `L1,0` call (`L1,3`: three more times).
+            // (`G99 T1 L+0 R+2` defines a tool: its L is a length.)
+            if let Some(l) = word(b'L')
+                && !g(99.0)
+            {
+                let n = whole(l)?;
+                if g(98.0) {
+                    return Some(if n == 0 {
+                        Stmt::Return {
+                            falls_through: true,
+                        }
+                    } else {
+                        Stmt::Label(Key::Label(n.to_string()))
+                    });
+                }
+                let rep = body.iter().find_map(|x| match x {
+                    Tok::Other(o) if o.first() == Some(&b',') => whole_text(&o[1..]),
+                    _ => None,
+                })?;
+                return Some(Stmt::Call {
+                    key: Key::Label(n.to_string()),
+                    repeats: rep > 0,
+                });
+            }
+            // `N50 %NAME *` inside a numbered block: another program is called (the header
+            // and end lines name the unit, `%NAME G71`; `% TEXT` with a blank is not a call).
+            let numbered = matches!(t.first(), Some(Tok::Word(b'N', _)));
+            let called = numbered
+                && body.iter().any(|x| match x {
+                    Tok::Other(o) if o.first() == Some(&b'%') => {
+                        let up = o.to_ascii_uppercase();
+                        o.get(1)
+                            .is_some_and(|c| c.is_ascii_alphanumeric() || *c == b'_')
+                            && !up.windows(3).any(|w| w == b"G70" || w == b"G71")
+                    }
+                    _ => false,
+                });
+            called.then_some(Stmt::External)
+        }
+        Dialect::Sinumerik => {
+            // `NAME:` label (a name followed by a colon at the start of the block).
+            if let (Some(Tok::Ident(name)), Some(Tok::Other(o))) = (body.first(), body.get(1))
+                && o.first() == Some(&b':')
+            {
+                return Some(Stmt::Label(Key::Label(name.clone())));
+            }
+            for name in ["GOTOF", "GOTOB", "GOTOC", "GOTO"] {
+                if let Some(i) = body
+                    .iter()
+                    .position(|x| matches!(x, Tok::Ident(s) if s == name))
+                {
+                    let cond = ident_at("IF").is_some() || name == "GOTOC";
+                    return Some(match target_after(i, name.len()) {
+                        Some(key) => Stmt::Jump { key, cond },
+                        None => Stmt::Opaque,
+                    });
+                }
+            }
+            let first_ident = body.iter().find_map(|x| match x {
+                Tok::Ident(s) => Some(s.as_str()),
+                _ => None,
+            });
+            match first_ident {
+                Some("IF" | "WHILE" | "FOR" | "LOOP") => {
+                    return Some(Stmt::Nested {
+                        role: Nest::Open,
+                        tag: 0,
+                    });
+                }
+                Some("REPEAT") => {
+                    // `REPEAT` alone opens a loop; with labels it repeats a section.
+                    let args = body.iter().skip(1).any(|x| matches!(x, Tok::Ident(_)));
+                    return Some(if args {
+                        Stmt::Opaque
+                    } else {
+                        Stmt::Nested {
+                            role: Nest::Open,
+                            tag: 0,
+                        }
+                    });
+                }
+                Some("REPEATB" | "CASE") => return Some(Stmt::Opaque),
+                Some("ELSE") => {
+                    return Some(Stmt::Nested {
+                        role: Nest::Middle,
+                        tag: 0,
+                    });
+                }
+                Some("ENDIF" | "ENDWHILE" | "ENDFOR" | "ENDLOOP" | "UNTIL") => {
+                    return Some(Stmt::Nested {
+                        role: Nest::Close,
+                        tag: 0,
+                    });
+                }
+                Some("RET") => {
+                    return Some(Stmt::Return {
+                        falls_through: false,
+                    });
+                }
+                _ => {}
+            }
+            if m(17.0) {
+                return Some(Stmt::Return {
+                    falls_through: false,
+                });
+            }
+            if let Some(i) = ident_at("MCALL") {
+                // A modal call of a standard cycle keeps TCPM; of anything else, every
+                // later move calls it.
+                return match body.get(i + 1) {
+                    Some(Tok::Ident(s)) if !s.starts_with("CYCLE") => Some(Stmt::Opaque),
+                    _ => None,
+                };
+            }
+            if word(b'L').is_some()
+                || body
+                    .iter()
+                    .any(|x| matches!(x, Tok::Ident(s) if matches!(s.as_str(), "CALL" | "PCALL" | "EXTCALL")))
+            {
+                return Some(Stmt::External);
+            }
+            // The first identifier of the block, not an instruction and not assigned to:
+            // a subprogram's name.
+            let first = body.iter().position(|x| matches!(x, Tok::Ident(_)))?;
+            let Tok::Ident(name) = &body[first] else {
+                return None;
+            };
+            let assigned =
+                matches!(body.get(first + 1), Some(Tok::Other(o)) if o.first() == Some(&b'='));
+            let call = !assigned
+                && !SINUMERIK_INSTRUCTIONS.contains(&name.as_str())
+                && !name.starts_with("CYCLE")
+                && !name.starts_with("TRA")
+                && !crate::interp::is_sinumerik_frame(name.as_bytes());
+            call.then_some(Stmt::External)
+        }
+        _ => {
+            // LinuxCNC o-words.
+            if let Some(Tok::Other(o)) = body.first()
+                && o.eq_ignore_ascii_case(b"o")
+                && let (Some(Tok::Other(name)), Some(Tok::Ident(kw))) = (body.get(1), body.get(2))
+            {
+                return Some(o_word(
+                    &format!("O{}", String::from_utf8_lossy(name).to_ascii_uppercase()),
+                    kw,
+                ));
+            }
+            if let (Some(Tok::Word(b'O', v)), Some(Tok::Ident(kw))) = (body.first(), body.get(1)) {
+                return Some(o_word(&format!("O{v}"), kw));
+            }
+            // A Fanuc program number starts a (sub)program.
+            if let (Some(Tok::Word(b'O', v)), None) = (t.first(), t.get(1)) {
+                return whole(*v).map(|n| Stmt::Label(Key::Program(n)));
+            }
+            if let Some(i) = ident_at("GOTO") {
+                let cond = ident_at("IF").is_some_and(|k| k < i);
+                return Some(match target_after(i, 4) {
+                    Some(Key::Block(n)) => Stmt::Jump {
+                        key: Key::Block(n),
+                        cond,
+                    },
+                    _ => Stmt::Opaque,
+                });
+            }
+            // Fanuc loops: `WHILE [...] DO 1` … `END 1` (also `DO1`, `END1`).
+            let loop_tag = |i: usize, name: &str| -> u32 {
+                let n = match (&body[i], body.get(i + 1)) {
+                    (Tok::Ident(s), _) if s.len() > name.len() => {
+                        whole_text(&s.as_bytes()[name.len()..])
+                    }
+                    (_, Some(Tok::Other(o))) => whole_text(o),
+                    _ => None,
+                };
+                n.and_then(|n| u32::try_from(n).ok()).unwrap_or(0)
+            };
+            if let Some(i) = ident_at("DO") {
+                return Some(Stmt::Nested {
+                    role: Nest::Open,
+                    tag: loop_tag(i, "DO"),
+                });
+            }
+            if let Some(i) = ident_at("END") {
+                return Some(Stmt::Nested {
+                    role: Nest::Close,
+                    tag: loop_tag(i, "END"),
+                });
+            }
+            let p = word(b'P').and_then(whole);
+            let repeat = word(b'L').and_then(whole).is_some_and(|l| l > 1);
+            if m(98.0) {
+                return Some(match p {
+                    // `M98 P32000`: three times program 2000 (the old form, count first).
+                    Some(p) if p > 9999 => Stmt::Call {
+                        key: Key::Program(p % 10000),
+                        repeats: p / 10000 > 1 || repeat,
+                    },
+                    Some(p) => Stmt::Call {
+                        key: Key::Program(p),
+                        repeats: repeat,
+                    },
+                    None => Stmt::External,
+                });
+            }
+            if m(97.0) {
+                return Some(match p {
+                    Some(p) => Stmt::Call {
+                        key: Key::Block(p),
+                        repeats: repeat,
+                    },
+                    None => Stmt::Opaque,
+                });
+            }
+            if m(99.0) {
+                return Some(if p.is_some() {
+                    Stmt::Opaque
+                } else {
+                    Stmt::Return {
+                        falls_through: false,
+                    }
+                });
+            }
+            if g(65.0) {
+                return Some(match p {
+                    Some(p) => Stmt::Call {
+                        key: Key::Program(p),
+                        repeats: repeat,
+                    },
+                    None => Stmt::External,
+                });
+            }
+            if g(66.0) || g(66.1) {
+                return Some(Stmt::Opaque);
+            }
+            if m(198.0) {
+                return Some(Stmt::External);
+            }
+            if m(6.0) {
+                return Some(Stmt::ToolChange);
+            }
+            None
+        }
+    }
+}
+
+/// A LinuxCNC o-word statement `oNAME keyword`.
+fn o_word(name: &str, kw: &str) -> Stmt {
+    let key = Key::Label(name.to_string());
+    match kw {
+        "SUB" => Stmt::SubStart(key),
+        "ENDSUB" => Stmt::SubEnd(key),
+        "CALL" => Stmt::Call {
+            key,
+            repeats: false,
+        },
+        "RETURN" => Stmt::Return {
+            falls_through: false,
+        },
+        "IF" | "ELSEIF" | "ELSE" | "ENDIF" | "WHILE" | "ENDWHILE" | "DO" | "REPEAT"
+        | "ENDREPEAT" | "BREAK" | "CONTINUE" => Stmt::Group(Key::Group(name.to_string())),
+        _ => Stmt::Opaque,
+    }
+}
