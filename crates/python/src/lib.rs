@@ -88,7 +88,7 @@ fn post_cl<'py>(
     let mut opts = post.post(f.patch(&p))?;
     let m = &machine.0;
     let out = detached(py, || {
-        let post = || -> Result<Vec<u8>, polepatch::Error> {
+        let mut post = || -> Result<Vec<u8>, polepatch::Error> {
             let program = polepatch::post::read_cl(&cl, &opts.patch_options.name)?;
             polepatch::post::tool_from_cl(&cl, &program, &mut opts);
             polepatch::post::post_cl(&program, m, &opts).map(|(out, _)| out)
