@@ -445,6 +445,23 @@ fn print_summary(
             })
             .collect();
         writeln!(out, "  reasons: {}", counts.join(", "))?;
+        // The positioning moves after runs whose end is free: they start from the patched
+        // end (a re-selected end may turn C further, or less).
+        let rapids: Vec<(f64, f64)> = rep
+            .zones
+            .iter()
+            .filter_map(|z| z.rapid_time_before_s.zip(z.rapid_time_after_s))
+            .collect();
+        if !rapids.is_empty() {
+            let (b, a) = rapids
+                .iter()
+                .fold((0.0, 0.0), |(b, a), &(x, y)| (b + x, a + y));
+            writeln!(
+                out,
+                "  positioning moves after the runs ({}): {b:.3} → {a:.3} s",
+                rapids.len()
+            )?;
+        }
         for (letter, written, file) in [
             ("C", rep.written_c_decimals, rep.file_c_decimals),
             (

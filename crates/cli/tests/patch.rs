@@ -317,3 +317,53 @@ fn f4000_on_the_hsm600_with_three_decimals_reaches_feed_by_default() {
         );
     }
 }
+
+/// Issue 31 §3: the positioning move after a run whose end is free starts from the patched
+/// end. On a zigzag of near-pole passes every such move's time is reported before and after,
+/// and a run whose patched end makes that move slower keeps the end only when the run plus
+/// the move is still faster than with its end pinned: over each run, zone times plus the
+/// move's time after are at most what they were before.
+#[test]
+fn rapids_after_runs_are_accounted_for() {
+    let base = Pass {
+        domain_rule: true,
+        ..Pass::default()
+    };
+    let text = polepatch_fixturegen::zigzag_program(
+        &base,
+        10,
+        &[0.1, 0.5, 1.0, 2.0, 4.0, 0.3, 0.05, 1.5, 0.2, 3.0],
+        "ZIGZAG",
+    );
+    for m in machines() {
+        let lp = load_bytes(text.as_bytes(), "zigzag", &m);
+        let (_, report) = polepatch::patch_loaded(&lp, &m, &PatchOptions::default());
+        let mut with_rapid = 0;
+        let runs: std::collections::BTreeSet<usize> = report.zones.iter().map(|z| z.run).collect();
+        for run in runs {
+            let zones: Vec<_> = report.zones.iter().filter(|z| z.run == run).collect();
+            let last = zones.last().unwrap();
+            let (Some(rb), Some(ra)) = (last.rapid_time_before_s, last.rapid_time_after_s) else {
+                continue;
+            };
+            with_rapid += 1;
+            assert!(last.rapid_line.is_some(), "{last:?}");
+            let before: f64 = zones.iter().map(|z| z.before.time_s).sum::<f64>() + rb;
+            let after: f64 = zones.iter().map(|z| z.after.time_s).sum::<f64>() + ra;
+            assert!(
+                after <= before + 1e-3,
+                "{} run {run}: zones and rapid {before:.3} s → {after:.3} s",
+                m.name
+            );
+            if last.end_pose == "pinned" {
+                assert_eq!(ra, rb, "{last:?}");
+            }
+        }
+        // Every pass but the last is followed by the next pass's positioning move.
+        assert!(
+            with_rapid >= 8,
+            "{}: {with_rapid} runs with a rapid",
+            m.name
+        );
+    }
+}

@@ -54,7 +54,7 @@ use polepatch_nc::modal::{C, X, Y, Z};
 use polepatch_nc::{Flags, Modal, Word};
 
 /// What the blocks after a run say about its last point.
-#[derive(Debug, Clone, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct EndPose {
     /// The last point may change (module docs).
     pub free: bool,
@@ -63,6 +63,56 @@ pub struct EndPose {
     /// Blocks before the deciding one that restate the run's last rotary values: when the
     /// last point changes they are rewritten with its new values.
     pub restate: Vec<usize>,
+    /// The positioning move that freed the end (a rotary-only repositioning or a move above
+    /// the clearance), when it is one: a changed last point changes how far it turns the
+    /// rotary axes ([`NextMove::time_s`]).
+    pub next: Option<NextMove>,
+}
+
+/// The move after a run that freed its end: where it takes the rotary axes, and how far it
+/// moves the tool tip (what it costs does not depend on the run's end otherwise).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NextMove {
+    /// Its 1-based file line.
+    pub line: usize,
+    /// The primary axis' and C's values it programs, degrees.
+    pub p_deg: f64,
+    /// C, degrees.
+    pub c_deg: f64,
+    /// |ΔX|, |ΔY|, |ΔZ| of the tool tip over the move, mm.
+    pub linear_mm: [f64; 3],
+}
+
+impl NextMove {
+    /// The move's time from the run's last pose `(p_deg, c_deg)`, s: every axis at its
+    /// velocity and acceleration limits (a trapezoid, jerk left out), the slowest axis
+    /// setting the time — how a controller positions with rapid traverse. An estimate for
+    /// comparing two ends of the same run, not the controller's exact time.
+    pub fn time_s(&self, machine: &polepatch_kinematics::Machine, p_deg: f64, c_deg: f64) -> f64 {
+        let d = [
+            self.linear_mm[0],
+            self.linear_mm[1],
+            self.linear_mm[2],
+            (self.p_deg - p_deg).abs(),
+            (self.c_deg - c_deg).abs(),
+        ];
+        d.iter()
+            .zip(&machine.limits)
+            .map(|(&d, lim)| trapezoid_time_s(d, lim.v, lim.a))
+            .fold(0.0, f64::max)
+    }
+}
+
+/// The time to travel `d` from rest to rest at velocity `v` and acceleration `a` at most.
+fn trapezoid_time_s(d: f64, v: f64, a: f64) -> f64 {
+    if [d, v, a].iter().any(|x| x.is_nan() || *x <= 0.0) {
+        return 0.0;
+    }
+    if d >= v * v / a {
+        d / v + v / a
+    } else {
+        2.0 * (d / a).sqrt()
+    }
 }
 
 /// One block's answer (see [`After::verdict`]).
@@ -105,6 +155,30 @@ pub struct After<'a> {
 }
 
 impl After<'_> {
+    /// The positioning move this block is, when it freed the end by moving the rotary axes
+    /// to known values (`line` its file line).
+    pub fn next_move(&self, primary: u8, line: usize) -> Option<NextMove> {
+        if !self.is_move {
+            return None;
+        }
+        let p_idx = if primary == b'A' {
+            polepatch_nc::modal::A
+        } else {
+            polepatch_nc::modal::B
+        };
+        let (st, prev) = (self.state, self.before);
+        let linear = |i: usize| match (prev.pos[i], st.pos[i]) {
+            (Some(a), Some(b)) => Some((b - a).abs()),
+            _ => None,
+        };
+        Some(NextMove {
+            line,
+            p_deg: st.pos[p_idx]?,
+            c_deg: st.pos[C]?,
+            linear_mm: [linear(X)?, linear(Y)?, linear(Z)?],
+        })
+    }
+
     /// What this block says about the pose of the run's last point before it, for a
     /// program whose tilting letter is `primary` (`b'A'` or `b'B'`), given what the scan
     /// saw so far (updated: a retract raises the clearance). Module docs.
@@ -216,10 +290,12 @@ pub fn end_pose(lp: &LoadedProgram, r: usize) -> EndPose {
         };
         match after.verdict(lp.primary_letter, &mut scan) {
             Step::Free => {
+                let line = program.blocks[b].line;
                 return EndPose {
                     free: true,
-                    decided_line: Some(program.blocks[b].line),
+                    decided_line: Some(line),
                     restate,
+                    next: after.next_move(lp.primary_letter, line),
                 };
             }
             Step::Pinned => {
@@ -227,6 +303,7 @@ pub fn end_pose(lp: &LoadedProgram, r: usize) -> EndPose {
                     free: false,
                     decided_line: Some(program.blocks[b].line),
                     restate: Vec::new(),
+                    next: None,
                 };
             }
             Step::Restate if next_run_start.is_some_and(|n| b >= n) => {
@@ -234,6 +311,7 @@ pub fn end_pose(lp: &LoadedProgram, r: usize) -> EndPose {
                     free: false,
                     decided_line: Some(program.blocks[b].line),
                     restate: Vec::new(),
+                    next: None,
                 };
             }
             Step::Restate => restate.push(b),
@@ -245,6 +323,7 @@ pub fn end_pose(lp: &LoadedProgram, r: usize) -> EndPose {
         free: true,
         decided_line: None,
         restate,
+        next: None,
     }
 }
 
@@ -255,6 +334,29 @@ pub fn end_pose_is_free(lp: &LoadedProgram, r: usize) -> bool {
 
 #[cfg(test)]
 mod tests {
+    /// Planted: the trapezoid's time below and above the distance that reaches v, and the
+    /// slowest axis setting a move's time (C turning 180° more costs 180/v).
+    #[test]
+    fn a_positioning_move_takes_its_slowest_axis_time() {
+        assert!((trapezoid_time_s(4.0, 2.0, 1.0) - 4.0).abs() < 1e-12); // d = v²/a: 2·√4
+        assert!((trapezoid_time_s(1.0, 2.0, 1.0) - 2.0).abs() < 1e-12);
+        assert!((trapezoid_time_s(10.0, 2.0, 1.0) - 7.0).abs() < 1e-12); // 10/2 + 2/1
+        assert_eq!(trapezoid_time_s(0.0, 2.0, 1.0), 0.0);
+        let m = polepatch_kinematics::Machine::builtin("mikron-ucp710").unwrap();
+        let next = NextMove {
+            line: 1,
+            p_deg: 10.0,
+            c_deg: 90.0,
+            linear_mm: [0.0; 3],
+        };
+        let c = &m.limits[4];
+        // Both turns beyond v²/a (48° on the UCP710's C): the far one costs 180/v more.
+        let t_near = next.time_s(&m, 10.0, -10.0);
+        let t_far = next.time_s(&m, 10.0, -190.0);
+        assert!((t_near - trapezoid_time_s(100.0, c.v, c.a)).abs() < 1e-12);
+        assert!((t_far - t_near - 180.0 / c.v).abs() < 1e-9, "{t_near} {t_far}");
+    }
+
     use super::*;
     use crate::program::load_nc;
     use polepatch_kinematics::Machine;

@@ -145,7 +145,21 @@ pub struct ZoneRow {
     /// Reason `deviation_cap` or `tool_limited`: the orientation change a patch reaching
     /// feed needed, degrees.
     pub needed_deviation_deg: Option<f64>,
+    /// On the last zone of a run whose end is free: the positioning move after the run
+    /// (the rapid or rotary repositioning that freed it) — its line and its time before
+    /// and after the patch, s (each axis at its V and A limits, the slowest setting the
+    /// time: [`crate::end_pose::NextMove::time_s`]). A re-selected end can make it turn C
+    /// by up to 180° more, or less.
+    pub rapid_line: Option<usize>,
+    /// That move's time from the original end, s.
+    pub rapid_time_before_s: Option<f64>,
+    /// That move's time from the patched end, s.
+    pub rapid_time_after_s: Option<f64>,
 }
+
+/// Below this, a positioning move's time after a run is the same before and after a patch
+/// (what the end's choice ignores), s.
+const RAPID_TIME_TOL_S: f64 = 1e-3;
 
 /// Report name of a feed mode: `G94`, `G93` or `G95`.
 pub fn feed_mode_name(m: polepatch_nc::FeedMode) -> &'static str {
@@ -174,6 +188,7 @@ impl ZoneRow {
         self.centre_shift_per_mm_radius = 0.0;
         self.max_cutter_shift_mm = self.max_cutter_shift_mm.map(|_| 0.0);
         self.centre_chord_mm = None;
+        self.rapid_time_after_s = self.rapid_time_before_s;
     }
 }
 
@@ -199,7 +214,7 @@ fn method_name(m: Method) -> &'static str {
 
 impl ZoneRow {
     /// CSV column names of [`ZoneRow::csv_fields`] (the row's fields after `file`).
-    pub const CSV_COLUMNS: [&'static str; 41] = [
+    pub const CSV_COLUMNS: [&'static str; 44] = [
         "run",
         "first_line",
         "last_line",
@@ -241,6 +256,9 @@ impl ZoneRow {
         "max_cutter_shift_um",
         "centre_chord_um",
         "needed_deviation_deg",
+        "rapid_line",
+        "rapid_time_before_s",
+        "rapid_time_after_s",
     ];
 
     /// The row as CSV fields, in [`ZoneRow::CSV_COLUMNS`] order.
@@ -297,6 +315,11 @@ impl ZoneRow {
                 .map_or(String::new(), |v| format!("{:.3}", v * 1e3)),
             self.needed_deviation_deg
                 .map_or(String::new(), |v| format!("{v:.6}")),
+            self.rapid_line.map_or(String::new(), |l| l.to_string()),
+            self.rapid_time_before_s
+                .map_or(String::new(), |v| format!("{v:.6}")),
+            self.rapid_time_after_s
+                .map_or(String::new(), |v| format!("{v:.6}")),
         ]
     }
 
@@ -340,6 +363,9 @@ impl ZoneRow {
             max_cutter_shift_mm: None,
             centre_chord_mm: None,
             needed_deviation_deg: z.needed_deviation_deg,
+            rapid_line: None,
+            rapid_time_before_s: None,
+            rapid_time_after_s: None,
         }
     }
 }
@@ -763,11 +789,48 @@ pub fn patch_program(
             _ => None,
         };
         let work_path = part_path.as_ref().unwrap_or(path);
-        let patched = if part_path.is_some() {
-            machine_frame::patch_part_frame(work_path, machine, &run_opts)
-        } else {
-            patch_path(work_path, machine, &run_opts)
+        let patch_with = |o: &PatchOptions| {
+            if part_path.is_some() {
+                machine_frame::patch_part_frame(work_path, machine, o)
+            } else {
+                patch_path(work_path, machine, o)
+            }
         };
+        let mut patched = patch_with(&run_opts);
+        // The positioning move after a free end starts from the patched end: where that
+        // costs more time than the patch saves in the run (a re-selected end whose next
+        // rapid turns C by 180° more), the end is pinned instead when that is faster overall
+        // (issue 31: every move the patch changes is accounted for).
+        let rapid = |res: &polepatch_patcher::PatchResult| -> Option<(usize, f64, f64)> {
+            let next = end.next.as_ref()?;
+            let n = path.axes.len();
+            let (p0, c0) = (path.axes[n - 1][3], path.axes[n - 1][4]);
+            let (p1, c1) = (*res.p_deg.last()?, *res.c_deg.last()?);
+            Some((
+                next.line,
+                next.time_s(machine, p0, c0),
+                next.time_s(machine, p1, c1),
+            ))
+        };
+        let run_time = |res: &polepatch_patcher::PatchResult| -> f64 {
+            res.zones.iter().map(|z| z.after.time_s).sum::<f64>()
+                + rapid(res).map_or(0.0, |(_, _, after)| after)
+        };
+        if let Ok(res) = &patched
+            && !run_opts.keep_last_point
+            && rapid(res).is_some_and(|(_, before, after)| after > before + RAPID_TIME_TOL_S)
+        {
+            let pinned_opts = PatchOptions {
+                keep_last_point: true,
+                ..run_opts.clone()
+            };
+            if let Ok(pinned) = patch_with(&pinned_opts)
+                && run_time(&pinned) + RAPID_TIME_TOL_S < run_time(res)
+            {
+                patched = Ok(pinned);
+                run_opts = pinned_opts;
+            }
+        }
         let result = match patched {
             Ok(res) => res,
             Err(e) => {
@@ -798,6 +861,18 @@ pub fn patch_program(
             };
             row
         }));
+        if rp.run.tcpm.is_on()
+            && let (Some((line, before, after)), Some(last)) =
+                (rapid(&result), report.zones[first_row..].last_mut())
+        {
+            last.rapid_line = Some(line);
+            last.rapid_time_before_s = Some(before);
+            last.rapid_time_after_s = Some(if run_opts.keep_last_point {
+                before
+            } else {
+                after
+            });
+        }
         // A ball programmed at its tip keeps its centre at the points; between them its
         // path may not leave the original's line by more than the chord tolerance (where
         // the original block stayed within it).

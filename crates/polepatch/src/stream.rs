@@ -101,6 +101,8 @@ struct EndRec {
     /// Blocks that restate the run's last values: (file block index, 1-based line).
     restate: Vec<(usize, usize)>,
     scan: Scan,
+    /// The positioning move that freed the end, if it was one.
+    next: Option<crate::end_pose::NextMove>,
 }
 
 impl EndRec {
@@ -110,7 +112,10 @@ impl EndRec {
             return;
         }
         match after.verdict(letter, &mut self.scan) {
-            Step::Free => self.decided = Some((true, line)),
+            Step::Free => {
+                self.decided = Some((true, line));
+                self.next = after.next_move(letter, line);
+            }
             Step::Pinned => {
                 self.decided = Some((false, line));
                 self.restate.clear();
@@ -131,6 +136,7 @@ impl EndRec {
             } else {
                 Vec::new()
             },
+            next: if free { self.next } else { None },
         }
     }
 }
