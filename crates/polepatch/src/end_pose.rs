@@ -354,7 +354,10 @@ mod tests {
         let t_near = next.time_s(&m, 10.0, -10.0);
         let t_far = next.time_s(&m, 10.0, -190.0);
         assert!((t_near - trapezoid_time_s(100.0, c.v, c.a)).abs() < 1e-12);
-        assert!((t_far - t_near - 180.0 / c.v).abs() < 1e-9, "{t_near} {t_far}");
+        assert!(
+            (t_far - t_near - 180.0 / c.v).abs() < 1e-9,
+            "{t_near} {t_far}"
+        );
     }
 
     use super::*;

@@ -68,6 +68,45 @@ impl std::fmt::Display for RunProblem {
     }
 }
 
+/// Whether programs for `machine` can be read, analysed and patched: a pair of the
+/// standard form ([`Machine::standard_form`]: the pole axis along Z, the tilting axis about X
+/// or Y, the tool along Z at zero — table-table, head-table and head-head alike) whose
+/// tilting axis is A or B and whose pole axis is C. The kinematics crate computes any
+/// pair's FK and IK; what reads programs (the pole at P = 0, the other branch (−P, C + 180°),
+/// the C words as the pole axis) assumes this form, so another pair is refused by name
+/// rather than patched with the wrong kinematics (issue 29).
+pub fn check_layout(machine: &Machine) -> Result<(), Error> {
+    let refuse = |why: String| {
+        Err(Error::Options(format!(
+            "machine {}: {why}; polepatch reads, analyses and patches programs for pairs with \
+             the pole axis along Z called C and the tilting axis about X or Y called A or B \
+             (table or head) so far — another pair's zones, branches and letters are not \
+             wired yet",
+            machine.name
+        )))
+    };
+    if machine.standard_form().is_none() {
+        return refuse(
+            "its rotary axes are not of that form (an inclined axis, or the tool not along Z \
+             at zero)"
+                .to_string(),
+        );
+    }
+    if machine.c_letter() != 'C' {
+        return refuse(format!(
+            "its pole axis is called {} (programs are read with C as the pole axis)",
+            machine.c_letter()
+        ));
+    }
+    if !matches!(machine.primary_letter(), 'A' | 'B') {
+        return refuse(format!(
+            "its tilting axis is called {}",
+            machine.primary_letter()
+        ));
+    }
+    Ok(())
+}
+
 /// How to read programs for `machine`: the dialect detected, the machine's TCPM codes, mm
 /// when the program states no units.
 pub fn read_options(machine: &Machine) -> Result<polepatch_nc::ReadOptions, Error> {
@@ -79,6 +118,7 @@ pub fn read_options_with(
     machine: &Machine,
     inch: bool,
 ) -> Result<polepatch_nc::ReadOptions, Error> {
+    check_layout(machine)?;
     let codes = |field: &str, list: &[String]| {
         list.iter()
             .map(|c| {
