@@ -805,6 +805,18 @@ pub fn post_cl(
     for (w, n) in &cl.skipped {
         comments.push(format!("{w} records skipped by --ignore {w}: {n}"));
     }
+    // The writer names the pole axis C and the tilting axis A or B: a machine whose letters
+    // differ (an A-B trunnion) would get words for axes it does not have.
+    if machine.c_letter() != 'C' || !matches!(machine.primary_letter(), 'A' | 'B') {
+        return Err(Error::Options(format!(
+            "machine {}: its rotary axes are called {} and {}; post writes the tilting axis as \
+             A or B and the pole axis as C so far (issue 29), so it would write words for axes \
+             the machine does not have",
+            machine.name,
+            machine.primary_letter(),
+            machine.c_letter()
+        )));
+    }
     let bytes = emit(
         &items,
         &EmitOptions {

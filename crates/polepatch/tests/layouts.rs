@@ -110,3 +110,24 @@ fn pairs_not_wired_yet_are_refused_by_name() {
         assert!(err.contains(says) && err.contains(&m.name), "{file}: {err}");
     }
 }
+
+/// `post` names the tilting axis A or B and the pole axis C: a machine whose pole axis is
+/// called B (an A-B trunnion) is refused rather than given C words; the 45° nutating table,
+/// whose letters are B and C, is posted through its own inverse kinematics.
+#[test]
+fn post_refuses_letters_it_cannot_write() {
+    use polepatch::post::{PostOptions, post_cl, read_cl};
+    let apt = b"UNITS/MM\nFEDRAT/1000\nGOTO/10,0,-5,0.2588190,0,0.9659258\nGOTO/11,0,-5,0.25,0.05,0.9669\nFINI\n";
+    let cl = read_cl(apt, "t.apt").unwrap();
+    let opts = PostOptions {
+        patch: false,
+        ..PostOptions::default()
+    };
+    let ab = machine("example-trunnion-ab.toml");
+    let err = post_cl(&cl, &ab, &opts).err().expect("refused").to_string();
+    assert!(err.contains("called A and B"), "{err}");
+    let nut = machine("example-nutating-table-45.toml");
+    let (out, _) = post_cl(&cl, &nut, &opts).unwrap();
+    let text = String::from_utf8(out).unwrap();
+    assert!(text.contains(" B") && text.contains(" C"), "{text}");
+}
