@@ -157,6 +157,14 @@ pub struct ZoneRow {
     pub rapid_time_after_s: Option<f64>,
 }
 
+/// How many times a run whose kept ball centre would leave its path between the points by
+/// more than the chord tolerance is solved again with its orientation change capped.
+const CENTRE_PATH_RETRIES: usize = 3;
+
+/// The cap of such a retry: the deviation that gave the excursion, scaled by the tolerance
+/// over the excursion and by this margin.
+const CENTRE_PATH_CAP_SAFETY: f64 = 0.9;
+
 /// Below this, a positioning move's time after a run is the same before and after a patch
 /// (what the end's choice ignores), s.
 const RAPID_TIME_TOL_S: f64 = 1e-3;
@@ -629,7 +637,7 @@ pub fn patch_program(
     let mut edits: Vec<Edit> = Vec::new();
     let mut written_c = c_style.decimals;
     let mut written_p = p_style.decimals;
-    for (r, rp) in lp.runs.iter().enumerate() {
+    'runs: for (r, rp) in lp.runs.iter().enumerate() {
         let path = match &rp.path {
             Ok(p) => p,
             Err(problem) => {
@@ -831,61 +839,89 @@ pub fn patch_program(
                 run_opts = pinned_opts;
             }
         }
-        let result = match patched {
-            Ok(res) => res,
-            Err(e) => {
-                report.untouched_runs.push(untouched(
-                    lp,
-                    r,
-                    UntouchedReason::Invalid,
-                    0,
-                    e.to_string(),
-                    opts.reach_deg(),
-                ));
-                continue;
-            }
-        };
-        let first_row = report.zones.len();
-        report.zones.extend(result.zones.iter().map(|z| {
-            let mut row = ZoneRow::new(lp, r, z);
-            tool_fields(&mut row, &rt, z, work_path, &result, machine, tool_capped);
-            row.end_pose = if run_opts.keep_last_point {
-                "pinned"
-            } else {
-                "free"
-            };
-            row.end_pose_line = if rp.run.tcpm.is_on() {
-                end.decided_line
-            } else {
-                None
-            };
-            row
-        }));
-        if rp.run.tcpm.is_on()
-            && let (Some((line, before, after)), Some(last)) =
-                (rapid(&result), report.zones[first_row..].last_mut())
-        {
-            last.rapid_line = Some(line);
-            last.rapid_time_before_s = Some(before);
-            last.rapid_time_after_s = Some(if run_opts.keep_last_point {
-                before
-            } else {
-                after
-            });
-        }
         // A ball programmed at its tip keeps its centre at the points; between them its
         // path may not leave the original's line by more than the chord tolerance (where
-        // the original block stayed within it).
+        // the original block stayed within it). Where it would, the patch is solved again
+        // with its orientation change capped in proportion (the centre's excursion between
+        // two points grows with the change), up to CENTRE_PATH_RETRIES times.
         let chord_limit = lp.chord_tolerance_mm + machine_frame::TIP_TOLERANCE_MM;
-        if let Some(row) = report.zones[first_row..]
-            .iter()
-            .find(|z| z.centre_chord_mm.is_some_and(|c| c > chord_limit))
-        {
+        let mut centre_capped = false;
+        let mut retries = 0;
+        let (result, first_row) = loop {
+            let result = match patched {
+                Ok(res) => res,
+                Err(e) => {
+                    report.untouched_runs.push(untouched(
+                        lp,
+                        r,
+                        UntouchedReason::Invalid,
+                        0,
+                        e.to_string(),
+                        opts.reach_deg(),
+                    ));
+                    continue 'runs;
+                }
+            };
+            let first_row = report.zones.len();
+            report.zones.extend(result.zones.iter().map(|z| {
+                let mut row = ZoneRow::new(lp, r, z);
+                tool_fields(&mut row, &rt, z, work_path, &result, machine, tool_capped);
+                if centre_capped && z.reason == polepatch_patcher::Reason::DeviationCap {
+                    row.reason = "centre_path";
+                }
+                row.end_pose = if run_opts.keep_last_point {
+                    "pinned"
+                } else {
+                    "free"
+                };
+                row.end_pose_line = if rp.run.tcpm.is_on() {
+                    end.decided_line
+                } else {
+                    None
+                };
+                row
+            }));
+            if rp.run.tcpm.is_on()
+                && let (Some((line, before, after)), Some(last)) =
+                    (rapid(&result), report.zones[first_row..].last_mut())
+            {
+                last.rapid_line = Some(line);
+                last.rapid_time_before_s = Some(before);
+                last.rapid_time_after_s = Some(if run_opts.keep_last_point {
+                    before
+                } else {
+                    after
+                });
+            }
+            let rows = &report.zones[first_row..];
+            let worst_chord = rows
+                .iter()
+                .filter_map(|z| z.centre_chord_mm)
+                .fold(0.0, f64::max);
+            if worst_chord <= chord_limit {
+                break (result, first_row);
+            }
+            let worst_dev = rows.iter().map(|z| z.max_deviation_deg).fold(0.0, f64::max);
+            if retries < CENTRE_PATH_RETRIES && worst_dev > 0.0 {
+                retries += 1;
+                let cap = worst_dev * (chord_limit / worst_chord) * CENTRE_PATH_CAP_SAFETY;
+                run_opts.max_deviation_deg =
+                    Some(run_opts.max_deviation_deg.map_or(cap, |c| c.min(cap)));
+                centre_capped = true;
+                report.zones.truncate(first_row);
+                patched = patch_with(&run_opts);
+                continue;
+            }
+            let row = rows
+                .iter()
+                .find(|z| z.centre_chord_mm.is_some_and(|c| c > chord_limit))
+                .expect("a row over the limit");
             let why = format!(
                 "between the points of lines {}–{} the ball's centre (X Y Z rewritten to keep it \
                  at the points) would leave the line between its original positions by {:.3} mm \
                  with the axes interpolated between the blocks (chord tolerance {} mm; the points \
-                 are too far apart for the orientation change); the run keeps its values",
+                 are too far apart for the orientation change, also with the change capped); \
+                 the run keeps its values",
                 row.lines[0],
                 row.lines[1],
                 row.centre_chord_mm.unwrap_or(0.0),
@@ -903,9 +939,10 @@ pub fn patch_program(
                 why,
                 opts.cone_deg,
             ));
-            continue;
-        }
+            continue 'runs;
+        };
         let mut run_edits: Vec<Edit> = Vec::new();
+
         if let Some((ch, d)) = chain {
             match through_chain(
                 lp,
