@@ -576,5 +576,9 @@ fn a_centre_path_beyond_the_chord_tolerance_is_not_written() {
     }
     let u = &report.untouched_runs[0];
     assert_eq!(u.reason, polepatch::UntouchedReason::CentrePath);
-    assert!(u.message.contains("chord tolerance 0.001 mm"), "{}", u.message);
+    assert!(
+        u.message.contains("chord tolerance 0.001 mm"),
+        "{}",
+        u.message
+    );
 }
