@@ -29,6 +29,13 @@ class PpOptions(ctypes.Structure):
         ("has_work_offset", ctypes.c_bool),
         ("work_offset_mm", ctypes.c_double * 3),
         ("name", ctypes.c_char_p),
+        # Added with issue 27 (after `name`): the tool, as the CLI's --tool, --tool-point
+        # and --surface-tolerance. Start from pp_options_default().
+        ("tool_kind", ctypes.c_int32),  # 0 none given, 1 ball, 2 flat, 3 bull-nose
+        ("tool_diameter_mm", ctypes.c_double),
+        ("tool_corner_radius_mm", ctypes.c_double),
+        ("tool_point", ctypes.c_int32),  # 0 as the program says, 1 tip, 2 centre
+        ("surface_tolerance_mm", ctypes.c_double),  # <= 0: 0.005
     ]
 
 

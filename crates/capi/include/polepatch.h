@@ -81,6 +81,46 @@ typedef enum PpBranchRule {
 } PpBranchRule;
 
 /*
+ Kind of cutter ([`PpOptions::tool_kind`]).
+ */
+typedef enum PpToolKind {
+  /*
+   No tool given: per run from the program (TOOL DEF, CAM comments), else unknown.
+   */
+  PP_TOOL_NONE = 0,
+  /*
+   A ball-end mill.
+   */
+  PP_TOOL_BALL = 1,
+  /*
+   A flat end mill.
+   */
+  PP_TOOL_FLAT = 2,
+  /*
+   A bull-nose (torus) end mill.
+   */
+  PP_TOOL_BULL = 3,
+} PpToolKind;
+
+/*
+ The point of the tool X Y Z state ([`PpOptions::tool_point`]).
+ */
+typedef enum PpToolPoint {
+  /*
+   As the program says (the machine file, else the TCPM code in force).
+   */
+  PP_TOOL_POINT_PROGRAM = 0,
+  /*
+   The tool tip.
+   */
+  PP_TOOL_POINT_TIP = 1,
+  /*
+   The centre of the ball.
+   */
+  PP_TOOL_POINT_CENTRE = 2,
+} PpToolPoint;
+
+/*
  A machine (opaque). Made by [`pp_machine_builtin`] or [`pp_machine_from_toml`], freed
  by [`pp_machine_free`].
  */
@@ -138,6 +178,35 @@ typedef struct PpOptions {
    "input".
    */
   const char *name;
+  /*
+   The cutter for the whole program (`--tool`), a [`PpToolKind`] as an integer:
+   0 none given (per run from the program, as the CLI without `--tool`), 1 ball,
+   2 flat, 3 bull-nose (default 0). The fields from here on were added at the end,
+   after `name` (issue 27): `sizeof(PpOptions)` grew and the struct carries no size or
+   version field, so a program compiled against an older header must be rebuilt; as
+   always, start from [`pp_options_default`] and change fields.
+   */
+  int32_t tool_kind;
+  /*
+   The cutter's diameter, mm (used when `tool_kind` ≠ 0; default 0).
+   */
+  double tool_diameter_mm;
+  /*
+   The cutter's corner radius, mm: a bull-nose's, 0 < r < diameter / 2 (a ball's is
+   half its diameter and a flat's 0 whatever is given here; default 0).
+   */
+  double tool_corner_radius_mm;
+  /*
+   Which point of the tool the program's X Y Z are (`--tool-point`), a
+   [`PpToolPoint`] as an integer: 0 as the program says (the machine file, else the
+   TCPM code: `M128` the centre, …), 1 tip, 2 centre (default 0).
+   */
+  int32_t tool_point;
+  /*
+   How far a flat or bull-nose cutter's surface may move at a CL point, mm
+   (`--surface-tolerance`); ≤ 0: the default, 0.005 (default 0).
+   */
+  double surface_tolerance_mm;
 } PpOptions;
 
 /*
@@ -291,6 +360,9 @@ enum PpStatus pp_cl_to_joints(const struct PpMachine *m,
  c (rounded to `opts.max_decimals`; the first and last points keep their values). Up to
  `zones_cap` zone summaries go to `out_zones` (may be NULL when `zones_cap` is 0) and
  their total number to `*out_zone_count`.
+ The tool fields of `opts` (`tool_kind` …) are not used here: x y z are never changed
+ (a ball-end mill programmed at its tip keeps its centre only through
+ [`pp_patch_nc`]).
 
  # Safety
  `m` is a live machine; `xyzpc` points to `5·n` readable doubles, `out_xyzpc` to `5·n`

@@ -112,6 +112,51 @@ pub struct PpOptions {
     /// Name of the input in messages and in the report (UTF-8, NUL-terminated); NULL:
     /// "input".
     pub name: *const c_char,
+    /// The cutter for the whole program (`--tool`), a [`PpToolKind`] as an integer:
+    /// 0 none given (per run from the program, as the CLI without `--tool`), 1 ball,
+    /// 2 flat, 3 bull-nose (default 0). The fields from here on were added at the end,
+    /// after `name` (issue 27): `sizeof(PpOptions)` grew and the struct carries no size or
+    /// version field, so a program compiled against an older header must be rebuilt; as
+    /// always, start from [`pp_options_default`] and change fields.
+    pub tool_kind: i32,
+    /// The cutter's diameter, mm (used when `tool_kind` ≠ 0; default 0).
+    pub tool_diameter_mm: f64,
+    /// The cutter's corner radius, mm: a bull-nose's, 0 < r < diameter / 2 (a ball's is
+    /// half its diameter and a flat's 0 whatever is given here; default 0).
+    pub tool_corner_radius_mm: f64,
+    /// Which point of the tool the program's X Y Z are (`--tool-point`), a
+    /// [`PpToolPoint`] as an integer: 0 as the program says (the machine file, else the
+    /// TCPM code: `M128` the centre, …), 1 tip, 2 centre (default 0).
+    pub tool_point: i32,
+    /// How far a flat or bull-nose cutter's surface may move at a CL point, mm
+    /// (`--surface-tolerance`); ≤ 0: the default, 0.005 (default 0).
+    pub surface_tolerance_mm: f64,
+}
+
+/// Kind of cutter ([`PpOptions::tool_kind`]).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PpToolKind {
+    /// No tool given: per run from the program (TOOL DEF, CAM comments), else unknown.
+    PpToolNone = 0,
+    /// A ball-end mill.
+    PpToolBall = 1,
+    /// A flat end mill.
+    PpToolFlat = 2,
+    /// A bull-nose (torus) end mill.
+    PpToolBull = 3,
+}
+
+/// The point of the tool X Y Z state ([`PpOptions::tool_point`]).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PpToolPoint {
+    /// As the program says (the machine file, else the TCPM code in force).
+    PpToolPointProgram = 0,
+    /// The tool tip.
+    PpToolPointTip = 1,
+    /// The centre of the ball.
+    PpToolPointCentre = 2,
 }
 
 /// One zone of [`pp_patch_joints`].
@@ -253,7 +298,61 @@ pub extern "C" fn pp_options_default() -> PpOptions {
         has_work_offset: false,
         work_offset_mm: [0.0; 3],
         name: std::ptr::null(),
+        tool_kind: PpToolKind::PpToolNone as i32,
+        tool_diameter_mm: 0.0,
+        tool_corner_radius_mm: 0.0,
+        tool_point: PpToolPoint::PpToolPointProgram as i32,
+        surface_tolerance_mm: 0.0,
     }
+}
+
+/// The tool options of `o`, parsed by the library's own reader of `--tool`
+/// ([`polepatch::tool::Tool::parse`]), so a tool the CLI refuses is refused here too.
+fn tool_options(o: &PpOptions) -> Result<polepatch::tool::ToolOptions, Fail> {
+    use polepatch::tool::{Tool, ToolOptions, ToolPoint};
+    let (d, r) = (o.tool_diameter_mm, o.tool_corner_radius_mm);
+    let spec = match o.tool_kind {
+        0 => None,
+        1 => Some(format!("ball:{d}")),
+        2 => Some(format!("flat:{d}")),
+        3 => Some(format!("bull:{d},{r}")),
+        other => {
+            return Err(bad(format!(
+                "tool_kind must be 0…3 (PpToolKind: none, ball, flat, bull), got {other}"
+            )));
+        }
+    };
+    let tool = spec
+        .map(|s| Tool::parse(&s))
+        .transpose()
+        .map_err(|m| bad(format!("tool_kind {}: {m}", o.tool_kind)))?;
+    let point = match o.tool_point {
+        0 => None,
+        1 => Some(ToolPoint::Tip),
+        2 => Some(ToolPoint::Centre),
+        other => {
+            return Err(bad(format!(
+                "tool_point must be 0…2 (PpToolPoint: as the program says, tip, centre), got {other}"
+            )));
+        }
+    };
+    if !o.surface_tolerance_mm.is_finite() {
+        return Err(bad(format!(
+            "surface_tolerance_mm must be finite, got {}",
+            o.surface_tolerance_mm
+        )));
+    }
+    let defaults = ToolOptions::default();
+    Ok(ToolOptions {
+        tool,
+        point,
+        surface_tolerance_mm: if o.surface_tolerance_mm > 0.0 {
+            o.surface_tolerance_mm
+        } else {
+            defaults.surface_tolerance_mm
+        },
+        ..defaults
+    })
 }
 
 /// The library options for `opts` (NULL: defaults), checked.
@@ -300,6 +399,7 @@ unsafe fn options(opts: *const PpOptions) -> Result<polepatch::PatchOptions, Fai
     p.tcy_s = (o.tcy_ms > 0.0).then_some(o.tcy_ms / 1000.0);
     out.feed_fallback_mm_min = (o.feed_fallback_mm_min > 0.0).then_some(o.feed_fallback_mm_min);
     out.work_offset_mm = o.has_work_offset.then_some(o.work_offset_mm);
+    out.tool = tool_options(o)?;
     if !o.name.is_null() {
         // SAFETY: non-NULL and NUL-terminated (header contract).
         out.name = unsafe { c_str(o.name, "opts.name") }?.to_string();
@@ -533,6 +633,9 @@ pub unsafe extern "C" fn pp_cl_to_joints(
 /// c (rounded to `opts.max_decimals`; the first and last points keep their values). Up to
 /// `zones_cap` zone summaries go to `out_zones` (may be NULL when `zones_cap` is 0) and
 /// their total number to `*out_zone_count`.
+/// The tool fields of `opts` (`tool_kind` …) are not used here: x y z are never changed
+/// (a ball-end mill programmed at its tip keeps its centre only through
+/// [`pp_patch_nc`]).
 ///
 /// # Safety
 /// `m` is a live machine; `xyzpc` points to `5·n` readable doubles, `out_xyzpc` to `5·n`

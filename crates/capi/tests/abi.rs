@@ -460,3 +460,162 @@ fn simulate_nc_through_the_abi_is_the_library() {
         unsafe { pp_machine_free(m) };
     }
 }
+
+/// A tool case: kind, diameter, corner radius, point, surface tolerance as the ABI takes
+/// them; the `--tool` text, the point and the tolerance the library gets.
+type Case = (
+    PpToolKind,
+    f64,
+    f64,
+    PpToolPoint,
+    f64,
+    &'static str,
+    Option<polepatch::tool::ToolPoint>,
+    f64,
+);
+
+/// What is refused, how it is set, and what the message says.
+type Refusal = (&'static str, fn(&mut PpOptions), &'static str);
+
+/// The tool fields of `PpOptions` are the library's `ToolOptions` (`--tool`,
+/// `--tool-point`, `--surface-tolerance`): the same bytes and report on a ball at its tip,
+/// a ball at its centre and a flat end mill; bad values refused with a message.
+#[test]
+fn tool_options_through_the_abi_are_the_librarys() {
+    use polepatch::tool::{Tool, ToolOptions, ToolPoint};
+    let name = "fixtures/c17/SING.I";
+    let bytes = std::fs::read(root().join(name)).unwrap();
+    let m = machine("mikron-ucp710");
+    let rust_machine = Machine::builtin("mikron-ucp710").unwrap();
+    let c_name = CString::new(name).unwrap();
+    let cases: [Case; 4] = [
+        (
+            PpToolKind::PpToolBall,
+            10.0,
+            0.0,
+            PpToolPoint::PpToolPointTip,
+            0.0,
+            "ball:10",
+            Some(ToolPoint::Tip),
+            0.005,
+        ),
+        (
+            PpToolKind::PpToolBall,
+            10.0,
+            0.0,
+            PpToolPoint::PpToolPointCentre,
+            0.0,
+            "ball:10",
+            Some(ToolPoint::Centre),
+            0.005,
+        ),
+        (
+            PpToolKind::PpToolFlat,
+            10.0,
+            0.0,
+            PpToolPoint::PpToolPointProgram,
+            0.01,
+            "flat:10",
+            None,
+            0.01,
+        ),
+        (
+            PpToolKind::PpToolBull,
+            10.0,
+            2.0,
+            PpToolPoint::PpToolPointProgram,
+            0.0,
+            "bull:10,2",
+            None,
+            0.005,
+        ),
+    ];
+    for (kind, d, r, point, tol, spec, lib_point, lib_tol) in cases {
+        let mut opts = pp_options_default();
+        opts.name = c_name.as_ptr();
+        opts.tool_kind = kind as i32;
+        opts.tool_diameter_mm = d;
+        opts.tool_corner_radius_mm = r;
+        opts.tool_point = point as i32;
+        opts.surface_tolerance_mm = tol;
+        let mut out = PpBuffer {
+            data: std::ptr::null_mut(),
+            len: 0,
+        };
+        let mut report = PpBuffer {
+            data: std::ptr::null_mut(),
+            len: 0,
+        };
+        let status =
+            unsafe { pp_patch_nc(m, bytes.as_ptr(), bytes.len(), &opts, &mut out, &mut report) };
+        assert_eq!(status, PpStatus::PpOk, "{spec}: {}", last_error());
+        let lib_opts = polepatch::PatchOptions {
+            name: name.into(),
+            tool: ToolOptions {
+                tool: Some(Tool::parse(spec).unwrap()),
+                point: lib_point,
+                surface_tolerance_mm: lib_tol,
+                ..ToolOptions::default()
+            },
+            ..polepatch::PatchOptions::default()
+        };
+        let (want, want_report) = polepatch::patch_nc(&bytes, &rust_machine, &lib_opts).unwrap();
+        assert_eq!(take(&mut out), want, "{spec}");
+        let got = without_timing(&take(&mut report));
+        assert_eq!(
+            got,
+            without_timing(&serde_json::to_vec_pretty(&want_report).unwrap()),
+            "{spec}"
+        );
+        let described = Tool::parse(spec).unwrap().describe();
+        for z in got["zones"].as_array().unwrap() {
+            assert_eq!(z["tool"], described.as_str(), "{spec}");
+            assert_eq!(z["tool_source"], "--tool", "{spec}");
+        }
+    }
+    // Refusals: a kind, a point or a geometry the CLI's `--tool` refuses.
+    let refused: [Refusal; 5] = [
+        ("kind 4", |o| o.tool_kind = 4, "tool_kind must be 0…3"),
+        (
+            "bull without a corner radius",
+            |o| {
+                o.tool_kind = PpToolKind::PpToolBull as i32;
+                o.tool_diameter_mm = 10.0;
+            },
+            "bull:D,R",
+        ),
+        (
+            "ball without a diameter",
+            |o| o.tool_kind = PpToolKind::PpToolBall as i32,
+            "ball:D",
+        ),
+        ("point 3", |o| o.tool_point = 3, "tool_point must be 0…2"),
+        (
+            "NaN surface tolerance",
+            |o| o.surface_tolerance_mm = f64::NAN,
+            "surface_tolerance_mm",
+        ),
+    ];
+    for (what, set, message) in refused {
+        let mut opts = pp_options_default();
+        set(&mut opts);
+        let mut out = PpBuffer {
+            data: std::ptr::null_mut(),
+            len: 0,
+        };
+        let status = unsafe {
+            pp_patch_nc(
+                m,
+                bytes.as_ptr(),
+                bytes.len(),
+                &opts,
+                &mut out,
+                std::ptr::null_mut(),
+            )
+        };
+        assert_eq!(status, PpStatus::PpBadInput, "{what}");
+        assert!(last_error().contains(message), "{what}: {}", last_error());
+        assert!(out.data.is_null(), "{what}");
+    }
+    unsafe { pp_machine_free(m) };
+}

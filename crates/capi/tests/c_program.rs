@@ -61,9 +61,18 @@ fn have(tool: &str) -> bool {
 }
 
 fn expected(name: &str, machine: &str) -> (Vec<u8>, String) {
+    expected_with(name, machine, polepatch::tool::ToolOptions::default())
+}
+
+fn expected_with(
+    name: &str,
+    machine: &str,
+    tool: polepatch::tool::ToolOptions,
+) -> (Vec<u8>, String) {
     let m = Machine::builtin(machine).unwrap();
     let opts = polepatch::PatchOptions {
         name: name.into(),
+        tool,
         ..polepatch::PatchOptions::default()
     };
     let (out, report) =
@@ -116,13 +125,21 @@ fn a_c_program_patches_sing_byte_for_byte() {
     let dir = temp("c");
     let exe = compile(&dir);
     let name = "fixtures/c17/SING.I";
+    // The ball run: `PpOptions.tool_*` are the library's `--tool ball:10 --tool-point tip`.
+    let ball_tip = polepatch::tool::ToolOptions {
+        tool: Some(polepatch::tool::Tool::parse("ball:10").unwrap()),
+        point: Some(polepatch::tool::ToolPoint::Tip),
+        ..polepatch::tool::ToolOptions::default()
+    };
     for machine in ["mikron-ucp710", "mikron-hsm600"] {
         let (out, report) = (dir.join("out.I"), dir.join("report.json"));
+        let (ball_out, ball_report) = (dir.join("ball.I"), dir.join("ball.json"));
         let run = Command::new(&exe)
             .arg(machine)
             .arg(root().join(name))
             .args([&out, &report])
             .arg(name)
+            .args([&ball_out, &ball_report])
             .output()
             .unwrap();
         succeeded(&run);
@@ -132,6 +149,16 @@ fn a_c_program_patches_sing_byte_for_byte() {
             without_timing(&std::fs::read_to_string(&report).unwrap()),
             without_timing(&want_report)
         );
+        let (want, want_report) = expected_with(name, machine, ball_tip.clone());
+        assert_eq!(std::fs::read(&ball_out).unwrap(), want, "{machine}, ball");
+        let got = without_timing(&std::fs::read_to_string(&ball_report).unwrap());
+        assert_eq!(got, without_timing(&want_report));
+        let zones = got["zones"].as_array().unwrap();
+        assert!(!zones.is_empty());
+        for z in zones {
+            assert_eq!(z["tool"], "ball D10", "{machine}");
+            assert_eq!(z["tool_point"], "tip", "{machine}");
+        }
     }
 }
 

@@ -113,6 +113,9 @@ pub struct BenchOptions {
     pub skip_bound: bool,
     /// Keep the data of the per-zone plots ([`BenchZone::plot`]). Default false.
     pub plots: bool,
+    /// The tool and the point X Y Z state (`--tool`, `--tool-point`,
+    /// `--surface-tolerance`, as `patch`). Default: from the program and the TCPM codes.
+    pub tool: polepatch::tool::ToolOptions,
 }
 
 impl Default for BenchOptions {
@@ -123,6 +126,7 @@ impl Default for BenchOptions {
             feed_fallback_mm_min: None,
             skip_bound: false,
             plots: false,
+            tool: polepatch::tool::ToolOptions::default(),
         }
     }
 }
@@ -166,9 +170,51 @@ pub struct BenchZone {
     /// `max_deviation_deg / reference` for a zone at feed (both axes for the strategies
     /// that change both, C for `only-c`) with a positive reference (`None` otherwise).
     pub ratio: Option<f64>,
+    /// The ball-centre shift of the zone ([`BallCentreShift`]).
+    pub ball_centre_shift: BallCentreShift,
     /// Plot data (with [`BenchOptions::plots`]).
     #[serde(skip)]
     pub plot: Option<plot::ZonePlot>,
+}
+
+/// How far the centre of a ball-end mill moves at a written point of a zone, in µm (the
+/// table's `ctr µm` column).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", content = "um", rename_all = "snake_case")]
+pub enum BallCentreShift {
+    /// A ball of known radius: the largest distance between the original and the written
+    /// centre at a point, µm (the row's `max_cutter_shift_mm`; within the written rounding
+    /// of 0 where the patch keeps the centre: a ball at its tip, or at its centre).
+    Ball(f64),
+    /// The tool is unknown: the shift per mm of the ball's radius were X Y Z its tip,
+    /// µm/mm (1000 · 2·sin(δ/2), δ the zone's largest orientation change).
+    PerMmRadius(f64),
+    /// A flat or bull-nose cutter (its figure is the surface bound, `max_cutter_shift_mm`),
+    /// or a zone not changed.
+    None,
+}
+
+impl BallCentreShift {
+    /// The shift of a report row.
+    pub fn of(row: &ZoneRow) -> BallCentreShift {
+        if row.tool.starts_with("ball") {
+            row.max_cutter_shift_mm
+                .map_or(BallCentreShift::None, |v| BallCentreShift::Ball(v * 1e3))
+        } else if row.tool == "unknown" {
+            BallCentreShift::PerMmRadius(row.centre_shift_per_mm_radius * 1e3)
+        } else {
+            BallCentreShift::None
+        }
+    }
+
+    /// For the table: `0.4` (µm), `17.5/mm` (µm per mm of radius), `—`.
+    pub fn text(self) -> String {
+        match self {
+            BallCentreShift::Ball(v) => format!("{v:.1}"),
+            BallCentreShift::PerMmRadius(v) => format!("{v:.1}/mm"),
+            BallCentreShift::None => "—".into(),
+        }
+    }
 }
 
 /// One program on one machine with one strategy.
@@ -354,7 +400,8 @@ pub fn bench_file(
     opts: &BenchOptions,
 ) -> Result<Vec<BenchCase>, JobError> {
     let name = file.display().to_string();
-    let lp = load_nc(read(file)?, &name, machine, opts.feed_fallback_mm_min)?;
+    let mut lp = load_nc(read(file)?, &name, machine, opts.feed_fallback_mm_min)?;
+    lp.tool = opts.tool.clone();
     Ok(bench_program(&lp, machine, opts)?)
 }
 
@@ -379,7 +426,8 @@ fn analysis_zones(lp: &LoadedProgram, machine: &Machine, opts: &PatchOptions) ->
         .collect()
 }
 
-/// Analyse, patch with every strategy, and measure one loaded program.
+/// Analyse, patch with every strategy, and measure one loaded program (its tool options
+/// are `lp.tool`: [`bench_file`] sets them to `opts.tool`).
 pub fn bench_program(
     lp: &LoadedProgram,
     machine: &Machine,
@@ -509,6 +557,7 @@ pub fn bench_program(
                 at_feed_both,
                 bound,
                 ratio,
+                ball_centre_shift: BallCentreShift::of(row),
                 plot,
             });
         }

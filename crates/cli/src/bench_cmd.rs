@@ -6,7 +6,7 @@ use polepatch::kinematics::Machine;
 use polepatch::patch::{FiguresRow, ZoneRow};
 use polepatch::patcher::PatchOptions;
 use polepatch_cli::bench::{
-    BenchOptions, BenchReport, BenchStrategy, BenchZone, RATIO_TARGET, plot,
+    BallCentreShift, BenchOptions, BenchReport, BenchStrategy, BenchZone, RATIO_TARGET, plot,
 };
 use polepatch_cli::outputs::{Input, Output, Target, plan};
 use std::path::{Path, PathBuf};
@@ -55,6 +55,17 @@ pub(crate) struct BenchArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     jobs: Option<usize>,
+    /// The cutter for every program (as `patch`): ball:D, flat:D or bull:D,R (mm).
+    /// Default: per run, from the program; the `ctr µm` column then gives the shift per
+    /// mm of a ball's radius.
+    #[arg(long, value_parser = polepatch::tool::Tool::parse, value_name = "KIND:D[,R]")]
+    tool: Option<polepatch::tool::Tool>,
+    /// Which point of the tool X Y Z are (as `patch`): tip or centre.
+    #[arg(long, value_parser = polepatch::tool::ToolPoint::parse, value_name = "tip|centre")]
+    tool_point: Option<polepatch::tool::ToolPoint>,
+    /// How far a flat or bull-nose cutter's surface may move at a CL point, mm (as `patch`).
+    #[arg(long, value_name = "MM", default_value_t = polepatch::tool::SURFACE_TOLERANCE_MM)]
+    surface_tolerance: f64,
 }
 
 /// Files of the inputs: folders expand recursively (hidden entries skipped), sorted.
@@ -96,6 +107,7 @@ fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
 pub(crate) fn run(args: BenchArgs) -> Result<ExitCode> {
     check_positive("--feed", args.feed)?;
     let (cone_deg, pole_reach_deg) = crate::cone_and_reach(args.cone, args.pole_reach)?;
+    check_positive("--surface-tolerance", Some(args.surface_tolerance))?;
     if !(0.0..0.5).contains(&args.margin) {
         bail!("--margin must be in [0, 0.5), got {}", args.margin);
     }
@@ -167,6 +179,12 @@ pub(crate) fn run(args: BenchArgs) -> Result<ExitCode> {
         feed_fallback_mm_min: args.feed,
         skip_bound: args.no_bound,
         plots: args.plots.is_some(),
+        tool: polepatch::tool::ToolOptions {
+            tool: args.tool,
+            point: args.tool_point,
+            surface_tolerance_mm: args.surface_tolerance,
+            ..polepatch::tool::ToolOptions::default()
+        },
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.jobs.unwrap_or(0))
@@ -260,7 +278,7 @@ pub(crate) fn table(report: &BenchReport) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "{:<30} {:<13} {:<9} {:>3} {:>11} {:>15} {:>15} {:>15} {:>4} {:>4} {:>21} {:>7} {:>11} {:>6} {:>6} {:>8} {:>8}",
+        "{:<30} {:<13} {:<9} {:>3} {:>11} {:>15} {:>15} {:>15} {:>4} {:>4} {:>21} {:>7} {:>11} {:>6} {:>6} {:>8} {:>9} {:>8}",
         "file",
         "machine",
         "strategy",
@@ -277,6 +295,7 @@ pub(crate) fn table(report: &BenchReport) -> String {
         "ours/r",
         "points",
         "len mm",
+        "ctr µm",
         "solve ms"
     );
     for case in &report.cases {
@@ -297,7 +316,7 @@ pub(crate) fn table(report: &BenchReport) -> String {
             let f = |g: fn(&FiguresRow) -> f64| arrow(g(&r.before), g(&r.after));
             let _ = writeln!(
                 out,
-                "{name:<30} {:<13} {:<9} {:>3} {:>11} {:>15} {:>15} {:>15} {:>4} {:>4} {:>21} {:>7.3} {:>11} {:>6} {:>6} {:>8.3} {:>8.3}",
+                "{name:<30} {:<13} {:<9} {:>3} {:>11} {:>15} {:>15} {:>15} {:>4} {:>4} {:>21} {:>7.3} {:>11} {:>6} {:>6} {:>8.3} {:>9} {:>8.3}",
                 case.machine,
                 case.strategy.name(),
                 r.run,
@@ -317,6 +336,7 @@ pub(crate) fn table(report: &BenchReport) -> String {
                 ratio_text(z),
                 r.points_modified,
                 r.patch_length_mm,
+                z.ball_centre_shift.text(),
                 r.solve_time_ms,
             );
         }
@@ -408,6 +428,8 @@ fn csv_rows(report: &BenchReport) -> Result<Vec<u8>> {
         "reference_kind",
         "bound_deg",
         "ratio",
+        "ball_centre_shift_um",
+        "ball_centre_shift_um_per_mm_radius",
     ]);
     w.write_record(&header)?;
     for z in report.zones() {
@@ -425,6 +447,13 @@ fn csv_rows(report: &BenchReport) -> Result<Vec<u8>> {
             (s, _) => s.to_string(),
         });
         rec.push(z.ratio.map_or(String::new(), |v| format!("{v:.6}")));
+        let (um, per_mm) = match z.ball_centre_shift {
+            BallCentreShift::Ball(v) => (format!("{v:.3}"), String::new()),
+            BallCentreShift::PerMmRadius(v) => (String::new(), format!("{v:.3}")),
+            BallCentreShift::None => (String::new(), String::new()),
+        };
+        rec.push(um);
+        rec.push(per_mm);
         w.write_record(&rec)?;
     }
     Ok(w.into_inner()?)

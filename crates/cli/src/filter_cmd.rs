@@ -155,10 +155,11 @@ pub(crate) fn run(args: FilterArgs) -> Result<ExitCode> {
             .with_context(|| format!("cannot write {}", target.path.display()))?;
     }
     let below = report.zones_below_feed();
-    let unanalysed = report.strict_failures() - below;
-    if args.strict && below + unanalysed > 0 {
+    let unknown_tool = report.zones_with_unknown_tool();
+    let unanalysed = report.strict_failures() - below - unknown_tool;
+    if args.strict && below + unanalysed + unknown_tool > 0 {
         eprintln!(
-            "polepatch: {}: refused (--strict): {below} zone(s) stay below feed, {unanalysed} run(s) or line range(s) near the pole could not be analysed",
+            "polepatch: {}: refused (--strict): {below} zone(s) stay below feed, {unanalysed} run(s) or line range(s) near the pole could not be analysed, {unknown_tool} changed zone(s) with the tool unknown",
             report.file
         );
         return Ok(ExitCode::from(crate::STRICT_EXIT));

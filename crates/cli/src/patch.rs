@@ -295,9 +295,10 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
             .with_context(|| format!("cannot write {}", target.path.display()))?;
     }
     let below: usize = ok.iter().map(|r| r.zones_below_feed()).sum();
+    let unknown_tool: usize = ok.iter().map(|r| r.zones_with_unknown_tool()).sum();
     let unanalysed: usize = ok
         .iter()
-        .map(|r| r.strict_failures() - r.zones_below_feed())
+        .map(|r| r.strict_failures() - r.zones_below_feed() - r.zones_with_unknown_tool())
         .sum();
     let no_tcpm: usize = ok.iter().map(|r| r.runs_left_without_tcpm()).sum();
     if no_tcpm > 0 {
@@ -316,7 +317,7 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
         }
         return Ok(ExitCode::from(1));
     }
-    if args.strict && below + unanalysed > 0 {
+    if args.strict && below + unanalysed + unknown_tool > 0 {
         if below > 0 {
             eprintln!("polepatch: {below} zone(s) stay below feed (--strict)");
         }
@@ -324,6 +325,12 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
             eprintln!(
                 "polepatch: {unanalysed} run(s) near the pole or line range(s) could not be \
                  analysed (see the warnings above): whether they reach feed is unknown (--strict)"
+            );
+        }
+        if unknown_tool > 0 {
+            eprintln!(
+                "polepatch: {unknown_tool} changed zone(s) with the tool unknown: whether the \
+                 cutter stayed on the part cannot be told (--strict; give --tool)"
             );
         }
         return Ok(ExitCode::from(crate::STRICT_EXIT));

@@ -399,24 +399,37 @@ fn csv_has_reference_and_ratio_columns() {
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     assert_eq!(&header[..3], &["file", "machine", "strategy"]);
     assert_eq!(
-        &header[header.len() - 5..],
+        &header[header.len() - 7..],
         &[
             "at_feed_c",
             "at_feed_both",
             "reference_kind",
             "bound_deg",
-            "ratio"
+            "ratio",
+            "ball_centre_shift_um",
+            "ball_centre_shift_um_per_mm_radius"
         ]
     );
     let row: Vec<&str> = lines.next().expect("one zone row").split(',').collect();
     assert_eq!(row.len(), header.len());
     assert_eq!(row[2], "polepatch");
-    assert_eq!(
-        &row[header.len() - 5..header.len() - 2],
-        &["true", "true", "best-found"]
+    let n = header.len();
+    assert_eq!(&row[n - 7..n - 4], &["true", "true", "best-found"]);
+    let bound: f64 = row[n - 4].parse().unwrap();
+    let ratio: f64 = row[n - 3].parse().unwrap();
+    // The tool is unknown: the centre shift per mm of radius, 1000·2·sin(δ/2).
+    assert_eq!(row[n - 2], "");
+    let per_mm: f64 = row[n - 1].parse().unwrap();
+    let dev: f64 = row[header
+        .iter()
+        .position(|h| *h == "max_deviation_deg")
+        .unwrap()]
+    .parse()
+    .unwrap();
+    assert!(
+        (per_mm - 2e3 * (dev.to_radians() / 2.0).sin()).abs() < 1e-2,
+        "{row:?}"
     );
-    let bound: f64 = row[header.len() - 2].parse().unwrap();
-    let ratio: f64 = row[header.len() - 1].parse().unwrap();
     assert!(
         bound > 0.0 && ratio > 0.0 && ratio <= RATIO_TARGET,
         "{row:?}"
@@ -462,4 +475,82 @@ fn docs_quality_table_matches_a_fresh_run() {
         want,
         "docs/quality.md is stale: regenerate it with the command at its top"
     );
+}
+
+/// Issue 27 §7: the `ctr µm` column. With a D10 ball at its tip the centre is kept (the
+/// column is the report's `max_cutter_shift_mm` in µm, within the written rounding of 0);
+/// with the ball at its centre X Y Z do not move; with the tool unknown the column gives
+/// the shift per mm of radius, 1000·2·sin(δ/2).
+#[test]
+fn the_ball_centre_shift_column() {
+    use polepatch::tool::{Tool, ToolOptions, ToolPoint};
+    use polepatch_cli::bench::BallCentreShift;
+    let files = [root().join("fixtures/c17/SING.I")];
+    let ucp = [Machine::builtin("mikron-ucp710").unwrap()];
+    let bench = |tool: Option<&str>, point: Option<ToolPoint>| {
+        let opts = BenchOptions {
+            skip_bound: true,
+            tool: ToolOptions {
+                tool: tool.map(|t| Tool::parse(t).unwrap()),
+                point,
+                ..ToolOptions::default()
+            },
+            ..BenchOptions::default()
+        };
+        let report = run(&files, &ucp, &opts);
+        assert!(report.errors.is_empty(), "{:?}", report.errors);
+        assert!(report.zones().count() > 0);
+        report
+    };
+    for point in [ToolPoint::Tip, ToolPoint::Centre] {
+        let report = bench(Some("ball:10"), Some(point));
+        for z in report.zones() {
+            let BallCentreShift::Ball(um) = z.ball_centre_shift else {
+                panic!("{:?}", z.ball_centre_shift)
+            };
+            assert_eq!(um, z.row.max_cutter_shift_mm.unwrap() * 1e3);
+            assert!(um <= 1.0, "{point:?}: {um} µm");
+            assert!(z.at_feed_both);
+        }
+    }
+    let report = bench(None, None);
+    for z in report.zones() {
+        let BallCentreShift::PerMmRadius(per_mm) = z.ball_centre_shift else {
+            panic!("{:?}", z.ball_centre_shift)
+        };
+        let want = 1e3 * 2.0 * (z.row.max_deviation_deg.to_radians() / 2.0).sin();
+        assert!((per_mm - want).abs() < 1e-9, "{per_mm} {want}");
+        assert!(per_mm > 0.0);
+    }
+    let report = bench(Some("flat:10"), None);
+    for z in report.zones() {
+        assert_eq!(z.ball_centre_shift, BallCentreShift::None);
+    }
+    // The command line: the column and its flag.
+    let out = bin()
+        .current_dir(root())
+        .args([
+            "bench",
+            "fixtures/c17/SING.I",
+            "-m",
+            "mikron-ucp710",
+            "--no-bound",
+            "--tool",
+            "ball:10",
+            "--tool-point",
+            "tip",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = String::from_utf8(out.stdout).unwrap();
+    assert!(table.lines().next().unwrap().contains("ctr µm"), "{table}");
+    let row = table.lines().find(|l| l.starts_with("SING.I")).unwrap();
+    let cols: Vec<&str> = row.split_whitespace().collect();
+    let um: f64 = cols[cols.len() - 2].parse().unwrap();
+    assert!(um <= 1.0, "{row}");
 }

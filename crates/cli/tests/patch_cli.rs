@@ -326,3 +326,78 @@ fn options_mean_what_they_say() {
         assert!(z["reason"].is_string(), "{z}");
     }
 }
+
+/// Issue 27 §5: no tool given and none in the program (SING calls T5 without describing
+/// it): the file is patched as before, the table's tool column says unknown, the report
+/// gives every changed zone's centre shift per mm of radius, one warning says how to give
+/// the tool, and `--strict` exits 2. Given the tool, `--strict` passes.
+#[test]
+fn an_unknown_tool_warns_and_fails_strict() {
+    let dir = temp_dir("unknown-tool");
+    let out = dir.join("SING.out.I");
+    let report = dir.join("r.json");
+    let args = |strict: bool, tool: Option<&str>| {
+        let mut a = vec![
+            "patch",
+            "fixtures/c17/SING.I",
+            "-o",
+            out.to_str().unwrap(),
+            "--machine",
+            "mikron-ucp710",
+            "--report",
+            report.to_str().unwrap(),
+        ];
+        if strict {
+            a.push("--strict");
+        }
+        if let Some(t) = tool {
+            a.extend(["--tool", t]);
+        }
+        a.into_iter().map(String::from).collect::<Vec<String>>()
+    };
+    let run = |a: Vec<String>| {
+        let refs: Vec<&str> = a.iter().map(String::as_str).collect();
+        polepatch(&refs)
+    };
+    let (code, stdout, err) = run(args(false, None));
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("unknown"), "the tool column: {stdout}");
+    let warnings: Vec<&str> = err
+        .lines()
+        .filter(|l| l.contains("the tool is not known"))
+        .collect();
+    assert_eq!(warnings.len(), 1, "{err}");
+    assert!(warnings[0].contains("--tool ball:D"), "{}", warnings[0]);
+    assert!(
+        warnings[0].contains("--tool-point tip|centre"),
+        "{}",
+        warnings[0]
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    let zones = doc["zones"].as_array().unwrap();
+    assert!(!zones.is_empty());
+    for z in zones {
+        assert_eq!(z["tool"], "unknown");
+        let dev = z["max_deviation_deg"].as_f64().unwrap();
+        let per_mm = z["centre_shift_per_mm_radius"].as_f64().unwrap();
+        assert!(dev > 0.0);
+        assert!(
+            (per_mm - 2.0 * (dev.to_radians() / 2.0).sin()).abs() < 1e-12,
+            "{z}"
+        );
+    }
+    // The patch is written all the same.
+    assert_ne!(
+        std::fs::read(&out).unwrap(),
+        std::fs::read(root().join("fixtures/c17/SING.I")).unwrap()
+    );
+
+    let (code, _, err) = run(args(true, None));
+    assert_eq!(code, 2, "--strict with the tool unknown: {err}");
+    assert!(err.contains("the tool is not known"), "{err}");
+
+    let (code, stdout, err) = run(args(true, Some("ball:10")));
+    assert_eq!(code, 0, "--strict with the tool given: {err}");
+    assert!(!err.contains("the tool is not known"), "{err}");
+    assert!(stdout.contains("ball D10"), "{stdout}");
+}

@@ -16,7 +16,7 @@ use errors::{Failure, detached, detached_cancellable};
 use machine::NativeMachine;
 use numpy::ndarray::Array2;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
-use options::{AnalysisKw, FileKw, PatcherKw, PostKw};
+use options::{AnalysisKw, FileKw, PatcherKw, PostKw, ToolKw};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::pybacked::PyBackedBytes;
@@ -39,7 +39,9 @@ fn patch_nc<'py>(
 ) -> PyResult<(Bound<'py, PyBytes>, String)> {
     let p: PatcherKw = options.extract()?;
     let f: FileKw = options.extract()?;
-    let opts = f.patch(&p);
+    let t: ToolKw = options.extract()?;
+    let mut opts = f.patch(&p);
+    opts.tool = t.tool()?;
     let m = &machine.0;
     // Ctrl-C stops the patch between stretches (`detached_cancellable`).
     let (out, report) = detached_cancellable(py, |cancelled| {
@@ -85,11 +87,16 @@ fn post_cl<'py>(
     let p: PatcherKw = options.extract()?;
     let f: FileKw = options.extract()?;
     let post: PostKw = options.extract()?;
-    let mut opts = post.post(f.patch(&p))?;
+    let t: ToolKw = options.extract()?;
+    let mut patch = f.patch(&p);
+    patch.tool = t.tool()?;
+    let opts = post.post(patch)?;
     let m = &machine.0;
     let out = detached(py, || {
         let mut post = || -> Result<Vec<u8>, polepatch::Error> {
             let program = polepatch::post::read_cl(&cl, &opts.patch_options.name)?;
+            // The CL file's CUTTER/ and the tip, where the keywords did not say them.
+            let mut opts = opts.clone();
             polepatch::post::tool_from_cl(&cl, &program, &mut opts);
             polepatch::post::post_cl(&program, m, &opts).map(|(out, _)| out)
         };

@@ -142,6 +142,54 @@ impl FileKw {
     }
 }
 
+/// The cutter and the point X Y Z state (`polepatch::tool::ToolOptions`), as the CLI's
+/// `--tool`, `--tool-point` and `--surface-tolerance`.
+#[derive(Debug, Clone, FromPyObject, IntoPyObject)]
+#[pyo3(from_item_all)]
+pub(crate) struct ToolKw {
+    /// `"ball:10"`, `"flat:12"`, `"bull:10,2"` (None: per run, from the program).
+    tool: Option<String>,
+    /// `"tip"` or `"centre"` (None: the machine file's, else the TCPM code's).
+    tool_point: Option<String>,
+    /// How far a flat or bull-nose cutter's surface may move at a CL point, mm.
+    surface_tolerance_mm: f64,
+}
+
+impl ToolKw {
+    fn of(t: &polepatch::tool::ToolOptions) -> ToolKw {
+        ToolKw {
+            tool: None,
+            tool_point: None,
+            surface_tolerance_mm: t.surface_tolerance_mm,
+        }
+    }
+
+    /// The library's tool options, read by the library's own parsers of `--tool` and
+    /// `--tool-point` ([`polepatch::tool::Tool::parse`], [`polepatch::tool::ToolPoint::parse`]):
+    /// what they refuse is a `ValueError` with their message.
+    pub(crate) fn tool(&self) -> PyResult<polepatch::tool::ToolOptions> {
+        use polepatch::tool::{Tool, ToolOptions, ToolPoint};
+        let tool = self
+            .tool
+            .as_deref()
+            .map(Tool::parse)
+            .transpose()
+            .map_err(PyValueError::new_err)?;
+        let point = self
+            .tool_point
+            .as_deref()
+            .map(ToolPoint::parse)
+            .transpose()
+            .map_err(PyValueError::new_err)?;
+        Ok(ToolOptions {
+            tool,
+            point,
+            surface_tolerance_mm: self.surface_tolerance_mm,
+            ..ToolOptions::default()
+        })
+    }
+}
+
 /// What `post_cl` adds (`polepatch::post::PostOptions`).
 #[derive(Debug, Clone, FromPyObject, IntoPyObject)]
 #[pyo3(from_item_all)]
@@ -235,8 +283,8 @@ impl PostKw {
     }
 }
 
-/// The library's defaults by Python keyword: `{"patch": …, "file": …, "post": …,
-/// "analyze": …}` (what the keyword defaults of `polepatch/__init__.py` must be).
+/// The library's defaults by Python keyword: `{"patch": …, "file": …, "tool": …,
+/// "post": …, "analyze": …}` (what the keyword defaults of `polepatch/__init__.py` must be).
 #[pyfunction]
 pub(crate) fn defaults(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyDict>> {
     let patch = polepatch::PatchOptions::default();
@@ -251,6 +299,7 @@ pub(crate) fn defaults(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyDict
             name: None,
         },
     )?;
+    d.set_item("tool", ToolKw::of(&patch.tool))?;
     d.set_item("post", PostKw::of(&polepatch::post::PostOptions::default()))?;
     d.set_item("analyze", AnalysisKw::of(&analyze.analysis))?;
     Ok(d)

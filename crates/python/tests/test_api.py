@@ -14,8 +14,8 @@ from polepatch import _polepatch as native
 def test_keyword_defaults_are_the_librarys() -> None:
     d = native.defaults()
     groups = {
-        polepatch.patch_nc: ["patch", "file"],
-        polepatch.post_cl: ["patch", "file", "post"],
+        polepatch.patch_nc: ["patch", "file", "tool"],
+        polepatch.post_cl: ["patch", "file", "tool", "post"],
         polepatch.patch_joints: ["patch"],
         polepatch.analyze_nc: ["analyze", "file"],
         polepatch.feed_profile: ["analyze", "file"],

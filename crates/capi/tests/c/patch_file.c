@@ -1,7 +1,10 @@
 /* Patch an NC file through the polepatch C ABI, and check the ABI's refusals.
  *
- *   patch_file MACHINE INPUT OUTPUT REPORT.json NAME
+ *   patch_file MACHINE INPUT OUTPUT REPORT.json NAME [BALL_OUTPUT BALL_REPORT.json]
  *
+ * With the last two, the file is also patched for a D10 ball-end mill programmed at its
+ * tip (tool_kind, tool_diameter_mm, tool_point: the CLI's --tool ball:10 --tool-point
+ * tip) and that output and report written there.
  * Exit 0 when the file was patched and every bad call gave the expected status with a
  * message; otherwise a message on stderr and exit 1. Built and run by tests/c_program.rs. */
 #include "polepatch.h"
@@ -44,8 +47,8 @@ static int write_file(const char *path, const PpBuffer *b) {
 }
 
 int main(int argc, char **argv) {
-    if (argc != 6) {
-        fprintf(stderr, "usage: patch_file MACHINE INPUT OUTPUT REPORT NAME\n");
+    if (argc != 6 && argc != 8) {
+        fprintf(stderr, "usage: patch_file MACHINE INPUT OUTPUT REPORT NAME [BALL_OUTPUT BALL_REPORT]\n");
         return 2;
     }
     PpMachine *m = NULL;
@@ -70,6 +73,26 @@ int main(int argc, char **argv) {
     pp_buffer_free(&report);
     pp_buffer_free(&out); /* freeing twice is harmless: the buffer was emptied */
 
+    if (argc == 8) {
+        PpOptions ball = pp_options_default();
+        if (ball.tool_kind != PP_TOOL_NONE || ball.tool_point != PP_TOOL_POINT_PROGRAM) {
+            fprintf(stderr, "pp_options_default gives a tool\n");
+            failures++;
+        }
+        ball.name = argv[5];
+        ball.tool_kind = PP_TOOL_BALL;
+        ball.tool_diameter_mm = 10.0;
+        ball.tool_point = PP_TOOL_POINT_TIP;
+        PpBuffer bout = {0}, breport = {0};
+        expect("patch ball:10 at the tip", pp_patch_nc(m, input, len, &ball, &bout, &breport), PP_OK);
+        if (write_file(argv[6], &bout) || write_file(argv[7], &breport)) {
+            fprintf(stderr, "cannot write the ball outputs\n");
+            failures++;
+        }
+        pp_buffer_free(&bout);
+        pp_buffer_free(&breport);
+    }
+
     /* Refusals: the right status, a message, no crash. */
     PpBuffer junk_out = {0};
     expect("NULL machine", pp_patch_nc(NULL, input, len, NULL, &junk_out, NULL), PP_BAD_MACHINE);
@@ -87,6 +110,20 @@ int main(int argc, char **argv) {
     PpOptions wrong = pp_options_default();
     wrong.margin = 0.9;
     expect("bad option", pp_patch_nc(m, input, len, &wrong, &junk_out, NULL), PP_BAD_INPUT);
+    PpOptions wrong_tool = pp_options_default();
+    wrong_tool.tool_kind = 7;
+    expect("bad tool kind", pp_patch_nc(m, input, len, &wrong_tool, &junk_out, NULL), PP_BAD_INPUT);
+    wrong_tool = pp_options_default();
+    wrong_tool.tool_kind = PP_TOOL_BULL;
+    wrong_tool.tool_diameter_mm = 10.0;
+    wrong_tool.tool_corner_radius_mm = 6.0; /* more than half the diameter */
+    expect("bad corner radius", pp_patch_nc(m, input, len, &wrong_tool, &junk_out, NULL), PP_BAD_INPUT);
+    wrong_tool = pp_options_default();
+    wrong_tool.tool_kind = PP_TOOL_FLAT; /* no diameter */
+    expect("no diameter", pp_patch_nc(m, input, len, &wrong_tool, &junk_out, NULL), PP_BAD_INPUT);
+    wrong_tool = pp_options_default();
+    wrong_tool.tool_point = 3;
+    expect("bad tool point", pp_patch_nc(m, input, len, &wrong_tool, &junk_out, NULL), PP_BAD_INPUT);
     double cl[6] = {0, 0, 0, 0, 0, 0}, joints[5];
     expect("zero tool axis", pp_cl_to_joints(m, cl, 1, PP_BRANCH_NEAREST, joints), PP_BAD_INPUT);
     expect("bad branch rule", pp_cl_to_joints(m, cl, 1, 9, joints), PP_BAD_INPUT);

@@ -23,6 +23,7 @@ in parallel; a Rust panic arrives as :class:`InternalError`, never as a crash.
 from __future__ import annotations
 
 import json
+import os
 from typing import TYPE_CHECKING, Any, Dict, List, Optional, Tuple, Union
 
 from . import _polepatch as _native
@@ -195,11 +196,15 @@ def patch_nc(
     feed_fallback_mm_min: Optional[float] = None,
     work_offset_mm: Optional[Tuple[float, float, float]] = None,
     name: Optional[str] = None,
+    tool: Optional[str] = None,
+    tool_point: Optional[str] = None,
+    surface_tolerance_mm: float = 0.005,
 ) -> Tuple[bytes, Dict[str, Any]]:
     """Patch an NC program: the rewritten bytes and the report.
 
-    The output is ``data`` byte for byte except the rotary words that had to change (the
-    bytes ``polepatch patch`` writes). The report is the document of
+    The output is ``data`` byte for byte except the rotary words that had to change, and
+    X Y Z where a ball-end mill programmed at its tip keeps its centre (the bytes
+    ``polepatch patch`` writes). The report is the document of
     ``polepatch patch --report`` for one file: per zone the lines, kind, feed ratios
     before/after, times (s), orientation deviation (degrees), points changed, QP status
     and solve time (``solve_time_ms``, measured); ``output`` is ``None`` (no file is
@@ -229,6 +234,18 @@ def patch_nc(
             zero), for a machine with a ``[chain]``; ``None``: the program's datum.
         name: the input's name in messages, errors (``InputError.path``) and the report
             (``file``); ``None``: ``"input"`` in messages and no ``path``.
+        tool: the cutter for the whole program, as the CLI's ``--tool``: ``"ball:10"``,
+            ``"flat:12"``, ``"bull:10,2"`` (diameter and corner radius, mm); ``None``:
+            per run from the program (``TOOL DEF``, the CAM post's tool comments), else
+            unknown (the report's ``tool`` is ``"unknown"`` and a warning says so). A ball
+            programmed at its tip keeps its centre (X Y Z rewritten where the orientation
+            changes); a flat or bull-nose cutter's orientation change is capped by
+            ``surface_tolerance_mm`` (reason ``tool_limited``).
+        tool_point: which point of the tool the program's X Y Z are, ``"tip"`` or
+            ``"centre"`` (``--tool-point``); ``None``: the machine file's, else the TCPM
+            code's (``M128`` and ``REFPNT CENTER-CENTER`` the centre, every other the tip).
+        surface_tolerance_mm: how far a flat or bull-nose cutter's surface may move at a
+            CL point, mm (``--surface-tolerance``).
 
     Raises:
         InputError: a syntax error (with ``line`` and ``column``), an unsupported form
@@ -326,6 +343,9 @@ def post_cl(
     feed_fallback_mm_min: Optional[float] = None,
     work_offset_mm: Optional[Tuple[float, float, float]] = None,
     name: Optional[str] = None,
+    tool: Optional[str] = None,
+    tool_point: Optional[str] = None,
+    surface_tolerance_mm: float = 0.005,
 ) -> bytes:
     """Post a CL file as a TCPM program for ``machine``, with pole handling: the bytes
     of ``polepatch post``.
@@ -349,6 +369,9 @@ def post_cl(
         feed_fallback_mm_min: feed, mm/min, for points without one.
         name: the CL file's name in messages, errors and the program's comment.
         only_c, cone_deg, …: the patch options of :func:`patch_nc`.
+        tool, tool_point, surface_tolerance_mm: as :func:`patch_nc`'s; ``None`` here:
+            the CL file's ``CUTTER/`` (or ``TLDATA/MILL``) and the tool tip (APT's
+            ``GOTO/`` states the tip), as ``polepatch post`` does.
 
     Raises:
         InputError: a bad CL record (with ``line`` and ``column``), a point that needs

@@ -1,0 +1,584 @@
+//! Issue 27's checks, through the library: the cutter is kept where CAM put it.
+//!
+//! - `fixtures/c17/SING.I` (an `M128` program) on the UCP710 with a D10 ball at its tip:
+//!   every zone reaches feed, X Y Z change only on points whose orientation changed, and
+//!   every written block's ball centre (tip + R·o, o from the forward kinematics of the
+//!   written A C) is within 0.001 mm plus the written rounding of the original centre;
+//!   without a tool point (`M128`: the centre) X Y Z are byte-identical.
+//! - Heidenhain conversational `FUNCTION TCPM … REFPNT CENTER-CENTER`: X Y Z unchanged;
+//!   `REFPNT TIP-TIP`: the centres kept.
+//! - The CAMWorks APT file (`CUTTER/10,5,…`) posted with the patch: the centres kept.
+//! - A flat D10: every written point within the surface bound; zones that needed more
+//!   report `tool_limited` with the deviation they needed.
+//! - Each tool-source reader on its fixture: the kind, diameter, corner radius and line.
+
+use polepatch::kinematics::{Machine, forward};
+use polepatch::post::{PostOptions, post_cl, read_cl, tool_from_cl};
+use polepatch::tool::{SURFACE_TOLERANCE_MM, Tool, ToolKind, ToolOptions, ToolPoint};
+use polepatch::{FileReport, PatchOptions, patch_nc};
+use std::path::PathBuf;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn fixture(rel: &str) -> Vec<u8> {
+    std::fs::read(root().join(rel)).unwrap()
+}
+
+fn ucp710() -> Machine {
+    Machine::builtin("mikron-ucp710").unwrap()
+}
+
+fn with_tool(tool: Option<&str>, point: Option<ToolPoint>) -> PatchOptions {
+    PatchOptions {
+        tool: ToolOptions {
+            tool: tool.map(|t| Tool::parse(t).unwrap()),
+            point,
+            ..ToolOptions::default()
+        },
+        ..PatchOptions::default()
+    }
+}
+
+/// One axis word of a line: its value and its decimals.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Word {
+    value: f64,
+    decimals: u32,
+}
+
+/// A move under TCPM: its file line, X Y Z A C in force (with the words that last set
+/// them), and the text of its X Y Z words.
+#[derive(Debug, Clone)]
+struct Point {
+    line: usize,
+    axes: [Word; 5],
+    xyz_text: Vec<String>,
+    other_text: Vec<String>,
+    /// A rapid move (`FMAX`, `G0`): no cut.
+    rapid: bool,
+}
+
+/// The moves between the TCPM switch (`M128`, `FUNCTION TCPM`) and its end of a
+/// Heidenhain program (ISO or conversational), read word by word: a small reader of the
+/// fixtures' forms, independent of the library's.
+fn points(text: &str) -> Vec<Point> {
+    let mut on = false;
+    let mut axes: [Option<Word>; 5] = [None; 5];
+    let mut out = Vec::new();
+    for (k, line) in text.lines().enumerate() {
+        let up = line.to_ascii_uppercase();
+        if up.contains("M129") || up.contains("RESET TCPM") {
+            on = false;
+            continue;
+        }
+        if up.contains("M128") || up.contains("FUNCTION TCPM") {
+            on = true;
+            continue;
+        }
+        if !on || up.contains("G54") || up.contains("TOOL") {
+            continue;
+        }
+        let mut moved = false;
+        let mut xyz_text = Vec::new();
+        let mut other_text = Vec::new();
+        for tok in line.split_whitespace() {
+            let Some(letter) = tok.chars().next() else {
+                continue;
+            };
+            let rest = &tok[1..];
+            let slot = "XYZAC".find(letter.to_ascii_uppercase());
+            let number = rest.starts_with(['+', '-', '.']) || rest.starts_with(char::is_numeric);
+            match (slot, number, rest.parse::<f64>()) {
+                (Some(i), true, Ok(value)) => {
+                    let decimals = rest.split_once('.').map_or(0, |(_, d)| d.len() as u32);
+                    axes[i] = Some(Word { value, decimals });
+                    moved = true;
+                    if i < 3 {
+                        xyz_text.push(tok.to_string());
+                    }
+                }
+                _ => other_text.push(tok.to_string()),
+            }
+        }
+        if moved && let [Some(x), Some(y), Some(z), Some(a), Some(c)] = axes {
+            let rapid =
+                up.contains("FMAX") || up.split_whitespace().any(|w| w == "G0" || w == "G00");
+            out.push(Point {
+                line: k + 1,
+                axes: [x, y, z, a, c],
+                xyz_text,
+                other_text,
+                rapid,
+            });
+        }
+    }
+    out
+}
+
+fn centre(m: &Machine, p: &Point, radius: f64) -> [f64; 3] {
+    let o = forward(m, p.axes[3].value, p.axes[4].value);
+    std::array::from_fn(|i| p.axes[i].value + radius * o[i])
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// The angle between the tool axes of two points, degrees.
+fn turn_deg(m: &Machine, a: &Point, b: &Point) -> f64 {
+    let (oa, ob) = (
+        forward(m, a.axes[3].value, a.axes[4].value),
+        forward(m, b.axes[3].value, b.axes[4].value),
+    );
+    let dot: f64 = (0..3).map(|i| oa[i] * ob[i]).sum();
+    dot.clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+/// How far the written rounding of X Y Z may move a point: half a unit of the last decimal
+/// the patch writes them with (the most decimals of a rewritten X Y Z word), per axis.
+fn xyz_rounding(before: &[Point], after: &[Point]) -> f64 {
+    let decimals = |p: &Point| {
+        p.xyz_text
+            .iter()
+            .map(|w| w.split_once('.').map_or(0, |(_, d)| d.len() as i32))
+            .max()
+            .unwrap_or(0)
+    };
+    let d = before
+        .iter()
+        .zip(after)
+        .filter(|(p, q)| p.xyz_text != q.xyz_text)
+        .map(|(_, q)| decimals(q))
+        .chain(after.iter().map(decimals))
+        .max()
+        .unwrap_or(0);
+    3f64.sqrt() * 0.5 * 10f64.powi(-d)
+}
+
+/// The same moves before and after, one to one.
+fn pairs(before: &[u8], after: &[u8]) -> (Vec<Point>, Vec<Point>) {
+    let (b, a) = (
+        points(&String::from_utf8_lossy(before)),
+        points(&String::from_utf8_lossy(after)),
+    );
+    assert_eq!(b.len(), a.len(), "the same moves");
+    assert!(b.len() > 10, "{} moves", b.len());
+    for (p, q) in b.iter().zip(&a) {
+        assert_eq!(p.line, q.line);
+    }
+    (b, a)
+}
+
+/// A ball at its tip: X Y Z change only where the orientation changed, and every written
+/// centre of a cutting move is within 0.001 mm plus the written rounding of the original.
+/// Returns how many points turned and the largest centre error, mm. (A rapid retract after
+/// the run — `L Z+100 R0 FMAX` — keeps its own Z and the modal X Y of the rewritten last
+/// point: its centre may move by R·|Δo|, above the part; it is not checked.)
+fn centres_kept(m: &Machine, before: &[u8], after: &[u8], radius: f64, what: &str) -> (usize, f64) {
+    let (b, a) = pairs(before, after);
+    let rounding = xyz_rounding(&b, &a);
+    let mut turned = 0;
+    let mut worst: f64 = 0.0;
+    for (p, q) in b.iter().zip(&a) {
+        let turn = turn_deg(m, p, q);
+        if turn > 0.0 {
+            turned += 1;
+        }
+        let xyz_same = (0..3).all(|i| p.axes[i].value == q.axes[i].value);
+        assert!(
+            xyz_same || turn > 0.0,
+            "{what}: line {}: X Y Z changed ({:?} → {:?}) but the orientation did not",
+            p.line,
+            p.xyz_text,
+            q.xyz_text
+        );
+        if p.rapid {
+            continue;
+        }
+        let err = dist(centre(m, p, radius), centre(m, q, radius));
+        worst = worst.max(err);
+        let limit = 0.001 + rounding;
+        assert!(
+            err <= limit,
+            "{what}: line {}: the ball's centre moved {err} mm (limit {limit} mm)",
+            p.line
+        );
+    }
+    (turned, worst)
+}
+
+/// X Y Z words byte-identical, lines otherwise differing only in rotary words.
+fn xyz_identical(before: &[u8], after: &[u8], what: &str) {
+    let (b, a) = pairs(before, after);
+    for (p, q) in b.iter().zip(&a) {
+        assert_eq!(p.xyz_text, q.xyz_text, "{what}: line {}", p.line);
+        assert_eq!(p.other_text, q.other_text, "{what}: line {}", p.line);
+    }
+    let (bt, at) = (
+        String::from_utf8_lossy(before).into_owned(),
+        String::from_utf8_lossy(after).into_owned(),
+    );
+    assert_eq!(
+        bt.lines().count(),
+        at.lines().count(),
+        "{what}: no line added"
+    );
+}
+
+fn all_reached(report: &FileReport, what: &str) {
+    assert!(!report.zones.is_empty(), "{what}: zones");
+    for z in &report.zones {
+        assert_eq!(z.outcome, "reached", "{what}: {:?} {}", z.lines, z.reason);
+        assert!(z.after.c_ratio >= 1.0 - 1e-9 && z.after.primary_ratio >= 1.0 - 1e-9);
+    }
+}
+
+#[test]
+fn sing_with_a_ball_at_its_tip_keeps_the_centre() {
+    let m = ucp710();
+    let input = fixture("fixtures/c17/SING.I");
+    let opts = with_tool(Some("ball:10"), Some(ToolPoint::Tip));
+    let (out, report) = patch_nc(&input, &m, &opts).unwrap();
+    all_reached(&report, "SING ball:10 tip");
+    let (turned, worst) = centres_kept(&m, &input, &out, 5.0, "SING ball:10 tip");
+    assert!(turned > 10, "{turned} points turned");
+    // X Y Z did change (else the check above says nothing).
+    assert_ne!(points(&String::from_utf8_lossy(&out))[20].xyz_text, {
+        let b = points(&String::from_utf8_lossy(&input));
+        b[20].xyz_text.clone()
+    });
+    for z in &report.zones {
+        assert_eq!((z.tool.as_str(), z.tool_point), ("ball D10", "tip"));
+        assert_eq!(z.tool_source, "--tool");
+        assert_eq!(z.tool_point_source, "--tool-point");
+        let shift = z.max_cutter_shift_mm.unwrap();
+        assert!(shift <= 0.001 + 0.5e-3 * 3f64.sqrt(), "{shift}");
+        let chord = z.centre_chord_mm.unwrap();
+        assert!(chord <= opts.chord_tolerance_mm + 1e-3, "{chord}");
+    }
+    println!("SING ball:10 tip: {turned} points turned, largest centre error {worst:.6} mm");
+}
+
+#[test]
+fn sing_with_m128_keeps_x_y_z() {
+    let m = ucp710();
+    let input = fixture("fixtures/c17/SING.I");
+    for (what, opts) in [
+        ("ball:10", with_tool(Some("ball:10"), None)),
+        ("no tool", PatchOptions::default()),
+    ] {
+        let (out, report) = patch_nc(&input, &m, &opts).unwrap();
+        all_reached(&report, what);
+        assert_ne!(out, input, "{what}: patched");
+        xyz_identical(&input, &out, what);
+        for z in &report.zones {
+            assert_eq!(z.tool_point, "centre", "{what}");
+            assert!(
+                z.tool_point_source.contains("M128"),
+                "{}",
+                z.tool_point_source
+            );
+        }
+    }
+}
+
+#[test]
+fn refpnt_center_center_keeps_x_y_z_and_tip_tip_the_centre() {
+    let m = ucp710();
+    let centre_file = fixture("fixtures/tools/ac-swing-d1-conv-refpnt-centre.H");
+    let (out, report) = patch_nc(&centre_file, &m, &PatchOptions::default()).unwrap();
+    assert_ne!(out, centre_file, "CENTER-CENTER: patched");
+    xyz_identical(&centre_file, &out, "REFPNT CENTER-CENTER");
+    for z in report.zones.iter().filter(|z| z.max_deviation_deg > 0.0) {
+        assert_eq!((z.tool.as_str(), z.tool_point), ("ball D10", "centre"));
+        assert!(
+            z.tool_source.starts_with("line 4: 3 TOOL DEF 1"),
+            "{}",
+            z.tool_source
+        );
+    }
+
+    let tip_file = fixture("fixtures/tools/ac-swing-d1-conv-refpnt-tip.H");
+    let (out, report) = patch_nc(&tip_file, &m, &PatchOptions::default()).unwrap();
+    all_reached(&report, "REFPNT TIP-TIP");
+    let (turned, worst) = centres_kept(&m, &tip_file, &out, 5.0, "REFPNT TIP-TIP");
+    assert!(turned > 0, "TIP-TIP: the orientation changed somewhere");
+    assert!(
+        points(&String::from_utf8_lossy(&out))
+            .iter()
+            .zip(points(&String::from_utf8_lossy(&tip_file)))
+            .any(|(a, b)| a.xyz_text != b.xyz_text),
+        "TIP-TIP: X Y Z rewritten"
+    );
+    for z in report.zones.iter().filter(|z| z.max_deviation_deg > 0.0) {
+        assert_eq!((z.tool.as_str(), z.tool_point), ("ball D10", "tip"));
+    }
+    println!("REFPNT TIP-TIP: {turned} points turned, largest centre error {worst:.6} mm");
+}
+
+#[test]
+fn the_camworks_apt_posted_with_the_patch_keeps_the_centres() {
+    let m = ucp710();
+    let name = "fixtures/tools/camworks_ball_swing.apt";
+    let bytes = fixture(name);
+    let cl = read_cl(&bytes, name).unwrap();
+    let post = |patch: bool| {
+        let mut opts = PostOptions {
+            patch,
+            ..PostOptions::default()
+        };
+        tool_from_cl(&bytes, &cl, &mut opts);
+        assert_eq!(
+            opts.patch_options.tool.tool,
+            Some(Tool::parse("ball:10").unwrap()),
+            "CUTTER/10,5"
+        );
+        assert_eq!(opts.patch_options.tool.point, Some(ToolPoint::Tip));
+        post_cl(&cl, &m, &opts).unwrap()
+    };
+    let (raw, none) = post(false);
+    assert!(none.is_none());
+    let (patched, report) = post(true);
+    let report = report.unwrap();
+    assert_ne!(raw, patched, "the swing is patched");
+    all_reached(&report, "CAMWorks APT");
+    let (turned, worst) = centres_kept(&m, &raw, &patched, 5.0, "CAMWorks APT");
+    assert!(turned > 0);
+    for z in report.zones.iter().filter(|z| z.max_deviation_deg > 0.0) {
+        assert_eq!((z.tool.as_str(), z.tool_point), ("ball D10", "tip"));
+    }
+    // And against the CL file itself: each posted tip + R·o is the GOTO's tip + R·(i j k)
+    // within the post's rounding (3 decimals) and 0.001 mm.
+    let gotos: Vec<[f64; 6]> = String::from_utf8_lossy(&bytes)
+        .lines()
+        .filter_map(|l| l.strip_prefix("GOTO/"))
+        .map(|r| {
+            let v: Vec<f64> = r.split(',').map(|x| x.trim().parse().unwrap()).collect();
+            [v[0], v[1], v[2], v[3], v[4], v[5]]
+        })
+        .collect();
+    let written = points(&String::from_utf8_lossy(&patched));
+    let rounding = xyz_rounding(&written, &written);
+    let near = |c: [f64; 3]| {
+        gotos
+            .iter()
+            .map(|g| dist(c, std::array::from_fn(|i| g[i] + 5.0 * g[i + 3])))
+            .fold(f64::INFINITY, f64::min)
+    };
+    for p in written.iter().filter(|p| !p.rapid) {
+        let e = near(centre(&m, p, 5.0));
+        assert!(
+            e <= 0.001 + rounding,
+            "line {}: {e} mm from every CL centre",
+            p.line
+        );
+    }
+    println!("CAMWorks APT: {turned} points turned, largest centre error {worst:.6} mm");
+}
+
+/// A flat D10: every written point's end moves at most the surface tolerance (from the
+/// written A C: 2·R·sin(δ/2), R = 5 mm the largest distance of its end from the tip); the
+/// zones that needed more say `tool_limited` and how much they needed.
+#[test]
+fn a_flat_end_mill_stays_within_the_surface_bound() {
+    let m = ucp710();
+    for rel in [
+        "fixtures/c17/SING.I",
+        "fixtures/tools/fusion-ac-swing-d0.5-flat.nc",
+    ] {
+        let input = fixture(rel);
+        for tol in [SURFACE_TOLERANCE_MM, 0.05] {
+            let mut opts = with_tool(Some("flat:10"), None);
+            opts.tool.surface_tolerance_mm = tol;
+            let (out, report) = patch_nc(&input, &m, &opts).unwrap();
+            let mut limited = 0;
+            for z in &report.zones {
+                assert_eq!(z.tool, "flat D10");
+                let shift = z.max_cutter_shift_mm.unwrap();
+                assert!(shift <= tol * (1.0 + 1e-9), "{rel} {tol}: {shift}");
+                if z.reason == "tool_limited" {
+                    limited += 1;
+                    let needed = z.needed_deviation_deg.expect("the deviation needed");
+                    let cap =
+                        polepatch::tool::deviation_cap_deg(&Tool::parse("flat:10").unwrap(), tol);
+                    assert!(needed > cap, "{rel}: needed {needed}° ≤ cap {cap}°");
+                    assert_ne!(z.outcome, "reached");
+                }
+            }
+            if tol == SURFACE_TOLERANCE_MM {
+                assert!(limited > 0, "{rel}: a 0.057° cap stops these zones");
+            }
+            // The written values: no point turned by more than the cap allows (the
+            // written rotary rounding, ≤ 0.5·10⁻⁶° at 6 decimals, aside).
+            if rel.ends_with("SING.I") {
+                let (b, a) = pairs(&input, &out);
+                for (p, q) in b.iter().zip(&a) {
+                    let moved = 2.0 * 5.0 * (turn_deg(&m, p, q).to_radians() / 2.0).sin();
+                    assert!(moved <= tol + 1e-6, "{rel}: line {}: {moved} mm", p.line);
+                    assert_eq!(p.xyz_text, q.xyz_text, "a flat end mill's X Y Z stay");
+                }
+            }
+        }
+    }
+}
+
+/// Each reader of a tool's description, on the fixture written in its style: the kind,
+/// the diameter, the corner radius and the line it came from.
+#[test]
+fn each_tool_source_on_its_fixture() {
+    let m = ucp710();
+    let cases: [(&str, ToolKind, f64, f64, &str); 8] = [
+        (
+            "fusion-ac-swing-d0.5-ball.nc",
+            ToolKind::Ball,
+            10.0,
+            5.0,
+            "line 3: (T1  D=10. CR=5.",
+        ),
+        (
+            "fusion-ac-swing-d0.5-flat.nc",
+            ToolKind::Flat,
+            12.0,
+            0.0,
+            "line 4: (T2  D=12. CR=0.",
+        ),
+        (
+            "mastercam-ac-swing-d0.5-ball.nc",
+            ToolKind::Ball,
+            10.0,
+            5.0,
+            "line 3: ( TOOL - 1  10MM BALL ENDMILL",
+        ),
+        (
+            "nx-ac-swing-d0.5-ball.nc",
+            ToolKind::Ball,
+            10.0,
+            5.0,
+            "line 4: (   1       BALL_MILL_D10",
+        ),
+        (
+            "powermill-ac-swing-d0.5-ball.nc",
+            ToolKind::Ball,
+            10.0,
+            5.0,
+            "line 4: (",
+        ),
+        (
+            "hypermill-ac-swing-d1-bull.H",
+            ToolKind::Bull,
+            10.0,
+            2.0,
+            "line 4: 3 * - TOOL: T1554880489 | TGT-VLM10-R2 / DM=10 CR=2",
+        ),
+        (
+            "ac-swing-d1-conv-refpnt-tip.H",
+            ToolKind::Ball,
+            10.0,
+            5.0,
+            "line 4: 3 TOOL DEF 1 L+0 R+5 R2+5",
+        ),
+        (
+            "ac-swing-d1-conv-refpnt-centre.H",
+            ToolKind::Ball,
+            10.0,
+            5.0,
+            "line 4: 3 TOOL DEF 1 L+0 R+5 R2+5",
+        ),
+    ];
+    for (file, kind, d, r, source) in cases {
+        let rel = format!("fixtures/tools/{file}");
+        let (_, report) = patch_nc(&fixture(&rel), &m, &PatchOptions::default()).unwrap();
+        let want = Tool {
+            kind,
+            diameter_mm: d,
+            corner_radius_mm: r,
+        };
+        assert!(!report.zones.is_empty(), "{file}: zones");
+        for z in &report.zones {
+            assert_eq!(z.tool, want.describe(), "{file}: {}", z.tool_source);
+            assert!(
+                z.tool_source.starts_with(source),
+                "{file}: source {:?}, expected {source:?}…",
+                z.tool_source
+            );
+        }
+        assert_eq!(report.zones_with_unknown_tool(), 0, "{file}");
+    }
+    // APT CUTTER (read by `post`).
+    let apt = fixture("fixtures/tools/camworks_ball_swing.apt");
+    let (tool, source) = polepatch::tool::cl_tool(&apt, 1.0).unwrap();
+    assert_eq!(tool, Tool::parse("ball:10").unwrap());
+    assert!(
+        source.starts_with("line 9: CUTTER/10.000000,5.000000"),
+        "{source}"
+    );
+}
+
+/// No tool given and none in the program: the report says unknown, every changed zone
+/// gives its centre shift per mm of radius (2·sin(δ/2)), one warning, a strict failure.
+#[test]
+fn an_unknown_tool_is_never_silent() {
+    let m = ucp710();
+    let (_, report) = patch_nc(
+        &fixture("fixtures/c17/SING.I"),
+        &m,
+        &PatchOptions::default(),
+    )
+    .unwrap();
+    let changed: Vec<_> = report
+        .zones
+        .iter()
+        .filter(|z| z.max_deviation_deg > 0.0)
+        .collect();
+    assert!(!changed.is_empty());
+    for z in &changed {
+        assert_eq!(z.tool, "unknown");
+        assert!(z.tool_source.contains("T5"), "{}", z.tool_source);
+        let want = 2.0 * (z.max_deviation_deg.to_radians() / 2.0).sin();
+        assert!((z.centre_shift_per_mm_radius - want).abs() < 1e-12);
+        assert_eq!(z.max_cutter_shift_mm, None);
+    }
+    assert_eq!(report.zones_with_unknown_tool(), changed.len());
+    assert!(report.strict_failures() >= changed.len());
+    let warnings: Vec<_> = report
+        .warnings
+        .iter()
+        .filter(|w| w.contains("the tool is not known"))
+        .collect();
+    assert_eq!(warnings.len(), 1, "{:?}", report.warnings);
+    assert!(warnings[0].contains("--tool ball:D"), "{}", warnings[0]);
+}
+
+/// The centre between the points, on a case built to exceed the chord tolerance: a D50
+/// ball at its tip on SING, whose centre path between the 1 mm-spaced points leaves the
+/// original's line by 2.9 µm (`centre_chord_mm`), against a chord tolerance of 1 µm
+/// (limit 1 + 1 µm of rounding room). The run keeps its values (`centre_path`, and
+/// `untouched_runs` says why); with the default 5 µm it is written.
+#[test]
+fn a_centre_path_beyond_the_chord_tolerance_is_not_written() {
+    let m = ucp710();
+    let input = fixture("fixtures/c17/SING.I");
+    let mut opts = with_tool(Some("ball:50"), Some(ToolPoint::Tip));
+    let (_, written) = patch_nc(&input, &m, &opts).unwrap();
+    let chord = written.zones[0].centre_chord_mm.unwrap();
+    assert!(chord > 0.0025 && chord < 0.004, "{chord}");
+    all_reached(&written, "ball:50, default chord tolerance");
+
+    opts.chord_tolerance_mm = 0.001;
+    let (out, report) = patch_nc(&input, &m, &opts).unwrap();
+    assert_eq!(out, input, "the run keeps its values");
+    assert!(!report.zones.is_empty());
+    for z in &report.zones {
+        assert_eq!(z.reason, "centre_path");
+        assert_eq!(z.outcome, "unchanged");
+    }
+    let u = &report.untouched_runs[0];
+    assert_eq!(u.reason, polepatch::UntouchedReason::CentrePath);
+    assert!(
+        u.message.contains("chord tolerance 0.001 mm"),
+        "{}",
+        u.message
+    );
+}
