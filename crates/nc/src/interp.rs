@@ -6,7 +6,7 @@
 use crate::error::ParseError;
 use crate::lexer::{Lexer, Token};
 use crate::modal::{A, AXES, B, C, FeedMode, Modal, Motion, Tcpm, X, Y, Z};
-use crate::program::{Block, Dialect, Flags, Word};
+use crate::program::{Block, Dialect, Flags, RotaryForm, Word};
 use crate::tcpm::{ControllerCodes, ReadOptions, Switch, code10};
 use std::ops::Range;
 
@@ -14,6 +14,8 @@ use std::ops::Range;
 #[derive(Debug, Default)]
 pub(crate) struct Scan {
     pub(crate) axes: [Option<f64>; 6],
+    /// The direction forms of A B C (`C=DC(…)`, `C=ACP(…)`, `C=ACN(…)`).
+    pub(crate) axes_form: [RotaryForm; 3],
     /// Bit `i`: axis `i`'s value is an expression or a variable (not a plain number).
     pub(crate) axes_expr: u8,
     /// Bit `i`: axis `i`'s word is incremental for this block only (conversational `IX`).
@@ -444,7 +446,11 @@ impl Interpreter {
                     span: wspan,
                     value_span,
                     value,
+                    form,
                 } => {
+                    if let Some(i) = [A, B, C].into_iter().find(|&i| AXES[i] == letter) {
+                        s.axes_form[i - A] = form;
+                    }
                     once(letter, wspan.start)?;
                     match letter {
                         b'X' => s.axes[X] = Some(value),
@@ -486,9 +492,12 @@ impl Interpreter {
                     // Offsets fit: files are at most 4 GiB.
                     words.push(Word {
                         letter,
+                        form,
+                        // `)` and the blanks before it: a few bytes.
+                        tail: (wspan.end - value_span.end).min(255) as u8,
                         start: wspan.start as u32,
                         value_start: value_span.start as u32,
-                        end: wspan.end as u32,
+                        end: value_span.end as u32,
                         value,
                     });
                 }
@@ -773,7 +782,26 @@ impl Interpreter {
                 breaks = true;
             }
             for (i, v) in s.axes.iter().enumerate() {
-                if let Some(v) = *v {
+                let form = if i >= A {
+                    s.axes_form[i - A]
+                } else {
+                    RotaryForm::Plain
+                };
+                if let Some(v) = *v
+                    && form.is_directional()
+                {
+                    // A position modulo 360 and a direction (absolute in G91 too): the
+                    // controller's unwrapped position follows from where the axis is; from
+                    // an unknown position, the value itself (the same pose). DC to a half
+                    // turn names no direction: unknown.
+                    m.pos[i] = match m.pos[i] {
+                        Some(p) => form.delta(p, v).map(|d| p + d),
+                        None => Some(v.rem_euclid(360.0)),
+                    };
+                    if m.pos[i].is_none() {
+                        breaks = true;
+                    }
+                } else if let Some(v) = *v {
                     let v = if i < A { v * scale } else { v };
                     m.pos[i] = if m.incremental || s.axes_incremental & bit(i) != 0 {
                         m.pos[i].map(|p| p + v)
