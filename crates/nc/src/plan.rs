@@ -94,9 +94,14 @@ pub struct FormConflict {
     pub cause: usize,
     /// What is wrong, for people.
     pub message: String,
+    /// The word is a macro variable or an expression (`C#105`), which is never rewritten,
+    /// rather than a direction form that cannot make the move.
+    pub variable: bool,
 }
 
-/// Write the edits of rotary letters that the file writes in a direction form
+/// Check the edits against the words they change: a word whose value is a variable or an
+/// expression (`C#105`) is never rewritten ([`FormConflict::variable`]); and write the
+/// edits of rotary letters that the file writes in a direction form
 /// ([`crate::RotaryForm`]): an edited `C=DC(…)` gets the patched position modulo 360 in
 /// [0, 360), rounded to the edit's decimals, where that number makes the controller move
 /// from the (patched) position before it to the patched position — DC the shorter way,
@@ -112,6 +117,32 @@ pub fn write_direction_forms(program: &Program, edits: &mut [Edit]) -> Vec<FormC
     use crate::modal::A;
     use std::collections::HashMap;
     let mut conflicts = Vec::new();
+    // A word whose value is a variable or an expression (`C#105`, read as the variable's
+    // constant value): never rewritten, nor given a second word of its letter.
+    for e in edits.iter() {
+        let block = &program.blocks[e.block];
+        let held = crate::lexer::Lexer::new(&program.bytes, block.span())
+            .filter_map(Result::ok)
+            .find_map(|t| match t {
+                crate::lexer::Token::Assign { letter, span } if letter == e.letter => Some(span),
+                _ => None,
+            });
+        if let Some(span) = held {
+            conflicts.push(FormConflict {
+                block: e.block,
+                letter: e.letter,
+                cause: e.block,
+                message: format!(
+                    "line {}: the patch would change {}, and the block writes it as `{}` (a \
+                     variable or an expression, never rewritten)",
+                    block.line,
+                    e.letter as char,
+                    String::from_utf8_lossy(&program.bytes[span])
+                ),
+                variable: true,
+            });
+        }
+    }
     for (k, &letter) in AXES.iter().enumerate().skip(A) {
         if !program
             .words
@@ -152,6 +183,7 @@ pub fn write_direction_forms(program: &Program, edits: &mut [Edit]) -> Vec<FormC
                     letter,
                     cause,
                     message,
+                    variable: false,
                 });
             };
             match (word, edit) {
@@ -352,7 +384,7 @@ mod tests {
         let out = String::from_utf8(write(&p, &edits)).unwrap();
         assert_eq!(
             out,
-            "G1 X0 A1 C=DC(350.) F1000\nX1 C=DC(5.)\nX2 C=DC(10.)\n"
+            "G1 X0 A1 C=DC(350.) F1000\nX1 C=DC(5.000)\nX2 C=DC(10.)\n"
         );
     }
 
@@ -377,5 +409,35 @@ mod tests {
         // ACN cannot move forward.
         let mut edits = vec![c(3, 362.0)];
         assert!(!write_direction_forms(&p, &mut edits).is_empty());
+    }
+}
+
+#[cfg(test)]
+mod variable_tests {
+    use super::*;
+    use crate::{Dialect, parse};
+
+    /// Issue 30 item 11: `C#105` is read as the constant but never rewritten.
+    #[test]
+    fn a_variable_word_is_never_rewritten() {
+        let src = "#105=10.\nG1 X0 A1 C#105 F1000\nX1 C20.\n";
+        let p = parse(src.as_bytes().to_vec(), Dialect::Fanuc).unwrap();
+        assert_eq!(p.state(1).pos[crate::modal::C], Some(10.0));
+        let mut edits = vec![Edit {
+            block: 1,
+            letter: b'C',
+            value: 12.0,
+            decimals: 3,
+        }];
+        let k = write_direction_forms(&p, &mut edits);
+        assert_eq!(k.len(), 1);
+        assert!(k[0].variable && k[0].message.contains("`C#105`"), "{k:?}");
+        let mut edits = vec![Edit {
+            block: 2,
+            letter: b'C',
+            value: 22.0,
+            decimals: 3,
+        }];
+        assert!(write_direction_forms(&p, &mut edits).is_empty());
     }
 }

@@ -69,6 +69,10 @@ impl Flags {
     pub fn set(&mut self, other: Flags) {
         self.0 |= other.0;
     }
+    /// Clear the bits of `other`.
+    pub(crate) fn clear(&mut self, other: Flags) {
+        self.0 &= !other.0;
+    }
 }
 
 /// How a rotary word states where the axis goes: as a plain number (`C12.5`, `C=12.5`:

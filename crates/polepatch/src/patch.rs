@@ -384,6 +384,9 @@ pub enum UntouchedReason {
     /// cannot make the patched move (DC goes the shorter way, ACP/ACN in their direction),
     /// or the patch would insert a plain word of a letter the file writes in that form.
     DirectionForm,
+    /// The patch would change a word whose value is a macro variable or an expression
+    /// (`C#105`, read as the variable's constant value): such a word is never rewritten.
+    MacroVariable,
 }
 
 impl UntouchedReason {
@@ -393,6 +396,7 @@ impl UntouchedReason {
             UntouchedReason::TcpmUnknown => Some("tcpm_unknown"),
             UntouchedReason::FrameTransformed => Some("frame_transformed"),
             UntouchedReason::DirectionForm => Some("direction_form"),
+            UntouchedReason::MacroVariable => Some("macro_variable"),
             _ => None,
         }
     }
@@ -1035,6 +1039,11 @@ fn direction_forms(
             return Vec::new();
         };
         dropped.push(run);
+        let reason = if k.variable {
+            UntouchedReason::MacroVariable
+        } else {
+            UntouchedReason::DirectionForm
+        };
         let Some((_, first_row, _)) = run_edit_ranges.iter().find(|(r, _, _)| *r == run) else {
             continue;
         };
@@ -1044,20 +1053,22 @@ fn direction_forms(
             .count();
         for row in &mut report.zones[*first_row..*first_row + zones] {
             row.not_written();
-            row.reason = UntouchedReason::DirectionForm
-                .zone_reason()
-                .unwrap_or("not_patched");
+            row.reason = reason.zone_reason().unwrap_or("not_patched");
         }
         report.untouched_runs.push(untouched(
             lp,
             run,
-            UntouchedReason::DirectionForm,
+            reason,
             zones,
-            format!(
-                "{}: the form cannot make the patched move, and polepatch never writes a word \
-                 that makes a different one; the run keeps its values",
-                k.message
-            ),
+            if k.variable {
+                format!("{}; the run keeps its values", k.message)
+            } else {
+                format!(
+                    "{}: the form cannot make the patched move, and polepatch never writes a \
+                     word that makes a different one; the run keeps its values",
+                    k.message
+                )
+            },
             opts.reach_deg(),
         ));
     }
