@@ -98,7 +98,8 @@ pub(crate) struct Interpreter {
     consts: std::collections::HashMap<u32, f64>,
 }
 
-/// `#100`, `-#100`, `+#100`: a macro variable's number and whether it is negated.
+/// `#100`, `-#100`, `+#100`: a macro variable's number (below 1000) and whether it is
+/// negated.
 fn macro_variable(text: &[u8]) -> Option<(u32, bool)> {
     let (neg, t) = match text.first()? {
         b'-' => (true, &text[1..]),
@@ -109,11 +110,11 @@ fn macro_variable(text: &[u8]) -> Option<(u32, bool)> {
     if digits.is_empty() || digits.len() > 9 || !digits.iter().all(u8::is_ascii_digit) {
         return None;
     }
-    std::str::from_utf8(digits)
-        .ok()?
-        .parse()
-        .ok()
-        .map(|n| (n, neg))
+    // Local (#1–#33) and common (#100–#199, #500–#999) variables, which only programs
+    // change; system variables (#1000 on: positions, offsets, modal information) may change
+    // under the program.
+    let n: u32 = std::str::from_utf8(digits).ok()?.parse().ok()?;
+    (1..1000).contains(&n).then_some((n, neg))
 }
 
 /// The assignment a parameter token at `at..end` starts, if `=` follows it: the variable
@@ -1063,6 +1064,9 @@ mod tests {
         // A reassignment in straight-line code: the new value.
         let p = read("#100=1200.\n#100=800.\nG1 X1 F#100\n");
         assert_eq!(p.state(2).feed_mm_min, Some(800.0));
+        // System variables may change under the program.
+        let p = read("#5221=-100.\nG1 X#5221 F100.\n");
+        assert_eq!(p.state(1).pos[X], None);
     }
 
     /// Anything that may change a variable between assignment and use leaves the use an
