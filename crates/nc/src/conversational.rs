@@ -32,7 +32,7 @@ use crate::interp::{Interpreter, Scan, function};
 use crate::lexer::parse_number;
 use crate::modal::transform;
 use crate::modal::{A, AXES, B, C, Motion};
-use crate::program::{Flags, Word};
+use crate::program::{Flags, RotaryForm, Word};
 use crate::tcpm::code10;
 use std::ops::Range;
 
@@ -164,6 +164,8 @@ impl Words<'_> {
                             value_start: value.start as u32,
                             end: value.end as u32,
                             value: v,
+                            form: RotaryForm::Plain,
+                            tail: 0,
                         });
                     }
                     _ if value_text.iter().any(|c| c.eq_ignore_ascii_case(&b'Q')) => {
@@ -196,6 +198,8 @@ impl Words<'_> {
                                 value_start: value.start as u32,
                                 end: value.end as u32,
                                 value: v,
+                                form: RotaryForm::Plain,
+                                tail: 0,
                             });
                         }
                         _ if value_text.iter().any(|c| c.eq_ignore_ascii_case(&b'Q')) => {
@@ -235,6 +239,8 @@ impl Words<'_> {
                         value_start: value.start as u32,
                         end: value.end as u32,
                         value: v,
+                        form: RotaryForm::Plain,
+                        tail: 0,
                     });
                     match code10(v) {
                         // Machine coordinates for this block; retract along the tool axis;

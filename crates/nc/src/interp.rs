@@ -6,7 +6,7 @@
 use crate::error::ParseError;
 use crate::lexer::{Lexer, Token};
 use crate::modal::{A, AXES, B, C, FeedMode, Modal, Motion, Tcpm, X, Y, Z};
-use crate::program::{Block, Dialect, Flags, Word};
+use crate::program::{Block, Dialect, Flags, RotaryForm, Word};
 use crate::tcpm::{ControllerCodes, ReadOptions, Switch, code10};
 use std::ops::Range;
 
@@ -14,6 +14,18 @@ use std::ops::Range;
 #[derive(Debug, Default)]
 pub(crate) struct Scan {
     pub(crate) axes: [Option<f64>; 6],
+    /// The direction forms of A B C (`C=DC(…)`, `C=ACP(…)`, `C=ACN(…)`).
+    pub(crate) axes_form: [RotaryForm; 3],
+    /// Axis (X Y Z A B C) and F words whose value is one macro variable (`F#100`,
+    /// `X-#101`): its number and whether it is negated.
+    pub(crate) vars: [Option<(u32, bool)>; 7],
+    /// A macro variable assigned in the block (`#100=1200.`): its number and the value
+    /// when it is a plain number.
+    pub(crate) assign: Option<(u32, Option<f64>)>,
+    /// Another assignment (`#<name>=…`, `#[#1]=…`, a second one): any variable may change.
+    pub(crate) assign_other: bool,
+    /// `breaks` was set by the expression words alone.
+    pub(crate) expr_breaks: bool,
     /// Bit `i`: axis `i`'s value is an expression or a variable (not a plain number).
     pub(crate) axes_expr: u8,
     /// Bit `i`: axis `i`'s word is incremental for this block only (conversational `IX`).
@@ -82,6 +94,60 @@ pub(crate) struct Interpreter {
     pub(crate) stated_datum: Option<[f64; 3]>,
     /// The last block changed the frame without stating it, taken by the caller.
     pub(crate) frame_changed: bool,
+    /// Fanuc macro variables whose value is a constant here ([`Interpreter::constants`]).
+    consts: std::collections::HashMap<u32, f64>,
+}
+
+/// `#100`, `-#100`, `+#100`: a macro variable's number (below 1000) and whether it is
+/// negated.
+fn macro_variable(text: &[u8]) -> Option<(u32, bool)> {
+    let (neg, t) = match text.first()? {
+        b'-' => (true, &text[1..]),
+        b'+' => (false, &text[1..]),
+        _ => (false, text),
+    };
+    let digits = t.strip_prefix(b"#")?;
+    if digits.is_empty() || digits.len() > 9 || !digits.iter().all(u8::is_ascii_digit) {
+        return None;
+    }
+    // Local (#1–#33) and common (#100–#199, #500–#999) variables, which only programs
+    // change; system variables (#1000 on: positions, offsets, modal information) may change
+    // under the program.
+    let n: u32 = std::str::from_utf8(digits).ok()?.parse().ok()?;
+    (1..1000).contains(&n).then_some((n, neg))
+}
+
+/// The assignment a parameter token at `at..end` starts, if `=` follows it: the variable
+/// (`None` for `#<name>`, `#[…]`) and the value when it is a plain number alone up to the
+/// end of the block (a comment may follow).
+fn macro_assignment(
+    bytes: &[u8],
+    param: Range<usize>,
+    end: usize,
+) -> Option<(Option<u32>, Option<f64>)> {
+    let blank = |c: u8| matches!(c, b' ' | b'\t');
+    let mut i = param.end;
+    while i < end && blank(bytes[i]) {
+        i += 1;
+    }
+    if i >= end || bytes[i] != b'=' {
+        return None;
+    }
+    let var = macro_variable(&bytes[param]).and_then(|(n, neg)| (!neg).then_some(n));
+    i += 1;
+    while i < end && blank(bytes[i]) {
+        i += 1;
+    }
+    let start = i;
+    while i < end && (bytes[i].is_ascii_digit() || matches!(bytes[i], b'.' | b'-' | b'+')) {
+        i += 1;
+    }
+    let value = crate::lexer::parse_number(&bytes[start..i]);
+    while i < end && blank(bytes[i]) {
+        i += 1;
+    }
+    let rest_is_comment = i >= end || matches!(bytes[i], b'(' | b';');
+    Some((var, value.filter(|v| v.is_finite() && rest_is_comment)))
 }
 
 /// Identifiers of program flow: LinuxCNC O-word statements (`o100 call`, `o<x> if`, …) and
@@ -223,6 +289,7 @@ impl Interpreter {
             recorder: (opts.flow.is_none() && !always).then(crate::flow::Recorder::default),
             stated_datum: None,
             frame_changed: false,
+            consts: std::collections::HashMap::new(),
         }
     }
 
@@ -444,7 +511,11 @@ impl Interpreter {
                     span: wspan,
                     value_span,
                     value,
+                    form,
                 } => {
+                    if let Some(i) = [A, B, C].into_iter().find(|&i| AXES[i] == letter) {
+                        s.axes_form[i - A] = form;
+                    }
                     once(letter, wspan.start)?;
                     match letter {
                         b'X' => s.axes[X] = Some(value),
@@ -486,9 +557,12 @@ impl Interpreter {
                     // Offsets fit: files are at most 4 GiB.
                     words.push(Word {
                         letter,
+                        form,
+                        // `)` and the blanks before it: a few bytes.
+                        tail: (wspan.end - value_span.end).min(255) as u8,
                         start: wspan.start as u32,
                         value_start: value_span.start as u32,
-                        end: wspan.end as u32,
+                        end: value_span.end as u32,
                         value,
                     });
                 }
@@ -517,8 +591,10 @@ impl Interpreter {
                     once(letter, aspan.start)?;
                     if let Some(i) = AXES.iter().position(|&l| l == letter) {
                         s.axes_expr |= bit(i);
+                        s.vars[i] = macro_variable(&bytes[aspan.start + 1..aspan.end]);
                     } else if letter == b'F' {
                         s.feed_expr = true;
+                        s.vars[6] = macro_variable(&bytes[aspan.start + 1..aspan.end]);
                     } else if letter == b'O' {
                         // `o<name> call`, `o<name> sub`: LinuxCNC program flow.
                         s.unknown_after = true;
@@ -557,7 +633,16 @@ impl Interpreter {
                 }
                 // A parameter outside an axis word (an assignment `#<a> = 5`, `#1=#2+1`):
                 // no motion, but the line is not a plain move either.
-                Token::Param { .. } => s.breaks = true,
+                Token::Param { span: pspan } => {
+                    s.breaks = true;
+                    match macro_assignment(bytes, pspan, span.end) {
+                        Some((Some(n), value)) if s.assign.is_none() => {
+                            s.assign = Some((n, value));
+                        }
+                        Some(_) => s.assign_other = true,
+                        None => {}
+                    }
+                }
                 Token::BlockEnd { .. } | Token::Other { .. } => {}
             }
         }
@@ -640,14 +725,69 @@ impl Interpreter {
             }
         }
     }
+    /// Fanuc/Haas macro variables with constant values (`#100=1200.` then `G1 F#100`, `X#101`):
+    /// a use takes the value of the variable's assignment of a plain number when nothing
+    /// between them can change it — straight-line blocks only: any program flow (a jump, a
+    /// loop, a call, a label, `M6` that may run a macro, `G65`), a block-delete block, an
+    /// assignment that is not a plain number or whose variable is not named by its number
+    /// forgets every value. A file whose flow joins paths (a jump or a loop anywhere, read
+    /// again with its [`crate::flow::FlowPlan`]) and a machine that is always TCP (whose
+    /// reader does not look at flow) evaluate none. Uses are substituted into `s`, and a
+    /// block left without an expression is analysed like any other.
+    fn constants(&mut self, s: &mut Scan) {
+        let on = self.dialect == Dialect::Fanuc && self.plan.is_none() && !self.controller.always;
+        if !on {
+            return;
+        }
+        let had_expr = s.axes_expr != 0 || s.feed_expr;
+        for (i, v) in s.vars.iter().enumerate() {
+            let Some((n, neg)) = *v else { continue };
+            let Some(&value) = self.consts.get(&n) else {
+                continue;
+            };
+            let value = if neg { -value } else { value };
+            if i < 6 {
+                s.axes[i] = Some(value);
+                s.axes_expr &= !bit(i);
+            } else {
+                s.feed = Some(value);
+                s.feed_expr = false;
+            }
+        }
+        if had_expr && s.axes_expr == 0 && !s.feed_expr {
+            s.flags.clear(Flags::NOT_ANALYSABLE);
+            if s.expr_breaks {
+                s.breaks = false;
+            }
+        }
+        if s.flow.is_some()
+            || s.maybe_flow
+            || s.unknown_after
+            || s.assign_other
+            || s.flags.has(Flags::SKIPPABLE)
+        {
+            self.consts.clear();
+        } else if let Some((n, v)) = s.assign {
+            match v {
+                Some(v) => {
+                    self.consts.insert(n, v);
+                }
+                None => {
+                    self.consts.remove(&n);
+                }
+            }
+        }
+    }
+
     /// Update the modal state; the block's `state` index is set by the caller.
     pub(crate) fn apply(
         &mut self,
-        s: Scan,
+        mut s: Scan,
         line: usize,
         span: Range<usize>,
         words: Range<usize>,
     ) -> Block {
+        self.constants(&mut s);
         let always = self.controller.always;
         // Before the block: what program flow settles ([`crate::flow`]).
         if let Some(plan) = &self.plan {
@@ -773,7 +913,26 @@ impl Interpreter {
                 breaks = true;
             }
             for (i, v) in s.axes.iter().enumerate() {
-                if let Some(v) = *v {
+                let form = if i >= A {
+                    s.axes_form[i - A]
+                } else {
+                    RotaryForm::Plain
+                };
+                if let Some(v) = *v
+                    && form.is_directional()
+                {
+                    // A position modulo 360 and a direction (absolute in G91 too): the
+                    // controller's unwrapped position follows from where the axis is; from
+                    // an unknown position, the value itself (the same pose). DC to a half
+                    // turn names no direction: unknown.
+                    m.pos[i] = match m.pos[i] {
+                        Some(p) => form.delta(p, v).map(|d| p + d),
+                        None => Some(v.rem_euclid(360.0)),
+                    };
+                    if m.pos[i].is_none() {
+                        breaks = true;
+                    }
+                } else if let Some(v) = *v {
                     let v = if i < A { v * scale } else { v };
                     m.pos[i] = if m.incremental || s.axes_incremental & bit(i) != 0 {
                         m.pos[i].map(|p| p + v)
@@ -831,11 +990,13 @@ impl Interpreter {
 pub(crate) fn after_lex(bytes: &[u8], span: &Range<usize>, s: &mut Scan) {
     if s.axes_expr != 0 || s.feed_expr {
         s.flags.set(Flags::NOT_ANALYSABLE);
+        s.expr_breaks = !s.breaks;
         s.breaks = true;
     }
     if s.flow.is_some() {
         s.unknown_after = true;
         s.breaks = true;
+        s.expr_breaks = false;
     }
     let line = &bytes[span.clone()];
     if let Some(cr) = line.iter().position(|&b| b == b'\r')
@@ -875,5 +1036,63 @@ pub(crate) fn function(text: &[u8], s: &mut Scan) {
     match sw {
         Some(sw) => s.tcpm = Some(sw),
         None => s.breaks = true,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::modal::{C, X};
+    use crate::{Dialect, Flags, parse};
+
+    fn read(src: &str) -> crate::Program {
+        parse(src.as_bytes().to_vec(), Dialect::Fanuc).unwrap()
+    }
+
+    /// Issue 30 item 11: a macro variable assigned a constant, used with nothing between
+    /// that can change it, is read as its value.
+    #[test]
+    fn macro_constants_are_evaluated_in_straight_line_code() {
+        let p = read("#100=1200. (FEED)\n#101 = -10.\nG1 X#101 Y0 F#100\nX-#101 C#105\n");
+        assert_eq!(p.state(2).feed_mm_min, Some(1200.0));
+        assert_eq!(p.state(2).pos[X], Some(-10.0));
+        assert!(!p.blocks[2].flags.has(Flags::NOT_ANALYSABLE));
+        assert!(!p.blocks[2].breaks_run);
+        assert_eq!(p.state(3).pos[X], Some(10.0));
+        // #105 was never assigned: listed as before.
+        assert!(p.blocks[3].flags.has(Flags::NOT_ANALYSABLE));
+        assert_eq!(p.state(3).pos[C], None);
+        // A reassignment in straight-line code: the new value.
+        let p = read("#100=1200.\n#100=800.\nG1 X1 F#100\n");
+        assert_eq!(p.state(2).feed_mm_min, Some(800.0));
+        // System variables may change under the program.
+        let p = read("#5221=-100.\nG1 X#5221 F100.\n");
+        assert_eq!(p.state(1).pos[X], None);
+    }
+
+    /// Anything that may change a variable between assignment and use leaves the use an
+    /// expression: a call, a tool change (a macro), a non-constant assignment, a
+    /// block-delete block, a loop or jump anywhere in the file.
+    #[test]
+    fn flow_calls_and_other_assignments_forget_the_values() {
+        for src in [
+            "#100=1200.\nM98 P2000\nG1 X1 F#100\n",
+            "#100=1200.\nT2 M6\nG1 X1 F#100\n",
+            "#100=1200.\nG65 P9000 A1.\nG1 X1 F#100\n",
+            "#100=1200.\n#100=#100*2\nG1 X1 F#100\n",
+            "#100=1200.\n#[#1]=5.\nG1 X1 F#100\n",
+            "#100=1200.\n/#100=500.\nG1 X1 F#100\n",
+            "#100=1200.\nIF [#1 GT 0] THEN #100=500.\nG1 X1 F#100\n",
+            "#100=1200.\nN10 G1 X1 F#100\n#100=500.\nGOTO 10\nM30\n",
+            "#100=1200.\nWHILE [#1 LT 3] DO 1\nG1 X1 F#100\n#1=#1+1\nEND 1\n",
+        ] {
+            let p = read(src);
+            let b = p
+                .blocks
+                .iter()
+                .position(|b| String::from_utf8_lossy(&p.bytes[b.span()]).contains("F#100"))
+                .unwrap();
+            assert!(p.blocks[b].flags.has(Flags::NOT_ANALYSABLE), "{src}");
+            assert_eq!(p.state(b).feed_mm_min, None, "{src}");
+        }
     }
 }

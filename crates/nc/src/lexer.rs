@@ -30,6 +30,7 @@
 //! a number but has none (`X`, `X+`), and an ASCII control byte (NUL, ESC, DEL…) outside
 //! a comment.
 
+use crate::program::RotaryForm;
 use std::ops::Range;
 
 /// One token of a line. Spans are absolute byte offsets into the file.
@@ -45,6 +46,8 @@ pub enum Token {
         value_span: Range<usize>,
         /// The number as written.
         value: f64,
+        /// A rotary word's direction form (`C=DC(12.5)`: the span ends at the `)`).
+        form: RotaryForm,
     },
     /// An identifier with its arguments or assignment: `TRAORI`, `CYCLE800(0,1)`,
     /// `MSG("…")`.
@@ -365,6 +368,12 @@ impl<'a> Lexer<'a> {
         {
             ns = k;
         }
+        if eq
+            && matches!(letter, b'A' | b'B' | b'C')
+            && let Some(t) = self.direction_form(p, letter, ns)
+        {
+            return Some(Ok(t));
+        }
         let (ds, e, fast) = self.scan_number(ns);
         if e < self.end && is_control(b[e]) {
             return self.err(e, control_message(b[e]));
@@ -509,7 +518,55 @@ impl<'a> Lexer<'a> {
             span: p..e,
             value_span: ns..e,
             value,
+            form: RotaryForm::Plain,
         }))
+    }
+
+    /// A Sinumerik rotary word in a direction form, `C=DC(12.5)`, `C=ACP(12.5)`,
+    /// `C=ACN(12.5)` (`ns`: just past the `=`), with a plain number in its brackets (blanks
+    /// allowed around it); `None` for anything else (`C=DC(R1)` is an expression).
+    fn direction_form(&mut self, p: usize, letter: u8, ns: usize) -> Option<Token> {
+        let b = self.bytes;
+        let open = b[ns..self.end].iter().position(|&c| c == b'(')? + ns;
+        let form = match b[ns..open].to_ascii_uppercase().as_slice() {
+            b"DC" => RotaryForm::Dc,
+            b"ACP" => RotaryForm::Acp,
+            b"ACN" => RotaryForm::Acn,
+            _ => return None,
+        };
+        let mut vs = open + 1;
+        while vs < self.end && is_blank(b[vs]) {
+            vs += 1;
+        }
+        let (ds, e, fast) = self.scan_number(vs);
+        if e == ds {
+            return None;
+        }
+        let mut close = e;
+        while close < self.end && is_blank(b[close]) {
+            close += 1;
+        }
+        if close >= self.end || b[close] != b')' {
+            return None;
+        }
+        // `C=DC(5)+1` is an expression.
+        if b.get(close + 1)
+            .is_some_and(|&c| close + 1 < self.end && !is_blank(c) && c != b';')
+        {
+            return None;
+        }
+        let value = fast.or_else(|| parse_number(&b[vs..e]))?;
+        if !value.is_finite() || b[vs..e].iter().any(|&c| is_blank(c)) {
+            return None;
+        }
+        self.pos = close + 1;
+        Some(Token::Word {
+            letter,
+            span: p..close + 1,
+            value_span: vs..e,
+            value,
+            form,
+        })
     }
 
     fn ident(&mut self, p: usize) -> Option<Result<Token, LexError>> {
@@ -732,7 +789,8 @@ mod tests {
                 letter: b'C',
                 span: 26..35,
                 value_span: 27..35,
-                value: 135.638
+                value: 135.638,
+                form: RotaryForm::Plain,
             }
         );
         assert_eq!(t[6], Token::BlockEnd { span: 36..37 });
@@ -904,5 +962,38 @@ mod tests {
         // Inside a comment the bytes are the user's: passed through.
         let line = b"G1 X1 (a\x00b) ; c\x07";
         assert!(Lexer::new(line, 0..line.len()).all(|t| t.is_ok()));
+    }
+
+    /// Issue 30 item 10: Sinumerik direction forms are rotary words whose number is in
+    /// brackets; anything else in the brackets is an expression.
+    #[test]
+    fn direction_forms() {
+        let t = lex("N20 G1 X1 A=ACP(  5.5 ) C=DC(350.) B=acn(0)");
+        assert!(matches!(
+            &t[3],
+            Token::Word { letter: b'A', value: 5.5, form: RotaryForm::Acp, span, value_span }
+                if *span == (10..23) && *value_span == (18..21)
+        ));
+        assert!(matches!(
+            &t[4],
+            Token::Word { letter: b'C', value: 350.0, form: RotaryForm::Dc, span, .. }
+                if *span == (24..34)
+        ));
+        assert!(matches!(
+            t[5],
+            Token::Word {
+                letter: b'B',
+                value: 0.0,
+                form: RotaryForm::Acn,
+                ..
+            }
+        ));
+        for text in ["C=DC(R1)", "C=DC(5)+1", "C=ACX(5)", "C=DC(5", "X=DC(5)"] {
+            assert!(
+                !matches!(lex(text)[0], Token::Word { .. }),
+                "{text}: {:?}",
+                lex(text)
+            );
+        }
     }
 }

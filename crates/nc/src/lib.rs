@@ -29,10 +29,10 @@ pub use error::ParseError;
 pub use flow::FlowPlan;
 pub use lines::LineEnds;
 pub use modal::{FeedMode, Modal, Motion, Tcpm};
-pub use plan::restore_modal;
+pub use plan::{FormConflict, restore_modal, write_direction_forms};
 pub use program::{
-    Block, Dialect, Flags, Program, ProgramBuilder, Scanned, Settled, Word, parse, parse_with,
-    scan, scan_blocks, scan_blocks_with,
+    Block, Dialect, Flags, Program, ProgramBuilder, RotaryForm, Scanned, Settled, Word, parse,
+    parse_with, scan, scan_blocks, scan_blocks_with,
 };
 pub use run::{Run, RunBreak, RunBuilder, primary_in_use, primary_of, runs};
 pub use style::{FileStyle, NumberStyle, StyleEvidence};

@@ -66,6 +66,218 @@ pub fn restore_modal(
     edits.extend(extra);
 }
 
+/// The form a word of `letter` inserted into `block` is written in: that of the last word
+/// of the letter before it (`C=DC(…)` in a program that writes them), else of the first
+/// after it (a stretch of a file may start at the block), else plain.
+pub fn inserted_form(program: &Program, block: usize, letter: u8) -> crate::RotaryForm {
+    if !matches!(letter, b'A' | b'B' | b'C') {
+        return crate::RotaryForm::Plain;
+    }
+    let words = program.blocks[block].words();
+    program.words[..words.start]
+        .iter()
+        .rev()
+        .chain(&program.words[words.end..])
+        .find(|w| w.letter == letter)
+        .map_or(crate::RotaryForm::Plain, |w| w.form)
+}
+
+/// A rotary word in a direction form (Sinumerik `C=DC(…)`, `C=ACP(…)`, `C=ACN(…)`) that
+/// cannot make the move a rewrite asks of it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FormConflict {
+    /// The block whose word would make another move (or would get a word inserted).
+    pub block: usize,
+    /// Its letter.
+    pub letter: u8,
+    /// The last edited block of that letter at or before `block`: the edit that causes it.
+    pub cause: usize,
+    /// What is wrong, for people.
+    pub message: String,
+    /// The word is a macro variable or an expression (`C#105`), which is never rewritten,
+    /// rather than a direction form that cannot make the move.
+    pub variable: bool,
+}
+
+/// Check the edits against the words they change: a word whose value is a variable or an
+/// expression (`C#105`) is never rewritten ([`FormConflict::variable`]); and write the
+/// edits of rotary letters that the file writes in a direction form
+/// ([`crate::RotaryForm`]): an edited `C=DC(…)` gets the patched position modulo 360 in
+/// [0, 360), rounded to the edit's decimals, where that number makes the controller move
+/// from the (patched) position before it to the patched position — DC the shorter way,
+/// ACP in the positive, ACN in the negative direction; an unedited direction word after an
+/// edit is checked the same way from its new starting point. The edits' values are the
+/// unwrapped positions the reader follows ([`crate::Modal::pos`]); those of direction words
+/// are replaced by the numbers to write. Where the form cannot make the move, or where an
+/// edit would insert a word of a letter the file writes in a direction form (a plain word
+/// there is not the same kind of move), a [`FormConflict`] names it: the caller must drop
+/// the edits that cause it (and call again on the original values). Letters without a
+/// direction word in the file are left as they are.
+pub fn write_direction_forms(program: &Program, edits: &mut [Edit]) -> Vec<FormConflict> {
+    use crate::modal::A;
+    use std::collections::HashMap;
+    let mut conflicts = Vec::new();
+    // A word whose value is a variable or an expression (`C#105`, read as the variable's
+    // constant value): never rewritten, nor given a second word of its letter.
+    for e in edits.iter() {
+        let block = &program.blocks[e.block];
+        let held = crate::lexer::Lexer::new(&program.bytes, block.span())
+            .filter_map(Result::ok)
+            .find_map(|t| match t {
+                crate::lexer::Token::Assign { letter, span } if letter == e.letter => Some(span),
+                _ => None,
+            });
+        if let Some(span) = held {
+            conflicts.push(FormConflict {
+                block: e.block,
+                letter: e.letter,
+                cause: e.block,
+                message: format!(
+                    "line {}: the patch would change {}, and the block writes it as `{}` (a \
+                     variable or an expression, never rewritten)",
+                    block.line,
+                    e.letter as char,
+                    String::from_utf8_lossy(&program.bytes[span])
+                ),
+                variable: true,
+            });
+        }
+    }
+    for (k, &letter) in AXES.iter().enumerate().skip(A) {
+        if !program
+            .words
+            .iter()
+            .any(|w| w.letter == letter && w.form.is_directional())
+        {
+            continue;
+        }
+        let by_block: HashMap<usize, usize> = edits
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| e.letter == letter)
+            .map(|(i, e)| (e.block, i))
+            .collect();
+        let Some(&first) = by_block.keys().min() else {
+            continue;
+        };
+        let last = by_block.keys().copied().max().unwrap_or(first);
+        let l = letter as char;
+        // The patched position before block `b`, and the block of the last edit.
+        let mut now = program.state_before(first).pos[k];
+        let mut cause = first;
+        for b in first..program.blocks.len() {
+            let before = program.state_before(b).pos[k];
+            if b > last && now == before {
+                break;
+            }
+            let after = program.state(b).pos[k];
+            let word = program.word(b, letter);
+            let line = program.blocks[b].line;
+            let edit = by_block.get(&b).copied();
+            if edit.is_some() {
+                cause = b;
+            }
+            let mut conflict = |message: String| {
+                conflicts.push(FormConflict {
+                    block: b,
+                    letter,
+                    cause,
+                    message,
+                    variable: false,
+                });
+            };
+            match (word, edit) {
+                (Some(w), Some(i)) if w.form.is_directional() => {
+                    let to = edits[i].value;
+                    let form = w.form.name();
+                    let from = now.unwrap_or(to);
+                    match w.form.write(from, to, edits[i].decimals) {
+                        Ok(t) => {
+                            edits[i].value = t;
+                            now = Some(from + w.form.delta(from, t).unwrap_or(to - from));
+                        }
+                        Err(d) => {
+                            conflict(format!(
+                                "line {line}: the patched {l} moves {:+.3}° (from {from:.3} to \
+                                 {to:.3}); {l}={form}(…) {}",
+                                to - from,
+                                match d {
+                                    Some(d) => format!("would move {d:+.3}° instead"),
+                                    None => "names no direction for a half turn".into(),
+                                }
+                            ));
+                            now = Some(to);
+                        }
+                    }
+                }
+                (Some(w), None) if w.form.is_directional() => {
+                    // Unedited: from where the patch left the axis, the word moves as it
+                    // did only if it reaches the same unwrapped position.
+                    let form = w.form.name();
+                    now = match (now, after) {
+                        (Some(p), Some(a)) => {
+                            let reached = w.form.delta(p, w.value).map(|d| p + d);
+                            if reached.is_none_or(|r| (r - a).abs() > 1e-6) {
+                                conflict(format!(
+                                    "line {line}: {l}={form}({}) after the patched moves starts from \
+                                     {p:.3}, not {}, and reaches {} instead of {a:.3}",
+                                    w.value,
+                                    before.map_or("an unknown position".into(), |v| format!(
+                                        "{v:.3}"
+                                    )),
+                                    reached.map_or("no settled position".into(), |r| format!(
+                                        "{r:.3}"
+                                    )),
+                                ));
+                            }
+                            Some(a)
+                        }
+                        _ => after,
+                    };
+                }
+                (None, Some(i)) => {
+                    // Inserted in the form of the letter's word before it.
+                    let form = inserted_form(program, b, letter);
+                    let to = edits[i].value;
+                    let from = now.unwrap_or(to);
+                    if form.is_directional() {
+                        match form.write(from, to, edits[i].decimals) {
+                            Ok(t) => edits[i].value = t,
+                            Err(d) => conflict(format!(
+                                "line {line}: the patched {l} moves {:+.3}° (from {from:.3} to \
+                                 {to:.3}); an inserted {l}={}(…) {}",
+                                to - from,
+                                form.name(),
+                                match d {
+                                    Some(d) => format!("would move {d:+.3}° instead"),
+                                    None => "names no direction for a half turn".into(),
+                                }
+                            )),
+                        }
+                    } else if !(0.0..360.0).contains(&to) {
+                        // A plain word after direction words, outside [0, 360): how the
+                        // controller reads it on a modulo axis is not settled here.
+                        conflict(format!(
+                            "line {line}: the patch would insert a plain {l} word ({to:.3}, \
+                             outside [0, 360)) into a file that writes {l} in a direction form \
+                             (DC/ACP/ACN)"
+                        ));
+                    }
+                    now = Some(to);
+                }
+                (Some(_), Some(i)) => now = Some(edits[i].value),
+                (Some(_), None) => now = after,
+                (None, None) => {
+                    if after.is_none() {
+                        now = None;
+                    }
+                }
+            }
+        }
+    }
+    conflicts
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -130,5 +342,102 @@ mod tests {
             out,
             "G20 G1 X0 Y0 Z0 A1 C10 F10\n(NOTE)\nX1.500 A-2.000 C20\nM8\nX1.0 Y2 A2.0\n"
         );
+    }
+
+    fn dc_program() -> crate::Program {
+        let src = "N10 TRAORI\nN20 G1 X0 Y0 Z0 A1 C=DC(350.) F1000\nN30 X1 A0.5 C=DC(10.)\n\
+                   N40 X2 A0.5 C=DC(30.)\nN50 X3 A1 C=DC(40.)\n";
+        parse(src.as_bytes().to_vec(), Dialect::Sinumerik).unwrap()
+    }
+
+    /// Issue 30 item 10: an edited `C=DC(…)` is written modulo 360 in the same form where
+    /// the shorter way is the patched move; an unedited one after it is checked from its
+    /// new starting point.
+    #[test]
+    fn direction_forms_are_written_modulo_360_where_they_make_the_move() {
+        let p = dc_program();
+        assert_eq!(p.state(2).pos[crate::modal::C], Some(370.0));
+        let mut edits = vec![c(2, 375.5), c(3, 385.25)];
+        assert_eq!(write_direction_forms(&p, &mut edits), vec![]);
+        assert_eq!((edits[0].value, edits[1].value), (15.5, 25.25));
+        let out = String::from_utf8(write(&p, &edits)).unwrap();
+        assert!(
+            out.contains("C=DC(15.5)") && out.contains("C=DC(25.25)"),
+            "{out}"
+        );
+        // A patched move the shorter way cannot make (a turn of +190°).
+        let mut edits = vec![c(2, 540.0)];
+        let conflicts = write_direction_forms(&p, &mut edits);
+        assert_eq!(conflicts.len(), 1, "{conflicts:?}");
+        assert_eq!((conflicts[0].block, conflicts[0].cause), (2, 2));
+        assert!(
+            conflicts[0]
+                .message
+                .contains("would move -170.000° instead")
+        );
+        // From 540 the unedited DC(30.) after it still reaches 390 (−150°).
+        // A word inserted after direction words takes their form.
+        let src = "G1 X0 A1 C=DC(350.) F1000\nX1\nX2 C=DC(10.)\n";
+        let p = parse(src.as_bytes().to_vec(), Dialect::Sinumerik).unwrap();
+        let mut edits = vec![c(1, 365.0)];
+        assert_eq!(write_direction_forms(&p, &mut edits), vec![]);
+        let out = String::from_utf8(write(&p, &edits)).unwrap();
+        assert_eq!(
+            out,
+            "G1 X0 A1 C=DC(350.) F1000\nX1 C=DC(5.000)\nX2 C=DC(10.)\n"
+        );
+    }
+
+    #[test]
+    fn acp_and_acn_keep_their_direction() {
+        let src = "G1 X0 A1 C=ACP(350.) F1000\nX1 C=ACP(10.)\nX2 C=ACN(0.)\nX3 C=ACN(355.)\n";
+        let p = parse(src.as_bytes().to_vec(), Dialect::Sinumerik).unwrap();
+        let cs: Vec<_> = (0..4).map(|b| p.state(b).pos[crate::modal::C]).collect();
+        assert_eq!(cs, [Some(350.0), Some(370.0), Some(360.0), Some(355.0)]);
+        // ACP to 362 is +12 from 350: written 2.
+        let mut edits = vec![c(1, 362.0)];
+        assert_eq!(write_direction_forms(&p, &mut edits), vec![]);
+        assert_eq!(edits[0].value, 2.0);
+        // ACP cannot move back.
+        let mut edits = vec![c(1, 345.0)];
+        let k = write_direction_forms(&p, &mut edits);
+        assert!(k[0].message.contains("ACP"), "{k:?}");
+        // ACN to 357 from 360 is −3: written 357; the ACN(355.) after it still goes −2.
+        let mut edits = vec![c(2, 357.0)];
+        assert_eq!(write_direction_forms(&p, &mut edits), vec![]);
+        assert_eq!(edits[0].value, 357.0);
+        // ACN cannot move forward.
+        let mut edits = vec![c(3, 362.0)];
+        assert!(!write_direction_forms(&p, &mut edits).is_empty());
+    }
+}
+
+#[cfg(test)]
+mod variable_tests {
+    use super::*;
+    use crate::{Dialect, parse};
+
+    /// Issue 30 item 11: `C#105` is read as the constant but never rewritten.
+    #[test]
+    fn a_variable_word_is_never_rewritten() {
+        let src = "#105=10.\nG1 X0 A1 C#105 F1000\nX1 C20.\n";
+        let p = parse(src.as_bytes().to_vec(), Dialect::Fanuc).unwrap();
+        assert_eq!(p.state(1).pos[crate::modal::C], Some(10.0));
+        let mut edits = vec![Edit {
+            block: 1,
+            letter: b'C',
+            value: 12.0,
+            decimals: 3,
+        }];
+        let k = write_direction_forms(&p, &mut edits);
+        assert_eq!(k.len(), 1);
+        assert!(k[0].variable && k[0].message.contains("`C#105`"), "{k:?}");
+        let mut edits = vec![Edit {
+            block: 2,
+            letter: b'C',
+            value: 22.0,
+            decimals: 3,
+        }];
+        assert!(write_direction_forms(&p, &mut edits).is_empty());
     }
 }

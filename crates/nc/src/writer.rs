@@ -96,12 +96,7 @@ pub fn write_styled(program: &Program, edits: &[Edit], file: &FileStyle) -> Vec<
             && let Some(next) = words.iter().find(|w| rank(w.letter) < AXES.len())
         {
             let mut text = Vec::with_capacity(number.len() + 3);
-            text.push(letter);
-            if style.equals {
-                text.push(b'=');
-            }
-            text.extend_from_slice(file.letter_gap);
-            text.extend_from_slice(number.as_bytes());
+            inserted(&mut text, program, e.block, letter, &style, file, &number);
             text.extend_from_slice(file.gap);
             splices.push((next.span().start, next.span().start, own_rank, text));
             continue;
@@ -125,12 +120,7 @@ pub fn write_styled(program: &Program, edits: &[Edit], file: &FileStyle) -> Vec<
             }
             None => program.blocks[e.block].span().start,
         };
-        text.push(letter);
-        if style.equals {
-            text.push(b'=');
-        }
-        text.extend_from_slice(file.letter_gap);
-        text.extend_from_slice(number.as_bytes());
+        inserted(&mut text, program, e.block, letter, &style, file, &number);
         if anchor.is_none() && !program.blocks[e.block].span().is_empty() {
             text.push(b' ');
         }
@@ -164,6 +154,34 @@ pub fn write_styled(program: &Program, edits: &[Edit], file: &FileStyle) -> Vec<
     }
     out.extend_from_slice(&bytes[pos..]);
     out
+}
+
+/// An inserted word: `letter [=] number`, or where the letter's word before it is in a
+/// direction form ([`crate::plan::inserted_form`]), `letter=FORM(number)`.
+fn inserted(
+    text: &mut Vec<u8>,
+    program: &Program,
+    block: usize,
+    letter: u8,
+    style: &NumberStyle,
+    file: &FileStyle,
+    number: &str,
+) {
+    text.push(letter);
+    let form = crate::plan::inserted_form(program, block, letter);
+    if form.is_directional() {
+        text.push(b'=');
+        text.extend_from_slice(form.name().as_bytes());
+        text.push(b'(');
+        text.extend_from_slice(number.as_bytes());
+        text.push(b')');
+        return;
+    }
+    if style.equals {
+        text.push(b'=');
+    }
+    text.extend_from_slice(file.letter_gap);
+    text.extend_from_slice(number.as_bytes());
 }
 
 /// Position of `letter` in X Y Z A B C order; other letters come after.

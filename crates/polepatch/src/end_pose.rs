@@ -39,7 +39,9 @@
 //!   can — as this module cannot see its parameters.)
 //!
 //! **Pinned** (the last point keeps its values; [`EndPose::decided_line`] says which block):
-//! anything else — a move with X or Y in machine coordinates, a move that changes a rotary
+//! anything else — a rotary word in a Sinumerik direction form (`C=DC(…)`, `C=ACP(…)`,
+//! `C=ACN(…)`: where it goes depends on where the axis starts), a move with X or Y in
+//! machine coordinates, a move that changes a rotary
 //! axis below the clearance or with TCPM off (together with a linear move, or one rotary
 //! axis alone), a positioning move before any retract, incremental mode, a non-move naming
 //! a rotary axis (a datum shift on it), or a restating block that belongs to another run
@@ -234,6 +236,16 @@ impl After<'_> {
             scan.clearance_mm = Some(scan.clearance_mm.map_or(z1, |c| c.max(z1)));
         }
         if has_p || has_c {
+            // A Sinumerik direction form (`C=DC(…)`, `C=ACP(…)`, `C=ACN(…)`) moves from
+            // where the axis is: from another pose it reaches another unwrapped position,
+            // or turns another way.
+            if self
+                .words
+                .iter()
+                .any(|w| (w.letter == primary || w.letter == b'C') && w.form.is_directional())
+            {
+                return Step::Pinned;
+            }
             if !rotary_moves && (st.tcpm.is_on() || !xy_moves) {
                 return Step::Restate;
             }

@@ -414,6 +414,13 @@ pub enum UntouchedReason {
     FrameTransformed,
     /// The run turns a tilting axis the machine does not have (or holds it away from 0).
     OtherRotary,
+    /// A rotary word in a Sinumerik direction form (`C=DC(…)`, `C=ACP(…)`, `C=ACN(…)`)
+    /// cannot make the patched move (DC goes the shorter way, ACP/ACN in their direction),
+    /// or the patch would insert a plain word of a letter the file writes in that form.
+    DirectionForm,
+    /// The patch would change a word whose value is a macro variable or an expression
+    /// (`C#105`, read as the variable's constant value): such a word is never rewritten.
+    MacroVariable,
 }
 
 impl UntouchedReason {
@@ -422,6 +429,8 @@ impl UntouchedReason {
         match self {
             UntouchedReason::TcpmUnknown => Some("tcpm_unknown"),
             UntouchedReason::FrameTransformed => Some("frame_transformed"),
+            UntouchedReason::DirectionForm => Some("direction_form"),
+            UntouchedReason::MacroVariable => Some("macro_variable"),
             _ => None,
         }
     }
@@ -637,6 +646,8 @@ pub fn patch_program(
     let mut edits: Vec<Edit> = Vec::new();
     let mut written_c = c_style.decimals;
     let mut written_p = p_style.decimals;
+    // For each patched run: its index, its first zone row and its edits.
+    let mut run_edit_ranges: Vec<(usize, usize, std::ops::Range<usize>)> = Vec::new();
     'runs: for (r, rp) in lp.runs.iter().enumerate() {
         let path = match &rp.path {
             Ok(p) => p,
@@ -941,6 +952,7 @@ pub fn patch_program(
             ));
             continue 'runs;
         };
+        let first_edit = edits.len();
         let mut run_edits: Vec<Edit> = Vec::new();
 
         if let Some((ch, d)) = chain {
@@ -1054,6 +1066,7 @@ pub fn patch_program(
                 }
             }
         }
+        run_edit_ranges.push((r, first_row, first_edit..edits.len()));
     }
     let file_decimals = |l: u8| match l {
         b'C' => c_style.decimals,
@@ -1075,6 +1088,8 @@ pub fn patch_program(
             .is_some_and(|r| run_of.get(&b) == Some(r))
     };
     polepatch_nc::restore_modal(program, &mut edits, &file_decimals, &same_run);
+    let edits = direction_forms(lp, edits, &run_edit_ranges, &run_of, &mut report, &opts);
+    let mut edits = edits;
     edits.sort_by_key(|e| (e.block, e.letter));
     report.words_changed = edits.len();
     report.file_c_decimals = Some(c_style.decimals);
@@ -1082,6 +1097,93 @@ pub fn patch_program(
     report.file_primary_decimals = Some(p_style.decimals);
     report.written_primary_decimals = Some(written_p);
     (edits, report)
+}
+
+/// Rotary words in a Sinumerik direction form (`C=DC(…)`, `C=ACP(…)`, `C=ACN(…)`): the
+/// edits of such words are written modulo 360 in the same form where it makes the patched
+/// move ([`polepatch_nc::write_direction_forms`]); a run whose edits ask a move the form
+/// cannot make keeps its values (its zones `direction_form`), and the check is made again
+/// without it (its edits changed where the next words start from).
+fn direction_forms(
+    lp: &LoadedProgram,
+    edits: Vec<Edit>,
+    run_edit_ranges: &[(usize, usize, std::ops::Range<usize>)],
+    run_of: &std::collections::HashMap<usize, usize>,
+    report: &mut FileReport,
+    opts: &PatchOptions,
+) -> Vec<Edit> {
+    let program = &lp.program;
+    // The run each edit belongs to (words restored by `restore_modal` are in its run).
+    let mut owner: Vec<Option<usize>> = vec![None; edits.len()];
+    for (r, _, range) in run_edit_ranges {
+        for o in &mut owner[range.clone()] {
+            *o = Some(*r);
+        }
+    }
+    for (o, e) in owner.iter_mut().zip(&edits) {
+        if o.is_none() {
+            *o = run_of.get(&e.block).copied();
+        }
+    }
+    let mut dropped: Vec<usize> = Vec::new();
+    loop {
+        let mut kept: Vec<Edit> = edits
+            .iter()
+            .zip(&owner)
+            .filter(|(_, o)| o.is_none_or(|r| !dropped.contains(&r)))
+            .map(|(e, _)| *e)
+            .collect();
+        let conflicts = polepatch_nc::write_direction_forms(program, &mut kept);
+        let Some(k) = conflicts.first() else {
+            return kept;
+        };
+        // The run of the edit that causes it.
+        let run = edits
+            .iter()
+            .zip(&owner)
+            .filter(|(e, o)| e.block == k.cause && o.is_some_and(|r| !dropped.contains(&r)))
+            .find_map(|(_, o)| *o);
+        let Some(run) = run else {
+            // Not attributable (should not happen): write nothing in a direction form.
+            report
+                .warnings
+                .push(format!("{}; no rotary word was changed", k.message));
+            return Vec::new();
+        };
+        dropped.push(run);
+        let reason = if k.variable {
+            UntouchedReason::MacroVariable
+        } else {
+            UntouchedReason::DirectionForm
+        };
+        let Some((_, first_row, _)) = run_edit_ranges.iter().find(|(r, _, _)| *r == run) else {
+            continue;
+        };
+        let zones = report.zones[*first_row..]
+            .iter()
+            .take_while(|z| z.run == lp.run_number(run))
+            .count();
+        for row in &mut report.zones[*first_row..*first_row + zones] {
+            row.not_written();
+            row.reason = reason.zone_reason().unwrap_or("not_patched");
+        }
+        report.untouched_runs.push(untouched(
+            lp,
+            run,
+            reason,
+            zones,
+            if k.variable {
+                format!("{}; the run keeps its values", k.message)
+            } else {
+                format!(
+                    "{}: the form cannot make the patched move, and polepatch never writes a \
+                     word that makes a different one; the run keeps its values",
+                    k.message
+                )
+            },
+            opts.reach_deg(),
+        ));
+    }
 }
 
 /// With a kinematic chain: for a run without TCPM, the X Y Z edits that keep the part-frame

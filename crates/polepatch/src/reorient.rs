@@ -196,6 +196,21 @@ pub fn reorient_edits(
                 "incremental mode (G91) is not supported by reorient",
             ));
         }
+        if let Some(w) = program
+            .block_words(b)
+            .iter()
+            .find(|w| w.form.is_directional())
+        {
+            return Err(refuse(
+                lp,
+                block.line,
+                format!(
+                    "{}={}(…) (a Sinumerik direction form) is not supported by reorient",
+                    w.letter as char,
+                    w.form.name()
+                ),
+            ));
+        }
         if st.inch {
             return Err(refuse(
                 lp,

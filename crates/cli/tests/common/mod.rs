@@ -233,6 +233,17 @@ pub fn check_patch_both(
             left_on_purpose += 1;
             continue;
         }
+        // A zone whose patch cannot be written in the file's words (issue 30): a
+        // Sinumerik direction form that cannot make the patched move, a word whose value
+        // is a macro variable (`C#105`). Its run is listed with the reason.
+        if matches!(z.reason, "direction_form" | "macro_variable") {
+            assert!(
+                z.outcome == "unchanged" && report.untouched_runs.iter().any(|u| u.run == z.run),
+                "{name} on {m}: {z:?}"
+            );
+            left_on_purpose += 1;
+            continue;
+        }
         if z.outcome != "reached" {
             // Left below feed: only where no values at all can reach it (the LP proof).
             assert!(
@@ -413,10 +424,15 @@ pub fn check_patch_only_c(
         // A ball programmed at its tip keeps its centre: X Y Z move with C, which the bound
         // LP below does not model (its answer is no bound on that patch); a flat or
         // bull-nose cutter's zone is held by the surface bound, which it does not know.
+        // A zone whose patch cannot be written in the file's words (issue 30: a direction
+        // form, a macro-variable word) is left on purpose.
         let keeps_centre = report.zones.iter().any(|z| {
             z.run == k + 1
                 && ((z.tool.starts_with("ball") && z.tool_point == "tip")
-                    || z.reason == "tool_limited")
+                    || matches!(
+                        z.reason,
+                        "tool_limited" | "direction_form" | "macro_variable"
+                    ))
         });
         if a.1 > 0 && !keeps_centre {
             // Left below feed: acceptable only when no C-only change of the whole run can
