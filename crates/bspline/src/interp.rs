@@ -249,11 +249,11 @@ impl NotAKnotSystem {
     /// first), every weight outside taken as zero. Cost O(1) in the number of points
     /// instead of O(n).
     ///
-    /// A weight is left out only when it is at most [`DATA_ROW_TOL`] times the row's
-    /// largest, and the weights left out decrease away from `t` (see
-    /// [`DATA_ROW_TOL`]): any weighted sum `Σ_i m_i·y_i` or `Σ |m_i|` over the row is
-    /// that of [`NotAKnotSystem::data_row`] to a few `DATA_ROW_TOL` of its largest term
-    /// (each weight within 10⁻¹⁶ of the largest, tested), at the rounding of a double. How far the row reaches depends on the knots
+    /// The solve stops where the entries fall below [`DATA_ROW_TOL`] of the largest, and
+    /// the entries left out decrease away from `t`: any weighted sum `Σ_i m_i·y_i` or
+    /// `Σ |m_i|` over the row is that of [`NotAKnotSystem::data_row`] to a few
+    /// `DATA_ROW_TOL` of its largest term (each weight within 10⁻¹⁶ of the largest,
+    /// tested), at the rounding of a double. How far the row reaches depends on the knots
     /// (about 32 points either side of `t` on even knots, see [`DATA_ROW_TOL`]); the test
     /// `local_data_rows_match_the_full_ones` checks it on uneven knots and at both ends.
     pub fn data_row_local(&self, t: f64, order: usize, out: &mut Vec<f64>) -> usize {
