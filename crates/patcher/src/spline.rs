@@ -159,6 +159,14 @@ impl SplineSystem {
         self.sys.data_row(t, order)
     }
 
+    /// [`SplineSystem::data_row`] where it is not negligible: the weights of points
+    /// `start..start + out.len()` (`start` returned, `out` cleared first), the others
+    /// below `polepatch_bspline::interp::DATA_ROW_TOL` of the largest and taken as zero
+    /// ([`polepatch_bspline::NotAKnotSystem::data_row_local`]). O(1) in the knots.
+    pub fn data_row_local(&self, t: f64, order: usize, out: &mut Vec<f64>) -> usize {
+        self.sys.data_row_local(t, order, out)
+    }
+
     /// The analysis spline of the values `y` (one per knot, finite).
     pub fn fit(&self, y: &[f64]) -> Result<AnalysisSpline, PathError> {
         self.sys
