@@ -93,7 +93,7 @@ fn post_cl<'py>(
     let opts = post.post(patch)?;
     let m = &machine.0;
     let out = detached(py, || {
-        let mut post = || -> Result<Vec<u8>, polepatch::Error> {
+        let post = || -> Result<Vec<u8>, polepatch::Error> {
             let program = polepatch::post::read_cl(&cl, &opts.patch_options.name)?;
             // The CL file's CUTTER/ and the tip, where the keywords did not say them.
             let mut opts = opts.clone();
