@@ -72,8 +72,11 @@ def test_analyze_nc_is_the_cli_on_every_fixture(cli: Path) -> None:
             continue
         assert report == json.loads(out), f"{rel} on {machine}"
         assert report["file"] == rel and report["runs"], rel
-        # Runs that could not be analysed make the CLI exit 1; the report says why.
-        assert code == (1 if any(r.get("error") for r in report["runs"]) else 0), err
+        # The file was read: runs that could not be analysed are in the report (with why)
+        # and on stderr, and the CLI exits 0 (2 only with --strict, docs/user-guide.md).
+        assert code == 0, err
+        if any(r.get("error") for r in report["runs"]):
+            assert "not analysed" in err, err
         compared += 1
     assert compared >= 90, compared
 
