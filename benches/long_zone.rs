@@ -32,7 +32,7 @@ fn long_zone_program(n: usize) -> Vec<u8> {
 
 /// The run of the program that holds the zone.
 fn long_run(n: usize, machine: &Machine) -> Path {
-    let lp = load_nc(long_zone_program(n), "long", machine, None).expect("parsable program");
+    let lp = load_nc(&long_zone_program(n), "long", machine, None).expect("parsable program");
     lp.runs
         .into_iter()
         .filter_map(|r| r.path.ok())

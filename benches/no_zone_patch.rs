@@ -1,13 +1,10 @@
 //! The whole no-zone path of `polepatch patch` minus the file system: `polepatch::patch_nc`
-//! (since issue 10 §2 the streaming scan `far::far_from_pole` that proves no point is in
-//! the cone, then a copy), and the full path's analysis alone from a parsed program
-//! (`program::load` → `patch_program`). Run:
+//! (the one reader's first read, which finds no run near the pole, then a copy). Run:
 //! `cargo bench -p polepatch-benches --bench no_zone_patch -- --warm-up-time 1 --measurement-time 5`
 //! Figures are written up in docs/performance-nc.md.
 
 use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use polepatch::program::{load, parse_program};
-use polepatch::{PatchOptions, patch_nc, patch_program};
+use polepatch::{PatchOptions, patch_nc};
 use polepatch_benches::{Style, no_zone_program};
 use polepatch_kinematics::Machine;
 
@@ -37,20 +34,6 @@ fn no_zone(c: &mut Criterion) {
                     );
                     assert_eq!(out.len(), text.len());
                     (input, out)
-                },
-                BatchSize::PerIteration,
-            )
-        });
-        // The analysis alone, from a parsed program: runs, paths, patch_path per run.
-        let parsed = parse_program(text.clone(), "bench", &machine).expect("parses");
-        g.bench_with_input(BenchmarkId::new("runs_and_patch", name), &parsed, |b, p| {
-            b.iter_batched(
-                || p.clone(),
-                |program| {
-                    let lp = load(program, "bench", &machine, None).expect("has runs");
-                    let (edits, _) = patch_program(&lp, &machine, &opts.patch);
-                    assert!(edits.is_empty());
-                    lp
                 },
                 BatchSize::PerIteration,
             )

@@ -24,7 +24,7 @@ use polepatch_patcher::{PatchAxes, PatchOptions, Path, patch_path};
 fn sing_runs(machine: &Machine) -> Vec<Path> {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let bytes = std::fs::read(root.join("fixtures/c17/SING.I")).expect("fixture");
-    let lp = load_nc(bytes, "SING", machine, None).expect("parsable fixture");
+    let lp = load_nc(&bytes, "SING", machine, None).expect("parsable fixture");
     lp.runs
         .into_iter()
         .filter_map(|r| {

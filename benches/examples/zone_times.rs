@@ -57,7 +57,7 @@ fn main() {
     let sing = std::fs::read(root.join("fixtures/c17/SING.I")).expect("SING.I");
     for name in ["mikron-ucp710", "mikron-hsm600"] {
         let m = Machine::builtin(name).expect("machine");
-        let lp = load_nc(sing.clone(), "SING", &m, None).expect("SING parses");
+        let lp = load_nc(&sing, "SING", &m, None).expect("SING parses");
         for r in lp.runs {
             if let Ok(p) = r.path
                 && p.axes.iter().any(|q| q[3].abs() < 5.0)

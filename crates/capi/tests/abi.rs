@@ -238,7 +238,7 @@ fn patch_joints_is_the_patcher_on_the_arrays() {
     // SING's long TCPM run, as a CAM plugin would hold it.
     let rust_machine = Machine::builtin("mikron-ucp710").unwrap();
     let lp = polepatch::program::load_nc(
-        std::fs::read(root().join("fixtures/c17/SING.I")).unwrap(),
+        &std::fs::read(root().join("fixtures/c17/SING.I")).unwrap(),
         "SING.I",
         &rust_machine,
         None,

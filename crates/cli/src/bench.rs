@@ -28,7 +28,7 @@ pub mod plot;
 use crate::files::{JobError, read};
 use polepatch::program::{LoadedProgram, load_nc};
 use polepatch::report::{AnalyzeReport, analyze_program};
-use polepatch::{Error, FileReport, ZoneRow, patch_loaded};
+use polepatch::{Error, FileReport, ZoneRow, patch_nc};
 use polepatch_kinematics::{Axis, Machine};
 use polepatch_patcher::direct::deviation_bound_zone;
 use polepatch_patcher::reference::{Reference, zone_reference};
@@ -400,7 +400,7 @@ pub fn bench_file(
     opts: &BenchOptions,
 ) -> Result<Vec<BenchCase>, JobError> {
     let name = file.display().to_string();
-    let mut lp = load_nc(read(file)?, &name, machine, opts.feed_fallback_mm_min)?;
+    let mut lp = load_nc(&read(file)?, &name, machine, opts.feed_fallback_mm_min)?;
     lp.tool = opts.tool.clone();
     Ok(bench_program(&lp, machine, opts)?)
 }
@@ -451,7 +451,7 @@ pub fn bench_program(
     let sim_opts = polepatch::SimulateOptions {
         name: lp.name.clone(),
         feed_fallback_mm_min: opts.feed_fallback_mm_min,
-        work_offset_mm: lp.work_offset_mm,
+        work_offset_mm: None,
         sim: polepatch::sim::SimOptions {
             tcy_s: opts.patch.tcy_s,
             ..Default::default()
@@ -477,7 +477,18 @@ pub fn bench_program(
     for &strategy in &opts.strategies {
         let popts = strategy.options(&opts.patch);
         let t0 = Instant::now();
-        let (bytes, report): (_, FileReport) = patch_loaded(lp, machine, &popts);
+        let (bytes, report): (_, FileReport) = patch_nc(
+            &lp.program.bytes,
+            machine,
+            &polepatch::PatchOptions {
+                patch: popts,
+                feed_fallback_mm_min: opts.feed_fallback_mm_min,
+                name: lp.name.clone(),
+                chord_tolerance_mm: lp.chord_tolerance_mm,
+                tool: lp.tool.clone(),
+                ..polepatch::PatchOptions::default()
+            },
+        )?;
         let patch_time_ms = t0.elapsed().as_secs_f64() * 1e3;
         let sim_after = if report.words_changed > 0 {
             simulated(&bytes)
@@ -486,7 +497,7 @@ pub fn bench_program(
         };
         let after = if report.words_changed > 0 {
             Some(load_nc(
-                bytes,
+                &bytes,
                 &lp.name,
                 machine,
                 opts.feed_fallback_mm_min,

@@ -87,7 +87,7 @@ pub(crate) fn run(args: ReorientArgs) -> Result<ExitCode> {
     }
     if let Some(target) = plot_target {
         let path = &target.path;
-        let lp = load_nc(bytes, &name, &machine, None)?;
+        let lp = load_nc(&bytes, &name, &machine, None)?;
         let axes = tool_axes(&lp, &machine);
         let tilt = Tilt {
             theta_x_deg: report.theta_x_deg,

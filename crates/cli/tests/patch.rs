@@ -142,7 +142,7 @@ fn impossible_zone_keeps_the_best_improvement() {
     .unwrap();
     assert!(!reachable, "the planted zone must be unreachable");
     for opts in [PatchOptions::default(), only_c()] {
-        let (out, report) = polepatch::patch_loaded(&lp, &m, &opts);
+        let (out, report) = patch_lp(&lp, &m, &opts);
         assert!(!report.zones.is_empty());
         for z in &report.zones {
             assert_ne!(z.outcome, "reached", "{z:?}");
@@ -168,7 +168,7 @@ fn capped_deviation_keeps_the_best_improvement() {
         ..PatchOptions::default()
     };
     let lp = load_bytes(&bytes, "SING", &m);
-    let (out, report) = polepatch::patch_loaded(&lp, &m, &opts);
+    let (out, report) = patch_lp(&lp, &m, &opts);
     assert_eq!(report.zones.len(), 1);
     let z = &report.zones[0];
     assert_ne!(z.outcome, "reached", "{z:?}");
@@ -190,7 +190,7 @@ fn a_cap_the_default_meets_changes_nothing() {
         for m in machines() {
             let name = name_of(f);
             let lp = load_bytes(&bytes, &name, &m);
-            let (out, report) = polepatch::patch_loaded(&lp, &m, &PatchOptions::default());
+            let (out, report) = patch_lp(&lp, &m, &PatchOptions::default());
             if report.zones.is_empty() {
                 continue;
             }
@@ -209,7 +209,7 @@ fn a_cap_the_default_meets_changes_nothing() {
                 max_deviation_deg: Some(worst),
                 ..PatchOptions::default()
             };
-            let (out_c, report_c) = polepatch::patch_loaded(&lp, &m, &opts);
+            let (out_c, report_c) = patch_lp(&lp, &m, &opts);
             for (a, b) in report.zones.iter().zip(&report_c.zones) {
                 assert!(
                     b.max_deviation_deg <= worst + 1e-9,
@@ -246,7 +246,7 @@ fn sing_capped_at_one_degree_or_more_reaches_feed() {
     let bytes = std::fs::read(root().join("fixtures/c17/SING.I")).unwrap();
     let m = polepatch::kinematics::Machine::builtin("mikron-ucp710").unwrap();
     let lp = load_bytes(&bytes, "SING", &m);
-    let (_, report) = polepatch::patch_loaded(&lp, &m, &PatchOptions::default());
+    let (_, report) = patch_lp(&lp, &m, &PatchOptions::default());
     let default_deg = report.zones[0].max_deviation_deg;
     assert!((default_deg - 1.0).abs() < 1e-3, "{default_deg}");
     for cap in [default_deg, 1.2] {
@@ -254,7 +254,7 @@ fn sing_capped_at_one_degree_or_more_reaches_feed() {
             max_deviation_deg: Some(cap),
             ..PatchOptions::default()
         };
-        let (_, report) = polepatch::patch_loaded(&lp, &m, &opts);
+        let (_, report) = patch_lp(&lp, &m, &opts);
         let z = &report.zones[0];
         assert_eq!(
             (z.outcome, z.reason),
@@ -337,7 +337,7 @@ fn rapids_after_runs_are_accounted_for() {
     );
     for m in machines() {
         let lp = load_bytes(text.as_bytes(), "zigzag", &m);
-        let (_, report) = polepatch::patch_loaded(&lp, &m, &PatchOptions::default());
+        let (_, report) = patch_lp(&lp, &m, &PatchOptions::default());
         let mut with_rapid = 0;
         let runs: std::collections::BTreeSet<usize> = report.zones.iter().map(|z| z.run).collect();
         for run in runs {

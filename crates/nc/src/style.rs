@@ -69,8 +69,8 @@ struct Evidence {
     /// Values whose last decimal is a `0` (`12.500`): evidence against stripping.
     trailing_zero: usize,
     /// The first zero written (a zero is evidence of its own form only: `B0.0` says
-    /// nothing about how `B.387` is written).
-    zero_form: Option<ZeroStyle>,
+    /// nothing about how `B.387` is written), and its word's byte offset.
+    zero_form: Option<(ZeroStyle, u32)>,
 }
 
 impl Evidence {
@@ -114,11 +114,14 @@ impl Evidence {
         };
         e.max_decimals = e.max_decimals.max(decimals);
         if body.iter().all(|&b| b == b'0' || b == b'.') {
-            e.zero_form.get_or_insert(ZeroStyle {
-                leading_zero: body.first() == Some(&b'0'),
-                point: has_point,
-                decimals: decimals.min(usize::from(u8::MAX)) as u8,
-            });
+            e.zero_form.get_or_insert((
+                ZeroStyle {
+                    leading_zero: body.first() == Some(&b'0'),
+                    point: has_point,
+                    decimals: decimals.min(usize::from(u8::MAX)) as u8,
+                },
+                w.start,
+            ));
             return;
         }
         e.min_decimals = e.min_decimals.min(decimals);
@@ -140,6 +143,28 @@ impl Evidence {
 }
 
 impl Evidence {
+    /// The evidence of the words of `self` and of `other` together (the first zero the
+    /// one of the two that comes first in the file).
+    fn merged(&self, other: &Evidence) -> Evidence {
+        Evidence {
+            words: self.words + other.words,
+            max_decimals: self.max_decimals.max(other.max_decimals),
+            min_decimals: self.min_decimals.min(other.min_decimals),
+            plus: self.plus + other.plus,
+            unsigned: self.unsigned + other.unsigned,
+            point: self.point + other.point,
+            no_point: self.no_point + other.no_point,
+            zero: self.zero + other.zero,
+            no_zero: self.no_zero + other.no_zero,
+            equals: self.equals + other.equals,
+            trailing_zero: self.trailing_zero + other.trailing_zero,
+            zero_form: match (self.zero_form, other.zero_form) {
+                (Some(a), Some(b)) => Some(if b.1 < a.1 { b } else { a }),
+                (a, b) => a.or(b),
+            },
+        }
+    }
+
     /// Whether these words strip trailing zeros: `Some(true)` if some are written with
     /// fewer decimals than others, `Some(false)` if one ends in a decimal `0`, `None`
     /// when they cannot tell (no words, or all with the same decimals).
@@ -203,7 +228,7 @@ impl NumberStyle {
             trailing_point: point.point > 0,
             leading_zero: !(zero.no_zero > 0 && zero.zero == 0),
             equals: main.equals > 0,
-            zero: main.zero_form.or(axes.zero_form),
+            zero: main.zero_form.or(axes.zero_form).map(|z| z.0),
         }
     }
 
@@ -293,7 +318,6 @@ impl FileStyle {
 /// stream ([`crate::scan`]): the same figures as [`FileStyle::of`] on the whole program.
 pub struct StyleEvidence {
     letters: [Evidence; 6],
-    any_axis: Evidence,
     spaced: usize,
     tight: usize,
     /// Axis words with / without a blank between letter and number.
@@ -305,7 +329,6 @@ impl Default for StyleEvidence {
     fn default() -> Self {
         StyleEvidence {
             letters: std::array::from_fn(|_| Evidence::empty()),
-            any_axis: Evidence::empty(),
             spaced: 0,
             tight: 0,
             letter_spaced: 0,
@@ -320,7 +343,6 @@ impl StyleEvidence {
         for w in words {
             if let Some(i) = AXES.iter().position(|&a| a == w.letter) {
                 self.letters[i].add(bytes, w);
-                self.any_axis.add(bytes, w);
                 if bytes
                     .get(w.start as usize + 1)
                     .is_some_and(|&b| b == b' ' || b == b'\t')
@@ -342,10 +364,13 @@ impl StyleEvidence {
 
     /// The file's style from what was counted.
     pub fn style(&self) -> FileStyle {
+        // The axis words together: every letter's evidence merged.
+        let any_axis = self
+            .letters
+            .iter()
+            .fold(Evidence::empty(), |all, e| all.merged(e));
         FileStyle {
-            axes: std::array::from_fn(|i| {
-                NumberStyle::from_evidence(&self.letters[i], &self.any_axis)
-            }),
+            axes: std::array::from_fn(|i| NumberStyle::from_evidence(&self.letters[i], &any_axis)),
             gap: if self.tight > self.spaced { b"" } else { b" " },
             letter_gap: if self.letter_spaced > self.letter_tight {
                 b" "

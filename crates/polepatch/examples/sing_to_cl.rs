@@ -12,7 +12,7 @@ fn main() {
     let machine = Machine::builtin("mikron-ucp710").expect("built-in");
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let bytes = std::fs::read(root.join("fixtures/c17/SING.I")).expect("SING.I");
-    let lp = load_nc(bytes, "SING.I", &machine, None).expect("loads");
+    let lp = load_nc(&bytes, "SING.I", &machine, None).expect("loads");
     let p = &lp.program;
     let points: Vec<ClPoint> = (0..p.blocks.len())
         .filter(|&b| p.blocks[b].is_move && p.state(b).tcpm.is_on())

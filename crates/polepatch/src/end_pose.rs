@@ -139,21 +139,64 @@ pub struct Scan {
     pub clearance_mm: Option<f64>,
 }
 
-/// One block after a run's last point, for [`After::verdict`].
+/// One block after a run's last point, for [`After::verdict`]: what the verdicts of both
+/// tilting letters need of its words, read once ([`After::new`]).
 #[derive(Debug, Clone, Copy)]
 pub struct After<'a> {
-    /// Its words.
-    pub words: &'a [Word],
     /// It moves ([`polepatch_nc::Block::is_move`]).
-    pub is_move: bool,
+    is_move: bool,
     /// What the reader marked on it ([`polepatch_nc::Block::flags`]): a tool change or the
     /// program's end in any dialect (Heidenhain `TOOL CALL`, `END PGM` included), and
     /// block delete.
-    pub flags: Flags,
+    flags: Flags,
     /// The modal state after it.
-    pub state: &'a Modal,
+    state: &'a Modal,
     /// The modal state before it.
-    pub before: &'a Modal,
+    before: &'a Modal,
+    /// Letters it has a word of (bit `letter − b'A'`).
+    letters: u32,
+    /// Letters it has a word of in a Sinumerik direction form (`C=DC(…)`, …).
+    directional: u32,
+    /// It has a T word or M6, M2 or M30.
+    ends: bool,
+}
+
+/// The bit of `letter` (`b'A'`…`b'Z'`) in [`After`]'s letter sets.
+fn bit(letter: u8) -> u32 {
+    1u32.checked_shl(u32::from(letter.wrapping_sub(b'A')))
+        .unwrap_or(0)
+}
+
+impl<'a> After<'a> {
+    /// The block with words `words`, in state `state` after it and `before` before it.
+    pub fn new(
+        words: &[Word],
+        is_move: bool,
+        flags: Flags,
+        state: &'a Modal,
+        before: &'a Modal,
+    ) -> Self {
+        let mut letters = 0;
+        let mut directional = 0;
+        let mut ends = false;
+        for w in words {
+            letters |= bit(w.letter);
+            if w.form.is_directional() {
+                directional |= bit(w.letter);
+            }
+            ends |= w.letter == b'T'
+                || (w.letter == b'M' && (w.value == 6.0 || w.value == 2.0 || w.value == 30.0));
+        }
+        After {
+            is_move,
+            flags,
+            state,
+            before,
+            letters,
+            directional,
+            ends,
+        }
+    }
 }
 
 impl After<'_> {
@@ -197,14 +240,10 @@ impl After<'_> {
 
     /// [`After::verdict`] for a block that is executed.
     fn verdict_executed(&self, primary: u8, scan: &mut Scan) -> Step {
-        if self.flags.has(Flags::TOOL_CHANGE) || self.flags.has(Flags::PROGRAM_END) {
+        if self.flags.has(Flags::TOOL_CHANGE) || self.flags.has(Flags::PROGRAM_END) || self.ends {
             return Step::Free;
         }
-        let has = |l: u8| self.words.iter().any(|w| w.letter == l);
-        let m_code = |v: f64| self.words.iter().any(|w| w.letter == b'M' && w.value == v);
-        if has(b'T') || m_code(6.0) || m_code(2.0) || m_code(30.0) {
-            return Step::Free;
-        }
+        let has = |l: u8| self.letters & bit(l) != 0;
         let (st, prev) = (self.state, self.before);
         if st.incremental {
             return Step::Pinned;
@@ -239,11 +278,7 @@ impl After<'_> {
             // A Sinumerik direction form (`C=DC(…)`, `C=ACP(…)`, `C=ACN(…)`) moves from
             // where the axis is: from another pose it reaches another unwrapped position,
             // or turns another way.
-            if self
-                .words
-                .iter()
-                .any(|w| (w.letter == primary || w.letter == b'C') && w.form.is_directional())
-            {
+            if self.directional & (bit(primary) | bit(b'C')) != 0 {
                 return Step::Pinned;
             }
             if !rotary_moves && (st.tcpm.is_on() || !xy_moves) {
@@ -269,74 +304,10 @@ impl After<'_> {
     }
 }
 
-/// The end pose of run `r` of `lp` (module docs): from the whole file when `lp` is a
-/// stretch of it ([`crate::program::Window`]), else from the blocks after the run.
+/// The end pose of run `r` of `lp` (module docs), as the survey of the whole file decided
+/// it ([`crate::program::Window`]).
 pub fn end_pose(lp: &LoadedProgram, r: usize) -> EndPose {
-    if let Some(w) = &lp.window {
-        return w.end[r].clone();
-    }
-    let program = &lp.program;
-    let run = &lp.runs[r].run;
-    let Some(&last) = run.blocks.last() else {
-        return EndPose::default();
-    };
-    // Restating blocks must lie before the next run's first block (it cannot be rewritten
-    // for this run once it is another's).
-    let next_run_start = lp
-        .runs
-        .iter()
-        .filter_map(|rp| rp.run.blocks.first().copied())
-        .filter(|&b| b > last)
-        .min();
-    let mut prev = program.state(last);
-    let mut scan = Scan::default();
-    let mut restate = Vec::new();
-    for b in last + 1..program.blocks.len() {
-        let st = program.state(b);
-        let after = After {
-            words: program.block_words(b),
-            is_move: program.blocks[b].is_move,
-            flags: program.blocks[b].flags,
-            state: &st,
-            before: &prev,
-        };
-        match after.verdict(lp.primary_letter, &mut scan) {
-            Step::Free => {
-                let line = program.blocks[b].line;
-                return EndPose {
-                    free: true,
-                    decided_line: Some(line),
-                    restate,
-                    next: after.next_move(lp.primary_letter, line),
-                };
-            }
-            Step::Pinned => {
-                return EndPose {
-                    free: false,
-                    decided_line: Some(program.blocks[b].line),
-                    restate: Vec::new(),
-                    next: None,
-                };
-            }
-            Step::Restate if next_run_start.is_some_and(|n| b >= n) => {
-                return EndPose {
-                    free: false,
-                    decided_line: Some(program.blocks[b].line),
-                    restate: Vec::new(),
-                    next: None,
-                };
-            }
-            Step::Restate => restate.push(b),
-            Step::Continue => {}
-        }
-        prev = st;
-    }
-    EndPose {
-        free: true,
-        decided_line: None,
-        restate,
-        next: None,
-    }
+    lp.window.end[r].clone()
 }
 
 /// Whether the moves after run `r` of `lp` leave its last point free ([`end_pose`]).
@@ -378,7 +349,7 @@ mod tests {
 
     fn poses(text: &str) -> Vec<EndPose> {
         let m = Machine::builtin("mikron-ucp710").unwrap();
-        let lp = load_nc(text.as_bytes().to_vec(), "t", &m, None).unwrap();
+        let lp = load_nc(text.as_bytes(), "t", &m, None).unwrap();
         (0..lp.runs.len()).map(|r| end_pose(&lp, r)).collect()
     }
 

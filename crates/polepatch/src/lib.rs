@@ -12,9 +12,10 @@
 //!
 //! [`patch_nc`] and [`analyze_nc`] are the entry points for NC programs held in memory
 //! ([`patch_nc_to`] writes the output to a writer as it goes, parsing in full only the
-//! stretches near the pole); [`program::load_nc`] + [`patch::patch_loaded`] the same
-//! on the whole parsed program, for callers that want it (the quality suite). CAM plugins that hold CL points rather
-//! than a file use the patcher directly on a [`patcher::Path`].
+//! stretches near the pole); [`program::load_nc`] reads a whole program with its runs as
+//! paths, through the same reader, for callers that want it (the quality suite, reorient).
+//! CAM plugins that hold CL points rather than a file use the patcher directly on a
+//! [`patcher::Path`].
 //!
 //! This crate does no file I/O and depends on no command-line crate: the `polepatch`
 //! binary (`polepatch-cli`) and the C ABI (`polepatch-capi`) are thin layers over it.
@@ -28,7 +29,6 @@ pub use polepatch_simulate as sim;
 
 pub mod end_pose;
 pub mod error;
-pub mod far;
 pub mod hooks;
 pub mod joints;
 pub mod machine_frame;
@@ -44,7 +44,7 @@ pub mod tool;
 
 pub use error::Error;
 pub use hooks::Hooks;
-pub use patch::{FileReport, UntouchedReason, UntouchedRun, ZoneRow, patch_loaded, patch_program};
+pub use patch::{FileReport, UntouchedReason, UntouchedRun, ZoneRow};
 pub use report::AnalyzeReport;
 pub use simulate::{SimulateOptions, SimulateReport, simulate_nc, simulate_nc_with};
 
@@ -187,7 +187,7 @@ pub fn check_patcher_options(p: &patcher::PatchOptions) -> Result<(), Error> {
 
 impl PatchOptions {
     /// Every value in range, or an [`Error::Options`] naming the field. The entry points
-    /// ([`patch_nc`], [`far::far_from_pole`], [`stream::patch_nc_to`]) call it, so a
+    /// ([`patch_nc`], [`stream::patch_nc_to`]) call it, so a
     /// caller need not; a front end checks earlier only to name its own flags.
     pub fn check(&self) -> Result<(), Error> {
         check_patcher_options(&self.patch)?;
@@ -238,10 +238,10 @@ pub fn patch_nc(
 /// Patch an NC program held in memory, writing the output to `out`: the one entry every
 /// caller goes through (the CLI's file jobs, [`patch_nc`], hence the C ABI and `post`).
 ///
-/// 1. [`far::far_from_pole`]: a streaming scan on all cores; a program with no run point
-///    within the cone has no zone, and its output is its input, written in one piece.
-/// 2. Otherwise [`stream::patch_nc_to`]: the stretches near the pole are parsed, patched
-///    and written in file order, everything between them copied.
+/// [`stream`]: a first read finds the runs and which come near the pole; a program with
+/// none has no zone, and its output is its input, written in one piece. Otherwise a second
+/// read parses the stretches near the pole; they are patched and written in file order,
+/// everything between them copied.
 ///
 /// On an error nothing more is written; what was written before it must be discarded by
 /// the caller (the CLI writes to a temporary file). A failed write is [`Error::Output`].
@@ -263,16 +263,11 @@ pub fn patch_nc_hooked(
     out: &mut dyn std::io::Write,
     hooks: Hooks<'_>,
 ) -> Result<FileReport, Error> {
-    let cl_instead = |e| program::or_cl_file(e, bytes, &opts.name);
     if (hooks.cancelled)() {
         return Err(Error::Cancelled);
     }
-    if let Some(report) = far::far_from_pole(bytes, machine, opts).map_err(cl_instead)? {
-        out.write_all(bytes).map_err(Error::Output)?;
-        (hooks.progress)(bytes.len(), bytes.len());
-        return Ok(report);
-    }
-    stream::patch_nc_hooked(bytes, machine, opts, out, hooks).map_err(cl_instead)
+    stream::patch_nc_hooked(bytes, machine, opts, out, hooks)
+        .map_err(|e| program::or_cl_file(e, bytes, &opts.name))
 }
 
 /// Equation 6 along every run of an NC program held in memory (what `polepatch analyze`

@@ -62,17 +62,8 @@ pub const NOT_WORSE_REL: f64 = 1e-4;
 ///   offset such as Fanuc `G54`, or nothing at all): `given` (`--work-offset`);
 /// - else (the frame changed more than once, or by a shift polepatch does not follow —
 ///   `G92`, `TRANS`, … — after the last stated datum): unknown.
-pub fn run_datum(lp: &LoadedProgram, r: usize, given: Option<[f64; 3]>) -> Option<[f64; 3]> {
-    if let Some(w) = &lp.window {
-        return w.datum_mm[r];
-    }
-    let p = &lp.program;
-    datum_at(
-        &p.datum_shifts,
-        &p.frame_changes,
-        lp.runs[r].run.blocks[0],
-        given,
-    )
+pub fn run_datum(lp: &LoadedProgram, r: usize) -> Option<[f64; 3]> {
+    lp.window.datum_mm[r]
 }
 
 /// [`run_datum`] for a run whose first block is `first`, from the program's stated datum

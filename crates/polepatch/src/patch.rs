@@ -677,7 +677,7 @@ pub fn patch_program(
         let chain = machine
             .chain
             .as_ref()
-            .and_then(|ch| machine_frame::run_datum(lp, r, lp.work_offset_mm).map(|d| (ch, d)));
+            .and_then(|ch| machine_frame::run_datum(lp, r).map(|d| (ch, d)));
         let inch = rp.run.blocks.iter().any(|&b| program.state(b).inch);
         let leave = if rp.run.transform != 0 {
             Some((
@@ -1492,21 +1492,4 @@ fn untouched(
             .any(|p| p[pi].is_none_or(|v| v.abs() <= cone_deg)),
         message,
     }
-}
-
-/// Patch a loaded program and render the output bytes: `(output, report)`. The output
-/// is the input bytes, unchanged, when nothing was changed.
-pub fn patch_loaded(
-    lp: &LoadedProgram,
-    machine: &Machine,
-    opts: &PatchOptions,
-) -> (Vec<u8>, FileReport) {
-    let (edits, mut report) = patch_program(lp, machine, opts);
-    report.warn_unknown_tool();
-    let bytes = if edits.is_empty() {
-        lp.program.bytes.clone()
-    } else {
-        polepatch_nc::write_styled(&lp.program, &edits, &lp.file_style())
-    };
-    (bytes, report)
 }

@@ -168,16 +168,12 @@ pub struct LoadedProgram {
     pub runs: Vec<RunPath>,
     /// Things the user should know (e.g. primary-letter substitution).
     pub warnings: Vec<String>,
-    /// Work offset given by the caller (machine coordinates of the program's zero, mm),
-    /// used with a machine's kinematic chain; `None`: from the program
-    /// ([`crate::machine_frame::run_datum`]).
-    pub work_offset_mm: Option<[f64; 3]>,
     /// Chord tolerance for runs patched through the kinematic chain, mm (default
     /// [`crate::machine_frame::CHORD_TOLERANCE_MM`]; see [`crate::PatchOptions`]).
     pub chord_tolerance_mm: f64,
-    /// When `program` is a stretch of a larger file ([`crate::stream`]): what the rest
-    /// of the file says about it. `None` for a whole program.
-    pub window: Option<Window>,
+    /// What the rest of the file says about `program`, a stretch of it
+    /// ([`crate::stream`]; the whole file is one stretch).
+    pub window: Window,
     /// What the reader carried through without analysing ([`crate::notes`]); empty for a
     /// stretch (the stream lists it once for the file).
     pub notes: crate::notes::Notes,
@@ -215,14 +211,11 @@ impl LoadedProgram {
     }
     /// Number of run `r` in the file, from 1 (as reports give it).
     pub fn run_number(&self, r: usize) -> usize {
-        r + 1 + self.window.as_ref().map_or(0, |w| w.first_run)
+        r + 1 + self.window.first_run
     }
     /// The file's number style (of the whole file, also for a stretch).
     pub fn file_style(&self) -> FileStyle {
-        match &self.window {
-            Some(w) => w.style,
-            None => FileStyle::of(&self.program),
-        }
+        self.window.style
     }
     /// Index of the primary letter in [`polepatch_nc::Modal::pos`].
     pub fn primary_index(&self) -> usize {
@@ -232,28 +225,6 @@ impl LoadedProgram {
             modal::B
         }
     }
-}
-
-/// Parse `bytes` named `name` (for messages) as the NC reader reads programs for
-/// `machine` ([`read_options`]).
-pub fn parse_program(bytes: Vec<u8>, name: &str, machine: &Machine) -> Result<Program, Error> {
-    parse_program_with(bytes, name, &read_options(machine)?)
-}
-
-/// [`parse_program`] with the reading options `read` ([`read_options_with`]).
-pub fn parse_program_with(
-    bytes: Vec<u8>,
-    name: &str,
-    read: &polepatch_nc::ReadOptions,
-) -> Result<Program, Error> {
-    if bytes.iter().all(|b| b.is_ascii_whitespace()) {
-        return Err(Error::Empty {
-            path: name.to_string(),
-        });
-    }
-    let cl = cl_file_error(&bytes, name);
-    polepatch_nc::parse_with(bytes, read)
-        .map_err(|e| cl.unwrap_or_else(|| Error::Parse(e.with_path(name))))
 }
 
 /// `e`, or — when it is a syntax error and `bytes` is a CL file — the error that says so
@@ -304,91 +275,35 @@ fn line_number(bytes: &[u8], at: usize) -> usize {
     line
 }
 
-/// Parse `bytes` and build each run's path for `machine`; `feed_fallback_mm_min` is used
-/// for runs with no F in force.
+/// Read `bytes` (named `name` in messages) as one stretch of the one reader
+/// ([`crate::stream`]) and build each run's path for `machine`; `feed_fallback_mm_min` is
+/// used for runs with no F in force. A program with nothing to analyse is an error.
 pub fn load_nc(
-    bytes: Vec<u8>,
+    bytes: &[u8],
     name: &str,
     machine: &Machine,
     feed_fallback_mm_min: Option<f64>,
 ) -> Result<LoadedProgram, Error> {
-    load(
-        parse_program(bytes, name, machine)?,
-        name,
+    load_nc_with(
+        bytes,
         machine,
-        feed_fallback_mm_min,
+        &crate::AnalyzeOptions {
+            name: name.to_string(),
+            feed_fallback_mm_min,
+            ..crate::AnalyzeOptions::default()
+        },
     )
 }
 
-/// [`load_nc`] with the reading options `read` ([`read_options_with`]).
+/// [`load_nc`] with the reading options of `opts` (name, feed fallback, work offset,
+/// units; its analysis options are not used).
 pub fn load_nc_with(
-    bytes: Vec<u8>,
-    name: &str,
+    bytes: &[u8],
     machine: &Machine,
-    feed_fallback_mm_min: Option<f64>,
-    read: &polepatch_nc::ReadOptions,
+    opts: &crate::AnalyzeOptions,
 ) -> Result<LoadedProgram, Error> {
-    load(
-        parse_program_with(bytes, name, read)?,
-        name,
-        machine,
-        feed_fallback_mm_min,
-    )
-}
-
-/// Why a program has no run of G1 motion to analyse: the first G1 block that could not
-/// start one, and the reason, or plainly [`Error::NoRuns`] when there is no G1 move.
-fn why_no_runs(program: &Program, name: &str) -> Error {
-    for (i, block) in program.blocks.iter().enumerate() {
-        if !block.is_move {
-            continue;
-        }
-        let st = program.state(i);
-        if st.motion != polepatch_nc::Motion::Linear {
-            continue;
-        }
-        if block.flags.has(polepatch_nc::Flags::NOT_ANALYSABLE) {
-            return Error::NothingAnalysable {
-                path: name.to_string(),
-                line: block.line,
-            };
-        }
-        if st.incremental {
-            // The error is where G91 was programmed (the move only follows it).
-            let set = (0..=i)
-                .rev()
-                .find(|&b| !program.state_before(b).incremental && program.state(b).incremental)
-                .unwrap_or(i);
-            return Error::Unsupported {
-                path: name.to_string(),
-                line: program.blocks[set].line,
-                what: format!(
-                    "incremental mode (G91) is not supported: polepatch reads absolute programs \
-                     (G90), because a rotary value changed in incremental mode would shift every \
-                     later position (the first move in it is at line {})",
-                    block.line
-                ),
-            };
-        }
-        let what = if st.pos[..3].iter().any(Option::is_none) {
-            "G1 moves from a position the program does not state (after G28/G53/G92 or a datum \
-             change, or before X Y Z are all programmed): nothing can be analysed without it"
-        } else {
-            continue;
-        };
-        return Error::Unsupported {
-            path: name.to_string(),
-            line: block.line,
-            what: what.to_string(),
-        };
-    }
-    // A CL file handed to `patch`: say what it is.
-    if let Some(e) = cl_file_error(&program.bytes, name) {
-        return e;
-    }
-    Error::NoRuns {
-        path: name.to_string(),
-    }
+    opts.check()?;
+    crate::stream::load_program(bytes, machine, opts).map_err(|e| or_cl_file(e, bytes, &opts.name))
 }
 
 fn tilt_letter(idx: usize) -> u8 {
@@ -556,84 +471,4 @@ fn inverse_time_feed(run: &Run) -> f64 {
         .map(|(k, f)| (run.s_mm[k + 1] - run.s_mm[k]) / f)
         .sum();
     run.length_mm() / time
-}
-
-/// Group a parsed program into runs and build each run's path for `machine`.
-/// `feed_fallback_mm_min` is used for runs with no F in force.
-pub fn load(
-    program: Program,
-    name: &str,
-    machine: &Machine,
-    feed_fallback_mm_min: Option<f64>,
-) -> Result<LoadedProgram, Error> {
-    let runs = polepatch_nc::runs(&program);
-    if runs.is_empty() {
-        return Err(why_no_runs(&program, name));
-    }
-    let own = if machine.primary_letter() == 'A' {
-        modal::A
-    } else {
-        modal::B
-    };
-    let p_idx = polepatch_nc::primary_in_use(&runs, own);
-    let primary_letter = tilt_letter(p_idx);
-    let warnings: Vec<String> = primary_mismatch_warning(name, machine, p_idx)
-        .into_iter()
-        .collect();
-    let mut notes = crate::notes::Notes::new();
-    // The tool of each run: the program's as it stands at the run's last block (a tool
-    // change ends runs, so the state there is the run's).
-    let mut tracker = crate::tool::Tracker::default();
-    let mut found = Vec::with_capacity(runs.len());
-    let mut next_run = 0;
-    for b in 0..program.blocks.len() {
-        notes.push(
-            &program.blocks[b],
-            program.block_words(b),
-            &program.state_before(b),
-            &program.state(b),
-        );
-        while next_run < runs.len() && runs[next_run].blocks.last() == Some(&b) {
-            found.push(tracker.found());
-            next_run += 1;
-        }
-        let blk = &program.blocks[b];
-        tracker.block(
-            program.dialect,
-            blk.line,
-            &program.bytes[blk.span()],
-            program.block_words(b),
-            program.state(b).inch,
-        );
-    }
-    let has = |idx: usize| runs.iter().any(|r| r.uses(idx));
-    if !has(p_idx) && !has(modal::C) {
-        return Err(Error::NoRotary {
-            path: name.to_string(),
-            primary: machine.primary_letter(),
-        });
-    }
-    found.resize(runs.len(), tracker.found());
-    let runs = runs
-        .into_iter()
-        .zip(found)
-        .map(|(run, found)| {
-            let line = program.blocks[run.blocks[0]].line;
-            let mut rp = run_path(run, p_idx, feed_fallback_mm_min, line);
-            rp.found_tool = found;
-            rp
-        })
-        .collect();
-    Ok(LoadedProgram {
-        name: name.to_string(),
-        program,
-        primary_letter,
-        runs,
-        warnings,
-        work_offset_mm: None,
-        chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
-        window: None,
-        notes,
-        tool: crate::tool::ToolOptions::default(),
-    })
 }

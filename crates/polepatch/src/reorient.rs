@@ -469,7 +469,7 @@ pub fn reorient_nc(
 ) -> Result<(Vec<u8>, ReorientReport), Error> {
     check_tilt(tilt)?;
     let opts = analysis_options(cone_deg, tilt.pivot_mm)?;
-    let lp = load_nc(bytes.to_vec(), name, machine, None)?;
+    let lp = load_nc(&bytes, name, machine, None)?;
     let before = program_figures(&lp, machine, &opts);
     let (out, after, words, untouched) = apply(&lp, machine, tilt, &opts)?;
     let report = ReorientReport {
@@ -518,7 +518,7 @@ fn apply(
 ) -> Result<(Vec<u8>, ProgramFigures, usize, Vec<usize>), Error> {
     let (edits, untouched) = reorient_edits(lp, machine, tilt)?;
     let out = polepatch_nc::write(&lp.program, &edits);
-    let lp2 = load_nc(out.clone(), &lp.name, machine, None)?;
+    let lp2 = load_nc(&out, &lp.name, machine, None)?;
     let after = program_figures(&lp2, machine, opts);
     Ok((out, after, edits.len(), untouched))
 }
@@ -534,7 +534,7 @@ pub fn search(
     cone_deg: f64,
 ) -> Result<(Vec<u8>, ReorientReport), Error> {
     let opts = analysis_options(cone_deg, pivot_mm)?;
-    let lp = load_nc(bytes.to_vec(), name, machine, None)?;
+    let lp = load_nc(&bytes, name, machine, None)?;
     let before = program_figures(&lp, machine, &opts);
     let primary = lp.primary_letter;
     let mut alternatives: Vec<Alternative> = Vec::new();

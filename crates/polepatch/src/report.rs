@@ -208,7 +208,7 @@ fn machine_frame_figures(
     opts: &AnalysisOptions,
 ) -> Option<MachineFrameFigures> {
     let chain = machine.chain.as_ref()?;
-    let datum_mm = crate::machine_frame::run_datum(lp, r, lp.work_offset_mm)?;
+    let datum_mm = crate::machine_frame::run_datum(lp, r)?;
     let mp = crate::machine_frame::machine_frame_path(
         chain,
         machine,

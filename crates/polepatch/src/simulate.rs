@@ -141,7 +141,7 @@ struct RunIn {
     feed_change_after: bool,
 }
 
-fn run_inputs(lp: &LoadedProgram, machine: &Machine, opts: &SimulateOptions) -> Vec<RunIn> {
+fn run_inputs(lp: &LoadedProgram, machine: &Machine) -> Vec<RunIn> {
     lp.runs
         .iter()
         .enumerate()
@@ -174,7 +174,7 @@ fn run_inputs(lp: &LoadedProgram, machine: &Machine, opts: &SimulateOptions) -> 
                 }
                 Ok(path) => {
                     let frame = machine.chain.as_ref().and_then(|chain| {
-                        let datum = crate::machine_frame::run_datum(lp, r, opts.work_offset_mm)?;
+                        let datum = crate::machine_frame::run_datum(lp, r)?;
                         Some(crate::machine_frame::machine_frame_path(
                             chain,
                             machine,
@@ -352,7 +352,7 @@ pub fn simulate_nc_with(
         &opts.name,
         opts.feed_fallback_mm_min,
         opts.work_offset_mm,
-        |lp| run_inputs(lp, machine, opts),
+        |lp| run_inputs(lp, machine),
         |runs| {
             for r in runs {
                 sim.take(r);

@@ -50,7 +50,7 @@
 
 use crate::end_pose::{After, EndPose, Scan, Step};
 use crate::error::Error;
-use crate::patch::{FileReport, patch_loaded, patch_program};
+use crate::patch::{FileReport, patch_program};
 use crate::program::{LoadedProgram, RunPath, Window, primary_mismatch_warning, run_path};
 use crate::report::{AnalyzeReport, RunReport};
 use polepatch_kinematics::Machine;
@@ -89,8 +89,6 @@ struct RunRec {
     end: [EndRec; 2],
     /// Work offset for this run ([`crate::machine_frame::datum_at`]).
     datum_mm: Option<[f64; 3]>,
-    /// The program's tool for this run: an index into [`Survey::tools`].
-    tool: usize,
 }
 
 /// The end pose of a run as the survey finds it ([`crate::end_pose`]).
@@ -152,8 +150,74 @@ struct Survey {
     style: FileStyle,
     /// What the reader carried through without analysing.
     notes: crate::notes::Notes,
-    /// The program's tools as the runs found them ([`RunRec::tool`]), one per change.
-    tools: Vec<crate::tool::FoundTool>,
+    /// Blocks in the file.
+    blocks: usize,
+    /// The first G1 move that cannot start a run, and why ([`NoRunWhy`]).
+    no_run_why: Option<NoRunWhy>,
+}
+
+/// Why a G1 move cannot start a run: what [`Error`] a program without runs gets, from its
+/// first such move.
+#[derive(Debug, Clone, Copy)]
+enum NoRunWhy {
+    /// Its axis or feed words are expressions or variables (at `line`).
+    NotAnalysable { line: usize },
+    /// Incremental mode, programmed at `set_line`; the move at `line`.
+    Incremental { set_line: usize, line: usize },
+    /// X Y Z are not all known (at `line`).
+    PositionUnknown { line: usize },
+}
+
+impl NoRunWhy {
+    /// The move at `line` of a block `block` in state `st` cannot start a run, and why;
+    /// `incremental_set_line` is where the incremental mode in force was programmed.
+    fn of(
+        block: &polepatch_nc::Block,
+        st: &polepatch_nc::Modal,
+        incremental_set_line: Option<usize>,
+    ) -> Option<NoRunWhy> {
+        if !block.is_move || st.motion != polepatch_nc::Motion::Linear {
+            return None;
+        }
+        let line = block.line;
+        if block.flags.has(polepatch_nc::Flags::NOT_ANALYSABLE) {
+            Some(NoRunWhy::NotAnalysable { line })
+        } else if st.incremental {
+            Some(NoRunWhy::Incremental {
+                set_line: incremental_set_line.unwrap_or(line),
+                line,
+            })
+        } else if st.pos[..3].iter().any(Option::is_none) {
+            Some(NoRunWhy::PositionUnknown { line })
+        } else {
+            None
+        }
+    }
+
+    /// The error of a program named `name` that has no run.
+    fn error(self, name: &str) -> Error {
+        let path = name.to_string();
+        match self {
+            NoRunWhy::NotAnalysable { line } => Error::NothingAnalysable { path, line },
+            NoRunWhy::Incremental { set_line, line } => Error::Unsupported {
+                path,
+                line: set_line,
+                what: format!(
+                    "incremental mode (G91) is not supported: polepatch reads absolute programs \
+                     (G90), because a rotary value changed in incremental mode would shift every \
+                     later position (the first move in it is at line {line})"
+                ),
+            },
+            NoRunWhy::PositionUnknown { line } => Error::Unsupported {
+                path,
+                line,
+                what: "G1 moves from a position the program does not state (after G28/G53/G92 \
+                       or a datum change, or before X Y Z are all programmed): nothing can be \
+                       analysed without it"
+                    .to_string(),
+            },
+        }
+    }
 }
 
 /// The first read in progress.
@@ -170,11 +234,6 @@ struct Surveying {
     /// The end pose of the open run so far, from the blocks after its last block, per
     /// letter.
     first_after: [EndRec; 2],
-    /// The tool in use ([`crate::tool`]).
-    tracker: crate::tool::Tracker,
-    /// The tools found so far, and the tracker's revision of the last.
-    tools: Vec<crate::tool::FoundTool>,
-    tools_revision: Option<u64>,
 }
 
 impl Surveying {
@@ -191,10 +250,6 @@ impl Surveying {
         }
         let first_block = run.blocks[0];
         let r = self.runs.len();
-        if self.tools_revision != Some(self.tracker.revision()) {
-            self.tools.push(self.tracker.found());
-            self.tools_revision = Some(self.tracker.revision());
-        }
         for (l, rec) in self.first_after.iter().enumerate() {
             if rec.decided.is_none() {
                 self.pending[l].push(r);
@@ -212,20 +267,21 @@ impl Surveying {
                 first_block,
                 self.work_offset_mm,
             ),
-            tool: self.tools.len() - 1,
         });
     }
 
     /// Block `i` (on `line`) has its say on the end pose of the runs before it, per
-    /// letter.
-    fn decide(&mut self, after: &After<'_>, i: usize, line: usize) {
+    /// letter: the pending ones and, with `open`, the open run's.
+    fn decide(&mut self, after: &After<'_>, i: usize, line: usize, open: bool) {
         for (l, letter) in LETTERS.into_iter().enumerate() {
             let runs = &mut self.runs;
             self.pending[l].retain(|&r| {
                 runs[r].end[l].step(after, letter, i, line);
                 runs[r].end[l].decided.is_none()
             });
-            self.first_after[l].step(after, letter, i, line);
+            if open {
+                self.first_after[l].step(after, letter, i, line);
+            }
         }
     }
 }
@@ -278,20 +334,21 @@ fn survey_once(
         frame_changes: Vec::new(),
         pending: [Vec::new(), Vec::new()],
         first_after: [EndRec::default(), EndRec::default()],
-        tracker: crate::tool::Tracker::default(),
-        tools: Vec::new(),
-        tools_revision: None,
-    };
-    let dialect = match read.dialect {
-        Dialect::Auto => polepatch_nc::program::detect(bytes),
-        d => d,
     };
     let mut style = StyleEvidence::default();
     let mut notes = crate::notes::Notes::new();
     let mut builder = RunBuilder::default();
     let mut prev = opts.read.initial();
     let mut i = 0usize;
+    let mut no_run_why = None;
+    let mut incremental_set_line = None;
     let settled = scan_blocks_with(bytes, read, |s: Scanned<'_>| {
+        if s.state.incremental && !prev.incremental {
+            incremental_set_line = Some(s.block.line);
+        }
+        if no_run_why.is_none() {
+            no_run_why = NoRunWhy::of(s.block, s.state, incremental_set_line);
+        }
         style.add_block(bytes, s.words);
         notes.push(s.block, s.words, &prev, s.state);
         if let Some(d) = s.stated_datum {
@@ -300,26 +357,14 @@ fn survey_once(
         if s.frame_changed {
             sv.frame_changes.push(i);
         }
-        let after = After {
-            words: s.words,
-            is_move: s.block.is_move,
-            flags: s.block.flags,
-            state: s.state,
-            before: &prev,
-        };
-        sv.decide(&after, i, s.block.line);
         builder.push(i, s.block, s.state, &mut |run| sv.take(run));
-        // After the runs this block ends: a tool change is the next run's.
-        sv.tracker.block(
-            dialect,
-            s.block.line,
-            &bytes[s.block.span()],
-            s.words,
-            s.state.inch,
-        );
         // Deciding blocks count from the open run's last block on: when this block
-        // extended it, or no run is open, the verdicts seen so far are spent.
-        if builder.open_run_last_block().is_none_or(|last| last == i) {
+        // extended it, or no run is open, the verdicts seen so far are spent (the open run's
+        // are not taken; a run this block ended is among the pending ones now).
+        let spent = builder.open_run_last_block().is_none_or(|last| last == i);
+        let after = After::new(s.words, s.block.is_move, s.block.flags, s.state, &prev);
+        sv.decide(&after, i, s.block.line, !spent);
+        if spent {
             sv.first_after = [EndRec::default(), EndRec::default()];
         }
         prev = *s.state;
@@ -351,7 +396,8 @@ fn survey_once(
             uses: sv.uses,
             style: style.style(),
             notes,
-            tools: sv.tools,
+            blocks: i,
+            no_run_why,
         },
         settled,
     ))
@@ -364,6 +410,9 @@ struct Stretch {
     first_block: usize,
     last_block: usize,
     runs: std::ops::Range<usize>,
+    /// The whole file ([`load_program`]): its bytes from the first to the last, also
+    /// before the first block and after the last.
+    whole: bool,
 }
 
 /// The stretches (module docs, step 2): one per run `wanted` picks.
@@ -385,6 +434,7 @@ fn stretches(runs: &[RunRec], l: usize, wanted: impl Fn(&RunRec) -> bool) -> Vec
                 first_block: rec.first_block,
                 last_block: rec.last_block.max(restated.unwrap_or(0)),
                 runs: r..r + 1,
+                whole: false,
             }
         })
         .collect()
@@ -396,7 +446,8 @@ struct InHand {
     program: ProgramBuilder,
     /// Byte just past the stretch's last line (its line ending included).
     end_byte: Option<usize>,
-    runs: Vec<Run>,
+    /// Its runs, each with the program's tool for it.
+    runs: Vec<(Run, crate::tool::FoundTool)>,
 }
 
 /// The byte just past the line ending after `at` (the end of `bytes` if none).
@@ -418,11 +469,9 @@ fn tilting_index(sv: &Survey, machine: &Machine) -> usize {
     polepatch_nc::primary_of(&sv.uses, own)
 }
 
-/// After the first read: the whole-program path for a program it must reject (no runs and
-/// why, no rotary words — it names what is wrong), or the survey and the tilting letter
-/// (0 A, 1 B) for the stretches.
+/// After the first read: the survey and the tilting letter (0 A, 1 B) for the stretches,
+/// or a program that holds nothing to analyse.
 enum Begun {
-    Whole(Box<LoadedProgram>),
     Stretches {
         sv: Box<Survey>,
         l: usize,
@@ -437,37 +486,46 @@ enum Begun {
     },
 }
 
+/// The first read, and what it says of the program as a whole: an empty program, a
+/// program with no run (the first G1 move that cannot start one, a CL file) or with no
+/// rotary word is an error — [`Begun::Nothing`] where the error only says there is nothing
+/// to analyse.
 fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Error> {
+    if bytes.iter().all(|b| b.is_ascii_whitespace()) {
+        return Err(Error::Empty {
+            path: rd.name.to_string(),
+        });
+    }
     let sv = survey(bytes, rd)?;
     let p_idx = tilting_index(&sv, machine);
-    if sv.runs.is_empty() || (!sv.uses[p_idx] && !sv.uses[C]) {
-        let mut lp = match crate::program::load_nc_with(
-            bytes.to_vec(),
-            rd.name,
-            machine,
-            rd.fallback,
-            &rd.read,
-        ) {
-            Ok(lp) => lp,
-            Err(why) if why.is_nothing_to_analyse() => {
-                return Ok(Begun::Nothing {
-                    sv: Box::new(sv),
-                    p_idx,
-                    why,
-                });
-            }
-            Err(e) => return Err(e),
-        };
-        lp.work_offset_mm = rd.work_offset_mm;
-        lp.chord_tolerance_mm = rd.chord_tolerance_mm;
-        lp.tool = rd.tool.clone();
-        return Ok(Begun::Whole(Box::new(lp)));
+    let why = if sv.runs.is_empty() {
+        Some(match sv.no_run_why {
+            Some(why) => why.error(rd.name),
+            None => crate::program::cl_file_error(bytes, rd.name).unwrap_or(Error::NoRuns {
+                path: rd.name.to_string(),
+            }),
+        })
+    } else if !sv.uses[p_idx] && !sv.uses[C] {
+        Some(Error::NoRotary {
+            path: rd.name.to_string(),
+            primary: machine.primary_letter(),
+        })
+    } else {
+        None
+    };
+    match why {
+        None => Ok(Begun::Stretches {
+            l: usize::from(p_idx == B),
+            sv: Box::new(sv),
+            p_idx,
+        }),
+        Some(why) if why.is_nothing_to_analyse() => Ok(Begun::Nothing {
+            sv: Box::new(sv),
+            p_idx,
+            why,
+        }),
+        Some(e) => Err(e),
     }
-    Ok(Begun::Stretches {
-        sv: Box::new(sv),
-        l: usize::from(p_idx == B),
-        p_idx,
-    })
 }
 
 /// Patch an NC program held in memory, writing the output to `out` as it goes (module
@@ -504,15 +562,6 @@ pub fn patch_nc_hooked(
         tool: opts.tool.clone(),
     };
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
-        Begun::Whole(lp) => {
-            let (output, report) = patch_loaded(&lp, machine, &opts.patch);
-            if (hooks.cancelled)() {
-                return Err(Error::Cancelled);
-            }
-            out.write_all(&output).map_err(Error::Output)?;
-            (hooks.progress)(bytes.len(), bytes.len());
-            return Ok(report);
-        }
         Begun::Nothing { sv, p_idx, why } => {
             let mut report = FileReport::unchanged(
                 &opts.name,
@@ -539,6 +588,15 @@ pub fn patch_nc_hooked(
     report.not_analysed = not_analysed;
     report.warnings.extend(warnings);
     let todo = stretches(&sv.runs, l, |rec| rec.near[l] || rec.feedless[l]);
+    if todo.is_empty() {
+        // No run comes near the pole: no zone, and the output is the input.
+        if (hooks.cancelled)() {
+            return Err(Error::Cancelled);
+        }
+        out.write_all(bytes).map_err(Error::Output)?;
+        (hooks.progress)(bytes.len(), bytes.len());
+        return Ok(report);
+    }
     let mut copied_to = 0usize;
     // Set when a stretch was skipped because the caller cancelled: its part is not
     // written, and the patch ends with `Error::Cancelled`.
@@ -662,15 +720,6 @@ fn analyze_each(
         tool: crate::tool::ToolOptions::default(),
     };
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
-        Begun::Whole(lp) => {
-            let mut report = crate::report::analyze_program(&lp, machine, &opts.analysis);
-            let runs = std::mem::take(&mut report.runs);
-            each(Piece::Head(&report)).map_err(Error::Output)?;
-            for run in runs {
-                each(Piece::Run(Box::new(run))).map_err(Error::Output)?;
-            }
-            return Ok(());
-        }
         Begun::Nothing { sv, p_idx, why } => {
             let (not_analysed, warnings) = sv.notes.finish(p_idx, rd.cone_deg, &opts.name);
             let l = usize::from(p_idx == B);
@@ -744,10 +793,6 @@ pub(crate) fn each_run<T: Send>(
         tool: crate::tool::ToolOptions::default(),
     };
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
-        Begun::Whole(lp) => {
-            sink(work(&lp)).map_err(Error::Output)?;
-            return Ok((lp.primary_letter as char, lp.warnings.clone()));
-        }
         Begun::Nothing { why, .. } => return Err(why),
         Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx),
     };
@@ -757,6 +802,57 @@ pub(crate) fn each_run<T: Send>(
     let todo = stretches(&sv.runs, l, |_| true);
     each_stretch(bytes, &sv, &todo, l, &rd, |lp| work(&lp), |t, _| sink(t))?;
     Ok((LETTERS[l] as char, warnings))
+}
+
+/// The whole program as one stretch ([`crate::program::load_nc`]): the same two reads as
+/// a patch, with every block and every run in the stretch. A program that holds nothing to
+/// analyse is an error here.
+pub(crate) fn load_program(
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &crate::AnalyzeOptions,
+) -> Result<LoadedProgram, Error> {
+    let name = opts.name.as_str();
+    let rd = Reading {
+        name,
+        cone_deg: opts.analysis.reach_deg(),
+        fallback: opts.feed_fallback_mm_min,
+        work_offset_mm: opts.work_offset_mm,
+        read: crate::program::read_options_with(machine, opts.inch)?,
+        chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
+        tool: crate::tool::ToolOptions::default(),
+    };
+    let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
+        Begun::Nothing { why, .. } => return Err(why),
+        Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx),
+    };
+    let whole = Stretch {
+        first_block: 0,
+        last_block: sv.blocks.saturating_sub(1),
+        runs: 0..sv.runs.len(),
+        whole: true,
+    };
+    let mut loaded = None;
+    each_stretch(
+        bytes,
+        &sv,
+        &[whole],
+        l,
+        &rd,
+        |lp| lp,
+        |lp, _| {
+            loaded = Some(lp);
+            Ok(())
+        },
+    )?;
+    let mut lp = loaded.ok_or(Error::NoRuns {
+        path: name.to_string(),
+    })?;
+    lp.warnings = primary_mismatch_warning(name, machine, p_idx)
+        .into_iter()
+        .collect();
+    lp.notes = sv.notes;
+    Ok(lp)
 }
 
 /// The second read (module docs, step 3): each stretch of `todo` built as a program with
@@ -797,10 +893,14 @@ fn each_stretch<T: Send>(
         }
         Ok::<(), std::io::Error>(())
     };
+    // The tool in use ([`crate::tool`]): a run's is the program's as it stands at the
+    // run's last block (a tool change ends runs).
+    let mut tracker = crate::tool::Tracker::default();
     let give_run = |run: Run,
                     run_no: &mut usize,
                     building: &mut Option<InHand>,
-                    done: &mut VecDeque<InHand>| {
+                    done: &mut VecDeque<InHand>,
+                    tracker: &crate::tool::Tracker| {
         let r = *run_no;
         *run_no += 1;
         let hand = done
@@ -808,7 +908,7 @@ fn each_stretch<T: Send>(
             .chain(building.iter_mut())
             .find(|h| h.stretch.runs.contains(&r));
         if let Some(h) = hand {
-            h.runs.push(run);
+            h.runs.push((run, tracker.found()));
         }
     };
     // The survey's options: the dialect found and the program flow settled, so this read
@@ -817,7 +917,11 @@ fn each_stretch<T: Send>(
         if let Some(h) = &mut building {
             h.program.push(&s);
             if h.stretch.last_block == i {
-                h.end_byte = Some(line_end_after(bytes, s.block.span().end));
+                h.end_byte = Some(if h.stretch.whole {
+                    bytes.len()
+                } else {
+                    line_end_after(bytes, s.block.span().end)
+                });
                 done.extend(building.take());
             }
         }
@@ -827,7 +931,8 @@ fn each_stretch<T: Send>(
             && let Some(st) = todo.get(next)
             && st.first_block == i
         {
-            let mut program = ProgramBuilder::new(s.block.span().start, &prev);
+            let base = if st.whole { 0 } else { s.block.span().start };
+            let mut program = ProgramBuilder::new(base, &prev);
             program.push(&s);
             building = Some(InHand {
                 stretch: st.clone(),
@@ -838,8 +943,16 @@ fn each_stretch<T: Send>(
             next += 1;
         }
         builder.push(i, s.block, s.state, &mut |run| {
-            give_run(run, &mut run_no, &mut building, &mut done)
+            give_run(run, &mut run_no, &mut building, &mut done, &tracker)
         });
+        // After the runs this block ends: a tool change is the next run's.
+        tracker.block(
+            sv.dialect,
+            s.block.line,
+            &bytes[s.block.span()],
+            s.words,
+            s.state.inch,
+        );
         while done
             .front()
             .is_some_and(|h| h.runs.len() == h.stretch.runs.len())
@@ -864,7 +977,7 @@ fn each_stretch<T: Send>(
     if let Some(e) = failure {
         return Err(e);
     }
-    builder.finish(&mut |run| give_run(run, &mut run_no, &mut building, &mut done));
+    builder.finish(&mut |run| give_run(run, &mut run_no, &mut building, &mut done, &tracker));
     ready.extend(done);
     flush(&mut ready).map_err(Error::Output)
 }
@@ -881,14 +994,13 @@ fn loaded(bytes: &[u8], hand: InHand, sv: &Survey, l: usize, rd: &Reading<'_>) -
     let runs: Vec<RunPath> = hand
         .runs
         .into_iter()
-        .zip(recs)
-        .map(|(mut run, rec)| {
+        .map(|(mut run, tool)| {
             for b in &mut run.blocks {
                 *b -= first;
             }
             let line = program.blocks[run.blocks[0]].line;
             let mut rp = run_path(run, p_idx, rd.fallback, line);
-            rp.found_tool = sv.tools[rec.tool].clone();
+            rp.found_tool = tool;
             rp
         })
         .collect();
@@ -898,14 +1010,13 @@ fn loaded(bytes: &[u8], hand: InHand, sv: &Survey, l: usize, rd: &Reading<'_>) -
         primary_letter: LETTERS[l],
         runs,
         warnings: Vec::new(),
-        work_offset_mm: rd.work_offset_mm,
         chord_tolerance_mm: rd.chord_tolerance_mm,
-        window: Some(Window {
+        window: Window {
             first_run: hand.stretch.runs.start,
             style: sv.style,
             end: recs.iter().map(|r| r.end[l].pose(first)).collect(),
             datum_mm: recs.iter().map(|r| r.datum_mm).collect(),
-        }),
+        },
         notes: crate::notes::Notes::new(),
         tool: rd.tool.clone(),
     }

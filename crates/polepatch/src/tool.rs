@@ -535,6 +535,12 @@ impl Tracker {
             self.revision += 1;
         }
         self.inch = inch;
+        if !may_name_tool(text, words) {
+            // What a block without a T, a comment or M6 does (below): it ends a table.
+            self.nx_table = false;
+            self.powermill_table = false;
+            return;
+        }
         let unit = 1.0;
         let raw = String::from_utf8_lossy(text);
         let up = raw.to_ascii_uppercase();
@@ -719,6 +725,24 @@ fn fusion_id(c: &str) -> Option<ToolId> {
 
 /// The text of a line's comment, upper case: inside `( )` or after `;` (also a
 /// conversational `* -` line).
+/// Whether a block (`text`, `words`) may say anything of the tool: a T in any case (`T`
+/// words, `TOOL DEF`/`TOOL CALL`, `T="…"`, the tables' headers), a comment
+/// ([`comment_text`]'s forms) or M6. Most blocks do not, and [`Tracker::block`] skips them
+/// without looking further.
+fn may_name_tool(text: &[u8], words: &[Word]) -> bool {
+    if text.iter().any(|&b| matches!(b, b'T' | b't' | b'(' | b';')) {
+        return true;
+    }
+    let t = text.trim_ascii_start();
+    let digits = t.iter().take_while(|b| b.is_ascii_digit()).count();
+    if t[digits..].trim_ascii_start().starts_with(b"*") {
+        return true;
+    }
+    words
+        .iter()
+        .any(|w| w.letter == b'M' && (w.value - 6.0).abs() < 1e-9)
+}
+
 fn comment_text(up: &str) -> Option<&str> {
     if let Some(k) = up.find('(') {
         let rest = &up[k + 1..];

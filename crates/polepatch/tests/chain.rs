@@ -31,7 +31,7 @@ const SING_DATUM: [f64; 3] = [-30.489, -7.1, 38.054];
 /// the part-frame tool tip it was made from.
 fn sing_without_tcpm(machine: &Machine) -> (Vec<u8>, Vec<Option<[f64; 3]>>) {
     let chain = machine.chain.unwrap();
-    let lp = load_nc(sing(), "SING.I", machine, None).unwrap();
+    let lp = load_nc(&sing(), "SING.I", machine, None).unwrap();
     let program = &lp.program;
     let mut edits = Vec::new();
     let mut tips = vec![None; program.blocks.len()];
@@ -79,8 +79,8 @@ fn chord_errors(
 ) -> (f64, usize) {
     use polepatch::machine_frame::chord_error_mm;
     let chain = machine.chain.unwrap();
-    let a = load_nc(input.to_vec(), "in", machine, None).unwrap();
-    let b = load_nc(output.to_vec(), "out", machine, None).unwrap();
+    let a = load_nc(input, "in", machine, None).unwrap();
+    let b = load_nc(output, "out", machine, None).unwrap();
     assert_eq!(a.runs.len(), b.runs.len());
     let mut worst: f64 = 0.0;
     let mut checked = 0;
@@ -184,7 +184,7 @@ fn without_tcpm_every_changed_block_stays_within_the_chord_tolerance() {
 /// removed.
 fn machine_coordinates(machine: &Machine, tcpm_program: &[u8], datum: [f64; 3]) -> Vec<u8> {
     let chain = machine.chain.unwrap();
-    let lp = load_nc(tcpm_program.to_vec(), "tcpm", machine, None).unwrap();
+    let lp = load_nc(tcpm_program, "tcpm", machine, None).unwrap();
     let program = &lp.program;
     let mut edits = Vec::new();
     for rp in lp.runs.iter().filter(|rp| rp.run.tcpm.is_on()) {
@@ -236,8 +236,8 @@ fn without_tcpm_x_y_z_change_with_the_rotary_axes_and_the_tool_tip_stays() {
     assert_eq!(report.zones.len(), 1);
     assert_eq!(report.zones[0].outcome, "reached", "{:?}", report.zones[0]);
     // X Y Z and C change together, block by block.
-    let before = load_nc(input.clone(), "in", &machine, None).unwrap();
-    let after = load_nc(out.clone(), "out", &machine, None).unwrap();
+    let before = load_nc(&input, "in", &machine, None).unwrap();
+    let after = load_nc(&out, "out", &machine, None).unwrap();
     let (bp, ap) = (&before.program, &after.program);
     assert_eq!(bp.blocks.len(), ap.blocks.len());
     let mut c_changed = 0;
@@ -405,8 +405,12 @@ fn the_work_offset_is_known_or_the_run_is_left() {
     let m = Machine::builtin("mikron-ucp710").unwrap();
     let given = Some([10.0, 20.0, 30.0]);
     let datum = |text: &str, given: Option<[f64; 3]>| {
-        let lp = load_nc(text.as_bytes().to_vec(), "t", &m, None).unwrap();
-        run_datum(&lp, lp.runs.len() - 1, given)
+        let opts = polepatch::AnalyzeOptions {
+            work_offset_mm: given,
+            ..polepatch::AnalyzeOptions::default()
+        };
+        let lp = polepatch::program::load_nc_with(text.as_bytes(), &m, &opts).unwrap();
+        run_datum(&lp, lp.runs.len() - 1)
     };
     let run = "G1 X0 Y0 Z0 A30 C0 F1000\nX1 C10\nX2 C20\n";
     // Fanuc names G54 once: the command line's value.

@@ -132,7 +132,7 @@ fn joints_to_cl_to_post_gives_the_same_joints() {
     let mut n = 0;
     for (path, machine, rule) in cases() {
         let what = path.display().to_string();
-        let lp = load_nc(std::fs::read(&path).unwrap(), &what, &machine, None).unwrap();
+        let lp = load_nc(&std::fs::read(&path).unwrap(), &what, &machine, None).unwrap();
         let original = tcpm_moves(&lp);
         let pts = cl_points(&lp, &machine);
         let decimals = NumberStyle::of(&lp.program, lp.primary_letter)
@@ -148,7 +148,7 @@ fn joints_to_cl_to_post_gives_the_same_joints() {
             };
             let (bytes, report) = post_cl(&cl, &machine, &opts).unwrap();
             assert!(report.is_none());
-            let posted = load_nc(bytes, "posted", &machine, None).unwrap();
+            let posted = load_nc(&bytes, "posted", &machine, None).unwrap();
             // Rounding to the file's decimals twice (the original, then the post).
             same_joints(
                 &original,
@@ -167,7 +167,7 @@ fn the_posted_program_patches_like_the_original() {
     for (path, machine, rule) in cases().into_iter().step_by(3) {
         let what = path.display().to_string();
         let bytes = std::fs::read(&path).unwrap();
-        let lp = load_nc(bytes.clone(), &what, &machine, None).unwrap();
+        let lp = load_nc(&bytes, &what, &machine, None).unwrap();
         let decimals = NumberStyle::of(&lp.program, lp.primary_letter)
             .decimals
             .max(NumberStyle::of(&lp.program, b'C').decimals);
@@ -183,8 +183,8 @@ fn the_posted_program_patches_like_the_original() {
         let outcomes =
             |r: &polepatch::FileReport| r.zones.iter().map(|z| z.outcome).collect::<Vec<_>>();
         assert_eq!(outcomes(&report), outcomes(&orig_report), "{what}");
-        let a = tcpm_moves(&load_nc(orig_out, "a", &machine, None).unwrap());
-        let b = tcpm_moves(&load_nc(posted, "b", &machine, None).unwrap());
+        let a = tcpm_moves(&load_nc(&orig_out, "a", &machine, None).unwrap());
+        let b = tcpm_moves(&load_nc(&posted, "b", &machine, None).unwrap());
         let tol =
             1.5 * 10f64.powi(-(report.written_c_decimals.unwrap_or(decimals).max(decimals) as i32));
         same_joints(&a, &b, tol.max(1.5e-3), &what);

@@ -16,7 +16,7 @@ fn read(p: &str) -> Vec<u8> {
 
 /// (line, A, C) of every block that writes a rotary word, in order.
 fn rotary_words(bytes: &[u8], machine: &Machine) -> Vec<(usize, f64, f64)> {
-    let lp = load_nc(bytes.to_vec(), "x", machine, None).unwrap();
+    let lp = load_nc(bytes, "x", machine, None).unwrap();
     let p = &lp.program;
     (0..p.blocks.len())
         .filter(|&b| {
@@ -113,8 +113,8 @@ fn reorientation_and_back_returns_the_words() {
     };
     let there = step(&sing, 12.0, 30.0);
     let back = step(&step(&there, -12.0, 0.0), 0.0, -30.0);
-    let a = load_nc(sing.clone(), "a", &m, None).unwrap();
-    let b = load_nc(back, "b", &m, None).unwrap();
+    let a = load_nc(&sing, "a", &m, None).unwrap();
+    let b = load_nc(&back, "b", &m, None).unwrap();
     let (mut compared, mut same_branch) = (0, 0);
     for blk in 0..a.program.blocks.len() {
         let (sa, sb) = (a.program.state(blk), b.program.state(blk));
@@ -372,7 +372,7 @@ fn out_of_range_tilts_are_refused() {
 
 /// (line, P, C) of every move under TCPM, from the modal state (whichever tilting letter).
 fn rotary_words_of(bytes: &[u8], machine: &Machine) -> Vec<(usize, f64, f64)> {
-    let lp = load_nc(bytes.to_vec(), "x", machine, None).unwrap();
+    let lp = load_nc(bytes, "x", machine, None).unwrap();
     let p = &lp.program;
     let pi = lp.primary_index();
     (0..p.blocks.len())

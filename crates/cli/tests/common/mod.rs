@@ -1,6 +1,7 @@
 //! Shared checks of the patch tests.
 #![allow(dead_code)]
 
+use polepatch::FileReport;
 use polepatch::kinematics::{Axis, Machine};
 use polepatch::nc::{Dialect, parse};
 use polepatch::patcher::analysis::{SpanFigures, analyze_spans};
@@ -8,7 +9,6 @@ use polepatch::patcher::direct::deviation_bound_zone;
 use polepatch::patcher::verify::NOT_WORSE_REL;
 use polepatch::patcher::{AnalysisOptions, CLimits, PatchAxes, PatchOptions, analyze_path};
 use polepatch::program::{LoadedProgram, load_nc};
-use polepatch::{FileReport, patch_loaded};
 use std::path::{Path, PathBuf};
 
 /// Run the `polepatch` binary in the repository root: (exit code, stdout, stderr).
@@ -57,7 +57,27 @@ pub fn fixtures() -> Vec<PathBuf> {
 }
 
 pub fn load_bytes(bytes: &[u8], name: &str, machine: &Machine) -> LoadedProgram {
-    load_nc(bytes.to_vec(), name, machine, None).unwrap_or_else(|e| panic!("{name}: {e}"))
+    load_nc(bytes, name, machine, None).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// Patch `lp`'s bytes through the one pipeline ([`polepatch::patch_nc`]) with the
+/// patcher's options `opts`, the tool options `lp.tool`.
+pub fn patch_lp(
+    lp: &LoadedProgram,
+    machine: &Machine,
+    opts: &PatchOptions,
+) -> (Vec<u8>, FileReport) {
+    polepatch::patch_nc(
+        &lp.program.bytes,
+        machine,
+        &polepatch::PatchOptions {
+            patch: opts.clone(),
+            name: lp.name.clone(),
+            tool: lp.tool.clone(),
+            ..polepatch::PatchOptions::default()
+        },
+    )
+    .unwrap_or_else(|e| panic!("{}: {e}", lp.name))
 }
 
 /// Per run: (lowest C ratio, number of zones) as `polepatch analyze` sees the program.
@@ -193,7 +213,7 @@ pub fn check_patch_both(
     let m = &machine.name;
     let lp = load_bytes(bytes, name, machine);
     let before = c_ratios_and_zones(&lp, machine, opts.cone_deg);
-    let (out, report) = patch_loaded(&lp, machine, opts);
+    let (out, report) = patch_lp(&lp, machine, opts);
     if before.iter().all(|r| r.1 == 0) {
         assert_eq!(out, bytes, "{name} on {m}: no zone, so byte-identical");
     }
@@ -396,7 +416,7 @@ pub fn check_patch_only_c(
 ) -> (FileReport, Vec<u8>) {
     let lp = load_bytes(bytes, name, machine);
     let before = c_ratios_and_zones(&lp, machine, opts.cone_deg);
-    let (out, report) = patch_loaded(&lp, machine, opts);
+    let (out, report) = patch_lp(&lp, machine, opts);
     if before.iter().all(|r| r.1 == 0) {
         assert_eq!(
             out, bytes,
@@ -444,7 +464,7 @@ pub fn check_patch_only_c(
                     max_decimals: 8,
                     ..opts.clone()
                 };
-                let (out, _) = patch_loaded(&lp, machine, &fine);
+                let (out, _) = patch_lp(&lp, machine, &fine);
                 let zones_left =
                     c_ratios_and_zones(&load_bytes(&out, name, machine), machine, opts.cone_deg)[k]
                         .1;
