@@ -8,7 +8,7 @@
 //!    span) and find its singular zones; zones closer than
 //!    [`SolverSettings::merge_gap_points`] are one.
 //! 3. For each zone, in path order, on the values the zones before it left:
-//!    - the methods of the strategy ([`methods`]) propose candidates through a [`Sink`],
+//!    - the methods of the strategy ([`crate::strategy::methods`]) propose candidates through a [`Sink`],
 //!      for each rung of the margin ladder ([`SolverSettings::margin_ladder`]) until one
 //!      passes;
 //!    - every candidate is **rounded as it will be written** (the file's decimals, then one
@@ -35,28 +35,30 @@
 //!   `max_deviation_deg`;
 //! - `end_pinned`: the run's last point must keep its values (`keep_last_point`, the NC
 //!   pipeline says which block pins it), and with it held **no** values reach feed, while
-//!   with it free some would (both by the relaxation of [`crate::reference::reachable`]);
+//!   with it free some would (both by the relaxation of [`crate::proof::reachable`]);
 //! - `range`: the machine's axis ranges forbid every values that would reach feed (the
 //!   relaxation is infeasible with them, feasible without);
 //! - `proven_unreachable`: no values of the movable points reach feed at all (the
-//!   relaxation is infeasible — a proof, see [`crate::reference`]);
+//!   relaxation is infeasible — a proof, see [`crate::proof`]);
 //! - `not_found`: none of the above: polepatch found no patch, and cannot prove there is
 //!   none (or a patch failed the whole-run verification);
 //! - `not_patched`: the run may not be patched (no TCPM, incremental, …: the caller's
 //!   reason), so the zone is only reported ([`crate::report_unpatched`]).
 
 use crate::{
-    analysis::{AnalysisOptions, RATIO_TOL, SpanFigures, Zone, ZoneKind, analyze_spans, validate},
+    analysis::{AnalysisOptions, RATIO_TOL, SpanFigures, Zone, analyze_spans, validate},
+    centre::{tip_length, written_path},
     options::{PatchAxes, PatchOptions, round_written},
     path::{Path, PathError},
-    peers::Strategy,
+    proof::why_not_reached,
+    protocol::{Offered, Proposal, Proposer, Sink, Tail, ZoneCtx},
     qp::add_stats,
     report::{Method, Outcome, QpStats, Reason, ZoneFigures, ZoneReport},
-    settings::SolverSettings,
-    verify::{AxisChange, Verdict, verify_change_on, verify_change_with_core},
+    verify::{AxisChange, Verdict, not_worse_floor, verify_change_on, verify_change_with_core},
 };
-use polepatch_kinematics::{Axis, LimitKind, Machine, angle_between_deg, forward};
-use std::ops::Range;
+use polepatch_kinematics::{Axis, Machine, angle_between_deg, forward};
+
+pub use crate::zones::{figures_over, merge_zones, zone_core};
 
 /// Narrowing a patch that slowed a linear axis away from its zone ([`patch_with`], a
 /// ball's centre kept) moves its bound at least this fraction of the way to the zone.
@@ -72,120 +74,6 @@ const SCALE_SAFETY: f64 = 0.98;
 /// Points of unchanged path either side of a candidate's change and its zone that the
 /// candidate check verifies (the whole run is verified again at the end).
 pub const CHECK_MARGIN_POINTS: usize = crate::verify::VERIFY_MARGIN_POINTS + 1;
-
-/// What happens to the points after a candidate's last point.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Tail {
-    /// They keep their values.
-    Keep,
-    /// They move to the other IK branch as a block, `(P, C) → (−P, C + shift)`: the same
-    /// tool axes, every derivative's size kept.
-    Reselect {
-        /// ±180°.
-        shift_deg: f64,
-    },
-    /// C gets a 360° multiple added (`--c-offset`, the C-only method).
-    COffset {
-        /// The multiple of 360°.
-        deg: f64,
-    },
-}
-
-/// A method's proposal for a zone: new (unrounded) values for points `first..=last`.
-#[derive(Debug, Clone)]
-pub struct Proposal {
-    /// The method that made it.
-    pub method: Method,
-    /// First point with new values.
-    pub first: usize,
-    /// Last point with new values.
-    pub last: usize,
-    /// New primary values for `first..=last`, degrees.
-    pub p: Vec<f64>,
-    /// New C values for `first..=last`, degrees.
-    pub c: Vec<f64>,
-    /// The points after `last`.
-    pub tail: Tail,
-    /// Solver statistics of the solves that made it.
-    pub qp: QpStats,
-}
-
-/// What the driver says about a proposal it was offered.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Offered {
-    /// Reaches feed over the zone's core and nothing got worse, as written.
-    pub passes: bool,
-    /// Exact largest orientation change, degrees, as written.
-    pub deviation_deg: f64,
-}
-
-/// Where a method hands its proposals (the driver's checker).
-pub trait Sink {
-    /// Round, verify and consider `p`; `None` when it cannot be evaluated (non-finite
-    /// values, a range the zone may not change).
-    fn offer(&mut self, p: Proposal) -> Option<Offered>;
-    /// Add the statistics of solves that made no proposal.
-    fn add_stats(&mut self, qp: &QpStats);
-    /// The smallest deviation of a passing proposal so far (within the cap), degrees.
-    fn best_passing_deg(&self) -> Option<f64>;
-}
-
-/// What a method sees of one zone.
-pub struct ZoneCtx<'a> {
-    /// Path length per point, mm.
-    pub s: &'a [f64],
-    /// The program's tool axes (what every change is measured against).
-    pub target: &'a [[f64; 3]],
-    /// The machine.
-    pub machine: &'a Machine,
-    /// The caller's options.
-    pub opts: &'a PatchOptions,
-    /// Numerical settings.
-    pub settings: &'a SolverSettings,
-    /// Programmed feed, mm/min.
-    pub feed_mm_min: f64,
-    /// The zone.
-    pub zone: &'a Zone,
-    /// The spans that must reach feed (the zone ± the core margin).
-    pub core: Range<usize>,
-    /// First point a proposal may change.
-    pub lower: usize,
-    /// Last point a proposal may change (the run's last, or the one before it when the
-    /// last must stay).
-    pub end: usize,
-    /// Current primary values of the whole path, degrees.
-    pub p: &'a [f64],
-    /// Current C values of the whole path, degrees.
-    pub c: &'a [f64],
-    /// The margin on the limits for this rung of the ladder.
-    pub margin: f64,
-    /// Index of the rung (0: the configured margin).
-    pub rung: usize,
-}
-
-/// A method: proposes candidates for a zone.
-pub trait Proposer {
-    /// Offer candidates for `ctx`'s zone to `sink`.
-    fn propose(&mut self, ctx: &ZoneCtx<'_>, sink: &mut dyn Sink);
-}
-
-/// The methods of a strategy, in the order they are asked, and whether their proposals
-/// are verified (a peer's rule is scored as it is, never held back).
-pub fn methods(opts: &PatchOptions) -> (Vec<Box<dyn Proposer>>, bool) {
-    match (opts.strategy, opts.axes) {
-        (Strategy::Polepatch, PatchAxes::Both) => (
-            vec![
-                Box::new(crate::reselect::Reselect),
-                Box::new(crate::joint_method::JointMethod),
-            ],
-            true,
-        ),
-        (Strategy::Polepatch, PatchAxes::OnlyC) => {
-            (vec![Box::new(crate::c_only::COnly::default())], true)
-        }
-        (peer, _) => (vec![Box::new(crate::peers::Peer(peer))], false),
-    }
-}
 
 /// A candidate after rounding and verification.
 #[derive(Debug, Clone)]
@@ -286,7 +174,7 @@ impl Selection<'_> {
                     std::array::from_fn(|j| q[j] + keep.radius_mm * (o0[j] - o1[j]))
                 })
                 .collect();
-            Some(crate::centre::tip_length(self.s[lo], &tips))
+            Some(tip_length(self.s[lo], &tips))
         };
         let verify = |wp: &[f64], wc: &[f64]| {
             let ch: Vec<AxisChange> = axes
@@ -578,58 +466,6 @@ pub(crate) fn analysis_options(opts: &PatchOptions) -> AnalysisOptions {
     }
 }
 
-/// Zones in order, those closer than `gap` points merged.
-pub fn merge_zones(zones: &[Zone], gap: usize) -> Vec<Zone> {
-    let mut out: Vec<Zone> = Vec::new();
-    let mut sorted = zones.to_vec();
-    sorted.sort_by_key(|z| z.first);
-    for z in sorted {
-        match out.last_mut() {
-            Some(m) if z.first <= m.last + gap => {
-                if z.min_abs_primary_deg < m.min_abs_primary_deg {
-                    m.singular = z.singular;
-                    m.min_abs_primary_deg = z.min_abs_primary_deg;
-                }
-                if z.kind == ZoneKind::AFlip {
-                    m.kind = ZoneKind::AFlip;
-                }
-                m.last = m.last.max(z.last);
-                m.c_ratio_min = m.c_ratio_min.min(z.c_ratio_min);
-            }
-            _ => out.push(z),
-        }
-    }
-    out
-}
-
-/// The spans a zone's patch must bring to feed: the zone's, ± `margin` points.
-pub fn zone_core(zone: &Zone, n: usize, margin: usize) -> Range<usize> {
-    zone.first.saturating_sub(margin)..(zone.last + margin).min(n - 1)
-}
-
-/// Equation-6 figures over the spans `spans` of a run's span figures.
-pub fn figures_over(spans: &[SpanFigures], range: Range<usize>) -> ZoneFigures {
-    let mut f = ZoneFigures {
-        c_ratio: 1.0,
-        primary_ratio: 1.0,
-        overall_ratio: 1.0,
-        limiting_axis: None,
-        limiting_kind: LimitKind::Feed,
-        time_s: 0.0,
-    };
-    for sp in &spans[range.start.min(spans.len())..range.end.min(spans.len())] {
-        f.c_ratio = f.c_ratio.min(sp.axis_ratio[Axis::C.index()]);
-        f.primary_ratio = f.primary_ratio.min(sp.axis_ratio[Axis::Primary.index()]);
-        if sp.bound.ratio < f.overall_ratio {
-            f.overall_ratio = sp.bound.ratio;
-            f.limiting_axis = sp.bound.axis;
-            f.limiting_kind = sp.bound.kind;
-        }
-        f.time_s += sp.time_s;
-    }
-    f
-}
-
 /// Spans on which the machine is slower after than before: the overall ratio (every axis
 /// and the feed) below [`crate::verify::not_worse_floor`] of the ratio before. Where a
 /// patch moves the tips (a ball's centre kept), a linear axis may take over a span's limit
@@ -639,7 +475,7 @@ pub fn whole_run_slower(before: &[SpanFigures], after: &[SpanFigures]) -> Vec<us
         .iter()
         .zip(after)
         .enumerate()
-        .filter(|(_, (b, a))| a.bound.ratio < crate::verify::not_worse_floor(b.bound.ratio))
+        .filter(|(_, (b, a))| a.bound.ratio < not_worse_floor(b.bound.ratio))
         .map(|(k, _)| k)
         .collect()
 }
@@ -654,7 +490,7 @@ pub fn whole_run_worse(before: &[SpanFigures], after: &[SpanFigures], axes: &[Ax
         .filter(|(_, (b, a))| {
             axes.iter().any(|ax| {
                 let k = ax.index();
-                a.axis_ratio[k] < crate::verify::not_worse_floor(b.axis_ratio[k])
+                a.axis_ratio[k] < not_worse_floor(b.axis_ratio[k])
             })
         })
         .map(|(k, _)| k)
@@ -756,17 +592,6 @@ fn solve_zone(
     }
 }
 
-/// Patch every singular zone of `path` with the methods of `opts`' strategy (module
-/// docs).
-pub fn patch_path(
-    path: &Path,
-    machine: &Machine,
-    opts: &PatchOptions,
-) -> Result<PatchResult, PathError> {
-    let (m, verify) = methods(opts);
-    patch_with(path, machine, opts, m, verify)
-}
-
 /// [`patch_path`] with the given methods (asked in order) and whether their proposals are
 /// verified.
 ///
@@ -798,7 +623,7 @@ pub fn patch_with(
         if reached(&best) == best.zones.len() {
             break;
         }
-        let s = crate::centre::tip_length(path.s_mm[0], &last.xyz_mm);
+        let s = tip_length(path.s_mm[0], &last.xyz_mm);
         let moved = s
             .windows(2)
             .zip(solve_s.windows(2))
@@ -895,7 +720,7 @@ fn patch_on(
         let keep = keep_written.as_ref();
         // Written tips that do not make a path (two on one spot) count as worse at the
         // first span.
-        let written = crate::centre::written_path(path, &cur_p, &cur_c, machine, keep);
+        let written = written_path(path, &cur_p, &cur_c, machine, keep);
         let worse = match &written {
             Some(w) => {
                 spans_after = analyze_spans(w, machine, &aopts)?.1;
@@ -1076,7 +901,7 @@ fn patch_on(
         } else if d.reverted {
             Reason::NotFound
         } else {
-            crate::reference::why_not_reached(
+            why_not_reached(
                 path,
                 &cur_p,
                 &cur_c,
@@ -1227,6 +1052,7 @@ pub fn report_unpatched(
 mod tests {
     use super::*;
     use crate::analysis::analyze_path;
+    use crate::strategy::patch_path;
     use crate::testutil::{machine, planted, sing_path};
     use crate::verify::NOT_WORSE_REL;
 

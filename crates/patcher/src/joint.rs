@@ -598,8 +598,8 @@ mod tests {
         let k = (0..p.len())
             .min_by(|&a, &b| p[a].abs().total_cmp(&p[b].abs()))
             .unwrap();
-        let shift = crate::reselect::tail_shift(&m, &p, &c, k, false).unwrap();
-        let (op, oc) = crate::reselect::other_branch(&p, &c, k, shift);
+        let shift = crate::starts::tail_shift(&m, &p, &c, k, false).unwrap();
+        let (op, oc) = crate::starts::other_branch(&p, &c, k, shift);
         let sol = solve_joint(&problem(&path, &op, &oc, &target, &m, &st, None)).unwrap();
         assert!(sol.excess <= st.elastic_tol, "{sol:?}");
         assert!(sol.max_deviation_deg < 1.05, "{}", sol.max_deviation_deg);

@@ -1,6 +1,7 @@
 //! Options of the patcher.
 
 use crate::path::PathError;
+pub use crate::path::round_written;
 use crate::settings::SolverSettings;
 
 /// Which rotary axes the patcher may change.
@@ -12,6 +13,42 @@ pub enum PatchAxes {
     Both,
     /// C only, the primary axis as programmed (G16's method, `--only-c`).
     OnlyC,
+}
+
+/// How the patcher treats a zone: polepatch's method (see [`PatchOptions::axes`]) or one of
+/// the peers' rules ([`crate::peers`]); [`crate::strategy`] says which methods
+/// answer each.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Strategy {
+    /// polepatch: branch re-selection, joint patch, verification (or the C-only method).
+    #[default]
+    Polepatch,
+    /// C held at its entry value inside the cone.
+    Freeze,
+    /// C linear in s across the cone.
+    Linearize,
+    /// C a cubic blend across the cone.
+    Smooth,
+}
+
+impl Strategy {
+    /// Every strategy, polepatch first.
+    pub const ALL: [Strategy; 4] = [
+        Strategy::Polepatch,
+        Strategy::Freeze,
+        Strategy::Linearize,
+        Strategy::Smooth,
+    ];
+    /// The name used on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Strategy::Polepatch => "polepatch",
+            Strategy::Freeze => "freeze",
+            Strategy::Linearize => "linearize",
+            Strategy::Smooth => "smooth",
+        }
+    }
 }
 
 /// Options of [`crate::patch_path`]. Plain struct: every field public, documented default.
@@ -29,7 +66,7 @@ pub struct PatchOptions {
     pub axes: PatchAxes,
     /// polepatch's method, or a peer's rule for comparison ([`crate::peers`]). Default
     /// [`Strategy::Polepatch`].
-    pub strategy: crate::peers::Strategy,
+    pub strategy: Strategy,
     /// Largest orientation deviation allowed at any point, degrees; `None` = no limit
     /// (the deviation is still minimised). Default `None`.
     pub max_deviation_deg: Option<f64>,
@@ -82,7 +119,7 @@ impl Default for PatchOptions {
             cone_deg: crate::analysis::CONE_DEG,
             pole_reach_deg: crate::analysis::POLE_REACH_DEG,
             axes: PatchAxes::Both,
-            strategy: crate::peers::Strategy::Polepatch,
+            strategy: Strategy::Polepatch,
             max_deviation_deg: None,
             tcy_s: None,
             margin: 0.02,
@@ -110,7 +147,7 @@ impl PatchOptions {
     /// method, a cone, margin or cap out of range.
     pub fn validate(&self) -> Result<(), PathError> {
         let bad = |what: &str| Err(PathError::Options(what.to_string()));
-        if self.axes == PatchAxes::Both && self.strategy == crate::peers::Strategy::Polepatch {
+        if self.axes == PatchAxes::Both && self.strategy == Strategy::Polepatch {
             if self.allow_c_offset {
                 return bad(
                     "a 360° C offset (allow_c_offset) is G16's join option: it needs the C-only method",
@@ -165,10 +202,4 @@ impl PatchOptions {
         }
         Ok(())
     }
-}
-
-/// The value the controller receives when `v` is written with `decimals` places
-/// (the same rounding as the NC writer: `format!("{:.*}", decimals, v)`).
-pub fn round_written(v: f64, decimals: usize) -> f64 {
-    format!("{v:.decimals$}").parse().unwrap_or(v)
 }

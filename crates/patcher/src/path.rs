@@ -59,3 +59,9 @@ pub enum PathError {
     #[error("programmed feed must be positive, got {0} mm/min")]
     BadFeed(f64),
 }
+
+/// The value the controller receives when `v` is written with `decimals` places
+/// (the same rounding as the NC writer: `format!("{:.*}", decimals, v)`).
+pub fn round_written(v: f64, decimals: usize) -> f64 {
+    format!("{v:.decimals$}").parse().unwrap_or(v)
+}
