@@ -6,16 +6,16 @@
 //!    unchanged without any spline work.
 //! 2. **Analyse** the run ([`crate::analysis::analyze_spans`]: Equation 6 exact over every
 //!    span) and find its singular zones; zones closer than
-//!    [`SolverSettings::merge_gap_points`] are one.
+//!    [`crate::SolverSettings::merge_gap_points`] are one.
 //! 3. For each zone, in path order, on the values the zones before it left:
 //!    - the methods of the strategy ([`crate::strategy::methods`]) propose candidates through a [`Sink`],
-//!      for each rung of the margin ladder ([`SolverSettings::margin_ladder`]) until one
+//!      for each rung of the margin ladder ([`crate::SolverSettings::margin_ladder`]) until one
 //!      passes;
 //!    - every candidate is **rounded as it will be written** (the file's decimals, then one
 //!      more at a time up to `max_decimals` where rounding alone breaks it) and **verified**
 //!      ([`crate::verify::verify_change_with_core`]): the checked rotary axes (both, or C
 //!      with `--only-c`) reach feed over the zone's core (the zone ±
-//!      [`SolverSettings::core_margin_points`]), and nothing gets worse around it;
+//!      [`crate::SolverSettings::core_margin_points`]), and nothing gets worse around it;
 //!    - **selection**: of the passing candidates whose exact largest orientation change
 //!      (the angle between the old and new tool axes, on the written values) is within
 //!      `max_deviation_deg`, the smallest; else the best improvement within it; else
@@ -46,7 +46,7 @@
 //!   reason), so the zone is only reported ([`crate::report_unpatched`]).
 
 use crate::{
-    analysis::{AnalysisOptions, RATIO_TOL, SpanFigures, Zone, analyze_spans, validate},
+    analysis::{AnalysisOptions, SpanFigures, Zone, analyze_spans, validate},
     centre::{tip_length, written_path},
     options::{PatchAxes, PatchOptions, round_written},
     path::{Path, PathError},
@@ -54,26 +54,12 @@ use crate::{
     protocol::{Offered, Proposal, Proposer, Sink, Tail, ZoneCtx},
     qp::add_stats,
     report::{Method, Outcome, QpStats, Reason, ZoneFigures, ZoneReport},
+    tolerances::{CAP_SLACK_DEG, CHECK_MARGIN_POINTS, RATIO_TOL},
     verify::{AxisChange, Verdict, not_worse_floor, verify_change_on, verify_change_with_core},
 };
 use polepatch_kinematics::{Axis, Machine, angle_between_deg, forward};
 
 pub use crate::zones::{figures_over, merge_zones, zone_core};
-
-/// Narrowing a patch that slowed a linear axis away from its zone ([`patch_with`], a
-/// ball's centre kept) moves its bound at least this fraction of the way to the zone.
-const NARROW_STEP_DIV: usize = 4;
-
-/// Tries at scaling a change that reaches feed beyond `max_deviation_deg` into the cap
-/// (the best improvement within it).
-const SCALE_TRIES: usize = 4;
-/// Each try aims this fraction of the cap (the deviation is nearly, not exactly, linear in
-/// the scale; rounding adds a little).
-const SCALE_SAFETY: f64 = 0.98;
-
-/// Points of unchanged path either side of a candidate's change and its zone that the
-/// candidate check verifies (the whole run is verified again at the end).
-pub const CHECK_MARGIN_POINTS: usize = crate::verify::VERIFY_MARGIN_POINTS + 1;
 
 /// A candidate after rounding and verification.
 #[derive(Debug, Clone)]
@@ -176,6 +162,7 @@ impl Selection<'_> {
                 .collect();
             Some(tip_length(self.s[lo], &tips))
         };
+        let margin = self.opts.solver.core_margin_points;
         let verify = |wp: &[f64], wc: &[f64]| {
             let ch: Vec<AxisChange> = axes
                 .iter()
@@ -190,14 +177,22 @@ impl Selection<'_> {
                 (self.zone.first.max(lo) - lo, self.zone.last.min(hi) - lo),
             );
             match (tip_s(bp, bc), tip_s(wp, wc)) {
-                (Some(sb), Some(sa)) => {
-                    verify_change_on(&sb, &sa, &ch, changed, core, self.machine, self.feed_mm_s)
-                }
+                (Some(sb), Some(sa)) => verify_change_on(
+                    &sb,
+                    &sa,
+                    &ch,
+                    changed,
+                    core,
+                    margin,
+                    self.machine,
+                    self.feed_mm_s,
+                ),
                 _ => verify_change_with_core(
                     &self.s[lo..=hi],
                     &ch,
                     changed,
                     core,
+                    margin,
                     self.machine,
                     self.feed_mm_s,
                 ),
@@ -281,8 +276,9 @@ impl Selection<'_> {
         }
         let mut lambda = 1.0;
         let mut dev = dev_deg;
-        for _ in 0..SCALE_TRIES {
-            lambda *= (cap / dev) * SCALE_SAFETY;
+        let st = &self.opts.solver;
+        for _ in 0..st.scale_tries {
+            lambda *= (cap / dev) * st.scale_safety;
             let mut scaled = prop.clone();
             for (k, i) in (prop.first..=prop.last).enumerate() {
                 scaled.p[k] = self.p[i] + lambda * (prop.p[k] - self.p[i]);
@@ -300,7 +296,7 @@ impl Selection<'_> {
     fn within_cap(&self, dev: f64) -> bool {
         self.opts
             .max_deviation_deg
-            .is_none_or(|cap| dev <= cap + 1e-9)
+            .is_none_or(|cap| dev <= cap + CAP_SLACK_DEG)
     }
 }
 
@@ -598,7 +594,7 @@ fn solve_zone(
 /// Keeping a ball's centre ([`PatchOptions::keep_centre`]) moves the tips, so the tip
 /// path's length s — Equation 6's parameter — depends on the solution: the zones are
 /// solved again on the length of the tips the last solve wrote, until the lengths agree
-/// within [`CENTRE_S_TOL`] (a fixed point: a few solves), and the solve that reaches feed
+/// within [`crate::SolverSettings::centre_s_tol`] (a fixed point: a few solves), and the solve that reaches feed
 /// on most zones is kept. Every solve is verified on the path as written, with its own s.
 pub fn patch_with(
     path: &Path,
@@ -619,7 +615,7 @@ pub fn patch_with(
     };
     let mut last = best.clone();
     let mut solve_s = path.s_mm.clone();
-    for _ in 0..CENTRE_S_ITERATIONS {
+    for _ in 0..opts.solver.centre_s_iterations {
         if reached(&best) == best.zones.len() {
             break;
         }
@@ -630,7 +626,7 @@ pub fn patch_with(
             .map(|(a, b)| ((a[1] - a[0]) - (b[1] - b[0])).abs() / (b[1] - b[0]))
             .fold(0.0, f64::max);
         if moved.is_nan()
-            || moved <= CENTRE_S_TOL
+            || moved <= opts.solver.centre_s_tol
             || s.windows(2).any(|w| w[1].is_nan() || w[1] <= w[0])
         {
             break;
@@ -643,11 +639,6 @@ pub fn patch_with(
     }
     Ok(best)
 }
-
-/// Solves of a path whose tips move to keep a ball's centre, at most ([`patch_with`]).
-const CENTRE_S_ITERATIONS: usize = 4;
-/// Relative change of a block's length below which the tip path's length has settled.
-const CENTRE_S_TOL: f64 = 1e-3;
 
 /// [`patch_with`] with the methods solving on the path length `solve_s`.
 fn patch_on(
@@ -816,10 +807,10 @@ fn patch_on(
             // The analysis spline is not local: a change a few points away still reaches
             // the span, so each narrowing also steps a quarter of the way to the zone.
             let narrowed = if k + 1 < core.start {
-                let step = (d.zone.first.saturating_sub(lo) / NARROW_STEP_DIV).max(1);
+                let step = (d.zone.first.saturating_sub(lo) / st.narrow_step_div).max(1);
                 Some(((lo + step).max(k + 2).min(d.zone.first), hi))
             } else if k >= core.end {
-                let step = (hi.saturating_sub(d.zone.last) / NARROW_STEP_DIV).max(1);
+                let step = (hi.saturating_sub(d.zone.last) / st.narrow_step_div).max(1);
                 Some((
                     lo,
                     hi.saturating_sub(step)

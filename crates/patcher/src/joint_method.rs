@@ -32,9 +32,9 @@ use crate::limits::GeomLimits;
 use crate::protocol::{Proposal, Proposer, Sink, Tail, ZoneCtx};
 use crate::report::Method;
 use crate::starts::{
-    POLE_DEG, Rule, apply_rule, branch_switch, cone_stretch, least_primary, other_branch,
-    tail_shift,
+    Rule, apply_rule, branch_switch, cone_stretch, least_primary, other_branch, tail_shift,
 };
+use crate::tolerances::{POLE_DEG, ZERO_DEVIATION_DEG};
 use polepatch_kinematics::Axis;
 
 /// The joint method (module docs).
@@ -299,7 +299,8 @@ impl JointMethod {
             };
             match problem(&s0.p, &s0.c, s0.rule.then_some((p, c)), None, false, solves) {
                 Ok(sol) => {
-                    let perfect = sol.excess <= st.elastic_tol && sol.max_deviation_deg <= 1e-9;
+                    let perfect =
+                        sol.excess <= st.elastic_tol && sol.max_deviation_deg <= ZERO_DEVIATION_DEG;
                     screened.push((i, sol));
                     if perfect {
                         break; // within the limits, no orientation change: the best there is
@@ -310,9 +311,9 @@ impl JointMethod {
             }
         }
         rank(&mut screened);
-        let perfect = screened
-            .first()
-            .is_some_and(|(_, s)| s.excess <= st.elastic_tol && s.max_deviation_deg <= 1e-9);
+        let perfect = screened.first().is_some_and(|(_, s)| {
+            s.excess <= st.elastic_tol && s.max_deviation_deg <= ZERO_DEVIATION_DEG
+        });
         if starts.len() > 1 && !perfect {
             if screen > 1 {
                 for (i, sol) in screened.iter_mut().take(st.screen_keep.max(1)) {

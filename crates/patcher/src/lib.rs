@@ -39,6 +39,7 @@ pub mod starts;
 pub mod strategy;
 #[cfg(test)]
 mod testutil;
+pub mod tolerances;
 pub mod verify;
 pub(crate) mod window;
 pub mod zones;

@@ -29,7 +29,7 @@
 //! the range rows (feasible: `range`).
 
 use crate::{
-    analysis::{RATIO_TOL, Zone},
+    analysis::Zone,
     candidate::PatchFailure,
     hermite::{Aff, Hermite, push_abs},
     limits::GeomLimits,
@@ -38,17 +38,11 @@ use crate::{
     qp::QpBuilder,
     report::{QpStats, Reason},
     spline::{AnalysisSpline, span_offsets},
+    tolerances::{PROOF_SAMPLES_PER_SPAN, PROOF_SPAN_MARGIN, RATIO_TOL},
     verify::not_worse_floor,
     zones::zone_core,
 };
 use polepatch_kinematics::{Axis, Machine, axis_feed_ratio};
-
-/// Samples of q' per span in the relaxation (its ends included).
-pub const PROOF_SAMPLES_PER_SPAN: usize = 8;
-
-/// Spans beyond the movable points and the core that the relaxation constrains (fewer
-/// constraints keep it a relaxation; these are where a change still matters).
-pub const PROOF_SPAN_MARGIN: usize = 40;
 
 /// Whether some values of points `first..=last` could pass (the relaxation of the module
 /// docs; `Ok(false)` is a proof that none can). `p_deg`, `c_deg` are the values of the

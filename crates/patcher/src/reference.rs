@@ -18,20 +18,21 @@
 //! suite reports `ours / reference`; below 1 means the patcher beat every reference start.
 
 use crate::{
-    analysis::Zone,
+    analysis::{CONE_DEG, Zone},
     candidate::PatchFailure,
     joint::{JointProblem, solve_joint},
     limits::GeomLimits,
     options::PatchAxes,
     settings::SolverSettings,
     spline::AnalysisSpline,
-    starts::{POLE_DEG, Rule, apply_rule, cone_stretch},
+    starts::{Rule, apply_rule, cone_stretch},
+    tolerances::POLE_DEG,
     verify::{AxisChange, verify_change_with_core},
     zones::zone_core,
 };
 use polepatch_kinematics::{Axis, Machine, forward, unwrap_near_deg};
 
-pub use crate::proof::{PROOF_SAMPLES_PER_SPAN, PROOF_SPAN_MARGIN, reachable};
+pub use crate::proof::reachable;
 
 /// The reference of one zone.
 #[derive(Debug, Clone, PartialEq)]
@@ -109,6 +110,7 @@ pub fn zone_reference(
             &ch,
             changed,
             (zone.first, zone.last),
+            st.core_margin_points,
             machine,
             feed_mm_min / 60.0,
         )
@@ -158,7 +160,7 @@ pub fn zone_reference(
         starts.push(("other-branch", op, oc));
     }
     // FREEZE and LINEARIZE across the cone stretch (the peers' rules, crate::starts).
-    let cone = 5.0f64.max(zone.min_abs_primary_deg);
+    let cone = CONE_DEG.max(zone.min_abs_primary_deg);
     if let (Some(stretch), Ok(spline)) = (
         cone_stretch(p_deg, zone, cone),
         AnalysisSpline::new(s_mm, c_deg),

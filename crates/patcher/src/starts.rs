@@ -29,7 +29,7 @@
 //! ([`primary_on_meridian`]). FREEZE and LINEARIZE are starts of the joint patch and of
 //! the bench reference; the bench scores all three as peers ([`crate::peers`]).
 
-use crate::{analysis::Zone, spline::AnalysisSpline};
+use crate::{analysis::Zone, spline::AnalysisSpline, tolerances::POLE_DEG};
 use polepatch_kinematics::{Machine, forward_jacobian, wrap_deg};
 
 /// A cone rule (module docs).
@@ -42,10 +42,6 @@ pub enum Rule {
     /// C a cubic blend across the cone.
     Smooth,
 }
-
-/// |P| below which a point counts as on the pole when C's continuity is judged, degrees
-/// (C does not orient the tool there).
-pub const POLE_DEG: f64 = 1e-6;
 
 /// The index after which the program switches branch inside the zone: the last point
 /// before the primary axis changes sign (points exactly at 0 skipped), nearest to the
