@@ -18,6 +18,7 @@ pub mod candidate;
 pub mod centre;
 pub mod direct;
 pub mod driver;
+pub mod error;
 pub mod g16;
 pub(crate) mod hermite;
 pub mod ipm;
@@ -51,8 +52,9 @@ pub use analysis::{
 pub use candidate::{Candidate, PatchFailure};
 pub use centre::KeepCentre;
 pub use driver::{PatchResult, report_unpatched};
+pub use error::{OptionField, OptionRule, OptionsError};
 pub use limits::{CLimits, GeomLimits};
-pub use options::{PatchAxes, PatchOptions, Strategy};
+pub use options::{MAX_WRITTEN_DECIMALS, PatchAxes, PatchOptions, Strategy};
 pub use path::{Path, PathError};
 pub use report::{Method, Outcome, QpStats, QpStatus, Reason, ZoneFigures, ZoneReport};
 pub use settings::SolverSettings;
