@@ -6,16 +6,16 @@
 //!    unchanged without any spline work.
 //! 2. **Analyse** the run ([`crate::analysis::analyze_spans`]: Equation 6 exact over every
 //!    span) and find its singular zones; zones closer than
-//!    [`crate::SolverSettings::merge_gap_points`] are one.
+//!    [`SolverSettings::merge_gap_points`] are one.
 //! 3. For each zone, in path order, on the values the zones before it left:
 //!    - the methods of the strategy ([`crate::strategy::methods`]) propose candidates through a [`Sink`],
-//!      for each rung of the margin ladder ([`crate::SolverSettings::margin_ladder`]) until one
+//!      for each rung of the margin ladder ([`SolverSettings::margin_ladder`]) until one
 //!      passes;
 //!    - every candidate is **rounded as it will be written** (the file's decimals, then one
 //!      more at a time up to `max_decimals` where rounding alone breaks it) and **verified**
 //!      ([`crate::verify::verify_change_with_core`]): the checked rotary axes (both, or C
 //!      with `--only-c`) reach feed over the zone's core (the zone ±
-//!      [`crate::SolverSettings::core_margin_points`]), and nothing gets worse around it;
+//!      [`SolverSettings::core_margin_points`]), and nothing gets worse around it;
 //!    - **selection**: of the passing candidates whose exact largest orientation change
 //!      (the angle between the old and new tool axes, on the written values) is within
 //!      `max_deviation_deg`, the smallest; else the best improvement within it; else
@@ -47,13 +47,14 @@
 
 use crate::{
     analysis::{AnalysisOptions, SpanFigures, Zone, analyze_spans, validate},
-    centre::{tip_length, written_path},
+    centre::{KeepCentre, tip_length, written_path},
     options::{PatchAxes, PatchOptions, round_written},
     path::{Path, PathError},
     proof::why_not_reached,
     protocol::{Offered, Proposal, Proposer, Sink, Tail, ZoneCtx},
     qp::add_stats,
     report::{Method, Outcome, QpStats, Reason, ZoneFigures, ZoneReport},
+    settings::SolverSettings,
     tolerances::{CAP_SLACK_DEG, CHECK_MARGIN_POINTS, RATIO_TOL},
     verify::{AxisChange, Verdict, not_worse_floor, verify_change_on, verify_change_with_core},
 };
@@ -97,10 +98,7 @@ struct Selection<'a> {
 
 impl Selection<'_> {
     fn axes(&self) -> &'static [Axis] {
-        match self.opts.axes {
-            PatchAxes::Both => &[Axis::Primary, Axis::C],
-            PatchAxes::OnlyC => &[Axis::C],
-        }
+        checked_axes(self.opts.axes)
     }
 
     /// Values of `(p, c)` on `lo..=hi` with `prop` applied, rounded with `decimals` where
@@ -502,7 +500,7 @@ struct Fixed<'a> {
     machine: &'a Machine,
     opts: &'a PatchOptions,
     /// The program's tool axes.
-    target: &'a [[f64; 3]],
+    target: Vec<[f64; 3]>,
     verify: bool,
 }
 
@@ -523,7 +521,7 @@ fn solve_zone(
     let mut sel = Selection {
         s: f.s,
         axes: &path.axes,
-        target: f.target,
+        target: &f.target,
         machine: f.machine,
         opts,
         zone: &zone,
@@ -542,7 +540,7 @@ fn solve_zone(
     for (rung, factor) in st.margin_ladder.iter().enumerate() {
         let ctx = ZoneCtx {
             s: f.s,
-            target: f.target,
+            target: &f.target,
             machine: f.machine,
             opts,
             settings: st,
@@ -588,13 +586,13 @@ fn solve_zone(
     }
 }
 
-/// [`patch_path`] with the given methods (asked in order) and whether their proposals are
-/// verified.
+/// [`crate::patch_path`] with the given methods (asked in order) and whether their
+/// proposals are verified: the strategy table ([`crate::strategy::methods`]) gives them.
 ///
 /// Keeping a ball's centre ([`PatchOptions::keep_centre`]) moves the tips, so the tip
 /// path's length s — Equation 6's parameter — depends on the solution: the zones are
 /// solved again on the length of the tips the last solve wrote, until the lengths agree
-/// within [`crate::SolverSettings::centre_s_tol`] (a fixed point: a few solves), and the solve that reaches feed
+/// within [`SolverSettings::centre_s_tol`] (a fixed point: a few solves), and the solve that reaches feed
 /// on most zones is kept. Every solve is verified on the path as written, with its own s.
 pub fn patch_with(
     path: &Path,
@@ -640,7 +638,8 @@ pub fn patch_with(
     Ok(best)
 }
 
-/// [`patch_with`] with the methods solving on the path length `solve_s`.
+/// [`patch_with`] with the methods solving on the path length `solve_s`: the steps of the
+/// module docs, one function each.
 fn patch_on(
     path: &Path,
     solve_s: &[f64],
@@ -649,196 +648,302 @@ fn patch_on(
     methods: &mut [Box<dyn Proposer>],
     verify: bool,
 ) -> Result<PatchResult, PathError> {
+    // 1. Validate; a path with no point near the pole is unchanged.
     validate(path)?;
     opts.validate()?;
-    let n = path.s_mm.len();
-    let (pi, ci) = (Axis::Primary.index(), Axis::C.index());
-    if !path.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg()) {
+    if !near_pole(path, opts) {
         return Ok(PatchResult::unchanged(path, opts));
     }
-    let st = &opts.solver;
+    // 2. Analyse the run and find its zones.
     let aopts = analysis_options(opts);
     let (analysis, spans_before) = analyze_spans(path, machine, &aopts)?;
     if analysis.zones.is_empty() {
         return Ok(PatchResult::unchanged(path, opts));
     }
-    let p0: Vec<f64> = path.axes.iter().map(|q| q[pi]).collect();
-    let c0: Vec<f64> = path.axes.iter().map(|q| q[ci]).collect();
-    let target: Vec<[f64; 3]> = p0
+    let run = Run::new(path, solve_s, machine, opts, verify, aopts, spans_before);
+    // 3. Each zone, in path order, on the values the zones before it left.
+    let mut state = run.solve_zones(methods, &analysis.zones);
+    // 4. Verify what is written, whole: a zone whose patch made a span worse is put back.
+    let written = run.verify_whole(methods, &mut state)?;
+    // 5. Report each zone with its outcome and reason.
+    let zones = state
+        .done
         .iter()
-        .zip(&c0)
-        .map(|(p, c)| forward(machine, *p, *c))
+        .map(|d| run.zone_report(&state, &written, d))
         .collect();
-    let (mut cur_p, mut cur_c) = (p0.clone(), c0.clone());
-    let end = if opts.keep_last_point { n - 2 } else { n - 1 };
-    let mut lower = 1;
-    let mut done: Vec<Done> = Vec::new();
-    let fixed = Fixed {
-        path,
-        s: solve_s,
-        machine,
-        opts,
-        target: &target,
-        verify,
-    };
-    for zone in merge_zones(&analysis.zones, st.merge_gap_points) {
-        let d = solve_zone(&fixed, methods, zone, &cur_p, &cur_c, lower, end);
-        if let Some(k) = &d.kept {
-            let (p, c) = materialize(&cur_p, &cur_c, &k.prop, 0, n - 1, Some(k.decimals));
-            (cur_p, cur_c) = (p, c);
-            lower = k.prop.last + 1;
-        } else {
-            lower = lower.max(d.zone.last + 1);
-        }
-        done.push(d);
-    }
+    Ok(run.result(state, written, zones))
+}
 
-    // Verify what is written, whole: the run analysed again; a zone whose patch made a
-    // span of a checked axis worse is put back.
-    // Keeping a ball's centre rewrites X Y Z with the rotary values: they are checked too.
-    // The tips are written with the file's decimals, and more where their rounding would
-    // slow the run (the rounding of a tip moves the path's length s, and jitter in s eats
-    // the rotary axes' jerk budget: at 0.5 mm spacing, 0.5 µm of it takes a third of the
-    // UCP710's A budget at F3000) — up to `max_decimals`, as for the rotary words.
-    let mut keep_written = opts.keep_centre;
-    let checked_axes: &[Axis] = match opts.axes {
+/// Whether some point of `path` is near enough the pole to lie in a zone
+/// ([`PatchOptions::reach_deg`]).
+fn near_pole(path: &Path, opts: &PatchOptions) -> bool {
+    let pi = Axis::Primary.index();
+    path.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg())
+}
+
+/// The rotary axes that must reach feed and may not get worse.
+fn checked_axes(axes: PatchAxes) -> &'static [Axis] {
+    match axes {
         PatchAxes::Both => &[Axis::Primary, Axis::C],
         PatchAxes::OnlyC => &[Axis::C],
-    };
-    let mut spans_after;
-    let mut after_path;
-    loop {
-        let keep = keep_written.as_ref();
-        // Written tips that do not make a path (two on one spot) count as worse at the
-        // first span.
-        let written = written_path(path, &cur_p, &cur_c, machine, keep);
-        let worse = match &written {
-            Some(w) => {
-                spans_after = analyze_spans(w, machine, &aopts)?.1;
-                if !verify {
-                    after_path = written;
-                    break;
-                }
-                let mut w = whole_run_worse(&spans_before, &spans_after, checked_axes);
-                if keep.is_some() {
-                    // The linear axes the tips moved: the machine may not get slower there.
-                    w.extend(whole_run_slower(&spans_before, &spans_after));
-                    w.sort_unstable();
-                    w.dedup();
-                }
-                w
-            }
-            None => {
-                spans_after = spans_before.clone();
-                vec![0]
-            }
-        };
-        after_path = written;
-        // The tips' rounding may also keep a zone the candidate brought to feed below it:
-        // more decimals first.
-        let short_of_feed = || {
-            done.iter()
-                .filter(|d| d.kept.is_some() && !d.reverted)
-                .any(|d| {
-                    let f =
-                        figures_over(&spans_after, zone_core(&d.zone, n, st.core_margin_points));
-                    let worst = match opts.axes {
-                        PatchAxes::Both => f.c_ratio.min(f.primary_ratio),
-                        PatchAxes::OnlyC => f.c_ratio,
-                    };
-                    worst < 1.0 - RATIO_TOL
-                })
-        };
-        if let Some(kw) = keep_written.as_mut()
-            && kw.decimals < opts.max_decimals
-            && (!worse.is_empty() || short_of_feed())
-        {
-            kw.decimals += 1;
-            continue;
-        }
-        let Some(&k) = worse.first() else { break };
-        // The kept zone whose change lies nearest the worse span.
-        let culprit = done
+    }
+}
+
+/// The lowest ratio of the checked rotary axes over `f`.
+fn worst_ratio(axes: PatchAxes, f: &ZoneFigures) -> f64 {
+    match axes {
+        PatchAxes::Both => f.c_ratio.min(f.primary_ratio),
+        PatchAxes::OnlyC => f.c_ratio,
+    }
+}
+
+/// One solve of a path: what the steps of [`patch_on`] share.
+struct Run<'a> {
+    /// What every zone's solve sees.
+    f: Fixed<'a>,
+    /// The analysis options.
+    aopts: AnalysisOptions,
+    /// The run's span figures as programmed.
+    spans_before: Vec<SpanFigures>,
+    /// The program's primary values, degrees.
+    p0: Vec<f64>,
+    /// The program's C values, degrees.
+    c0: Vec<f64>,
+    /// The last point a patch may change (the one before the last when it must stay).
+    end: usize,
+}
+
+/// The values as they stand, and what was kept for each zone.
+struct Patched {
+    /// Primary values, degrees, as written.
+    p: Vec<f64>,
+    /// C values, degrees, as written.
+    c: Vec<f64>,
+    /// One per zone, in path order.
+    done: Vec<Done>,
+}
+
+/// What is written, as the whole-run verification left it.
+struct Written {
+    /// The run's span figures as written (the report's "after").
+    spans_after: Vec<SpanFigures>,
+    /// The path as written (its tips moved where a ball's centre is kept); `None` when the
+    /// written tips make no path.
+    path: Option<Path>,
+    /// How the tips are written, with a ball's centre kept.
+    keep: Option<KeepCentre>,
+}
+
+impl<'a> Run<'a> {
+    fn new(
+        path: &'a Path,
+        solve_s: &'a [f64],
+        machine: &'a Machine,
+        opts: &'a PatchOptions,
+        verify: bool,
+        aopts: AnalysisOptions,
+        spans_before: Vec<SpanFigures>,
+    ) -> Run<'a> {
+        let (pi, ci) = (Axis::Primary.index(), Axis::C.index());
+        let n = path.s_mm.len();
+        let p0: Vec<f64> = path.axes.iter().map(|q| q[pi]).collect();
+        let c0: Vec<f64> = path.axes.iter().map(|q| q[ci]).collect();
+        let target: Vec<[f64; 3]> = p0
             .iter()
-            .enumerate()
-            .filter(|(_, d)| d.kept.is_some() && !d.reverted)
-            .min_by_key(|(_, d)| {
-                let pr = &d
-                    .kept
-                    .as_ref()
-                    .map(|c| (c.prop.first, c.prop.last))
-                    .unwrap_or((0, 0));
-                if k + 1 < pr.0 {
-                    pr.0 - k - 1
-                } else {
-                    k.saturating_sub(pr.1)
+            .zip(&c0)
+            .map(|(p, c)| forward(machine, *p, *c))
+            .collect();
+        Run {
+            f: Fixed {
+                path,
+                s: solve_s,
+                machine,
+                opts,
+                target,
+                verify,
+            },
+            aopts,
+            spans_before,
+            p0,
+            c0,
+            end: if opts.keep_last_point { n - 2 } else { n - 1 },
+        }
+    }
+
+    /// Step 3: the zones (those closer than `merge_gap_points` merged) in path order, each
+    /// solved on the values the zones before it left and from the point after the last
+    /// patch ([`solve_zone`]).
+    fn solve_zones(&self, methods: &mut [Box<dyn Proposer>], zones: &[Zone]) -> Patched {
+        let n = self.f.path.s_mm.len();
+        let (mut p, mut c) = (self.p0.clone(), self.c0.clone());
+        let mut lower = 1;
+        let mut done: Vec<Done> = Vec::new();
+        for zone in merge_zones(zones, self.f.opts.solver.merge_gap_points) {
+            let d = solve_zone(&self.f, methods, zone, &p, &c, lower, self.end);
+            if let Some(k) = &d.kept {
+                (p, c) = materialize(&p, &c, &k.prop, 0, n - 1, Some(k.decimals));
+                lower = k.prop.last + 1;
+            } else {
+                lower = lower.max(d.zone.last + 1);
+            }
+            done.push(d);
+        }
+        Patched { p, c, done }
+    }
+
+    /// Step 4: verify what is written, whole. The run is analysed again as written; a zone
+    /// whose patch made a span of a checked axis worse is put back, until nothing is
+    /// worse.
+    ///
+    /// Keeping a ball's centre rewrites X Y Z with the rotary values: they are checked too.
+    /// The tips are written with the file's decimals, and more where their rounding would
+    /// slow the run (the rounding of a tip moves the path's length s, and jitter in s eats
+    /// the rotary axes' jerk budget: at 0.5 mm spacing, 0.5 µm of it takes a third of the
+    /// UCP710's A budget at F3000) — up to `max_decimals`, as for the rotary words.
+    fn verify_whole(
+        &self,
+        methods: &mut [Box<dyn Proposer>],
+        state: &mut Patched,
+    ) -> Result<Written, PathError> {
+        let (path, opts) = (self.f.path, self.f.opts);
+        let mut keep_written = opts.keep_centre;
+        loop {
+            let keep = keep_written.as_ref();
+            // Written tips that do not make a path (two on one spot) count as worse at the
+            // first span.
+            let written = written_path(path, &state.p, &state.c, self.f.machine, keep);
+            let (worse, spans_after) = match &written {
+                Some(w) => {
+                    let spans_after = analyze_spans(w, self.f.machine, &self.aopts)?.1;
+                    if !self.f.verify {
+                        return Ok(Written {
+                            spans_after,
+                            path: written,
+                            keep: keep_written,
+                        });
+                    }
+                    (self.worse_spans(&spans_after, keep.is_some()), spans_after)
                 }
+                None => (vec![0], self.spans_before.clone()),
+            };
+            // The tips' rounding may also keep a zone the candidate brought to feed below
+            // it: more decimals first.
+            if let Some(kw) = keep_written.as_mut()
+                && kw.decimals < opts.max_decimals
+                && (!worse.is_empty() || self.short_of_feed(state, &spans_after))
+            {
+                kw.decimals += 1;
+                continue;
+            }
+            let Some(&k) = worse.first() else {
+                return Ok(Written {
+                    spans_after,
+                    path: written,
+                    keep: keep_written,
+                });
+            };
+            let Some(i) = culprit(&state.done, k) else {
+                // Nothing left to put back (only possible with written tips that are not a
+                // path): every value as it was.
+                (state.p, state.c) = (self.p0.clone(), self.c0.clone());
+                return Ok(Written {
+                    spans_after: self.spans_before.clone(),
+                    path: Some(path.clone()),
+                    keep: keep_written,
+                });
+            };
+            self.put_back(state, i);
+            // Keeping a ball's centre moves the tips wherever the orientation changes, and a
+            // wide patch may slow a linear axis at a corner far from the zone: narrow the
+            // patch so that span keeps its values, and solve the zone again.
+            if let Some(kw) = keep_written.as_mut() {
+                // Start the decimals over for the narrowed patch.
+                kw.decimals = opts.keep_centre.map_or(kw.decimals, |k| k.decimals);
+                self.narrow_and_solve_again(methods, state, i, k);
+            }
+        }
+    }
+
+    /// The spans worse after than before on a checked axis; with the tips moved
+    /// (`tips_moved`: a ball's centre kept) also those where the machine is slower: the
+    /// linear axes the tips moved may not make it slower there.
+    fn worse_spans(&self, spans_after: &[SpanFigures], tips_moved: bool) -> Vec<usize> {
+        let axes = checked_axes(self.f.opts.axes);
+        let mut w = whole_run_worse(&self.spans_before, spans_after, axes);
+        if tips_moved {
+            w.extend(whole_run_slower(&self.spans_before, spans_after));
+            w.sort_unstable();
+            w.dedup();
+        }
+        w
+    }
+
+    /// Whether a kept zone's core is below feed on a checked axis as written.
+    fn short_of_feed(&self, state: &Patched, spans_after: &[SpanFigures]) -> bool {
+        let n = self.f.path.s_mm.len();
+        let st = &self.f.opts.solver;
+        state
+            .done
+            .iter()
+            .filter(|d| d.kept.is_some() && !d.reverted)
+            .any(|d| {
+                let f = figures_over(spans_after, zone_core(&d.zone, n, st.core_margin_points));
+                worst_ratio(self.f.opts.axes, &f) < 1.0 - RATIO_TOL
             })
-            .map(|(i, _)| i);
-        let Some(i) = culprit else {
-            // Nothing left to put back (only possible with written tips that are not a
-            // path): every value as it was.
-            (cur_p, cur_c) = (p0.clone(), c0.clone());
-            after_path = Some(path.clone());
-            spans_after = spans_before.clone();
-            break;
-        };
-        // Put it back: its points (and a re-selected or offset tail) as they were.
-        let d = &mut done[i];
-        let prop = &d.kept.as_ref().map(|c| c.prop.clone());
-        if let Some(prop) = prop {
+    }
+
+    /// Put zone `i`'s patch back: its points (and a re-selected or offset tail) as they
+    /// were.
+    fn put_back(&self, state: &mut Patched, i: usize) {
+        let n = self.f.path.s_mm.len();
+        let d = &mut state.done[i];
+        if let Some(prop) = d.kept.as_ref().map(|c| &c.prop) {
             let hi = if matches!(prop.tail, Tail::Keep) {
                 prop.last
             } else {
                 n - 1
             };
-            cur_p[prop.first..=hi].copy_from_slice(&p0[prop.first..=hi]);
-            cur_c[prop.first..=hi].copy_from_slice(&c0[prop.first..=hi]);
+            state.p[prop.first..=hi].copy_from_slice(&self.p0[prop.first..=hi]);
+            state.c[prop.first..=hi].copy_from_slice(&self.c0[prop.first..=hi]);
         }
         d.reverted = true;
-        // Keeping a ball's centre moves the tips wherever the orientation changes, and a
-        // wide patch may slow a linear axis at a corner far from the zone: narrow the patch
-        // so that span keeps its values, and solve the zone again ("narrow the patch").
-        if let Some(kw) = keep_written.as_mut() {
-            // Start the decimals over for the narrowed patch.
-            kw.decimals = opts.keep_centre.map_or(kw.decimals, |k| k.decimals);
-            let core = zone_core(&d.zone, n, st.core_margin_points);
-            let (lo, hi) = d.bounds;
-            // The analysis spline is not local: a change a few points away still reaches
-            // the span, so each narrowing also steps a quarter of the way to the zone.
-            let narrowed = if k + 1 < core.start {
-                let step = (d.zone.first.saturating_sub(lo) / st.narrow_step_div).max(1);
-                Some(((lo + step).max(k + 2).min(d.zone.first), hi))
-            } else if k >= core.end {
-                let step = (hi.saturating_sub(d.zone.last) / st.narrow_step_div).max(1);
-                Some((
-                    lo,
-                    hi.saturating_sub(step)
-                        .min(k.saturating_sub(1))
-                        .max(d.zone.last),
-                ))
-            } else {
-                None
-            };
-            if let Some((lo2, hi2)) = narrowed
-                && (lo2, hi2) != (lo, hi)
-                && lo2 <= d.zone.first
-                && hi2 >= d.zone.last
-            {
-                let zone = d.zone.clone();
-                let again = solve_zone(&fixed, methods, zone, &cur_p, &cur_c, lo2, hi2);
-                if let Some(kept) = &again.kept {
-                    (cur_p, cur_c) =
-                        materialize(&cur_p, &cur_c, &kept.prop, 0, n - 1, Some(kept.decimals));
-                }
-                done[i] = again;
-            }
-        }
     }
 
-    let mut reports = Vec::with_capacity(done.len());
-    let mut decimals = (opts.p_decimals, opts.c_decimals);
-    for d in &done {
+    /// Solve zone `i`, put back for the worse span `k`, again on a narrower range that
+    /// leaves `k` alone ([`narrowed`]), when there is one.
+    fn narrow_and_solve_again(
+        &self,
+        methods: &mut [Box<dyn Proposer>],
+        state: &mut Patched,
+        i: usize,
+        k: usize,
+    ) {
+        let n = self.f.path.s_mm.len();
+        let d = &state.done[i];
+        let Some((lo, hi)) = narrowed(d, k, n, &self.f.opts.solver) else {
+            return;
+        };
+        let zone = d.zone.clone();
+        let again = solve_zone(&self.f, methods, zone, &state.p, &state.c, lo, hi);
+        if let Some(kept) = &again.kept {
+            (state.p, state.c) = materialize(
+                &state.p,
+                &state.c,
+                &kept.prop,
+                0,
+                n - 1,
+                Some(kept.decimals),
+            );
+        }
+        state.done[i] = again;
+    }
+
+    /// Step 5: the report of zone `d` on the values as written.
+    fn zone_report(&self, state: &Patched, written: &Written, d: &Done) -> ZoneReport {
+        let (path, machine, opts) = (self.f.path, self.f.machine, self.f.opts);
+        let st = &opts.solver;
+        let n = path.s_mm.len();
+        let (cur_p, cur_c) = (&state.p, &state.c);
         let kept = d.kept.as_ref().filter(|_| !d.reverted);
         let (first, last) = match kept {
             Some(k) => (d.zone.first.min(k.prop.first), d.zone.last.max(k.prop.last)),
@@ -861,21 +966,16 @@ fn patch_on(
         } else {
             core.clone()
         };
-        let before = figures_over(&spans_before, range.clone());
-        let after = figures_over(&spans_after, range.clone());
-        let core_after = figures_over(&spans_after, core.clone());
-        let reached = match opts.axes {
-            PatchAxes::Both => core_after.c_ratio.min(core_after.primary_ratio),
-            PatchAxes::OnlyC => core_after.c_ratio,
-        } >= 1.0 - RATIO_TOL;
-        let core_before = figures_over(&spans_before, core.clone());
-        let worst = |f: &ZoneFigures| match opts.axes {
-            PatchAxes::Both => f.c_ratio.min(f.primary_ratio),
-            PatchAxes::OnlyC => f.c_ratio,
-        };
+        let before = figures_over(&self.spans_before, range.clone());
+        let after = figures_over(&written.spans_after, range.clone());
+        let core_after = figures_over(&written.spans_after, core.clone());
+        let reached = worst_ratio(opts.axes, &core_after) >= 1.0 - RATIO_TOL;
+        let core_before = figures_over(&self.spans_before, core.clone());
         let outcome = if reached {
             Outcome::Reached
-        } else if kept.is_some() && worst(&core_after) > worst(&core_before) {
+        } else if kept.is_some()
+            && worst_ratio(opts.axes, &core_after) > worst_ratio(opts.axes, &core_before)
+        {
             Outcome::Improved
         } else {
             Outcome::Unchanged
@@ -885,7 +985,7 @@ fn patch_on(
             Reason::Reselected
         } else if reached {
             Reason::Reached
-        } else if !verify {
+        } else if !self.f.verify {
             Reason::NotFound
         } else if d.over_cap_deg.is_some() {
             Reason::DeviationCap
@@ -894,23 +994,22 @@ fn patch_on(
         } else {
             why_not_reached(
                 path,
-                &cur_p,
-                &cur_c,
+                cur_p,
+                cur_c,
                 &d.zone,
                 machine,
                 opts,
-                lower_of(&done, d),
-                end,
+                lower_of(&state.done, d),
+                self.end,
             )
         };
+        let target = &self.f.target;
         let dev = (first..=last)
             .map(|i| angle_between_deg(target[i], forward(machine, cur_p[i], cur_c[i])))
             .fold(0.0, f64::max);
-        if let Some(k) = kept {
-            decimals = (decimals.0.max(k.decimals.0), decimals.1.max(k.decimals.1));
-        }
+        let (p0, c0) = (&self.p0, &self.c0);
         let modified = |v: &[f64], v0: &[f64]| (first..=last).filter(|&i| v[i] != v0[i]).count();
-        reports.push(ZoneReport {
+        ZoneReport {
             first,
             last,
             kind: d.zone.kind,
@@ -923,7 +1022,7 @@ fn patch_on(
             points_modified: (first..=last)
                 .filter(|&i| cur_p[i] != p0[i] || cur_c[i] != c0[i])
                 .count(),
-            primary_points_modified: modified(&cur_p, &p0),
+            primary_points_modified: modified(cur_p, p0),
             reselected_points: kept
                 .filter(|k| matches!(k.prop.tail, Tail::Reselect { .. }))
                 .map_or(0, |k| n - 1 - k.prop.last),
@@ -939,42 +1038,102 @@ fn patch_on(
                 _ => 0.0,
             }),
             needed_deviation_deg: d.over_cap_deg.filter(|_| reason == Reason::DeviationCap),
-        });
+        }
     }
-    let p_changed: Vec<bool> = cur_p.iter().zip(&p0).map(|(a, b)| a != b).collect();
-    let c_changed: Vec<bool> = cur_c.iter().zip(&c0).map(|(a, b)| a != b).collect();
-    let xyz_mm: Vec<[f64; 3]> = after_path
-        .as_ref()
-        .unwrap_or(path)
-        .axes
-        .iter()
-        .map(|q| [q[0], q[1], q[2]])
-        .collect();
-    let xyz_changed = xyz_mm
-        .iter()
-        .zip(&path.axes)
-        .map(|(w, q)| std::array::from_fn(|i| w[i] != q[i]))
-        .collect();
-    Ok(PatchResult {
-        xyz_mm,
-        xyz_changed,
-        xyz_decimals: keep_written.map_or(0, |k| k.decimals),
-        p_decimals: if p_changed.iter().any(|&x| x) {
-            decimals.0
-        } else {
-            opts.p_decimals
-        },
-        c_decimals: if c_changed.iter().any(|&x| x) {
-            decimals.1
-        } else {
-            opts.c_decimals
-        },
-        p_deg: cur_p,
-        p_changed,
-        c_deg: cur_c,
-        c_changed,
-        zones: reports,
-    })
+
+    /// The values as they must be written, with the zones' reports: the decimals are the
+    /// most any kept patch needs (the file's where nothing changed).
+    fn result(&self, state: Patched, written: Written, zones: Vec<ZoneReport>) -> PatchResult {
+        let (path, opts) = (self.f.path, self.f.opts);
+        let decimals = state
+            .done
+            .iter()
+            .filter(|d| !d.reverted)
+            .filter_map(|d| d.kept.as_ref())
+            .fold((opts.p_decimals, opts.c_decimals), |acc, k| {
+                (acc.0.max(k.decimals.0), acc.1.max(k.decimals.1))
+            });
+        let p_changed: Vec<bool> = state.p.iter().zip(&self.p0).map(|(a, b)| a != b).collect();
+        let c_changed: Vec<bool> = state.c.iter().zip(&self.c0).map(|(a, b)| a != b).collect();
+        let xyz_mm: Vec<[f64; 3]> = written
+            .path
+            .as_ref()
+            .unwrap_or(path)
+            .axes
+            .iter()
+            .map(|q| [q[0], q[1], q[2]])
+            .collect();
+        let xyz_changed = xyz_mm
+            .iter()
+            .zip(&path.axes)
+            .map(|(w, q)| std::array::from_fn(|i| w[i] != q[i]))
+            .collect();
+        PatchResult {
+            xyz_mm,
+            xyz_changed,
+            xyz_decimals: written.keep.map_or(0, |k| k.decimals),
+            p_decimals: if p_changed.iter().any(|&x| x) {
+                decimals.0
+            } else {
+                opts.p_decimals
+            },
+            c_decimals: if c_changed.iter().any(|&x| x) {
+                decimals.1
+            } else {
+                opts.c_decimals
+            },
+            p_deg: state.p,
+            p_changed,
+            c_deg: state.c,
+            c_changed,
+            zones,
+        }
+    }
+}
+
+/// The kept zone whose change lies nearest the worse span `k` (not one already put back).
+fn culprit(done: &[Done], k: usize) -> Option<usize> {
+    done.iter()
+        .enumerate()
+        .filter(|(_, d)| d.kept.is_some() && !d.reverted)
+        .min_by_key(|(_, d)| {
+            let pr = &d
+                .kept
+                .as_ref()
+                .map(|c| (c.prop.first, c.prop.last))
+                .unwrap_or((0, 0));
+            if k + 1 < pr.0 {
+                pr.0 - k - 1
+            } else {
+                k.saturating_sub(pr.1)
+            }
+        })
+        .map(|(i, _)| i)
+}
+
+/// The range a zone put back for the worse span `k` may change next: its bounds narrowed
+/// so that `k` keeps its values, by at least 1/[`SolverSettings::narrow_step_div`] of the
+/// way to the zone (the analysis spline is not local: a change a few points away still
+/// reaches the span); `None` when `k` is in the zone's core or nothing narrower holds the
+/// zone.
+fn narrowed(d: &Done, k: usize, n: usize, st: &SolverSettings) -> Option<(usize, usize)> {
+    let core = zone_core(&d.zone, n, st.core_margin_points);
+    let (lo, hi) = d.bounds;
+    let (lo2, hi2) = if k + 1 < core.start {
+        let step = (d.zone.first.saturating_sub(lo) / st.narrow_step_div).max(1);
+        ((lo + step).max(k + 2).min(d.zone.first), hi)
+    } else if k >= core.end {
+        let step = (hi.saturating_sub(d.zone.last) / st.narrow_step_div).max(1);
+        (
+            lo,
+            hi.saturating_sub(step)
+                .min(k.saturating_sub(1))
+                .max(d.zone.last),
+        )
+    } else {
+        return None;
+    };
+    ((lo2, hi2) != (lo, hi) && lo2 <= d.zone.first && hi2 >= d.zone.last).then_some((lo2, hi2))
 }
 
 /// The first point the patch of `d`'s zone could change (after the previous kept zone).
@@ -1000,8 +1159,7 @@ pub fn report_unpatched(
     opts: &PatchOptions,
 ) -> Result<Vec<ZoneReport>, PathError> {
     validate(path)?;
-    let pi = Axis::Primary.index();
-    if !path.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg()) {
+    if !near_pole(path, opts) {
         return Ok(Vec::new());
     }
     let n = path.s_mm.len();
