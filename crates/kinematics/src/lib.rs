@@ -27,6 +27,7 @@
 pub mod chain;
 pub mod feed;
 pub mod forward;
+mod frames;
 pub mod inverse;
 pub mod linuxcnc;
 pub mod machine;
