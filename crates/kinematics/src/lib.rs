@@ -30,6 +30,7 @@ pub mod forward;
 mod frames;
 pub mod inverse;
 pub mod linuxcnc;
+mod load;
 pub mod machine;
 mod machine_file;
 pub mod reorient;
