@@ -21,6 +21,7 @@
 //! [`Machine::pole_p_deg`], and the two solutions are not in general (P, C) and
 //! (−P, C + 180°) ([`Machine::other_solution`]).
 
+pub use crate::angles::{unwrap_near_deg, wrap_deg};
 use crate::forward::StandardForm;
 use crate::machine::{Machine, PrimaryAxis};
 use crate::rotary::{Ik, inverse_general, pole_p_general, pole_tilt_general};
@@ -193,26 +194,6 @@ impl Machine {
             _ => Some(IkSolution { p_deg, c_deg }),
         }
     }
-}
-
-/// An angle in degrees wrapped to (−180, 180].
-pub fn wrap_deg(angle_deg: f64) -> f64 {
-    if angle_deg > -180.0 && angle_deg <= 180.0 {
-        return angle_deg;
-    }
-    let w = angle_deg % 360.0; // exact, in (−360, 360)
-    if w > 180.0 {
-        w - 360.0
-    } else if w <= -180.0 {
-        w + 360.0
-    } else {
-        w
-    }
-}
-
-/// `angle_deg + n·360` for the integer n that puts it within (ref − 180, ref + 180], degrees.
-pub fn unwrap_near_deg(angle_deg: f64, ref_deg: f64) -> f64 {
-    ref_deg + wrap_deg(angle_deg - ref_deg)
 }
 
 /// atan2 in degrees, exact (0, ±90, 180) when an argument is zero, in (−180, 180].
@@ -727,18 +708,6 @@ mod tests {
         let o = forward(&m, 150.0, 0.0);
         assert!(inverse_path(&m, &[o], BranchRule::PreferPositive)[0].p_deg > 0.0);
         assert!(inverse_path(&m, &[o], BranchRule::PreferNegative)[0].p_deg < 0.0);
-    }
-
-    #[test]
-    fn wrap_and_unwrap() {
-        assert_eq!(wrap_deg(180.0), 180.0);
-        assert_eq!(wrap_deg(-180.0), 180.0);
-        assert_eq!(wrap_deg(540.0), 180.0);
-        assert_eq!(wrap_deg(-190.0), 170.0);
-        assert_eq!(wrap_deg(0.0), 0.0);
-        assert_eq!(unwrap_near_deg(-170.0, 170.0), 190.0);
-        assert_eq!(unwrap_near_deg(10.0, 725.0), 730.0);
-        assert_eq!(unwrap_near_deg(-1e-20, 0.0), -1e-20);
     }
 
     /// A pair whose pole is not at P = 0: LinuxCNC's xyzab_tdr layout, the A table along X

@@ -24,6 +24,7 @@
 //! A built-in name, a TOML file in either form ([`Machine::from_toml_str`]), or a
 //! LinuxCNC INI file ([`linuxcnc`]), all through [`Machine::load`].
 
+mod angles;
 pub mod chain;
 pub mod feed;
 pub mod forward;
@@ -40,12 +41,12 @@ pub mod tolerances;
 #[cfg(test)]
 mod testutil;
 
+pub use angles::{unwrap_near_deg, wrap_deg};
 pub use chain::Chain;
 pub use feed::{AxisBound, FeedBound, LimitKind, axis_feed_bound, axis_feed_ratio, feed_bound};
 pub use forward::{StandardForm, angle_between_deg, forward, forward_jacobian};
 pub use inverse::{
     BranchRule, IkSolution, domain_rule_index, inverse, inverse_path, inverse_path_from, solve_ik,
-    unwrap_near_deg, wrap_deg,
 };
 pub use machine::{Axis, AxisLimits, Controller, Machine, MachineError, PrimaryAxis};
 pub use reorient::JigRotation;

@@ -369,7 +369,7 @@ pub(crate) fn inverse_general(rot: &Rotaries, sp: f64, sc: f64, o_wp: [f64; 3]) 
     let g = PairGeometry::new(rot);
     let sin_gamma = norm(cross(g.a, o));
     let gamma = sin_gamma.atan2(dot(g.a, o));
-    let to_p = |beta: f64| crate::wrap_deg(sp * beta.to_degrees());
+    let to_p = |beta: f64| crate::angles::wrap_deg(sp * beta.to_degrees());
     let Some(betas) = g.betas(gamma) else {
         let (lo, hi) = g.reach_rad();
         return Ik::Unreachable {
@@ -385,7 +385,7 @@ pub(crate) fn inverse_general(rot: &Rotaries, sp: f64, sc: f64, o_wp: [f64; 3]) 
     }
     let mut sols = betas.map(|beta| crate::IkSolution {
         p_deg: to_p(beta),
-        c_deg: crate::wrap_deg(sc * g.alpha(g.v(beta), o).to_degrees()),
+        c_deg: crate::angles::wrap_deg(sc * g.alpha(g.v(beta), o).to_degrees()),
     });
     if sols[1].p_deg > sols[0].p_deg {
         sols.swap(0, 1);
@@ -398,7 +398,7 @@ pub(crate) fn inverse_general(rot: &Rotaries, sp: f64, sc: f64, o_wp: [f64; 3]) 
 pub(crate) fn pole_p_general(rot: &Rotaries, sp: f64) -> Option<f64> {
     let g = PairGeometry::new(rot);
     g.betas(0.0)
-        .map(|b| crate::wrap_deg(sp * b[0].to_degrees()))
+        .map(|b| crate::angles::wrap_deg(sp * b[0].to_degrees()))
 }
 
 /// The angle between the pole axis and the tool turned by the primary axis alone,
