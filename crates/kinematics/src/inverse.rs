@@ -24,17 +24,9 @@
 pub use crate::angles::{unwrap_near_deg, wrap_deg};
 use crate::forward::StandardForm;
 use crate::machine::{Machine, PrimaryAxis};
+pub use crate::rotary::IkSolution;
 use crate::rotary::{Ik, inverse_general, pole_p_general, pole_tilt_general};
 use crate::tolerances::POLE_SIN_TOL;
-
-/// One joint solution, degrees.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct IkSolution {
-    /// Primary angle (the tilting axis: A or B on the built-ins), degrees.
-    pub p_deg: f64,
-    /// C angle (the pole axis), degrees, in (−180, 180] before unwrapping.
-    pub c_deg: f64,
-}
 
 /// How [`inverse_path`] picks between the two solutions ((P, C) and (−P, C+180°) on the
 /// built-ins).
