@@ -440,7 +440,7 @@ fn scan_with(
         })?;
         flow = again.recorder.take().unwrap_or_default();
     }
-    let plan = flow.solve(crate::modal::initial(&opts.controller).tcpm);
+    let plan = flow.solve(crate::tcpm::initial(&opts.controller).tcpm);
     Ok(Settled::Again(ReadOptions {
         dialect,
         controller: opts.controller.clone(),
