@@ -26,14 +26,15 @@
 //! An axis word whose value is a Q parameter (`X+Q1`, `C-QR5`) marks the block not
 //! analysable (positions unknown after it), never the file.
 
+use crate::block::Flags;
 use crate::error::ParseError;
 use crate::flow::{Key, Stmt};
 use crate::interp::{Interpreter, Scan, function};
 use crate::lexer::parse_number;
 use crate::modal::transform;
 use crate::modal::{A, AXES, B, C, Motion};
-use crate::program::{Flags, RotaryForm, Word};
 use crate::tcpm::code10;
+use crate::word::{RotaryForm, Word};
 use std::ops::Range;
 
 fn axis_index(letter: u8) -> Option<usize> {

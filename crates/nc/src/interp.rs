@@ -3,11 +3,13 @@
 //! TCPM codes in [`crate::tcpm`]; Heidenhain conversational lines in
 //! [`crate::conversational`].
 
+use crate::block::{Block, Flags};
+use crate::dialect::Dialect;
 use crate::error::ParseError;
 use crate::lexer::{Lexer, Token};
 use crate::modal::{A, AXES, B, C, FeedMode, Modal, Motion, Tcpm, X, Y, Z};
-use crate::program::{Block, Dialect, Flags, RotaryForm, Word};
 use crate::tcpm::{ControllerCodes, ReadOptions, Switch, code10};
+use crate::word::{RotaryForm, Word};
 use std::ops::Range;
 
 /// What one block says, collected before the modal state is updated.

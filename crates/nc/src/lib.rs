@@ -9,7 +9,9 @@
 //! Units: linear values and s in mm (inch programs, G20/G70, are converted on read),
 //! feed in mm/min, rotary values in degrees as written.
 
+mod block;
 pub mod conversational;
+mod dialect;
 pub mod emit;
 pub mod error;
 pub mod flow;
@@ -23,18 +25,22 @@ pub mod program;
 pub mod run;
 pub mod style;
 pub mod tcpm;
+mod word;
 pub mod writer;
 
+pub use block::{Block, Flags};
+pub use dialect::Dialect;
 pub use error::ParseError;
 pub use flow::FlowPlan;
 pub use lines::LineEnds;
 pub use modal::{FeedMode, Modal, Motion, Tcpm};
 pub use plan::{FormConflict, restore_modal, write_direction_forms};
 pub use program::{
-    Block, Dialect, Flags, Program, ProgramBuilder, RotaryForm, Scanned, Settled, Word, parse,
-    parse_with, scan, scan_blocks, scan_blocks_with,
+    Program, ProgramBuilder, Scanned, Settled, parse, parse_with, scan, scan_blocks,
+    scan_blocks_with,
 };
 pub use run::{Run, RunBreak, RunBuilder, primary_in_use, primary_of, runs};
 pub use style::{FileStyle, NumberStyle, StyleEvidence};
 pub use tcpm::{Code, ControllerCodes, ReadOptions};
+pub use word::{RotaryForm, Word};
 pub use writer::{Edit, write, write_styled};

@@ -2,7 +2,8 @@
 
 use crate::modal::{A, B, C, Modal, X, Y, Z};
 
-use crate::program::{Block, Program};
+use crate::block::Block;
+use crate::program::Program;
 
 /// Why a run ended (for reports).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -28,8 +28,8 @@
 //! LinuxCNC's switchable kinematics), or says its kinematics are always TCP
 //! (`tcpm_always = true`: every block is read with TCPM on and no code turns it off).
 
+use crate::dialect::Dialect;
 use crate::modal::{Modal, Tcpm};
-use crate::program::Dialect;
 
 /// A code that can switch TCPM: a G or M code (number × 10: `G43.4` → 434) or an
 /// identifier (`TRAORI`, upper case).

@@ -1,8 +1,9 @@
 //! Rewriting: changed or inserted words, every other byte copied.
 
 use crate::modal::AXES;
-use crate::program::{Program, RotaryForm};
+use crate::program::Program;
 use crate::style::{FileStyle, NumberStyle};
+use crate::word::RotaryForm;
 
 /// Set word `letter` of block `block` to `value`, written with `decimals` places in the
 /// file's style for that letter ([`crate::NumberStyle::of`]). A block without the word gets
