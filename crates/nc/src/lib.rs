@@ -16,6 +16,7 @@ pub mod emit;
 pub mod error;
 pub mod flow;
 mod interp;
+mod lexed;
 pub mod lexer;
 pub mod lines;
 pub mod millplus;

@@ -18,7 +18,7 @@
 //! with an indexed address, or starts with `%PM`.
 
 use crate::dialect::Dialect;
-use crate::interp::Scan;
+use crate::lexed::Scan;
 use crate::modal::AXES;
 
 /// What MillPlus G code `code` (× 10) does, when it differs from Fanuc's reading (module

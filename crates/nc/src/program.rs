@@ -7,7 +7,8 @@ pub use crate::dialect::Dialect;
 pub use crate::word::{RotaryForm, Word};
 use crate::{
     error::ParseError,
-    interp::{Interpreter, Scan},
+    interp::Interpreter,
+    lexed::Scan,
     lines::LineEnds,
     modal::{Modal, PackedModal},
     tcpm::ReadOptions,
