@@ -11,6 +11,7 @@
 
 mod block;
 pub mod conversational;
+mod detect;
 mod dialect;
 pub mod emit;
 pub mod error;
