@@ -10,6 +10,7 @@
 //! feed in mm/min, rotary values in degrees as written.
 
 mod block;
+mod builder;
 pub mod conversational;
 mod detect;
 mod dialect;
@@ -24,6 +25,7 @@ pub mod millplus;
 pub mod modal;
 pub mod plan;
 pub mod program;
+mod reader;
 pub mod run;
 pub mod style;
 pub mod tcpm;
@@ -31,16 +33,15 @@ mod word;
 pub mod writer;
 
 pub use block::{Block, Flags};
+pub use builder::{ProgramBuilder, parse, parse_with};
 pub use dialect::Dialect;
 pub use error::ParseError;
 pub use flow::FlowPlan;
 pub use lines::LineEnds;
 pub use modal::{FeedMode, Modal, Motion, Tcpm};
 pub use plan::{FormConflict, restore_modal, write_direction_forms};
-pub use program::{
-    Program, ProgramBuilder, Scanned, Settled, parse, parse_with, scan, scan_blocks,
-    scan_blocks_with,
-};
+pub use program::Program;
+pub use reader::{Scanned, Settled, scan, scan_blocks, scan_blocks_with};
 pub use run::{Run, RunBreak, RunBuilder, primary_in_use, primary_of, runs};
 pub use style::{FileStyle, NumberStyle, StyleEvidence};
 pub use tcpm::{Code, ControllerCodes, ReadOptions};

@@ -99,7 +99,7 @@ pub fn runs(program: &Program) -> Vec<Run> {
 }
 
 /// The run-finding walk of [`runs`], one block at a time, for callers that read a
-/// program as a stream ([`crate::program::scan`]) and want each run as it ends instead of
+/// program as a stream ([`crate::scan`]) and want each run as it ends instead of
 /// a [`Program`] and all runs at once.
 #[derive(Debug, Clone, Default)]
 pub struct RunBuilder {
