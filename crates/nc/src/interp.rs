@@ -9,6 +9,7 @@ use crate::error::ParseError;
 use crate::lexed::{Scan, after_lex, function, m_code};
 use crate::lexer::{Lexer, Token};
 use crate::modal::{A, AXES, B, C, FeedMode, Modal, Motion, Tcpm, X, Y, Z};
+use crate::statements::is_sinumerik_frame;
 use crate::tcpm::{ControllerCodes, ReadOptions, Switch, code10};
 use crate::word::{RotaryForm, Word};
 use std::ops::Range;
@@ -113,33 +114,6 @@ const FLOW: &[&[u8]] = &[
     b"PCALL",
     b"MCALL",
 ];
-
-/// Sinumerik frame instructions (a shift, rotation, scaling or mirror of the programmable
-/// frame).
-pub(crate) fn is_sinumerik_frame(name: &[u8]) -> bool {
-    [
-        &b"TRANS"[..],
-        b"ATRANS",
-        b"CTRANS",
-        b"ROT",
-        b"AROT",
-        b"CROT",
-        b"RPL",
-        b"SCALE",
-        b"ASCALE",
-        b"CSCALE",
-        b"MIRROR",
-        b"AMIRROR",
-        b"CMIRROR",
-        b"TOFRAME",
-        b"TOROT",
-        b"TOROTOF",
-        b"PAROT",
-        b"PAROTOF",
-    ]
-    .iter()
-    .any(|n| name.eq_ignore_ascii_case(n))
-}
 
 /// What a Sinumerik frame instruction does to the transformation bits, given whether the
 /// block states values (axis words, `RPL=`): (switched on, switched off).
@@ -552,7 +526,7 @@ impl Interpreter {
             cycle800_level,
         );
         if s.maybe_flow {
-            s.flow = crate::flow::read_iso(self.dialect, bytes, span.clone());
+            s.flow = crate::statements::read_iso(self.dialect, bytes, span.clone());
         }
         after_lex(bytes, &span, &mut s);
         Ok(s)

@@ -27,6 +27,7 @@ pub mod plan;
 pub mod program;
 mod reader;
 pub mod run;
+mod statements;
 pub mod style;
 pub mod tcpm;
 mod word;
