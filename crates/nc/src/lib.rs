@@ -8,6 +8,25 @@
 //!
 //! Units: linear values and s in mm (inch programs, G20/G70, are converted on read),
 //! feed in mm/min, rotary values in degrees as written.
+//!
+//! # Where things are
+//!
+//! Each module imports only modules listed before it:
+//!
+//! - the basic types: `dialect.rs` ([`Dialect`]), `word.rs` ([`Word`], [`RotaryForm`]),
+//!   `block.rs` ([`Block`], [`Flags`]), [`modal`] (the state after a block: [`Modal`],
+//!   positions, TCPM), [`lines`] (line ends), [`error`];
+//! - [`lexer`] (the tokens of a line), [`flow`] (program flow and how it settles TCPM),
+//!   [`tcpm`] (which codes switch TCPM; [`ReadOptions`]);
+//! - reading a line: `lexed.rs` (what a line says, and what every dialect reads alike),
+//!   [`millplus`], [`conversational`], `statements.rs` (the flow statements of ISO lines),
+//!   `interp.rs` (ISO lines, and how a line changes the modal state);
+//! - reading a file: `detect.rs` (the dialect), [`program`] ([`Program`]), `reader.rs` (the
+//!   one reader, [`scan_blocks_with`], and its simpler forms), `builder.rs` ([`parse`],
+//!   [`ProgramBuilder`]);
+//! - using a program: [`run`] (runs of G1 motion), [`style`] (the file's number style),
+//!   [`writer`] ([`write()`]), [`plan`] (the words a rewrite must add), [`emit`] (new
+//!   programs).
 
 mod block;
 mod builder;
