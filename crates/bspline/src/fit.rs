@@ -10,7 +10,7 @@
 use faer::Mat;
 use faer::linalg::solvers::SolveLstsq;
 
-use crate::basis::{basis_funs, find_span};
+use crate::cox_de_boor::{basis_funs, find_span};
 use crate::error::SplineError;
 use crate::interp::{check_finite, check_lengths};
 use crate::spline::{BSpline, check_knots};

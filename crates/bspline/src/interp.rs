@@ -25,7 +25,7 @@
 //! constraints on the analysis spline's derivatives as linear functions of the C values.
 
 use crate::banded::{BandedLu, W};
-use crate::basis::{basis_funs, ders_basis, find_span};
+use crate::cox_de_boor::{basis_funs, ders_basis, find_span};
 use crate::error::SplineError;
 use crate::knots::{clamped_cubic, not_a_knot};
 use crate::spline::BSpline;

@@ -1,6 +1,6 @@
-//! Knot vectors: span search and the standard constructions.
+//! Knot vectors: the standard constructions.
 //!
-//! (The span search itself lives with the basis functions, `basis::find_span`, and is
+//! (The span search lives with the Cox–de Boor recurrence, `cox_de_boor::find_span`, and is
 //! used through [`crate::BSpline::eval_derivs`] and [`crate::BSpline::basis_row`].)
 
 /// Clamped cubic knot vector with the given breakpoints (first and last repeated 4 times).

@@ -31,6 +31,7 @@
 
 mod banded;
 pub mod basis;
+mod cox_de_boor;
 pub mod error;
 pub mod fit;
 pub mod interp;

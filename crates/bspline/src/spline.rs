@@ -1,6 +1,6 @@
 //! The B-spline type and its evaluation.
 
-use crate::basis::{ders_basis, find_span};
+use crate::cox_de_boor::{ders_basis, find_span};
 use crate::error::SplineError;
 
 /// A scalar B-spline of degree `degree` (≤ 3 in practice) with a clamped or general knot

@@ -250,6 +250,14 @@ fn e(at: At, message: impl Into<String>) -> ClError {
     err(at.line, at.column, message)
 }
 
+/// The error for values after a record that takes none (`GOHOME/Z`).
+fn no_args(f: &[(&str, At)], w: &str) -> Result<(), ClError> {
+    match f.first() {
+        Some(&(t, a)) if !t.is_empty() => Err(e(a, format!("{w} takes no values, got '{t}'"))),
+        _ => Ok(()),
+    }
+}
+
 impl Reader<'_> {
     fn scale(&self) -> f64 {
         if self.inch { MM_PER_INCH } else { 1.0 }
@@ -332,8 +340,9 @@ impl Reader<'_> {
         }
     }
 
-    fn record(&mut self, rec: &Record) -> Result<(), ClError> {
-        let at0 = rec.at(0);
+    /// The major word of a record and the byte where its values start (after `/`, or after
+    /// the blank of `PARTNO NAME`, `PPRINT text`); a `RAPID,` before the word is read here.
+    fn major_word(&mut self, rec: &Record, at0: At) -> Result<(String, Option<usize>), ClError> {
         let (head, args_from) = match rec.text.find('/') {
             Some(p) => (&rec.text[..p], Some(p + 1)),
             None => (rec.text.as_str(), None),
@@ -372,6 +381,13 @@ impl Reader<'_> {
                 _ => (word, None),
             },
         };
+        Ok((word, args_from))
+    }
+
+    /// Read one record: counted, skipped when the caller asks, else read by its kind.
+    fn record(&mut self, rec: &Record) -> Result<(), ClError> {
+        let at0 = rec.at(0);
+        let (word, args_from) = self.major_word(rec, at0)?;
         *self.prog.records.entry(word.clone()).or_default() += 1;
         if self
             .opts
@@ -384,331 +400,29 @@ impl Reader<'_> {
         }
         let args = args_from.map_or("", |p| &rec.text[p..]);
         let f = args_from.map_or_else(Vec::new, |p| rec.fields(p));
-        let no_args = |w: &str| -> Result<(), ClError> {
-            match f.first() {
-                Some(&(t, a)) if !t.is_empty() => {
-                    Err(e(a, format!("{w} takes no values, got '{t}'")))
-                }
-                _ => Ok(()),
-            }
-        };
         match word.as_str() {
-            "GOTO" => {
-                self.check_cutcom()?;
-                if let Some(init) = self.cycle_init {
-                    return Err(e(
-                        init,
-                        "CYCLE/INIT without a cycle before the next GOTO (is it a hole or a move?): refused",
-                    ));
-                }
-                let p = self.point("GOTO", &f, at0)?;
-                let kind = if let Some(PendingCircle {
-                    center: c,
-                    normal: n,
-                    radius_mm: r,
-                    angle_deg: angle,
-                    at: cat,
-                }) = self.circle.take()
-                {
-                    if self.rapid_next {
-                        return Err(e(cat, "RAPID before a circular move (CIRCLE): refused"));
-                    }
-                    let Some(start) = self.pos else {
-                        return Err(e(
-                            cat,
-                            "CIRCLE after a hole or at the start: its start point is unknown",
-                        ));
-                    };
-                    // Without a stated radius: the start point's distance from the axis.
-                    let r = r.unwrap_or_else(|| {
-                        let a = crate::arcs::sub(start, c);
-                        let ax = crate::arcs::dot(a, n);
-                        crate::arcs::norm(crate::arcs::sub(a, crate::arcs::scale(n, ax)))
-                    });
-                    MoveKind::Arc(
-                        Arc::new(c, n, r, start, p, angle, self.last_axis)
-                            .map_err(|m| e(cat, format!("CIRCLE: {m}")))?,
-                    )
-                } else if self.cycle_on {
-                    if self.rapid_next {
-                        return Err(e(
-                            at0,
-                            "RAPID before a GOTO while a CYCLE is on (is it a hole or a move between holes?): refused; end the cycle with CYCLE/OFF first",
-                        ));
-                    }
-                    MoveKind::Hole(self.cycle.clone().expect("on implies defined"))
-                } else if self.rapid_next {
-                    MoveKind::Rapid
-                } else {
-                    MoveKind::Linear
-                };
-                self.push_move(p, kind, at0);
-            }
-            "FROM" => {
-                self.check_cutcom()?;
-                let p = self.point("FROM", &f, at0)?;
-                self.from = Some((p, self.axis));
-                self.push_move(p, MoveKind::Rapid, at0);
-            }
-            "GOHOME" => {
-                no_args("GOHOME")?;
-                self.check_cutcom()?;
-                let Some((p, axis)) = self.from else {
-                    return Err(e(
-                        at0,
-                        "GOHOME without a FROM point before it: where home is is unknown",
-                    ));
-                };
-                self.axis = axis;
-                self.push_move(p, MoveKind::Rapid, at0);
-            }
-            "GODLTA" => {
-                self.check_cutcom()?;
-                if self.cycle_on || self.circle.is_some() {
-                    return Err(e(at0, "GODLTA while a CYCLE or CIRCLE is pending: refused"));
-                }
-                let Some(pos) = self.pos else {
-                    return Err(e(
-                        at0,
-                        "GODLTA after a hole or at the start: the point it moves from is unknown",
-                    ));
-                };
-                let d = match f.len() {
-                    1 => {
-                        let d = number(f[0].0, f[0].1, "distance")? * self.scale();
-                        [self.axis[0] * d, self.axis[1] * d, self.axis[2] * d]
-                    }
-                    3 => {
-                        let mut d = [0.0; 3];
-                        for (i, &(t, a)) in f.iter().enumerate() {
-                            d[i] = number(t, a, ["dx", "dy", "dz"][i])? * self.scale();
-                        }
-                        self.dir(d)
-                    }
-                    n => {
-                        return Err(e(
-                            f.first().map_or(at0, |x| x.1),
-                            format!("GODLTA needs d or dx,dy,dz; got {n} values"),
-                        ));
-                    }
-                };
-                let mut p = [0.0; 3];
-                for i in 0..3 {
-                    p[i] = coordinate(pos[i] + d[i], f[0].1, "GODLTA target", args)?;
-                }
-                let kind = if self.rapid_next {
-                    MoveKind::Rapid
-                } else {
-                    MoveKind::Linear
-                };
-                self.push_move(p, kind, at0);
-            }
+            "GOTO" => self.goto(&f, at0)?,
+            "FROM" => self.from(&f, at0)?,
+            "GOHOME" => self.gohome(&f, at0)?,
+            "GODLTA" => self.godlta(&f, args, at0)?,
             "FEDRAT" => self.fedrat(&f, at0)?,
-            "RAPID" => {
-                no_args("RAPID")?;
-                self.rapid_next = true;
-            }
-            "UNITS" | "UNIT" => {
-                let v = args.trim().to_ascii_uppercase();
-                let inch = match v.as_str() {
-                    "MM" => false,
-                    "INCHES" | "INCH" => true,
-                    other => {
-                        return Err(e(
-                            f.first().map_or(at0, |x| x.1),
-                            format!("{word} '{other}' is not MM, INCH or INCHES"),
-                        ));
-                    }
-                };
-                self.inch = inch;
-                if !self.units_seen {
-                    self.units_seen = true;
-                    self.prog.units = if inch { Units::Inch } else { Units::Mm };
-                }
-            }
-            "TLAXIS" => {
-                if f.len() != 3 {
-                    return Err(e(
-                        f.first().map_or(at0, |x| x.1),
-                        format!(
-                            "TLAXIS needs i,j,k; got '{}' (other TLAXIS forms are not posted)",
-                            args.trim()
-                        ),
-                    ));
-                }
-                let mut v = [0.0; 3];
-                for (i, &(t, a)) in f.iter().enumerate() {
-                    v[i] = number(t, a, ["i", "j", "k"][i])?;
-                }
-                let a = unit_axis(v, f[0].1.line, f[0].1.column)?;
-                self.axis = self.dir(a);
-            }
+            "RAPID" => self.rapid(&f)?,
+            "UNITS" | "UNIT" => self.units(&word, &f, args, at0)?,
+            "TLAXIS" => self.tlaxis(&f, args, at0)?,
             "CIRCLE" | "MOVARC" => self.circle(&word, &f, at0)?,
-            "CYCLE" => {
-                let ctx = CycleContext {
-                    scale: self.scale(),
-                    feed_mm_min: self.feed,
-                    spindle_rpm: self.spindle_rpm,
-                    uniform_peck: self.opts.uniform_peck,
-                };
-                match parse_cycle(&f, at0, &ctx, &number)? {
-                    CycleRecord::Define(c) => {
-                        for (v, what) in [
-                            (c.depth_mm, "FEDTO"),
-                            (c.clearance_mm, "RAPTO"),
-                            (c.retract_mm.unwrap_or(0.0), "RTRCTO"),
-                            (c.peck_mm.unwrap_or(0.0), "STEP"),
-                        ] {
-                            coordinate(v, at0, what, &format!("{v}"))?;
-                        }
-                        if c.feed_mm_min > MAX_FEED_MM_MIN || c.dwell_s > 1e5 {
-                            return Err(e(
-                                at0,
-                                format!(
-                                    "CYCLE/{}: feed {} mm/min or dwell {} s out of range (at most {MAX_FEED_MM_MIN} mm/min, 100000 s)",
-                                    c.mode, c.feed_mm_min, c.dwell_s
-                                ),
-                            ));
-                        }
-                        self.cycle = Some(c);
-                        self.cycle_on = true;
-                        self.cycle_init = None;
-                    }
-                    CycleRecord::On => {
-                        if self.cycle.is_none() {
-                            return Err(e(at0, "CYCLE/ON without a cycle defined before it"));
-                        }
-                        self.cycle_on = true;
-                        self.cycle_init = None;
-                    }
-                    CycleRecord::Off => {
-                        self.cycle_on = false;
-                        self.cycle_init = None;
-                    }
-                    CycleRecord::Init => {
-                        self.cycle_on = false;
-                        self.cycle_init = Some(at0);
-                    }
-                }
-            }
+            "CYCLE" => self.cycle(&f, at0)?,
             "LOADTL" | "LOAD" => self.loadtl(&word, &f, at0)?,
             "SPINDL" => self.spindl(&f, at0)?,
-            "COOLNT" => {
-                let mut mode = None;
-                for &(t, a) in &f {
-                    mode = Some(match t.to_ascii_uppercase().as_str() {
-                        "ON" | "FLOOD" => Coolant::Flood,
-                        "MIST" => Coolant::Mist,
-                        "OFF" => Coolant::Off,
-                        other => {
-                            return Err(e(
-                                a,
-                                format!(
-                                    "COOLNT/{other} is not posted (ON, FLOOD, MIST, OFF are); give --ignore COOLNT to skip every COOLNT record"
-                                ),
-                            ));
-                        }
-                    });
-                }
-                let mode = mode.ok_or_else(|| e(at0, "COOLNT without a mode"))?;
-                self.prog.items.push(ClItem::Coolant { mode, at: at0 });
-            }
+            "COOLNT" => self.coolnt(&f, at0)?,
             "CUTCOM" => self.cutcom(&f, at0)?,
-            "DELAY" => {
-                if f.len() != 1 {
-                    return Err(e(
-                        f.first().map_or(at0, |x| x.1),
-                        format!(
-                            "DELAY needs one value (seconds); got '{}' (DELAY/REV is not posted)",
-                            args.trim()
-                        ),
-                    ));
-                }
-                let s = number(f[0].0, f[0].1, "DELAY seconds")?;
-                if !(0.0..=1e5).contains(&s) {
-                    return Err(e(f[0].1, format!("DELAY {s} s must be within 0…100000 s")));
-                }
-                self.prog.items.push(ClItem::Dwell {
-                    seconds: s,
-                    at: at0,
-                });
-            }
-            "STOP" | "OPSTOP" => {
-                no_args(&word)?;
-                self.prog.items.push(ClItem::Stop {
-                    optional: word == "OPSTOP",
-                    at: at0,
-                });
-            }
-            "PARTNO" => {
-                let name = args.trim().trim_matches('\'').trim().to_string();
-                self.prog
-                    .notes
-                    .push(format!("line {}: PARTNO {name}", at0.line));
-                self.prog
-                    .items
-                    .push(ClItem::Comment(format!("PARTNO {name}")));
-                self.prog.name = Some(name);
-            }
-            "PPRINT" | "TPRINT" => {
-                let text = args.trim().trim_matches('\'').trim().to_string();
-                self.prog
-                    .notes
-                    .push(format!("line {}: {word} {text}", at0.line));
-                self.prog.items.push(ClItem::Comment(text));
-            }
-            "INSERT" => {
-                // Text for the NC program, written there as it is (every APT post does);
-                // listed for the user.
-                let text = args.trim_end().to_string();
-                if let Some(c) = text.chars().find(|c| c.is_control()) {
-                    return Err(e(
-                        at0,
-                        format!(
-                            "INSERT text holds the control character {:?}; it cannot be written into an NC program",
-                            c
-                        ),
-                    ));
-                }
-                self.prog.notes.push(format!(
-                    "line {}: INSERT/{text} is written into the program as it is",
-                    at0.line
-                ));
-                self.prog.items.push(ClItem::Insert { text, at: at0 });
-            }
-            "TRNTYP" => {
-                // CAMWorks: TRNTYP/WORLD,0,0,0 (no transformation) is read; any other is not.
-                let identity = matches!(f.first(), Some((w, _)) if w.eq_ignore_ascii_case("WORLD"))
-                    && f.len() == 4
-                    && f[1..]
-                        .iter()
-                        .all(|&(t, _)| t.parse::<f64>().is_ok_and(|v| v == 0.0));
-                if !identity {
-                    return Err(e(
-                        at0,
-                        "TRNTYP other than WORLD,0,0,0 is not posted (it moves the part frame); give --ignore TRNTYP only if the frame is set on the machine",
-                    ));
-                }
-            }
+            "DELAY" => self.delay(&f, args, at0)?,
+            "STOP" | "OPSTOP" => self.stop(&word, &f, at0)?,
+            "PARTNO" => self.partno(args, at0)?,
+            "PPRINT" | "TPRINT" => self.pprint(&word, args, at0)?,
+            "INSERT" => self.insert(args, at0)?,
+            "TRNTYP" => self.trntyp(&f, at0)?,
             "CSYS" => self.csys(&f, at0)?,
-            "MSYS" => {
-                // NX writes its GOTOs in the machine coordinate system (MCS) and MSYS says
-                // where that is in the model: only the identity is read (else the program
-                // zero is not the part frame the post assumes).
-                let mut v = Vec::with_capacity(f.len());
-                for &(t, a) in &f {
-                    v.push(number(t, a, "MSYS")?);
-                }
-                let identity = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
-                let is_identity =
-                    v.len() == 9 && v.iter().zip(identity).all(|(a, b)| (a - b).abs() <= 1e-9);
-                if !is_identity {
-                    return Err(e(
-                        at0,
-                        "MSYS other than the identity frame is not posted (the program zero would not be the part frame); give --ignore MSYS only if the frame is set on the machine",
-                    ));
-                }
-            }
+            "MSYS" => self.msys(&f, at0)?,
             w if PASSIVE.contains(&w) => {}
             other => {
                 return Err(e(
@@ -718,6 +432,361 @@ impl Reader<'_> {
                     ),
                 ));
             }
+        }
+        Ok(())
+    }
+
+    /// `GOTO/x,y,z[,i,j,k]`: a straight or rapid move, the end of a pending arc, or a hole while a cycle is on.
+    fn goto(&mut self, f: &[(&str, At)], at: At) -> Result<(), ClError> {
+        self.check_cutcom()?;
+        if let Some(init) = self.cycle_init {
+            return Err(e(
+                init,
+                "CYCLE/INIT without a cycle before the next GOTO (is it a hole or a move?): refused",
+            ));
+        }
+        let p = self.point("GOTO", f, at)?;
+        let kind = if let Some(PendingCircle {
+            center: c,
+            normal: n,
+            radius_mm: r,
+            angle_deg: angle,
+            at: cat,
+        }) = self.circle.take()
+        {
+            if self.rapid_next {
+                return Err(e(cat, "RAPID before a circular move (CIRCLE): refused"));
+            }
+            let Some(start) = self.pos else {
+                return Err(e(
+                    cat,
+                    "CIRCLE after a hole or at the start: its start point is unknown",
+                ));
+            };
+            // Without a stated radius: the start point's distance from the axis.
+            let r = r.unwrap_or_else(|| {
+                let a = crate::arcs::sub(start, c);
+                let ax = crate::arcs::dot(a, n);
+                crate::arcs::norm(crate::arcs::sub(a, crate::arcs::scale(n, ax)))
+            });
+            MoveKind::Arc(
+                Arc::new(c, n, r, start, p, angle, self.last_axis)
+                    .map_err(|m| e(cat, format!("CIRCLE: {m}")))?,
+            )
+        } else if self.cycle_on {
+            if self.rapid_next {
+                return Err(e(
+                    at,
+                    "RAPID before a GOTO while a CYCLE is on (is it a hole or a move between holes?): refused; end the cycle with CYCLE/OFF first",
+                ));
+            }
+            MoveKind::Hole(self.cycle.clone().expect("on implies defined"))
+        } else if self.rapid_next {
+            MoveKind::Rapid
+        } else {
+            MoveKind::Linear
+        };
+        self.push_move(p, kind, at);
+        Ok(())
+    }
+
+    /// `FROM/x,y,z[,i,j,k]`: a rapid move, and the home point.
+    fn from(&mut self, f: &[(&str, At)], at: At) -> Result<(), ClError> {
+        self.check_cutcom()?;
+        let p = self.point("FROM", f, at)?;
+        self.from = Some((p, self.axis));
+        self.push_move(p, MoveKind::Rapid, at);
+        Ok(())
+    }
+
+    /// `GOHOME`: a rapid move to the `FROM` point.
+    fn gohome(&mut self, f: &[(&str, At)], at: At) -> Result<(), ClError> {
+        no_args(f, "GOHOME")?;
+        self.check_cutcom()?;
+        let Some((p, axis)) = self.from else {
+            return Err(e(
+                at,
+                "GOHOME without a FROM point before it: where home is is unknown",
+            ));
+        };
+        self.axis = axis;
+        self.push_move(p, MoveKind::Rapid, at);
+        Ok(())
+    }
+
+    /// `GODLTA/d` or `/dx,dy,dz`: a move by d along the tool axis or by the vector.
+    fn godlta(&mut self, f: &[(&str, At)], args: &str, at: At) -> Result<(), ClError> {
+        self.check_cutcom()?;
+        if self.cycle_on || self.circle.is_some() {
+            return Err(e(at, "GODLTA while a CYCLE or CIRCLE is pending: refused"));
+        }
+        let Some(pos) = self.pos else {
+            return Err(e(
+                at,
+                "GODLTA after a hole or at the start: the point it moves from is unknown",
+            ));
+        };
+        let d = match f.len() {
+            1 => {
+                let d = number(f[0].0, f[0].1, "distance")? * self.scale();
+                [self.axis[0] * d, self.axis[1] * d, self.axis[2] * d]
+            }
+            3 => {
+                let mut d = [0.0; 3];
+                for (i, &(t, a)) in f.iter().enumerate() {
+                    d[i] = number(t, a, ["dx", "dy", "dz"][i])? * self.scale();
+                }
+                self.dir(d)
+            }
+            n => {
+                return Err(e(
+                    f.first().map_or(at, |x| x.1),
+                    format!("GODLTA needs d or dx,dy,dz; got {n} values"),
+                ));
+            }
+        };
+        let mut p = [0.0; 3];
+        for i in 0..3 {
+            p[i] = coordinate(pos[i] + d[i], f[0].1, "GODLTA target", args)?;
+        }
+        let kind = if self.rapid_next {
+            MoveKind::Rapid
+        } else {
+            MoveKind::Linear
+        };
+        self.push_move(p, kind, at);
+        Ok(())
+    }
+
+    /// `RAPID`: the next move is rapid.
+    fn rapid(&mut self, f: &[(&str, At)]) -> Result<(), ClError> {
+        no_args(f, "RAPID")?;
+        self.rapid_next = true;
+        Ok(())
+    }
+
+    /// `UNITS/MM|INCHES|INCH`, `UNIT/MM|INCH`: the units of the values from here.
+    fn units(&mut self, word: &str, f: &[(&str, At)], args: &str, at: At) -> Result<(), ClError> {
+        let v = args.trim().to_ascii_uppercase();
+        let inch = match v.as_str() {
+            "MM" => false,
+            "INCHES" | "INCH" => true,
+            other => {
+                return Err(e(
+                    f.first().map_or(at, |x| x.1),
+                    format!("{word} '{other}' is not MM, INCH or INCHES"),
+                ));
+            }
+        };
+        self.inch = inch;
+        if !self.units_seen {
+            self.units_seen = true;
+            self.prog.units = if inch { Units::Inch } else { Units::Mm };
+        }
+        Ok(())
+    }
+
+    /// `TLAXIS/i,j,k`: the tool axis for the next 3-value GOTOs.
+    fn tlaxis(&mut self, f: &[(&str, At)], args: &str, at: At) -> Result<(), ClError> {
+        if f.len() != 3 {
+            return Err(e(
+                f.first().map_or(at, |x| x.1),
+                format!(
+                    "TLAXIS needs i,j,k; got '{}' (other TLAXIS forms are not posted)",
+                    args.trim()
+                ),
+            ));
+        }
+        let mut v = [0.0; 3];
+        for (i, &(t, a)) in f.iter().enumerate() {
+            v[i] = number(t, a, ["i", "j", "k"][i])?;
+        }
+        let a = unit_axis(v, f[0].1.line, f[0].1.column)?;
+        self.axis = self.dir(a);
+        Ok(())
+    }
+
+    /// `CYCLE/…`: a cycle defined, `ON`, `OFF` or `INIT` (`crate::cycles`).
+    fn cycle(&mut self, f: &[(&str, At)], at: At) -> Result<(), ClError> {
+        let ctx = CycleContext {
+            scale: self.scale(),
+            feed_mm_min: self.feed,
+            spindle_rpm: self.spindle_rpm,
+            uniform_peck: self.opts.uniform_peck,
+        };
+        match parse_cycle(f, at, &ctx, &number)? {
+            CycleRecord::Define(c) => {
+                for (v, what) in [
+                    (c.depth_mm, "FEDTO"),
+                    (c.clearance_mm, "RAPTO"),
+                    (c.retract_mm.unwrap_or(0.0), "RTRCTO"),
+                    (c.peck_mm.unwrap_or(0.0), "STEP"),
+                ] {
+                    coordinate(v, at, what, &format!("{v}"))?;
+                }
+                if c.feed_mm_min > MAX_FEED_MM_MIN || c.dwell_s > 1e5 {
+                    return Err(e(
+                        at,
+                        format!(
+                            "CYCLE/{}: feed {} mm/min or dwell {} s out of range (at most {MAX_FEED_MM_MIN} mm/min, 100000 s)",
+                            c.mode, c.feed_mm_min, c.dwell_s
+                        ),
+                    ));
+                }
+                self.cycle = Some(c);
+                self.cycle_on = true;
+                self.cycle_init = None;
+            }
+            CycleRecord::On => {
+                if self.cycle.is_none() {
+                    return Err(e(at, "CYCLE/ON without a cycle defined before it"));
+                }
+                self.cycle_on = true;
+                self.cycle_init = None;
+            }
+            CycleRecord::Off => {
+                self.cycle_on = false;
+                self.cycle_init = None;
+            }
+            CycleRecord::Init => {
+                self.cycle_on = false;
+                self.cycle_init = Some(at);
+            }
+        }
+        Ok(())
+    }
+
+    /// `COOLNT/ON|FLOOD|MIST|OFF`.
+    fn coolnt(&mut self, f: &[(&str, At)], at: At) -> Result<(), ClError> {
+        let mut mode = None;
+        for &(t, a) in f {
+            mode = Some(match t.to_ascii_uppercase().as_str() {
+                "ON" | "FLOOD" => Coolant::Flood,
+                "MIST" => Coolant::Mist,
+                "OFF" => Coolant::Off,
+                other => {
+                    return Err(e(
+                        a,
+                        format!(
+                            "COOLNT/{other} is not posted (ON, FLOOD, MIST, OFF are); give --ignore COOLNT to skip every COOLNT record"
+                        ),
+                    ));
+                }
+            });
+        }
+        let mode = mode.ok_or_else(|| e(at, "COOLNT without a mode"))?;
+        self.prog.items.push(ClItem::Coolant { mode, at });
+        Ok(())
+    }
+
+    /// `DELAY/t`: dwell, seconds.
+    fn delay(&mut self, f: &[(&str, At)], args: &str, at: At) -> Result<(), ClError> {
+        if f.len() != 1 {
+            return Err(e(
+                f.first().map_or(at, |x| x.1),
+                format!(
+                    "DELAY needs one value (seconds); got '{}' (DELAY/REV is not posted)",
+                    args.trim()
+                ),
+            ));
+        }
+        let s = number(f[0].0, f[0].1, "DELAY seconds")?;
+        if !(0.0..=1e5).contains(&s) {
+            return Err(e(f[0].1, format!("DELAY {s} s must be within 0…100000 s")));
+        }
+        self.prog.items.push(ClItem::Dwell { seconds: s, at });
+        Ok(())
+    }
+
+    /// `STOP`, `OPSTOP`.
+    fn stop(&mut self, word: &str, f: &[(&str, At)], at: At) -> Result<(), ClError> {
+        no_args(f, word)?;
+        self.prog.items.push(ClItem::Stop {
+            optional: word == "OPSTOP",
+            at,
+        });
+        Ok(())
+    }
+
+    /// `PARTNO name`: a comment, a note and the program name.
+    fn partno(&mut self, args: &str, at: At) -> Result<(), ClError> {
+        let name = args.trim().trim_matches('\'').trim().to_string();
+        self.prog
+            .notes
+            .push(format!("line {}: PARTNO {name}", at.line));
+        self.prog
+            .items
+            .push(ClItem::Comment(format!("PARTNO {name}")));
+        self.prog.name = Some(name);
+        Ok(())
+    }
+
+    /// `PPRINT text`, `TPRINT text`: a comment and a note.
+    fn pprint(&mut self, word: &str, args: &str, at: At) -> Result<(), ClError> {
+        let text = args.trim().trim_matches('\'').trim().to_string();
+        self.prog
+            .notes
+            .push(format!("line {}: {word} {text}", at.line));
+        self.prog.items.push(ClItem::Comment(text));
+        Ok(())
+    }
+
+    /// `INSERT/text`: text for the NC program.
+    fn insert(&mut self, args: &str, at: At) -> Result<(), ClError> {
+        // Text for the NC program, written there as it is (every APT post does);
+        // listed for the user.
+        let text = args.trim_end().to_string();
+        if let Some(c) = text.chars().find(|c| c.is_control()) {
+            return Err(e(
+                at,
+                format!(
+                    "INSERT text holds the control character {:?}; it cannot be written into an NC program",
+                    c
+                ),
+            ));
+        }
+        self.prog.notes.push(format!(
+            "line {}: INSERT/{text} is written into the program as it is",
+            at.line
+        ));
+        self.prog.items.push(ClItem::Insert { text, at });
+        Ok(())
+    }
+
+    /// `TRNTYP/WORLD,0,0,0` (CAMWorks): read; any other is refused.
+    fn trntyp(&mut self, f: &[(&str, At)], at: At) -> Result<(), ClError> {
+        // CAMWorks: TRNTYP/WORLD,0,0,0 (no transformation) is read; any other is not.
+        let identity = matches!(f.first(), Some((w, _)) if w.eq_ignore_ascii_case("WORLD"))
+            && f.len() == 4
+            && f[1..]
+                .iter()
+                .all(|&(t, _)| t.parse::<f64>().is_ok_and(|v| v == 0.0));
+        if !identity {
+            return Err(e(
+                at,
+                "TRNTYP other than WORLD,0,0,0 is not posted (it moves the part frame); give --ignore TRNTYP only if the frame is set on the machine",
+            ));
+        }
+        Ok(())
+    }
+
+    /// `MSYS/…` (NX): the identity frame is read; any other is refused.
+    fn msys(&mut self, f: &[(&str, At)], at: At) -> Result<(), ClError> {
+        // NX writes its GOTOs in the machine coordinate system (MCS) and MSYS says
+        // where that is in the model: only the identity is read (else the program
+        // zero is not the part frame the post assumes).
+        let mut v = Vec::with_capacity(f.len());
+        for &(t, a) in f {
+            v.push(number(t, a, "MSYS")?);
+        }
+        let identity = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+        let is_identity =
+            v.len() == 9 && v.iter().zip(identity).all(|(a, b)| (a - b).abs() <= 1e-9);
+        if !is_identity {
+            return Err(e(
+                at,
+                "MSYS other than the identity frame is not posted (the program zero would not be the part frame); give --ignore MSYS only if the frame is set on the machine",
+            ));
         }
         Ok(())
     }

@@ -22,7 +22,7 @@
 //!   values mean a clearance in some CAM systems and a rapid rate in others) is refused
 //!   with its column.
 
-use crate::records::At;
+use crate::At;
 
 /// What the cycle does at each hole.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

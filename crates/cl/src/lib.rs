@@ -25,7 +25,7 @@ pub mod write;
 
 pub use arcs::{Arc, Plane};
 pub use cycles::{Cycle, CycleKind};
-pub use records::{At, ClItem, ClPoint, ClProgram, CompSide, Coolant, MoveKind, SpindleDir, Units};
+pub use records::{ClItem, ClPoint, ClProgram, CompSide, Coolant, MoveKind, SpindleDir, Units};
 pub use write::{to_apt, to_csv};
 
 /// A tool axis may differ from unit length by this much (CAM files round to 4–7
@@ -45,6 +45,15 @@ pub const MAX_SPINDLE_RPM: f64 = 1_000_000.0;
 
 /// mm per inch.
 pub const MM_PER_INCH: f64 = 25.4;
+
+/// Where a record starts in the file: 1-based line and byte column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct At {
+    /// 1-based line of the record's first line (a `$`-continued record has its first line).
+    pub line: usize,
+    /// 1-based byte column of the record word (or of the value a message is about).
+    pub column: usize,
+}
 
 /// A bad record.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

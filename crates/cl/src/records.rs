@@ -3,18 +3,10 @@
 //! compensation, dwell, stops, comments). Lengths in mm, feeds in mm/min, whatever the
 //! file's units (converted on read); tool axes are unit vectors in the part frame.
 
+pub use crate::At;
 use crate::arcs::Arc;
 use crate::cycles::Cycle;
 use std::collections::BTreeMap;
-
-/// Where a record starts in the file: 1-based line and byte column.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct At {
-    /// 1-based line of the record's first line (a `$`-continued record has its first line).
-    pub line: usize,
-    /// 1-based byte column of the record word (or of the value a message is about).
-    pub column: usize,
-}
 
 /// Length units of a CL file (`UNITS/MM|INCHES`, `UNIT/MM|INCH`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -21,19 +21,12 @@
 //! [`Machine::pole_p_deg`], and the two solutions are not in general (P, C) and
 //! (−P, C + 180°) ([`Machine::other_solution`]).
 
+pub use crate::angles::{unwrap_near_deg, wrap_deg};
 use crate::forward::StandardForm;
 use crate::machine::{Machine, PrimaryAxis};
+pub use crate::rotary::IkSolution;
 use crate::rotary::{Ik, inverse_general, pole_p_general, pole_tilt_general};
 use crate::tolerances::POLE_SIN_TOL;
-
-/// One joint solution, degrees.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct IkSolution {
-    /// Primary angle (the tilting axis: A or B on the built-ins), degrees.
-    pub p_deg: f64,
-    /// C angle (the pole axis), degrees, in (−180, 180] before unwrapping.
-    pub c_deg: f64,
-}
 
 /// How [`inverse_path`] picks between the two solutions ((P, C) and (−P, C+180°) on the
 /// built-ins).
@@ -193,26 +186,6 @@ impl Machine {
             _ => Some(IkSolution { p_deg, c_deg }),
         }
     }
-}
-
-/// An angle in degrees wrapped to (−180, 180].
-pub fn wrap_deg(angle_deg: f64) -> f64 {
-    if angle_deg > -180.0 && angle_deg <= 180.0 {
-        return angle_deg;
-    }
-    let w = angle_deg % 360.0; // exact, in (−360, 360)
-    if w > 180.0 {
-        w - 360.0
-    } else if w <= -180.0 {
-        w + 360.0
-    } else {
-        w
-    }
-}
-
-/// `angle_deg + n·360` for the integer n that puts it within (ref − 180, ref + 180], degrees.
-pub fn unwrap_near_deg(angle_deg: f64, ref_deg: f64) -> f64 {
-    ref_deg + wrap_deg(angle_deg - ref_deg)
 }
 
 /// atan2 in degrees, exact (0, ±90, 180) when an argument is zero, in (−180, 180].
@@ -727,18 +700,6 @@ mod tests {
         let o = forward(&m, 150.0, 0.0);
         assert!(inverse_path(&m, &[o], BranchRule::PreferPositive)[0].p_deg > 0.0);
         assert!(inverse_path(&m, &[o], BranchRule::PreferNegative)[0].p_deg < 0.0);
-    }
-
-    #[test]
-    fn wrap_and_unwrap() {
-        assert_eq!(wrap_deg(180.0), 180.0);
-        assert_eq!(wrap_deg(-180.0), 180.0);
-        assert_eq!(wrap_deg(540.0), 180.0);
-        assert_eq!(wrap_deg(-190.0), 170.0);
-        assert_eq!(wrap_deg(0.0), 0.0);
-        assert_eq!(unwrap_near_deg(-170.0, 170.0), 190.0);
-        assert_eq!(unwrap_near_deg(10.0, 725.0), 730.0);
-        assert_eq!(unwrap_near_deg(-1e-20, 0.0), -1e-20);
     }
 
     /// A pair whose pole is not at P = 0: LinuxCNC's xyzab_tdr layout, the A table along X

@@ -24,11 +24,14 @@
 //! A built-in name, a TOML file in either form ([`Machine::from_toml_str`]), or a
 //! LinuxCNC INI file ([`linuxcnc`]), all through [`Machine::load`].
 
+mod angles;
 pub mod chain;
 pub mod feed;
 pub mod forward;
+mod frames;
 pub mod inverse;
 pub mod linuxcnc;
+mod load;
 pub mod machine;
 mod machine_file;
 pub mod reorient;
@@ -38,13 +41,13 @@ pub mod tolerances;
 #[cfg(test)]
 mod testutil;
 
+pub use angles::{unwrap_near_deg, wrap_deg};
 pub use chain::Chain;
 pub use feed::{AxisBound, FeedBound, LimitKind, axis_feed_bound, axis_feed_ratio, feed_bound};
 pub use forward::{StandardForm, angle_between_deg, forward, forward_jacobian};
 pub use inverse::{
-    BranchRule, IkSolution, domain_rule_index, inverse, inverse_path, inverse_path_from, solve_ik,
-    unwrap_near_deg, wrap_deg,
+    BranchRule, domain_rule_index, inverse, inverse_path, inverse_path_from, solve_ik,
 };
 pub use machine::{Axis, AxisLimits, Controller, Machine, MachineError, PrimaryAxis};
 pub use reorient::JigRotation;
-pub use rotary::{Carrier, Ik, Layout, Rotaries, RotaryAxis};
+pub use rotary::{Carrier, Ik, IkSolution, Layout, Rotaries, RotaryAxis};

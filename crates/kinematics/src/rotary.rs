@@ -209,13 +209,22 @@ pub(crate) fn rotate_deg(u: [f64; 3], angle_deg: f64, v: [f64; 3]) -> [f64; 3] {
     }
 }
 
+/// One joint solution, degrees.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IkSolution {
+    /// Primary angle (the tilting axis: A or B on the built-ins), degrees.
+    pub p_deg: f64,
+    /// C angle (the pole axis), degrees, in (−180, 180] before unwrapping.
+    pub c_deg: f64,
+}
+
 /// The solutions of the inverse kinematics of one tool axis.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Ik {
     /// Off the pole: two joint solutions (P, C), degrees, both wrapped to (−180°, 180°];
     /// the first has the larger P. They are equal where the orientation is on the border
     /// of what the pair reaches.
-    Two([crate::IkSolution; 2]),
+    Two([IkSolution; 2]),
     /// On the pole (`o` along the pole axis, within [`POLE_SIN_TOL`]) or on the opposite
     /// pole (`o` against it, `opposite = true`): C does not change the tool axis and is
     /// undefined; P is `p_deg`.
@@ -369,7 +378,7 @@ pub(crate) fn inverse_general(rot: &Rotaries, sp: f64, sc: f64, o_wp: [f64; 3]) 
     let g = PairGeometry::new(rot);
     let sin_gamma = norm(cross(g.a, o));
     let gamma = sin_gamma.atan2(dot(g.a, o));
-    let to_p = |beta: f64| crate::wrap_deg(sp * beta.to_degrees());
+    let to_p = |beta: f64| crate::angles::wrap_deg(sp * beta.to_degrees());
     let Some(betas) = g.betas(gamma) else {
         let (lo, hi) = g.reach_rad();
         return Ik::Unreachable {
@@ -383,9 +392,9 @@ pub(crate) fn inverse_general(rot: &Rotaries, sp: f64, sc: f64, o_wp: [f64; 3]) 
             opposite: gamma > std::f64::consts::FRAC_PI_2,
         };
     }
-    let mut sols = betas.map(|beta| crate::IkSolution {
+    let mut sols = betas.map(|beta| IkSolution {
         p_deg: to_p(beta),
-        c_deg: crate::wrap_deg(sc * g.alpha(g.v(beta), o).to_degrees()),
+        c_deg: crate::angles::wrap_deg(sc * g.alpha(g.v(beta), o).to_degrees()),
     });
     if sols[1].p_deg > sols[0].p_deg {
         sols.swap(0, 1);
@@ -398,7 +407,7 @@ pub(crate) fn inverse_general(rot: &Rotaries, sp: f64, sc: f64, o_wp: [f64; 3]) 
 pub(crate) fn pole_p_general(rot: &Rotaries, sp: f64) -> Option<f64> {
     let g = PairGeometry::new(rot);
     g.betas(0.0)
-        .map(|b| crate::wrap_deg(sp * b[0].to_degrees()))
+        .map(|b| crate::angles::wrap_deg(sp * b[0].to_degrees()))
 }
 
 /// The angle between the pole axis and the tool turned by the primary axis alone,

@@ -26,14 +26,16 @@
 //! An axis word whose value is a Q parameter (`X+Q1`, `C-QR5`) marks the block not
 //! analysable (positions unknown after it), never the file.
 
+use crate::block::Flags;
+use crate::dialect::Dialect;
 use crate::error::ParseError;
 use crate::flow::{Key, Stmt};
-use crate::interp::{Interpreter, Scan, function};
+use crate::lexed::{Scan, after_lex, function, m_code};
 use crate::lexer::parse_number;
 use crate::modal::transform;
 use crate::modal::{A, AXES, B, C, Motion};
-use crate::program::{Flags, RotaryForm, Word};
-use crate::tcpm::code10;
+use crate::tcpm::{ControllerCodes, code10};
+use crate::word::{RotaryForm, Word};
 use std::ops::Range;
 
 fn axis_index(letter: u8) -> Option<usize> {
@@ -84,7 +86,7 @@ impl Words<'_> {
     /// Read the words of `toks` into `s` and `words`.
     fn read(
         &self,
-        interp: &Interpreter,
+        controller: &ControllerCodes,
         toks: &[Range<usize>],
         s: &mut Scan,
         words: &mut Vec<Word>,
@@ -249,7 +251,7 @@ impl Words<'_> {
                             s.unknown_after = true;
                             s.breaks = true;
                         }
-                        c => interp.m(c, s),
+                        c => m_code(Dialect::Conversational, controller, c, s),
                     }
                 }
                 // Radius compensation: R0 none, RL/RR/R+/R- on (ends runs).
@@ -266,7 +268,7 @@ impl Words<'_> {
 
 /// What a conversational line says (module docs), its words appended to `words`.
 pub(crate) fn lex(
-    interp: &Interpreter,
+    controller: &ControllerCodes,
     bytes: &[u8],
     span: Range<usize>,
     line: usize,
@@ -325,11 +327,11 @@ pub(crate) fn lex(
         }
         b"END" => {
             s.flags.set(Flags::PROGRAM_END);
-            interp.m(Some(300), &mut s);
+            m_code(Dialect::Conversational, controller, Some(300), &mut s);
         }
         b"L" => {
             s.motion = Some(Motion::Linear);
-            w.read(interp, rest, &mut s, words)?;
+            w.read(controller, rest, &mut s, words)?;
         }
         b"LN" => {
             s.motion = Some(Motion::Linear);
@@ -345,7 +347,7 @@ pub(crate) fn lex(
                 })
                 .cloned()
                 .collect();
-            w.read(interp, &axes, &mut s, words)?;
+            w.read(controller, &axes, &mut s, words)?;
             // The tool axis follows the normal vectors: rotary positions unknown.
             for i in [A, B, C] {
                 s.axes_expr |= 1 << i;
@@ -353,7 +355,7 @@ pub(crate) fn lex(
         }
         b"C" | b"CR" | b"CT" => {
             s.motion = Some(Motion::ArcCw);
-            w.read(interp, rest, &mut s, words)?;
+            w.read(controller, rest, &mut s, words)?;
             s.breaks = true;
         }
         b"LP" | b"CP" | b"APPR" | b"DEP" => {
@@ -511,10 +513,10 @@ pub(crate) fn lex(
         }
         b"STOP" => {
             s.breaks = true;
-            w.read(interp, rest, &mut s, words)?;
+            w.read(controller, rest, &mut s, words)?;
         }
         k if k.first() == Some(&b'M') && k.len() > 1 && k[1].is_ascii_digit() => {
-            w.read(interp, &toks, &mut s, words)?;
+            w.read(controller, &toks, &mut s, words)?;
         }
         _ => {
             s.flags.set(Flags::NOT_MODELLED);
@@ -522,7 +524,7 @@ pub(crate) fn lex(
             s.breaks = true;
         }
     }
-    crate::interp::after_lex(bytes, &span, &mut s);
+    after_lex(bytes, &span, &mut s);
     Ok(s)
 }
 

@@ -28,7 +28,7 @@
 //! Units: every length and feed is written in mm, or in inches with `inch` (`G20`,
 //! `G700`, Heidenhain `G70` with F in 0.1 inch/min as Heidenhain inch programs take it).
 
-use crate::program::Dialect;
+use crate::dialect::Dialect;
 use crate::style::NumberStyle;
 
 /// One straight move: tool tip (part frame, mm), primary and C (degrees), feed.

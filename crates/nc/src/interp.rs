@@ -1,85 +1,18 @@
-//! What a line says ([`Scan`], lexed on any thread) and how it changes the modal state
-//! ([`Interpreter::apply`], in file order). The rules are in [`crate::modal`]'s docs; the
-//! TCPM codes in [`crate::tcpm`]; Heidenhain conversational lines in
-//! [`crate::conversational`].
+//! What a line says ([`Scan`], lexed on any thread: ISO lines here, Heidenhain
+//! conversational lines in [`crate::conversational`], the readings they share in
+//! `lexed.rs`) and how it changes the modal state ([`Interpreter::apply`], in file order).
+//! The rules are in [`crate::modal`]'s docs; the TCPM codes in [`crate::tcpm`].
 
+use crate::block::{Block, Flags};
+use crate::dialect::Dialect;
 use crate::error::ParseError;
+use crate::lexed::{Scan, after_lex, function, m_code};
 use crate::lexer::{Lexer, Token};
 use crate::modal::{A, AXES, B, C, FeedMode, Modal, Motion, Tcpm, X, Y, Z};
-use crate::program::{Block, Dialect, Flags, RotaryForm, Word};
+use crate::statements::is_sinumerik_frame;
 use crate::tcpm::{ControllerCodes, ReadOptions, Switch, code10};
+use crate::word::{RotaryForm, Word};
 use std::ops::Range;
-
-/// What one block says, collected before the modal state is updated.
-#[derive(Debug, Default)]
-pub(crate) struct Scan {
-    pub(crate) axes: [Option<f64>; 6],
-    /// The direction forms of A B C (`C=DC(…)`, `C=ACP(…)`, `C=ACN(…)`).
-    pub(crate) axes_form: [RotaryForm; 3],
-    /// Axis (X Y Z A B C) and F words whose value is one macro variable (`F#100`,
-    /// `X-#101`): its number and whether it is negated.
-    pub(crate) vars: [Option<(u32, bool)>; 7],
-    /// A macro variable assigned in the block (`#100=1200.`): its number and the value
-    /// when it is a plain number.
-    pub(crate) assign: Option<(u32, Option<f64>)>,
-    /// Another assignment (`#<name>=…`, `#[#1]=…`, a second one): any variable may change.
-    pub(crate) assign_other: bool,
-    /// `breaks` was set by the expression words alone.
-    pub(crate) expr_breaks: bool,
-    /// Bit `i`: axis `i`'s value is an expression or a variable (not a plain number).
-    pub(crate) axes_expr: u8,
-    /// Bit `i`: axis `i`'s word is incremental for this block only (conversational `IX`).
-    pub(crate) axes_incremental: u8,
-    pub(crate) feed: Option<f64>,
-    /// The F word is an expression or a variable.
-    pub(crate) feed_expr: bool,
-    /// The feed is not per minute for this block (conversational `FU`, `FZ`, `FAUTO`).
-    pub(crate) feed_unknown: bool,
-    pub(crate) motion: Option<Motion>,
-    /// A canned cycle switched on (`G81`…) or off (`G80`).
-    pub(crate) cycle: Option<bool>,
-    /// Conversational `FMAX`: this block is a rapid, the next one is not.
-    pub(crate) rapid_once: bool,
-    pub(crate) incremental: Option<bool>,
-    pub(crate) inch: Option<bool>,
-    /// Conversational: F is in 1/10 inch/min in an inch program.
-    pub(crate) tcpm: Option<Switch>,
-    pub(crate) feed_mode: Option<FeedMode>,
-    /// Axis words define a datum/frame (Heidenhain G54, G92, G10, G52, TRANS…): not a move.
-    pub(crate) datum_shift: bool,
-    /// Heidenhain ISO `G54`: the block's X Y Z are the new datum.
-    pub(crate) stated_datum: bool,
-    /// Work offset selection (Fanuc/Sinumerik G54…G59, G500): positions re-based.
-    pub(crate) work_offset: bool,
-    /// Reference / machine-coordinate move (G28, G30, G53, SUPA).
-    pub(crate) reference: bool,
-    /// Axis words are arguments, not a move (G4 dwell, G65 macro call, conversational
-    /// `BLK FORM`, `CC`).
-    pub(crate) no_move: bool,
-    /// Positions are unknown afterwards (macro or subprogram call, label, cycle call).
-    pub(crate) unknown_after: bool,
-    /// X and Y are unknown afterwards (a polar move).
-    pub(crate) xy_unknown_after: bool,
-    pub(crate) breaks: bool,
-    /// Flags for the block.
-    pub(crate) flags: Flags,
-    /// The block may hold a flow statement ([`crate::flow`]): read it after lexing.
-    pub(crate) maybe_flow: bool,
-    /// Its flow statement.
-    pub(crate) flow: Option<crate::flow::Stmt>,
-    /// The block's number (`N…`), when it is a whole number.
-    pub(crate) number: Option<u64>,
-    /// A TCPM-on code that refers X Y Z to the centre of a ball (Heidenhain `M128`, `FUNCTION
-    /// TCPM … REFPNT CENTER-CENTER`) rather than to the tool tip.
-    pub(crate) tcpm_centre: bool,
-    /// Heidenhain ISO `G73`, `G72` or `G28` (× 10): the frame code whose values the block
-    /// gives.
-    pub(crate) heidenhain_frame: Option<i64>,
-    /// Frame transformations the block switches on (bits of [`crate::modal::transform`]).
-    pub(crate) transform_on: u8,
-    /// … and off.
-    pub(crate) transform_off: u8,
-}
 
 pub(crate) struct Interpreter {
     pub(crate) dialect: Dialect,
@@ -181,33 +114,6 @@ const FLOW: &[&[u8]] = &[
     b"PCALL",
     b"MCALL",
 ];
-
-/// Sinumerik frame instructions (a shift, rotation, scaling or mirror of the programmable
-/// frame).
-pub(crate) fn is_sinumerik_frame(name: &[u8]) -> bool {
-    [
-        &b"TRANS"[..],
-        b"ATRANS",
-        b"CTRANS",
-        b"ROT",
-        b"AROT",
-        b"CROT",
-        b"RPL",
-        b"SCALE",
-        b"ASCALE",
-        b"CSCALE",
-        b"MIRROR",
-        b"AMIRROR",
-        b"CMIRROR",
-        b"TOFRAME",
-        b"TOROT",
-        b"TOROTOF",
-        b"PAROT",
-        b"PAROTOF",
-    ]
-    .iter()
-    .any(|n| name.eq_ignore_ascii_case(n))
-}
 
 /// What a Sinumerik frame instruction does to the transformation bits, given whether the
 /// block states values (axis words, `RPL=`): (switched on, switched off).
@@ -389,41 +295,6 @@ impl Interpreter {
         }
     }
 
-    pub(crate) fn m(&self, code: Option<i64>, s: &mut Scan) {
-        let sw = code.and_then(|c| self.controller.m(self.dialect, c));
-        if let Some(sw) = sw {
-            s.tcpm = Some(sw);
-            // M128: the tool length refers to the ball's centre (Heidenhain's manuals).
-            s.tcpm_centre = sw == Switch::On
-                && code == Some(1280)
-                && matches!(self.dialect, Dialect::Heidenhain | Dialect::Conversational);
-        }
-        match code {
-            // Spindle and coolant.
-            Some(30 | 40 | 50 | 70 | 80 | 90 | 130 | 140) => {}
-            Some(60) => {
-                s.flags.set(Flags::TOOL_CHANGE);
-                s.breaks = true;
-                // Fanuc-style controls run M6 as a macro ([`crate::flow`]).
-                s.maybe_flow = matches!(self.dialect, Dialect::Fanuc | Dialect::Auto);
-            }
-            Some(20 | 300) => {
-                s.flags.set(Flags::PROGRAM_END);
-                s.breaks = true;
-            }
-            // Subprogram call and return, cycle call (Heidenhain M99): other blocks run.
-            Some(980 | 990 | 970 | 1980 | 170) => {
-                s.unknown_after = true;
-                s.breaks = true;
-                s.maybe_flow = self.dialect != Dialect::Heidenhain;
-            }
-            // A TCPM switch (breaks through the state change).
-            _ if sw.is_some() => {}
-            // Stops, anything unknown.
-            _ => s.breaks = true,
-        }
-    }
-
     fn ident(&self, name: &[u8], s: &mut Scan) {
         if let Some(sw) = self.controller.ident(self.dialect, name) {
             s.tcpm = Some(sw);
@@ -472,7 +343,7 @@ impl Interpreter {
         words: &mut Vec<Word>,
     ) -> Result<Scan, ParseError> {
         if self.dialect == Dialect::Conversational {
-            return crate::conversational::lex(self, bytes, span, line, words);
+            return crate::conversational::lex(&self.controller, bytes, span, line, words);
         }
         let mut s = Scan::default();
         // X Y Z A B C F seen in this block, with the column of the first.
@@ -526,7 +397,7 @@ impl Interpreter {
                         b'C' => s.axes[C] = Some(value),
                         b'F' => s.feed = Some(value),
                         b'G' => self.g(code10(value), &mut s),
-                        b'M' => self.m(code10(value), &mut s),
+                        b'M' => m_code(self.dialect, &self.controller, code10(value), &mut s),
                         b'T' => {
                             s.flags.set(Flags::TOOL_CHANGE);
                             s.breaks = true;
@@ -655,7 +526,7 @@ impl Interpreter {
             cycle800_level,
         );
         if s.maybe_flow {
-            s.flow = crate::flow::read_iso(self.dialect, bytes, span.clone());
+            s.flow = crate::statements::read_iso(self.dialect, bytes, span.clone());
         }
         after_lex(bytes, &span, &mut s);
         Ok(s)
@@ -980,62 +851,6 @@ impl Interpreter {
             breaks_run: breaks,
             flags,
         }
-    }
-}
-
-/// What every dialect's reading of a line ends with: expressions flag the block; a flow
-/// statement ends runs and leaves positions unknown; a lone CR inside the line, with text
-/// after it, may be a line end to the control (hiding what follows in a comment, or showing
-/// a comment's text as a block), so the block's effect on TCPM and positions is unknown.
-pub(crate) fn after_lex(bytes: &[u8], span: &Range<usize>, s: &mut Scan) {
-    if s.axes_expr != 0 || s.feed_expr {
-        s.flags.set(Flags::NOT_ANALYSABLE);
-        s.expr_breaks = !s.breaks;
-        s.breaks = true;
-    }
-    if s.flow.is_some() {
-        s.unknown_after = true;
-        s.breaks = true;
-        s.expr_breaks = false;
-    }
-    let line = &bytes[span.clone()];
-    if let Some(cr) = line.iter().position(|&b| b == b'\r')
-        && line[cr + 1..].iter().any(|b| !b.is_ascii_whitespace())
-    {
-        s.tcpm = Some(Switch::Unknown);
-        s.flags.set(Flags::NOT_MODELLED);
-        s.unknown_after = true;
-        s.breaks = true;
-    }
-}
-
-/// A Heidenhain `FUNCTION …` line (`text` from the word `FUNCTION` on): `FUNCTION TCPM …`
-/// switches TCPM on, `FUNCTION RESET TCPM` off; any other function breaks runs.
-pub(crate) fn function(text: &[u8], s: &mut Scan) {
-    let mut words = text
-        .split(|b| b.is_ascii_whitespace())
-        .filter(|w| !w.is_empty())
-        .skip(1);
-    let first = words.next().unwrap_or_default();
-    let second = words.next().unwrap_or_default();
-    let sw = if first.eq_ignore_ascii_case(b"TCPM") {
-        // `REFPNT TIP-TIP` (the default), `TIP-CENTER`: X Y Z are the tip; `CENTER-CENTER`:
-        // the centre of the ball.
-        let mut rest = words.clone();
-        s.tcpm_centre = std::iter::once(second)
-            .chain(&mut rest)
-            .skip_while(|w| !w.eq_ignore_ascii_case(b"REFPNT"))
-            .nth(1)
-            .is_some_and(|w| w.len() >= 6 && w[..6].eq_ignore_ascii_case(b"CENTER"));
-        Some(Switch::On)
-    } else if first.eq_ignore_ascii_case(b"RESET") && second.eq_ignore_ascii_case(b"TCPM") {
-        Some(Switch::Off)
-    } else {
-        None
-    };
-    match sw {
-        Some(sw) => s.tcpm = Some(sw),
-        None => s.breaks = true,
     }
 }
 

@@ -30,7 +30,7 @@
 //! a number but has none (`X`, `X+`), and an ASCII control byte (NUL, ESC, DEL…) outside
 //! a comment.
 
-use crate::program::RotaryForm;
+use crate::word::RotaryForm;
 use std::ops::Range;
 
 /// One token of a line. Spans are absolute byte offsets into the file.

@@ -8,33 +8,62 @@
 //!
 //! Units: linear values and s in mm (inch programs, G20/G70, are converted on read),
 //! feed in mm/min, rotary values in degrees as written.
+//!
+//! # Where things are
+//!
+//! Each module imports only modules listed before it:
+//!
+//! - the basic types: `dialect.rs` ([`Dialect`]), `word.rs` ([`Word`], [`RotaryForm`]),
+//!   `block.rs` ([`Block`], [`Flags`]), [`modal`] (the state after a block: [`Modal`],
+//!   positions, TCPM), [`lines`] (line ends), [`error`];
+//! - [`lexer`] (the tokens of a line), [`flow`] (program flow and how it settles TCPM),
+//!   [`tcpm`] (which codes switch TCPM; [`ReadOptions`]);
+//! - reading a line: `lexed.rs` (what a line says, and what every dialect reads alike),
+//!   [`millplus`], [`conversational`], `statements.rs` (the flow statements of ISO lines),
+//!   `interp.rs` (ISO lines, and how a line changes the modal state);
+//! - reading a file: `detect.rs` (the dialect), [`program`] ([`Program`]), `reader.rs` (the
+//!   one reader, [`scan_blocks_with`], and its simpler forms), `builder.rs` ([`parse`],
+//!   [`ProgramBuilder`]);
+//! - using a program: [`run`] (runs of G1 motion), [`style`] (the file's number style),
+//!   [`writer`] ([`write()`]), [`plan`] (the words a rewrite must add), [`emit`] (new
+//!   programs).
 
+mod block;
+mod builder;
 pub mod conversational;
+mod detect;
+mod dialect;
 pub mod emit;
 pub mod error;
 pub mod flow;
 mod interp;
+mod lexed;
 pub mod lexer;
 pub mod lines;
 pub mod millplus;
 pub mod modal;
 pub mod plan;
 pub mod program;
+mod reader;
 pub mod run;
+mod statements;
 pub mod style;
 pub mod tcpm;
+mod word;
 pub mod writer;
 
+pub use block::{Block, Flags};
+pub use builder::{ProgramBuilder, parse, parse_with};
+pub use dialect::Dialect;
 pub use error::ParseError;
 pub use flow::FlowPlan;
 pub use lines::LineEnds;
 pub use modal::{FeedMode, Modal, Motion, Tcpm};
 pub use plan::{FormConflict, restore_modal, write_direction_forms};
-pub use program::{
-    Block, Dialect, Flags, Program, ProgramBuilder, RotaryForm, Scanned, Settled, Word, parse,
-    parse_with, scan, scan_blocks, scan_blocks_with,
-};
+pub use program::Program;
+pub use reader::{Scanned, Settled, scan, scan_blocks, scan_blocks_with};
 pub use run::{Run, RunBreak, RunBuilder, primary_in_use, primary_of, runs};
 pub use style::{FileStyle, NumberStyle, StyleEvidence};
 pub use tcpm::{Code, ControllerCodes, ReadOptions};
+pub use word::{RotaryForm, Word};
 pub use writer::{Edit, write, write_styled};

@@ -17,9 +17,9 @@
 //! A file is MillPlus ([`looks_like`]) when a line programs `G141` or `G174`, or `G7`
 //! with an indexed address, or starts with `%PM`.
 
-use crate::interp::Scan;
+use crate::dialect::Dialect;
+use crate::lexed::Scan;
 use crate::modal::AXES;
-use crate::program::Dialect;
 
 /// What MillPlus G code `code` (× 10) does, when it differs from Fanuc's reading (module
 /// docs); `false` leaves the code to the common rules.

@@ -218,19 +218,6 @@ impl Default for Modal {
     }
 }
 
-/// The state before a program's first block on a machine with `controller`'s codes (TCPM
-/// on from the start where the kinematics are always TCP).
-pub fn initial(controller: &crate::tcpm::ControllerCodes) -> Modal {
-    Modal {
-        tcpm: if controller.always {
-            Tcpm::On
-        } else {
-            Tcpm::Off
-        },
-        ..Modal::default()
-    }
-}
-
 /// [`Modal`] as the program stores it: 64 bytes instead of 136 (one bit per known value
 /// instead of an `Option` tag on each), converted losslessly both ways.
 #[derive(Debug, Clone, Copy, PartialEq)]

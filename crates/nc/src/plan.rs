@@ -10,6 +10,7 @@
 use crate::modal::{AXES, X, Z};
 use crate::program::Program;
 use crate::writer::Edit;
+pub use crate::writer::inserted_form;
 
 /// For every edit, find the next block after it that moves or carries the edited letter;
 /// when that block has no word for the letter and is not edited for it itself, add an edit
@@ -64,22 +65,6 @@ pub fn restore_modal(
         }
     }
     edits.extend(extra);
-}
-
-/// The form a word of `letter` inserted into `block` is written in: that of the last word
-/// of the letter before it (`C=DC(…)` in a program that writes them), else of the first
-/// after it (a stretch of a file may start at the block), else plain.
-pub fn inserted_form(program: &Program, block: usize, letter: u8) -> crate::RotaryForm {
-    if !matches!(letter, b'A' | b'B' | b'C') {
-        return crate::RotaryForm::Plain;
-    }
-    let words = program.blocks[block].words();
-    program.words[..words.start]
-        .iter()
-        .rev()
-        .chain(&program.words[words.end..])
-        .find(|w| w.letter == letter)
-        .map_or(crate::RotaryForm::Plain, |w| w.form)
 }
 
 /// A rotary word in a direction form (Sinumerik `C=DC(…)`, `C=ACP(…)`, `C=ACN(…)`) that

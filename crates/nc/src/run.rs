@@ -2,7 +2,8 @@
 
 use crate::modal::{A, B, C, Modal, X, Y, Z};
 
-use crate::program::{Block, Program};
+use crate::block::Block;
+use crate::program::Program;
 
 /// Why a run ended (for reports).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -98,7 +99,7 @@ pub fn runs(program: &Program) -> Vec<Run> {
 }
 
 /// The run-finding walk of [`runs`], one block at a time, for callers that read a
-/// program as a stream ([`crate::program::scan`]) and want each run as it ends instead of
+/// program as a stream ([`crate::scan`]) and want each run as it ends instead of
 /// a [`Program`] and all runs at once.
 #[derive(Debug, Clone, Default)]
 pub struct RunBuilder {

@@ -2,7 +2,8 @@
 
 use crate::lexer::parse_number;
 use crate::modal::AXES;
-use crate::program::{Program, Word};
+use crate::program::Program;
+use crate::word::Word;
 
 /// How numbers of one address letter are written in a file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -28,7 +28,8 @@
 //! LinuxCNC's switchable kinematics), or says its kinematics are always TCP
 //! (`tcpm_always = true`: every block is read with TCPM on and no code turns it off).
 
-use crate::program::Dialect;
+use crate::dialect::Dialect;
+use crate::modal::{Modal, Tcpm};
 
 /// A code that can switch TCPM: a G or M code (number × 10: `G43.4` → 434) or an
 /// identifier (`TRAORI`, upper case).
@@ -126,11 +127,11 @@ pub(crate) enum Switch {
 
 impl Switch {
     /// The state the switch sets.
-    pub(crate) fn state(self) -> crate::Tcpm {
+    pub(crate) fn state(self) -> Tcpm {
         match self {
-            Switch::On => crate::Tcpm::On,
-            Switch::Off => crate::Tcpm::Off,
-            Switch::Unknown => crate::Tcpm::Unknown,
+            Switch::On => Tcpm::On,
+            Switch::Off => Tcpm::Off,
+            Switch::Unknown => Tcpm::Unknown,
         }
     }
 }
@@ -211,6 +212,19 @@ impl ControllerCodes {
     }
 }
 
+/// The state before a program's first block on a machine with `controller`'s codes (TCPM
+/// on from the start where the kinematics are always TCP).
+pub fn initial(controller: &ControllerCodes) -> Modal {
+    Modal {
+        tcpm: if controller.always {
+            Tcpm::On
+        } else {
+            Tcpm::Off
+        },
+        ..Modal::default()
+    }
+}
+
 /// How to read a program: its dialect, the machine's TCPM codes, how the file's program
 /// flow settles TCPM, and the units of a program that does not state them.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -240,10 +254,10 @@ impl ReadOptions {
     }
 
     /// The modal state at the start of a program read this way.
-    pub fn initial(&self) -> crate::Modal {
-        crate::Modal {
+    pub fn initial(&self) -> Modal {
+        Modal {
             inch: self.inch,
-            ..crate::modal::initial(&self.controller)
+            ..initial(&self.controller)
         }
     }
 }

@@ -3,6 +3,7 @@
 use crate::modal::AXES;
 use crate::program::Program;
 use crate::style::{FileStyle, NumberStyle};
+use crate::word::RotaryForm;
 
 /// Set word `letter` of block `block` to `value`, written with `decimals` places in the
 /// file's style for that letter ([`crate::NumberStyle::of`]). A block without the word gets
@@ -157,7 +158,7 @@ pub fn write_styled(program: &Program, edits: &[Edit], file: &FileStyle) -> Vec<
 }
 
 /// An inserted word: `letter [=] number`, or where the letter's word before it is in a
-/// direction form ([`crate::plan::inserted_form`]), `letter=FORM(number)`.
+/// direction form ([`inserted_form`]), `letter=FORM(number)`.
 fn inserted(
     text: &mut Vec<u8>,
     program: &Program,
@@ -168,7 +169,7 @@ fn inserted(
     number: &str,
 ) {
     text.push(letter);
-    let form = crate::plan::inserted_form(program, block, letter);
+    let form = inserted_form(program, block, letter);
     if form.is_directional() {
         text.push(b'=');
         text.extend_from_slice(form.name().as_bytes());
@@ -182,6 +183,22 @@ fn inserted(
     }
     text.extend_from_slice(file.letter_gap);
     text.extend_from_slice(number.as_bytes());
+}
+
+/// The form a word of `letter` inserted into `block` is written in: that of the last word
+/// of the letter before it (`C=DC(…)` in a program that writes them), else of the first
+/// after it (a stretch of a file may start at the block), else plain.
+pub fn inserted_form(program: &Program, block: usize, letter: u8) -> RotaryForm {
+    if !matches!(letter, b'A' | b'B' | b'C') {
+        return RotaryForm::Plain;
+    }
+    let words = program.blocks[block].words();
+    program.words[..words.start]
+        .iter()
+        .rev()
+        .chain(&program.words[words.end..])
+        .find(|w| w.letter == letter)
+        .map_or(RotaryForm::Plain, |w| w.form)
 }
 
 /// Position of `letter` in X Y Z A B C order; other letters come after.

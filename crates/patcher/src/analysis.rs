@@ -27,14 +27,8 @@
 
 use crate::path::{Path, PathError};
 use crate::spline::{AnalysisSpline, SpanCubic, SplineSystem};
+use crate::tolerances::{RATIO_TOL, TIME_MAX_DEPTH, TIME_REL_TOL};
 use polepatch_kinematics::{Axis, FeedBound, LimitKind, Machine, axis_feed_bound, feed_bound};
-
-/// A piece of a span is bisected while the bound on its time error exceeds this fraction of
-/// its time (module docs).
-pub const TIME_REL_TOL: f64 = 1e-3;
-
-/// Most bisections of a span for its time (at most `2^TIME_MAX_DEPTH` pieces).
-pub const TIME_MAX_DEPTH: u32 = 6;
 
 /// Default singular cone, degrees: every stretch where C is below feed and the primary
 /// axis comes this close to the pole is a zone ([`detect_zones`]).
@@ -170,9 +164,6 @@ pub struct RunAnalysis {
     /// `spans·(2^TIME_MAX_DEPTH + 2)`, whatever the feed.
     pub evaluations: usize,
 }
-
-/// Ratios below `1 − RATIO_TOL` count as "below feed" (absorbs round-off in the bound).
-pub const RATIO_TOL: f64 = 1e-9;
 
 /// Check a path's shape and values.
 pub fn validate(path: &Path) -> Result<(), PathError> {

@@ -23,10 +23,10 @@
 use crate::{
     candidate::{Candidate, PatchFailure},
     direct::direct_patch,
-    driver::{Proposal, Proposer, Sink, Tail, ZoneCtx},
     g16::g16_patch,
     limits::CLimits,
     options::PatchOptions,
+    protocol::{Proposal, Proposer, Sink, Tail, ZoneCtx},
     report::Method,
     settings::SolverSettings,
 };

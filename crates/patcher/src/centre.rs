@@ -47,7 +47,7 @@ impl KeepCentre {
     /// A value of mm as the controller receives it when written in the file's unit and
     /// decimals.
     pub fn written_mm(&self, v_mm: f64) -> f64 {
-        crate::options::round_written(v_mm / self.unit_mm, self.decimals) * self.unit_mm
+        crate::path::round_written(v_mm / self.unit_mm, self.decimals) * self.unit_mm
     }
 
     /// The tip that keeps the centre of the ball at `tip_mm` with the tool axis of

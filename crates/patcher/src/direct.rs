@@ -8,13 +8,13 @@
 //!
 //! New values `y_i = C_i + δ_i` at `i = first..=last` (every other point fixed), the
 //! slopes `m_k` of the window `lo = first − W .. hi = last + W` (clipped to the path,
-//! W = [`WINDOW_POINTS`]) and `t`. On a span the quadratic q' has Bernstein coefficients
+//! W = [`HERMITE_WINDOW_POINTS`]) and `t`. On a span the quadratic q' has Bernstein coefficients
 //! `b0 = m_k`, `b1 = 3σ_k − m_k − m_{k+1}`, `b2 = m_{k+1}`; by the convex-hull property
 //! `|b_i| ≤ v` gives `|q'| ≤ v` on the whole span, hence on every sample whatever the step.
 //! `q''` is linear on a span (its ends bind) and `q'''` constant.
 //!
 //! ```text
-//! minimise    t + μ Σ_i (w_i² + ε)·δ_i²            w_i = |sin P_i|, μ = DEVIATION_QUAD_WEIGHT/m
+//! minimise    t + μ Σ_i (w_i² + ε)·δ_i²            w_i = |sin P_i|, μ = direct_quad_weight/m
 //! subject to  Hermite continuity and end rows        (equalities, above)
 //!             −t ≤ w_i·δ_i ≤ t                       (t ≥ largest approximate deviation)
 //!             t ≤ d                                  (only with opts.max_deviation_deg = Some(d))
@@ -28,7 +28,7 @@
 //! of the constrained range are fixed points, `|C_b − C_a| ≤ v·(s_b − s_a)`.
 //!
 //! The constrained range is the spans in `[s(first − 3), s(last + 3)]` (clipped to the
-//! path, [`CONSTRAINED_MARGIN_POINTS`]). `(v, a, j)` are `lim` (V/F, A/F², J/F³, with the
+//! path, [`crate::tolerances::CONSTRAINED_MARGIN_POINTS`]). `(v, a, j)` are `lim` (V/F, A/F², J/F³, with the
 //! caller's margin). Each inequality row is divided by its bound so all rows have unit
 //! scale; each continuity row by `h_{k−1} + h_k`. Every row touches at most 5 variables, so
 //! the KKT system clarabel factors is banded-sparse. The deviation of a point whose C
@@ -36,8 +36,8 @@
 //! linearisation `|sin P|·|δ|`, which is never below the exact value for |δ| ≤ 180° up to
 //! the second order in |sin P| (so `t ≤ d` is a slightly conservative form of the exact
 //! limit for small P; the reported deviation always uses the exact formula). `ε`
-//! ([`PURE_POLE_REGULARISATION`]) keeps a point exactly at the pole (w = 0) from being
-//! free. The small quadratic (weight μ) pulls the points that do not bind the maximum back
+//! ([`crate::SolverSettings::direct_pole_regularisation`]) keeps a point exactly at the pole (w = 0) from being
+//! free. The small quadratic (weight μ, [`crate::SolverSettings::direct_quad_weight`]) pulls the points that do not bind the maximum back
 //! towards their original values.
 //!
 //! # The bound
@@ -57,28 +57,10 @@ use crate::{
     options::PatchOptions,
     report::{QpStats, QpStatus},
     spline::{AnalysisSpline, span_offsets},
+    tolerances::{BOUND_BISECTIONS, BOUND_REL_TOL, HERMITE_WINDOW_POINTS, NOT_WORSE_SLACK},
 };
 
-pub use crate::hermite::{CONSTRAINED_MARGIN_POINTS, WINDOW_POINTS};
-
-/// Weight of the quadratic pull-back term, per degree, divided by the number of variables
-/// (small, so the minimax term dominates).
-pub const DEVIATION_QUAD_WEIGHT: f64 = 1e-4;
-
-/// Added to `sin² P` in the quadratic term so a point exactly at the pole stays determined.
-pub const PURE_POLE_REGULARISATION: f64 = 1e-6;
-
-/// Samples per span of [`deviation_bound`] (both ends included): the bound checks the
-/// limits there only, a relaxation of the exact requirement (every s of the span), so it
-/// stays a lower bound; more samples tighten it. Bounded per span whatever the feed.
-pub const BOUND_SAMPLES_PER_SPAN: usize = 32;
-
-/// Most bisection steps of [`deviation_bound`].
-pub const BOUND_BISECTIONS: usize = 25;
-
-/// [`deviation_bound`] stops bisecting when the bracket is narrower than this fraction of
-/// its upper end (the bound is then known to 0.01 %).
-pub const BOUND_REL_TOL: f64 = 1e-4;
+pub use crate::tolerances::BOUND_SAMPLES_PER_SPAN;
 
 /// New C values for points `first..=last` (others fixed) minimising the largest orientation
 /// deviation such that the analysis spline of the whole path satisfies `lim` on every
@@ -86,7 +68,7 @@ pub const BOUND_REL_TOL: f64 = 1e-4;
 ///
 /// The QP is written out in the module docs. `s_mm`, `p_deg` (primary, degrees) and
 /// `c_deg` are per point of the whole path; the constraints cover the spans within
-/// [`CONSTRAINED_MARGIN_POINTS`] of the range, so the caller verifies the result.
+/// [`crate::tolerances::CONSTRAINED_MARGIN_POINTS`] of the range, so the caller verifies the result.
 #[allow(clippy::too_many_arguments)]
 pub fn direct_patch(
     s_mm: &[f64],
@@ -98,7 +80,7 @@ pub fn direct_patch(
     monotone: Option<f64>,
     opts: &PatchOptions,
 ) -> Result<Candidate, PatchFailure> {
-    let hm = Hermite::new(s_mm, c_deg, first, last, WINDOW_POINTS)?;
+    let hm = Hermite::new(s_mm, c_deg, first, last, HERMITE_WINDOW_POINTS)?;
     let spans = hm.constrained_spans();
     if !within_reach(s_mm, c_deg, first, last, &spans, lim.v) {
         // Net change beyond v·length.
@@ -134,12 +116,17 @@ pub fn direct_patch(
             }
         }
     }
-    let mu = DEVIATION_QUAD_WEIGHT / nd as f64;
+    let st = &opts.solver;
+    let mu = st.direct_quad_weight / nd as f64;
     for i in 0..nd {
         let w = p_deg[first + i].to_radians().sin().abs();
         qp.add_le(&[(i, w), (t, -1.0)], 0.0);
         qp.add_le(&[(i, -w), (t, -1.0)], 0.0);
-        qp.add_square(&[(i, 1.0)], mu * (w * w + PURE_POLE_REGULARISATION), 0.0);
+        qp.add_square(
+            &[(i, 1.0)],
+            mu * (w * w + st.direct_pole_regularisation),
+            0.0,
+        );
     }
     if let Some(d) = opts.max_deviation_deg {
         qp.add_le(&[(t, 1.0)], d);
@@ -186,7 +173,7 @@ pub fn orientation_deviation_deg(p_deg: f64, dc_deg: f64) -> f64 {
 
 /// The smallest possible largest orientation deviation (degrees) over C-only changes at
 /// points `first..=last` such that the analysis spline satisfies `lim` (no monotonicity
-/// asked): the bound the bench compares against. Samples every [`BOUND_STEP_MM`]; see
+/// asked): the bound the bench compares against. [`BOUND_SAMPLES_PER_SPAN`] samples per span; see
 /// [`deviation_bound_sampled`].
 pub fn deviation_bound(
     s_mm: &[f64],
@@ -201,7 +188,7 @@ pub fn deviation_bound(
 
 /// [`deviation_bound`] with the constraints on `samples_per_span + 1` equally spaced
 /// samples of each span of the constrained range (spans within
-/// [`CONSTRAINED_MARGIN_POINTS`] of the range), knots included: a relaxation of what the
+/// [`crate::tolerances::CONSTRAINED_MARGIN_POINTS`] of the range), knots included: a relaxation of what the
 /// verification checks (every s), hence a lower bound. Bisection (at most [`BOUND_BISECTIONS`] steps, to
 /// [`BOUND_REL_TOL`]) on the exact deviation, an LP feasibility problem per step (module
 /// docs); returns the smallest feasible T found.
@@ -248,9 +235,6 @@ pub fn deviation_bound_zone(
     )
 }
 
-/// Relative slack on "not worse than before" outside the zone (round-off only).
-const BEFORE_SLACK: f64 = 1e-9;
-
 #[allow(clippy::too_many_arguments)]
 fn deviation_bound_in(
     s_mm: &[f64],
@@ -262,7 +246,7 @@ fn deviation_bound_in(
     lim: &CLimits,
     samples_per_span: usize,
 ) -> Result<(f64, QpStats), PatchFailure> {
-    let hm = Hermite::new(s_mm, c_deg, first, last, WINDOW_POINTS)?;
+    let hm = Hermite::new(s_mm, c_deg, first, last, HERMITE_WINDOW_POINTS)?;
     let nd = hm.nd;
     let mut base = hm.builder(0);
     let spans = hm.constrained_spans();
@@ -274,7 +258,7 @@ fn deviation_bound_in(
     let relaxed = |t: f64, d: usize, limit: f64| -> f64 {
         match (zone, &before) {
             (Some((a, b)), Some(pp)) if t < s_mm[a] || t > s_mm[b] => {
-                limit.max(pp.eval_derivs(t)[d].abs() * (1.0 + BEFORE_SLACK))
+                limit.max(pp.eval_derivs(t)[d].abs() * (1.0 + NOT_WORSE_SLACK))
             }
             _ => limit,
         }
@@ -442,7 +426,7 @@ mod tests {
             before: &c,
             after: &c2,
         }];
-        let v = verify_change(&s, &ch, first, last, &m, 1000.0 / 60.0);
+        let v = verify_change(&s, &ch, first, last, 3, &m, 1000.0 / 60.0);
         assert!(
             v.core_min_before < 0.5,
             "planted case must be below feed: {v:?}"

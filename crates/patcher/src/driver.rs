@@ -8,7 +8,7 @@
 //!    span) and find its singular zones; zones closer than
 //!    [`SolverSettings::merge_gap_points`] are one.
 //! 3. For each zone, in path order, on the values the zones before it left:
-//!    - the methods of the strategy ([`methods`]) propose candidates through a [`Sink`],
+//!    - the methods of the strategy ([`crate::strategy::methods`]) propose candidates through a [`Sink`],
 //!      for each rung of the margin ladder ([`SolverSettings::margin_ladder`]) until one
 //!      passes;
 //!    - every candidate is **rounded as it will be written** (the file's decimals, then one
@@ -35,157 +35,32 @@
 //!   `max_deviation_deg`;
 //! - `end_pinned`: the run's last point must keep its values (`keep_last_point`, the NC
 //!   pipeline says which block pins it), and with it held **no** values reach feed, while
-//!   with it free some would (both by the relaxation of [`crate::reference::reachable`]);
+//!   with it free some would (both by the relaxation of [`crate::proof::reachable`]);
 //! - `range`: the machine's axis ranges forbid every values that would reach feed (the
 //!   relaxation is infeasible with them, feasible without);
 //! - `proven_unreachable`: no values of the movable points reach feed at all (the
-//!   relaxation is infeasible — a proof, see [`crate::reference`]);
+//!   relaxation is infeasible — a proof, see [`crate::proof`]);
 //! - `not_found`: none of the above: polepatch found no patch, and cannot prove there is
 //!   none (or a patch failed the whole-run verification);
 //! - `not_patched`: the run may not be patched (no TCPM, incremental, …: the caller's
 //!   reason), so the zone is only reported ([`crate::report_unpatched`]).
 
 use crate::{
-    analysis::{AnalysisOptions, RATIO_TOL, SpanFigures, Zone, ZoneKind, analyze_spans, validate},
+    analysis::{AnalysisOptions, SpanFigures, Zone, analyze_spans, validate},
+    centre::{KeepCentre, tip_length, written_path},
     options::{PatchAxes, PatchOptions, round_written},
     path::{Path, PathError},
-    peers::Strategy,
+    proof::why_not_reached,
+    protocol::{Offered, Proposal, Proposer, Sink, Tail, ZoneCtx},
     qp::add_stats,
     report::{Method, Outcome, QpStats, Reason, ZoneFigures, ZoneReport},
     settings::SolverSettings,
-    verify::{AxisChange, Verdict, verify_change_on, verify_change_with_core},
+    tolerances::{CAP_SLACK_DEG, CHECK_MARGIN_POINTS, RATIO_TOL},
+    verify::{AxisChange, Verdict, not_worse_floor, verify_change_on, verify_change_with_core},
 };
-use polepatch_kinematics::{Axis, LimitKind, Machine, angle_between_deg, forward};
-use std::ops::Range;
+use polepatch_kinematics::{Axis, Machine, angle_between_deg, forward};
 
-/// Narrowing a patch that slowed a linear axis away from its zone ([`patch_with`], a
-/// ball's centre kept) moves its bound at least this fraction of the way to the zone.
-const NARROW_STEP_DIV: usize = 4;
-
-/// Tries at scaling a change that reaches feed beyond `max_deviation_deg` into the cap
-/// (the best improvement within it).
-const SCALE_TRIES: usize = 4;
-/// Each try aims this fraction of the cap (the deviation is nearly, not exactly, linear in
-/// the scale; rounding adds a little).
-const SCALE_SAFETY: f64 = 0.98;
-
-/// Points of unchanged path either side of a candidate's change and its zone that the
-/// candidate check verifies (the whole run is verified again at the end).
-pub const CHECK_MARGIN_POINTS: usize = crate::verify::VERIFY_MARGIN_POINTS + 1;
-
-/// What happens to the points after a candidate's last point.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Tail {
-    /// They keep their values.
-    Keep,
-    /// They move to the other IK branch as a block, `(P, C) → (−P, C + shift)`: the same
-    /// tool axes, every derivative's size kept.
-    Reselect {
-        /// ±180°.
-        shift_deg: f64,
-    },
-    /// C gets a 360° multiple added (`--c-offset`, the C-only method).
-    COffset {
-        /// The multiple of 360°.
-        deg: f64,
-    },
-}
-
-/// A method's proposal for a zone: new (unrounded) values for points `first..=last`.
-#[derive(Debug, Clone)]
-pub struct Proposal {
-    /// The method that made it.
-    pub method: Method,
-    /// First point with new values.
-    pub first: usize,
-    /// Last point with new values.
-    pub last: usize,
-    /// New primary values for `first..=last`, degrees.
-    pub p: Vec<f64>,
-    /// New C values for `first..=last`, degrees.
-    pub c: Vec<f64>,
-    /// The points after `last`.
-    pub tail: Tail,
-    /// Solver statistics of the solves that made it.
-    pub qp: QpStats,
-}
-
-/// What the driver says about a proposal it was offered.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Offered {
-    /// Reaches feed over the zone's core and nothing got worse, as written.
-    pub passes: bool,
-    /// Exact largest orientation change, degrees, as written.
-    pub deviation_deg: f64,
-}
-
-/// Where a method hands its proposals (the driver's checker).
-pub trait Sink {
-    /// Round, verify and consider `p`; `None` when it cannot be evaluated (non-finite
-    /// values, a range the zone may not change).
-    fn offer(&mut self, p: Proposal) -> Option<Offered>;
-    /// Add the statistics of solves that made no proposal.
-    fn add_stats(&mut self, qp: &QpStats);
-    /// The smallest deviation of a passing proposal so far (within the cap), degrees.
-    fn best_passing_deg(&self) -> Option<f64>;
-}
-
-/// What a method sees of one zone.
-pub struct ZoneCtx<'a> {
-    /// Path length per point, mm.
-    pub s: &'a [f64],
-    /// The program's tool axes (what every change is measured against).
-    pub target: &'a [[f64; 3]],
-    /// The machine.
-    pub machine: &'a Machine,
-    /// The caller's options.
-    pub opts: &'a PatchOptions,
-    /// Numerical settings.
-    pub settings: &'a SolverSettings,
-    /// Programmed feed, mm/min.
-    pub feed_mm_min: f64,
-    /// The zone.
-    pub zone: &'a Zone,
-    /// The spans that must reach feed (the zone ± the core margin).
-    pub core: Range<usize>,
-    /// First point a proposal may change.
-    pub lower: usize,
-    /// Last point a proposal may change (the run's last, or the one before it when the
-    /// last must stay).
-    pub end: usize,
-    /// Current primary values of the whole path, degrees.
-    pub p: &'a [f64],
-    /// Current C values of the whole path, degrees.
-    pub c: &'a [f64],
-    /// The margin on the limits for this rung of the ladder.
-    pub margin: f64,
-    /// Index of the rung (0: the configured margin).
-    pub rung: usize,
-}
-
-/// A method: proposes candidates for a zone.
-pub trait Proposer {
-    /// Offer candidates for `ctx`'s zone to `sink`.
-    fn propose(&mut self, ctx: &ZoneCtx<'_>, sink: &mut dyn Sink);
-}
-
-/// The methods of a strategy, in the order they are asked, and whether their proposals
-/// are verified (a peer's rule is scored as it is, never held back).
-pub fn methods(opts: &PatchOptions) -> (Vec<Box<dyn Proposer>>, bool) {
-    match (opts.strategy, opts.axes) {
-        (Strategy::Polepatch, PatchAxes::Both) => (
-            vec![
-                Box::new(crate::reselect::Reselect),
-                Box::new(crate::joint_method::JointMethod),
-            ],
-            true,
-        ),
-        (Strategy::Polepatch, PatchAxes::OnlyC) => {
-            (vec![Box::new(crate::c_only::COnly::default())], true)
-        }
-        (peer, _) => (vec![Box::new(crate::peers::Peer(peer))], false),
-    }
-}
+pub use crate::zones::{figures_over, merge_zones, zone_core};
 
 /// A candidate after rounding and verification.
 #[derive(Debug, Clone)]
@@ -223,10 +98,7 @@ struct Selection<'a> {
 
 impl Selection<'_> {
     fn axes(&self) -> &'static [Axis] {
-        match self.opts.axes {
-            PatchAxes::Both => &[Axis::Primary, Axis::C],
-            PatchAxes::OnlyC => &[Axis::C],
-        }
+        checked_axes(self.opts.axes)
     }
 
     /// Values of `(p, c)` on `lo..=hi` with `prop` applied, rounded with `decimals` where
@@ -286,8 +158,9 @@ impl Selection<'_> {
                     std::array::from_fn(|j| q[j] + keep.radius_mm * (o0[j] - o1[j]))
                 })
                 .collect();
-            Some(crate::centre::tip_length(self.s[lo], &tips))
+            Some(tip_length(self.s[lo], &tips))
         };
+        let margin = self.opts.solver.core_margin_points;
         let verify = |wp: &[f64], wc: &[f64]| {
             let ch: Vec<AxisChange> = axes
                 .iter()
@@ -302,14 +175,22 @@ impl Selection<'_> {
                 (self.zone.first.max(lo) - lo, self.zone.last.min(hi) - lo),
             );
             match (tip_s(bp, bc), tip_s(wp, wc)) {
-                (Some(sb), Some(sa)) => {
-                    verify_change_on(&sb, &sa, &ch, changed, core, self.machine, self.feed_mm_s)
-                }
+                (Some(sb), Some(sa)) => verify_change_on(
+                    &sb,
+                    &sa,
+                    &ch,
+                    changed,
+                    core,
+                    margin,
+                    self.machine,
+                    self.feed_mm_s,
+                ),
                 _ => verify_change_with_core(
                     &self.s[lo..=hi],
                     &ch,
                     changed,
                     core,
+                    margin,
                     self.machine,
                     self.feed_mm_s,
                 ),
@@ -393,8 +274,9 @@ impl Selection<'_> {
         }
         let mut lambda = 1.0;
         let mut dev = dev_deg;
-        for _ in 0..SCALE_TRIES {
-            lambda *= (cap / dev) * SCALE_SAFETY;
+        let st = &self.opts.solver;
+        for _ in 0..st.scale_tries {
+            lambda *= (cap / dev) * st.scale_safety;
             let mut scaled = prop.clone();
             for (k, i) in (prop.first..=prop.last).enumerate() {
                 scaled.p[k] = self.p[i] + lambda * (prop.p[k] - self.p[i]);
@@ -412,7 +294,7 @@ impl Selection<'_> {
     fn within_cap(&self, dev: f64) -> bool {
         self.opts
             .max_deviation_deg
-            .is_none_or(|cap| dev <= cap + 1e-9)
+            .is_none_or(|cap| dev <= cap + CAP_SLACK_DEG)
     }
 }
 
@@ -578,58 +460,6 @@ pub(crate) fn analysis_options(opts: &PatchOptions) -> AnalysisOptions {
     }
 }
 
-/// Zones in order, those closer than `gap` points merged.
-pub fn merge_zones(zones: &[Zone], gap: usize) -> Vec<Zone> {
-    let mut out: Vec<Zone> = Vec::new();
-    let mut sorted = zones.to_vec();
-    sorted.sort_by_key(|z| z.first);
-    for z in sorted {
-        match out.last_mut() {
-            Some(m) if z.first <= m.last + gap => {
-                if z.min_abs_primary_deg < m.min_abs_primary_deg {
-                    m.singular = z.singular;
-                    m.min_abs_primary_deg = z.min_abs_primary_deg;
-                }
-                if z.kind == ZoneKind::AFlip {
-                    m.kind = ZoneKind::AFlip;
-                }
-                m.last = m.last.max(z.last);
-                m.c_ratio_min = m.c_ratio_min.min(z.c_ratio_min);
-            }
-            _ => out.push(z),
-        }
-    }
-    out
-}
-
-/// The spans a zone's patch must bring to feed: the zone's, ± `margin` points.
-pub fn zone_core(zone: &Zone, n: usize, margin: usize) -> Range<usize> {
-    zone.first.saturating_sub(margin)..(zone.last + margin).min(n - 1)
-}
-
-/// Equation-6 figures over the spans `spans` of a run's span figures.
-pub fn figures_over(spans: &[SpanFigures], range: Range<usize>) -> ZoneFigures {
-    let mut f = ZoneFigures {
-        c_ratio: 1.0,
-        primary_ratio: 1.0,
-        overall_ratio: 1.0,
-        limiting_axis: None,
-        limiting_kind: LimitKind::Feed,
-        time_s: 0.0,
-    };
-    for sp in &spans[range.start.min(spans.len())..range.end.min(spans.len())] {
-        f.c_ratio = f.c_ratio.min(sp.axis_ratio[Axis::C.index()]);
-        f.primary_ratio = f.primary_ratio.min(sp.axis_ratio[Axis::Primary.index()]);
-        if sp.bound.ratio < f.overall_ratio {
-            f.overall_ratio = sp.bound.ratio;
-            f.limiting_axis = sp.bound.axis;
-            f.limiting_kind = sp.bound.kind;
-        }
-        f.time_s += sp.time_s;
-    }
-    f
-}
-
 /// Spans on which the machine is slower after than before: the overall ratio (every axis
 /// and the feed) below [`crate::verify::not_worse_floor`] of the ratio before. Where a
 /// patch moves the tips (a ball's centre kept), a linear axis may take over a span's limit
@@ -639,7 +469,7 @@ pub fn whole_run_slower(before: &[SpanFigures], after: &[SpanFigures]) -> Vec<us
         .iter()
         .zip(after)
         .enumerate()
-        .filter(|(_, (b, a))| a.bound.ratio < crate::verify::not_worse_floor(b.bound.ratio))
+        .filter(|(_, (b, a))| a.bound.ratio < not_worse_floor(b.bound.ratio))
         .map(|(k, _)| k)
         .collect()
 }
@@ -654,7 +484,7 @@ pub fn whole_run_worse(before: &[SpanFigures], after: &[SpanFigures], axes: &[Ax
         .filter(|(_, (b, a))| {
             axes.iter().any(|ax| {
                 let k = ax.index();
-                a.axis_ratio[k] < crate::verify::not_worse_floor(b.axis_ratio[k])
+                a.axis_ratio[k] < not_worse_floor(b.axis_ratio[k])
             })
         })
         .map(|(k, _)| k)
@@ -670,7 +500,7 @@ struct Fixed<'a> {
     machine: &'a Machine,
     opts: &'a PatchOptions,
     /// The program's tool axes.
-    target: &'a [[f64; 3]],
+    target: Vec<[f64; 3]>,
     verify: bool,
 }
 
@@ -691,7 +521,7 @@ fn solve_zone(
     let mut sel = Selection {
         s: f.s,
         axes: &path.axes,
-        target: f.target,
+        target: &f.target,
         machine: f.machine,
         opts,
         zone: &zone,
@@ -710,7 +540,7 @@ fn solve_zone(
     for (rung, factor) in st.margin_ladder.iter().enumerate() {
         let ctx = ZoneCtx {
             s: f.s,
-            target: f.target,
+            target: &f.target,
             machine: f.machine,
             opts,
             settings: st,
@@ -756,24 +586,13 @@ fn solve_zone(
     }
 }
 
-/// Patch every singular zone of `path` with the methods of `opts`' strategy (module
-/// docs).
-pub fn patch_path(
-    path: &Path,
-    machine: &Machine,
-    opts: &PatchOptions,
-) -> Result<PatchResult, PathError> {
-    let (m, verify) = methods(opts);
-    patch_with(path, machine, opts, m, verify)
-}
-
-/// [`patch_path`] with the given methods (asked in order) and whether their proposals are
-/// verified.
+/// [`crate::patch_path`] with the given methods (asked in order) and whether their
+/// proposals are verified: the strategy table ([`crate::strategy::methods`]) gives them.
 ///
 /// Keeping a ball's centre ([`PatchOptions::keep_centre`]) moves the tips, so the tip
 /// path's length s — Equation 6's parameter — depends on the solution: the zones are
 /// solved again on the length of the tips the last solve wrote, until the lengths agree
-/// within [`CENTRE_S_TOL`] (a fixed point: a few solves), and the solve that reaches feed
+/// within [`SolverSettings::centre_s_tol`] (a fixed point: a few solves), and the solve that reaches feed
 /// on most zones is kept. Every solve is verified on the path as written, with its own s.
 pub fn patch_with(
     path: &Path,
@@ -794,18 +613,18 @@ pub fn patch_with(
     };
     let mut last = best.clone();
     let mut solve_s = path.s_mm.clone();
-    for _ in 0..CENTRE_S_ITERATIONS {
+    for _ in 0..opts.solver.centre_s_iterations {
         if reached(&best) == best.zones.len() {
             break;
         }
-        let s = crate::centre::tip_length(path.s_mm[0], &last.xyz_mm);
+        let s = tip_length(path.s_mm[0], &last.xyz_mm);
         let moved = s
             .windows(2)
             .zip(solve_s.windows(2))
             .map(|(a, b)| ((a[1] - a[0]) - (b[1] - b[0])).abs() / (b[1] - b[0]))
             .fold(0.0, f64::max);
         if moved.is_nan()
-            || moved <= CENTRE_S_TOL
+            || moved <= opts.solver.centre_s_tol
             || s.windows(2).any(|w| w[1].is_nan() || w[1] <= w[0])
         {
             break;
@@ -819,12 +638,8 @@ pub fn patch_with(
     Ok(best)
 }
 
-/// Solves of a path whose tips move to keep a ball's centre, at most ([`patch_with`]).
-const CENTRE_S_ITERATIONS: usize = 4;
-/// Relative change of a block's length below which the tip path's length has settled.
-const CENTRE_S_TOL: f64 = 1e-3;
-
-/// [`patch_with`] with the methods solving on the path length `solve_s`.
+/// [`patch_with`] with the methods solving on the path length `solve_s`: the steps of the
+/// module docs, one function each.
 fn patch_on(
     path: &Path,
     solve_s: &[f64],
@@ -833,196 +648,302 @@ fn patch_on(
     methods: &mut [Box<dyn Proposer>],
     verify: bool,
 ) -> Result<PatchResult, PathError> {
+    // 1. Validate; a path with no point near the pole is unchanged.
     validate(path)?;
     opts.validate()?;
-    let n = path.s_mm.len();
-    let (pi, ci) = (Axis::Primary.index(), Axis::C.index());
-    if !path.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg()) {
+    if !near_pole(path, opts) {
         return Ok(PatchResult::unchanged(path, opts));
     }
-    let st = &opts.solver;
+    // 2. Analyse the run and find its zones.
     let aopts = analysis_options(opts);
     let (analysis, spans_before) = analyze_spans(path, machine, &aopts)?;
     if analysis.zones.is_empty() {
         return Ok(PatchResult::unchanged(path, opts));
     }
-    let p0: Vec<f64> = path.axes.iter().map(|q| q[pi]).collect();
-    let c0: Vec<f64> = path.axes.iter().map(|q| q[ci]).collect();
-    let target: Vec<[f64; 3]> = p0
+    let run = Run::new(path, solve_s, machine, opts, verify, aopts, spans_before);
+    // 3. Each zone, in path order, on the values the zones before it left.
+    let mut state = run.solve_zones(methods, &analysis.zones);
+    // 4. Verify what is written, whole: a zone whose patch made a span worse is put back.
+    let written = run.verify_whole(methods, &mut state)?;
+    // 5. Report each zone with its outcome and reason.
+    let zones = state
+        .done
         .iter()
-        .zip(&c0)
-        .map(|(p, c)| forward(machine, *p, *c))
+        .map(|d| run.zone_report(&state, &written, d))
         .collect();
-    let (mut cur_p, mut cur_c) = (p0.clone(), c0.clone());
-    let end = if opts.keep_last_point { n - 2 } else { n - 1 };
-    let mut lower = 1;
-    let mut done: Vec<Done> = Vec::new();
-    let fixed = Fixed {
-        path,
-        s: solve_s,
-        machine,
-        opts,
-        target: &target,
-        verify,
-    };
-    for zone in merge_zones(&analysis.zones, st.merge_gap_points) {
-        let d = solve_zone(&fixed, methods, zone, &cur_p, &cur_c, lower, end);
-        if let Some(k) = &d.kept {
-            let (p, c) = materialize(&cur_p, &cur_c, &k.prop, 0, n - 1, Some(k.decimals));
-            (cur_p, cur_c) = (p, c);
-            lower = k.prop.last + 1;
-        } else {
-            lower = lower.max(d.zone.last + 1);
-        }
-        done.push(d);
-    }
+    Ok(run.result(state, written, zones))
+}
 
-    // Verify what is written, whole: the run analysed again; a zone whose patch made a
-    // span of a checked axis worse is put back.
-    // Keeping a ball's centre rewrites X Y Z with the rotary values: they are checked too.
-    // The tips are written with the file's decimals, and more where their rounding would
-    // slow the run (the rounding of a tip moves the path's length s, and jitter in s eats
-    // the rotary axes' jerk budget: at 0.5 mm spacing, 0.5 µm of it takes a third of the
-    // UCP710's A budget at F3000) — up to `max_decimals`, as for the rotary words.
-    let mut keep_written = opts.keep_centre;
-    let checked_axes: &[Axis] = match opts.axes {
+/// Whether some point of `path` is near enough the pole to lie in a zone
+/// ([`PatchOptions::reach_deg`]).
+fn near_pole(path: &Path, opts: &PatchOptions) -> bool {
+    let pi = Axis::Primary.index();
+    path.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg())
+}
+
+/// The rotary axes that must reach feed and may not get worse.
+fn checked_axes(axes: PatchAxes) -> &'static [Axis] {
+    match axes {
         PatchAxes::Both => &[Axis::Primary, Axis::C],
         PatchAxes::OnlyC => &[Axis::C],
-    };
-    let mut spans_after;
-    let mut after_path;
-    loop {
-        let keep = keep_written.as_ref();
-        // Written tips that do not make a path (two on one spot) count as worse at the
-        // first span.
-        let written = crate::centre::written_path(path, &cur_p, &cur_c, machine, keep);
-        let worse = match &written {
-            Some(w) => {
-                spans_after = analyze_spans(w, machine, &aopts)?.1;
-                if !verify {
-                    after_path = written;
-                    break;
-                }
-                let mut w = whole_run_worse(&spans_before, &spans_after, checked_axes);
-                if keep.is_some() {
-                    // The linear axes the tips moved: the machine may not get slower there.
-                    w.extend(whole_run_slower(&spans_before, &spans_after));
-                    w.sort_unstable();
-                    w.dedup();
-                }
-                w
-            }
-            None => {
-                spans_after = spans_before.clone();
-                vec![0]
-            }
-        };
-        after_path = written;
-        // The tips' rounding may also keep a zone the candidate brought to feed below it:
-        // more decimals first.
-        let short_of_feed = || {
-            done.iter()
-                .filter(|d| d.kept.is_some() && !d.reverted)
-                .any(|d| {
-                    let f =
-                        figures_over(&spans_after, zone_core(&d.zone, n, st.core_margin_points));
-                    let worst = match opts.axes {
-                        PatchAxes::Both => f.c_ratio.min(f.primary_ratio),
-                        PatchAxes::OnlyC => f.c_ratio,
-                    };
-                    worst < 1.0 - RATIO_TOL
-                })
-        };
-        if let Some(kw) = keep_written.as_mut()
-            && kw.decimals < opts.max_decimals
-            && (!worse.is_empty() || short_of_feed())
-        {
-            kw.decimals += 1;
-            continue;
-        }
-        let Some(&k) = worse.first() else { break };
-        // The kept zone whose change lies nearest the worse span.
-        let culprit = done
+    }
+}
+
+/// The lowest ratio of the checked rotary axes over `f`.
+fn worst_ratio(axes: PatchAxes, f: &ZoneFigures) -> f64 {
+    match axes {
+        PatchAxes::Both => f.c_ratio.min(f.primary_ratio),
+        PatchAxes::OnlyC => f.c_ratio,
+    }
+}
+
+/// One solve of a path: what the steps of [`patch_on`] share.
+struct Run<'a> {
+    /// What every zone's solve sees.
+    f: Fixed<'a>,
+    /// The analysis options.
+    aopts: AnalysisOptions,
+    /// The run's span figures as programmed.
+    spans_before: Vec<SpanFigures>,
+    /// The program's primary values, degrees.
+    p0: Vec<f64>,
+    /// The program's C values, degrees.
+    c0: Vec<f64>,
+    /// The last point a patch may change (the one before the last when it must stay).
+    end: usize,
+}
+
+/// The values as they stand, and what was kept for each zone.
+struct Patched {
+    /// Primary values, degrees, as written.
+    p: Vec<f64>,
+    /// C values, degrees, as written.
+    c: Vec<f64>,
+    /// One per zone, in path order.
+    done: Vec<Done>,
+}
+
+/// What is written, as the whole-run verification left it.
+struct Written {
+    /// The run's span figures as written (the report's "after").
+    spans_after: Vec<SpanFigures>,
+    /// The path as written (its tips moved where a ball's centre is kept); `None` when the
+    /// written tips make no path.
+    path: Option<Path>,
+    /// How the tips are written, with a ball's centre kept.
+    keep: Option<KeepCentre>,
+}
+
+impl<'a> Run<'a> {
+    fn new(
+        path: &'a Path,
+        solve_s: &'a [f64],
+        machine: &'a Machine,
+        opts: &'a PatchOptions,
+        verify: bool,
+        aopts: AnalysisOptions,
+        spans_before: Vec<SpanFigures>,
+    ) -> Run<'a> {
+        let (pi, ci) = (Axis::Primary.index(), Axis::C.index());
+        let n = path.s_mm.len();
+        let p0: Vec<f64> = path.axes.iter().map(|q| q[pi]).collect();
+        let c0: Vec<f64> = path.axes.iter().map(|q| q[ci]).collect();
+        let target: Vec<[f64; 3]> = p0
             .iter()
-            .enumerate()
-            .filter(|(_, d)| d.kept.is_some() && !d.reverted)
-            .min_by_key(|(_, d)| {
-                let pr = &d
-                    .kept
-                    .as_ref()
-                    .map(|c| (c.prop.first, c.prop.last))
-                    .unwrap_or((0, 0));
-                if k + 1 < pr.0 {
-                    pr.0 - k - 1
-                } else {
-                    k.saturating_sub(pr.1)
+            .zip(&c0)
+            .map(|(p, c)| forward(machine, *p, *c))
+            .collect();
+        Run {
+            f: Fixed {
+                path,
+                s: solve_s,
+                machine,
+                opts,
+                target,
+                verify,
+            },
+            aopts,
+            spans_before,
+            p0,
+            c0,
+            end: if opts.keep_last_point { n - 2 } else { n - 1 },
+        }
+    }
+
+    /// Step 3: the zones (those closer than `merge_gap_points` merged) in path order, each
+    /// solved on the values the zones before it left and from the point after the last
+    /// patch ([`solve_zone`]).
+    fn solve_zones(&self, methods: &mut [Box<dyn Proposer>], zones: &[Zone]) -> Patched {
+        let n = self.f.path.s_mm.len();
+        let (mut p, mut c) = (self.p0.clone(), self.c0.clone());
+        let mut lower = 1;
+        let mut done: Vec<Done> = Vec::new();
+        for zone in merge_zones(zones, self.f.opts.solver.merge_gap_points) {
+            let d = solve_zone(&self.f, methods, zone, &p, &c, lower, self.end);
+            if let Some(k) = &d.kept {
+                (p, c) = materialize(&p, &c, &k.prop, 0, n - 1, Some(k.decimals));
+                lower = k.prop.last + 1;
+            } else {
+                lower = lower.max(d.zone.last + 1);
+            }
+            done.push(d);
+        }
+        Patched { p, c, done }
+    }
+
+    /// Step 4: verify what is written, whole. The run is analysed again as written; a zone
+    /// whose patch made a span of a checked axis worse is put back, until nothing is
+    /// worse.
+    ///
+    /// Keeping a ball's centre rewrites X Y Z with the rotary values: they are checked too.
+    /// The tips are written with the file's decimals, and more where their rounding would
+    /// slow the run (the rounding of a tip moves the path's length s, and jitter in s eats
+    /// the rotary axes' jerk budget: at 0.5 mm spacing, 0.5 µm of it takes a third of the
+    /// UCP710's A budget at F3000) — up to `max_decimals`, as for the rotary words.
+    fn verify_whole(
+        &self,
+        methods: &mut [Box<dyn Proposer>],
+        state: &mut Patched,
+    ) -> Result<Written, PathError> {
+        let (path, opts) = (self.f.path, self.f.opts);
+        let mut keep_written = opts.keep_centre;
+        loop {
+            let keep = keep_written.as_ref();
+            // Written tips that do not make a path (two on one spot) count as worse at the
+            // first span.
+            let written = written_path(path, &state.p, &state.c, self.f.machine, keep);
+            let (worse, spans_after) = match &written {
+                Some(w) => {
+                    let spans_after = analyze_spans(w, self.f.machine, &self.aopts)?.1;
+                    if !self.f.verify {
+                        return Ok(Written {
+                            spans_after,
+                            path: written,
+                            keep: keep_written,
+                        });
+                    }
+                    (self.worse_spans(&spans_after, keep.is_some()), spans_after)
                 }
+                None => (vec![0], self.spans_before.clone()),
+            };
+            // The tips' rounding may also keep a zone the candidate brought to feed below
+            // it: more decimals first.
+            if let Some(kw) = keep_written.as_mut()
+                && kw.decimals < opts.max_decimals
+                && (!worse.is_empty() || self.short_of_feed(state, &spans_after))
+            {
+                kw.decimals += 1;
+                continue;
+            }
+            let Some(&k) = worse.first() else {
+                return Ok(Written {
+                    spans_after,
+                    path: written,
+                    keep: keep_written,
+                });
+            };
+            let Some(i) = culprit(&state.done, k) else {
+                // Nothing left to put back (only possible with written tips that are not a
+                // path): every value as it was.
+                (state.p, state.c) = (self.p0.clone(), self.c0.clone());
+                return Ok(Written {
+                    spans_after: self.spans_before.clone(),
+                    path: Some(path.clone()),
+                    keep: keep_written,
+                });
+            };
+            self.put_back(state, i);
+            // Keeping a ball's centre moves the tips wherever the orientation changes, and a
+            // wide patch may slow a linear axis at a corner far from the zone: narrow the
+            // patch so that span keeps its values, and solve the zone again.
+            if let Some(kw) = keep_written.as_mut() {
+                // Start the decimals over for the narrowed patch.
+                kw.decimals = opts.keep_centre.map_or(kw.decimals, |k| k.decimals);
+                self.narrow_and_solve_again(methods, state, i, k);
+            }
+        }
+    }
+
+    /// The spans worse after than before on a checked axis; with the tips moved
+    /// (`tips_moved`: a ball's centre kept) also those where the machine is slower: the
+    /// linear axes the tips moved may not make it slower there.
+    fn worse_spans(&self, spans_after: &[SpanFigures], tips_moved: bool) -> Vec<usize> {
+        let axes = checked_axes(self.f.opts.axes);
+        let mut w = whole_run_worse(&self.spans_before, spans_after, axes);
+        if tips_moved {
+            w.extend(whole_run_slower(&self.spans_before, spans_after));
+            w.sort_unstable();
+            w.dedup();
+        }
+        w
+    }
+
+    /// Whether a kept zone's core is below feed on a checked axis as written.
+    fn short_of_feed(&self, state: &Patched, spans_after: &[SpanFigures]) -> bool {
+        let n = self.f.path.s_mm.len();
+        let st = &self.f.opts.solver;
+        state
+            .done
+            .iter()
+            .filter(|d| d.kept.is_some() && !d.reverted)
+            .any(|d| {
+                let f = figures_over(spans_after, zone_core(&d.zone, n, st.core_margin_points));
+                worst_ratio(self.f.opts.axes, &f) < 1.0 - RATIO_TOL
             })
-            .map(|(i, _)| i);
-        let Some(i) = culprit else {
-            // Nothing left to put back (only possible with written tips that are not a
-            // path): every value as it was.
-            (cur_p, cur_c) = (p0.clone(), c0.clone());
-            after_path = Some(path.clone());
-            spans_after = spans_before.clone();
-            break;
-        };
-        // Put it back: its points (and a re-selected or offset tail) as they were.
-        let d = &mut done[i];
-        let prop = &d.kept.as_ref().map(|c| c.prop.clone());
-        if let Some(prop) = prop {
+    }
+
+    /// Put zone `i`'s patch back: its points (and a re-selected or offset tail) as they
+    /// were.
+    fn put_back(&self, state: &mut Patched, i: usize) {
+        let n = self.f.path.s_mm.len();
+        let d = &mut state.done[i];
+        if let Some(prop) = d.kept.as_ref().map(|c| &c.prop) {
             let hi = if matches!(prop.tail, Tail::Keep) {
                 prop.last
             } else {
                 n - 1
             };
-            cur_p[prop.first..=hi].copy_from_slice(&p0[prop.first..=hi]);
-            cur_c[prop.first..=hi].copy_from_slice(&c0[prop.first..=hi]);
+            state.p[prop.first..=hi].copy_from_slice(&self.p0[prop.first..=hi]);
+            state.c[prop.first..=hi].copy_from_slice(&self.c0[prop.first..=hi]);
         }
         d.reverted = true;
-        // Keeping a ball's centre moves the tips wherever the orientation changes, and a
-        // wide patch may slow a linear axis at a corner far from the zone: narrow the patch
-        // so that span keeps its values, and solve the zone again ("narrow the patch").
-        if let Some(kw) = keep_written.as_mut() {
-            // Start the decimals over for the narrowed patch.
-            kw.decimals = opts.keep_centre.map_or(kw.decimals, |k| k.decimals);
-            let core = zone_core(&d.zone, n, st.core_margin_points);
-            let (lo, hi) = d.bounds;
-            // The analysis spline is not local: a change a few points away still reaches
-            // the span, so each narrowing also steps a quarter of the way to the zone.
-            let narrowed = if k + 1 < core.start {
-                let step = (d.zone.first.saturating_sub(lo) / NARROW_STEP_DIV).max(1);
-                Some(((lo + step).max(k + 2).min(d.zone.first), hi))
-            } else if k >= core.end {
-                let step = (hi.saturating_sub(d.zone.last) / NARROW_STEP_DIV).max(1);
-                Some((
-                    lo,
-                    hi.saturating_sub(step)
-                        .min(k.saturating_sub(1))
-                        .max(d.zone.last),
-                ))
-            } else {
-                None
-            };
-            if let Some((lo2, hi2)) = narrowed
-                && (lo2, hi2) != (lo, hi)
-                && lo2 <= d.zone.first
-                && hi2 >= d.zone.last
-            {
-                let zone = d.zone.clone();
-                let again = solve_zone(&fixed, methods, zone, &cur_p, &cur_c, lo2, hi2);
-                if let Some(kept) = &again.kept {
-                    (cur_p, cur_c) =
-                        materialize(&cur_p, &cur_c, &kept.prop, 0, n - 1, Some(kept.decimals));
-                }
-                done[i] = again;
-            }
-        }
     }
 
-    let mut reports = Vec::with_capacity(done.len());
-    let mut decimals = (opts.p_decimals, opts.c_decimals);
-    for d in &done {
+    /// Solve zone `i`, put back for the worse span `k`, again on a narrower range that
+    /// leaves `k` alone ([`narrowed`]), when there is one.
+    fn narrow_and_solve_again(
+        &self,
+        methods: &mut [Box<dyn Proposer>],
+        state: &mut Patched,
+        i: usize,
+        k: usize,
+    ) {
+        let n = self.f.path.s_mm.len();
+        let d = &state.done[i];
+        let Some((lo, hi)) = narrowed(d, k, n, &self.f.opts.solver) else {
+            return;
+        };
+        let zone = d.zone.clone();
+        let again = solve_zone(&self.f, methods, zone, &state.p, &state.c, lo, hi);
+        if let Some(kept) = &again.kept {
+            (state.p, state.c) = materialize(
+                &state.p,
+                &state.c,
+                &kept.prop,
+                0,
+                n - 1,
+                Some(kept.decimals),
+            );
+        }
+        state.done[i] = again;
+    }
+
+    /// Step 5: the report of zone `d` on the values as written.
+    fn zone_report(&self, state: &Patched, written: &Written, d: &Done) -> ZoneReport {
+        let (path, machine, opts) = (self.f.path, self.f.machine, self.f.opts);
+        let st = &opts.solver;
+        let n = path.s_mm.len();
+        let (cur_p, cur_c) = (&state.p, &state.c);
         let kept = d.kept.as_ref().filter(|_| !d.reverted);
         let (first, last) = match kept {
             Some(k) => (d.zone.first.min(k.prop.first), d.zone.last.max(k.prop.last)),
@@ -1045,21 +966,16 @@ fn patch_on(
         } else {
             core.clone()
         };
-        let before = figures_over(&spans_before, range.clone());
-        let after = figures_over(&spans_after, range.clone());
-        let core_after = figures_over(&spans_after, core.clone());
-        let reached = match opts.axes {
-            PatchAxes::Both => core_after.c_ratio.min(core_after.primary_ratio),
-            PatchAxes::OnlyC => core_after.c_ratio,
-        } >= 1.0 - RATIO_TOL;
-        let core_before = figures_over(&spans_before, core.clone());
-        let worst = |f: &ZoneFigures| match opts.axes {
-            PatchAxes::Both => f.c_ratio.min(f.primary_ratio),
-            PatchAxes::OnlyC => f.c_ratio,
-        };
+        let before = figures_over(&self.spans_before, range.clone());
+        let after = figures_over(&written.spans_after, range.clone());
+        let core_after = figures_over(&written.spans_after, core.clone());
+        let reached = worst_ratio(opts.axes, &core_after) >= 1.0 - RATIO_TOL;
+        let core_before = figures_over(&self.spans_before, core.clone());
         let outcome = if reached {
             Outcome::Reached
-        } else if kept.is_some() && worst(&core_after) > worst(&core_before) {
+        } else if kept.is_some()
+            && worst_ratio(opts.axes, &core_after) > worst_ratio(opts.axes, &core_before)
+        {
             Outcome::Improved
         } else {
             Outcome::Unchanged
@@ -1069,32 +985,31 @@ fn patch_on(
             Reason::Reselected
         } else if reached {
             Reason::Reached
-        } else if !verify {
+        } else if !self.f.verify {
             Reason::NotFound
         } else if d.over_cap_deg.is_some() {
             Reason::DeviationCap
         } else if d.reverted {
             Reason::NotFound
         } else {
-            crate::reference::why_not_reached(
+            why_not_reached(
                 path,
-                &cur_p,
-                &cur_c,
+                cur_p,
+                cur_c,
                 &d.zone,
                 machine,
                 opts,
-                lower_of(&done, d),
-                end,
+                lower_of(&state.done, d),
+                self.end,
             )
         };
+        let target = &self.f.target;
         let dev = (first..=last)
             .map(|i| angle_between_deg(target[i], forward(machine, cur_p[i], cur_c[i])))
             .fold(0.0, f64::max);
-        if let Some(k) = kept {
-            decimals = (decimals.0.max(k.decimals.0), decimals.1.max(k.decimals.1));
-        }
+        let (p0, c0) = (&self.p0, &self.c0);
         let modified = |v: &[f64], v0: &[f64]| (first..=last).filter(|&i| v[i] != v0[i]).count();
-        reports.push(ZoneReport {
+        ZoneReport {
             first,
             last,
             kind: d.zone.kind,
@@ -1107,7 +1022,7 @@ fn patch_on(
             points_modified: (first..=last)
                 .filter(|&i| cur_p[i] != p0[i] || cur_c[i] != c0[i])
                 .count(),
-            primary_points_modified: modified(&cur_p, &p0),
+            primary_points_modified: modified(cur_p, p0),
             reselected_points: kept
                 .filter(|k| matches!(k.prop.tail, Tail::Reselect { .. }))
                 .map_or(0, |k| n - 1 - k.prop.last),
@@ -1123,42 +1038,102 @@ fn patch_on(
                 _ => 0.0,
             }),
             needed_deviation_deg: d.over_cap_deg.filter(|_| reason == Reason::DeviationCap),
-        });
+        }
     }
-    let p_changed: Vec<bool> = cur_p.iter().zip(&p0).map(|(a, b)| a != b).collect();
-    let c_changed: Vec<bool> = cur_c.iter().zip(&c0).map(|(a, b)| a != b).collect();
-    let xyz_mm: Vec<[f64; 3]> = after_path
-        .as_ref()
-        .unwrap_or(path)
-        .axes
-        .iter()
-        .map(|q| [q[0], q[1], q[2]])
-        .collect();
-    let xyz_changed = xyz_mm
-        .iter()
-        .zip(&path.axes)
-        .map(|(w, q)| std::array::from_fn(|i| w[i] != q[i]))
-        .collect();
-    Ok(PatchResult {
-        xyz_mm,
-        xyz_changed,
-        xyz_decimals: keep_written.map_or(0, |k| k.decimals),
-        p_decimals: if p_changed.iter().any(|&x| x) {
-            decimals.0
-        } else {
-            opts.p_decimals
-        },
-        c_decimals: if c_changed.iter().any(|&x| x) {
-            decimals.1
-        } else {
-            opts.c_decimals
-        },
-        p_deg: cur_p,
-        p_changed,
-        c_deg: cur_c,
-        c_changed,
-        zones: reports,
-    })
+
+    /// The values as they must be written, with the zones' reports: the decimals are the
+    /// most any kept patch needs (the file's where nothing changed).
+    fn result(&self, state: Patched, written: Written, zones: Vec<ZoneReport>) -> PatchResult {
+        let (path, opts) = (self.f.path, self.f.opts);
+        let decimals = state
+            .done
+            .iter()
+            .filter(|d| !d.reverted)
+            .filter_map(|d| d.kept.as_ref())
+            .fold((opts.p_decimals, opts.c_decimals), |acc, k| {
+                (acc.0.max(k.decimals.0), acc.1.max(k.decimals.1))
+            });
+        let p_changed: Vec<bool> = state.p.iter().zip(&self.p0).map(|(a, b)| a != b).collect();
+        let c_changed: Vec<bool> = state.c.iter().zip(&self.c0).map(|(a, b)| a != b).collect();
+        let xyz_mm: Vec<[f64; 3]> = written
+            .path
+            .as_ref()
+            .unwrap_or(path)
+            .axes
+            .iter()
+            .map(|q| [q[0], q[1], q[2]])
+            .collect();
+        let xyz_changed = xyz_mm
+            .iter()
+            .zip(&path.axes)
+            .map(|(w, q)| std::array::from_fn(|i| w[i] != q[i]))
+            .collect();
+        PatchResult {
+            xyz_mm,
+            xyz_changed,
+            xyz_decimals: written.keep.map_or(0, |k| k.decimals),
+            p_decimals: if p_changed.iter().any(|&x| x) {
+                decimals.0
+            } else {
+                opts.p_decimals
+            },
+            c_decimals: if c_changed.iter().any(|&x| x) {
+                decimals.1
+            } else {
+                opts.c_decimals
+            },
+            p_deg: state.p,
+            p_changed,
+            c_deg: state.c,
+            c_changed,
+            zones,
+        }
+    }
+}
+
+/// The kept zone whose change lies nearest the worse span `k` (not one already put back).
+fn culprit(done: &[Done], k: usize) -> Option<usize> {
+    done.iter()
+        .enumerate()
+        .filter(|(_, d)| d.kept.is_some() && !d.reverted)
+        .min_by_key(|(_, d)| {
+            let pr = &d
+                .kept
+                .as_ref()
+                .map(|c| (c.prop.first, c.prop.last))
+                .unwrap_or((0, 0));
+            if k + 1 < pr.0 {
+                pr.0 - k - 1
+            } else {
+                k.saturating_sub(pr.1)
+            }
+        })
+        .map(|(i, _)| i)
+}
+
+/// The range a zone put back for the worse span `k` may change next: its bounds narrowed
+/// so that `k` keeps its values, by at least 1/[`SolverSettings::narrow_step_div`] of the
+/// way to the zone (the analysis spline is not local: a change a few points away still
+/// reaches the span); `None` when `k` is in the zone's core or nothing narrower holds the
+/// zone.
+fn narrowed(d: &Done, k: usize, n: usize, st: &SolverSettings) -> Option<(usize, usize)> {
+    let core = zone_core(&d.zone, n, st.core_margin_points);
+    let (lo, hi) = d.bounds;
+    let (lo2, hi2) = if k + 1 < core.start {
+        let step = (d.zone.first.saturating_sub(lo) / st.narrow_step_div).max(1);
+        ((lo + step).max(k + 2).min(d.zone.first), hi)
+    } else if k >= core.end {
+        let step = (hi.saturating_sub(d.zone.last) / st.narrow_step_div).max(1);
+        (
+            lo,
+            hi.saturating_sub(step)
+                .min(k.saturating_sub(1))
+                .max(d.zone.last),
+        )
+    } else {
+        return None;
+    };
+    ((lo2, hi2) != (lo, hi) && lo2 <= d.zone.first && hi2 >= d.zone.last).then_some((lo2, hi2))
 }
 
 /// The first point the patch of `d`'s zone could change (after the previous kept zone).
@@ -1184,8 +1159,7 @@ pub fn report_unpatched(
     opts: &PatchOptions,
 ) -> Result<Vec<ZoneReport>, PathError> {
     validate(path)?;
-    let pi = Axis::Primary.index();
-    if !path.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg()) {
+    if !near_pole(path, opts) {
         return Ok(Vec::new());
     }
     let n = path.s_mm.len();
@@ -1227,6 +1201,7 @@ pub fn report_unpatched(
 mod tests {
     use super::*;
     use crate::analysis::analyze_path;
+    use crate::strategy::patch_path;
     use crate::testutil::{machine, planted, sing_path};
     use crate::verify::NOT_WORSE_REL;
 

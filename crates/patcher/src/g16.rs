@@ -11,12 +11,12 @@
 //!    are *before*, `singular + 1..` *after*.
 //! 2. **Fit** (stage 3) the not-a-knot interpolating cubics C_b(s) through the before
 //!    points and C_a(s) through the after points, on a local window of
-//!    [`FIT_MARGIN_POINTS`] CL points (plus the patch extension) beyond the zone on each
+//!    [`SolverSettings::g16_fit_margin_points`] CL points (plus the patch extension) beyond the zone on each
 //!    side: the far parts of the path do not matter to the patch.
 //! 3. **Offset and direction.** C_a may be shifted by k·360°, k ∈ {−1, 0, 1} (only with
 //!    `allow_c_offset`), and the patch moves C in the direction σ = ±1.
 //! 4. **Join search** (stages 4–6): for each (k, σ), step from the split outward with
-//!    h = [`JOIN_STEP_FRACTION`] · (median CL spacing), backwards on C_b and forwards on
+//!    h = [`SolverSettings::g16_join_step_fraction`] · (median CL spacing), backwards on C_b and forwards on
 //!    C_a independently, until σ·C'(s) ≥ 0: the *core* [s_b*, s_a*], where the patch
 //!    must be monotone. A choice is consistent when the change it asks,
 //!    gap = C_a(s_a*) + k·360 − C_b(s_b*), has the sign σ; among consistent choices the
@@ -43,7 +43,7 @@
 //! # The patch QP
 //!
 //! P(s) is a clamped cubic B-spline on [s_b, s_a] with breakpoints s_b, the CL points
-//! strictly inside (those closer than [`MIN_SPAN_FRACTION`] of the median spacing to
+//! strictly inside (those closer than [`SolverSettings::g16_min_span_fraction`] of the median spacing to
 //! s_b or s_a are skipped) and s_a; knots T (4-fold ends), control points x_0..x_{m−1}.
 //! Its derivatives are splines with control points
 //!
@@ -68,7 +68,7 @@
 //!            t ≤ max_deviation_deg                       (when given)
 //! ```
 //!
-//! μ = [`LSQ_WEIGHT`], ε = [`JERK_WEIGHT`]. The deviation of a point, SPEC §3:
+//! μ = [`SolverSettings::g16_lsq_weight`], ε = [`SolverSettings::g16_jerk_weight`]. The deviation of a point, SPEC §3:
 //! 2·asin(|sin p|·|sin(ΔC/2)|), is replaced by its small-angle form |sin p|·|ΔC| (both in
 //! degrees); the form is exact to first order and over-estimates the true deviation
 //! (asin x ≥ x, |sin y| ≤ |y|), so `t ≤ max_deviation_deg` is conservative.
@@ -93,39 +93,10 @@ use crate::{
     options::PatchOptions,
     qp::{QpBuilder, Row, combine, scaled},
     report::{QpStats, QpStatus},
+    settings::SolverSettings,
+    tolerances::{REACH_SLACK, REACH_STEPS},
 };
 use polepatch_bspline::{BSpline, interpolate_not_a_knot, knots::clamped_cubic};
-
-/// CL points beyond the zone (and the patch extension) on each side used to fit C_b and
-/// C_a.
-pub const FIT_MARGIN_POINTS: usize = 30;
-
-/// Join-search step as a fraction of the median CL spacing.
-pub const JOIN_STEP_FRACTION: f64 = 0.05;
-
-/// μ, weight of the least-squares deviation term, 1/degree (the minimax term t has
-/// weight 1): small, it only picks a solution among the minimax optima.
-pub const LSQ_WEIGHT: f64 = 1e-3;
-
-/// ε, weight of the jerk energy ∫P'''² ds, mm⁵/degree: small, it smooths the patch where
-/// the deviation does not bind.
-pub const JERK_WEIGHT: f64 = 1e-3;
-
-/// CL points closer than this fraction of the median spacing to a join are not made
-/// breakpoints of the patch (a very short span conditions the QP badly); they are still
-/// projected.
-pub const MIN_SPAN_FRACTION: f64 = 0.05;
-
-/// Most attempts (join-window enlargements plus patch widenings) before giving up.
-pub const MAX_ATTEMPTS: usize = 24;
-
-/// Relative slack of the reachability test that skips hopeless widenings (the trapezoid
-/// rule under-estimates the integral of the concave velocity envelope slightly).
-pub const REACH_SLACK: f64 = 1e-3;
-
-/// Probes per support interval when computing the monotonicity floor ℓ_k in the
-/// extensions.
-pub const MONOTONE_PROBES: usize = 8;
 
 /// Propose new C values for `zone` of a path (`s_mm`, primary `p_deg`, `c_deg` per point)
 /// by the G16 method; `extra` widens the patch by that many CL points on each side beyond
@@ -187,7 +158,8 @@ fn g16_patch_detail(
     if h_cl.is_nan() || h_cl <= 0.0 {
         return Err(PatchFailure::TooShort);
     }
-    let h = h_cl * JOIN_STEP_FRACTION;
+    let settings = &opts.solver;
+    let h = h_cl * settings.g16_join_step_fraction;
 
     // Offsets k·360 of C_a to consider (G16 stage 3, generalised).
     let offsets: &[f64] = if opts.allow_c_offset {
@@ -197,10 +169,10 @@ fn g16_patch_detail(
     };
 
     let mut stats = QpStats::default();
-    let mut fit_margin = FIT_MARGIN_POINTS;
+    let mut fit_margin = settings.g16_fit_margin_points;
     let mut grow = 0usize;
 
-    for _ in 0..MAX_ATTEMPTS {
+    for _ in 0..settings.g16_max_attempts {
         let ext = extra + grow;
         let lo_fit = first_z.saturating_sub(fit_margin + ext);
         let hi_fit = (last_z + fit_margin + ext).min(n - 1);
@@ -305,6 +277,7 @@ fn g16_patch_detail(
                 h_cl,
                 lim,
                 max_dev: opts.max_deviation_deg,
+                settings,
             };
             let mut out = None;
             let modes: &[bool] = if opts.third_derivative_continuity {
@@ -362,10 +335,9 @@ fn g16_patch_detail(
 /// velocity envelope min(v, v0 + a·s, v1 + a·(len − s)) (a double integrator; the jerk
 /// bound only lowers it, so this is a necessary condition for the QP).
 fn reachable(len: f64, v0: f64, v1: f64, v: f64, a: f64) -> f64 {
-    const N: usize = 256;
     let u = |s: f64| v.min(v0 + a * s).min(v1 + a * (len - s));
-    let dx = len / N as f64;
-    (0..N)
+    let dx = len / REACH_STEPS as f64;
+    (0..REACH_STEPS)
         .map(|k| 0.5 * (u(k as f64 * dx) + u((k + 1) as f64 * dx)) * dx)
         .sum()
 }
@@ -419,6 +391,7 @@ struct PatchSetup<'a> {
     h_cl: f64,
     lim: &'a CLimits,
     max_dev: Option<f64>,
+    settings: &'a SolverSettings,
 }
 
 /// A projected patch: first and last modified point and their new C, degrees.
@@ -441,7 +414,7 @@ fn solve_patch(
         return Err(PatchFailure::TooShort);
     }
     let last = last_excl - 1;
-    let min_span = MIN_SPAN_FRACTION * st.h_cl;
+    let min_span = st.settings.g16_min_span_fraction * st.h_cl;
     let mut breaks = vec![s_b];
     breaks.extend(
         s[first..=last]
@@ -514,7 +487,11 @@ fn solve_patch(
     for (k, fk) in f.iter().enumerate() {
         qp.add_le(fk, st.lim.j);
         qp.add_le(&scaled(-1.0, fk), st.lim.j);
-        qp.add_square(fk, JERK_WEIGHT * (tk(k + 4) - tk(k + 3)), 0.0);
+        qp.add_square(
+            fk,
+            st.settings.g16_jerk_weight * (tk(k + 4) - tk(k + 3)),
+            0.0,
+        );
     }
 
     // Deviation at the CL points.
@@ -536,7 +513,7 @@ fn solve_patch(
         let mut dn = scaled(-w, r);
         dn.push((t_var, -1.0));
         qp.add_le(&dn, -w * y);
-        qp.add_square(r, LSQ_WEIGHT * w * w, y);
+        qp.add_square(r, st.settings.g16_lsq_weight * w * w, y);
     }
     qp.add_linear(t_var, 1.0);
     if let Some(dmax) = st.max_dev {
@@ -563,8 +540,9 @@ fn monotone_floor(st: &PatchSetup, lo: f64, hi: f64) -> f64 {
     let mut floor: f64 = 0.0;
     let mut probe = |sp: &BSpline, a: f64, b: f64| {
         if a < b {
-            for q in 0..=MONOTONE_PROBES {
-                let x = a + (b - a) * q as f64 / MONOTONE_PROBES as f64;
+            let probes = st.settings.g16_monotone_probes;
+            for q in 0..=probes {
+                let x = a + (b - a) * q as f64 / probes as f64;
                 floor = floor.min(st.sigma * sp.eval_derivs(x)[1]);
             }
         }

@@ -26,8 +26,8 @@
 //!   neighbour (the condition of `polepatch_bspline::interpolate_not_a_knot`); a path of 2
 //!   or 3 points is a line or a parabola, `c3 = 0` on every span (and `c2 = 0` for 2);
 //! - at a window end **inside** the path, the slope is fixed to the current spline's
-//!   (`interpolate_not_a_knot` on the window widened by [`WINDOW_POINTS`] more points).
-//!   A change of the values moves that slope by ≈ 0.27^[`WINDOW_POINTS`] of itself
+//!   (`interpolate_not_a_knot` on the window widened by [`HERMITE_WINDOW_POINTS`] more points).
+//!   A change of the values moves that slope by ≈ 0.27^[`HERMITE_WINDOW_POINTS`] of itself
 //!   (the not-a-knot system's decay per knot), which the caller's verification on the
 //!   whole path covers.
 //!
@@ -38,17 +38,11 @@
 //! built with offsets `0` and `hp.vars()` live side by side in one QP.
 
 use crate::spline::AnalysisSpline;
+use crate::tolerances::{CONSTRAINED_MARGIN_POINTS, HERMITE_WINDOW_POINTS};
 use crate::{
     candidate::PatchFailure,
     qp::{QpBuilder, Row},
 };
-
-/// Points of the path kept either side of the modified range as Hermite unknowns; beyond
-/// them the slope is fixed to the current spline's (module docs).
-pub const WINDOW_POINTS: usize = 16;
-
-/// Points either side of the modified range whose spans are constrained.
-pub const CONSTRAINED_MARGIN_POINTS: usize = 3;
 
 /// An affine form `Σ coeff·x[var] + c`.
 #[derive(Debug, Clone, Default)]
@@ -131,8 +125,8 @@ impl<'a> Hermite<'a> {
         let hi = (last + window).min(n - 1);
         let mut fixed = [None, None];
         if lo > 0 || hi < n - 1 {
-            let lo2 = lo.saturating_sub(window.max(WINDOW_POINTS));
-            let hi2 = (hi + window.max(WINDOW_POINTS)).min(n - 1);
+            let lo2 = lo.saturating_sub(window.max(HERMITE_WINDOW_POINTS));
+            let hi2 = (hi + window.max(HERMITE_WINDOW_POINTS)).min(n - 1);
             let sp = AnalysisSpline::new(&s[lo2..=hi2], &c[lo2..=hi2])
                 .map_err(|_| PatchFailure::TooShort)?;
             if lo > 0 {
@@ -352,7 +346,7 @@ mod tests {
         for n in [2usize, 3, 4, 5, 40] {
             let (s, y) = data(n);
             let sp = interpolate_not_a_knot(&s, &y).unwrap();
-            for (first, last, window) in [(0, n - 1, WINDOW_POINTS), (n / 2, n / 2, 3)] {
+            for (first, last, window) in [(0, n - 1, HERMITE_WINDOW_POINTS), (n / 2, n / 2, 3)] {
                 let hm = Hermite::new(&s, &y, first, last, window).unwrap();
                 let mut x = vec![0.0; hm.vars()];
                 for k in hm.lo..=hm.hi {
@@ -384,7 +378,7 @@ mod tests {
     fn hermite_response_is_the_spline_of_the_changed_data() {
         let (s, y) = data(60);
         let (first, last) = (28, 32);
-        let hm = Hermite::new(&s, &y, first, last, WINDOW_POINTS).unwrap();
+        let hm = Hermite::new(&s, &y, first, last, HERMITE_WINDOW_POINTS).unwrap();
         let mut qp = hm.builder(0);
         let delta = [0.0, 3.0, -7.0, 1.0, 0.0];
         for (i, d) in delta.iter().enumerate() {

@@ -97,7 +97,8 @@ use crate::{
     qp::Row,
     report::{QpStats, QpStatus},
     settings::SolverSettings,
-    window::{JOINT_WINDOW_POINTS, Window},
+    tolerances::{JOINT_WINDOW_POINTS, ZERO_DEVIATION_DEG},
+    window::Window,
 };
 use polepatch_kinematics::{Machine, angle_between_deg, forward, forward_jacobian};
 use std::time::Instant;
@@ -332,7 +333,8 @@ impl<'a> Model<'a> {
             // ties.
             Some(cap) => {
                 let over = (dev_deg - cap).max(0.0) / cap.max(1e-9);
-                self.pr.settings.elastic_weight * (excess + over) + 1e-6 * chord(dev_deg)
+                self.pr.settings.elastic_weight * (excess + over)
+                    + self.pr.settings.cap_tie_weight * chord(dev_deg)
             }
         }
     }
@@ -413,7 +415,7 @@ pub fn solve_joint(pr: &JointProblem) -> Result<JointSolution, PatchFailure> {
     };
     let mut solved_any = false;
     // A start already within the limits with no orientation change cannot be bettered.
-    let solves = if exc <= st.elastic_tol && dev <= 1e-9 {
+    let solves = if exc <= st.elastic_tol && dev <= ZERO_DEVIATION_DEG {
         solved_any = true;
         0
     } else {
@@ -598,8 +600,8 @@ mod tests {
         let k = (0..p.len())
             .min_by(|&a, &b| p[a].abs().total_cmp(&p[b].abs()))
             .unwrap();
-        let shift = crate::reselect::tail_shift(&m, &p, &c, k, false).unwrap();
-        let (op, oc) = crate::reselect::other_branch(&p, &c, k, shift);
+        let shift = crate::starts::tail_shift(&m, &p, &c, k, false).unwrap();
+        let (op, oc) = crate::starts::other_branch(&p, &c, k, shift);
         let sol = solve_joint(&problem(&path, &op, &oc, &target, &m, &st, None)).unwrap();
         assert!(sol.excess <= st.elastic_tol, "{sol:?}");
         assert!(sol.max_deviation_deg < 1.05, "{}", sol.max_deviation_deg);

@@ -11,10 +11,10 @@
 //! - **Start.** Near the pole the best patch lets the tool axis pass through the pole, P
 //!   changing sign at almost constant C. When the points after the zone may move to the
 //!   other branch, the start is the program with the points after its branch switch (or
-//!   after the point of least |P|) on the other branch ([`crate::reselect::other_branch`]);
+//!   after the point of least |P|) on the other branch ([`crate::starts::other_branch`]);
 //!   the range is wide enough to hold the cone stretch;
 //!   FREEZE's and LINEARIZE's rules across the cone (C held at its entry value, or linear
-//!   in s, P on C's meridian: [`crate::peers`]) pass through the pole inside the range; the
+//!   in s, P on C's meridian: [`crate::starts`]) pass through the pole inside the range; the
 //!   program's own values are the last start. Every start gets one solve; the
 //!   [`SolverSettings::screen_keep`] best (less excess over the limits, then smaller
 //!   deviation) go on for the rest of [`SolverSettings::screen_solves`], and the best of
@@ -27,23 +27,25 @@
 //!   excess over the limits within the cap: the best improvement the cap allows, or a
 //!   patch within it that reaches feed).
 
-use crate::driver::{Proposal, Proposer, Sink, Tail, ZoneCtx};
 use crate::joint::{JointProblem, JointSolution, solve_joint};
 use crate::limits::GeomLimits;
-use crate::peers::{Strategy, apply_rule, cone_stretch};
+use crate::protocol::{Proposal, Proposer, Sink, Tail, ZoneCtx};
 use crate::report::Method;
-use crate::reselect::{branch_switch, least_primary, other_branch, tail_shift};
+use crate::starts::{
+    Rule, apply_rule, branch_switch, cone_stretch, least_primary, other_branch, tail_shift,
+};
+use crate::tolerances::{POLE_DEG, ZERO_DEVIATION_DEG};
 use polepatch_kinematics::Axis;
 
 /// The joint method (module docs).
 pub struct JointMethod;
 
-/// On a point exactly on the pole (|P| ≤ [`crate::reselect::POLE_DEG`]) C does not orient
+/// On a point exactly on the pole (|P| ≤ [`POLE_DEG`]) C does not orient
 /// the tool: give it C linear between its nearest neighbours off the pole within
 /// `first..=last`, so a start does not carry a spike of C there (a post writes anything:
 /// `atan2(0, 0)`). The tool axes are unchanged.
 fn smooth_pole_c(p: &[f64], c: &mut [f64], first: usize, last: usize) {
-    let on_pole = |i: usize| p[i].abs() <= crate::reselect::POLE_DEG;
+    let on_pole = |i: usize| p[i].abs() <= POLE_DEG;
     for i in first..=last {
         if !on_pole(i) {
             continue;
@@ -165,7 +167,7 @@ impl JointMethod {
         ) && stretch[1] >= first
             && stretch[2] <= last
         {
-            for rule in [Strategy::Freeze, Strategy::Linearize] {
+            for rule in [Rule::Freeze, Rule::Linearize] {
                 let (mut fp, mut fc) = (p.to_vec(), c.to_vec());
                 apply_rule(
                     rule,
@@ -182,9 +184,9 @@ impl JointMethod {
                 // branch when the path passed the pole; then the points after it follow
                 // on that branch (when they may move).
                 let b = stretch[2];
-                if rule == Strategy::Freeze
+                if rule == Rule::Freeze
                     && b < last
-                    && fp[b].abs() > crate::reselect::POLE_DEG
+                    && fp[b].abs() > POLE_DEG
                     && fp[b].signum() != p[b + 1].signum()
                     && let Some(shift) =
                         tail_shift(ctx.machine, &fp, &fc, b, ctx.opts.keep_last_point)
@@ -297,7 +299,8 @@ impl JointMethod {
             };
             match problem(&s0.p, &s0.c, s0.rule.then_some((p, c)), None, false, solves) {
                 Ok(sol) => {
-                    let perfect = sol.excess <= st.elastic_tol && sol.max_deviation_deg <= 1e-9;
+                    let perfect =
+                        sol.excess <= st.elastic_tol && sol.max_deviation_deg <= ZERO_DEVIATION_DEG;
                     screened.push((i, sol));
                     if perfect {
                         break; // within the limits, no orientation change: the best there is
@@ -308,9 +311,9 @@ impl JointMethod {
             }
         }
         rank(&mut screened);
-        let perfect = screened
-            .first()
-            .is_some_and(|(_, s)| s.excess <= st.elastic_tol && s.max_deviation_deg <= 1e-9);
+        let perfect = screened.first().is_some_and(|(_, s)| {
+            s.excess <= st.elastic_tol && s.max_deviation_deg <= ZERO_DEVIATION_DEG
+        });
         if starts.len() > 1 && !perfect {
             if screen > 1 {
                 for (i, sol) in screened.iter_mut().take(st.screen_keep.max(1)) {

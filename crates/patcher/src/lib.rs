@@ -2,7 +2,15 @@
 //!
 //! Works on in-memory paths (no file I/O): see [`Path`]. The NC crate and the CLI do the
 //! file side. [`driver`] is where the algorithm reads from top to bottom; each method
-//! ([`reselect`], [`joint_method`], [`c_only`], [`peers`]) only proposes candidates.
+//! ([`reselect`], [`joint_method`], [`c_only`], [`peers`]) only proposes candidates, through
+//! the [`protocol`]; [`strategy`] (the top) says which methods a strategy asks and hands
+//! them to the driver.
+//!
+//! From the ground up: the [`path`] and its [`analysis`] ([`spline`], [`zones`]); the
+//! [`options`] and [`settings`]; the solvers ([`qp`], [`ipm`], the joint patch [`joint`],
+//! G16's [`g16`], the [`direct`] QP); [`verify`] and the proofs ([`proof`]); the
+//! [`protocol`] and the [`starts`] the methods share; the methods; the [`driver`]; the
+//! [`strategy`] table. The bench reference ([`reference`]) stands beside the driver.
 
 pub mod analysis;
 pub mod c_only;
@@ -10,6 +18,7 @@ pub mod candidate;
 pub mod centre;
 pub mod direct;
 pub mod driver;
+pub mod error;
 pub mod g16;
 pub(crate) mod hermite;
 pub mod ipm;
@@ -19,16 +28,22 @@ pub mod limits;
 pub mod options;
 pub mod path;
 pub mod peers;
+pub mod proof;
+pub mod protocol;
 mod qp;
 pub mod reference;
 pub mod report;
 pub mod reselect;
 pub mod settings;
 pub mod spline;
+pub mod starts;
+pub mod strategy;
 #[cfg(test)]
 mod testutil;
+pub mod tolerances;
 pub mod verify;
 pub(crate) mod window;
+pub mod zones;
 
 pub use analysis::{
     AnalysisOptions, CONE_DEG, POLE_REACH_DEG, RunAnalysis, Sample, Zone, ZoneKind, analyze_path,
@@ -36,10 +51,11 @@ pub use analysis::{
 };
 pub use candidate::{Candidate, PatchFailure};
 pub use centre::KeepCentre;
-pub use driver::{PatchResult, patch_path, report_unpatched};
+pub use driver::{PatchResult, report_unpatched};
+pub use error::{OptionField, OptionRule, OptionsError};
 pub use limits::{CLimits, GeomLimits};
-pub use options::{PatchAxes, PatchOptions};
+pub use options::{MAX_WRITTEN_DECIMALS, PatchAxes, PatchOptions, Strategy};
 pub use path::{Path, PathError};
-pub use peers::Strategy;
 pub use report::{Method, Outcome, QpStats, QpStatus, Reason, ZoneFigures, ZoneReport};
 pub use settings::SolverSettings;
+pub use strategy::patch_path;

@@ -1,6 +1,8 @@
 //! Options of the patcher.
 
-use crate::path::PathError;
+use crate::analysis::AnalysisOptions;
+use crate::error::{OptionField, OptionRule, OptionsError};
+pub use crate::path::round_written;
 use crate::settings::SolverSettings;
 
 /// Which rotary axes the patcher may change.
@@ -12,6 +14,42 @@ pub enum PatchAxes {
     Both,
     /// C only, the primary axis as programmed (G16's method, `--only-c`).
     OnlyC,
+}
+
+/// How the patcher treats a zone: polepatch's method (see [`PatchOptions::axes`]) or one of
+/// the peers' rules ([`crate::peers`]); [`crate::strategy`] says which methods
+/// answer each.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Strategy {
+    /// polepatch: branch re-selection, joint patch, verification (or the C-only method).
+    #[default]
+    Polepatch,
+    /// C held at its entry value inside the cone.
+    Freeze,
+    /// C linear in s across the cone.
+    Linearize,
+    /// C a cubic blend across the cone.
+    Smooth,
+}
+
+impl Strategy {
+    /// Every strategy, polepatch first.
+    pub const ALL: [Strategy; 4] = [
+        Strategy::Polepatch,
+        Strategy::Freeze,
+        Strategy::Linearize,
+        Strategy::Smooth,
+    ];
+    /// The name used on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Strategy::Polepatch => "polepatch",
+            Strategy::Freeze => "freeze",
+            Strategy::Linearize => "linearize",
+            Strategy::Smooth => "smooth",
+        }
+    }
 }
 
 /// Options of [`crate::patch_path`]. Plain struct: every field public, documented default.
@@ -29,7 +67,7 @@ pub struct PatchOptions {
     pub axes: PatchAxes,
     /// polepatch's method, or a peer's rule for comparison ([`crate::peers`]). Default
     /// [`Strategy::Polepatch`].
-    pub strategy: crate::peers::Strategy,
+    pub strategy: Strategy,
     /// Largest orientation deviation allowed at any point, degrees; `None` = no limit
     /// (the deviation is still minimised). Default `None`.
     pub max_deviation_deg: Option<f64>,
@@ -82,7 +120,7 @@ impl Default for PatchOptions {
             cone_deg: crate::analysis::CONE_DEG,
             pole_reach_deg: crate::analysis::POLE_REACH_DEG,
             axes: PatchAxes::Both,
-            strategy: crate::peers::Strategy::Polepatch,
+            strategy: Strategy::Polepatch,
             max_deviation_deg: None,
             tcy_s: None,
             margin: 0.02,
@@ -106,69 +144,247 @@ impl PatchOptions {
         self.cone_deg.max(self.pole_reach_deg)
     }
 
-    /// Refuse options that would mean nothing: G16's join options with the default
-    /// method, a cone, margin or cap out of range.
-    pub fn validate(&self) -> Result<(), PathError> {
-        let bad = |what: &str| Err(PathError::Options(what.to_string()));
-        if self.axes == PatchAxes::Both && self.strategy == crate::peers::Strategy::Polepatch {
-            if self.allow_c_offset {
-                return bad(
-                    "a 360° C offset (allow_c_offset) is G16's join option: it needs the C-only method",
-                );
-            }
-            if !self.third_derivative_continuity {
-                return bad(
-                    "third-derivative continuity at the joins is G16's option: it needs the C-only method",
-                );
-            }
+    /// The one rule set of the patcher's options (the library, the CLI, the C ABI and
+    /// Python all call it and map [`OptionsError::field`] to their own spelling). The first
+    /// field that breaks its rule, in the order of [`OptionField::ALL`]:
+    ///
+    /// | field | rule |
+    /// |---|---|
+    /// | `cone_deg` | a positive angle, degrees |
+    /// | `pole_reach_deg` | an angle from 0 to [`MAX_POLE_REACH_DEG`] (90) |
+    /// | `max_deviation_deg` | `None` (no limit) or a positive angle: 0 is no patch at all, not "no limit" |
+    /// | `tcy_s` | `None` or a positive time, seconds |
+    /// | `margin` | a fraction in `[0, MAX_MARGIN)` ([`MAX_MARGIN`] = 0.5: the solvers aim at (1 − margin) of the limits) |
+    /// | `third_derivative_continuity` | `false` only with the C-only method |
+    /// | `max_decimals` | at most [`MAX_WRITTEN_DECIMALS`] (9) |
+    /// | `max_patch_length_mm` | `None` (the whole run) or a positive length, mm |
+    /// | `allow_c_offset` | `true` only with the C-only method |
+    /// | `keep_centre` | `None`, or a positive radius (mm) and unit (mm) |
+    ///
+    /// The G16 options are refused only for polepatch's default method ([`Strategy::Polepatch`]
+    /// with [`PatchAxes::Both`]); a peer's strategy ignores them. `c_decimals`, `p_decimals`
+    /// (the file's) and the [`SolverSettings`] have no rule here.
+    pub fn validate(&self) -> Result<(), OptionsError> {
+        rule_positive(OptionField::ConeDeg, self.cone_deg, "degrees")?;
+        rule_angle(OptionField::PoleReachDeg, self.pole_reach_deg)?;
+        if let Some(d) = self.max_deviation_deg {
+            rule_positive(OptionField::MaxDeviationDeg, d, "degrees")?;
         }
-        if !(self.cone_deg.is_finite() && self.cone_deg > 0.0) {
-            return bad(&format!(
-                "the singular cone must be a positive angle, got {}°",
-                self.cone_deg
-            ));
+        if let Some(t) = self.tcy_s {
+            rule_positive(OptionField::TcyS, t, "seconds")?;
         }
-        if !(self.pole_reach_deg.is_finite() && (0.0..=90.0).contains(&self.pole_reach_deg)) {
-            return bad(&format!(
-                "the pole reach must be an angle from 0° to 90°, got {}°",
-                self.pole_reach_deg
-            ));
+        if !(0.0..MAX_MARGIN).contains(&self.margin) {
+            return Err(OptionsError {
+                field: OptionField::Margin,
+                rule: OptionRule::FractionBelow { below: MAX_MARGIN },
+                value: self.margin.to_string(),
+            });
         }
-        if !(0.0..1.0).contains(&self.margin) {
-            return bad(&format!(
-                "the margin must be in [0, 1), got {}",
-                self.margin
-            ));
+        let default_method = self.axes == PatchAxes::Both && self.strategy == Strategy::Polepatch;
+        if default_method && !self.third_derivative_continuity {
+            return Err(OptionsError {
+                field: OptionField::ThirdDerivativeContinuity,
+                rule: OptionRule::NeedsOnlyC,
+                value: "false".to_string(),
+            });
         }
-        if let Some(d) = self.max_deviation_deg
-            && !(d.is_finite() && d >= 0.0)
-        {
-            return bad(&format!("the largest deviation must be ≥ 0°, got {d}°"));
+        if self.max_decimals > MAX_WRITTEN_DECIMALS {
+            return Err(OptionsError {
+                field: OptionField::MaxDecimals,
+                rule: OptionRule::AtMost {
+                    max: MAX_WRITTEN_DECIMALS,
+                },
+                value: self.max_decimals.to_string(),
+            });
         }
-        if let Some(k) = &self.keep_centre
-            && !(k.radius_mm.is_finite()
-                && k.radius_mm > 0.0
-                && k.unit_mm.is_finite()
-                && k.unit_mm > 0.0)
-        {
-            return bad(&format!(
-                "keeping a ball's centre needs a positive radius and unit, got {} mm and {} mm",
-                k.radius_mm, k.unit_mm
-            ));
+        if let Some(l) = self.max_patch_length_mm {
+            rule_positive(OptionField::MaxPatchLengthMm, l, "mm")?;
         }
-        if let Some(l) = self.max_patch_length_mm
-            && !(l.is_finite() && l > 0.0)
-        {
-            return bad(&format!(
-                "the longest patch must be a positive length, got {l} mm"
-            ));
+        if default_method && self.allow_c_offset {
+            return Err(OptionsError {
+                field: OptionField::AllowCOffset,
+                rule: OptionRule::NeedsOnlyC,
+                value: "true".to_string(),
+            });
+        }
+        if let Some(k) = &self.keep_centre {
+            rule_positive(OptionField::KeepCentreRadiusMm, k.radius_mm, "mm")?;
+            rule_positive(OptionField::KeepCentreUnitMm, k.unit_mm, "mm")?;
         }
         Ok(())
     }
 }
 
-/// The value the controller receives when `v` is written with `decimals` places
-/// (the same rounding as the NC writer: `format!("{:.*}", decimals, v)`).
-pub fn round_written(v: f64, decimals: usize) -> f64 {
-    format!("{v:.decimals$}").parse().unwrap_or(v)
+impl AnalysisOptions {
+    /// The rules of [`PatchOptions::validate`] for the fields the analysis shares with it:
+    /// `cone_deg`, `pole_reach_deg`, `tcy_s`.
+    pub fn validate(&self) -> Result<(), OptionsError> {
+        rule_positive(OptionField::ConeDeg, self.cone_deg, "degrees")?;
+        rule_angle(OptionField::PoleReachDeg, self.pole_reach_deg)?;
+        if let Some(t) = self.tcy_s {
+            rule_positive(OptionField::TcyS, t, "seconds")?;
+        }
+        Ok(())
+    }
+}
+
+/// Most decimal places a rotary value may be written with (`max_decimals`): beyond 9 the
+/// written digits are below any control's resolution and only lengthen the file.
+pub const MAX_WRITTEN_DECIMALS: usize = 9;
+
+/// The margin is below this (`margin` ∈ `[0, MAX_MARGIN)`): the solvers aim at
+/// (1 − margin) of the rotary axes' limits, and at half of them or less a patch gives
+/// away more than it gains.
+pub const MAX_MARGIN: f64 = 0.5;
+
+/// The pole reach is at most this, degrees (the pole is 90° from the equator).
+pub const MAX_POLE_REACH_DEG: f64 = 90.0;
+
+/// `v` is a finite number above 0 (in `unit`).
+fn rule_positive(field: OptionField, v: f64, unit: &'static str) -> Result<(), OptionsError> {
+    if v.is_finite() && v > 0.0 {
+        return Ok(());
+    }
+    Err(OptionsError {
+        field,
+        rule: OptionRule::Positive { unit },
+        value: v.to_string(),
+    })
+}
+
+/// `v` is a finite angle from 0 to [`MAX_POLE_REACH_DEG`].
+fn rule_angle(field: OptionField, v: f64) -> Result<(), OptionsError> {
+    if v.is_finite() && (0.0..=MAX_POLE_REACH_DEG).contains(&v) {
+        return Ok(());
+    }
+    Err(OptionsError {
+        field,
+        rule: OptionRule::AngleUpTo {
+            max: MAX_POLE_REACH_DEG,
+        },
+        value: v.to_string(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::centre::KeepCentre;
+
+    fn with(change: impl Fn(&mut PatchOptions)) -> PatchOptions {
+        let mut o = PatchOptions::default();
+        change(&mut o);
+        o
+    }
+
+    /// The defaults pass; every field out of range is refused with its field and rule, and
+    /// the message names it as the caller spells it.
+    #[test]
+    fn one_rule_set_names_the_field() {
+        assert_eq!(PatchOptions::default().validate(), Ok(()));
+        assert_eq!(AnalysisOptions::default().validate(), Ok(()));
+        let only_c = |o: &mut PatchOptions| o.axes = PatchAxes::OnlyC;
+        let centre = |r: f64, u: f64| KeepCentre {
+            radius_mm: r,
+            decimals: 3,
+            unit_mm: u,
+            s_is_length: true,
+        };
+        let cases: Vec<(OptionField, PatchOptions)> = vec![
+            (OptionField::ConeDeg, with(|o| o.cone_deg = 0.0)),
+            (OptionField::ConeDeg, with(|o| o.cone_deg = f64::NAN)),
+            (OptionField::PoleReachDeg, with(|o| o.pole_reach_deg = -1.0)),
+            (OptionField::PoleReachDeg, with(|o| o.pole_reach_deg = 91.0)),
+            (
+                OptionField::MaxDeviationDeg,
+                with(|o| o.max_deviation_deg = Some(0.0)),
+            ),
+            (
+                OptionField::MaxDeviationDeg,
+                with(|o| o.max_deviation_deg = Some(f64::INFINITY)),
+            ),
+            (OptionField::TcyS, with(|o| o.tcy_s = Some(-0.001))),
+            (OptionField::Margin, with(|o| o.margin = -0.01)),
+            (OptionField::Margin, with(|o| o.margin = MAX_MARGIN)),
+            (
+                OptionField::ThirdDerivativeContinuity,
+                with(|o| o.third_derivative_continuity = false),
+            ),
+            (OptionField::MaxDecimals, with(|o| o.max_decimals = 12)),
+            (
+                OptionField::MaxPatchLengthMm,
+                with(|o| o.max_patch_length_mm = Some(0.0)),
+            ),
+            (OptionField::AllowCOffset, with(|o| o.allow_c_offset = true)),
+            (
+                OptionField::KeepCentreRadiusMm,
+                with(|o| o.keep_centre = Some(centre(0.0, 1.0))),
+            ),
+            (
+                OptionField::KeepCentreUnitMm,
+                with(|o| o.keep_centre = Some(centre(5.0, f64::NAN))),
+            ),
+        ];
+        for (field, o) in cases {
+            let e = o.validate().unwrap_err();
+            assert_eq!(e.field, field, "{e}");
+            assert!(e.to_string().starts_with(field.name()), "{e}");
+            assert!(e.message("--the-flag").starts_with("--the-flag "), "{e}");
+            assert!(OptionField::ALL.contains(&field));
+        }
+        // G16's join options are the C-only method's, and a peer ignores them.
+        let g16 = |o: &mut PatchOptions| {
+            o.allow_c_offset = true;
+            o.third_derivative_continuity = false;
+        };
+        assert_eq!(
+            with(|o| {
+                g16(o);
+                only_c(o)
+            })
+            .validate(),
+            Ok(())
+        );
+        assert_eq!(
+            with(|o| {
+                g16(o);
+                o.strategy = Strategy::Freeze
+            })
+            .validate(),
+            Ok(())
+        );
+        // The limits themselves pass.
+        assert_eq!(
+            with(|o| {
+                o.max_decimals = MAX_WRITTEN_DECIMALS;
+                o.margin = 0.0;
+                o.pole_reach_deg = MAX_POLE_REACH_DEG;
+            })
+            .validate(),
+            Ok(())
+        );
+    }
+
+    /// The refusals of issue 28, as the library's field names.
+    #[test]
+    fn refusals_read_as_the_rule() {
+        let msg = |o: PatchOptions| o.validate().unwrap_err().to_string();
+        assert_eq!(
+            msg(with(|o| o.max_deviation_deg = Some(0.0))),
+            "max_deviation_deg must be a positive number of degrees, got 0"
+        );
+        assert_eq!(
+            msg(with(|o| o.margin = -0.1)),
+            "margin must be a fraction in [0, 0.5), got -0.1"
+        );
+        assert_eq!(
+            msg(with(|o| o.max_decimals = 12)),
+            "max_decimals must be at most 9, got 12"
+        );
+        let e = with(|o| o.max_decimals = 12).validate().unwrap_err();
+        assert_eq!(
+            e.message("--max-decimals"),
+            "--max-decimals must be at most 9, got 12"
+        );
+    }
 }

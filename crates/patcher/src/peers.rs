@@ -1,136 +1,27 @@
 //! The pole strategies that CAM posts and controllers document, as peers for the quality
 //! suite (issue 8 §5): each rewrites the rotary values inside the singular cone by a fixed
-//! rule, and `polepatch bench --strategy …` scores it with the same Equation-6 analysis as
-//! polepatch's own patch.
-//!
-//! For each singular zone, the **cone stretch** is the maximal run of consecutive points
-//! with |P| ≤ the cone around the zone's point of least |P|; `e0` and `e1` are the points
-//! just before and after it (the entry and exit). Inside the stretch:
-//! - [`Strategy::Freeze`] (ModuleWorks FREEZE, Fanuc's tool posture control): C holds its
-//!   entry value `C(e0)`;
-//! - [`Strategy::Linearize`] (ModuleWorks LINEAR_INTERPOLATION, Fusion LINEARIZE_ROTARY):
-//!   C linear in s from `C(e0)` to `C(e1)` (the program's values, as unwrapped);
-//! - [`Strategy::Smooth`] (ModuleWorks SMOOTH_INTERPOLATION, its default): C a cubic
-//!   Hermite blend in s from `(C, C')(e0)` to `(C, C')(e1)`, slopes from the program's
-//!   analysis spline.
-//!
-//! With C chosen, the primary axis takes the angle that puts the tool axis closest to the
-//! programmed one on C's meridian — `P = atan2(o·d, o_z)` with `d` the meridian's
-//! horizontal direction (∂o/∂P at P = 0) — which may pass through zero (through the pole).
-//! Values are written with the file's decimals, as a post would. Nothing is verified and
-//! nothing is kept back: a peer's result is what it is, and the suite reports it.
+//! rule ([`crate::starts`]: FREEZE, LINEARIZE, SMOOTH across the cone stretch, P on C's
+//! meridian), and `polepatch bench --strategy …` scores it with the same Equation-6
+//! analysis as polepatch's own patch. Values are written with the file's decimals, as a
+//! post would. Nothing is verified and nothing is kept back: a peer's result is what it
+//! is, and the suite reports it.
 
 use crate::{
-    analysis::Zone,
-    driver::{Proposal, Proposer, Sink, Tail, ZoneCtx},
+    protocol::{Proposal, Proposer, Sink, Tail, ZoneCtx},
     report::{Method, QpStats},
     spline::AnalysisSpline,
+    starts::{Rule, apply_rule, cone_stretch},
 };
-use polepatch_kinematics::{Machine, forward_jacobian};
-use serde::Serialize;
 
-/// How the patcher treats a zone: polepatch's method (see [`PatchOptions::axes`]) or one of
-/// the peers (module docs).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Strategy {
-    /// polepatch: branch re-selection, joint patch, verification (or the C-only method).
-    #[default]
-    Polepatch,
-    /// C held at its entry value inside the cone.
-    Freeze,
-    /// C linear in s across the cone.
-    Linearize,
-    /// C a cubic blend across the cone.
-    Smooth,
-}
+pub use crate::options::Strategy;
 
-impl Strategy {
-    /// Every strategy, polepatch first.
-    pub const ALL: [Strategy; 4] = [
-        Strategy::Polepatch,
-        Strategy::Freeze,
-        Strategy::Linearize,
-        Strategy::Smooth,
-    ];
-    /// The name used on the command line and in reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            Strategy::Polepatch => "polepatch",
-            Strategy::Freeze => "freeze",
-            Strategy::Linearize => "linearize",
-            Strategy::Smooth => "smooth",
-        }
-    }
-}
-
-/// The primary angle, degrees, that puts the tool axis closest to `o` on the meridian of
-/// `c_deg` (module docs).
-pub fn primary_on_meridian(machine: &Machine, o: [f64; 3], c_deg: f64) -> f64 {
-    let [_, d, _] = forward_jacobian(machine, 0.0, c_deg);
-    let norm = (d[0] * d[0] + d[1] * d[1]).sqrt();
-    let along = (o[0] * d[0] + o[1] * d[1]) / norm;
-    along.atan2(o[2]).to_degrees()
-}
-
-/// The cone stretch of a zone (module docs): points `a..=b` with |P| ≤ `cone_deg` around
-/// the zone's point of least |P|, and the entry and exit points `e0 = a − 1`, `e1 = b + 1`
-/// (clipped to the path; the first point is never in a stretch). `None` when empty.
-pub fn cone_stretch(p_deg: &[f64], zone: &Zone, cone_deg: f64) -> Option<[usize; 4]> {
-    let n = p_deg.len();
-    let k = (zone.first..=zone.last)
-        .min_by(|&a, &b| p_deg[a].abs().total_cmp(&p_deg[b].abs()))
-        .unwrap_or(zone.singular);
-    let (mut a, mut b) = (k, k);
-    while a > 1 && p_deg[a - 1].abs() <= cone_deg {
-        a -= 1;
-    }
-    while b + 1 < n - 1 && p_deg[b + 1].abs() <= cone_deg {
-        b += 1;
-    }
-    let (e0, e1) = (a.saturating_sub(1), (b + 1).min(n - 1));
-    let a = a.max(1);
-    (a <= b).then_some([e0, a, b, e1])
-}
-
-/// Rewrite the cone stretch `[e0, a, b, e1]` of `(p, c)` by a peer's rule (module docs),
-/// unrounded: C by the rule from the program's values `c0` (and the slopes of its analysis
-/// spline `c_spline` for [`Strategy::Smooth`]), P on C's meridian closest to `target`.
-#[allow(clippy::too_many_arguments)]
-pub fn apply_rule(
-    strategy: Strategy,
-    machine: &Machine,
-    s_mm: &[f64],
-    c0: &[f64],
-    c_spline: &AnalysisSpline,
-    target: &[[f64; 3]],
-    [e0, a, b, e1]: [usize; 4],
-    p: &mut [f64],
-    c: &mut [f64],
-) {
-    let (s0, s1) = (s_mm[e0], s_mm[e1]);
-    let (ca, cb) = (c0[e0], c0[e1]);
-    let (da, db) = (c_spline.eval_derivs(s0)[1], c_spline.eval_derivs(s1)[1]);
-    for i in a..=b {
-        let t = if s1 > s0 {
-            (s_mm[i] - s0) / (s1 - s0)
-        } else {
-            0.0
-        };
-        c[i] = match strategy {
-            Strategy::Freeze | Strategy::Polepatch => ca,
-            Strategy::Linearize => ca + t * (cb - ca),
-            Strategy::Smooth => {
-                // Cubic Hermite basis on [s0, s1].
-                let h = s1 - s0;
-                let (t2, t3) = (t * t, t * t * t);
-                (2.0 * t3 - 3.0 * t2 + 1.0) * ca
-                    + (t3 - 2.0 * t2 + t) * h * da
-                    + (-2.0 * t3 + 3.0 * t2) * cb
-                    + (t3 - t2) * h * db
-            }
-        };
-        p[i] = primary_on_meridian(machine, target[i], c[i]);
+/// The cone rule of a peer strategy ([`Strategy::Polepatch`] has none: FREEZE's, as the
+/// peers' rules always gave it).
+pub fn rule_of(strategy: Strategy) -> Rule {
+    match strategy {
+        Strategy::Freeze | Strategy::Polepatch => Rule::Freeze,
+        Strategy::Linearize => Rule::Linearize,
+        Strategy::Smooth => Rule::Smooth,
     }
 }
 
@@ -149,7 +40,7 @@ impl Proposer for Peer {
         };
         let (mut p, mut c) = (ctx.p.to_vec(), ctx.c.to_vec());
         apply_rule(
-            self.0,
+            rule_of(self.0),
             ctx.machine,
             ctx.s,
             ctx.c,
@@ -181,27 +72,7 @@ mod tests {
     use crate::options::{PatchOptions, round_written};
     use crate::path::Path;
     use crate::report::Reason;
-    use polepatch_kinematics::{angle_between_deg, forward};
-
-    /// The meridian projection is exact for a tool axis on the meridian (either side of
-    /// the pole) and the closest point otherwise.
-    #[test]
-    fn projection_onto_a_meridian() {
-        for name in ["mikron-ucp710", "mikron-hsm600"] {
-            let m = Machine::builtin(name).unwrap();
-            for (p, c) in [(3.0, 40.0), (-7.5, 40.0), (0.0, 10.0), (25.0, -170.0)] {
-                let o = forward(&m, p, c);
-                assert!(
-                    (primary_on_meridian(&m, o, c) - p).abs() < 1e-9,
-                    "{name} {p} {c}"
-                );
-                // Off the meridian by 10°: the closest point beats its neighbours.
-                let q = primary_on_meridian(&m, o, c + 10.0);
-                let dev = |x: f64| angle_between_deg(o, forward(&m, x, c + 10.0));
-                assert!(dev(q) <= dev(q + 0.01) && dev(q) <= dev(q - 0.01));
-            }
-        }
-    }
+    use polepatch_kinematics::Machine;
 
     /// FREEZE holds C inside the cone and keeps the tool axis on the right meridian;
     /// LINEARIZE and SMOOTH meet the program at the stretch's ends.

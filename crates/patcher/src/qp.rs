@@ -1,24 +1,19 @@
 //! A QP builder with sparse rows, for clarabel (one timed solve).
 
 use crate::report::{QpStats, QpStatus};
+use crate::tolerances::CLARABEL_MAX_ITER;
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettings, DefaultSolver, IPSolver, SupportedConeT::NonnegativeConeT,
 };
 use std::time::Instant;
 
-/// Clarabel's iteration cap. The patcher's QPs converge or prove infeasibility in 10–30
-/// iterations; one that has not after this many is reported as not solved rather than
-/// ground on (clarabel's default is 200). Tolerances stay at clarabel's defaults (1e-8):
-/// looser ones change which candidates pass verification.
-pub(crate) const SOLVER_MAX_ITER: u32 = 60;
-
-/// The settings every patcher solve uses: quiet, [`SOLVER_MAX_ITER`], the rest clarabel's
+/// The settings every patcher solve uses: quiet, [`CLARABEL_MAX_ITER`], the rest clarabel's
 /// defaults.
 pub(crate) fn settings() -> DefaultSettings<f64> {
     DefaultSettings {
         verbose: false,
-        max_iter: SOLVER_MAX_ITER,
+        max_iter: CLARABEL_MAX_ITER,
         ..DefaultSettings::default()
     }
 }

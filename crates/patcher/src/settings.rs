@@ -4,6 +4,10 @@
 //! [`SolverSettings::default`] is what `polepatch patch` uses; [`SolverSettings::reference`]
 //! is the same with more effort, what the quality suite judges the default against
 //! ([`crate::reference`]).
+//!
+//! These are the knobs of the methods (weights, trust regions, widening and iteration
+//! counts); the fixed round-off tolerances and window sizes every method shares are in
+//! [`crate::tolerances`].
 
 use crate::ipm::IpmSettings;
 
@@ -17,8 +21,24 @@ pub struct SolverSettings {
     /// Zones closer than this many points are patched as one. Default 6.
     pub merge_gap_points: usize,
     /// Points either side of a zone whose spans must reach feed with it (the zone's
-    /// "core"). Default 3.
+    /// "core"): what the verification of every candidate checks, what the report's
+    /// figures and the proofs cover. Default 3.
     pub core_margin_points: usize,
+    /// Tries at scaling a change that reaches feed beyond `max_deviation_deg` into the cap
+    /// (the best improvement within it). Default 4.
+    pub scale_tries: usize,
+    /// Each scaling try aims this fraction of the cap (dimensionless: the deviation is
+    /// nearly, not exactly, linear in the scale; rounding adds a little). Default 0.98.
+    pub scale_safety: f64,
+    /// With a ball's centre kept: solves of a path whose tips move, at most (the tip
+    /// path's length s is solved again on the tips the last solve wrote). Default 4.
+    pub centre_s_iterations: usize,
+    /// With a ball's centre kept: relative change of a block's length (dimensionless)
+    /// below which the tip path's length has settled. Default 1e-3.
+    pub centre_s_tol: f64,
+    /// With a ball's centre kept: narrowing a patch that slowed a linear axis away from its
+    /// zone moves its bound at least 1/`narrow_step_div` of the way to the zone. Default 4.
+    pub narrow_step_div: usize,
 
     // --- The joint patch (crate::joint) ----------------------------------------------
     /// Points added on each side of the zone to the range the joint patch may change
@@ -64,6 +84,10 @@ pub struct SolverSettings {
     /// Relative excess over the limit rows (`e`) below which a joint solution counts as
     /// within them (the margin covers it). Default 1e-6.
     pub elastic_tol: f64,
+    /// With a cap (`max_deviation_deg`): weight of the largest orientation change (chord)
+    /// in the SCP's merit against the excess over the limits and the cap, only to break
+    /// ties (dimensionless). Default 1e-6.
+    pub cap_tie_weight: f64,
     /// The interior-point solver's settings ([`crate::ipm`]).
     pub ipm: IpmSettings,
     /// Margin on the limits of the reference's joint solves ([`crate::reference`]; the
@@ -80,6 +104,38 @@ pub struct SolverSettings {
     /// Most widening levels tried after the level of the first passing candidate.
     /// Default 3.
     pub max_levels_after_pass: usize,
+
+    // --- The direct QP (crate::direct) -----------------------------------------------
+    /// μ·m: weight of the quadratic pull-back term, per degree², divided by the number m of
+    /// changed points (small, so the minimax term dominates). Default 1e-4.
+    pub direct_quad_weight: f64,
+    /// ε: added to `sin² P` in the quadratic term so a point exactly at the pole stays
+    /// determined (dimensionless). Default 1e-6.
+    pub direct_pole_regularisation: f64,
+
+    // --- G16's patch (crate::g16) -----------------------------------------------------
+    /// CL points beyond the zone (and the patch extension) on each side used to fit C_b
+    /// and C_a. Default 30.
+    pub g16_fit_margin_points: usize,
+    /// Join-search step as a fraction of the median CL spacing (dimensionless).
+    /// Default 0.05.
+    pub g16_join_step_fraction: f64,
+    /// μ: weight of the least-squares deviation term, 1/degree (the minimax term t has
+    /// weight 1): small, it only picks a solution among the minimax optima. Default 1e-3.
+    pub g16_lsq_weight: f64,
+    /// ε: weight of the jerk energy ∫P'''² ds, mm⁵/degree: small, it smooths the patch
+    /// where the deviation does not bind. Default 1e-3.
+    pub g16_jerk_weight: f64,
+    /// CL points closer than this fraction of the median spacing to a join are not made
+    /// breakpoints of the patch (a very short span conditions the QP badly); they are still
+    /// projected (dimensionless). Default 0.05.
+    pub g16_min_span_fraction: f64,
+    /// Most attempts (join-window enlargements plus patch widenings) before giving up.
+    /// Default 24.
+    pub g16_max_attempts: usize,
+    /// Probes per support interval when computing the monotonicity floor ℓ_k in the
+    /// extensions. Default 8.
+    pub g16_monotone_probes: usize,
 }
 
 impl Default for SolverSettings {
@@ -88,6 +144,11 @@ impl Default for SolverSettings {
             margin_ladder: vec![1.0, 0.25, 0.0],
             merge_gap_points: 6,
             core_margin_points: 3,
+            scale_tries: 4,
+            scale_safety: 0.98,
+            centre_s_iterations: 4,
+            centre_s_tol: 1e-3,
+            narrow_step_div: 4,
             joint_range_min_points: 10,
             joint_range_zone_factor: 1.0,
             scp_max_solves: 6,
@@ -103,11 +164,21 @@ impl Default for SolverSettings {
             proximal_weight: 1e-8,
             elastic_weight: 1e4,
             elastic_tol: 1e-6,
+            cap_tie_weight: 1e-6,
             ipm: IpmSettings::default(),
             reference_margin: 1e-3,
             direct_max_points: 400,
             deviation_improvement_min: 0.05,
             max_levels_after_pass: 3,
+            direct_quad_weight: 1e-4,
+            direct_pole_regularisation: 1e-6,
+            g16_fit_margin_points: 30,
+            g16_join_step_fraction: 0.05,
+            g16_lsq_weight: 1e-3,
+            g16_jerk_weight: 1e-3,
+            g16_min_span_fraction: 0.05,
+            g16_max_attempts: 24,
+            g16_monotone_probes: 8,
         }
     }
 }

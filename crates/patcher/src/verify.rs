@@ -11,27 +11,11 @@
 //! the change make the window spline equal to the whole-path spline to round-off where
 //! the checks are made.
 
-use crate::analysis::RATIO_TOL;
 use crate::spline::{SplineSystem, span_maxima};
+use crate::tolerances::{RATIO_TOL, VERIFY_MARGIN_POINTS, WINDOW_GUARD_SPANS};
+
+pub use crate::tolerances::NOT_WORSE_REL;
 use polepatch_kinematics::{Axis, Machine, axis_feed_ratio};
-
-/// Points of unchanged path kept either side of a change when verifying it.
-pub const VERIFY_MARGIN_POINTS: usize = 30;
-
-/// Points either side of the modified range where the ratios must reach 1.
-pub const CORE_MARGIN_POINTS: usize = 3;
-
-/// Spans next to a window end that was cut (not a path end) left out of the "never worse"
-/// comparison: there the window spline differs from the whole-path spline.
-const WINDOW_GUARD_SPANS: usize = 10;
-
-/// Resolution of the "not lower than before" comparison: a ratio may fall by this fraction
-/// of itself (0.01 %, a feed difference no controller resolves). It absorbs round-off, the
-/// solvers' own tolerance (clarabel's feasibility tolerance is relative to the problem's
-/// norms: with C changes of 100° the slope equalities hold to ~1e-7, which q''' multiplies
-/// by 6/h²; measured: 3.6e-6 on q''' at 0.25 mm spacing) and what a change propagates,
-/// through the spline's decay, beyond the window a solver constrains.
-pub const NOT_WORSE_REL: f64 = 1e-4;
 
 /// The lowest ratio a span may have after a change when it had `before`: a span at feed
 /// (`before ≥ 1 − RATIO_TOL`) stays at feed — a patch never makes a new slow spot — and a
@@ -60,8 +44,9 @@ pub struct AxisChange<'a> {
 /// Verdict of [`verify_change`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Verdict {
-    /// Lowest ratio after the change over the core (modified points ±
-    /// [`CORE_MARGIN_POINTS`]), over every axis checked.
+    /// Lowest ratio after the change over the core (the core points ± the caller's
+    /// `core_margin`, [`crate::SolverSettings::core_margin_points`]), over every axis
+    /// checked.
     pub core_min_after: f64,
     /// Lowest ratio before the change over the same core and axes.
     pub core_min_before: f64,
@@ -116,7 +101,8 @@ fn span_ratios(
 /// `feed_mm_s` is the programmed feed.
 ///
 /// Every axis must reach feed (ratio ≥ 1 − [`RATIO_TOL`]) on every sample of the spans
-/// within [`CORE_MARGIN_POINTS`] points of the modified range, and no span of the window
+/// within `core_margin` points of the modified range (the driver passes
+/// [`crate::SolverSettings::core_margin_points`]), and no span of the window
 /// may get a ratio below [`not_worse_floor`] of its ratio before on any checked axis.
 #[allow(clippy::too_many_arguments)]
 pub fn verify_change(
@@ -124,6 +110,7 @@ pub fn verify_change(
     changes: &[AxisChange],
     first: usize,
     last: usize,
+    core_margin: usize,
     machine: &Machine,
     feed_mm_s: f64,
 ) -> Verdict {
@@ -132,13 +119,14 @@ pub fn verify_change(
         changes,
         (first, last),
         (first, last),
+        core_margin,
         machine,
         feed_mm_s,
     )
 }
 
 /// [`verify_change`] where the stretch that must reach feed is given apart from the
-/// modified points: every axis must reach feed on the spans within [`CORE_MARGIN_POINTS`]
+/// modified points: every axis must reach feed on the spans within `core_margin` points
 /// of `core` (a point range, inclusive), and nothing may get worse in the window around
 /// `core ∪ changed`. The joint method passes the zone as `core`: where the original was
 /// below feed the result must reach it; around it, where the program's own values (its
@@ -149,10 +137,20 @@ pub fn verify_change_with_core(
     changes: &[AxisChange],
     changed: (usize, usize),
     core: (usize, usize),
+    core_margin: usize,
     machine: &Machine,
     feed_mm_s: f64,
 ) -> Verdict {
-    verify_change_on(s_mm, s_mm, changes, changed, core, machine, feed_mm_s)
+    verify_change_on(
+        s_mm,
+        s_mm,
+        changes,
+        changed,
+        core,
+        core_margin,
+        machine,
+        feed_mm_s,
+    )
 }
 
 /// [`verify_change_with_core`] where the values after run on another path length
@@ -165,6 +163,7 @@ pub fn verify_change_on(
     changes: &[AxisChange],
     changed: (usize, usize),
     core: (usize, usize),
+    core_margin: usize,
     machine: &Machine,
     feed_mm_s: f64,
 ) -> Verdict {
@@ -187,8 +186,8 @@ pub fn verify_change_on(
             Err(_) => return Verdict::failed(),
         }
     };
-    let core_lo = core.0.saturating_sub(CORE_MARGIN_POINTS).max(lo) - lo;
-    let core_hi = (core.1 + CORE_MARGIN_POINTS).min(hi) - lo; // knot index, exclusive span end
+    let core_lo = core.0.saturating_sub(core_margin).max(lo) - lo;
+    let core_hi = (core.1 + core_margin).min(hi) - lo; // knot index, exclusive span end
     let guard_lo = if lo > 0 { WINDOW_GUARD_SPANS } else { 0 };
     let guard_hi = if hi < n - 1 {
         (nw - 1).saturating_sub(WINDOW_GUARD_SPANS)
@@ -247,7 +246,7 @@ mod tests {
                 before: &y,
                 after,
             }];
-            verify_change(&s, &ch, 20, 20, &m, feed_mm_s)
+            verify_change(&s, &ch, 20, 20, 3, &m, feed_mm_s)
         };
         assert!(c(&y).passes(), "{:?}", c(&y));
         let mut bumped = y.clone();
@@ -255,6 +254,31 @@ mod tests {
         let v = c(&bumped);
         assert!(v.core_min_after < 1.0 && v.worse_somewhere, "{v:?}");
         assert!(!v.passes());
+    }
+
+    /// The core margin is the caller's (`SolverSettings::core_margin_points`, no constant
+    /// of its own): a kink of C two points from a change, whose jerk keeps its spans below
+    /// feed, is in the core with a margin of 3 (the change fails: those spans do not reach
+    /// feed) and outside it with a margin of 0 (unchanged there, so not worse: it passes).
+    #[test]
+    fn the_core_margin_is_the_callers() {
+        let m = ucp710();
+        let feed_mm_s = 20.0;
+        // C at 3 °/mm (half of V/F) up to point 12, at 3.4 °/mm after it: a kink.
+        let s: Vec<f64> = (0..61).map(|i| i as f64 * 0.5).collect();
+        let y: Vec<f64> = s
+            .iter()
+            .map(|&x| 3.0 * x + 0.4 * (x - 6.0).max(0.0))
+            .collect();
+        let ch = [AxisChange {
+            axis: Axis::C,
+            before: &y,
+            after: &y,
+        }];
+        let with = |margin| verify_change(&s, &ch, 10, 10, margin, &m, feed_mm_s);
+        assert!(with(0).passes(), "{:?}", with(0));
+        let v = with(3);
+        assert!(!v.passes() && v.core_min_after < 1.0, "{v:?}");
     }
 
     /// Two axes: a change that frees C but breaks the primary fails; the verdict is the
@@ -272,7 +296,7 @@ mod tests {
             before: &line,
             after: &line,
         }];
-        assert!(verify_change(&s, &only_c, 18, 22, &m, feed_mm_s).passes());
+        assert!(verify_change(&s, &only_c, 18, 22, 3, &m, feed_mm_s).passes());
         let both = [
             only_c[0],
             AxisChange {
@@ -281,7 +305,7 @@ mod tests {
                 after: &kinked,
             },
         ];
-        let v = verify_change(&s, &both, 18, 22, &m, feed_mm_s);
+        let v = verify_change(&s, &both, 18, 22, 3, &m, feed_mm_s);
         assert!(!v.passes() && v.worse_somewhere, "{v:?}");
     }
 
@@ -298,6 +322,6 @@ mod tests {
             before: &y,
             after: &bad,
         }];
-        assert_eq!(verify_change(&s, &ch, 5, 5, &m, 10.0), Verdict::failed());
+        assert_eq!(verify_change(&s, &ch, 5, 5, 3, &m, 10.0), Verdict::failed());
     }
 }

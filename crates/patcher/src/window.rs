@@ -34,28 +34,11 @@
 use crate::candidate::PatchFailure;
 use crate::qp::Row;
 use crate::spline::{AnalysisSpline, SplineSystem};
+use crate::tolerances::{
+    EDGE_SPANS, MIN_ROW_BOUND, NOT_WORSE_SAMPLES_PER_SPAN, NOT_WORSE_SLACK, WIDEN_POINTS,
+};
 
-/// Points of the path either side of the moving range in the joint patch's window.
-/// The window's spans next to a cut end are left out of the rows ([`EDGE_SPANS`]): the
-/// fixed end slope is exact only to about 0.27^window of the change.
-pub const JOINT_WINDOW_POINTS: usize = 24;
-
-/// Spans at each end of a window inside the path that [`Window::limit_rows`] leaves
-/// unconstrained: the fixed end slope's error (about 0.27^window of the change) enters
-/// q''' amplified by 6/h² next to the end; 8 spans further it has decayed by
-/// 0.27⁸ ≈ 3·10⁻⁵.
-pub const EDGE_SPANS: usize = 8;
-
-/// Rows per span (plus the spline's vertex of q' before) of the "not worse" velocity rows
-/// on a span that exceeded the velocity limit before ([`Window::limit_rows`]).
-pub const NOT_WORSE_SAMPLES_PER_SPAN: usize = 8;
-
-/// Relative slack of a "not worse than before" bound (round-off only).
-pub const NOT_WORSE_SLACK: f64 = 1e-9;
-
-/// At least this many points of the path either side of the window go into the spline
-/// the window's end slopes are taken from.
-const WIDEN_POINTS: usize = 16;
+pub use crate::tolerances::JOINT_WINDOW_POINTS;
 
 /// A linear form `Σ_j w[j]·c[first + j]` over four consecutive coefficients of the window.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -476,7 +459,7 @@ impl Window {
                     b.max(f.at(before).abs() * (1.0 + NOT_WORSE_SLACK))
                 };
                 // Never below a sliver of the limit: the row stays well posed.
-                b.max(1e-3 * limit)
+                b.max(MIN_ROW_BOUND * limit)
             };
             let (m0, m1, b1) = (sp.at(0.0, 1), sp.at(h, 1), sp.b1());
             let hull_now = [m0, b1, m1]
@@ -485,7 +468,7 @@ impl Window {
             if strict || hull_now <= lim.v {
                 // |q'| ≤ v on the whole span through its Bernstein coefficients (a span
                 // within the limit before may only stay within it: "not worse").
-                push(&b1, (lim.v - room[0]).max(1e-3 * lim.v), out);
+                push(&b1, (lim.v - room[0]).max(MIN_ROW_BOUND * lim.v), out);
             } else {
                 // Beyond the limit before: "not worse" on q' against the span's exact peak
                 // before (the hull overstates the peak, so it cannot stand for it).
@@ -506,7 +489,7 @@ impl Window {
                 let peak = taus.iter().fold(0.0f64, |m, &t| m.max(d1(t).abs()));
                 let bnd = (lim.v - room[0])
                     .max(peak * (1.0 + NOT_WORSE_SLACK))
-                    .max(1e-3 * lim.v);
+                    .max(MIN_ROW_BOUND * lim.v);
                 for &tau in taus.iter().filter(|&&t| t > 0.0 && t < h) {
                     push(&sp.at(tau, 1), bnd, out);
                 }

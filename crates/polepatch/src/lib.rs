@@ -123,9 +123,9 @@ impl Default for AnalyzeOptions {
     }
 }
 
-/// Most decimal places a rotary value may be written with (`max_decimals`): beyond 9 the
-/// written digits are below any control's resolution and only lengthen the file.
-pub const MAX_WRITTEN_DECIMALS: usize = 9;
+/// Most decimal places a rotary value may be written with (`max_decimals`): the patcher's
+/// rule ([`patcher::PatchOptions::validate`]).
+pub use patcher::MAX_WRITTEN_DECIMALS;
 
 /// `v` is a positive, finite number, else an [`Error::Options`] naming `field` and `unit`.
 pub(crate) fn positive(field: &str, unit: &str, v: f64) -> Result<(), Error> {
@@ -156,33 +156,12 @@ fn check_common(
     Ok(())
 }
 
-/// Check the patcher's options: every value in range, or an [`Error::Options`] naming the
-/// field, its unit and the value. [`PatchOptions::check`] and
-/// [`joints::patch_joints`] call it.
+/// Check the patcher's options: the patcher's one rule set
+/// ([`patcher::PatchOptions::validate`]), its refusal as an [`Error::Options`] naming the
+/// field, its unit and the value. [`PatchOptions::check`] and [`joints::patch_joints`]
+/// call it.
 pub fn check_patcher_options(p: &patcher::PatchOptions) -> Result<(), Error> {
-    positive("cone_deg", "degrees", p.cone_deg)?;
-    if let Some(d) = p.max_deviation_deg {
-        positive("max_deviation_deg", "degrees", d)?;
-    }
-    if let Some(t) = p.tcy_s {
-        positive("tcy_s (interpolation cycle time)", "seconds", t)?;
-    }
-    if let Some(l) = p.max_patch_length_mm {
-        positive("max_patch_length_mm", "mm", l)?;
-    }
-    if !(0.0..0.5).contains(&p.margin) {
-        return Err(Error::Options(format!(
-            "margin must be a fraction in [0, 0.5), got {}",
-            p.margin
-        )));
-    }
-    if p.max_decimals > MAX_WRITTEN_DECIMALS {
-        return Err(Error::Options(format!(
-            "max_decimals must be at most {MAX_WRITTEN_DECIMALS}, got {}",
-            p.max_decimals
-        )));
-    }
-    Ok(())
+    p.validate().map_err(|e| Error::Options(e.to_string()))
 }
 
 impl PatchOptions {
