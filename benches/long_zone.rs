@@ -9,7 +9,7 @@
 use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use polepatch::program::load_nc;
+use polepatch::load_nc;
 use polepatch_kinematics::Machine;
 use polepatch_patcher::{PatchOptions, Path, patch_path};
 

@@ -15,7 +15,7 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use polepatch::program::load_nc;
+use polepatch::load_nc;
 use polepatch_benches::held_out_zones;
 use polepatch_kinematics::Machine;
 use polepatch_patcher::{PatchAxes, PatchOptions, Path, patch_path};

@@ -9,7 +9,7 @@
 //! [--only LABEL-TEXT] [--set SETTING=VALUE …]`
 //! (the criterion figures are `benches/zone_solve.rs`; this is for quick looks).
 
-use polepatch::program::load_nc;
+use polepatch::load_nc;
 use polepatch_benches::held_out_zones;
 use polepatch_kinematics::Machine;
 use polepatch_patcher::reference::{Reference, zone_reference};

@@ -237,7 +237,7 @@ fn cl_to_joints_refuses_a_primary_angle_outside_the_range() {
 fn patch_joints_is_the_patcher_on_the_arrays() {
     // SING's long TCPM run, as a CAM plugin would hold it.
     let rust_machine = Machine::builtin("mikron-ucp710").unwrap();
-    let lp = polepatch::program::load_nc(
+    let lp = polepatch::load_nc(
         &std::fs::read(root().join("fixtures/c17/SING.I")).unwrap(),
         "SING.I",
         &rust_machine,

@@ -26,8 +26,10 @@
 pub mod plot;
 
 use crate::files::{JobError, read};
-use polepatch::program::{LoadedProgram, load_nc};
-use polepatch::report::{AnalyzeReport, analyze_program};
+use polepatch::analyze::analyze_program;
+use polepatch::load_nc;
+use polepatch::program::LoadedProgram;
+use polepatch::report::AnalyzeReport;
 use polepatch::{Error, FileReport, ZoneRow, patch_nc};
 use polepatch_kinematics::{Axis, Machine};
 use polepatch_patcher::direct::deviation_bound_zone;
@@ -612,11 +614,7 @@ fn reference(
     both: bool,
 ) -> ZoneBound {
     let n = lp.runs[r].run.len();
-    let end = if polepatch::end_pose::end_pose_is_free(lp, r) {
-        n - 1
-    } else {
-        n - 2
-    };
+    let end = if lp.end_pose(r).free { n - 1 } else { n - 2 };
     let (mut lo, mut hi) = (1, end);
     for z in run_zones {
         if z.last < zone.first {

@@ -3,8 +3,8 @@
 use crate::{check_positive, machine};
 use anyhow::{Context, Result, bail};
 use polepatch::kinematics::Machine;
-use polepatch::patch::{FiguresRow, ZoneRow};
 use polepatch::patcher::PatchOptions;
+use polepatch::report::{FiguresRow, ZoneRow};
 use polepatch_cli::bench::{
     BallCentreShift, BenchOptions, BenchReport, BenchStrategy, BenchZone, RATIO_TARGET, plot,
 };
@@ -128,7 +128,7 @@ pub(crate) fn run(args: BenchArgs) -> Result<ExitCode> {
     }
     let mut inputs: Vec<Input> = files.iter().map(|f| Input::new("the input", f)).collect();
     for m in &args.machine {
-        inputs.extend(crate::patch::machine_input(m));
+        inputs.extend(crate::machine_input(m));
     }
     let mut outputs = Vec::new();
     if let Some(path) = &args.json {

@@ -37,7 +37,7 @@ pub(crate) struct FilterArgs {
     pole_reach: Option<f64>,
     /// Units of a program that states none (as `patch`): mm unless said.
     #[arg(long, value_enum)]
-    units: Option<crate::post_cmd::UnitsArg>,
+    units: Option<crate::UnitsArg>,
     /// Largest orientation change allowed at any point, degrees (as `patch`).
     #[arg(long)]
     max_deviation: Option<f64>,
@@ -107,7 +107,7 @@ pub(crate) fn run(args: FilterArgs) -> Result<ExitCode> {
     let opts = crate::patch::file_options(&pa)?;
     let machine = machine(&args.machine)?;
     let mut inputs = vec![polepatch_cli::outputs::Input::new("the input", &args.file)];
-    inputs.extend(crate::patch::machine_input(&args.machine));
+    inputs.extend(crate::machine_input(&args.machine));
     if let Some(t) = &args.tools {
         inputs.push(polepatch_cli::outputs::Input::new("the tool table", t));
     }

@@ -66,7 +66,7 @@ pub(crate) fn run(
         let bytes = files::read(program)?;
         // The whole program is parsed here (this option is for checking a prediction, not
         // for files of gigabytes).
-        let lp = polepatch::program::load_nc(&bytes, &name, &machine, feed)?;
+        let lp = polepatch::load_nc(&bytes, &name, &machine, feed)?;
         let mut report = Report {
             file: name,
             machine: machine.name.clone(),

@@ -171,7 +171,7 @@ pub(crate) struct PatchArgs {
     /// nothing in the file tells inches from mm, so say it (default mm; the report says
     /// which was assumed).
     #[arg(long, value_enum)]
-    pub(crate) units: Option<post_cmd::UnitsArg>,
+    pub(crate) units: Option<UnitsArg>,
 }
 
 #[derive(clap::Args)]
@@ -203,7 +203,7 @@ struct AnalyzeArgs {
     strict: bool,
     /// Units of a program that states none (see `patch`). Default mm.
     #[arg(long, value_enum)]
-    units: Option<post_cmd::UnitsArg>,
+    units: Option<UnitsArg>,
 }
 
 /// `X,Y,Z` as three finite numbers.
@@ -282,6 +282,25 @@ mod post_cmd;
 mod reorient_cmd;
 mod simulate_cmd;
 
+/// `--units`: what a program that states no units is read in.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum UnitsArg {
+    /// Millimetres (G21, G71, G71).
+    Mm,
+    /// Inches (G20, G700; not for Heidenhain).
+    Inch,
+}
+
+/// The files a command reads besides its programs: the machine file, when `--machine`
+/// names one rather than a built-in.
+pub(crate) fn machine_input(name: &str) -> Vec<polepatch_cli::outputs::Input> {
+    if polepatch::kinematics::Machine::builtin(name).is_some() {
+        Vec::new()
+    } else {
+        vec![polepatch_cli::outputs::Input::new("the machine file", name)]
+    }
+}
+
 pub(crate) fn machine(name: &str) -> Result<Machine> {
     let machine = Machine::load(name)?;
     // What the loader assumed (a LinuxCNC INI without jerk limits, …).
@@ -338,7 +357,7 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
         feed_fallback_mm_min: args.feed,
         name: name.clone(),
         work_offset_mm: args.work_offset,
-        inch: args.units == Some(post_cmd::UnitsArg::Inch),
+        inch: args.units == Some(UnitsArg::Inch),
     };
     let bytes = files::read(&args.file)?;
     let args_strict = args.strict;

@@ -113,16 +113,6 @@ fn expand(inputs: &[PathBuf], skip: Option<&Path>) -> Result<Vec<(PathBuf, PathB
     Ok(out)
 }
 
-/// The files a command reads besides its programs: the machine file, when `--machine`
-/// names one rather than a built-in.
-pub(crate) fn machine_input(name: &str) -> Vec<Input> {
-    if polepatch::kinematics::Machine::builtin(name).is_some() {
-        Vec::new()
-    } else {
-        vec![Input::new("the machine file", name)]
-    }
-}
-
 /// The library's options for `args` (checked: a bad value is a usage error).
 pub(crate) fn file_options(args: &PatchArgs) -> Result<polepatch::PatchOptions> {
     check_positive("--chord-tolerance", Some(args.chord_tolerance))?;
@@ -148,7 +138,7 @@ pub(crate) fn file_options(args: &PatchArgs) -> Result<polepatch::PatchOptions> 
             point: args.tool_point,
             surface_tolerance_mm: args.surface_tolerance,
         },
-        inch: args.units == Some(crate::post_cmd::UnitsArg::Inch),
+        inch: args.units == Some(crate::UnitsArg::Inch),
         ..polepatch::PatchOptions::default()
     })
 }
@@ -183,7 +173,7 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
         .iter()
         .map(|(input, _)| Input::new("the input", input))
         .collect();
-    inputs.extend(machine_input(&args.machine));
+    inputs.extend(crate::machine_input(&args.machine));
     if let Some(t) = &args.tools {
         inputs.push(Input::new("the tool table", t));
     }
@@ -526,7 +516,7 @@ fn simulate_both(
         };
         match (sim(input), sim(Path::new(&output))) {
             (Ok(b), Ok(a)) => {
-                let t = polepatch::simulate::compare(&b, &a);
+                let t = polepatch::report::compare(&b, &a);
                 let _ = writeln!(
                     out,
                     "{}: simulated {:.3} s → {:.3} s ({:+.1} %), Equation 6 {:.3} s → {:.3} s",

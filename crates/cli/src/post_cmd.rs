@@ -18,14 +18,6 @@ enum DialectArg {
     Fanuc,
 }
 
-#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub(crate) enum UnitsArg {
-    /// Millimetres (G21, G71, G71).
-    Mm,
-    /// Inches (G20, G700; not for Heidenhain).
-    Inch,
-}
-
 #[derive(Clone, Copy, clap::ValueEnum)]
 enum BranchArg {
     /// Nearest to the previous point (continuous).
@@ -68,7 +60,7 @@ pub(crate) struct PostArgs {
     rotary_decimals: usize,
     /// Units of the program written (default: the CL file's).
     #[arg(long, value_enum)]
-    units: Option<UnitsArg>,
+    units: Option<crate::UnitsArg>,
     /// Write every arc as chords (default: G2/G3 where the arc lies in a principal plane
     /// with a fixed tool axis).
     #[arg(long)]
@@ -97,7 +89,7 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
     let machine = machine(&args.machine)?;
     let name = args.cl.display().to_string();
     let mut inputs = vec![Input::new("the CL input", &args.cl)];
-    inputs.extend(crate::patch::machine_input(&args.machine));
+    inputs.extend(crate::machine_input(&args.machine));
     let mut outputs = vec![Output::new("-o", &args.output)];
     if let Some(path) = &args.report {
         outputs.push(Output::new("--report", path));
@@ -133,8 +125,8 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
         rotary_decimals: args.rotary_decimals,
         linear_decimals: 3,
         units: args.units.map(|u| match u {
-            UnitsArg::Mm => Units::Mm,
-            UnitsArg::Inch => Units::Inch,
+            crate::UnitsArg::Mm => Units::Mm,
+            crate::UnitsArg::Inch => Units::Inch,
         }),
         linearize: args.linearize,
         arc_tolerance_mm: args.arc_tolerance,

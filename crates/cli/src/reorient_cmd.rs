@@ -3,7 +3,7 @@
 use crate::{check_positive, machine, parse_xyz};
 use anyhow::{Context, Result, bail};
 use plotters::prelude::*;
-use polepatch::program::load_nc;
+use polepatch::load_nc;
 use polepatch::reorient::{ReorientReport, Tilt, pole_after, reorient_nc, search, tool_axes};
 use polepatch_cli::files::read;
 use polepatch_cli::outputs::{Input, Output, plan};
@@ -53,7 +53,7 @@ pub(crate) fn run(args: ReorientArgs) -> Result<ExitCode> {
     let machine = machine(&args.machine)?;
     let name = args.file.display().to_string();
     let mut inputs = vec![Input::new("the input", &args.file)];
-    inputs.extend(crate::patch::machine_input(&args.machine));
+    inputs.extend(crate::machine_input(&args.machine));
     let mut outputs = Vec::new();
     if let Some(path) = &args.output {
         outputs.push(Output::new("-o", path));

@@ -6,8 +6,9 @@ use crate::{check_positive, machine, parse_xyz};
 use anyhow::{Context, Result, bail};
 use plotters::prelude::*;
 use polepatch::kinematics::Axis;
+use polepatch::report::SimulateReport;
 use polepatch::report::axis_letter;
-use polepatch::simulate::{SimState, SimulateOptions, SimulateReport, simulate_nc_with};
+use polepatch::simulate::{SimState, SimulateOptions, simulate_nc_with};
 use polepatch_cli::files::read;
 use polepatch_cli::outputs::{Input, Output, plan};
 use std::io::Write;
@@ -139,7 +140,7 @@ pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
         .iter()
         .map(|p| Input::new("the program", p))
         .collect();
-    inputs.extend(crate::patch::machine_input(&args.machine));
+    inputs.extend(crate::machine_input(&args.machine));
     let mut outputs = Vec::new();
     if let Some(p) = &args.trajectory {
         outputs.push(Output::new("--trajectory", p));

@@ -121,7 +121,7 @@ fn impossible_zone_keeps_the_best_improvement() {
         program(&pass, Dialect::Fanuc, "SHORT").replace("\nG49\n", "\nG0 Z50. A0. C0.\nG49\n");
     let m = polepatch::kinematics::Machine::builtin("mikron-ucp710").unwrap();
     let lp = load_bytes(text.as_bytes(), "short", &m);
-    assert!(!polepatch::end_pose::end_pose_is_free(&lp, 0));
+    assert!(!lp.end_pose(0).free);
     // The proof: with the last point fixed, no values of points 1..n−2 reach feed.
     let path = lp.runs[0].path.as_ref().unwrap();
     let n = path.s_mm.len();

@@ -5,8 +5,8 @@
 
 use polepatch::cl::{ClPoint, to_apt};
 use polepatch::kinematics::{Machine, forward};
+use polepatch::load_nc;
 use polepatch::nc::{Motion, modal};
-use polepatch::program::load_nc;
 
 fn main() {
     let machine = Machine::builtin("mikron-ucp710").expect("built-in");

@@ -51,7 +51,6 @@
 //! A run without TCPM is pinned by the pipeline whatever follows (its X Y Z are machine
 //! coordinates: [`crate::patch`]).
 
-use crate::program::LoadedProgram;
 use polepatch_nc::modal::{C, X, Y, Z};
 use polepatch_nc::{Flags, Modal, Word};
 
@@ -304,17 +303,6 @@ impl After<'_> {
     }
 }
 
-/// The end pose of run `r` of `lp` (module docs), as the survey of the whole file decided
-/// it ([`crate::program::Window`]).
-pub fn end_pose(lp: &LoadedProgram, r: usize) -> EndPose {
-    lp.window.end[r].clone()
-}
-
-/// Whether the moves after run `r` of `lp` leave its last point free ([`end_pose`]).
-pub fn end_pose_is_free(lp: &LoadedProgram, r: usize) -> bool {
-    end_pose(lp, r).free
-}
-
 #[cfg(test)]
 mod tests {
     /// Planted: the trapezoid's time below and above the distance that reaches v, and the
@@ -344,13 +332,13 @@ mod tests {
     }
 
     use super::*;
-    use crate::program::load_nc;
+    use crate::load_nc;
     use polepatch_kinematics::Machine;
 
     fn poses(text: &str) -> Vec<EndPose> {
         let m = Machine::builtin("mikron-ucp710").unwrap();
         let lp = load_nc(text.as_bytes(), "t", &m, None).unwrap();
-        (0..lp.runs.len()).map(|r| end_pose(&lp, r)).collect()
+        (0..lp.runs.len()).map(|r| lp.end_pose(r)).collect()
     }
 
     fn free(text: &str) -> Vec<bool> {

@@ -12,7 +12,7 @@
 //!
 //! [`patch_nc`] and [`analyze_nc`] are the entry points for NC programs held in memory
 //! ([`patch_nc_to`] writes the output to a writer as it goes, parsing in full only the
-//! stretches near the pole); [`program::load_nc`] reads a whole program with its runs as
+//! stretches near the pole); [`load_nc`] reads a whole program with its runs as
 //! paths, through the same reader, for callers that want it (the quality suite, reorient).
 //! CAM plugins that hold CL points rather than a file use the patcher directly on a
 //! [`patcher::Path`].
@@ -27,6 +27,7 @@ pub use polepatch_nc as nc;
 pub use polepatch_patcher as patcher;
 pub use polepatch_simulate as sim;
 
+pub mod analyze;
 pub mod end_pose;
 pub mod error;
 pub mod hooks;
@@ -44,9 +45,11 @@ pub mod tool;
 
 pub use error::Error;
 pub use hooks::Hooks;
-pub use patch::{FileReport, UntouchedReason, UntouchedRun, ZoneRow};
-pub use report::AnalyzeReport;
-pub use simulate::{SimulateOptions, SimulateReport, simulate_nc, simulate_nc_with};
+pub use report::{
+    AnalyzeReport, FileReport, SimulateReport, UntouchedReason, UntouchedRun, ZoneRow,
+};
+pub use simulate::{SimulateOptions, simulate_nc, simulate_nc_with};
+pub use stream::{load_nc, load_nc_with};
 
 use polepatch_kinematics::Machine;
 use polepatch_patcher::AnalysisOptions;

@@ -31,13 +31,12 @@
 //! program as the controller will run it.
 //!
 //! # The work offset
-//! [`run_datum`]: the last Heidenhain datum shift with values (`G54 X… Y… Z…`) before the
+//! [`crate::program::LoadedProgram::datum_mm`]: the last Heidenhain datum shift with values (`G54 X… Y… Z…`) before the
 //! run when no other frame change came after it; else the caller's (`--work-offset`) when
 //! the program changes its frame at most once before the run (it only names `G54`); else
 //! unknown — the run is left as it is, with a message asking for `--work-offset`, and no
 //! machine-frame check is made.
 
-use crate::program::LoadedProgram;
 use polepatch_kinematics::{Axis, Chain, Machine};
 use polepatch_patcher::{AnalysisOptions, Path, analyze_path};
 
@@ -53,20 +52,7 @@ pub const MIN_XYZ_DECIMALS: usize = 3;
 /// count as not worse: the analysis's own resolution.
 pub const NOT_WORSE_REL: f64 = 1e-4;
 
-/// The work offset (machine coordinates of the program's zero, mm) for run `r`, or `None`
-/// when it is not known for certain:
-///
-/// - the last frame change before the run states its values (Heidenhain `G54 X Y Z`):
-///   those values;
-/// - else, when the program changes its frame at most once before the run (a named work
-///   offset such as Fanuc `G54`, or nothing at all): `given` (`--work-offset`);
-/// - else (the frame changed more than once, or by a shift polepatch does not follow —
-///   `G92`, `TRANS`, … — after the last stated datum): unknown.
-pub fn run_datum(lp: &LoadedProgram, r: usize) -> Option<[f64; 3]> {
-    lp.window.datum_mm[r]
-}
-
-/// [`run_datum`] for a run whose first block is `first`, from the program's stated datum
+/// The work offset of a run whose first block is `first` ([`crate::program::LoadedProgram::datum_mm`]), from the program's stated datum
 /// shifts and other frame changes (block indices in file order, as in
 /// [`polepatch_nc::Program`]).
 pub fn datum_at(

@@ -22,7 +22,7 @@
 //! then patched like any other program, so `post` and `patch` can never disagree.
 
 use crate::error::Error;
-use crate::patch::FileReport;
+use crate::report::FileReport;
 use polepatch_cl::{
     Arc, ClError, ClItem, ClPoint, ClProgram, CompSide, Coolant, CycleKind, MoveKind, ParseOptions,
     Plane, SpindleDir, Units,

@@ -217,6 +217,25 @@ impl LoadedProgram {
     pub fn file_style(&self) -> FileStyle {
         self.window.style
     }
+    /// The end pose of run `r` ([`crate::end_pose`], module docs), as the survey of the
+    /// whole file decided it.
+    pub fn end_pose(&self, r: usize) -> crate::end_pose::EndPose {
+        self.window.end[r].clone()
+    }
+
+    /// The work offset (machine coordinates of the program's zero, mm) for run `r`, or `None`
+    /// when it is not known for certain:
+    ///
+    /// - the last frame change before the run states its values (Heidenhain `G54 X Y Z`):
+    ///   those values;
+    /// - else, when the program changes its frame at most once before the run (a named work
+    ///   offset such as Fanuc `G54`, or nothing at all): `given` (`--work-offset`);
+    /// - else (the frame changed more than once, or by a shift polepatch does not follow —
+    ///   `G92`, `TRANS`, … — after the last stated datum): unknown.
+    pub fn datum_mm(&self, r: usize) -> Option<[f64; 3]> {
+        self.window.datum_mm[r]
+    }
+
     /// Index of the primary letter in [`polepatch_nc::Modal::pos`].
     pub fn primary_index(&self) -> usize {
         if self.primary_letter == b'A' {
@@ -273,37 +292,6 @@ fn line_number(bytes: &[u8], at: usize) -> usize {
         k += 1;
     }
     line
-}
-
-/// Read `bytes` (named `name` in messages) as one stretch of the one reader
-/// ([`crate::stream`]) and build each run's path for `machine`; `feed_fallback_mm_min` is
-/// used for runs with no F in force. A program with nothing to analyse is an error.
-pub fn load_nc(
-    bytes: &[u8],
-    name: &str,
-    machine: &Machine,
-    feed_fallback_mm_min: Option<f64>,
-) -> Result<LoadedProgram, Error> {
-    load_nc_with(
-        bytes,
-        machine,
-        &crate::AnalyzeOptions {
-            name: name.to_string(),
-            feed_fallback_mm_min,
-            ..crate::AnalyzeOptions::default()
-        },
-    )
-}
-
-/// [`load_nc`] with the reading options of `opts` (name, feed fallback, work offset,
-/// units; its analysis options are not used).
-pub fn load_nc_with(
-    bytes: &[u8],
-    machine: &Machine,
-    opts: &crate::AnalyzeOptions,
-) -> Result<LoadedProgram, Error> {
-    opts.check()?;
-    crate::stream::load_program(bytes, machine, opts).map_err(|e| or_cl_file(e, bytes, &opts.name))
 }
 
 fn tilt_letter(idx: usize) -> u8 {

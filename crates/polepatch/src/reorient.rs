@@ -37,9 +37,11 @@
 //! does the job is preferred; the time is what the user gains, the pole distance a
 //! tie-break margin. Every candidate evaluated is reported.
 
+use crate::analyze::analyze_program;
 use crate::error::Error;
-use crate::program::{LoadedProgram, load_nc};
-use crate::report::{AnalyzeReport, analyze_program};
+use crate::load_nc;
+use crate::program::LoadedProgram;
+use crate::report::AnalyzeReport;
 use polepatch_kinematics::inverse::unwrap_near_deg;
 use polepatch_kinematics::{
     BranchRule, IkSolution, JigRotation, Machine, forward, inverse, inverse_path_from,

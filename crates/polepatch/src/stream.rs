@@ -33,7 +33,7 @@
 //!    [`polepatch_nc::write_styled`] renders it.
 //!
 //! The output and the report are those of the whole-program path
-//! ([`crate::program::load_nc`] + [`crate::patch::patch_loaded`]) — tested on every
+//! (see [`load_nc`]) — tested on every
 //! fixture, both machines, and programs built to cross stretch boundaries. Programs the
 //! whole-program path rejects (no runs, no rotary words) are handed to it for its error.
 //!
@@ -50,8 +50,9 @@
 
 use crate::end_pose::{After, EndPose, Scan, Step};
 use crate::error::Error;
-use crate::patch::{FileReport, patch_program};
+use crate::patch::patch_program;
 use crate::program::{LoadedProgram, RunPath, Window, primary_mismatch_warning, run_path};
+use crate::report::FileReport;
 use crate::report::{AnalyzeReport, RunReport};
 use polepatch_kinematics::Machine;
 use polepatch_nc::modal::{A, B, C};
@@ -762,7 +763,7 @@ fn analyze_each(
         &todo,
         l,
         &rd,
-        |lp| crate::report::analyze_program(&lp, machine, &opts.analysis).runs,
+        |lp| crate::analyze::analyze_program(&lp, machine, &opts.analysis).runs,
         |runs, _| {
             runs.into_iter()
                 .try_for_each(|r| each(Piece::Run(Box::new(r))))
@@ -804,7 +805,38 @@ pub(crate) fn each_run<T: Send>(
     Ok((LETTERS[l] as char, warnings))
 }
 
-/// The whole program as one stretch ([`crate::program::load_nc`]): the same two reads as
+/// Read `bytes` (named `name` in messages) as one stretch of the one reader
+/// ([`crate::stream`]) and build each run's path for `machine`; `feed_fallback_mm_min` is
+/// used for runs with no F in force. A program with nothing to analyse is an error.
+pub fn load_nc(
+    bytes: &[u8],
+    name: &str,
+    machine: &Machine,
+    feed_fallback_mm_min: Option<f64>,
+) -> Result<LoadedProgram, Error> {
+    load_nc_with(
+        bytes,
+        machine,
+        &crate::AnalyzeOptions {
+            name: name.to_string(),
+            feed_fallback_mm_min,
+            ..crate::AnalyzeOptions::default()
+        },
+    )
+}
+
+/// [`load_nc`] with the reading options of `opts` (name, feed fallback, work offset,
+/// units; its analysis options are not used).
+pub fn load_nc_with(
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &crate::AnalyzeOptions,
+) -> Result<LoadedProgram, Error> {
+    opts.check()?;
+    load_program(bytes, machine, opts).map_err(|e| crate::program::or_cl_file(e, bytes, &opts.name))
+}
+
+/// The whole program as one stretch ([`load_nc`]): the same two reads as
 /// a patch, with every block and every run in the stretch. A program that holds nothing to
 /// analyse is an error here.
 pub(crate) fn load_program(

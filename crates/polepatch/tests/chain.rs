@@ -3,9 +3,9 @@
 //! and TCPM programs are analysed and checked in the machine frame.
 
 use polepatch::kinematics::{Chain, Machine};
+use polepatch::load_nc;
 use polepatch::machine_frame::TIP_TOLERANCE_MM;
 use polepatch::nc::{Edit, modal};
-use polepatch::program::load_nc;
 use polepatch::{AnalyzeOptions, PatchOptions, UntouchedReason, analyze_nc, patch_nc};
 use std::path::PathBuf;
 
@@ -401,7 +401,6 @@ fn a_patch_that_slows_a_linear_axis_in_the_machine_frame_is_not_written() {
 /// The work offset is taken only where it is known for certain.
 #[test]
 fn the_work_offset_is_known_or_the_run_is_left() {
-    use polepatch::machine_frame::run_datum;
     let m = Machine::builtin("mikron-ucp710").unwrap();
     let given = Some([10.0, 20.0, 30.0]);
     let datum = |text: &str, given: Option<[f64; 3]>| {
@@ -409,8 +408,8 @@ fn the_work_offset_is_known_or_the_run_is_left() {
             work_offset_mm: given,
             ..polepatch::AnalyzeOptions::default()
         };
-        let lp = polepatch::program::load_nc_with(text.as_bytes(), &m, &opts).unwrap();
-        run_datum(&lp, lp.runs.len() - 1)
+        let lp = polepatch::load_nc_with(text.as_bytes(), &m, &opts).unwrap();
+        lp.datum_mm(lp.runs.len() - 1)
     };
     let run = "G1 X0 Y0 Z0 A30 C0 F1000\nX1 C10\nX2 C20\n";
     // Fanuc names G54 once: the command line's value.

@@ -5,9 +5,10 @@
 
 use polepatch::cl::{ClPoint, parse, to_apt, to_csv};
 use polepatch::kinematics::{BranchRule, Machine, forward};
+use polepatch::load_nc;
 use polepatch::nc::{Motion, NumberStyle, modal};
 use polepatch::post::{PostOptions, post_cl};
-use polepatch::program::{LoadedProgram, load_nc};
+use polepatch::program::LoadedProgram;
 use polepatch::{PatchOptions, patch_nc};
 use std::path::PathBuf;
 

@@ -1,8 +1,8 @@
 //! Issue 9: C17's avoidance by reorienting the workpiece (`polepatch reorient`).
 
 use polepatch::kinematics::Machine;
+use polepatch::load_nc;
 use polepatch::nc::modal;
-use polepatch::program::load_nc;
 use polepatch::reorient::{Tilt, reorient_nc, search};
 use std::path::PathBuf;
 

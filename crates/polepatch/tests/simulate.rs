@@ -3,8 +3,9 @@
 //! F, every programmed point is passed, the patched program is faster, and the simulated
 //! time is at least Equation 6's estimate, itself at least L/F.
 
+use polepatch::SimulateReport;
 use polepatch::kinematics::Machine;
-use polepatch::simulate::{SimState, SimulateOptions, SimulateReport};
+use polepatch::simulate::{SimState, SimulateOptions};
 use polepatch::{PatchOptions, patch_nc, simulate_nc_with};
 use std::path::PathBuf;
 

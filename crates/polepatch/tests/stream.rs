@@ -4,9 +4,9 @@
 //! both machines, and programs built so that runs, stretches, feed changes, end poses,
 //! frame changes and feedless runs meet at stretch boundaries.
 
+use polepatch::analyze::analyze_program;
 use polepatch::kinematics::Machine;
 use polepatch::patcher::AnalysisOptions;
-use polepatch::report::analyze_program;
 use polepatch::stream::{analyze_nc_stretches, patch_nc_to};
 use polepatch::{AnalyzeOptions, FileReport, PatchOptions};
 use std::path::PathBuf;
@@ -17,7 +17,7 @@ fn whole(
     machine: &Machine,
     opts: &PatchOptions,
 ) -> Result<polepatch::program::LoadedProgram, polepatch::Error> {
-    polepatch::program::load_nc_with(
+    polepatch::load_nc_with(
         bytes,
         machine,
         &AnalyzeOptions {

@@ -192,7 +192,7 @@ fn feed_profile<'py>(
     let (runs, axes) = detached(py, || {
         let profile = || -> Result<(Vec<RunSamples>, Vec<String>), polepatch::Error> {
             opts.check()?;
-            let lp = polepatch::program::load_nc(&data, &opts.name, m, opts.feed_fallback_mm_min)?;
+            let lp = polepatch::load_nc(&data, &opts.name, m, opts.feed_fallback_mm_min)?;
             let analysis = polepatch::patcher::AnalysisOptions {
                 keep_samples: true,
                 ..opts.analysis.clone()

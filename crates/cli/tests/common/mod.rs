@@ -3,12 +3,13 @@
 
 use polepatch::FileReport;
 use polepatch::kinematics::{Axis, Machine};
+use polepatch::load_nc;
 use polepatch::nc::{Dialect, parse};
 use polepatch::patcher::analysis::{SpanFigures, analyze_spans};
 use polepatch::patcher::direct::deviation_bound_zone;
 use polepatch::patcher::verify::NOT_WORSE_REL;
 use polepatch::patcher::{AnalysisOptions, CLimits, PatchAxes, PatchOptions, analyze_path};
-use polepatch::program::{LoadedProgram, load_nc};
+use polepatch::program::LoadedProgram;
 use std::path::{Path, PathBuf};
 
 /// Run the `polepatch` binary in the repository root: (exit code, stdout, stderr).
@@ -371,11 +372,7 @@ pub fn proven_unreachable(
         last: inside.iter().map(|x| x.last).max().unwrap(),
         ..inside[0].clone()
     };
-    let end = if polepatch::end_pose::end_pose_is_free(lp, r) {
-        n - 1
-    } else {
-        n - 2
-    };
+    let end = if lp.end_pose(r).free { n - 1 } else { n - 2 };
     let p: Vec<f64> = path.axes.iter().map(|q| q[Axis::Primary.index()]).collect();
     let c: Vec<f64> = path.axes.iter().map(|q| q[Axis::C.index()]).collect();
     !polepatch::patcher::reference::reachable(
@@ -528,11 +525,7 @@ pub fn reachable_bound_deg(lp: &LoadedProgram, r: usize, machine: &Machine) -> O
     let lim = CLimits::new(machine, path.feed_mm_min, 0.0);
     // A run whose end is pinned (`polepatch::end_pose`) keeps its last point, as the
     // patch does.
-    let end = if polepatch::end_pose::end_pose_is_free(lp, r) {
-        n - 1
-    } else {
-        n - 2
-    };
+    let end = if lp.end_pose(r).free { n - 1 } else { n - 2 };
     deviation_bound_zone(
         &path.s_mm,
         &p,
