@@ -26,9 +26,9 @@
 pub mod plot;
 
 use crate::files::{JobError, read};
-use polepatch::analyze::analyze_program;
+use polepatch::LoadedProgram;
+use polepatch::analyze_program;
 use polepatch::load_nc;
-use polepatch::program::LoadedProgram;
 use polepatch::report::AnalyzeReport;
 use polepatch::{Error, FileReport, ZoneRow, patch_nc};
 use polepatch_kinematics::{Axis, Machine};

@@ -2,10 +2,10 @@
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
+use polepatch::Piece;
 use polepatch::kinematics::{Axis, Machine};
 use polepatch::patcher::{AnalysisOptions, PatchOptions};
 use polepatch::report::{AnalyzeReport, axis_letter};
-use polepatch::stream::Piece;
 use polepatch_cli::files;
 use std::io::Write;
 use std::path::PathBuf;
@@ -368,7 +368,7 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
     let mut failed: Vec<polepatch::report::RunReport> = Vec::new();
     let mut runs = 0usize;
     let json = args.json;
-    polepatch::stream::analyze_nc_each(&bytes, &machine, &opts, &mut |piece| match piece {
+    polepatch::analyze_nc_each(&bytes, &machine, &opts, &mut |piece| match piece {
         Piece::Head(h) => {
             head = Some(h.clone());
             if json {

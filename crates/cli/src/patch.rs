@@ -5,7 +5,7 @@ use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use polepatch::patcher::{PatchAxes, PatchOptions};
 use polepatch::{FileReport, ZoneRow};
-use polepatch_cli::files::{JobError, patch_to};
+use polepatch_cli::files::{JobError, patch_job};
 use polepatch_cli::outputs::{Input, Output, is_std, plan};
 use rayon::prelude::*;
 use std::io::IsTerminal;
@@ -200,7 +200,13 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
     };
     let names: Vec<PathBuf> = files.iter().map(|(input, _)| input.clone()).collect();
     let reports: Vec<Result<FileReport, JobError>> = if files.len() == 1 && args.output.is_some() {
-        vec![patch_to(&files[0].0, &targets[0], &machine, &opts)]
+        vec![patch_job(
+            &files[0].0,
+            &targets[0],
+            &machine,
+            &opts,
+            args.simulate,
+        )]
     } else {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(args.jobs.unwrap_or(0))
@@ -221,7 +227,7 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
                 .par_iter()
                 .zip(&targets[..files.len()])
                 .map(|((input, _), target)| {
-                    let r = patch_to(input, target, &machine, &opts);
+                    let r = patch_job(input, target, &machine, &opts, args.simulate);
                     bar.inc(1);
                     r
                 })
@@ -234,9 +240,8 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
     let report_target = args.report.as_ref().and_then(|_| extra.next());
     let csv_target = args.csv.as_ref().and_then(|_| extra.next());
 
-    let mut reports = reports;
     if args.simulate {
-        simulate_both(&mut reports, &names, &machine, &opts, &mut table);
+        print_simulated(&reports, &mut table);
     }
     let mut ok: Vec<&FileReport> = Vec::new();
     let mut failed = 0;
@@ -480,58 +485,20 @@ fn print_summary(
     Ok(())
 }
 
-/// `--simulate`: the simulated times of every input and its output, into the reports
-/// (a file that cannot be simulated gets a warning and no figures).
-fn simulate_both(
-    reports: &mut [Result<FileReport, JobError>],
-    names: &[PathBuf],
-    machine: &polepatch::kinematics::Machine,
-    opts: &polepatch::PatchOptions,
-    out: &mut dyn std::io::Write,
-) {
-    for (rep, input) in reports.iter_mut().zip(names) {
-        let Ok(rep) = rep else { continue };
-        if is_std(input) || rep.output.as_deref() == Some("<stdout>") {
-            eprintln!(
-                "polepatch: warning: {}: not simulated: standard input and output cannot be read again",
-                rep.file
+/// `--simulate`: the simulated times the jobs put in the reports, a line per file.
+fn print_simulated(reports: &[Result<FileReport, JobError>], out: &mut dyn std::io::Write) {
+    for rep in reports.iter().flatten() {
+        if let Some(t) = &rep.simulated {
+            let _ = writeln!(
+                out,
+                "{}: simulated {:.3} s → {:.3} s ({:+.1} %), Equation 6 {:.3} s → {:.3} s",
+                rep.file,
+                t.before_s,
+                t.after_s,
+                100.0 * (t.after_s / t.before_s - 1.0),
+                t.eq6_before_s,
+                t.eq6_after_s
             );
-            continue;
-        }
-        let Some(output) = rep.output.clone() else {
-            continue;
-        };
-        let sim = |path: &Path| -> Result<polepatch::SimulateReport> {
-            let bytes = polepatch_cli::files::read(path)?;
-            let o = polepatch::SimulateOptions {
-                name: path.display().to_string(),
-                feed_fallback_mm_min: opts.feed_fallback_mm_min,
-                work_offset_mm: opts.work_offset_mm,
-                sim: polepatch::sim::SimOptions {
-                    tcy_s: opts.patch.tcy_s,
-                    ..Default::default()
-                },
-            };
-            Ok(polepatch::simulate_nc(&bytes, machine, &o)?)
-        };
-        match (sim(input), sim(Path::new(&output))) {
-            (Ok(b), Ok(a)) => {
-                let t = polepatch::report::compare(&b, &a);
-                let _ = writeln!(
-                    out,
-                    "{}: simulated {:.3} s → {:.3} s ({:+.1} %), Equation 6 {:.3} s → {:.3} s",
-                    rep.file,
-                    t.before_s,
-                    t.after_s,
-                    100.0 * (t.after_s / t.before_s - 1.0),
-                    t.eq6_before_s,
-                    t.eq6_after_s
-                );
-                rep.simulated = Some(t);
-            }
-            (Err(e), _) | (_, Err(e)) => {
-                eprintln!("polepatch: warning: {}: not simulated: {e:#}", rep.file);
-            }
         }
     }
 }

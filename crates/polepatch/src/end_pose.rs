@@ -66,7 +66,7 @@ pub struct EndPose {
     pub restate: Vec<usize>,
     /// The positioning move that freed the end (a rotary-only repositioning or a move above
     /// the clearance), when it is one: a changed last point changes how far it turns the
-    /// rotary axes ([`NextMove::time_s`]).
+    /// rotary axes (`NextMove::time_s`).
     pub next: Option<NextMove>,
 }
 

@@ -1,6 +1,6 @@
 //! What a caller may ask of a long patch while it runs: progress and cancellation.
 //!
-//! [`crate::patch_nc_hooked`] (and [`crate::stream::patch_nc_to`] under it) calls them
+//! [`crate::patch_nc_hooked`] (and [`crate::patch_nc_to`] on it) calls them
 //! between stretches — a stretch is a run near the pole, with the runs that share a
 //! block with it ([`crate::stream`]) — never inside one: a stretch is patched whole or not
 //! at all. The CLI's `filter` prints the progress as LinuxCNC's `FILTER_PROGRESS=N`; the

@@ -27,29 +27,35 @@ pub use polepatch_nc as nc;
 pub use polepatch_patcher as patcher;
 pub use polepatch_simulate as sim;
 
-pub mod analyze;
-pub mod end_pose;
-pub mod error;
-pub mod hooks;
+// The documented API: the entry points and options below, and these modules.
 pub mod joints;
 pub mod machine_frame;
-pub mod notes;
-pub mod patch;
 pub mod post;
-pub mod program;
 pub mod reorient;
 pub mod report;
 pub mod simulate;
-pub mod stream;
 pub mod tool;
 
+// The pipeline's rooms, private: what callers need of them is re-exported here.
+mod analyze;
+mod end_pose;
+mod error;
+mod hooks;
+mod notes;
+mod patch;
+mod program;
+mod stream;
+
+pub use analyze::analyze_program;
+pub use end_pose::EndPose;
 pub use error::Error;
 pub use hooks::Hooks;
+pub use program::{LoadedProgram, MIN_FEED_MM_MIN, RunPath, RunProblem, Window};
 pub use report::{
     AnalyzeReport, FileReport, SimulateReport, UntouchedReason, UntouchedRun, ZoneRow,
 };
 pub use simulate::{SimulateOptions, simulate_nc, simulate_nc_with};
-pub use stream::{load_nc, load_nc_with};
+pub use stream::{Piece, analyze_nc_each, load_nc, load_nc_with};
 
 use polepatch_kinematics::Machine;
 use polepatch_patcher::AnalysisOptions;
@@ -169,7 +175,7 @@ pub fn check_patcher_options(p: &patcher::PatchOptions) -> Result<(), Error> {
 
 impl PatchOptions {
     /// Every value in range, or an [`Error::Options`] naming the field. The entry points
-    /// ([`patch_nc`], [`stream::patch_nc_to`]) call it, so a
+    /// ([`patch_nc`], [`patch_nc_to`]) call it, so a
     /// caller need not; a front end checks earlier only to name its own flags.
     pub fn check(&self) -> Result<(), Error> {
         check_patcher_options(&self.patch)?;
@@ -220,7 +226,7 @@ pub fn patch_nc(
 /// Patch an NC program held in memory, writing the output to `out`: the one entry every
 /// caller goes through (the CLI's file jobs, [`patch_nc`], hence the C ABI and `post`).
 ///
-/// [`stream`]: a first read finds the runs and which come near the pole; a program with
+/// The one reader: a first read finds the runs and which come near the pole; a program with
 /// none has no zone, and its output is its input, written in one piece. Otherwise a second
 /// read parses the stretches near the pole; they are patched and written in file order,
 /// everything between them copied.
@@ -323,7 +329,7 @@ mod tests {
             let mut sink = Vec::new();
             assert!(
                 matches!(
-                    stream::patch_nc_to(program, &m, &o, &mut sink),
+                    patch_nc_to(program, &m, &o, &mut sink),
                     Err(Error::Options(_))
                 ),
                 "{field}"

@@ -47,35 +47,10 @@ pub fn patch_program(
     opts: &PatchOptions,
 ) -> (Vec<Edit>, FileReport) {
     let program = &lp.program;
-    let mut report = FileReport::unchanged(&lp.name, machine, lp.warnings.clone());
-    let (not_analysed, warnings) = lp
-        .notes
-        .finish(lp.primary_index(), opts.reach_deg(), &lp.name);
-    report.not_analysed = not_analysed;
-    report.warnings.extend(warnings);
-    // The file's number style is only needed when some run comes near the pole; reading
-    // it costs a pass over every word, so a program without such a run skips it.
+    // A stretch of a file: what the file says as a whole (its notes, the primary
+    // letter's substitution) is the stream's to report.
+    let mut report = FileReport::unchanged(&lp.name, machine, Vec::new());
     let pi = polepatch_kinematics::Axis::Primary.index();
-    let near_pole = lp.runs.iter().any(|r| {
-        r.path
-            .as_ref()
-            .is_ok_and(|p| p.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg()))
-    });
-    if !near_pole {
-        for (r, rp) in lp.runs.iter().enumerate() {
-            if let Err(problem) = &rp.path {
-                report.untouched_runs.push(untouched(
-                    lp,
-                    r,
-                    problem_reason(problem),
-                    0,
-                    problem.to_string(),
-                    opts.reach_deg(),
-                ));
-            }
-        }
-        return (Vec::new(), report);
-    }
     let file_style = lp.file_style();
     let style_of = |l: u8| {
         file_style
@@ -124,7 +99,11 @@ pub fn patch_program(
         };
         // A zone needs a point in the cone (`detect_zones`): a run with none has nothing to
         // patch or report, and its analysis is skipped.
-        if !path.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg()) {
+        if !path
+            .axes
+            .iter()
+            .any(|q| crate::program::near_pole(Some(q[pi]), opts.reach_deg()))
+        {
             continue;
         }
         let incremental = rp
@@ -551,10 +530,21 @@ pub fn patch_program(
     let mut edits = edits;
     edits.sort_by_key(|e| (e.block, e.letter));
     report.words_changed = edits.len();
-    report.file_c_decimals = Some(c_style.decimals);
-    report.written_c_decimals = Some(written_c);
-    report.file_primary_decimals = Some(p_style.decimals);
-    report.written_primary_decimals = Some(written_p);
+    // The file's decimals are reported where a run of the stretch comes near the pole
+    // (one with only runs that cannot be analysed says nothing of them).
+    let near = lp.runs.iter().any(|rp| {
+        rp.path.as_ref().is_ok_and(|p| {
+            p.axes
+                .iter()
+                .any(|q| crate::program::near_pole(Some(q[pi]), opts.reach_deg()))
+        })
+    });
+    if near {
+        report.file_c_decimals = Some(c_style.decimals);
+        report.written_c_decimals = Some(written_c);
+        report.file_primary_decimals = Some(p_style.decimals);
+        report.written_primary_decimals = Some(written_p);
+    }
     (edits, report)
 }
 
@@ -948,7 +938,7 @@ fn untouched(
             .run
             .pos
             .iter()
-            .any(|p| p[pi].is_none_or(|v| v.abs() <= cone_deg)),
+            .any(|p| crate::program::near_pole(p[pi], cone_deg)),
         message,
     }
 }

@@ -107,13 +107,8 @@ pub fn check_layout(machine: &Machine) -> Result<(), Error> {
     Ok(())
 }
 
-/// How to read programs for `machine`: the dialect detected, the machine's TCPM codes, mm
-/// when the program states no units.
-pub fn read_options(machine: &Machine) -> Result<polepatch_nc::ReadOptions, Error> {
-    read_options_with(machine, false)
-}
-
-/// [`read_options`], in inches when the program states no units and `inch` is true.
+/// How to read programs for `machine`: the dialect detected, the machine's TCPM codes;
+/// in inches when the program states no units and `inch` is true, else mm.
 pub fn read_options_with(
     machine: &Machine,
     inch: bool,
@@ -141,6 +136,13 @@ pub fn read_options_with(
         flow: None,
         inch,
     })
+}
+
+/// Whether a point whose tilting axis is at `primary_deg` lies within `reach_deg` of the
+/// pole, where a zone can be (`patcher::detect_zones`): a value never programmed reads as
+/// 0, as [`Run::axes5`] reads it. The one rule the survey, the patch and the report use.
+pub(crate) fn near_pole(primary_deg: Option<f64>, reach_deg: f64) -> bool {
+    primary_deg.is_none_or(|v| v.abs() <= reach_deg)
 }
 
 /// One run of the program with its path for the patcher.
@@ -172,9 +174,9 @@ pub struct LoadedProgram {
     /// [`crate::machine_frame::CHORD_TOLERANCE_MM`]; see [`crate::PatchOptions`]).
     pub chord_tolerance_mm: f64,
     /// What the rest of the file says about `program`, a stretch of it
-    /// ([`crate::stream`]; the whole file is one stretch).
+    /// (the one reader's stretch; the whole file is one stretch).
     pub window: Window,
-    /// What the reader carried through without analysing ([`crate::notes`]); empty for a
+    /// What the reader carried through without analysing; empty for a
     /// stretch (the stream lists it once for the file).
     pub notes: crate::notes::Notes,
     /// The caller's tool options ([`crate::PatchOptions::tool`]).
@@ -189,10 +191,10 @@ pub struct Window {
     pub first_run: usize,
     /// The whole file's number style.
     pub style: FileStyle,
-    /// The run's end pose ([`crate::end_pose`]), decided on the blocks after it in the
+    /// The run's end pose ([`EndPose`](crate::EndPose)), decided on the blocks after it in the
     /// whole file (restating blocks numbered in the stretch's program).
     pub end: Vec<crate::end_pose::EndPose>,
-    /// The run's work offset ([`crate::machine_frame::run_datum`]) from the whole file's
+    /// The run's work offset ([`LoadedProgram::datum_mm`]) from the whole file's
     /// frame changes.
     pub datum_mm: Vec<Option<[f64; 3]>>,
 }
@@ -217,7 +219,7 @@ impl LoadedProgram {
     pub fn file_style(&self) -> FileStyle {
         self.window.style
     }
-    /// The end pose of run `r` ([`crate::end_pose`], module docs), as the survey of the
+    /// The end pose of run `r` ([`EndPose`](crate::EndPose)), as the survey of the
     /// whole file decided it.
     pub fn end_pose(&self, r: usize) -> crate::end_pose::EndPose {
         self.window.end[r].clone()

@@ -471,7 +471,7 @@ pub fn reorient_nc(
 ) -> Result<(Vec<u8>, ReorientReport), Error> {
     check_tilt(tilt)?;
     let opts = analysis_options(cone_deg, tilt.pivot_mm)?;
-    let lp = load_nc(&bytes, name, machine, None)?;
+    let lp = load_nc(bytes, name, machine, None)?;
     let before = program_figures(&lp, machine, &opts);
     let (out, after, words, untouched) = apply(&lp, machine, tilt, &opts)?;
     let report = ReorientReport {
@@ -536,7 +536,7 @@ pub fn search(
     cone_deg: f64,
 ) -> Result<(Vec<u8>, ReorientReport), Error> {
     let opts = analysis_options(cone_deg, pivot_mm)?;
-    let lp = load_nc(&bytes, name, machine, None)?;
+    let lp = load_nc(bytes, name, machine, None)?;
     let before = program_figures(&lp, machine, &opts);
     let primary = lp.primary_letter;
     let mut alternatives: Vec<Alternative> = Vec::new();

@@ -1,7 +1,7 @@
 //! The cycle time of a program: every run simulated as a jerk-limited controller would
 //! move ([`polepatch_simulate`]), next to Equation 6's estimate and L/F.
 //!
-//! The program is read as `analyze` reads it ([`crate::stream`]: every run a stretch,
+//! The program is read as `analyze` reads it (the one reader: every run a stretch,
 //! the same runs and paths). Runs that follow one another without a stop — a feed change
 //! between them, which makes them share a point — are one motion; every other break (a
 //! G0/G2/G3 move, a stop, a TCPM switch, a tool change, a block without tool-tip motion,
@@ -279,12 +279,16 @@ pub fn simulate_nc_with(
         t0_s: 0.0,
         s0_mm: 0.0,
     };
+    let reading = crate::AnalyzeOptions {
+        name: opts.name.clone(),
+        feed_fallback_mm_min: opts.feed_fallback_mm_min,
+        work_offset_mm: opts.work_offset_mm,
+        ..crate::AnalyzeOptions::default()
+    };
     let (primary, warnings) = crate::stream::each_run(
         bytes,
         machine,
-        &opts.name,
-        opts.feed_fallback_mm_min,
-        opts.work_offset_mm,
+        &reading,
         |lp| run_inputs(lp, machine),
         |runs| {
             for r in runs {

@@ -246,7 +246,7 @@ impl Surveying {
                 *u |= v.is_some();
             }
             for (l, idx) in [A, B].into_iter().enumerate() {
-                near[l] |= p[idx].unwrap_or(0.0).abs() <= self.cone_deg;
+                near[l] |= crate::program::near_pole(p[idx], self.cone_deg);
             }
         }
         let first_block = run.blocks[0];
@@ -287,7 +287,8 @@ impl Surveying {
     }
 }
 
-/// What both reads need to know of the caller's options.
+/// What both reads need to know of the caller's options: built once per call, from the
+/// patch's or the analysis' options ([`Reading::patch`], [`Reading::analysis`]).
 struct Reading<'a> {
     name: &'a str,
     /// How far from the pole a zone can lie (the cone, or the pole reach beyond it).
@@ -300,6 +301,49 @@ struct Reading<'a> {
     chord_tolerance_mm: f64,
     /// The caller's tool options.
     tool: crate::tool::ToolOptions,
+}
+
+impl<'a> Reading<'a> {
+    /// How a patch with `opts` reads for `machine`.
+    fn patch(opts: &'a crate::PatchOptions, machine: &Machine) -> Result<Self, Error> {
+        Ok(Reading {
+            name: &opts.name,
+            cone_deg: opts.patch.reach_deg(),
+            fallback: opts.feed_fallback_mm_min,
+            work_offset_mm: opts.work_offset_mm,
+            read: crate::program::read_options_with(machine, opts.inch)?,
+            chord_tolerance_mm: opts.chord_tolerance_mm,
+            tool: opts.tool.clone(),
+        })
+    }
+
+    /// How an analysis (and [`load_nc`], [`each_run`]) with `opts` reads for `machine`.
+    fn analysis(opts: &'a crate::AnalyzeOptions, machine: &Machine) -> Result<Self, Error> {
+        Ok(Reading {
+            name: &opts.name,
+            cone_deg: opts.analysis.reach_deg(),
+            fallback: opts.feed_fallback_mm_min,
+            work_offset_mm: opts.work_offset_mm,
+            read: crate::program::read_options_with(machine, opts.inch)?,
+            chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
+            tool: crate::tool::ToolOptions::default(),
+        })
+    }
+}
+
+impl Survey {
+    /// What the file's report lists besides its runs: the lines carried through without
+    /// analysis, and the warnings — `first` (the primary letter's substitution, or why
+    /// nothing is analysed) before the notes'.
+    fn head(
+        &self,
+        rd: &Reading<'_>,
+        p_idx: usize,
+        first: Option<String>,
+    ) -> (Vec<crate::notes::NotAnalysed>, Vec<String>) {
+        let (not_analysed, warnings) = self.notes.finish(p_idx, rd.cone_deg, rd.name);
+        (not_analysed, first.into_iter().chain(warnings).collect())
+    }
 }
 
 /// The first read (module docs, step 1), read again when the file's program flow must
@@ -529,20 +573,7 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
     }
 }
 
-/// Patch an NC program held in memory, writing the output to `out` as it goes (module
-/// docs): the same output and report as [`crate::patch_nc`], with memory for the input
-/// and the stretches near the pole only. On an error nothing more is written to `out`;
-/// what was written before it must be discarded by the caller.
-pub fn patch_nc_to(
-    bytes: &[u8],
-    machine: &Machine,
-    opts: &crate::PatchOptions,
-    out: &mut dyn Write,
-) -> Result<FileReport, Error> {
-    patch_nc_hooked(bytes, machine, opts, out, crate::Hooks::NONE)
-}
-
-/// [`patch_nc_to`] with [`crate::Hooks`]: `progress` after each batch of stretches is
+/// [`crate::patch_nc_to`] with [`crate::Hooks`]: `progress` after each batch of stretches is
 /// written (and at the end), `cancelled` before each stretch is patched and before each
 /// batch is written ([`Error::Cancelled`]).
 pub fn patch_nc_hooked(
@@ -553,42 +584,25 @@ pub fn patch_nc_hooked(
     hooks: crate::Hooks<'_>,
 ) -> Result<FileReport, Error> {
     opts.check()?;
-    let rd = Reading {
-        name: &opts.name,
-        cone_deg: opts.patch.reach_deg(),
-        fallback: opts.feed_fallback_mm_min,
-        work_offset_mm: opts.work_offset_mm,
-        read: crate::program::read_options_with(machine, opts.inch)?,
-        chord_tolerance_mm: opts.chord_tolerance_mm,
-        tool: opts.tool.clone(),
-    };
-    let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
+    let rd = Reading::patch(opts, machine)?;
+    let (sv, l, p_idx, first, nothing) = match begin(bytes, machine, &rd)? {
         Begun::Nothing { sv, p_idx, why } => {
-            let mut report = FileReport::unchanged(
-                &opts.name,
-                machine,
-                vec![format!("{why}: nothing to patch, written unchanged")],
-            );
-            let (not_analysed, warnings) = sv.notes.finish(p_idx, rd.cone_deg, &opts.name);
-            report.not_analysed = not_analysed;
-            report.warnings.extend(warnings);
-            out.write_all(bytes).map_err(Error::Output)?;
-            (hooks.progress)(bytes.len(), bytes.len());
-            return Ok(report);
+            let why = format!("{why}: nothing to patch, written unchanged");
+            (sv, usize::from(p_idx == B), p_idx, Some(why), true)
         }
-        Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx),
+        Begun::Stretches { sv, l, p_idx } => {
+            let first = primary_mismatch_warning(&opts.name, machine, p_idx);
+            (sv, l, p_idx, first, false)
+        }
     };
-    let mut report = FileReport::unchanged(
-        &opts.name,
-        machine,
-        primary_mismatch_warning(&opts.name, machine, p_idx)
-            .into_iter()
-            .collect(),
-    );
-    let (not_analysed, warnings) = sv.notes.finish(p_idx, rd.cone_deg, &opts.name);
-    report.not_analysed = not_analysed;
-    report.warnings.extend(warnings);
-    let todo = stretches(&sv.runs, l, |rec| rec.near[l] || rec.feedless[l]);
+    let mut report = FileReport::unchanged(&opts.name, machine, Vec::new());
+    (report.not_analysed, report.warnings) = sv.head(&rd, p_idx, first);
+    // A program with nothing to analyse has no run to patch either.
+    let todo = if nothing {
+        Vec::new()
+    } else {
+        stretches(&sv.runs, l, |rec| rec.near[l] || rec.feedless[l])
+    };
     if todo.is_empty() {
         // No run comes near the pole: no zone, and the output is the input.
         if (hooks.cancelled)() {
@@ -690,7 +704,7 @@ pub enum Piece<'a> {
     Run(Box<RunReport>),
 }
 
-/// [`analyze_nc_stretches`] handing out the report as it is made, so that it need not be
+/// [`crate::analyze_nc`] handing out the report as it is made, so that it need not be
 /// kept: `each` gets the head ([`Piece::Head`]), then every run's report in file order.
 /// An error of `each` stops the reading ([`Error::Output`]).
 pub fn analyze_nc_each(
@@ -711,51 +725,32 @@ fn analyze_each(
     each: &mut dyn FnMut(Piece<'_>) -> std::io::Result<()>,
 ) -> Result<(), Error> {
     opts.check()?;
-    let rd = Reading {
-        name: &opts.name,
-        cone_deg: opts.analysis.reach_deg(),
-        fallback: opts.feed_fallback_mm_min,
-        work_offset_mm: opts.work_offset_mm,
-        read: crate::program::read_options_with(machine, opts.inch)?,
-        chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
-        tool: crate::tool::ToolOptions::default(),
-    };
-    let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
+    let rd = Reading::analysis(opts, machine)?;
+    let (sv, l, p_idx, first, nothing) = match begin(bytes, machine, &rd)? {
         Begun::Nothing { sv, p_idx, why } => {
-            let (not_analysed, warnings) = sv.notes.finish(p_idx, rd.cone_deg, &opts.name);
-            let l = usize::from(p_idx == B);
-            each(Piece::Head(&AnalyzeReport {
-                file: opts.name.clone(),
-                machine: machine.name.clone(),
-                cone_deg: opts.analysis.cone_deg,
-                pole_reach_deg: opts.analysis.pole_reach_deg,
-                primary: (LETTERS[l] as char).to_string(),
-                warnings: std::iter::once(format!("{why}: no run analysed"))
-                    .chain(warnings)
-                    .collect(),
-                not_analysed,
-                runs: Vec::new(),
-            }))
-            .map_err(Error::Output)?;
-            return Ok(());
+            let why = format!("{why}: no run analysed");
+            (sv, usize::from(p_idx == B), p_idx, Some(why), true)
         }
-        Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx),
+        Begun::Stretches { sv, l, p_idx } => {
+            let first = primary_mismatch_warning(&opts.name, machine, p_idx);
+            (sv, l, p_idx, first, false)
+        }
     };
-    let (not_analysed, notes_warnings) = sv.notes.finish(p_idx, rd.cone_deg, &opts.name);
+    let (not_analysed, warnings) = sv.head(&rd, p_idx, first);
     each(Piece::Head(&AnalyzeReport {
         file: opts.name.clone(),
         machine: machine.name.clone(),
         cone_deg: opts.analysis.cone_deg,
         pole_reach_deg: opts.analysis.pole_reach_deg,
         primary: (LETTERS[l] as char).to_string(),
-        warnings: primary_mismatch_warning(&opts.name, machine, p_idx)
-            .into_iter()
-            .chain(notes_warnings)
-            .collect(),
+        warnings,
         not_analysed,
         runs: Vec::new(),
     }))
     .map_err(Error::Output)?;
+    if nothing {
+        return Ok(());
+    }
     let todo = stretches(&sv.runs, l, |_| true);
     each_stretch(
         bytes,
@@ -778,21 +773,12 @@ fn analyze_each(
 pub(crate) fn each_run<T: Send>(
     bytes: &[u8],
     machine: &Machine,
-    name: &str,
-    fallback: Option<f64>,
-    work_offset_mm: Option<[f64; 3]>,
+    opts: &crate::AnalyzeOptions,
     work: impl Fn(&LoadedProgram) -> T + Sync,
     mut sink: impl FnMut(T) -> std::io::Result<()>,
 ) -> Result<(char, Vec<String>), Error> {
-    let rd = Reading {
-        name,
-        cone_deg: polepatch_patcher::AnalysisOptions::default().reach_deg(),
-        fallback,
-        work_offset_mm,
-        read: crate::program::read_options(machine)?,
-        chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
-        tool: crate::tool::ToolOptions::default(),
-    };
+    let rd = Reading::analysis(opts, machine)?;
+    let name = rd.name;
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
         Begun::Nothing { why, .. } => return Err(why),
         Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx),
@@ -806,7 +792,7 @@ pub(crate) fn each_run<T: Send>(
 }
 
 /// Read `bytes` (named `name` in messages) as one stretch of the one reader
-/// ([`crate::stream`]) and build each run's path for `machine`; `feed_fallback_mm_min` is
+/// (the module docs) and build each run's path for `machine`; `feed_fallback_mm_min` is
 /// used for runs with no F in force. A program with nothing to analyse is an error.
 pub fn load_nc(
     bytes: &[u8],
@@ -845,15 +831,7 @@ pub(crate) fn load_program(
     opts: &crate::AnalyzeOptions,
 ) -> Result<LoadedProgram, Error> {
     let name = opts.name.as_str();
-    let rd = Reading {
-        name,
-        cone_deg: opts.analysis.reach_deg(),
-        fallback: opts.feed_fallback_mm_min,
-        work_offset_mm: opts.work_offset_mm,
-        read: crate::program::read_options_with(machine, opts.inch)?,
-        chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
-        tool: crate::tool::ToolOptions::default(),
-    };
+    let rd = Reading::analysis(opts, machine)?;
     let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
         Begun::Nothing { why, .. } => return Err(why),
         Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx),

@@ -7,8 +7,8 @@
 use polepatch::kinematics::Machine;
 use polepatch::nc::modal::{B, C, X, Z};
 use polepatch::nc::{Dialect, FeedMode, ReadOptions, Tcpm, parse, parse_with};
-use polepatch::notes::SkipReason;
 use polepatch::post::{PostOptions, post_cl, read_cl};
+use polepatch::report::SkipReason;
 use polepatch::{PatchOptions, UntouchedReason, patch_nc};
 use std::path::PathBuf;
 

@@ -7,7 +7,7 @@
 
 use polepatch::PatchOptions;
 use polepatch::kinematics::Machine;
-use polepatch::stream::patch_nc_to;
+use polepatch::patch_nc_to;
 use polepatch_fixturegen::{Pass, joints};
 
 /// A Heidenhain ISO program: one pass (B-C, domain rule, `d` from the pole), a retract to

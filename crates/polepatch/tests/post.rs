@@ -3,12 +3,12 @@
 //! file's precision; and the posted program patches like the original (same zones, same
 //! outcomes, the same new rotary values).
 
+use polepatch::LoadedProgram;
 use polepatch::cl::{ClPoint, parse, to_apt, to_csv};
 use polepatch::kinematics::{BranchRule, Machine, forward};
 use polepatch::load_nc;
 use polepatch::nc::{Motion, NumberStyle, modal};
 use polepatch::post::{PostOptions, post_cl};
-use polepatch::program::LoadedProgram;
 use polepatch::{PatchOptions, patch_nc};
 use std::path::PathBuf;
 

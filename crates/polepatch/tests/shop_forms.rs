@@ -125,7 +125,7 @@ fn every_form_patches_like_its_g94_iso_twin() {
             let expression = report
                 .not_analysed
                 .iter()
-                .any(|n| n.reason == polepatch::notes::SkipReason::Expression);
+                .any(|n| n.reason == polepatch::report::SkipReason::Expression);
             assert_eq!(
                 expression,
                 form == "variables.nc",

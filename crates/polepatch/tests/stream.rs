@@ -4,11 +4,11 @@
 //! both machines, and programs built so that runs, stretches, feed changes, end poses,
 //! frame changes and feedless runs meet at stretch boundaries.
 
-use polepatch::analyze::analyze_program;
+use polepatch::analyze_program;
 use polepatch::kinematics::Machine;
 use polepatch::patcher::AnalysisOptions;
-use polepatch::stream::{analyze_nc_stretches, patch_nc_to};
 use polepatch::{AnalyzeOptions, FileReport, PatchOptions};
+use polepatch::{analyze_nc as analyze_nc_stretches, patch_nc_to};
 use std::path::PathBuf;
 
 /// The whole program, loaded.
@@ -16,7 +16,7 @@ fn whole(
     bytes: &[u8],
     machine: &Machine,
     opts: &PatchOptions,
-) -> Result<polepatch::program::LoadedProgram, polepatch::Error> {
+) -> Result<polepatch::LoadedProgram, polepatch::Error> {
     polepatch::load_nc_with(
         bytes,
         machine,

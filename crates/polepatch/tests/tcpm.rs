@@ -231,7 +231,7 @@ fn arcs_and_skippable_blocks_inside_a_zone_are_listed() {
                 "N540 X+24.5 Y+0 Z-5 A+0.591 C+58.315 *",
                 "N540 G02 X+24.5 Y+0 I+24.25 J+0.25 A+0.591 C+58.315 *\nN545 G01 *",
             ),
-            polepatch::notes::SkipReason::ArcNearPole,
+            polepatch::report::SkipReason::ArcNearPole,
         ),
         (
             "skippable",
@@ -239,7 +239,7 @@ fn arcs_and_skippable_blocks_inside_a_zone_are_listed() {
                 "N540 X+24.5 Y+0 Z-5 A+0.591 C+58.315 *",
                 "/N540 X+24.5 Y+0 Z-5 A+0.591 C+58.315 *",
             ),
-            polepatch::notes::SkipReason::SkippableNearPole,
+            polepatch::report::SkipReason::SkippableNearPole,
         ),
     ];
     for (label, text, reason) in cases {

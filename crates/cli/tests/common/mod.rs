@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 use polepatch::FileReport;
+use polepatch::LoadedProgram;
 use polepatch::kinematics::{Axis, Machine};
 use polepatch::load_nc;
 use polepatch::nc::{Dialect, parse};
@@ -9,7 +10,6 @@ use polepatch::patcher::analysis::{SpanFigures, analyze_spans};
 use polepatch::patcher::direct::deviation_bound_zone;
 use polepatch::patcher::verify::NOT_WORSE_REL;
 use polepatch::patcher::{AnalysisOptions, CLimits, PatchAxes, PatchOptions, analyze_path};
-use polepatch::program::LoadedProgram;
 use std::path::{Path, PathBuf};
 
 /// Run the `polepatch` binary in the repository root: (exit code, stdout, stderr).

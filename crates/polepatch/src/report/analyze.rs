@@ -102,7 +102,7 @@ pub struct AnalyzeReport {
     pub primary: String,
     /// Notes for the user.
     pub warnings: Vec<String>,
-    /// Lines carried through without analysis ([`crate::notes`]).
+    /// Lines carried through without analysis ([`super::NotAnalysed`]).
     pub not_analysed: Vec<crate::notes::NotAnalysed>,
     /// Runs in file order (last: the CLI prints the report as it goes).
     pub runs: Vec<RunReport>,

@@ -1,7 +1,7 @@
 //! Report documents (serde): what `analyze` prints, as data.
 //!
-//! Every report type of the library in one place: [`analyze`] (what `polepatch analyze`
-//! reports), [`patch`] (`polepatch patch --report`), [`simulate`] (`polepatch simulate`),
+//! Every report type of the library in one place: [`AnalyzeReport`] (what `polepatch analyze`
+//! reports), [`FileReport`] (`polepatch patch --report`), [`SimulateReport`] (`polepatch simulate`),
 //! and the names they print axes, limits, zone kinds, feeds and feed modes with.
 
 mod analyze;
@@ -14,6 +14,9 @@ pub use patch::{
     outcome_name,
 };
 pub use simulate::{RunTimes, SimRun, SimTotals, SimulateReport, SimulatedTimes, compare};
+
+/// A line carried through without analysis, and why ([`FileReport::not_analysed`]).
+pub use crate::notes::{NotAnalysed, SkipReason};
 
 use polepatch_kinematics::{Axis, LimitKind};
 use polepatch_patcher::ZoneKind;

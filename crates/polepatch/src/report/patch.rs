@@ -79,7 +79,7 @@ pub struct ZoneRow {
     /// `not_patched`.
     pub reason: &'static str,
     /// Whether the run's last point could change: `free` or `pinned`
-    /// ([`crate::end_pose`]); `-` for a run that was not patched.
+    /// ([`crate::EndPose`]); `-` for a run that was not patched.
     pub end_pose: &'static str,
     /// File line of the block after the run that decided its end pose (`None`: the end of
     /// the file, or a run without TCPM, whose end is always pinned).
@@ -132,7 +132,7 @@ pub struct ZoneRow {
     /// On the last zone of a run whose end is free: the positioning move after the run
     /// (the rapid or rotary repositioning that freed it) — its line and its time before
     /// and after the patch, s (each axis at its V and A limits, the slowest setting the
-    /// time: [`crate::end_pose::NextMove::time_s`]). A re-selected end can make it turn C
+    /// time: the slowest axis' trapezoid). A re-selected end can make it turn C
     /// by up to 180° more, or less.
     pub rapid_line: Option<usize>,
     /// That move's time from the original end, s.
@@ -406,14 +406,14 @@ pub struct FileReport {
     /// Runs left as they are (no TCPM, G91, no feed, invalid values), with why.
     pub untouched_runs: Vec<UntouchedRun>,
     /// Lines carried through without analysis (expressions, arcs and skippable blocks near
-    /// the pole, …; [`crate::notes`]).
+    /// the pole, …; [`super::NotAnalysed`]).
     pub not_analysed: Vec<crate::notes::NotAnalysed>,
     /// Notes for the user.
     pub warnings: Vec<String>,
     /// One row per zone.
     pub zones: Vec<ZoneRow>,
     /// The simulated cycle time of the input and of the output
-    /// ([`crate::simulate::compare`]), when the caller asked for it (`patch --simulate`).
+    /// ([`super::compare`]), when the caller asked for it (`patch --simulate`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub simulated: Option<SimulatedTimes>,
 }
