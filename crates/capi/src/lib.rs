@@ -93,14 +93,15 @@ pub struct PpOptions {
     /// Most decimals written for a rotary value when the file's are not enough (default 6,
     /// at most 9). [`pp_patch_joints`] rounds its output to this.
     pub max_decimals: u32,
-    /// Largest orientation change allowed, degrees; ≤ 0: no limit (default 0).
+    /// Largest orientation change allowed, degrees; 0: no limit (default 0); a negative
+    /// value is refused (`PP_BAD_OPTIONS`).
     pub max_deviation_deg: f64,
     /// Change C only (G16's method) instead of both rotary axes (default false).
     pub only_c: bool,
     /// Allow a 360° multiple offset of C after a zone (G16's join option: needs `only_c`,
     /// refused without it; default false).
     pub allow_c_offset: bool,
-    /// Interpolation cycle time, ms; ≤ 0: the machine's (default 0). No figure depends on
+    /// Interpolation cycle time, ms; 0: the machine's (default 0; negative refused). No figure depends on
     /// it (Equation 6 is bounded exactly over every span); kept for layout compatibility.
     pub tcy_ms: f64,
     /// Feed for runs without F, mm/min; ≤ 0: none (default 0).
@@ -355,6 +356,27 @@ fn tool_options(o: &PpOptions) -> Result<polepatch::tool::ToolOptions, Fail> {
     })
 }
 
+/// How a field of the patcher's options is named in messages: the member of [`PpOptions`]
+/// that sets it (`PpOptions.margin`), or the library's name for one that no member sets
+/// (the library's default, which the rules accept).
+fn c_member(field: polepatch::patcher::OptionField) -> String {
+    use polepatch::patcher::OptionField as F;
+    let member = match field {
+        F::ConeDeg => "cone_deg",
+        F::MaxDeviationDeg => "max_deviation_deg",
+        F::TcyS => "tcy_ms",
+        F::Margin => "margin",
+        F::MaxDecimals => "max_decimals",
+        F::AllowCOffset => "allow_c_offset",
+        F::PoleReachDeg
+        | F::ThirdDerivativeContinuity
+        | F::MaxPatchLengthMm
+        | F::KeepCentreRadiusMm
+        | F::KeepCentreUnitMm => return field.name().to_string(),
+    };
+    format!("PpOptions.{member}")
+}
+
 /// The library options for `opts` (NULL: defaults), checked.
 ///
 /// # Safety
@@ -377,11 +399,6 @@ unsafe fn options(opts: *const PpOptions) -> Result<polepatch::PatchOptions, Fai
             return Err(bad(format!("{what} must be finite, got {v}")));
         }
     }
-    if o.allow_c_offset && !o.only_c {
-        return Err(bad(
-            "allow_c_offset is G16's join option: it needs only_c (the default method re-selects the branch instead)",
-        ));
-    }
     if o.has_work_offset && o.work_offset_mm.iter().any(|v| !v.is_finite()) {
         return Err(bad("work_offset_mm must be finite"));
     }
@@ -389,17 +406,21 @@ unsafe fn options(opts: *const PpOptions) -> Result<polepatch::PatchOptions, Fai
     p.cone_deg = o.cone_deg;
     p.margin = o.margin;
     p.max_decimals = usize::try_from(o.max_decimals).unwrap_or(usize::MAX);
-    p.max_deviation_deg = (o.max_deviation_deg > 0.0).then_some(o.max_deviation_deg);
+    p.max_deviation_deg = (o.max_deviation_deg != 0.0).then_some(o.max_deviation_deg);
     p.axes = if o.only_c {
         PatchAxes::OnlyC
     } else {
         PatchAxes::Both
     };
     p.allow_c_offset = o.allow_c_offset;
-    p.tcy_s = (o.tcy_ms > 0.0).then_some(o.tcy_ms / 1000.0);
+    p.tcy_s = (o.tcy_ms != 0.0).then_some(o.tcy_ms / 1000.0);
     out.feed_fallback_mm_min = (o.feed_fallback_mm_min > 0.0).then_some(o.feed_fallback_mm_min);
     out.work_offset_mm = o.has_work_offset.then_some(o.work_offset_mm);
     out.tool = tool_options(o)?;
+    // The patcher's one rule set, its refusal naming the struct member.
+    out.patch
+        .validate()
+        .map_err(|e| bad(e.message(&c_member(e.field))))?;
     if !o.name.is_null() {
         // SAFETY: non-NULL and NUL-terminated (header contract).
         out.name = unsafe { c_str(o.name, "opts.name") }?.to_string();

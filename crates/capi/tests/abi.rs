@@ -619,3 +619,53 @@ fn tool_options_through_the_abi_are_the_librarys() {
     }
     unsafe { pp_machine_free(m) };
 }
+
+/// Issue 28 §3: the patcher's one rule set behind the C ABI, each refusal naming the
+/// `PpOptions` member: a negative cap (0 means no limit here), a negative margin, 12
+/// decimals, G16's join option without the C-only method.
+#[test]
+fn options_are_refused_by_the_patchers_rules_naming_the_member() {
+    let m = machine("mikron-ucp710");
+    let text = std::fs::read(root().join("fixtures/c17/SING.I")).unwrap();
+    type Case = (fn(&mut PpOptions), &'static str);
+    let cases: [Case; 4] = [
+        (
+            |o| o.max_deviation_deg = -1.0,
+            "PpOptions.max_deviation_deg must be a positive number of degrees, got -1",
+        ),
+        (
+            |o| o.margin = -0.1,
+            "PpOptions.margin must be a fraction in [0, 0.5), got -0.1",
+        ),
+        (
+            |o| o.max_decimals = 12,
+            "PpOptions.max_decimals must be at most 9, got 12",
+        ),
+        (
+            |o| o.allow_c_offset = true,
+            "PpOptions.allow_c_offset is G16's join option",
+        ),
+    ];
+    for (change, want) in cases {
+        let mut opts = pp_options_default();
+        change(&mut opts);
+        let mut out = PpBuffer {
+            data: std::ptr::null_mut(),
+            len: 0,
+        };
+        let status = unsafe {
+            pp_patch_nc(
+                m,
+                text.as_ptr(),
+                text.len(),
+                &opts,
+                &mut out,
+                std::ptr::null_mut(),
+            )
+        };
+        assert_eq!(status, PpStatus::PpBadInput, "{want}");
+        assert!(last_error().starts_with(want), "{}", last_error());
+        assert!(out.data.is_null());
+    }
+    unsafe { pp_machine_free(m) };
+}

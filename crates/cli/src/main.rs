@@ -320,18 +320,41 @@ pub(crate) fn check_tcy_ms(v: Option<f64>) -> Result<()> {
 
 /// The cone and the pole reach of `--cone` and `--pole-reach`: the defaults, or a fixed
 /// cone (the reach equal to it) unless the reach is given too.
+/// The cone and the pole reach of `--cone` and `--pole-reach` (the reach is the cone's
+/// when only `--cone` is given), checked by the patcher's rule set
+/// ([`AnalysisOptions::validate`]).
 pub(crate) fn cone_and_reach(cone: Option<f64>, reach: Option<f64>) -> Result<(f64, f64)> {
-    check_positive("--cone", cone)?;
-    if let Some(r) = reach
-        && !(r.is_finite() && (0.0..=90.0).contains(&r))
-    {
-        return Err(usage(format!(
-            "--pole-reach must be an angle from 0° to 90°, got {r}"
-        )));
-    }
     let d = AnalysisOptions::default();
-    let c = cone.unwrap_or(d.cone_deg);
-    Ok((c, reach.or(cone).unwrap_or(d.pole_reach_deg)))
+    let a = AnalysisOptions {
+        cone_deg: cone.unwrap_or(d.cone_deg),
+        pole_reach_deg: reach.or(cone).unwrap_or(d.pole_reach_deg),
+        ..d
+    };
+    a.validate().map_err(option_error)?;
+    Ok((a.cone_deg, a.pole_reach_deg))
+}
+
+/// The command line's flag for a field of the patcher's options.
+pub(crate) fn flag(field: polepatch::patcher::OptionField) -> &'static str {
+    use polepatch::patcher::OptionField as F;
+    match field {
+        F::ConeDeg => "--cone",
+        F::PoleReachDeg => "--pole-reach",
+        F::MaxDeviationDeg => "--max-deviation",
+        F::TcyS => "--tcy-ms",
+        F::Margin => "--margin",
+        F::ThirdDerivativeContinuity => "--no-jerk-continuity",
+        F::MaxDecimals => "--max-decimals",
+        F::MaxPatchLengthMm => "--max-patch-length",
+        F::AllowCOffset => "--c-offset",
+        F::KeepCentreRadiusMm => "--tool",
+        F::KeepCentreUnitMm => "--units",
+    }
+}
+
+/// The patcher's refusal of an option as a usage error naming the flag.
+pub(crate) fn option_error(e: polepatch::patcher::OptionsError) -> anyhow::Error {
+    usage(e.message(flag(e.field)))
 }
 
 pub(crate) fn check_positive(name: &str, v: Option<f64>) -> Result<()> {

@@ -12,30 +12,12 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+/// The patcher's options of `args`, checked by the patcher's one rule set
+/// ([`PatchOptions::validate`]) and refused as a usage error naming the flag.
 fn options(args: &PatchArgs) -> Result<PatchOptions> {
     let (cone_deg, pole_reach_deg) = crate::cone_and_reach(args.cone, args.pole_reach)?;
-    if let Some(d) = args.max_deviation
-        && !(d.is_finite() && d >= 0.0)
-    {
-        return Err(usage(format!(
-            "--max-deviation must be an angle ≥ 0°, got {d}"
-        )));
-    }
     check_positive("--feed", args.feed)?;
-    check_positive("--max-patch-length", args.max_patch_length)?;
-    if !(0.0..0.5).contains(&args.margin) {
-        return Err(usage(format!(
-            "--margin must be in [0, 0.5), got {}",
-            args.margin
-        )));
-    }
-    if args.max_decimals > 9 {
-        return Err(usage(format!(
-            "--max-decimals must be at most 9, got {}",
-            args.max_decimals
-        )));
-    }
-    Ok(PatchOptions {
+    let opts = PatchOptions {
         cone_deg,
         pole_reach_deg,
         max_deviation_deg: args.max_deviation,
@@ -50,7 +32,9 @@ fn options(args: &PatchArgs) -> Result<PatchOptions> {
             PatchAxes::Both
         },
         ..PatchOptions::default()
-    })
+    };
+    opts.validate().map_err(crate::option_error)?;
+    Ok(opts)
 }
 
 /// Files named on the command line, each with its path under `--out-dir`: a file given

@@ -401,3 +401,51 @@ fn an_unknown_tool_warns_and_fails_strict() {
     assert!(!err.contains("the tool is not known"), "{err}");
     assert!(stdout.contains("ball D10"), "{stdout}");
 }
+
+/// Issue 28 §3: the patcher's one rule set behind the flags — the refusal is the
+/// library's, with the flag's name, a usage error (64), nothing written.
+#[test]
+fn options_are_refused_by_the_patchers_rules_naming_the_flag() {
+    let dir = temp_dir("option-rules");
+    let out = dir.join("o.I");
+    let o = out.to_str().unwrap();
+    for (flag, value, want) in [
+        (
+            "--max-deviation",
+            "0",
+            "--max-deviation must be a positive number of degrees, got 0",
+        ),
+        (
+            "--margin=-0.1",
+            "",
+            "--margin must be a fraction in [0, 0.5), got -0.1",
+        ),
+        (
+            "--max-decimals",
+            "12",
+            "--max-decimals must be at most 9, got 12",
+        ),
+        (
+            "--pole-reach",
+            "95",
+            "--pole-reach must be an angle from 0 to 90 degrees, got 95",
+        ),
+    ] {
+        let mut args = vec![
+            "patch",
+            "fixtures/c17/SING.I",
+            "-o",
+            o,
+            "--machine",
+            "mikron-ucp710",
+            flag,
+        ];
+        if !value.is_empty() {
+            args.push(value);
+        }
+        let (code, _, err) = polepatch(&args);
+        assert_eq!(code, 64, "{flag}: {err}");
+        assert!(err.contains(want), "{flag}: {err}");
+        assert!(!out.exists(), "{flag}: nothing written");
+    }
+}

@@ -188,10 +188,9 @@ impl AnalyzeOptions {
     /// Every value in range, or an [`Error::Options`] naming the field ([`analyze_nc`] and
     /// [`stream::analyze_nc_each`] call it).
     pub fn check(&self) -> Result<(), Error> {
-        positive("cone_deg", "degrees", self.analysis.cone_deg)?;
-        if let Some(t) = self.analysis.tcy_s {
-            positive("tcy_s (interpolation cycle time)", "seconds", t)?;
-        }
+        self.analysis
+            .validate()
+            .map_err(|e| Error::Options(e.to_string()))?;
         check_common(self.feed_fallback_mm_min, self.work_offset_mm)
     }
 }

@@ -40,7 +40,7 @@ fn patch_nc<'py>(
     let p: PatcherKw = options.extract()?;
     let f: FileKw = options.extract()?;
     let t: ToolKw = options.extract()?;
-    let mut opts = f.patch(&p);
+    let mut opts = f.patch(&p)?;
     opts.tool = t.tool()?;
     let m = &machine.0;
     // Ctrl-C stops the patch between stretches (`detached_cancellable`).
@@ -88,7 +88,7 @@ fn post_cl<'py>(
     let f: FileKw = options.extract()?;
     let post: PostKw = options.extract()?;
     let t: ToolKw = options.extract()?;
-    let mut patch = f.patch(&p);
+    let mut patch = f.patch(&p)?;
     patch.tool = t.tool()?;
     let opts = post.post(patch)?;
     let m = &machine.0;
@@ -301,7 +301,7 @@ fn patch_joints<'py>(
     options: &Bound<'py, PyDict>,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, String)> {
     let p: PatcherKw = options.extract()?;
-    let opts = p.patcher();
+    let opts = p.patcher()?;
     let points = rows::<5>(&xyzpc, "xyzpc")?;
     let m = &machine.0;
     let result = detached(py, || {

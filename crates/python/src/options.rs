@@ -50,9 +50,10 @@ impl PatcherKw {
         }
     }
 
-    /// The patcher's options (checked by the library when used).
-    pub(crate) fn patcher(&self) -> patcher::PatchOptions {
-        patcher::PatchOptions {
+    /// The patcher's options, checked by the patcher's one rule set
+    /// (`PatchOptions::validate`): a refusal is a `ValueError` naming the keyword.
+    pub(crate) fn patcher(&self) -> PyResult<patcher::PatchOptions> {
+        let opts = patcher::PatchOptions {
             cone_deg: self.cone_deg,
             axes: if self.only_c {
                 PatchAxes::OnlyC
@@ -67,7 +68,31 @@ impl PatcherKw {
             max_patch_length_mm: self.max_patch_length_mm,
             allow_c_offset: self.allow_c_offset,
             ..patcher::PatchOptions::default()
-        }
+        };
+        opts.validate().map_err(|e| self.refusal(&e))?;
+        Ok(opts)
+    }
+
+    /// The patcher's refusal in the keywords' terms (`tcy_ms` in milliseconds).
+    fn refusal(&self, e: &patcher::OptionsError) -> PyErr {
+        use patcher::OptionField as F;
+        let message = match e.field {
+            F::TcyS => format!(
+                "tcy_ms must be a positive number of milliseconds, got {}",
+                self.tcy_ms.unwrap_or(f64::NAN)
+            ),
+            F::ThirdDerivativeContinuity => e.message("jerk_continuity"),
+            F::AllowCOffset => e.message("allow_c_offset"),
+            F::ConeDeg
+            | F::PoleReachDeg
+            | F::MaxDeviationDeg
+            | F::Margin
+            | F::MaxDecimals
+            | F::MaxPatchLengthMm
+            | F::KeepCentreRadiusMm
+            | F::KeepCentreUnitMm => e.to_string(),
+        };
+        PyValueError::new_err(message)
     }
 }
 
@@ -116,14 +141,14 @@ impl FileKw {
     }
 
     /// The library's patch options with the patcher's `p`.
-    pub(crate) fn patch(&self, p: &PatcherKw) -> polepatch::PatchOptions {
-        polepatch::PatchOptions {
-            patch: p.patcher(),
+    pub(crate) fn patch(&self, p: &PatcherKw) -> PyResult<polepatch::PatchOptions> {
+        Ok(polepatch::PatchOptions {
+            patch: p.patcher()?,
             feed_fallback_mm_min: self.feed_fallback_mm_min,
             name: self.name(),
             work_offset_mm: self.work_offset_mm.map(|(x, y, z)| [x, y, z]),
             ..polepatch::PatchOptions::default()
-        }
+        })
     }
 
     /// The library's analysis options with the analysis's `a`.

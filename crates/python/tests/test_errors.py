@@ -209,3 +209,19 @@ def test_cl_to_joints_refuses_a_joint_value_outside_the_range() -> None:
         polepatch.cl_to_joints(np.array([[0, 0, 0, 0, 0, 1.0], [1, 0, 0, 0, 0, -1.0]]), "mikron-ucp710")
     assert e.value.index == 1
     assert "180" in str(e.value) and "120" in str(e.value)
+
+
+@pytest.mark.parametrize(
+    "option, value, message",
+    [
+        ("max_deviation_deg", 0.0, "max_deviation_deg must be a positive number of degrees, got 0"),
+        ("margin", -0.1, "margin must be a fraction in [0, 0.5), got -0.1"),
+        ("max_decimals", 12, "max_decimals must be at most 9, got 12"),
+    ],
+)
+def test_options_are_refused_by_the_patchers_rules(option: str, value: object, message: str) -> None:
+    """Issue 28 §3: the patcher's one rule set, naming the keyword (the CLI names its flag)."""
+    data = read("fixtures/c17/SING.I")
+    with pytest.raises(ValueError) as info:
+        polepatch.patch_nc(data, "mikron-ucp710", **{option: value})
+    assert str(info.value).startswith(message), str(info.value)
