@@ -144,7 +144,8 @@ typedef struct PpOptions {
    */
   uint32_t max_decimals;
   /*
-   Largest orientation change allowed, degrees; ≤ 0: no limit (default 0).
+   Largest orientation change allowed, degrees; 0: no limit (default 0); a negative
+   value is refused (`PP_BAD_OPTIONS`).
    */
   double max_deviation_deg;
   /*
@@ -157,7 +158,7 @@ typedef struct PpOptions {
    */
   bool allow_c_offset;
   /*
-   Interpolation cycle time, ms; ≤ 0: the machine's (default 0). No figure depends on
+   Interpolation cycle time, ms; 0: the machine's (default 0; negative refused). No figure depends on
    it (Equation 6 is bounded exactly over every span); kept for layout compatibility.
    */
   double tcy_ms;
