@@ -423,12 +423,18 @@ fn refusals_give_a_status_and_a_message() {
     }
 }
 
-/// `pp_simulate_nc` is `polepatch::simulate_nc`: the same report JSON on SING for both
-/// machines; a NULL output is refused with a message.
+/// `pp_simulate_nc` is `polepatch::simulate_nc`: the same report JSON on SING (A-C) and a
+/// B-C program, each on its machine; a NULL output is refused with a message.
 #[test]
 fn simulate_nc_through_the_abi_is_the_library() {
-    let bytes = std::fs::read(root().join("fixtures/c17/SING.I")).unwrap();
-    for name in Machine::builtin_names() {
+    for (name, file) in [
+        ("mikron-ucp710", "fixtures/c17/SING.I"),
+        (
+            "mikron-hsm600",
+            "fixtures/generated/heidenhain-bc-swing-d0.1.I",
+        ),
+    ] {
+        let bytes = std::fs::read(root().join(file)).unwrap();
         let m = machine(name);
         let mut out = PpBuffer {
             data: std::ptr::null_mut(),

@@ -124,14 +124,21 @@ fn compile(dir: &Path) -> PathBuf {
 fn a_c_program_patches_sing_byte_for_byte() {
     let dir = temp("c");
     let exe = compile(&dir);
-    let name = "fixtures/c17/SING.I";
+    // Each machine with a program posted for it (a B-C program on the B-C machine: an A-C
+    // one is refused there, issue 29).
     // The ball run: `PpOptions.tool_*` are the library's `--tool ball:10 --tool-point tip`.
     let ball_tip = polepatch::tool::ToolOptions {
         tool: Some(polepatch::tool::Tool::parse("ball:10").unwrap()),
         point: Some(polepatch::tool::ToolPoint::Tip),
         ..polepatch::tool::ToolOptions::default()
     };
-    for machine in ["mikron-ucp710", "mikron-hsm600"] {
+    for (machine, name) in [
+        ("mikron-ucp710", "fixtures/c17/SING.I"),
+        (
+            "mikron-hsm600",
+            "fixtures/generated/heidenhain-bc-swing-d0.1.I",
+        ),
+    ] {
         let (out, report) = (dir.join("out.I"), dir.join("report.json"));
         let (ball_out, ball_report) = (dir.join("ball.I"), dir.join("ball.json"));
         let run = Command::new(&exe)

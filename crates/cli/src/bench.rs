@@ -372,14 +372,17 @@ pub fn run(files: &[std::path::PathBuf], machines: &[Machine], opts: &BenchOptio
         .iter()
         .flat_map(|f| machines.iter().map(move |m| (f, m)))
         .collect();
+    // A program is measured on the machines it was posted for: on a machine without its
+    // rotary letters it is refused (`Error::ForeignAxis`), and the pair is left out.
     let results: Vec<Result<Vec<BenchCase>, BenchError>> = pairs
         .par_iter()
-        .map(|(f, m)| {
-            bench_file(f, m, opts).map_err(|e| BenchError {
+        .map(|(f, m)| match bench_file(f, m, opts) {
+            Err(JobError::Input(Error::ForeignAxis { .. })) => Ok(Vec::new()),
+            r => r.map_err(|e| BenchError {
                 file: f.display().to_string(),
                 machine: m.name.clone(),
                 error: e.to_string(),
-            })
+            }),
         })
         .collect();
     let mut report = BenchReport {

@@ -215,14 +215,9 @@ pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
             })();
             written.with_context(|| format!("writing the trajectory {}", path.display()))?;
             let report = report.context("no report")?;
-            if report.primary != primary_guess.to_string() {
-                // The program uses the other tilting letter: the header says the machine's.
-                eprintln!(
-                    "polepatch: warning: {}: the trajectory's column {primary_guess} holds the program's {}",
-                    path.display(),
-                    report.primary
-                );
-            }
+            // (A program of another tilting letter is refused before any row: the header's
+            // letter is the program's.)
+            debug_assert_eq!(report.primary, primary_guess.to_string());
             sink.commit()
                 .with_context(|| format!("writing {}", path.display()))?;
             report

@@ -93,16 +93,20 @@ fn json_peak_speed_is_keyed_by_axis_letter() {
         let keys: Vec<&String> = r["peak_speed"].as_object().unwrap().keys().collect();
         assert_eq!(keys, ["A", "C", "X", "Y", "Z"]);
     }
-    // On the B-C machine the program's A words are read as its primary axis, with a warning.
+    // On the B-C machine the program's A words are refused (issue 29: reading A as B would
+    // analyse with another machine's kinematics), at the first A word.
     let (code, _, err) = polepatch(&[
         "analyze",
         "fixtures/c17/SING.I",
         "--machine",
         "mikron-hsm600",
     ]);
-    assert_eq!(code, 0);
+    assert_eq!(code, 1, "{err}");
     assert!(
-        err.contains("uses A but machine mikron-hsm600 has B"),
+        err.contains("fixtures/c17/SING.I:6:5:")
+            && err.contains(
+                "A is not an axis of machine mikron-hsm600, whose rotary axes are B and C"
+            ),
         "{err}"
     );
 }

@@ -29,6 +29,19 @@ fn small_set() -> Vec<PathBuf> {
     .collect()
 }
 
+/// B-C programs of the three dialects (the small set's are A-C): with both, each machine
+/// gets programs posted for it.
+fn small_set_bc() -> Vec<PathBuf> {
+    [
+        "generated/fanuc-bc-flip-d0.5.nc",
+        "generated/sinumerik-bc-swing-d1.mpf",
+        "generated/heidenhain-bc-flip-d0.1.I",
+    ]
+    .iter()
+    .map(|f| root().join("fixtures").join(f))
+    .collect()
+}
+
 fn machines() -> Vec<Machine> {
     Machine::builtin_names()
         .iter()
@@ -74,7 +87,18 @@ fn without_time(v: &Value) -> Value {
 fn bench_agrees_with_patch(file: &Path, bench_args: &[&str], patch_args: &[&str]) {
     let dir = tempfile::tempdir().unwrap();
     let stem = file.file_name().unwrap().to_string_lossy().into_owned();
+    let mut compared = 0;
     for m in Machine::builtin_names() {
+        // The machines the program was posted for (its rotary letters).
+        let fits = polepatch::analyze_nc(
+            &std::fs::read(file).unwrap(),
+            &Machine::builtin(m).unwrap(),
+            &polepatch::AnalyzeOptions::default(),
+        );
+        if matches!(fits, Err(polepatch::Error::ForeignAxis { .. })) {
+            continue;
+        }
+        compared += 1;
         let json = dir.path().join(format!("bench-{m}.json"));
         let out = bin()
             .arg("bench")
@@ -152,6 +176,7 @@ fn bench_agrees_with_patch(file: &Path, bench_args: &[&str], patch_args: &[&str]
             assert!(row.contains(&format!("{}–{}", lines[0], lines[1])), "{row}");
         }
     }
+    assert!(compared > 0, "{stem}: posted for no built-in machine");
 }
 
 #[test]
@@ -202,7 +227,8 @@ fn references_relate_to_ours() {
         strategies: vec![BenchStrategy::Polepatch, BenchStrategy::OnlyC],
         ..BenchOptions::default()
     };
-    let report = run(&small_set(), &machines(), &opts);
+    let files: Vec<PathBuf> = small_set().into_iter().chain(small_set_bc()).collect();
+    let report = run(&files, &machines(), &opts);
     assert!(report.errors.is_empty(), "{:?}", report.errors);
     let mut compared = [0, 0];
     for z in report.zones() {
@@ -257,16 +283,17 @@ fn strategies_side_by_side() {
     };
     let report = run(&small_set()[..1], &machines(), &opts);
     assert!(report.errors.is_empty(), "{:?}", report.errors);
-    assert_eq!(report.cases.len(), 2 * BenchStrategy::ALL.len());
+    // An A-C program: measured on the A-C machine only.
+    assert_eq!(report.cases.len(), BenchStrategy::ALL.len());
     for s in BenchStrategy::ALL {
         let sum = report.summary(s);
-        assert_eq!(sum.zones, 2, "{s:?}: one zone per machine");
+        assert_eq!(sum.zones, 1, "{s:?}: the one zone");
         if s == BenchStrategy::Polepatch {
-            assert_eq!(sum.at_feed_both, 2, "polepatch brings both axes to feed");
+            assert_eq!(sum.at_feed_both, 1, "polepatch brings both axes to feed");
         }
     }
     // The peers rewrite the cone by rule and are scored as they are: on fanuc.nc FREEZE
-    // leaves C below feed on both machines.
+    // leaves C below feed.
     assert_eq!(report.summary(BenchStrategy::Freeze).at_feed_c, 0);
     let out = bin()
         .arg("bench")
@@ -356,8 +383,8 @@ fn plots_are_valid_svg() {
         .map(|e| e.unwrap().path())
         .collect();
     files.sort();
-    // One zone per fixture and machine.
-    assert_eq!(files.len(), 6, "{files:?}");
+    // One zone per fixture on the machine it was posted for (A-C programs: the UCP710).
+    assert_eq!(files.len(), 3, "{files:?}");
     assert!(
         files
             .iter()
@@ -385,7 +412,7 @@ fn csv_has_reference_and_ratio_columns() {
     let out = bin()
         .arg("bench")
         .arg(root().join("fixtures/dialects/fanuc.nc"))
-        .args(["-m", "mikron-hsm600", "--csv"])
+        .args(["-m", "mikron-ucp710", "--csv"])
         .arg(&csv)
         .output()
         .unwrap();
@@ -468,8 +495,8 @@ fn docs_quality_table_matches_a_fresh_run() {
     );
     let fresh = String::from_utf8(out.stdout).unwrap();
     let want = doc_rows(&doc, &files);
-    // 3 files × 2 machines: 5 strategies' zone rows and one side-by-side row each.
-    assert_eq!(want.len(), 36, "docs/quality.md lacks the dialect rows");
+    // 3 A-C files × their machine: 5 strategies' zone rows and one side-by-side row each.
+    assert_eq!(want.len(), 18, "docs/quality.md lacks the dialect rows");
     assert_eq!(
         doc_rows(&fresh, &files),
         want,

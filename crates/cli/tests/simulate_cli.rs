@@ -66,7 +66,7 @@ fn two_programs_are_compared_and_outputs_never_overwrite_inputs() {
         "patch",
         "fixtures/c17/SING.I",
         "-m",
-        "mikron-hsm600",
+        "mikron-ucp710",
         "-o",
         patched.to_str().unwrap(),
     ]);
@@ -76,7 +76,7 @@ fn two_programs_are_compared_and_outputs_never_overwrite_inputs() {
         "fixtures/c17/SING.I",
         patched.to_str().unwrap(),
         "-m",
-        "mikron-hsm600",
+        "mikron-ucp710",
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(
@@ -90,7 +90,7 @@ fn two_programs_are_compared_and_outputs_never_overwrite_inputs() {
         "simulate",
         "fixtures/c17/SING.I",
         "-m",
-        "mikron-hsm600",
+        "mikron-ucp710",
         "--trajectory",
         "fixtures/c17/SING.I",
     ]);
@@ -106,7 +106,7 @@ fn two_programs_are_compared_and_outputs_never_overwrite_inputs() {
         "fixtures/c17/SING.I",
         patched.to_str().unwrap(),
         "-m",
-        "mikron-hsm600",
+        "mikron-ucp710",
         "--trajectory",
         dir.join("t.csv").to_str().unwrap(),
     ]);

@@ -47,6 +47,28 @@ pub enum Error {
         /// The machine's primary letter.
         primary: char,
     },
+    /// The program turns a rotary axis the machine does not have (a B-C program given an
+    /// A-C machine): its kinematics are not the machine's, so nothing computed for it
+    /// would be true of the machine it was posted for.
+    #[error(
+        "{path}:{line}:{column}: {letter} is not an axis of machine {machine}, whose rotary \
+         axes are {axes}: the program was posted for another machine; give that machine \
+         (--machine NAME, or a machine file whose rotary axes include {letter})"
+    )]
+    ForeignAxis {
+        /// File.
+        path: String,
+        /// 1-based line of the first word of that letter.
+        line: usize,
+        /// 1-based column of that word.
+        column: usize,
+        /// The letter.
+        letter: char,
+        /// The machine's name.
+        machine: String,
+        /// The machine's rotary letters (`A and C`).
+        axes: String,
+    },
     /// The program uses something polepatch does not support, at a line.
     #[error("{path}:{line}: {what}")]
     Unsupported {

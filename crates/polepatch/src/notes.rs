@@ -199,8 +199,9 @@ impl Notes {
         if let Some(line) = self.tilt_first[1 - l] {
             warnings.push(format!(
                 "{name}: words {other} (first at line {line}) are of a rotary axis the machine \
-                 does not have (the program is read with {own} and C): they are carried through \
-                 as written, and runs that turn {other} or hold it away from 0 are not analysed"
+                 does not have (the program is read with {own} and C); none turns it (each is 0, \
+                 or an expression): they are carried through as written, and a run where \
+                 {other} is not known to be 0 is not analysed"
             ));
         }
         if self.stated.is_none()

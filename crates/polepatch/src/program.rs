@@ -163,8 +163,8 @@ pub struct LoadedProgram {
     pub name: String,
     /// The parsed program.
     pub program: Program,
-    /// Letter used as the primary rotary axis (the machine's, unless the file uses only the
-    /// other tilting letter; see `warnings`).
+    /// Letter used as the primary rotary axis: the machine's (a program tilting with
+    /// another letter is refused, `Error::ForeignAxis`).
     pub primary_letter: u8,
     /// Runs in file order.
     pub runs: Vec<RunPath>,
@@ -294,27 +294,6 @@ fn line_number(bytes: &[u8], at: usize) -> usize {
         k += 1;
     }
     line
-}
-
-fn tilt_letter(idx: usize) -> u8 {
-    if idx == modal::A { b'A' } else { b'B' }
-}
-
-/// The warning when the program's tilting letter (`p_idx`, `modal::A` or `modal::B`) is
-/// not the machine's.
-pub(crate) fn primary_mismatch_warning(
-    name: &str,
-    machine: &Machine,
-    p_idx: usize,
-) -> Option<String> {
-    let used = tilt_letter(p_idx) as char;
-    let own = machine.primary_letter();
-    (used != own).then(|| {
-        format!(
-            "{name}: the program uses {used} but machine {} has {own}: {own}'s limits are applied to {used}",
-            machine.name
-        )
-    })
 }
 
 /// A run with its path for the patcher: axes X Y Z, the tilting letter at `p_idx`

@@ -285,7 +285,7 @@ pub fn simulate_nc_with(
         work_offset_mm: opts.work_offset_mm,
         ..crate::AnalyzeOptions::default()
     };
-    let (primary, warnings) = crate::stream::each_run(
+    let primary = crate::stream::each_run(
         bytes,
         machine,
         &reading,
@@ -299,6 +299,5 @@ pub fn simulate_nc_with(
     )?;
     sim.flush();
     sim.report.primary = primary.to_string();
-    sim.report.warnings = warnings;
     Ok(sim.report)
 }

@@ -51,7 +51,7 @@
 use crate::end_pose::{After, EndPose, Scan, Step};
 use crate::error::Error;
 use crate::patch::patch_program;
-use crate::program::{LoadedProgram, RunPath, Window, primary_mismatch_warning, run_path};
+use crate::program::{LoadedProgram, RunPath, Window, run_path};
 use crate::report::FileReport;
 use crate::report::{AnalyzeReport, RunReport};
 use polepatch_kinematics::Machine;
@@ -155,6 +155,10 @@ struct Survey {
     blocks: usize,
     /// The first G1 move that cannot start a run, and why ([`NoRunWhy`]).
     no_run_why: Option<NoRunWhy>,
+    /// The first word of each tilting letter (A, B): its line and column; and the first
+    /// one that is not 0 (the axis turned, not parked).
+    first_word: [Option<(usize, usize)>; 2],
+    first_turn: [Option<(usize, usize)>; 2],
 }
 
 /// Why a G1 move cannot start a run: what [`Error`] a program without runs gets, from its
@@ -387,12 +391,33 @@ fn survey_once(
     let mut i = 0usize;
     let mut no_run_why = None;
     let mut incremental_set_line = None;
+    let mut first_word: [Option<(usize, usize)>; 2] = [None, None];
+    let mut first_turn: [Option<(usize, usize)>; 2] = [None, None];
     let settled = scan_blocks_with(bytes, read, |s: Scanned<'_>| {
         if s.state.incremental && !prev.incremental {
             incremental_set_line = Some(s.block.line);
         }
         if no_run_why.is_none() {
             no_run_why = NoRunWhy::of(s.block, s.state, incremental_set_line);
+        }
+        for (l, letter) in LETTERS.into_iter().enumerate() {
+            let at = |w: &polepatch_nc::Word| {
+                let column = (w.start as usize).saturating_sub(s.block.span().start) + 1;
+                (s.block.line, column)
+            };
+            if first_word[l].is_none()
+                && let Some(w) = s.words.iter().find(|w| w.letter == letter)
+            {
+                first_word[l] = Some(at(w));
+            }
+            if first_turn[l].is_none()
+                && let Some(w) = s
+                    .words
+                    .iter()
+                    .find(|w| w.letter == letter && w.value != 0.0)
+            {
+                first_turn[l] = Some(at(w));
+            }
         }
         style.add_block(bytes, s.words);
         notes.push(s.block, s.words, &prev, s.state);
@@ -443,6 +468,8 @@ fn survey_once(
             notes,
             blocks: i,
             no_run_why,
+            first_word,
+            first_turn,
         },
         settled,
     ))
@@ -543,6 +570,28 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
     }
     let sv = survey(bytes, rd)?;
     let p_idx = tilting_index(&sv, machine);
+    // A rotary letter the machine does not have is refused (issue 29) where the program
+    // uses it as its tilting axis (reading it as the machine's would patch with the
+    // wrong kinematics) or turns it beside the machine's (an A-B trunnion's program on an
+    // A-C machine): named at its first word. A letter only ever written 0 (a post's
+    // `B0` reset) is carried through.
+    let own = usize::from(machine.primary_letter() == 'B');
+    let foreign = 1 - own;
+    let at = if p_idx != [A, B][own] {
+        sv.first_word[foreign]
+    } else {
+        sv.first_turn[foreign]
+    };
+    if let Some((line, column)) = at {
+        return Err(Error::ForeignAxis {
+            path: rd.name.to_string(),
+            line,
+            column,
+            letter: LETTERS[foreign] as char,
+            machine: machine.name.clone(),
+            axes: format!("{} and {}", machine.primary_letter(), machine.c_letter()),
+        });
+    }
     let why = if sv.runs.is_empty() {
         Some(match sv.no_run_why {
             Some(why) => why.error(rd.name),
@@ -590,10 +639,7 @@ pub fn patch_nc_hooked(
             let why = format!("{why}: nothing to patch, written unchanged");
             (sv, usize::from(p_idx == B), p_idx, Some(why), true)
         }
-        Begun::Stretches { sv, l, p_idx } => {
-            let first = primary_mismatch_warning(&opts.name, machine, p_idx);
-            (sv, l, p_idx, first, false)
-        }
+        Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx, None, false),
     };
     let mut report = FileReport::unchanged(&opts.name, machine, Vec::new());
     (report.not_analysed, report.warnings) = sv.head(&rd, p_idx, first);
@@ -731,10 +777,7 @@ fn analyze_each(
             let why = format!("{why}: no run analysed");
             (sv, usize::from(p_idx == B), p_idx, Some(why), true)
         }
-        Begun::Stretches { sv, l, p_idx } => {
-            let first = primary_mismatch_warning(&opts.name, machine, p_idx);
-            (sv, l, p_idx, first, false)
-        }
+        Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx, None, false),
     };
     let (not_analysed, warnings) = sv.head(&rd, p_idx, first);
     each(Piece::Head(&AnalyzeReport {
@@ -768,27 +811,22 @@ fn analyze_each(
 
 /// Every run of the program as a loaded program of its own (every run a stretch, as
 /// [`analyze_nc_each`] reads), in file order: `work` on all cores, `sink` in file order.
-/// Returns the tilting letter in use and the warnings. For readers of every run
-/// (`crate::simulate`).
+/// Returns the tilting letter in use. For readers of every run (`crate::simulate`).
 pub(crate) fn each_run<T: Send>(
     bytes: &[u8],
     machine: &Machine,
     opts: &crate::AnalyzeOptions,
     work: impl Fn(&LoadedProgram) -> T + Sync,
     mut sink: impl FnMut(T) -> std::io::Result<()>,
-) -> Result<(char, Vec<String>), Error> {
+) -> Result<char, Error> {
     let rd = Reading::analysis(opts, machine)?;
-    let name = rd.name;
-    let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
+    let (sv, l) = match begin(bytes, machine, &rd)? {
         Begun::Nothing { why, .. } => return Err(why),
-        Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx),
+        Begun::Stretches { sv, l, .. } => (sv, l),
     };
-    let warnings = primary_mismatch_warning(name, machine, p_idx)
-        .into_iter()
-        .collect();
     let todo = stretches(&sv.runs, l, |_| true);
     each_stretch(bytes, &sv, &todo, l, &rd, |lp| work(&lp), |t, _| sink(t))?;
-    Ok((LETTERS[l] as char, warnings))
+    Ok(LETTERS[l] as char)
 }
 
 /// Read `bytes` (named `name` in messages) as one stretch of the one reader
@@ -832,9 +870,9 @@ pub(crate) fn load_program(
 ) -> Result<LoadedProgram, Error> {
     let name = opts.name.as_str();
     let rd = Reading::analysis(opts, machine)?;
-    let (sv, l, p_idx) = match begin(bytes, machine, &rd)? {
+    let (sv, l) = match begin(bytes, machine, &rd)? {
         Begun::Nothing { why, .. } => return Err(why),
-        Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx),
+        Begun::Stretches { sv, l, .. } => (sv, l),
     };
     let whole = Stretch {
         first_block: 0,
@@ -858,9 +896,6 @@ pub(crate) fn load_program(
     let mut lp = loaded.ok_or(Error::NoRuns {
         path: name.to_string(),
     })?;
-    lp.warnings = primary_mismatch_warning(name, machine, p_idx)
-        .into_iter()
-        .collect();
     lp.notes = sv.notes;
     Ok(lp)
 }

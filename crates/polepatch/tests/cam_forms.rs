@@ -9,7 +9,7 @@ use polepatch::nc::modal::{B, C, X, Z};
 use polepatch::nc::{Dialect, FeedMode, ReadOptions, Tcpm, parse, parse_with};
 use polepatch::post::{PostOptions, post_cl, read_cl};
 use polepatch::report::SkipReason;
-use polepatch::{PatchOptions, UntouchedReason, patch_nc};
+use polepatch::{PatchOptions, patch_nc};
 use std::path::PathBuf;
 
 fn root() -> PathBuf {
@@ -184,48 +184,66 @@ fn units_stated_as_in_and_units_not_stated() {
     patches_rotary_words_only("haas inch", &haas, &hsm600(), &inch_opts);
 }
 
-/// Item 5: a program for an A-B trunnion (A tilts, B turns the table) on an A-C or a B-C
-/// machine: the letter the machine does not have is named, the runs that turn it are left
-/// with that reason — not "C is unknown".
+/// Item 5 (and issue 29): a program for an A-B trunnion (A tilts, B turns the table) on an
+/// A-C or a B-C machine is refused, the letter the machine does not have named at its first
+/// word that matters — B where it first turns on the A-C machine, A where it first appears
+/// on the B-C machine (the program's tilting axis is not the machine's): reading it with the
+/// wrong kinematics would report orientations the real machine does not have.
 #[test]
 fn rotary_letters_the_machine_does_not_have_are_named() {
     let bytes = cam("haas-vf2tr-trunnion-ab.nc");
-    for (m, other, own) in [(ucp710(), 'B', 'A'), (hsm600(), 'A', 'B')] {
-        let (out, report) = patch_nc(&bytes, &m, &opts("vf2tr")).unwrap();
-        assert_eq!(out, bytes);
-        let untouched: Vec<_> = report
-            .untouched_runs
-            .iter()
-            .filter(|u| u.reason == UntouchedReason::OtherRotary)
-            .collect();
+    let text = String::from_utf8(bytes.clone()).unwrap();
+    // The first word of `letter` (any value, or not 0) by a plain scan of the text.
+    let first = |letter: char, turned: bool| -> (usize, usize) {
+        for (i, line) in text.lines().enumerate() {
+            let code = line.split('(').next().unwrap();
+            let b = code.as_bytes();
+            for (j, &c) in b.iter().enumerate() {
+                if c as char != letter || (j > 0 && b[j - 1].is_ascii_alphabetic()) {
+                    continue;
+                }
+                let num: String = code[j + 1..]
+                    .chars()
+                    .take_while(|c| c.is_ascii_digit() || *c == '.' || *c == '-')
+                    .collect();
+                let Ok(v) = num.parse::<f64>() else { continue };
+                if !turned || v != 0.0 {
+                    return (i + 1, j + 1);
+                }
+            }
+        }
+        panic!("no {letter} word");
+    };
+    for (m, other, turned) in [(ucp710(), 'B', true), (hsm600(), 'A', false)] {
+        let e = patch_nc(&bytes, &m, &opts("vf2tr")).unwrap_err();
+        let (line, column) = first(other, turned);
+        match &e {
+            polepatch::Error::ForeignAxis {
+                line: l,
+                column: c,
+                letter,
+                ..
+            } => assert_eq!((*l, *c, *letter), (line, column, other), "{}: {e}", m.name),
+            _ => panic!("{}: {e}", m.name),
+        }
+        let msg = e.to_string();
         assert!(
-            !untouched.is_empty(),
-            "{}: {:?}",
-            m.name,
-            report.untouched_runs
-        );
-        assert!(
-            untouched[0].message.contains(&format!(
-                "the run turns {other} (or holds it away from 0), an axis the machine does not have — polepatch analyses {own} and C"
+            msg.starts_with(&format!(
+                "vf2tr:{line}:{column}: {other} is not an axis of machine {}",
+                m.name
             )),
+            "{msg}"
+        );
+        assert!(
+            msg.contains("the program was posted for another machine"),
+            "{msg}"
+        );
+        // The analysis refuses it the same way.
+        let a = polepatch::analyze_nc(&bytes, &m, &polepatch::AnalyzeOptions::default());
+        assert!(
+            matches!(a, Err(polepatch::Error::ForeignAxis { .. })),
             "{}",
-            untouched[0].message
-        );
-        assert!(
-            !report
-                .untouched_runs
-                .iter()
-                .any(|u| u.reason == UntouchedReason::UnknownRotary),
-            "{:?}",
-            report.untouched_runs
-        );
-        assert!(
-            report
-                .warnings
-                .iter()
-                .any(|w| w.contains(&format!("words {other} (first at line"))),
-            "{:?}",
-            report.warnings
+            m.name
         );
     }
 }
@@ -408,7 +426,9 @@ fn insert_records_are_written_and_listed() {
 #[test]
 fn corners_near_the_pole_are_zones_by_default() {
     let bytes = cam("haas-umc-corners-b6.nc");
-    for m in [ucp710(), hsm600()] {
+    // A B-C program: its machine (an A-C machine refuses it, issue 29).
+    {
+        let m = hsm600();
         let (_, report) = patch_nc(&bytes, &m, &opts("corners")).unwrap();
         assert!(!report.zones.is_empty(), "{}", m.name);
         for z in &report.zones {

@@ -3,6 +3,7 @@
 //! F, every programmed point is passed, the patched program is faster, and the simulated
 //! time is at least Equation 6's estimate, itself at least L/F.
 
+mod common;
 use polepatch::SimulateReport;
 use polepatch::kinematics::Machine;
 use polepatch::simulate::{SimState, SimulateOptions};
@@ -110,8 +111,8 @@ fn check(bytes: &[u8], m: &Machine, what: &str) -> SimulateReport {
 #[test]
 fn sing_and_its_patch_on_both_machines() {
     let bytes = std::fs::read(fixture("c17/SING.I")).unwrap();
-    for name in Machine::builtin_names() {
-        let m = Machine::builtin(name).unwrap();
+    for m in common::machines_for("SING", &bytes) {
+        let name = &m.name;
         let before = check(&bytes, &m, &format!("SING on {name}"));
         let (patched, _) = patch_nc(&bytes, &m, &PatchOptions::default()).unwrap();
         let after = check(&patched, &m, &format!("SING patched for {name}"));
@@ -134,8 +135,8 @@ fn generated_flips_and_swings() {
         "generated/heidenhain-bc-swing-d0.5.I",
     ] {
         let bytes = std::fs::read(fixture(f)).unwrap();
-        for name in Machine::builtin_names() {
-            let m = Machine::builtin(name).unwrap();
+        for m in common::machines_for(f, &bytes) {
+            let name = &m.name;
             let before = check(&bytes, &m, &format!("{f} on {name}"));
             let (patched, _) = patch_nc(&bytes, &m, &PatchOptions::default()).unwrap();
             if patched != bytes {
@@ -165,8 +166,8 @@ fn the_default_and_the_every_cycle_simulation_agree() {
         "generated/fanuc-bc-swing-d0.01.nc",
     ] {
         let bytes = std::fs::read(fixture(f)).unwrap();
-        for name in Machine::builtin_names() {
-            let m = Machine::builtin(name).unwrap();
+        for m in common::machines_for(f, &bytes) {
+            let name = &m.name;
             let time = |every_cycle: bool| {
                 let opts = SimulateOptions {
                     sim: polepatch::sim::SimOptions {

@@ -4,6 +4,7 @@
 //! both machines, and programs built so that runs, stretches, feed changes, end poses,
 //! frame changes and feedless runs meet at stretch boundaries.
 
+mod common;
 use polepatch::analyze_program;
 use polepatch::kinematics::Machine;
 use polepatch::patcher::AnalysisOptions;
@@ -168,7 +169,7 @@ fn programs_built_across_stretch_boundaries() {
         body(&sing),
     );
     let bytes = text.into_bytes();
-    for machine in machines() {
+    for machine in common::machines_for("all.I", &bytes) {
         let opts = PatchOptions {
             name: "all.I".into(),
             ..PatchOptions::default()

@@ -547,6 +547,34 @@ pub fn machines() -> Vec<Machine> {
         .collect()
 }
 
+/// The built-in machines a program was posted for: those whose rotary letters it uses.
+/// On the others it is refused by name, with line and column (`Error::ForeignAxis`,
+/// issue 29) — checked here for every machine left out.
+pub fn machines_for(name: &str, bytes: &[u8]) -> Vec<Machine> {
+    machines()
+        .into_iter()
+        .filter(|m| {
+            let opts = polepatch::AnalyzeOptions {
+                name: name.to_string(),
+                ..polepatch::AnalyzeOptions::default()
+            };
+            match polepatch::analyze_nc(bytes, m, &opts) {
+                Err(polepatch::Error::ForeignAxis {
+                    line,
+                    column,
+                    letter,
+                    ..
+                }) => {
+                    assert!(line >= 1 && column >= 1, "{name} on {}", m.name);
+                    assert_ne!(letter, m.primary_letter(), "{name} on {}", m.name);
+                    false
+                }
+                _ => true,
+            }
+        })
+        .collect()
+}
+
 pub fn name_of(p: &Path) -> String {
     p.strip_prefix(root()).unwrap_or(p).display().to_string()
 }
