@@ -566,6 +566,7 @@ impl Reader<'_> {
         if !self.units_seen {
             self.units_seen = true;
             self.prog.units = if inch { Units::Inch } else { Units::Mm };
+            self.prog.units_at = Some(at);
         }
         Ok(())
     }
@@ -1472,6 +1473,15 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.message.contains("posts GOTO"), "{e}");
+    }
+
+    /// The file's first units record is where an inch refusal points.
+    #[test]
+    fn the_first_units_record_is_located() {
+        let p = parse(b"PARTNO/X\n  UNITS/INCHES\nUNITS/MM\nGOTO/0,0,0\n").unwrap();
+        assert_eq!(p.units, Units::Inch);
+        assert_eq!(p.units_at, Some(crate::At { line: 2, column: 3 }));
+        assert_eq!(parse(b"GOTO/0,0,0\n").unwrap().units_at, None);
     }
 
     /// CAMWorks' forms: CIRCLE without a radius (the start point's), CYCLE/INIT before a

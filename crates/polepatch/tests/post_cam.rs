@@ -580,8 +580,9 @@ fn what_is_not_posted_is_refused_naming_the_record() {
             "t.apt:3:1: '0,0,1' does not start with an APT record word",
         ),
         (
-            "UNITS/INCHES\nFEDRAT/1\nGOTO/0,0,0\n",
-            "inch output for Heidenhain",
+            // At the units record (issue: the refusal named no line).
+            "PARTNO/X\n  UNITS/INCHES\nFEDRAT/1\nGOTO/0,0,0\n",
+            "t.apt:2:3: the CL file is in inches (this record): inch output for Heidenhain",
         ),
         (
             // The issue's repro without TRNTYP/WORLD: in which frame the GOTO is is not
