@@ -10,9 +10,10 @@
 //!   written into the program as it is, and listed in [`ClProgram::notes`]; it can still be
 //!   skipped with `--ignore INSERT`);
 //! - read, no effect on the motion (counted): [`PASSIVE`];
-//! - `CSYS/[R|t]` (CAMWorks): the values that follow are given in that frame and are
-//!   converted to the part frame (world = R·v + t, 3-value GOTOs along its Z);
-//!   `TRNTYP/WORLD,0,0,0` read; `MSYS` with the identity frame (counted), any other refused;
+//! - frames ([`crate::frames`]): `TRNTYP/WORLD,0,0,0` and `CSYS` (CAMWorks: the values
+//!   stay world coordinates; `CSYS` gives the setup's tool axis for 3-value `GOTO`s),
+//!   `MSYS` (NX: the values are in that MCS; another MCS later is refused); `TRACUT`,
+//!   `INDEX`, `COPY`, `REFSYS`, `TRANS`, `ORIGIN` refused by name;
 //! - every other record stops the read with its line, column and name, unless the caller
 //!   skips it by name ([`crate::ParseOptions::ignore`]).
 //!
@@ -20,6 +21,7 @@
 
 use crate::arcs::Arc;
 use crate::cycles::{Cycle, CycleContext, CycleRecord, parse_cycle};
+use crate::frames::{Frames, refused_frame_record};
 use crate::records::{
     At, ClItem, ClPoint, ClProgram, CompSide, Coolant, MoveKind, SpindleDir, Units,
 };
@@ -179,9 +181,8 @@ struct Reader<'o> {
     pos: Option<[f64; 3]>,
     /// Tool axis of the last move (an arc's start axis).
     last_axis: [f64; 3],
-    /// The frame the values are given in (`CSYS`): rows of R and t (mm), world = R·v + t;
-    /// `None`: the part frame itself.
-    frame: Option<([[f64; 3]; 3], [f64; 3])>,
+    /// The frame records read (`TRNTYP`, `CSYS`, `MSYS`).
+    frames: Frames,
     from: Option<([f64; 3], [f64; 3])>,
     /// `CIRCLE`/`MOVARC` waiting for its `GOTO`.
     circle: Option<PendingCircle>,
@@ -263,31 +264,6 @@ impl Reader<'_> {
         if self.inch { MM_PER_INCH } else { 1.0 }
     }
 
-    /// A direction given in the current frame, in the part frame.
-    fn dir(&self, v: [f64; 3]) -> [f64; 3] {
-        match &self.frame {
-            None => v,
-            Some((r, _)) => [0, 1, 2].map(|i| crate::arcs::dot(r[i], v)),
-        }
-    }
-
-    /// A position given in the current frame (mm), in the part frame, in range.
-    fn position(&self, v: [f64; 3], at: At, what: &str) -> Result<[f64; 3], ClError> {
-        let Some((_, t)) = &self.frame else {
-            return Ok(v);
-        };
-        let w = crate::arcs::add(self.dir(v), *t);
-        for (i, x) in w.into_iter().enumerate() {
-            coordinate(
-                x,
-                at,
-                &format!("{what} (in the part frame, {})", ["x", "y", "z"][i]),
-                &format!("{x}"),
-            )?;
-        }
-        Ok(w)
-    }
-
     /// x y z [i j k] of a GOTO-like record: a point in mm and the tool axis (the last one
     /// when only x y z).
     fn point(&mut self, word: &str, f: &[(&str, At)], at: At) -> Result<[f64; 3], ClError> {
@@ -306,10 +282,9 @@ impl Reader<'_> {
             }
         }
         if f.len() == 6 {
-            let a = unit_axis([v[3], v[4], v[5]], f[3].1.line, f[3].1.column)?;
-            self.axis = self.dir(a);
+            self.axis = unit_axis([v[3], v[4], v[5]], f[3].1.line, f[3].1.column)?;
         }
-        self.position([v[0], v[1], v[2]], f[0].1, word)
+        Ok([v[0], v[1], v[2]])
     }
 
     fn push_move(&mut self, pos: [f64; 3], kind: MoveKind, at: At) {
@@ -420,11 +395,20 @@ impl Reader<'_> {
             "PARTNO" => self.partno(args, at0)?,
             "PPRINT" | "TPRINT" => self.pprint(&word, args, at0)?,
             "INSERT" => self.insert(args, at0)?,
-            "TRNTYP" => self.trntyp(&f, at0)?,
-            "CSYS" => self.csys(&f, at0)?,
-            "MSYS" => self.msys(&f, at0)?,
+            "TRNTYP" => self.frames.trntyp(&f, at0)?,
+            "CSYS" => self.axis = self.frames.csys(&f, at0, self.scale())?,
+            "MSYS" => {
+                let first_move = self.prog.points().next().map(|p| At {
+                    line: p.line,
+                    column: p.column,
+                });
+                self.frames.msys(&f, at0, self.scale(), first_move)?;
+            }
             w if PASSIVE.contains(&w) => {}
             other => {
+                if let Some(refused) = refused_frame_record(other, at0) {
+                    return Err(refused);
+                }
                 return Err(e(
                     at0,
                     format!(
@@ -536,7 +520,7 @@ impl Reader<'_> {
                 for (i, &(t, a)) in f.iter().enumerate() {
                     d[i] = number(t, a, ["dx", "dy", "dz"][i])? * self.scale();
                 }
-                self.dir(d)
+                d
             }
             n => {
                 return Err(e(
@@ -582,6 +566,7 @@ impl Reader<'_> {
         if !self.units_seen {
             self.units_seen = true;
             self.prog.units = if inch { Units::Inch } else { Units::Mm };
+            self.prog.units_at = Some(at);
         }
         Ok(())
     }
@@ -601,8 +586,7 @@ impl Reader<'_> {
         for (i, &(t, a)) in f.iter().enumerate() {
             v[i] = number(t, a, ["i", "j", "k"][i])?;
         }
-        let a = unit_axis(v, f[0].1.line, f[0].1.column)?;
-        self.axis = self.dir(a);
+        self.axis = unit_axis(v, f[0].1.line, f[0].1.column)?;
         Ok(())
     }
 
@@ -753,86 +737,6 @@ impl Reader<'_> {
         Ok(())
     }
 
-    /// `TRNTYP/WORLD,0,0,0` (CAMWorks): read; any other is refused.
-    fn trntyp(&mut self, f: &[(&str, At)], at: At) -> Result<(), ClError> {
-        // CAMWorks: TRNTYP/WORLD,0,0,0 (no transformation) is read; any other is not.
-        let identity = matches!(f.first(), Some((w, _)) if w.eq_ignore_ascii_case("WORLD"))
-            && f.len() == 4
-            && f[1..]
-                .iter()
-                .all(|&(t, _)| t.parse::<f64>().is_ok_and(|v| v == 0.0));
-        if !identity {
-            return Err(e(
-                at,
-                "TRNTYP other than WORLD,0,0,0 is not posted (it moves the part frame); give --ignore TRNTYP only if the frame is set on the machine",
-            ));
-        }
-        Ok(())
-    }
-
-    /// `MSYS/…` (NX): the identity frame is read; any other is refused.
-    fn msys(&mut self, f: &[(&str, At)], at: At) -> Result<(), ClError> {
-        // NX writes its GOTOs in the machine coordinate system (MCS) and MSYS says
-        // where that is in the model: only the identity is read (else the program
-        // zero is not the part frame the post assumes).
-        let mut v = Vec::with_capacity(f.len());
-        for &(t, a) in f {
-            v.push(number(t, a, "MSYS")?);
-        }
-        let identity = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
-        let is_identity =
-            v.len() == 9 && v.iter().zip(identity).all(|(a, b)| (a - b).abs() <= 1e-9);
-        if !is_identity {
-            return Err(e(
-                at,
-                "MSYS other than the identity frame is not posted (the program zero would not be the part frame); give --ignore MSYS only if the frame is set on the machine",
-            ));
-        }
-        Ok(())
-    }
-
-    /// `CSYS/r11,r12,r13,t1, r21,r22,r23,t2, r31,r32,r33,t3` (CAMWorks): the values that
-    /// follow are in this frame, world = R·v + t; the tool axis of 3-value GOTOs is its Z.
-    /// R must be a rotation (orthonormal, right-handed, within 1e-4).
-    fn csys(&mut self, f: &[(&str, At)], at: At) -> Result<(), ClError> {
-        if f.len() != 12 {
-            return Err(e(
-                f.first().map_or(at, |x| x.1),
-                format!(
-                    "CSYS needs 12 values (a 3×4 matrix [R|t], by rows); got {}",
-                    f.len()
-                ),
-            ));
-        }
-        let mut v = [0.0; 12];
-        for (i, &(t, a)) in f.iter().enumerate() {
-            v[i] = number(t, a, "CSYS value")?;
-        }
-        let r = [[v[0], v[1], v[2]], [v[4], v[5], v[6]], [v[8], v[9], v[10]]];
-        let t = [3, 7, 11].map(|i| v[i] * self.scale());
-        let det = crate::arcs::dot(r[0], crate::arcs::cross(r[1], r[2]));
-        let orthonormal = (0..3).all(|i| {
-            (0..3).all(|j| {
-                let want = if i == j { 1.0 } else { 0.0 };
-                (crate::arcs::dot(r[i], r[j]) - want).abs() <= 1e-4
-            })
-        });
-        if !orthonormal || det <= 0.0 {
-            return Err(e(
-                at,
-                "CSYS: the matrix is not a rotation (orthonormal, right-handed): refused",
-            ));
-        }
-        for (i, x) in t.into_iter().enumerate() {
-            coordinate(x, f[[3, 7, 11][i]].1, "CSYS origin", f[[3, 7, 11][i]].0)?;
-        }
-        let identity = t == [0.0; 3]
-            && (0..3).all(|i| (0..3).all(|j| r[i][j] == if i == j { 1.0 } else { 0.0 }));
-        self.frame = (!identity).then_some((r, t));
-        self.axis = self.dir([0.0, 0.0, 1.0]);
-        Ok(())
-    }
-
     fn fedrat(&mut self, f: &[(&str, At)], at: At) -> Result<(), ClError> {
         let mut value: Option<(f64, At)> = None;
         let mut per_inch = self.inch;
@@ -896,8 +800,8 @@ impl Reader<'_> {
                 v[i] = coordinate(v[i] * self.scale(), a, what, t)?;
             }
         }
-        let n = self.dir(unit_axis([v[3], v[4], v[5]], f[3].1.line, f[3].1.column)?);
-        let center = self.position([v[0], v[1], v[2]], f[0].1, word)?;
+        let n = unit_axis([v[3], v[4], v[5]], f[3].1.line, f[3].1.column)?;
+        let center = [v[0], v[1], v[2]];
         let mut angle = None;
         let rest = &f[f.len().min(7)..];
         if word == "MOVARC" {
@@ -1137,7 +1041,7 @@ pub fn parse_apt(text: &str, opts: &ParseOptions) -> Result<ClProgram, ClError> 
         axis: [0.0, 0.0, 1.0],
         pos: None,
         last_axis: [0.0, 0.0, 1.0],
-        frame: None,
+        frames: Frames::default(),
         from: None,
         circle: None,
         cycle: None,
@@ -1569,65 +1473,15 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.message.contains("posts GOTO"), "{e}");
-        // Frames: the identity is read, anything else refused.
-        assert!(parse(b"MSYS/0,0,0,1,0,0,0,1,0\nGOTO/0,0,0\n").is_ok());
-        let e = parse(b"MSYS/10,0,0,1,0,0,0,1,0\nGOTO/0,0,0\n").unwrap_err();
-        assert!(e.message.contains("MSYS other than the identity"), "{e}");
     }
 
-    /// CAMWorks' CSYS: the values after it are in that frame (world = R·v + t, by rows),
-    /// 3-value GOTOs along its Z; TRNTYP/WORLD,0,0,0 is no transformation.
+    /// The file's first units record is where an inch refusal points.
     #[test]
-    fn csys_frames_are_converted_to_the_part_frame() {
-        // A frame turned 90° about Z and moved by (10, 20, 0); then one tilted 10° about X.
-        let s10 = 10f64.to_radians().sin();
-        let c10 = 10f64.to_radians().cos();
-        let text = format!(
-            "UNIT/MM\nTRNTYP/WORLD,0,0,0\nCSYS/0,-1.,0,10.,1.,0,0,20.,0,0,1.,0\nFEDRAT/100\n\
-             GOTO/1.,0,0\nCIRCLE/0,0,0,0,0,1.\nGOTO/0,1.,0\nGODLTA/1.,0,0\n\
-             CSYS/1.,0,0,0,0,{c10},{ms10},0,0,{s10},{c10},0\nGOTO/0,0,5.\n",
-            ms10 = -s10
-        );
-        let p = parse(text.as_bytes()).unwrap();
-        let pts: Vec<_> = p.points().collect();
-        let close = |a: [f64; 3], b: [f64; 3]| (0..3).all(|i| (a[i] - b[i]).abs() < 1e-12);
-        assert!(
-            close(pts[0].pos_mm, [10.0, 21.0, 0.0]),
-            "{:?}",
-            pts[0].pos_mm
-        );
-        assert_eq!(pts[0].axis, [0.0, 0.0, 1.0]);
-        // The arc's centre is the frame's origin; local (0,1) is world (9, 20).
-        let MoveKind::Arc(a) = &pts[1].kind else {
-            panic!()
-        };
-        assert!(close(a.center_mm, [10.0, 20.0, 0.0]) && close(pts[1].pos_mm, [9.0, 20.0, 0.0]));
-        assert!((a.sweep_rad - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
-        assert!(
-            close(pts[2].pos_mm, [9.0, 21.0, 0.0]),
-            "GODLTA turned with the frame"
-        );
-        // The tilted frame: the tool along its Z, (0, −sin 10°, cos 10°), the point too.
-        assert!(close(pts[3].axis, [0.0, -s10, c10]), "{:?}", pts[3].axis);
-        assert!(close(pts[3].pos_mm, [0.0, -5.0 * s10, 5.0 * c10]));
-        for (text, what) in [
-            (
-                "CSYS/1,0,0,0,0,2,0,0,0,0,1,0\nGOTO/0,0,0\n",
-                "not a rotation",
-            ),
-            (
-                "CSYS/1,0,0,0,0,1,0,0,0,0,-1,0\nGOTO/0,0,0\n",
-                "not a rotation",
-            ),
-            ("CSYS/1,0,0,0\nGOTO/0,0,0\n", "12 values"),
-            (
-                "TRNTYP/LOCAL,0,0,0\nGOTO/0,0,0\n",
-                "TRNTYP other than WORLD",
-            ),
-        ] {
-            let e = parse(text.as_bytes()).unwrap_err();
-            assert!(e.message.contains(what), "{text}: {e}");
-        }
+    fn the_first_units_record_is_located() {
+        let p = parse(b"PARTNO/X\n  UNITS/INCHES\nUNITS/MM\nGOTO/0,0,0\n").unwrap();
+        assert_eq!(p.units, Units::Inch);
+        assert_eq!(p.units_at, Some(crate::At { line: 2, column: 3 }));
+        assert_eq!(parse(b"GOTO/0,0,0\n").unwrap().units_at, None);
     }
 
     /// CAMWorks' forms: CIRCLE without a radius (the start point's), CYCLE/INIT before a

@@ -9,6 +9,8 @@
 //!   `SPINDL`, `COOLNT`, `CUTCOM`, `DELAY`, `STOP`, comments). A record that changes the
 //!   motion and is not read stops the read with its line, column and name (unless skipped
 //!   by name, [`ParseOptions::ignore`]); records that do not change the motion are counted.
+//!   Coordinate-frame records (`TRNTYP`, `CSYS`, `MSYS`, …) are read as the CAM systems
+//!   that write them mean them, or refused ([`frames`]).
 //! - **CSV** ([`csv`]) `x,y,z,i,j,k[,f]` per line, mm and mm/min: straight moves.
 //!
 //! Errors name the line and column and the value. Lengths are mm inside (inch files are
@@ -20,6 +22,7 @@ pub mod apt;
 pub mod arcs;
 pub mod csv;
 pub mod cycles;
+pub mod frames;
 pub mod records;
 pub mod write;
 

@@ -187,6 +187,8 @@ pub struct ClProgram {
     pub name: Option<String>,
     /// The file's units (its first `UNITS`/`UNIT` record; mm when it has none).
     pub units: Units,
+    /// Where that first units record is (`None`: the file has none, or is CSV).
+    pub units_at: Option<At>,
     /// How many records of each kind the file has (APT major word → count), every record
     /// counted, whatever became of it.
     pub records: BTreeMap<String, usize>,

@@ -190,10 +190,14 @@ fn units_both_spellings_and_a_byte_order_mark() {
     assert_eq!(outputs[2], outputs[3]);
     assert!(outputs[0].contains("G700") && outputs[2].contains("G71"));
     assert!(outputs[2].contains("X57.15 Y38.1 Z-3.175") && outputs[2].contains("F304.8"));
-    // Heidenhain in inches is refused with the way out.
+    // Heidenhain in inches is refused with the way out, at the units record.
     let (code, _, err) = post(&a, "heidenhain", &dir.join("x.I"));
     assert_eq!(code, 1);
     assert!(err.contains("--units mm"), "{err}");
+    assert!(
+        err.contains("unit.apt:4:1: the CL file is in inches (this record)"),
+        "{err}"
+    );
     // A CSV with a byte-order mark: both points posted.
     let csv = dir.join("bom.csv");
     std::fs::write(&csv, b"\xEF\xBB\xBF1,2,3,0,0,1,1000\n4,5,6,0,0,1\n").unwrap();

@@ -784,10 +784,17 @@ pub fn post_cl(
             Dialect::Heidenhain | Dialect::Conversational | Dialect::Auto
         )
     {
-        return Err(Error::Options(
-            "inch output for Heidenhain is not written: Heidenhain inch programs take F in 0.1 inch/min, which polepatch's reader does not read; post in mm (--units mm)"
-                .into(),
-        ));
+        let why = "inch output for Heidenhain is not written: Heidenhain inch programs take F in 0.1 inch/min, which polepatch's reader does not read; post in mm (--units mm)";
+        // At the CL file's units record when the inches are the file's, else the option's.
+        return Err(match (opts.units, cl.units_at) {
+            (None, Some(at)) => cl_error(
+                &opts.patch_options.name,
+                at.line,
+                at.column,
+                format!("the CL file is in inches (this record): {why}"),
+            ),
+            _ => Error::Options(format!("--units inch: {why}")),
+        });
     }
     let items = post_items(cl, machine, opts)?;
     let program_name = cl

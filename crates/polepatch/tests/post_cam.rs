@@ -580,12 +580,87 @@ fn what_is_not_posted_is_refused_naming_the_record() {
             "t.apt:3:1: '0,0,1' does not start with an APT record word",
         ),
         (
-            "UNITS/INCHES\nFEDRAT/1\nGOTO/0,0,0\n",
-            "inch output for Heidenhain",
+            // At the units record (issue: the refusal named no line).
+            "PARTNO/X\n  UNITS/INCHES\nFEDRAT/1\nGOTO/0,0,0\n",
+            "t.apt:2:3: the CL file is in inches (this record): inch output for Heidenhain",
+        ),
+        (
+            // The issue's repro without TRNTYP/WORLD: in which frame the GOTO is is not
+            // stated.
+            "CSYS/0,-1.,0,0,1.,0,0,0,0,0,1.,0\nFEDRAT/100\nGOTO/10.,0,5.,0,0,1.\n",
+            "t.apt:1:1: CSYS other than the identity (setup tool axis (0, 0, 1)) without TRNTYP/WORLD",
+        ),
+        (
+            "MSYS/0,0,0,1,0,0,0,1,0\nFEDRAT/100\nGOTO/0,0,0\nMSYS/0,0,50,1,0,0,0,1,0\nGOTO/0,0,0\n",
+            "t.apt:4:1: MSYS names a machine coordinate system",
+        ),
+        (
+            "FEDRAT/100\nGOTO/0,0,0\nTRACUT/1,0,0,10,0,1,0,0,0,0,1,0\nGOTO/1,0,0\n",
+            "t.apt:3:1: TRACUT records are not posted",
         ),
     ] {
         let e = refused(text);
         assert!(e.contains(want), "{text}\n→ {e}\nwanted {want}");
+    }
+}
+
+/// CAMWorks' setups (`fixtures/cl/camworks_setups.apt`: after `TRNTYP/WORLD`, a setup
+/// turned 90° about Z, one moved by (−60, −20, 30) and one with the tool along +X): CAMWorks
+/// writes world coordinates whatever the `CSYS`, so the program is the one posted from the
+/// same file without its `TRNTYP`/`CSYS` records, every point is the GOTO as written, the
+/// side setup is cut with the primary axis at ±90°, and the arcs (one in YZ) stay within
+/// the tolerance. Before, `CSYS` was applied as part = R·v + t: the first setup posted
+/// turned by 90°, the second moved, the third refused (tool axis −Z).
+#[test]
+fn camworks_setups_post_the_world_values_as_written() {
+    let text = String::from_utf8(fixture("camworks_setups.apt")).unwrap();
+    let bare: String = text
+        .lines()
+        .filter(|l| !l.starts_with("TRNTYP") && !l.starts_with("CSYS"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let cl = parse(text.as_bytes()).unwrap();
+    let without = parse(bare.as_bytes()).unwrap();
+    let key = |c: &ClProgram| -> Vec<_> {
+        c.points()
+            .map(|p| (p.pos_mm, p.axis, p.kind.clone()))
+            .collect()
+    };
+    assert_eq!(key(&cl), key(&without));
+    let side = cl
+        .points()
+        .find(|p| p.pos_mm == [120.0, 10.0, -15.0])
+        .unwrap();
+    assert_eq!(side.axis, [1.0, 0.0, 0.0]);
+    for dialect in DIALECTS {
+        let out = post(&cl, dialect, false, |_| {});
+        assert_eq!(out, post(&without, dialect, false, |_| {}), "{dialect:?}");
+        // The written points are the GOTOs (the first and the side setup's first cut).
+        let moves: Vec<[Option<f64>; 4]> = out
+            .lines()
+            .map(|l| {
+                let l = l.trim_end_matches(" *");
+                [word(l, "X"), word(l, "Y"), word(l, "Z"), word(l, "A")]
+            })
+            // Moves (under TCPM every one states A); not the INSERT text `X120. Y40. Z30.`.
+            .filter(|m| m.iter().all(Option::is_some))
+            .collect();
+        assert_eq!(
+            moves[0][..3],
+            [Some(-10.0), Some(5.0), Some(25.0)],
+            "{dialect:?}\n{out}"
+        );
+        let cut = moves
+            .iter()
+            .find(|m| m[..3] == [Some(120.0), Some(10.0), Some(-15.0)])
+            .unwrap_or_else(|| panic!("{dialect:?}\n{out}"));
+        assert_eq!(cut[3].map(f64::abs), Some(90.0), "{dialect:?}: {cut:?}");
+        let rounding = 3f64.sqrt() * 0.0005;
+        let errs = arc_errors(&cl, &out);
+        assert_eq!(errs.len(), 3, "{dialect:?}");
+        for (a, worst, _) in errs {
+            assert!(worst <= 0.001 + rounding, "{dialect:?}: {worst} from {a:?}");
+        }
     }
 }
 
