@@ -17,6 +17,23 @@ MACHINES = ["mikron-ucp710", "mikron-hsm600"]
 NC_EXTENSIONS = {".I", ".H", ".mpf", ".MPF", ".nc", ".NC", ".ngc", ".tap"}
 
 
+def posted_for(data: bytes) -> List[str]:
+    """The built-in machines a program was posted for: those whose rotary letters it uses
+    (on the others it is refused by name, issue 29 — checked here)."""
+    import polepatch
+
+    fit = []
+    for m in MACHINES:
+        try:
+            polepatch.analyze_nc(data, m)
+        except polepatch.InputError as e:
+            if " is not an axis of machine " in str(e):
+                assert e.line >= 1 and e.column >= 1, str(e)
+                continue
+        fit.append(m)
+    return fit
+
+
 def nc_fixtures() -> List[str]:
     """Every NC program under fixtures/ (recursively, by extension), sorted, as paths
     relative to the repository root (the names the CLI prints in its reports)."""

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 import polepatch
-from conftest import MACHINES, ROOT, nc_fixtures, read, run_cli, without_timing
+from conftest import MACHINES, ROOT, nc_fixtures, posted_for, read, run_cli, without_timing
 
 
 def test_the_issue_check_sing_on_the_ucp710(cli: Path, tmp_path: Path) -> None:
@@ -54,7 +54,9 @@ def test_patch_nc_is_the_cli_on_every_fixture(cli: Path, tmp_path: Path, machine
         assert data == (tmp_path / rel).read_bytes(), f"{rel} on {machine}"
         assert without_timing(report) == without_timing(cli_reports[rel]), rel
         patched += 1
-    assert patched >= 90, patched
+    # Each machine patches the programs posted for it (A-C or B-C) and refuses the others
+    # by name, with the same message as the CLI (checked above).
+    assert patched >= 50, patched
 
 
 def test_analyze_nc_is_the_cli_on_every_fixture(cli: Path) -> None:
@@ -64,6 +66,8 @@ def test_analyze_nc_is_the_cli_on_every_fixture(cli: Path) -> None:
     compared = 0
     for k, rel in enumerate(fixtures):
         machine = MACHINES[k % 2]
+        if machine not in posted_for(read(rel)):
+            machine = MACHINES[(k + 1) % 2]  # the machine the program was posted for
         code, out, err = run_cli(cli, "analyze", rel, "-m", machine, "--json")
         try:
             report = polepatch.analyze_nc(read(rel), machine, name=rel)

@@ -26,12 +26,16 @@ def load_post():
 
 def test_the_freecad_post_patches_the_base_posts_program(tmp_path: Path, monkeypatch) -> None:
     post = load_post()
-    program = read("fixtures/c17/SING.I").decode("ascii")
+    # A B-C program for --polepatch-machine mikron-hsm600; C17's SING (A-C) for the
+    # post's default MACHINE.
+    bc = read("fixtures/generated/heidenhain-bc-swing-d0.1.I").decode("ascii")
+    sing = read("fixtures/c17/SING.I").decode("ascii")
+    program = [bc]
     calls = []
 
     def base_export(objectslist, filename, argstring):
         calls.append((objectslist, filename, argstring))
-        return program
+        return program[0]
 
     fake = types.ModuleType("standin_post")
     fake.export = base_export
@@ -41,12 +45,13 @@ def test_the_freecad_post_patches_the_base_posts_program(tmp_path: Path, monkeyp
     returned = post.export(["op"], str(out), args)
     # The base post got its own arguments and "-" (return, do not write).
     assert calls == [(["op"], "-", "--no-header --precision 4")]
-    want, report = polepatch.patch_nc(program.encode(), "mikron-hsm600")
-    assert report["zones"] and want != program.encode()
+    want, report = polepatch.patch_nc(bc.encode(), "mikron-hsm600")
+    assert report["zones"] and want != bc.encode()
     assert out.read_bytes() == want and returned == want.decode()
-    # "-": returned, not written.
+    # "-": returned, not written; the default machine.
+    program[0] = sing
     assert post.export([], "-", "--polepatch-base standin") == polepatch.patch_nc(
-        program.encode(), post.MACHINE
+        sing.encode(), post.MACHINE
     )[0].decode()
 
 
