@@ -25,10 +25,8 @@ use crate::frames::{Frames, refused_frame_record};
 use crate::records::{
     At, ClItem, ClPoint, ClProgram, CompSide, Coolant, MoveKind, SpindleDir, Units,
 };
-use crate::{
-    ClError, MAX_COORDINATE_MM, MAX_FEED_MM_MIN, MAX_SPINDLE_RPM, MM_PER_INCH, ParseOptions, err,
-    unit_axis,
-};
+use crate::values::{coordinate, number};
+use crate::{ClError, MAX_FEED_MM_MIN, MAX_SPINDLE_RPM, MM_PER_INCH, ParseOptions, err, unit_axis};
 
 /// Records that do not change what the machine does: read, counted, not posted.
 pub const PASSIVE: &[&str] = &[
@@ -215,36 +213,6 @@ fn no_record_word(text: &str, at: At) -> ClError {
             "'{shown}' does not start with an APT record word (GOTO/, FEDRAT/, …): values without a record, as a continuation line is when the line before it does not end with '$'"
         ),
     )
-}
-
-/// A finite number in a field (mm or whatever `what` is), with its column for errors.
-pub(crate) fn number(field: &str, at: At, what: &str) -> Result<f64, ClError> {
-    let t = field.trim();
-    let v: f64 = t
-        .parse()
-        .map_err(|_| err(at.line, at.column, format!("{what} '{t}' is not a number")))?;
-    if !v.is_finite() {
-        return Err(err(
-            at.line,
-            at.column,
-            format!("{what} '{t}' is not a finite number"),
-        ));
-    }
-    Ok(v)
-}
-
-/// A coordinate in range (after conversion to mm).
-pub(crate) fn coordinate(v_mm: f64, at: At, what: &str, text: &str) -> Result<f64, ClError> {
-    if v_mm.abs() > MAX_COORDINATE_MM {
-        return Err(err(
-            at.line,
-            at.column,
-            format!(
-                "{what} '{text}' is {v_mm:.6e} mm, beyond the ±{MAX_COORDINATE_MM} mm polepatch accepts for a coordinate"
-            ),
-        ));
-    }
-    Ok(v_mm)
 }
 
 fn e(at: At, message: impl Into<String>) -> ClError {

@@ -6,8 +6,8 @@
 //! (`x,y,z,i,j,k,f`, `X Y Z I J K`), and a point otherwise (an error then points at it);
 //! a missing `f` carries the previous feed on.
 
-use crate::apt::{coordinate, number};
 use crate::records::{At, ClItem, ClPoint, ClProgram};
+use crate::values::{coordinate, number};
 use crate::{ClError, MAX_FEED_MM_MIN, err, unit_axis};
 
 /// Split `s` into its values (module docs): (value, byte offset of the value in `s`).

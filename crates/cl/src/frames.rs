@@ -26,8 +26,8 @@
 //!
 //! Where each meaning comes from is in `docs/post.md` ("Coordinate frames").
 
-use crate::apt::{coordinate, number};
 use crate::records::At;
+use crate::values::{coordinate, number};
 use crate::{ClError, err};
 
 /// Rotation matrices and MCS axes are accepted when orthonormal within this (CAM files

@@ -24,6 +24,7 @@ pub mod csv;
 pub mod cycles;
 pub mod frames;
 pub mod records;
+mod values;
 pub mod write;
 
 pub use arcs::{Arc, Plane};
