@@ -87,8 +87,8 @@ pub enum ZoneKind {
     CSwing,
 }
 
-/// A singular zone: where the C-limited ratio is below 1 with the primary axis inside the
-/// cone.
+/// A singular zone: where the C-limited ratio is below 1 because the tool axis passes near
+/// the pole ([`detect_zones`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Zone {
     /// First point index of the zone (the point before the first sample with ratio < 1).
@@ -104,6 +104,12 @@ pub struct Zone {
     pub min_abs_primary_deg: f64,
     /// Smallest C-limited Equation-6 ratio over the zone.
     pub c_ratio_min: f64,
+    /// C stays below feed before the zone's first point, where the pole does not dominate
+    /// its slowdown (the program's own, [`detect_zones`]): the zone was cut there from a
+    /// longer stretch, and its core takes no margin on that side ([`crate::zone_core`]).
+    pub cut_before: bool,
+    /// The same after the zone's last point.
+    pub cut_after: bool,
 }
 
 /// One point where Equation 6 was evaluated (a span's start, or a piece of its time
@@ -266,7 +272,7 @@ fn run_analysis(
 }
 
 /// A stretch of consecutive spans whose C-limited ratio is below 1.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct BelowFeed {
     /// First span.
     pub first_span: usize,
@@ -276,6 +282,22 @@ pub struct BelowFeed {
     pub min_ratio: f64,
     /// C's limit that binds that lowest ratio (velocity, acceleration or jerk).
     pub kind: LimitKind,
+    /// Each span's lowest C ratio and the limit binding it, `first_span..=last_span`:
+    /// what decides which of the stretch's spans are the pole's ([`detect_zones`]).
+    pub spans: Vec<(f64, LimitKind)>,
+}
+
+impl BelowFeed {
+    /// A stretch whose spans all have the stretch's lowest ratio and limit (tests).
+    pub fn uniform(first_span: usize, last_span: usize, ratio: f64, kind: LimitKind) -> Self {
+        BelowFeed {
+            first_span,
+            last_span,
+            min_ratio: ratio,
+            kind,
+            spans: vec![(ratio, kind); last_span + 1 - first_span],
+        }
+    }
 }
 
 /// Equation 6 at one point of a span: `d[axis] = [q', q'', q''']`.
@@ -416,19 +438,13 @@ impl Accumulator {
             match &mut self.open {
                 Some(b) => {
                     b.last_span = k;
+                    b.spans.push((rc, kc));
                     if rc < b.min_ratio {
                         b.min_ratio = rc;
                         b.kind = kc;
                     }
                 }
-                None => {
-                    self.open = Some(BelowFeed {
-                        first_span: k,
-                        last_span: k,
-                        min_ratio: rc,
-                        kind: kc,
-                    })
-                }
+                None => self.open = Some(BelowFeed::uniform(k, k, rc, kc)),
             }
         } else if let Some(b) = self.open.take() {
             self.below.push(b);
@@ -533,13 +549,84 @@ pub fn pole_dominates(min_abs_deg: f64, c_ratio: f64, kind: LimitKind) -> bool {
     s.powf(2.0 / e) <= c_ratio
 }
 
-/// Zones from the stretches where C is below feed: each stretch covers the points of its
-/// spans; overlapping or touching stretches merge; a stretch is a zone when a point in it
-/// has |primary| ≤ `cone_deg`, or — out to `pole_reach_deg` — when the pole dominates its
-/// slowdown ([`pole_dominates`], on the stretch's lowest C ratio and the limit binding it).
-/// A stretch admitted by the reach and the zone before it are one zone when the primary
-/// axis stays within the reach between them (one pass by the pole); zones the cone
-/// admits are never joined to each other here (the driver merges close ones).
+/// Whether span `k` of a stretch below feed is the pole's doing: one of its ends lies in the
+/// cone, or the pole dominates the span's own slowdown ([`pole_dominates`] on the span's
+/// closest end to the pole, its lowest C ratio and the limit binding it).
+fn pole_span(p: &impl Fn(usize) -> f64, k: usize, ratio: f64, kind: LimitKind, cone: f64) -> bool {
+    let d = p(k).abs().min(p(k + 1).abs());
+    d <= cone || pole_dominates(d, ratio, kind)
+}
+
+/// The zone over points `first..=last` (its spans' lowest C ratio `c_ratio_min`): its kind
+/// and singular point.
+fn zone_over(
+    p: &impl Fn(usize) -> f64,
+    first: usize,
+    last: usize,
+    c_ratio_min: f64,
+    (cut_before, cut_after): (bool, bool),
+) -> Zone {
+    let min_abs = (first..=last)
+        .map(|i| p(i).abs())
+        .fold(f64::INFINITY, f64::min);
+    // A flip: the primary changes sign between two points (or passes through 0 with
+    // opposite signs either side) inside the zone.
+    let mut flip = None;
+    let mut last_nonzero: Option<usize> = None;
+    for i in first..=last {
+        if p(i) == 0.0 {
+            continue;
+        }
+        if let Some(j) = last_nonzero
+            && p(j).signum() != p(i).signum()
+        {
+            flip = Some(j);
+            break;
+        }
+        last_nonzero = Some(i);
+    }
+    let least = (first..=last)
+        .min_by(|&a, &b| p(a).abs().total_cmp(&p(b).abs()))
+        .unwrap_or(first);
+    let (kind, singular) = match flip {
+        Some(j) => (ZoneKind::AFlip, j),
+        None => (ZoneKind::CSwing, least),
+    };
+    Zone {
+        first,
+        last,
+        singular,
+        kind,
+        min_abs_primary_deg: min_abs,
+        c_ratio_min,
+        cut_before,
+        cut_after,
+    }
+}
+
+/// Zones from the stretches where C is below feed (docs/method.md, "What a zone is").
+///
+/// Each stretch covers the points of its spans; overlapping or touching stretches merge. A
+/// stretch holds a zone when a point in it has |primary| ≤ `cone_deg`, or — out to
+/// `pole_reach_deg` — when the pole dominates its slowdown ([`pole_dominates`], on the
+/// stretch's closest approach, lowest C ratio and the limit binding it).
+///
+/// **The zone is the pole passage, not the whole stretch** (issue: a stretch that starts at
+/// the pole and sweeps C through 1800° while the primary axis goes out to 89° was one zone,
+/// and its patch turned tool axes 60–90° from the pole by up to 94°). From the stretch's
+/// spans in the cone (or, for a stretch the reach admits, the span(s) at its closest
+/// approach) the zone grows outward span by span while each span is the pole's: an end in
+/// the cone, or the pole dominating that span's own slowdown (`pole_span`). It stops at
+/// the first span that is not: there C crawls by the program's own doing (the table turning
+/// round with the tool far from the pole), which a patch near the pole neither causes nor
+/// can cure at a small change of tool axis. A zone cut so is marked on that side
+/// ([`Zone::cut_before`], [`Zone::cut_after`]); the rest of the stretch is no zone. One
+/// stretch may so hold several zones (passes into and out of the cone); the driver merges
+/// close ones.
+///
+/// A zone the reach admits and the zone before it are one zone when the primary axis stays
+/// within the reach between them (one pass by the pole); zones the cone admits are never
+/// joined to each other here (the driver merges close ones).
 pub fn detect_zones(
     path: &Path,
     below: &[BelowFeed],
@@ -547,84 +634,114 @@ pub fn detect_zones(
     pole_reach_deg: f64,
 ) -> Vec<Zone> {
     let p = |i: usize| path.axes[i][Axis::Primary.index()];
-    let mut merged: Vec<(usize, usize, f64, LimitKind)> = Vec::new();
+    // Touching stretches merged: first and last point, lowest ratio and its limit, and
+    // every span's (ratio, limit) from the first point on.
+    struct Stretch {
+        first: usize,
+        last: usize,
+        min_ratio: f64,
+        kind: LimitKind,
+        spans: Vec<(f64, LimitKind)>,
+    }
+    let mut merged: Vec<Stretch> = Vec::new();
     for b in below {
         let (first, last) = (b.first_span, b.last_span + 1);
+        let spans = || {
+            (0..=b.last_span - b.first_span)
+                .map(|k| b.spans.get(k).copied().unwrap_or((b.min_ratio, b.kind)))
+        };
         match merged.last_mut() {
-            Some(m) if first <= m.1 => {
-                m.1 = m.1.max(last);
-                if b.min_ratio < m.2 {
-                    m.2 = b.min_ratio;
-                    m.3 = b.kind;
+            Some(m) if first <= m.last => {
+                for (j, sp) in spans().enumerate() {
+                    let k = first + j - m.first;
+                    match m.spans.get_mut(k) {
+                        Some(x) if x.0 <= sp.0 => {}
+                        Some(x) => *x = sp,
+                        None => m.spans.push(sp),
+                    }
+                }
+                m.last = m.last.max(last);
+                if b.min_ratio < m.min_ratio {
+                    m.min_ratio = b.min_ratio;
+                    m.kind = b.kind;
                 }
             }
-            _ => merged.push((first, last, b.min_ratio, b.kind)),
+            _ => merged.push(Stretch {
+                first,
+                last,
+                min_ratio: b.min_ratio,
+                kind: b.kind,
+                spans: spans().collect(),
+            }),
         }
     }
+    let reach = pole_reach_deg.max(cone_deg);
     let mut zones: Vec<Zone> = Vec::new();
-    for (first, last, c_ratio_min, kind) in merged {
+    for st in merged {
+        let (first, last) = (st.first, st.last);
         let min_abs = (first..=last)
             .map(|i| p(i).abs())
             .fold(f64::INFINITY, f64::min);
         let in_cone = min_abs <= cone_deg;
-        let dominated = min_abs <= pole_reach_deg && pole_dominates(min_abs, c_ratio_min, kind);
+        let dominated = min_abs <= pole_reach_deg && pole_dominates(min_abs, st.min_ratio, st.kind);
         if !(in_cone || dominated) {
             continue;
         }
-        // A flip: the primary changes sign between two points (or passes through 0 with
-        // opposite signs either side) inside the zone.
-        let mut flip = None;
-        let mut last_nonzero: Option<usize> = None;
-        for i in first..=last {
-            if p(i) == 0.0 {
+        // The stretch's spans (k from `first`), which are the pole's, and the seeds.
+        let span = |k: usize| st.spans[k - first];
+        let is_pole = |k: usize| pole_span(&p, k, span(k).0, span(k).1, cone_deg);
+        let near = |k: usize| p(k).abs().min(p(k + 1).abs());
+        let mut seeds: Vec<usize> = (first..last).filter(|&k| near(k) <= cone_deg).collect();
+        if seeds.is_empty() {
+            let least = (first..=last)
+                .min_by(|&a, &b| p(a).abs().total_cmp(&p(b).abs()))
+                .unwrap_or(first);
+            seeds.push(least.min(last - 1));
+        }
+        let mut grown: Vec<(usize, usize)> = Vec::new();
+        for seed in seeds {
+            if grown.last().is_some_and(|g| seed <= g.1) {
                 continue;
             }
-            if let Some(j) = last_nonzero
-                && p(j).signum() != p(i).signum()
-            {
-                flip = Some(j);
-                break;
+            let (mut a, mut b) = (seed, seed);
+            while a > first && is_pole(a - 1) {
+                a -= 1;
             }
-            last_nonzero = Some(i);
+            while b + 1 < last && is_pole(b + 1) {
+                b += 1;
+            }
+            grown.push((a, b));
         }
-        let least = (first..=last)
-            .min_by(|&a, &b| p(a).abs().total_cmp(&p(b).abs()))
-            .unwrap_or(first);
-        let (kind, singular) = match flip {
-            Some(j) => (ZoneKind::AFlip, j),
-            None => (ZoneKind::CSwing, least),
-        };
-        let zone = Zone {
-            first,
-            last,
-            singular,
-            kind,
-            min_abs_primary_deg: min_abs,
-            c_ratio_min,
-        };
-        // One pass by the pole is one zone: a stretch the reach admits joins the zone
-        // before it (and a zone joins such a stretch) when the primary axis stays within
-        // the reach between them — the same pass, patched in one go.
-        if let Some(prev) = zones.last_mut()
-            && (!in_cone || prev.min_abs_primary_deg > cone_deg)
-            && (prev.last..=zone.first).all(|i| p(i).abs() <= pole_reach_deg.max(cone_deg))
-        {
-            let keep_prev = prev.min_abs_primary_deg <= zone.min_abs_primary_deg;
-            *prev = Zone {
-                first: prev.first,
-                last: zone.last,
-                singular: if keep_prev {
-                    prev.singular
-                } else {
-                    zone.singular
-                },
-                kind: if keep_prev { prev.kind } else { zone.kind },
-                min_abs_primary_deg: prev.min_abs_primary_deg.min(zone.min_abs_primary_deg),
-                c_ratio_min: prev.c_ratio_min.min(zone.c_ratio_min),
-            };
-            continue;
+        for (a, b) in grown {
+            let c_ratio_min = (a..=b).map(|k| span(k).0).fold(f64::INFINITY, f64::min);
+            let zone = zone_over(&p, a, b + 1, c_ratio_min, (a > first, b + 1 < last));
+            let zone_in_cone = zone.min_abs_primary_deg <= cone_deg;
+            // One pass by the pole is one zone: a zone the reach admits joins the zone
+            // before it (and a zone joins such a zone) when the primary axis stays within
+            // the reach between them — the same pass, patched in one go.
+            if let Some(prev) = zones.last_mut()
+                && (!zone_in_cone || prev.min_abs_primary_deg > cone_deg)
+                && (prev.last..=zone.first).all(|i| p(i).abs() <= reach)
+            {
+                let keep_prev = prev.min_abs_primary_deg <= zone.min_abs_primary_deg;
+                *prev = Zone {
+                    first: prev.first,
+                    last: zone.last,
+                    singular: if keep_prev {
+                        prev.singular
+                    } else {
+                        zone.singular
+                    },
+                    kind: if keep_prev { prev.kind } else { zone.kind },
+                    min_abs_primary_deg: prev.min_abs_primary_deg.min(zone.min_abs_primary_deg),
+                    c_ratio_min: prev.c_ratio_min.min(zone.c_ratio_min),
+                    cut_before: prev.cut_before,
+                    cut_after: zone.cut_after,
+                };
+                continue;
+            }
+            zones.push(zone);
         }
-        zones.push(zone);
     }
     zones
 }
@@ -806,24 +923,9 @@ mod tests {
     fn touching_stretches_merge() {
         let path = planted(41, 1.0, 1.0, false, 1000.0);
         let below = [
-            BelowFeed {
-                first_span: 10,
-                last_span: 14,
-                min_ratio: 0.5,
-                kind: LimitKind::Velocity,
-            },
-            BelowFeed {
-                first_span: 15,
-                last_span: 22,
-                min_ratio: 0.2,
-                kind: LimitKind::Jerk,
-            },
-            BelowFeed {
-                first_span: 30,
-                last_span: 31,
-                min_ratio: 0.9,
-                kind: LimitKind::Acceleration,
-            },
+            BelowFeed::uniform(10, 14, 0.5, LimitKind::Velocity),
+            BelowFeed::uniform(15, 22, 0.2, LimitKind::Jerk),
+            BelowFeed::uniform(30, 31, 0.9, LimitKind::Acceleration),
         ];
         let zones = detect_zones(&path, &below, 50.0, 50.0);
         assert_eq!(zones.len(), 2, "{zones:?}");
@@ -867,14 +969,7 @@ mod tests {
         for q in &mut path.axes {
             q[3] = q[3].abs() + 9.0;
         }
-        let below = |r: f64| {
-            [BelowFeed {
-                first_span: 10,
-                last_span: 14,
-                min_ratio: r,
-                kind: LimitKind::Acceleration,
-            }]
-        };
+        let below = |r: f64| [BelowFeed::uniform(10, 14, r, LimitKind::Acceleration)];
         // min |P| is 9° + the planted pass's own least |P|.
         let least = (10..=15)
             .map(|i| path.axes[i][3])
@@ -894,6 +989,60 @@ mod tests {
             1,
             "in the cone"
         );
+    }
+
+    /// A stretch below feed that starts at the pole and goes on far from it (the shape of a
+    /// real NX post's run, B 0 → 62° with C turning all along): the zone is the stretch's
+    /// spans that are the pole's — grown from the cone span by span while the pole
+    /// dominates each span's own slowdown — and is marked cut where the stretch goes on.
+    #[test]
+    fn a_zone_stops_where_the_pole_no_longer_dominates() {
+        // P = 1° a point, 0 → 40°.
+        let path = Path {
+            s_mm: (0..41).map(f64::from).collect(),
+            axes: (0..41)
+                .map(|i| [f64::from(i), 0.0, 0.0, f64::from(i), 0.0])
+                .collect(),
+            feed_mm_min: 1000.0,
+        };
+        // C at 2 % of feed by its velocity on every span: the pole's while sin²P ≤ 0.02,
+        // P ≤ 8.13°: spans 0..=8 (their nearer end ≤ 8°), points 0..=9.
+        let zones = detect_zones(
+            &path,
+            &[BelowFeed::uniform(0, 39, 0.02, LimitKind::Velocity)],
+            5.0,
+            10.0,
+        );
+        assert_eq!(zones.len(), 1, "{zones:?}");
+        let z = &zones[0];
+        assert_eq!((z.first, z.last), (0, 9), "{z:?}");
+        assert!(!z.cut_before && z.cut_after);
+        // At 50 % the pole dominates out to 45°: the whole stretch, not cut.
+        let zones = detect_zones(
+            &path,
+            &[BelowFeed::uniform(0, 39, 0.5, LimitKind::Velocity)],
+            5.0,
+            10.0,
+        );
+        assert_eq!((zones[0].first, zones[0].last), (0, 40));
+        assert!(!zones[0].cut_before && !zones[0].cut_after);
+        // Each span's own ratio counts: one span far below feed (a corner of the program's
+        // own) ends the zone there.
+        let mut below = BelowFeed::uniform(0, 39, 0.5, LimitKind::Velocity);
+        below.spans[20] = (0.01, LimitKind::Velocity);
+        below.min_ratio = 0.01;
+        let zones = detect_zones(&path, &[below], 5.0, 10.0);
+        assert_eq!((zones[0].first, zones[0].last), (0, 20), "{zones:?}");
+        assert!(zones[0].cut_after && zones[0].c_ratio_min == 0.5);
+        // With a fixed cone (the reach at it) and a slowdown the pole dominates nowhere
+        // beyond it, the zone is the cone's spans.
+        let zones = detect_zones(
+            &path,
+            &[BelowFeed::uniform(0, 39, 0.001, LimitKind::Jerk)],
+            5.0,
+            5.0,
+        );
+        assert_eq!((zones[0].first, zones[0].last), (0, 6), "{zones:?}");
     }
 
     /// Bad paths are errors, never a panic or a silent result.

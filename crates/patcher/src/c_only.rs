@@ -5,7 +5,8 @@
 //! G16 patch ([`crate::g16::g16_patch`]) with `extra` CL points beyond its joins, and the
 //! direct QP ([`crate::direct::direct_patch`]) over the hull of the zone widened by
 //! `extra`, the G16 patch's range and the previous level's direct range, monotone with the
-//! sign of the net change, then (only if that does not pass) without monotonicity.
+//! sign of the net change, then (only if that does not pass, or passes only beyond the pole
+//! reach — the safety bound's, `crate::driver::pole_bound_deg`) without monotonicity.
 //!
 //! Widening goes on after the first pass while a level lowers the best deviation by at
 //! least [`SolverSettings::deviation_improvement_min`], for at most
@@ -51,6 +52,7 @@ impl COnly {
         let n = ctx.s.len();
         let lim = CLimits::new(ctx.machine, ctx.feed_mm_min, ctx.margin);
         let zone = ctx.zone;
+        let reach = ctx.opts.reach_deg();
         let mut direct_range: Option<(usize, usize)> = None;
         let mut levels_after_pass = 0usize;
         let mut g16_gave_up = !self.g16;
@@ -120,7 +122,11 @@ impl COnly {
                 for &mono in tries {
                     match direct_patch(ctx.s, ctx.p, ctx.c, first, last, &lim, mono, opts) {
                         Ok(c) => {
-                            if offer(c, Method::Direct, sink).is_some_and(|o| o.passes) {
+                            // A pass beyond the pole reach is beyond the safety bound (the
+                            // driver refuses it): then try without monotonicity too.
+                            if offer(c, Method::Direct, sink)
+                                .is_some_and(|o| o.passes && o.deviation_deg <= reach)
+                            {
                                 break;
                             }
                         }
@@ -152,15 +158,57 @@ impl COnly {
     }
 }
 
+/// A sink that passes everything on to `sink` and notes whether a proposal passed with a
+/// deviation beyond `cap_deg`.
+struct Noting<'s> {
+    sink: &'s mut dyn Sink,
+    cap_deg: f64,
+    passed_beyond: bool,
+}
+
+impl Sink for Noting<'_> {
+    fn offer(&mut self, p: Proposal) -> Option<crate::protocol::Offered> {
+        let o = self.sink.offer(p)?;
+        self.passed_beyond |= o.passes && o.deviation_deg > self.cap_deg;
+        Some(o)
+    }
+    fn add_stats(&mut self, qp: &crate::report::QpStats) {
+        self.sink.add_stats(qp);
+    }
+    fn best_passing_deg(&self) -> Option<f64> {
+        self.sink.best_passing_deg()
+    }
+}
+
 impl Proposer for COnly {
+    /// The levels without a cap; when nothing within `max_deviation_deg` and the safety
+    /// bound passes, again with the cap imposed in the QPs: the smaller of
+    /// `max_deviation_deg` and the pole reach — the safety bound of a C-only change
+    /// (`crate::driver::pole_bound_deg`: a change of C alone keeps each tool axis at its
+    /// distance |P| from the pole, so it never turns it by more than 2|P|; the reach is
+    /// the part of the bound that can bind), imposed when a proposal passed beyond it.
     fn propose(&mut self, ctx: &ZoneCtx<'_>, sink: &mut dyn Sink) {
         let uncapped = PatchOptions {
             max_deviation_deg: None,
             ..ctx.opts.clone()
         };
-        self.levels(ctx, &uncapped, sink);
-        if ctx.opts.max_deviation_deg.is_some() && sink.best_passing_deg().is_none() {
-            self.levels(ctx, ctx.opts, sink);
+        let reach = ctx.opts.reach_deg();
+        let cap = ctx.opts.max_deviation_deg.map_or(reach, |d| d.min(reach));
+        let mut noting = Noting {
+            sink,
+            cap_deg: cap,
+            passed_beyond: false,
+        };
+        self.levels(ctx, &uncapped, &mut noting);
+        let (passed_beyond, sink) = (noting.passed_beyond, noting.sink);
+        if (ctx.opts.max_deviation_deg.is_some() || passed_beyond)
+            && sink.best_passing_deg().is_none()
+        {
+            let capped = PatchOptions {
+                max_deviation_deg: Some(cap),
+                ..ctx.opts.clone()
+            };
+            self.levels(ctx, &capped, sink);
         }
     }
 }

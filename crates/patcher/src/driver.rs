@@ -18,8 +18,10 @@
 //!      [`SolverSettings::core_margin_points`]), and nothing gets worse around it;
 //!    - **selection**: of the passing candidates whose exact largest orientation change
 //!      (the angle between the old and new tool axes, on the written values) is within
-//!      `max_deviation_deg`, the smallest; else the best improvement within it; else
-//!      nothing.
+//!      `max_deviation_deg` and within every point's safety bound ([`pole_bound_deg`],
+//!      on the exact angle of the written words), the smallest; else the best improvement
+//!      within them (a change beyond them scaled into them, or the joint method's capped
+//!      solve); else nothing.
 //! 4. **Verify what is written, whole** ([`whole_run_worse`]): the whole run with the
 //!    written values is analysed again, exactly as `analyze` does; a zone whose patch made
 //!    any span of a checked axis worse than before ([`crate::verify::not_worse_floor`]: a
@@ -33,6 +35,11 @@
 //! - `reselected`: branch re-selection alone reaches feed: no orientation change at all;
 //! - `deviation_cap`: a patch that reaches feed exists, but its orientation change exceeds
 //!   `max_deviation_deg`;
+//! - `safety_bound`: a patch that reaches feed exists, but it turns some point's tool axis
+//!   beyond the safety bound near the pole ([`pole_bound_deg`]: twice the point's distance
+//!   from the pole, at most the pole reach);
+//! - `tip_path`: a ball kept at its tip: a patch reaches feed on the tip path it was solved
+//!   on, but not on the tips it writes;
 //! - `end_pinned`: the run's last point must keep its values (`keep_last_point`, the NC
 //!   pipeline says which block pins it), and with it held **no** values reach feed, while
 //!   with it free some would (both by the relaxation of [`crate::proof::reachable`]);
@@ -55,12 +62,12 @@ use crate::{
     qp::add_stats,
     report::{Method, Outcome, QpStats, Reason, ZoneFigures, ZoneReport},
     settings::SolverSettings,
-    tolerances::{CAP_SLACK_DEG, CHECK_MARGIN_POINTS, RATIO_TOL},
+    tolerances::{CAP_SLACK_DEG, CENTRE_TIME_REL, CHECK_MARGIN_POINTS, RATIO_TOL},
     verify::{AxisChange, Verdict, not_worse_floor, verify_change_on, verify_change_with_core},
 };
 use polepatch_kinematics::{Axis, Machine, angle_between_deg, forward};
 
-pub use crate::zones::{figures_over, merge_zones, zone_core};
+pub use crate::zones::{core_margins, figures_over, merge_zones, zone_core};
 
 /// A candidate after rounding and verification.
 #[derive(Debug, Clone)]
@@ -70,6 +77,31 @@ struct Checked {
     decimals: (usize, usize),
     verdict: Verdict,
     deviation_deg: f64,
+    /// The largest ratio of a point's exact orientation change to its safety bound
+    /// ([`pole_bound_deg`]; 0 where nothing changed).
+    bound_ratio: f64,
+    /// Every point's change within its safety bound, up to the rounding of the words
+    /// written ([`bound_room_deg`]).
+    within_bound: bool,
+    /// With a ball's centre kept: it fails on the tips it writes, but passes on the path
+    /// length the methods solved on (the moved tips spoiled it).
+    tips_spoiled: bool,
+}
+
+/// The safety bound on the orientation change of a point whose primary axis is programmed
+/// at `p_deg`, degrees (docs/method.md, "The safety bound"): twice its distance from the
+/// pole — every tool axis no farther from the pole than the programmed one is within
+/// that — and never more than the pole reach `reach_deg` (the cone, or the pole reach
+/// beyond it: how far from the pole a zone lies).
+pub fn pole_bound_deg(p_deg: f64, reach_deg: f64) -> f64 {
+    (2.0 * p_deg.abs()).min(reach_deg)
+}
+
+/// What the rounding of the written words adds to a point's orientation change at most,
+/// degrees, with `decimals` (P, C): half a unit of the last decimal of each (a change of
+/// C by δ turns the tool axis by at most δ·sin|P| ≤ δ).
+fn bound_room_deg(decimals: (usize, usize)) -> f64 {
+    0.5 * (10f64.powi(-(decimals.0 as i32)) + 10f64.powi(-(decimals.1 as i32))) + CAP_SLACK_DEG
 }
 
 /// The driver's [`Sink`] for one zone: checks proposals and keeps the best.
@@ -78,6 +110,8 @@ struct Selection<'a> {
     /// The path's axis values (the tips the program states).
     axes: &'a [[f64; 5]],
     target: &'a [[f64; 3]],
+    /// Per point, the safety bound on its orientation change ([`pole_bound_deg`]).
+    bound: &'a [f64],
     machine: &'a Machine,
     opts: &'a PatchOptions,
     zone: &'a Zone,
@@ -90,8 +124,16 @@ struct Selection<'a> {
     stats: QpStats,
     passed: Option<Checked>,
     improved: Option<Checked>,
-    /// The smallest deviation of a passing proposal beyond the cap.
+    /// The smallest deviation of a passing proposal within the safety bound but beyond
+    /// the cap.
     over_cap_deg: Option<f64>,
+    /// The smallest deviation of a passing proposal beyond the safety bound.
+    over_bound_deg: Option<f64>,
+    /// A proposal within the safety bound passed on the path length it was solved on
+    /// but not on the tips it writes (a ball's centre kept).
+    tips_spoiled: bool,
+    /// The one of those within the cap with the smallest deviation.
+    spoiled: Option<Checked>,
     /// The peer's proposal, taken as it is.
     as_is: Option<Checked>,
 }
@@ -160,8 +202,10 @@ impl Selection<'_> {
                 .collect();
             Some(tip_length(self.s[lo], &tips))
         };
-        let margin = self.opts.solver.core_margin_points;
-        let verify = |wp: &[f64], wc: &[f64]| {
+        let margin = core_margins(self.zone, self.opts.solver.core_margin_points);
+        // `tips`: on the tips the values write (with a ball's centre kept), else on the
+        // path length the methods solved on.
+        let verify_on = |wp: &[f64], wc: &[f64], tips: bool| {
             let ch: Vec<AxisChange> = axes
                 .iter()
                 .map(|&axis| AxisChange {
@@ -174,8 +218,9 @@ impl Selection<'_> {
                 (first - lo, changed_hi - lo),
                 (self.zone.first.max(lo) - lo, self.zone.last.min(hi) - lo),
             );
-            match (tip_s(bp, bc), tip_s(wp, wc)) {
-                (Some(sb), Some(sa)) => verify_change_on(
+            let moved = || Some((tip_s(bp, bc)?, tip_s(wp, wc)?)).filter(|_| tips);
+            match moved() {
+                Some((sb, sa)) => verify_change_on(
                     &sb,
                     &sa,
                     &ch,
@@ -196,31 +241,60 @@ impl Selection<'_> {
                 ),
             }
         };
-        let deviation = |wp: &[f64], wc: &[f64]| {
-            (first..=last)
-                .map(|i| {
-                    angle_between_deg(
-                        self.target[i],
-                        forward(self.machine, wp[i - lo], wc[i - lo]),
-                    )
-                })
-                .fold(0.0, f64::max)
+        let verify = |wp: &[f64], wc: &[f64]| verify_on(wp, wc, true);
+        // With a ball's centre kept, a change that fails on the tips it writes but passes on
+        // the path length it was solved on: the moved tips spoiled it.
+        let keeps_centre = self.opts.keep_centre.is_some_and(|k| k.s_is_length);
+        let spoiled = |wp: &[f64], wc: &[f64]| keeps_centre && verify_on(wp, wc, false).passes();
+        // The largest exact change, its largest ratio to the safety bound, and whether every
+        // point is within its bound (up to the rounding of `d`'s decimals).
+        let deviation = |wp: &[f64], wc: &[f64], d: (usize, usize)| {
+            let room = bound_room_deg(d);
+            let (mut dev, mut ratio, mut within) = (0.0f64, 0.0f64, true);
+            for i in first..=last {
+                let a = angle_between_deg(
+                    self.target[i],
+                    forward(self.machine, wp[i - lo], wc[i - lo]),
+                );
+                dev = dev.max(a);
+                if a > 0.0 {
+                    ratio = ratio.max(a / self.bound[i].max(f64::MIN_POSITIVE));
+                }
+                within &= a <= self.bound[i] + room;
+            }
+            (dev, ratio, within)
         };
         let (pd0, cd0) = (self.opts.p_decimals, self.opts.c_decimals);
         if !self.verify {
             let (wp, wc) = self.materialize(prop, lo, hi, Some((pd0, cd0)));
+            let (deviation_deg, bound_ratio, within_bound) = deviation(&wp, &wc, (pd0, cd0));
             return Some((
                 Checked {
                     prop: prop.clone(),
                     decimals: (pd0, cd0),
                     verdict: verify(&wp, &wc),
-                    deviation_deg: deviation(&wp, &wc),
+                    deviation_deg,
+                    bound_ratio,
+                    within_bound,
+                    tips_spoiled: false,
                 },
                 false,
             ));
         }
+        // (Unrounded: where only the rounding fails on the solve's path length, more
+        // decimals would mend it, as they do on the tips.)
+        let fails = |mut checked: Checked| {
+            if keeps_centre {
+                let (up, uc) = self.materialize(prop, lo, hi, None);
+                checked.tips_spoiled = spoiled(&up, &uc);
+            }
+            Some((checked, false))
+        };
         let max_d = self.opts.max_decimals.max(pd0).max(cd0);
         let mut last_checked: Option<Checked> = None;
+        // Only an improvement to keep (the unrounded values improve, but do not reach
+        // feed): more decimals until the rounding no longer spoils it.
+        let mut improving = false;
         for extra in 0..=max_d - pd0.min(cd0) {
             let d = ((pd0 + extra).min(max_d), (cd0 + extra).min(max_d));
             if last_checked.as_ref().is_some_and(|l| l.decimals == d) {
@@ -228,30 +302,59 @@ impl Selection<'_> {
             }
             let (wp, wc) = self.materialize(prop, lo, hi, Some(d));
             let verdict = verify(&wp, &wc);
+            let (deviation_deg, bound_ratio, within_bound) = deviation(&wp, &wc, d);
             let checked = Checked {
                 prop: prop.clone(),
                 decimals: d,
                 verdict,
-                deviation_deg: deviation(&wp, &wc),
+                deviation_deg,
+                bound_ratio,
+                within_bound,
+                tips_spoiled: false,
             };
             if verdict.passes() {
                 return Some((checked, true));
             }
+            if improving && verdict.improves() {
+                return fails(checked);
+            }
             if extra == 0 {
-                // Not a rounding problem if the unrounded values fail too.
+                // Not a rounding problem if the unrounded values fail too — unless they
+                // improve the zone and the rounding made a span worse (a capped solve's
+                // best improvement: its spans beyond their limits may not grow).
                 let (up, uc) = self.materialize(prop, lo, hi, None);
-                if !verify(&up, &uc).passes() {
-                    return Some((checked, false));
+                let unrounded = verify(&up, &uc);
+                if !unrounded.passes() {
+                    if verdict.improves() || !unrounded.improves() {
+                        return fails(checked);
+                    }
+                    improving = true;
                 }
             }
             last_checked = Some(checked);
         }
-        last_checked.map(|l| (l, false))
+        last_checked.and_then(fails)
     }
 
-    /// Keep `ck` as the best improvement so far when it improves the zone more.
+    /// Whether `prop` keeps to the pole passage: beyond a side where the zone was cut from
+    /// a longer stretch below feed (the program slow by its own doing, far from the pole,
+    /// `crate::analysis::detect_zones`) it changes at most
+    /// [`SolverSettings::joint_range_min_points`] points, to join the program.
+    fn local(&self, prop: &Proposal) -> bool {
+        let (z, join) = (self.zone, self.opts.solver.joint_range_min_points);
+        let changed_last = match prop.tail {
+            Tail::Keep => prop.last,
+            _ => self.s.len() - 1,
+        };
+        (!z.cut_before || prop.first + join >= z.first)
+            && (!z.cut_after || changed_last <= z.last + join)
+    }
+
+    /// Keep `ck` as the best improvement so far when it improves the zone more (and keeps
+    /// to the pole passage: [`Selection::local`]).
     fn consider_improved(&mut self, ck: Checked) {
         if ck.verdict.improves()
+            && self.local(&ck.prop)
             && ck.verdict.core_min_after > 0.0
             && self
                 .improved
@@ -263,30 +366,36 @@ impl Selection<'_> {
     }
 
     /// `prop`'s change from the current values scaled by λ < 1 so that its deviation
-    /// (`dev_deg` unscaled) is within the cap, checked as written; λ shrinks by the ratio of
-    /// cap to deviation until it fits (a few tries: the deviation is nearly linear in λ).
-    /// `None` for a change that moves the points after it (a re-selected tail is not a
-    /// change to scale) or that does not fit.
-    fn scaled_into_cap(&self, prop: &Proposal, dev_deg: f64) -> Option<Checked> {
-        let cap = self.opts.max_deviation_deg?;
+    /// (`dev_deg` unscaled) is within the cap and every point's within its safety bound
+    /// (`bound_ratio` unscaled: the largest ratio of a point's change to its bound), checked
+    /// as written; λ shrinks by the ratio of cap to deviation (or of bound to change) until
+    /// it fits (a few tries: the deviation is nearly linear in λ). `None` for a change that
+    /// moves the points after it (a re-selected tail is not a change to scale) or that
+    /// does not fit.
+    fn scaled_into_cap(&self, prop: &Proposal, dev_deg: f64, bound_ratio: f64) -> Option<Checked> {
+        let cap = self.opts.max_deviation_deg.unwrap_or(f64::INFINITY);
         if !matches!(prop.tail, Tail::Keep) || cap <= 0.0 {
             return None;
         }
         let mut lambda = 1.0;
-        let mut dev = dev_deg;
+        let (mut dev, mut ratio) = (dev_deg, bound_ratio);
         let st = &self.opts.solver;
         for _ in 0..st.scale_tries {
-            lambda *= (cap / dev) * st.scale_safety;
+            let over = (dev / cap).max(ratio);
+            if !(over > 0.0 && over.is_finite()) {
+                return None;
+            }
+            lambda *= st.scale_safety / over;
             let mut scaled = prop.clone();
             for (k, i) in (prop.first..=prop.last).enumerate() {
                 scaled.p[k] = self.p[i] + lambda * (prop.p[k] - self.p[i]);
                 scaled.c[k] = self.c[i] + lambda * (prop.c[k] - self.c[i]);
             }
             let (ck, _) = self.check(&scaled)?;
-            if self.within_cap(ck.deviation_deg) {
+            if self.within_cap(ck.deviation_deg) && ck.within_bound {
                 return Some(ck);
             }
-            dev = ck.deviation_deg;
+            (dev, ratio) = (ck.deviation_deg, ck.bound_ratio);
         }
         None
     }
@@ -311,21 +420,36 @@ impl Sink for Selection<'_> {
             return Some(out);
         }
         let in_cap = self.within_cap(ck.deviation_deg);
-        if passes && !in_cap {
-            self.over_cap_deg = Some(
-                self.over_cap_deg
-                    .map_or(ck.deviation_deg, |d| d.min(ck.deviation_deg)),
-            );
+        let in_bound = ck.within_bound;
+        self.tips_spoiled |= ck.tips_spoiled && in_bound;
+        if ck.tips_spoiled
+            && in_bound
+            && in_cap
+            && self
+                .spoiled
+                .as_ref()
+                .is_none_or(|b| ck.deviation_deg < b.deviation_deg)
+        {
+            self.spoiled = Some(ck.clone());
         }
-        if !in_cap {
-            // The best improvement within the cap: the change scaled down until its
-            // deviation as written fits (issue 26: a cap below what the zone needs gave
-            // nothing; a solve capped at the limit can exceed it by its rounding).
-            if let Some(scaled) = self.scaled_into_cap(&prop, ck.deviation_deg) {
+        let keep_min =
+            |x: Option<f64>| Some(x.map_or(ck.deviation_deg, |d| d.min(ck.deviation_deg)));
+        // Beyond the bound, a change that reaches feed on the path it was solved on counts
+        // even where the moved tips spoil it: the bound refuses it first.
+        if (passes || ck.tips_spoiled) && !in_bound {
+            self.over_bound_deg = keep_min(self.over_bound_deg);
+        } else if passes && !in_cap {
+            self.over_cap_deg = keep_min(self.over_cap_deg);
+        }
+        if !in_cap || !in_bound {
+            // The best improvement within the cap and the bound: the change scaled down
+            // until its deviation as written fits (issue 26: a cap below what the zone
+            // needs gave nothing; a solve capped at the limit can exceed it by its
+            // rounding).
+            if let Some(scaled) = self.scaled_into_cap(&prop, ck.deviation_deg, ck.bound_ratio) {
                 self.consider_improved(scaled);
             }
-        }
-        if passes && in_cap {
+        } else if passes {
             if self
                 .passed
                 .as_ref()
@@ -333,7 +457,7 @@ impl Sink for Selection<'_> {
             {
                 self.passed = Some(ck);
             }
-        } else if in_cap {
+        } else {
             self.consider_improved(ck);
         }
         Some(out)
@@ -392,6 +516,11 @@ struct Done {
     kept: Option<Checked>,
     stats: QpStats,
     over_cap_deg: Option<f64>,
+    over_bound_deg: Option<f64>,
+    /// A patch passed on the path length it was solved on but not on the tips it writes.
+    tips_spoiled: bool,
+    /// The best such patch within the cap (the next solve aims at its tips).
+    spoiled: Option<Checked>,
     /// The zone's patch was put back by the whole-run verification.
     reverted: bool,
     /// The first and last point its patch could change.
@@ -501,6 +630,8 @@ struct Fixed<'a> {
     opts: &'a PatchOptions,
     /// The program's tool axes.
     target: Vec<[f64; 3]>,
+    /// Per point, the safety bound on its orientation change ([`pole_bound_deg`]).
+    bound: Vec<f64>,
     verify: bool,
 }
 
@@ -522,6 +653,7 @@ fn solve_zone(
         s: f.s,
         axes: &path.axes,
         target: &f.target,
+        bound: &f.bound,
         machine: f.machine,
         opts,
         zone: &zone,
@@ -535,12 +667,16 @@ fn solve_zone(
         passed: None,
         improved: None,
         over_cap_deg: None,
+        over_bound_deg: None,
+        tips_spoiled: false,
+        spoiled: None,
         as_is: None,
     };
     for (rung, factor) in st.margin_ladder.iter().enumerate() {
         let ctx = ZoneCtx {
             s: f.s,
             target: &f.target,
+            bound_deg: &f.bound,
             machine: f.machine,
             opts,
             settings: st,
@@ -575,12 +711,21 @@ fn solve_zone(
     } else {
         sel.as_is.take()
     };
-    let (stats, over_cap_deg) = (sel.stats.clone(), sel.over_cap_deg);
+    let (stats, over_cap_deg, over_bound_deg, tips_spoiled) = (
+        sel.stats.clone(),
+        sel.over_cap_deg,
+        sel.over_bound_deg,
+        sel.tips_spoiled,
+    );
+    let spoiled = sel.spoiled.take();
     Done {
         zone,
         kept,
         stats,
         over_cap_deg,
+        over_bound_deg,
+        tips_spoiled,
+        spoiled,
         reverted: false,
         bounds: (lower, end),
     }
@@ -601,7 +746,7 @@ pub fn patch_with(
     mut methods: Vec<Box<dyn Proposer>>,
     verify: bool,
 ) -> Result<PatchResult, PathError> {
-    let mut best = patch_on(path, &path.s_mm, machine, opts, &mut methods, verify)?;
+    let (mut best, mut next_s) = patch_on(path, &path.s_mm, machine, opts, &mut methods, verify)?;
     if opts.keep_centre.is_none_or(|k| !k.s_is_length) {
         return Ok(best);
     }
@@ -611,35 +756,50 @@ pub fn patch_with(
             .filter(|z| z.outcome == Outcome::Reached)
             .count()
     };
-    let mut last = best.clone();
-    let mut solve_s = path.s_mm.clone();
+    // More zones at feed, else less time over the zones (each solve's figures are those of
+    // the tips it writes): a later solve that only improves more is kept too.
+    let time = |r: &PatchResult| r.zones.iter().map(|z| z.after.time_s).sum::<f64>();
+    let better = |a: &PatchResult, b: &PatchResult| {
+        reached(a) > reached(b)
+            || (reached(a) == reached(b) && time(a) < time(b) * (1.0 - CENTRE_TIME_REL))
+    };
+    // Every path length solved on: solving on one again would go round in a cycle (a
+    // solve that kept nothing and had nothing spoiled by its tips writes the program's
+    // tips, whose length was solved on first).
+    let mut solved: Vec<Vec<f64>> = vec![path.s_mm.clone()];
+    let moved = |s: &[f64], t: &[f64]| {
+        s.windows(2)
+            .zip(t.windows(2))
+            .map(|(a, b)| ((a[1] - a[0]) - (b[1] - b[0])).abs() / (b[1] - b[0]))
+            .fold(0.0, f64::max)
+    };
     for _ in 0..opts.solver.centre_s_iterations {
         if reached(&best) == best.zones.len() {
             break;
         }
-        let s = tip_length(path.s_mm[0], &last.xyz_mm);
-        let moved = s
-            .windows(2)
-            .zip(solve_s.windows(2))
-            .map(|(a, b)| ((a[1] - a[0]) - (b[1] - b[0])).abs() / (b[1] - b[0]))
-            .fold(0.0, f64::max);
-        if moved.is_nan()
-            || moved <= opts.solver.centre_s_tol
-            || s.windows(2).any(|w| w[1].is_nan() || w[1] <= w[0])
+        let Some(s) = next_s else { break };
+        if s.windows(2).any(|w| w[1].is_nan() || w[1] <= w[0])
+            || solved.iter().any(|t| {
+                let m = moved(&s, t);
+                m.is_nan() || m <= opts.solver.centre_s_tol
+            })
         {
             break;
         }
-        solve_s = s;
-        last = patch_on(path, &solve_s, machine, opts, &mut methods, verify)?;
-        if reached(&last) > reached(&best) {
-            best = last.clone();
+        let last;
+        (last, next_s) = patch_on(path, &s, machine, opts, &mut methods, verify)?;
+        solved.push(s);
+        if better(&last, &best) {
+            best = last;
         }
     }
     Ok(best)
 }
 
 /// [`patch_with`] with the methods solving on the path length `solve_s`: the steps of the
-/// module docs, one function each.
+/// module docs, one function each. With a ball's centre kept, also the path length to
+/// solve on next: the length of the tips written, where a zone kept nothing with those of
+/// its best change that passed on `solve_s` but not on its own tips ([`Run::next_s`]).
 fn patch_on(
     path: &Path,
     solve_s: &[f64],
@@ -647,18 +807,18 @@ fn patch_on(
     opts: &PatchOptions,
     methods: &mut [Box<dyn Proposer>],
     verify: bool,
-) -> Result<PatchResult, PathError> {
+) -> Result<(PatchResult, Option<Vec<f64>>), PathError> {
     // 1. Validate; a path with no point near the pole is unchanged.
     validate(path)?;
     opts.validate()?;
     if !near_pole(path, opts) {
-        return Ok(PatchResult::unchanged(path, opts));
+        return Ok((PatchResult::unchanged(path, opts), None));
     }
     // 2. Analyse the run and find its zones.
     let aopts = analysis_options(opts);
     let (analysis, spans_before) = analyze_spans(path, machine, &aopts)?;
     if analysis.zones.is_empty() {
-        return Ok(PatchResult::unchanged(path, opts));
+        return Ok((PatchResult::unchanged(path, opts), None));
     }
     let run = Run::new(path, solve_s, machine, opts, verify, aopts, spans_before);
     // 3. Each zone, in path order, on the values the zones before it left.
@@ -671,7 +831,8 @@ fn patch_on(
         .iter()
         .map(|d| run.zone_report(&state, &written, d))
         .collect();
-    Ok(run.result(state, written, zones))
+    let next_s = run.next_s(&state, written.keep.as_ref());
+    Ok((run.result(state, written, zones), next_s))
 }
 
 /// Whether some point of `path` is near enough the pole to lie in a zone
@@ -753,6 +914,10 @@ impl<'a> Run<'a> {
             .zip(&c0)
             .map(|(p, c)| forward(machine, *p, *c))
             .collect();
+        let bound = p0
+            .iter()
+            .map(|&p| pole_bound_deg(p, opts.reach_deg()))
+            .collect();
         Run {
             f: Fixed {
                 path,
@@ -760,6 +925,7 @@ impl<'a> Run<'a> {
                 machine,
                 opts,
                 target,
+                bound,
                 verify,
             },
             aopts,
@@ -938,6 +1104,28 @@ impl<'a> Run<'a> {
         state.done[i] = again;
     }
 
+    /// With a ball's centre kept (X Y Z the tip, s its length, `written` how the tips were
+    /// written): the tip path's length to solve on next — that of the values written, with, for each zone that kept nothing,
+    /// its best change that reached feed on the path length it was solved on but not on the
+    /// tips it writes (the solve must see those tips to aim at them; a zone that kept
+    /// nothing otherwise leaves the program's tips, solved on already).
+    fn next_s(&self, state: &Patched, written: Option<&KeepCentre>) -> Option<Vec<f64>> {
+        // The tips as written (with the decimals the whole-run verification chose).
+        let keep = written.copied().filter(|k| k.s_is_length)?;
+        let n = self.f.path.s_mm.len();
+        let (mut p, mut c) = (state.p.clone(), state.c.clone());
+        for d in &state.done {
+            if let Some(sp) = d
+                .spoiled
+                .as_ref()
+                .filter(|_| d.kept.is_none() || d.reverted)
+            {
+                (p, c) = materialize(&p, &c, &sp.prop, 0, n - 1, Some(sp.decimals));
+            }
+        }
+        written_path(self.f.path, &p, &c, self.f.machine, Some(&keep)).map(|w| w.s_mm)
+    }
+
     /// Step 5: the report of zone `d` on the values as written.
     fn zone_report(&self, state: &Patched, written: &Written, d: &Done) -> ZoneReport {
         let (path, machine, opts) = (self.f.path, self.f.machine, self.f.opts);
@@ -989,6 +1177,10 @@ impl<'a> Run<'a> {
             Reason::NotFound
         } else if d.over_cap_deg.is_some() {
             Reason::DeviationCap
+        } else if d.tips_spoiled {
+            Reason::TipPath
+        } else if d.over_bound_deg.is_some() {
+            Reason::SafetyBound
         } else if d.reverted {
             Reason::NotFound
         } else {
@@ -1037,7 +1229,11 @@ impl<'a> Run<'a> {
                 Tail::COffset { deg } => deg,
                 _ => 0.0,
             }),
-            needed_deviation_deg: d.over_cap_deg.filter(|_| reason == Reason::DeviationCap),
+            needed_deviation_deg: match reason {
+                Reason::DeviationCap => d.over_cap_deg,
+                Reason::SafetyBound => d.over_bound_deg,
+                _ => None,
+            },
         }
     }
 
@@ -1201,9 +1397,10 @@ pub fn report_unpatched(
 mod tests {
     use super::*;
     use crate::analysis::analyze_path;
+    use crate::report::ZoneFigures;
     use crate::strategy::patch_path;
     use crate::testutil::{machine, planted, sing_path};
-    use crate::verify::NOT_WORSE_REL;
+    use crate::verify::{NOT_WORSE_REL, not_worse_floor};
 
     fn spans(path: &Path, m: &Machine) -> Vec<crate::analysis::SpanFigures> {
         crate::analysis::analyze_spans(path, m, &AnalysisOptions::default())
@@ -1254,6 +1451,23 @@ mod tests {
         }
         let a = analyze_path(&after, m, &AnalysisOptions::default()).unwrap();
         assert!(a.zones.is_empty(), "{what}: zones left {:?}", a.zones);
+        // No point turned beyond its safety bound, as written.
+        let (reach, room) = (
+            PatchOptions::default().reach_deg(),
+            bound_room_deg((res.p_decimals, res.c_decimals)),
+        );
+        for (i, q) in path.axes.iter().enumerate() {
+            let turned = angle_between_deg(
+                forward(m, q[3], q[4]),
+                forward(m, res.p_deg[i], res.c_deg[i]),
+            );
+            let bound = pole_bound_deg(q[3], reach);
+            assert!(
+                turned <= bound + room,
+                "{what}: point {i} at P {} turned {turned}° > {bound}°",
+                q[3]
+            );
+        }
         (0..path.s_mm.len())
             .map(|i| {
                 let o = forward(m, path.axes[i][3], path.axes[i][4]);
@@ -1310,6 +1524,168 @@ mod tests {
         assert!(zones >= 16, "{zones}");
     }
 
+    /// A pass that starts near the pole and spirals out (a real NX post for a Mori Seiki
+    /// NMV5000, B-C, G43.4: B 0 → −62° and +89° while C turns 1800°, the tip barely
+    /// moving): C crawls over the whole run, but the pole's doing only near its start. The
+    /// zone is that pole passage, and no patch turns a tool axis by more than twice its
+    /// distance from the pole or more than the pole reach: the sweep far from the pole
+    /// keeps its orientations, and nothing gets slower. (The whole run was one zone, and
+    /// its patch turned tool axes 60–90° from the pole by up to 94°.)
+    #[test]
+    fn a_zone_is_the_pole_passage_not_the_sweep_after_it() {
+        let opts = PatchOptions::default();
+        let reach = opts.reach_deg();
+        // C at 28 (UCP710) and 15 (HSM600) times what reaching feed allows.
+        for (name, c_rate, feed) in [
+            ("mikron-ucp710", 200.0, 1000.0),
+            ("mikron-hsm600", 400.0, 5000.0),
+        ] {
+            let m = machine(name);
+            // B from −0.2° to −70° (1°/mm), 0.1 mm a point.
+            let path = crate::testutil::spiral(701, 0.1, (0.0, 1.0), c_rate, feed);
+            let p = |i: usize| path.axes[i][Axis::Primary.index()];
+            let before = analyze_path(&path, &m, &AnalysisOptions::default()).unwrap();
+            assert!(
+                before.axis_min[Axis::C.index()].0 < 0.1,
+                "{name}: C crawls over the run"
+            );
+            // One zone, at the start, within reach of the pole (the sweep after it is the
+            // program's own slowness: the pole does not dominate it).
+            assert_eq!(before.zones.len(), 1, "{name}: {:?}", before.zones);
+            let z = &before.zones[0];
+            assert!(
+                (z.first..=z.last).all(|i| p(i).abs() <= 2.0 * reach),
+                "{name}: zone {}..={} reaches |B| {}",
+                z.first,
+                z.last,
+                p(z.last).abs()
+            );
+            let res = patch_path(&path, &m, &opts).unwrap();
+            assert_eq!(res.zones.len(), 1, "{name}");
+            // No point turned beyond its bound; the sweep (beyond twice the reach) as it was.
+            for i in 0..path.s_mm.len() {
+                let dev = angle_between_deg(
+                    forward(&m, p(i), path.axes[i][4]),
+                    forward(&m, res.p_deg[i], res.c_deg[i]),
+                );
+                let bound = (2.0 * p(i).abs()).min(reach);
+                assert!(
+                    dev <= bound + 1e-3,
+                    "{name}: point {i} |B| {}: {dev}°",
+                    p(i).abs()
+                );
+                if p(i).abs() > 2.0 * reach {
+                    assert!(
+                        !res.p_changed[i] && !res.c_changed[i],
+                        "{name}: point {i} at |B| {} changed",
+                        p(i).abs()
+                    );
+                }
+            }
+            // Nothing slower anywhere.
+            let after = written(&path, &res);
+            for (k, (x, y)) in spans(&path, &m).iter().zip(&spans(&after, &m)).enumerate() {
+                assert!(
+                    y.bound.ratio >= not_worse_floor(x.bound.ratio),
+                    "{name}: span {k} slower: {} → {}",
+                    x.bound.ratio,
+                    y.bound.ratio
+                );
+            }
+            // The report says why the zone ended as it did.
+            let zr = &res.zones[0];
+            assert!(
+                zr.outcome == Outcome::Reached || zr.reason != Reason::Reached,
+                "{name}: {zr:#?}"
+            );
+        }
+    }
+
+    /// Issue 26 §4: a cap below what C17's `%SING` needs (1.0° through the pole) gives the
+    /// best improvement within it that makes nothing slower — at 0.5°, 0.9° and 0.99° the
+    /// zone's lowest ratio rises, no span of the run gets slower, the written change is
+    /// within the cap, and the reason says what reaching feed needed; a cap at or above what
+    /// the default achieves writes the default's values.
+    #[test]
+    fn a_cap_below_the_need_gives_the_best_improvement_within_it() {
+        let m = machine("mikron-ucp710");
+        let path = sing_path();
+        let default = patch_path(&path, &m, &PatchOptions::default()).unwrap();
+        let need = default.zones[0].max_deviation_deg;
+        assert!((1.0..1.01).contains(&need), "{need}");
+        let capped = |cap: f64| {
+            let opts = PatchOptions {
+                max_deviation_deg: Some(cap),
+                ..PatchOptions::default()
+            };
+            patch_path(&path, &m, &opts).unwrap()
+        };
+        for cap in [0.5, 0.9, 0.99] {
+            let res = capped(cap);
+            assert_eq!(res.zones.len(), 1);
+            let z = &res.zones[0];
+            assert_eq!(z.outcome, Outcome::Improved, "cap {cap}: {z:#?}");
+            assert_eq!(z.reason, Reason::DeviationCap, "cap {cap}");
+            assert!(z.needed_deviation_deg.is_some_and(|d| d > cap), "cap {cap}");
+            let worst = |f: &ZoneFigures| f.c_ratio.min(f.primary_ratio);
+            assert!(
+                worst(&z.after) > worst(&z.before) * 1.2,
+                "cap {cap}: {:?} → {:?}",
+                z.before,
+                z.after
+            );
+            assert!(z.max_deviation_deg <= cap + CAP_SLACK_DEG, "cap {cap}");
+            let after = written(&path, &res);
+            for (k, (x, y)) in spans(&path, &m).iter().zip(&spans(&after, &m)).enumerate() {
+                assert!(
+                    y.bound.ratio >= not_worse_floor(x.bound.ratio),
+                    "cap {cap}: span {k} slower: {} → {}",
+                    x.bound.ratio,
+                    y.bound.ratio
+                );
+            }
+        }
+        for cap in [need, 2.0] {
+            let res = capped(cap);
+            assert_eq!(
+                (&res.p_deg, &res.c_deg, res.p_decimals, res.c_decimals),
+                (
+                    &default.p_deg,
+                    &default.c_deg,
+                    default.p_decimals,
+                    default.c_decimals
+                ),
+                "cap {cap}"
+            );
+        }
+    }
+
+    /// A ball kept at its tip on points 0.02 mm apart: turning the tool axis by δ moves a
+    /// tip by 2R·sin(δ/2) (87 µm for R = 5 mm at 1°), several times the spacing, so the
+    /// tip path's length — Equation 6's s — changes with the solution. A zone that ends
+    /// short of feed so says it (`tip_path`), never `not_found` without a why.
+    #[test]
+    fn a_zone_the_moved_tips_spoil_says_so() {
+        let m = machine("mikron-hsm600");
+        let path = planted(241, 0.05, 0.5, false, 3000.0);
+        let res = patch_path(&path, &m, &PatchOptions::default()).unwrap();
+        check_both(&path, &m, &res, "centre programmed");
+        let opts = PatchOptions {
+            keep_centre: Some(crate::centre::KeepCentre {
+                radius_mm: 5.0,
+                decimals: 4,
+                unit_mm: 1.0,
+                s_is_length: true,
+            }),
+            ..PatchOptions::default()
+        };
+        let res = patch_path(&path, &m, &opts).unwrap();
+        assert_eq!(res.zones.len(), 1);
+        let z = &res.zones[0];
+        assert_ne!(z.outcome, Outcome::Reached, "{z:#?}");
+        assert_eq!(z.reason, Reason::TipPath, "{z:#?}");
+    }
+
     /// C17's `%SING` on the UCP710: A and C both reach feed, the tool passes (within
     /// rounding) through the pole, about 1° from the programmed axes (C-only: 3.35°).
     #[test]
@@ -1361,6 +1737,16 @@ mod tests {
         pole.axes[40][3] = 0.0;
         let res = patch_path(&pole, &m, &PatchOptions::default()).unwrap();
         check_both(&pole, &m, &res, "exact pole");
+        // The point on the pole (bound 0) keeps its tool axis, the pole: the zone through
+        // it is still patched (its C is free there; re-selection keeps every tool axis).
+        let on_pole = angle_between_deg(
+            forward(&m, 0.0, pole.axes[40][4]),
+            forward(&m, res.p_deg[40], res.c_deg[40]),
+        );
+        assert!(
+            on_pole <= bound_room_deg((res.p_decimals, res.c_decimals)),
+            "{on_pole}"
+        );
     }
     /// No point within reach of the pole (the cone, or the pole reach beyond it): nothing
     /// changes, with either method, and no spline work is needed (no zone reported).
@@ -1398,5 +1784,145 @@ mod tests {
         assert_eq!(z[0].before, z[0].after);
         assert!(z[0].before.c_ratio < 1.0);
         assert_eq!((z[0].points_modified, z[0].max_deviation_deg), (0, 0.0));
+    }
+
+    /// The safety bound: a point may turn at most twice its distance from the pole (every
+    /// tool axis no farther from the pole than its own), and never beyond the pole reach; a
+    /// point on the pole has bound 0 (its tool axis is the pole whatever C: C is free
+    /// there, the primary must stay 0 up to the rounding of the words written).
+    #[test]
+    fn the_bound_is_twice_the_distance_from_the_pole_within_the_reach() {
+        let reach = PatchOptions::default().reach_deg();
+        assert_eq!(reach, 10.0);
+        // P = 1°: at most 2°, on either side of the pole.
+        assert_eq!(pole_bound_deg(1.0, reach), 2.0);
+        assert_eq!(pole_bound_deg(-1.0, reach), 2.0);
+        assert_eq!(pole_bound_deg(0.0, reach), 0.0);
+        assert_eq!(pole_bound_deg(3.0, 5.0), 5.0);
+        assert_eq!(pole_bound_deg(-30.0, reach), reach);
+        // The room for rounding: half a unit of each word's last decimal (and round-off).
+        assert!((bound_room_deg((3, 3)) - 1e-3).abs() < 1e-8);
+        assert!((bound_room_deg((4, 5)) - 0.5 * (1e-4 + 1e-5)).abs() < 1e-8);
+        // On the pole a C change turns nothing; a primary change turns the tool by itself.
+        let m = machine("mikron-ucp710");
+        assert!(angle_between_deg(forward(&m, 0.0, 0.0), forward(&m, 0.0, 137.0)) < 1e-9);
+        assert!(
+            (angle_between_deg(forward(&m, 1.0, 0.0), forward(&m, -1.0, 0.0)) - 2.0).abs() < 1e-9
+        );
+    }
+
+    /// Every method wrapped so that each proposal it offers also turns the tool axes far
+    /// from the pole (points 10..=70 of a 241-point planted pass, |A| 10°–22°) by a smooth
+    /// bump of the primary axis of `bump_deg`: a change that still reaches feed (the bump
+    /// is slow), but beyond the safety bound there (the pole reach, 10°).
+    struct Bumped {
+        inner: Vec<Box<dyn Proposer>>,
+        bump_deg: f64,
+    }
+
+    struct BumpSink<'s> {
+        sink: &'s mut dyn Sink,
+        p: Vec<f64>,
+        c: Vec<f64>,
+        bump_deg: f64,
+    }
+
+    const BUMP: (usize, usize) = (10, 70);
+
+    impl Sink for BumpSink<'_> {
+        fn offer(&mut self, prop: Proposal) -> Option<crate::protocol::Offered> {
+            let (first, last) = (prop.first.min(BUMP.0), prop.last.max(BUMP.1));
+            let (mut p, mut c) = (self.p.clone(), self.c.clone());
+            p[prop.first..=prop.last].copy_from_slice(&prop.p);
+            c[prop.first..=prop.last].copy_from_slice(&prop.c);
+            for (i, q) in p.iter_mut().enumerate().take(BUMP.1 + 1).skip(BUMP.0) {
+                let x = (i - BUMP.0) as f64 / (BUMP.1 - BUMP.0) as f64;
+                let w = 0.5 * (1.0 - (2.0 * std::f64::consts::PI * x).cos());
+                *q += self.bump_deg * w * q.signum();
+            }
+            self.sink.offer(Proposal {
+                first,
+                last,
+                p: p[first..=last].to_vec(),
+                c: c[first..=last].to_vec(),
+                ..prop
+            })
+        }
+        fn add_stats(&mut self, qp: &QpStats) {
+            self.sink.add_stats(qp);
+        }
+        fn best_passing_deg(&self) -> Option<f64> {
+            self.sink.best_passing_deg()
+        }
+    }
+
+    impl Proposer for Bumped {
+        fn propose(&mut self, ctx: &ZoneCtx<'_>, sink: &mut dyn Sink) {
+            assert!(ctx.lower <= BUMP.0 && ctx.zone.first > BUMP.1);
+            let mut bs = BumpSink {
+                sink,
+                p: ctx.p.to_vec(),
+                c: ctx.c.to_vec(),
+                bump_deg: self.bump_deg,
+            };
+            for m in &mut self.inner {
+                m.propose(ctx, &mut bs);
+            }
+        }
+    }
+
+    /// A zone whose only changes that reach feed turn some point beyond its safety bound:
+    /// none is written (every point's change as written is within its bound), the zone
+    /// does not count as reached, and its report says why (`safety_bound`) and what reaching
+    /// feed needed. The same bump within the bound is written and the zone reached.
+    #[test]
+    fn a_patch_beyond_the_bound_is_not_written_and_says_so() {
+        let m = machine("mikron-ucp710");
+        let path = planted(241, 0.5, 1.0, false, 1000.0);
+        let opts = PatchOptions::default();
+        let reach = opts.reach_deg();
+        let run = |bump_deg: f64| {
+            let (inner, verify) = crate::strategy::methods(&opts);
+            let methods: Vec<Box<dyn Proposer>> = vec![Box::new(Bumped { inner, bump_deg })];
+            patch_with(&path, &m, &opts, methods, verify).unwrap()
+        };
+        let turned = |res: &PatchResult, i: usize| {
+            angle_between_deg(
+                forward(&m, path.axes[i][3], path.axes[i][4]),
+                forward(&m, res.p_deg[i], res.c_deg[i]),
+            )
+        };
+        // Within the bound (5° where the bound is 10°): written, the zone reached.
+        let res = run(5.0);
+        assert_eq!(res.zones.len(), 1);
+        assert_eq!(
+            res.zones[0].outcome,
+            Outcome::Reached,
+            "{:#?}",
+            res.zones[0]
+        );
+        assert!(
+            (turned(&res, 40) - 5.0).abs() < 0.01,
+            "{}",
+            turned(&res, 40)
+        );
+        // Beyond it (12°): not written.
+        let res = run(12.0);
+        assert_eq!(res.zones.len(), 1);
+        let z = &res.zones[0];
+        assert_ne!(z.outcome, Outcome::Reached, "{z:#?}");
+        assert_eq!(z.reason, Reason::SafetyBound, "{z:#?}");
+        assert!(z.needed_deviation_deg.is_some_and(|d| d > reach), "{z:#?}");
+        // What is written is the best improvement within the bound (the bump scaled down).
+        assert!(z.max_deviation_deg <= reach + 1e-3, "{z:#?}");
+        let room = bound_room_deg((res.p_decimals, res.c_decimals));
+        for i in 0..path.s_mm.len() {
+            let bound = pole_bound_deg(path.axes[i][3], reach);
+            assert!(
+                turned(&res, i) <= bound + room,
+                "point {i}: {} > {bound}",
+                turned(&res, i)
+            );
+        }
     }
 }

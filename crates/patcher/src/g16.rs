@@ -687,6 +687,8 @@ mod tests {
                     min_abs_primary_deg: (first..=last)
                         .fold(f64::INFINITY, |m, q| m.min(p[q].abs())),
                     c_ratio_min: 0.0,
+                    cut_before: false,
+                    cut_after: false,
                 });
             }
             i = k + 1;
@@ -890,6 +892,8 @@ mod tests {
             kind: ZoneKind::AFlip,
             min_abs_primary_deg: 0.5,
             c_ratio_min: 0.1,
+            cut_before: false,
+            cut_after: false,
         };
         let lim = ucp710(1000.0);
         for sing in 0..3 {

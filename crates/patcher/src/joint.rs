@@ -98,9 +98,9 @@ use crate::{
     report::{QpStats, QpStatus},
     settings::SolverSettings,
     tolerances::{JOINT_WINDOW_POINTS, ZERO_DEVIATION_DEG},
-    window::Window,
+    window::{RowSet, Window},
 };
-use polepatch_kinematics::{Machine, angle_between_deg, forward, forward_jacobian};
+use polepatch_kinematics::{Axis, Machine, angle_between_deg, forward, forward_jacobian};
 use std::time::Instant;
 
 pub use crate::window::WindowMemo;
@@ -124,6 +124,9 @@ pub struct JointProblem<'a> {
     pub lim_p: GeomLimits,
     /// C limits along s (with the caller's margin).
     pub lim_c: GeomLimits,
+    /// The programmed feed, mm/min: the machine's own limits along s (without the margin)
+    /// tell which spans were below feed before.
+    pub feed_mm_min: f64,
     /// The machine (kinematics and axis ranges).
     pub machine: &'a Machine,
     /// The spans that must reach feed (the zone's), `k` for `[s_k, s_{k+1}]`: they get the
@@ -138,10 +141,22 @@ pub struct JointProblem<'a> {
     /// rewrote points of the range by a rule, FREEZE say, is not what the verification
     /// compares with: the values before it are). Per point of the whole path.
     pub reference: Option<(&'a [f64], &'a [f64])>,
+    /// The values the verification compares with (the path's current values), per point
+    /// of the whole path: a span between movable points outside the core that exceeded a
+    /// limit on them need only not get worse there ([`Window::limit_rows`]).
+    pub verified: (&'a [f64], &'a [f64]),
+    /// The spans the pole's slowdown may reach (all, unless the zone was cut from a longer
+    /// stretch below feed: [`crate::analysis::Zone::cut_before`]); beyond them a span the
+    /// program itself keeps below feed need only not get worse ([`Window::limit_rows`]).
+    pub pole_spans: std::ops::Range<usize>,
     /// `None`: minimise the largest orientation change. `Some(d)`: the least excess over
     /// the limits with no point's orientation changed by more than `d` degrees (module
     /// docs: capped).
     pub cap_deg: Option<f64>,
+    /// Per point of the whole path, the most its orientation may change, degrees (the
+    /// driver's safety bound near the pole, `crate::driver::pole_bound_deg`): with it the
+    /// solve is capped too, each point at the smaller of this and `cap_deg`.
+    pub point_cap_deg: Option<&'a [f64]>,
     /// The base already meets the limits (a previous solution): iterate from it with the
     /// narrow trust region.
     pub warm: bool,
@@ -197,6 +212,19 @@ fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
+impl JointProblem<'_> {
+    /// Whether the solve is capped (by `cap_deg` or per point): the least excess over the
+    /// core's limits within the caps, nothing else worse (module docs).
+    pub fn capped(&self) -> bool {
+        self.cap_deg.is_some() || self.point_cap_deg.is_some()
+    }
+}
+
+/// The smallest cap of a point in a capped solve, degrees (a point exactly on the pole
+/// whose bound is 0 still gets a cone that is not degenerate; the driver measures the
+/// written angle against the bound itself).
+const MIN_POINT_CAP_DEG: f64 = 1e-6;
+
 /// The problem's fixed part: the unknowns (each axis' free spline coefficients, interleaved
 /// along the path, then `t` and `e`), the limit rows and the machine's ranges.
 struct Model<'a> {
@@ -207,6 +235,10 @@ struct Model<'a> {
     deltas: Vec<(Aff, Aff)>,
     /// The limit rows `|f| ≤ 1` in relative form (`f = row/bound`), relaxed by e.
     limits: Vec<Aff>,
+    /// Capped: the rows that hold without relaxation (every span "not worse"), `|f| ≤ 1`.
+    hard: Vec<Aff>,
+    /// Capped: per point of the range, the most its orientation may change, degrees.
+    caps: Option<Vec<f64>>,
     /// Per point of the range, the machine's ranges as bounds on its changes `(δP, δC)`
     /// (hard; C's infinite when it turns endlessly).
     ranges: Vec<[(f64, f64); 2]>,
@@ -238,22 +270,64 @@ impl<'a> Model<'a> {
             None => (cp.clone(), cc.clone()),
             Some((rp, rc)) => (win.coeffs(pr.s_mm, rp)?, win.coeffs(pr.s_mm, rc)?),
         };
+        let (vp, vc) = (
+            win.coeffs(pr.s_mm, pr.verified.0)?,
+            win.coeffs(pr.s_mm, pr.verified.1)?,
+        );
+        let capped = pr.capped();
         let mut rows: Vec<(Row, f64, f64)> = Vec::new();
+        let mut hard_rows: Vec<(Row, f64, f64)> = Vec::new();
         // P's unknowns at even indices, C's at odd ones: interleaved along the path.
-        for (c, b, lim, round, offset) in [
-            (&cp, &bp, &pr.lim_p, pr.round_p_deg, 0),
-            (&cc, &bc, &pr.lim_c, pr.round_c_deg, 1),
+        for (c, b, v, lim, axis, round, offset) in [
+            (&cp, &bp, &vp, &pr.lim_p, Axis::Primary, pr.round_p_deg, 0),
+            (&cc, &bc, &vc, &pr.lim_c, Axis::C, pr.round_c_deg, 1),
         ] {
             let room = win.rounding_room(round);
-            win.limit_rows(n, c, b, lim, &room, pr.core.clone(), offset, 2, &mut rows);
+            let core = pr.core.clone();
+            let machine_lim = GeomLimits::of(pr.machine, axis, pr.feed_mm_min, 0.0);
+            let was = (v.as_slice(), &machine_lim, &pr.pole_spans);
+            let rows_of = |set, out: &mut Vec<(Row, f64, f64)>| {
+                win.limit_rows(
+                    n,
+                    c,
+                    b,
+                    lim,
+                    was,
+                    &room,
+                    core.clone(),
+                    set,
+                    (offset, 2),
+                    out,
+                );
+            };
+            if capped {
+                // The core's limits, relaxed by e; every span not worse, held.
+                rows_of(RowSet::Core, &mut rows);
+                rows_of(RowSet::NotWorse, &mut hard_rows);
+            } else {
+                rows_of(RowSet::Patch, &mut rows);
+            }
         }
-        let limits = rows
-            .into_iter()
-            .map(|(row, c, b)| Aff {
-                row: row.into_iter().map(|(j, v)| (j, v / b)).collect(),
-                c: c / b,
-            })
-            .collect();
+        let relative = |rows: Vec<(Row, f64, f64)>| -> Vec<Aff> {
+            rows.into_iter()
+                .map(|(row, c, b)| Aff {
+                    row: row.into_iter().map(|(j, v)| (j, v / b)).collect(),
+                    c: c / b,
+                })
+                .collect()
+        };
+        let (limits, hard) = (relative(rows), relative(hard_rows));
+        let caps = capped.then(|| {
+            (first..=last)
+                .map(|i| {
+                    let point = pr.point_cap_deg.map_or(f64::INFINITY, |c| c[i]);
+                    pr.cap_deg
+                        .unwrap_or(f64::INFINITY)
+                        .min(point)
+                        .max(MIN_POINT_CAP_DEG)
+                })
+                .collect()
+        });
         // The machine's ranges as bounds on each point's changes; the trust region
         // bounds the same forms, so each QP takes the intersection (one pair of rows).
         let (p_lo, p_hi) = pr.machine.primary_range_deg;
@@ -280,6 +354,8 @@ impl<'a> Model<'a> {
             nb,
             deltas,
             limits,
+            hard,
+            caps,
             ranges,
         })
     }
@@ -305,37 +381,53 @@ impl<'a> Model<'a> {
         x
     }
 
-    /// The exact largest relative excess of `x` over the limit rows (linear: exact).
+    /// The exact largest relative excess of `x` over the limit rows, and over the rows that
+    /// hold (linear: exact).
     fn excess(&self, x: &[f64]) -> f64 {
         self.limits
             .iter()
+            .chain(&self.hard)
             .map(|f| f.at(x).abs() - 1.0)
             .fold(0.0f64, f64::max)
+    }
+
+    /// Exact angle of point `i`'s values at `x` against its target, degrees.
+    fn angle(&self, i: usize, x: &[f64]) -> f64 {
+        let pr = self.pr;
+        let (dp, dc) = self.deltas(i, x);
+        let o = forward(pr.machine, pr.p_deg[i] + dp, pr.c_deg[i] + dc);
+        angle_between_deg(o, pr.target[i])
     }
 
     /// Exact largest angle of `x`'s values against the targets, degrees.
     fn deviation(&self, x: &[f64]) -> f64 {
         let pr = self.pr;
         (pr.first..=pr.last)
-            .map(|i| {
-                let (dp, dc) = self.deltas(i, x);
-                let o = forward(pr.machine, pr.p_deg[i] + dp, pr.c_deg[i] + dc);
-                angle_between_deg(o, pr.target[i])
-            })
+            .map(|i| self.angle(i, x))
             .fold(0.0, f64::max)
     }
 
-    fn merit(&self, dev_deg: f64, excess: f64) -> f64 {
-        match self.pr.cap_deg {
-            None => chord(dev_deg) + self.pr.settings.elastic_weight * excess,
-            // Capped: the excess first — over the limits, and of the exact angle over the
-            // cap (the QP bounds the linearised change only) — the angle only to break
-            // ties.
-            Some(cap) => {
-                let over = (dev_deg - cap).max(0.0) / cap.max(1e-9);
-                self.pr.settings.elastic_weight * (excess + over)
-                    + self.pr.settings.cap_tie_weight * chord(dev_deg)
-            }
+    /// Capped: the largest relative excess of a point's exact angle over its cap.
+    fn over_caps(&self, x: &[f64]) -> f64 {
+        let pr = self.pr;
+        self.caps.as_ref().map_or(0.0, |caps| {
+            (pr.first..=pr.last)
+                .zip(caps)
+                .map(|(i, &cap)| (self.angle(i, x) - cap).max(0.0) / cap)
+                .fold(0.0, f64::max)
+        })
+    }
+
+    /// The merit of `x` (module docs), with its exact largest angle and excess.
+    fn merit(&self, x: &[f64], dev_deg: f64, excess: f64) -> f64 {
+        let st = self.pr.settings;
+        if self.caps.is_none() {
+            chord(dev_deg) + st.elastic_weight * excess
+        } else {
+            // Capped: the excess first — over the limits, and of the exact angles over
+            // the caps (the QP bounds the linearised change only) — the angle only to
+            // break ties.
+            st.elastic_weight * (excess + self.over_caps(x)) + st.cap_tie_weight * chord(dev_deg)
         }
     }
 
@@ -350,9 +442,13 @@ impl<'a> Model<'a> {
         for f in &self.limits {
             qp.add_pair(&f.row, -1.0 - f.c, 1.0 - f.c, Some(e));
         }
+        for f in &self.hard {
+            qp.add_pair(&f.row, -1.0 - f.c, 1.0 - f.c, None);
+        }
         qp.add_le(&[(e, -1.0)], 0.0);
-        if let Some(d) = pr.cap_deg {
-            qp.add_le(&[(t, 1.0)], d.to_radians().sin());
+        if self.caps.is_some() {
+            // t is the largest change relative to each point's cap: at most 1.
+            qp.add_le(&[(t, 1.0)], 1.0);
         }
         for (i, ((fp, fc), [rp, rc])) in
             (pr.first..=pr.last).zip(self.deltas.iter().zip(&self.ranges))
@@ -371,7 +467,13 @@ impl<'a> Model<'a> {
             // ‖(u, v)‖ ≤ t: slacks s_k = rhs_k − row_k·x are (t, u, v).
             let neg = |f: &Aff| f.row.iter().map(|&(j, c)| (j, -c)).collect::<Vec<_>>();
             let (nu, nv) = (neg(&u), neg(&v));
-            qp.add_soc(&[(&[(t, -1.0)], 0.0), (&nu, u.c), (&nv, v.c)]);
+            // ‖(u, v)‖ ≤ t, or capped ‖(u, v)‖ ≤ t·sin(cap_i) (t ≤ 1: the tangent-plane
+            // change of an exact change by θ is sin θ, module docs).
+            let scale = self
+                .caps
+                .as_ref()
+                .map_or(1.0, |caps| caps[i - pr.first].to_radians().sin());
+            qp.add_soc(&[(&[(t, -scale)], 0.0), (&nu, u.c), (&nv, v.c)]);
             qp.add_square(&u.row, st.joint_quad_weight, -u.c);
             qp.add_square(&v.row, st.joint_quad_weight, -v.c);
             qp.add_square(&fp.row, st.proximal_weight, dp - fp.c);
@@ -407,7 +509,7 @@ pub fn solve_joint(pr: &JointProblem) -> Result<JointSolution, PatchFailure> {
     let mut xbar = model.start();
     let mut dev = model.deviation(&xbar);
     let mut exc = xbar[model.e()];
-    let mut merit = model.merit(dev, exc);
+    let mut merit = model.merit(&xbar, dev, exc);
     let mut rho = if pr.warm || exc <= st.elastic_tol {
         (st.trust_p_deg, st.trust_c_deg)
     } else {
@@ -444,7 +546,7 @@ pub fn solve_joint(pr: &JointProblem) -> Result<JointSolution, PatchFailure> {
         }
         solved_any = true;
         let (d, ex) = (model.deviation(&x), model.excess(&x));
-        let m = model.merit(d, ex);
+        let m = model.merit(&x, d, ex);
         if m < merit {
             let gain = merit - m;
             let was_infeasible = exc > st.elastic_tol;
@@ -483,7 +585,6 @@ pub fn solve_joint(pr: &JointProblem) -> Result<JointSolution, PatchFailure> {
 mod tests {
     use super::*;
     use crate::testutil::{machine, planted, sing_path};
-    use polepatch_kinematics::Axis;
 
     /// The linearisation the QPs use, against finite differences and exactly: the
     /// Jacobian of the tool axis (per degree) matches central differences, and the
@@ -571,12 +672,16 @@ mod tests {
             last: n - 1,
             lim_p: GeomLimits::of(m, Axis::Primary, path.feed_mm_min, 0.02),
             lim_c: GeomLimits::of(m, Axis::C, path.feed_mm_min, 0.02),
+            feed_mm_min: path.feed_mm_min,
             machine: m,
             core: 0..n - 1,
             round_p_deg: 0.0,
             round_c_deg: 0.0,
             reference: None,
+            verified: (p, c),
+            pole_spans: 0..n,
             cap_deg: cap,
+            point_cap_deg: None,
             warm: false,
             max_solves: st.scp_max_solves,
             memo: None,

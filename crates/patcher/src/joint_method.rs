@@ -118,11 +118,10 @@ impl Proposer for JointMethod {
             let Some((first, last)) = Self::range(ctx, extra) else {
                 return;
             };
-            let whole = first <= ctx.lower && last >= ctx.end;
-            if Self::solve_range(ctx, sink, &memo, first, last, whole)
-                || whole
-                || extra > ctx.s.len()
-            {
+            // The widest range: the next widening would not grow it.
+            let widest = extra > ctx.s.len()
+                || Self::range(ctx, 2 * extra).is_none_or(|r| r == (first, last));
+            if Self::solve_range(ctx, sink, &memo, first, last, widest) || widest {
                 return;
             }
             extra *= 2;
@@ -219,13 +218,22 @@ impl JointMethod {
         let lim_p = GeomLimits::of(ctx.machine, Axis::Primary, ctx.feed_mm_min, ctx.margin);
         let lim_c = GeomLimits::of(ctx.machine, Axis::C, ctx.feed_mm_min, ctx.margin);
         let round_deg = 0.5 * 10f64.powi(-(ctx.opts.max_decimals as i32));
-        // `before`: what "not worse" compares with (None: the start's own values).
+        // Beyond a side where the zone was cut from a longer stretch below feed, the
+        // program's own slowness need only not get worse (crate::analysis::detect_zones).
+        let z = ctx.zone;
+        let pole_spans =
+            if z.cut_before { z.first } else { 0 }..if z.cut_after { z.last } else { ctx.s.len() };
+        // `before`: what "not worse" compares with (None: the start's own values); `capped`:
+        // the least excess over the core's limits within the caps, nothing else worse
+        // (`crate::joint`, capped).
         let problem = |sp: &'_ [f64],
                        sc: &'_ [f64],
                        before: Option<(&'_ [f64], &'_ [f64])>,
-                       cap: Option<f64>,
+                       capped: Option<(usize, usize)>,
                        warm: bool,
                        solves: u32| {
+            let (first, last) = capped.unwrap_or((first, last));
+            let capped = capped.is_some();
             let pr = JointProblem {
                 s_mm: ctx.s,
                 p_deg: sp,
@@ -235,12 +243,16 @@ impl JointMethod {
                 last,
                 lim_p,
                 lim_c,
+                feed_mm_min: ctx.feed_mm_min,
                 machine: ctx.machine,
                 core: ctx.core.clone(),
                 round_p_deg: round_deg,
                 round_c_deg: round_deg,
                 reference: before,
-                cap_deg: cap,
+                verified: (p, c),
+                pole_spans: pole_spans.clone(),
+                cap_deg: ctx.opts.max_deviation_deg.filter(|_| capped),
+                point_cap_deg: capped.then_some(ctx.bound_deg),
                 warm,
                 max_solves: solves,
                 memo: Some(memo),
@@ -330,18 +342,22 @@ impl JointMethod {
                 keep_better(sol, more);
             }
         }
-        // The best solution's values (whole path) and its start's tail, for a capped solve.
+        // The best solution's values (whole path), its start's tail and what "not worse"
+        // compares with for it, for a capped solve.
         let best = screened.first().map(|(i, sol)| {
             let s0 = &starts[*i];
             let (mut wp, mut wc) = (s0.p.clone(), s0.c.clone());
             wp[first..=last].copy_from_slice(&sol.p_deg);
             wc[first..=last].copy_from_slice(&sol.c_deg);
-            Start {
-                p: wp,
-                c: wc,
-                tail: s0.tail,
-                rule: s0.rule,
-            }
+            (
+                Start {
+                    p: wp,
+                    c: wc,
+                    tail: s0.tail,
+                    rule: s0.rule,
+                },
+                *i,
+            )
         });
         let within = screened
             .first()
@@ -371,31 +387,65 @@ impl JointMethod {
                 offered_all = false; // the rest only count their solves
             }
         }
-        // With a cap that nothing passing met: the least excess within it — from the best
-        // solution (near the cap when it is just over it: a small step), and from each
-        // start that keeps every tool axis (the program's values, the other branch after
-        // the switch: within any cap; near the pole only the second passes through it).
-        if let Some(cap) = ctx.opts.max_deviation_deg
-            && sink.best_passing_deg().is_none()
-        {
+        // When nothing passing met the caps — the user's `max_deviation_deg` and the safety
+        // bound near the pole (`crate::driver::pole_bound_deg`), or nothing passed at all:
+        // the least excess over the core's limits within them, every other span not worse
+        // (`crate::joint`, capped) — from the best solution (near the cap when it is just
+        // over it: a small step), and from each start that keeps every tool axis (the
+        // program's values, the other branch after the switch: within any cap; near the
+        // pole only the second passes through it). "Not worse" compares with what the
+        // verification compares with: the program's values, or for the other branch its
+        // own (the same sizes of every derivative past the switch). Beyond a side where the
+        // zone was cut from a longer stretch below feed the program is slow by its own
+        // doing, far from the pole: there the range keeps only `joint_range_min_points` to
+        // join it (and the best solution, which may reach further, is no start).
+        if sink.best_passing_deg().is_none() {
+            let z = ctx.zone;
+            let join = st.joint_range_min_points;
+            let range = (
+                if z.cut_before {
+                    first.max(z.first.saturating_sub(join))
+                } else {
+                    first
+                },
+                if z.cut_after {
+                    last.min(z.last + join)
+                } else {
+                    last
+                },
+            );
+            let own = |s0: &Start| -> (Vec<f64>, Vec<f64>) {
+                if s0.rule {
+                    (p.to_vec(), c.to_vec())
+                } else {
+                    (s0.p.clone(), s0.c.clone())
+                }
+            };
             let capped = best
                 .iter()
-                .map(|b| (b, true))
-                .chain(starts.iter().filter(|s0| !s0.rule).map(|s0| (s0, false)));
-            for (s0, warm) in capped {
-                match problem(
+                .filter(|_| range == (first, last))
+                .map(|(b, i)| (b, own(&starts[*i]), true))
+                .chain(
+                    starts
+                        .iter()
+                        .filter(|s0| !s0.rule)
+                        .map(|s0| (s0, own(s0), false)),
+                );
+            for (s0, (bp, bc), warm) in capped {
+                let r = problem(
                     &s0.p,
                     &s0.c,
-                    s0.rule.then_some((p, c)),
-                    Some(cap),
+                    Some((&bp, &bc)),
+                    Some(range),
                     warm,
                     st.scp_max_solves,
-                ) {
+                );
+                match r {
                     Ok(sol) => {
                         sink.offer(Proposal {
                             method: Method::Joint,
-                            first,
-                            last,
+                            first: range.0,
+                            last: range.1,
                             p: sol.p_deg,
                             c: sol.c_deg,
                             tail: s0.tail,

@@ -77,6 +77,9 @@ pub struct ZoneCtx<'a> {
     pub s: &'a [f64],
     /// The program's tool axes (what every change is measured against).
     pub target: &'a [[f64; 3]],
+    /// Per point, the most its orientation may change, degrees: the safety bound near the
+    /// pole ([`crate::driver::pole_bound_deg`]); a proposal beyond it is refused.
+    pub bound_deg: &'a [f64],
     /// The machine.
     pub machine: &'a Machine,
     /// The caller's options.

@@ -28,7 +28,7 @@ use crate::{
     starts::{Rule, apply_rule, cone_stretch},
     tolerances::POLE_DEG,
     verify::{AxisChange, verify_change_with_core},
-    zones::zone_core,
+    zones::{core_margins, zone_core},
 };
 use polepatch_kinematics::{Axis, Machine, forward, unwrap_near_deg};
 
@@ -110,7 +110,7 @@ pub fn zone_reference(
             &ch,
             changed,
             (zone.first, zone.last),
-            st.core_margin_points,
+            core_margins(zone, st.core_margin_points),
             machine,
             feed_mm_min / 60.0,
         )
@@ -184,12 +184,20 @@ pub fn zone_reference(
             last,
             lim_p: GeomLimits::of(machine, Axis::Primary, feed_mm_min, st.reference_margin),
             lim_c: GeomLimits::of(machine, Axis::C, feed_mm_min, st.reference_margin),
+            feed_mm_min,
             machine,
             core: core.clone(),
             round_p_deg: 0.0,
             round_c_deg: 0.0,
             reference: Some((p_deg, c_deg)),
+            verified: (p_deg, c_deg),
+            pole_spans: if zone.cut_before { zone.first } else { 0 }..if zone.cut_after {
+                zone.last
+            } else {
+                n
+            },
             cap_deg: None,
+            point_cap_deg: None,
             warm: false,
             max_solves: st.scp_max_solves,
             memo: None,

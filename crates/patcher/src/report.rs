@@ -49,6 +49,15 @@ pub enum Reason {
     /// A patch reaching feed exists, but it changes the orientation by more than
     /// `max_deviation_deg`.
     DeviationCap,
+    /// A patch reaching feed exists, but it turns some point's tool axis by more than the
+    /// safety bound near the pole allows (twice the point's distance from the pole, and at
+    /// most the pole reach: `crate::driver::pole_bound_deg`).
+    SafetyBound,
+    /// With a ball's centre kept (programmed at its tip): a patch reaches feed on the tip
+    /// path it was solved on, but the tips it writes move with the orientation, and on
+    /// them it falls short (the tip path's length did not settle:
+    /// `SolverSettings::centre_s_iterations`).
+    TipPath,
     /// No values of the movable points reach feed (the relaxation is infeasible: a proof).
     ProvenUnreachable,
     /// No patch found, and no proof that there is none (or a patch failed the whole-run
@@ -60,12 +69,14 @@ pub enum Reason {
 
 impl Reason {
     /// Every reason, in report order.
-    pub const ALL: [Reason; 8] = [
+    pub const ALL: [Reason; 10] = [
         Reason::Reached,
         Reason::Reselected,
         Reason::EndPinned,
         Reason::Range,
         Reason::DeviationCap,
+        Reason::SafetyBound,
+        Reason::TipPath,
         Reason::ProvenUnreachable,
         Reason::NotFound,
         Reason::NotPatched,
@@ -78,6 +89,8 @@ impl Reason {
             Reason::EndPinned => "end_pinned",
             Reason::Range => "range",
             Reason::DeviationCap => "deviation_cap",
+            Reason::SafetyBound => "safety_bound",
+            Reason::TipPath => "tip_path",
             Reason::ProvenUnreachable => "proven_unreachable",
             Reason::NotFound => "not_found",
             Reason::NotPatched => "not_patched",

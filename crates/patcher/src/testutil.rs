@@ -89,3 +89,35 @@ pub(crate) fn sing_path() -> Path {
         feed_mm_min: 2000.0,
     }
 }
+
+/// A pass that starts near the pole and spirals out of it (the shape of a real NX post's
+/// run on a Mori Seiki NMV5000): the primary axis rises from `p0_deg` at `p_rate` °/mm
+/// while C turns at a constant `c_rate` °/mm, the tool tip moving along X at `spacing`
+/// mm per point. Far from the pole C still crawls — by the program's own doing: its rate
+/// is what the table turns round with the tool. Values rounded to 3 decimals.
+pub(crate) fn spiral(
+    n: usize,
+    spacing: f64,
+    (p0_deg, p_rate): (f64, f64),
+    c_rate: f64,
+    feed: f64,
+) -> Path {
+    let s_mm: Vec<f64> = (0..n).map(|k| k as f64 * spacing).collect();
+    let axes = s_mm
+        .iter()
+        .map(|&s| {
+            [
+                s,
+                0.0,
+                0.0,
+                -round_written(p0_deg + p_rate * s, 3),
+                round_written(315.0 + c_rate * s, 3),
+            ]
+        })
+        .collect();
+    Path {
+        s_mm,
+        axes,
+        feed_mm_min: feed,
+    }
+}

@@ -34,6 +34,11 @@ pub const NOT_WORSE_SLACK: f64 = 1e-9;
 /// within it (round-off of the exact angle).
 pub const CAP_SLACK_DEG: f64 = 1e-9;
 
+/// With a ball's centre kept, a later solve on the settled tip path that reaches feed on no
+/// more zones is kept only when it lowers the zones' estimated time by more than this
+/// fraction (the estimate's own accuracy, `TIME_REL_TOL`, is 10⁻³ per span).
+pub const CENTRE_TIME_REL: f64 = 1e-3;
+
 /// A largest orientation change at or below this, degrees, is none: a start within the
 /// limits with it cannot be bettered (the joint patch stops there).
 pub const ZERO_DEVIATION_DEG: f64 = 1e-9;

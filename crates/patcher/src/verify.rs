@@ -119,7 +119,7 @@ pub fn verify_change(
         changes,
         (first, last),
         (first, last),
-        core_margin,
+        (core_margin, core_margin),
         machine,
         feed_mm_s,
     )
@@ -127,7 +127,9 @@ pub fn verify_change(
 
 /// [`verify_change`] where the stretch that must reach feed is given apart from the
 /// modified points: every axis must reach feed on the spans within `core_margin` points
-/// of `core` (a point range, inclusive), and nothing may get worse in the window around
+/// of `core` (a point range, inclusive; the margin before and after it: a zone cut from a
+/// longer stretch below feed takes none on that side, [`crate::zone_core`]), and nothing
+/// may get worse in the window around
 /// `core ∪ changed`. The joint method passes the zone as `core`: where the original was
 /// below feed the result must reach it; around it, where the program's own values (its
 /// rounding, say) may already exceed a limit, it may only not get worse.
@@ -137,7 +139,7 @@ pub fn verify_change_with_core(
     changes: &[AxisChange],
     changed: (usize, usize),
     core: (usize, usize),
-    core_margin: usize,
+    core_margin: (usize, usize),
     machine: &Machine,
     feed_mm_s: f64,
 ) -> Verdict {
@@ -163,7 +165,7 @@ pub fn verify_change_on(
     changes: &[AxisChange],
     changed: (usize, usize),
     core: (usize, usize),
-    core_margin: usize,
+    core_margin: (usize, usize),
     machine: &Machine,
     feed_mm_s: f64,
 ) -> Verdict {
@@ -186,8 +188,8 @@ pub fn verify_change_on(
             Err(_) => return Verdict::failed(),
         }
     };
-    let core_lo = core.0.saturating_sub(core_margin).max(lo) - lo;
-    let core_hi = (core.1 + core_margin).min(hi) - lo; // knot index, exclusive span end
+    let core_lo = core.0.saturating_sub(core_margin.0).max(lo) - lo;
+    let core_hi = (core.1 + core_margin.1).min(hi) - lo; // knot index, exclusive span end
     let guard_lo = if lo > 0 { WINDOW_GUARD_SPANS } else { 0 };
     let guard_hi = if hi < n - 1 {
         (nw - 1).saturating_sub(WINDOW_GUARD_SPANS)

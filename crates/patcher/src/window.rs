@@ -390,15 +390,29 @@ impl Window {
     /// bounds then hold for every s of a span, hence at every sample): `|m_k| ≤ v`,
     /// `|b1| ≤ v`, `|q''(knot)| ≤ a`, `|q'''| ≤ j`, each row `(row, constant, bound)`
     /// saying `|row·x + constant| ≤ bound` in the unknowns at `offset + stride·r`, the
-    /// constant the spline of coefficients `cur` (the start's).
+    /// constant the spline of coefficients `cur` (the start's). Which spans get rows, and
+    /// which bounds, is `set`'s ([`RowSet`]).
     ///
-    /// A span with both knots movable, or in `core` (the spans that must reach feed), gets
-    /// `limit − room`; any other span that touches a fixed point gets
-    /// `max(limit − room, |value before|·(1 + NOT_WORSE_SLACK))` — for q', where the span
-    /// exceeded the velocity limit before, at [`NOT_WORSE_SAMPLES_PER_SPAN`] samples and the
-    /// spline's vertex of q' before (where its exact peak is) against that exact peak
-    /// instead of the hull: it may not get worse, and need not reach feed (a fixed
-    /// neighbour may already exceed the limits, e.g. through the file's own rounding).
+    /// [`RowSet::Patch`]: a span in `core` (the spans that must reach feed) gets
+    /// `limit − room`; so does a row of a span with both knots movable — unless the span
+    /// lies beyond `pole` (the spans the pole's slowdown may reach: beyond a side where the
+    /// zone was cut from a longer stretch below feed, `crate::analysis::detect_zones`) and
+    /// the row exceeded the machine's own limit (`machine_lim`, without the margin `lim`
+    /// has) on the values the verification compares with (the spline of coefficients
+    /// `verified`); any other row gets `max(limit − room, |value before|·(1 + NOT_WORSE_SLACK))`
+    /// — for q', where the span exceeded the velocity limit before (a span touching a fixed
+    /// point: by its hull; between movable points: by its exact peak beyond the machine's
+    /// limit), at
+    /// [`NOT_WORSE_SAMPLES_PER_SPAN`] samples and the spline's vertex of q' before (where
+    /// its exact peak is) against that exact peak instead of the hull: it may not get
+    /// worse, and need not reach feed (a fixed neighbour may already exceed the limits,
+    /// e.g. through the file's own rounding; a span outside the zone's core may be slow by
+    /// the program's own doing, far from the pole: `crate::analysis::detect_zones`).
+    /// [`RowSet::Core`]: the core's spans only, each at `limit − room`.
+    /// [`RowSet::NotWorse`]: every span as a span touching a fixed point (a q' hull within
+    /// the limit before may grow to the limit less the room, or to its size before when
+    /// that is larger: the start meets every row).
+    ///
     /// "Before" is the spline of coefficients `before` (the reference's values, or the
     /// start's). `room[k − lo][r]` ([`Window::rounding_room`]) is what rounding the
     /// written values can add to the (r+1)-th derivative on span k, so the limits still
@@ -418,10 +432,15 @@ impl Window {
         cur: &[f64],
         before: &[f64],
         lim: &crate::limits::GeomLimits,
+        (verified, machine_lim, pole): (
+            &[f64],
+            &crate::limits::GeomLimits,
+            &std::ops::Range<usize>,
+        ),
         room: &[[f64; 3]],
         core: std::ops::Range<usize>,
-        offset: usize,
-        stride: usize,
+        set: RowSet,
+        (offset, stride): (usize, usize),
         out: &mut Vec<(Row, f64, f64)>,
     ) {
         let a = if self.lo > 0 {
@@ -446,17 +465,31 @@ impl Window {
             out.push((self.reduce(f, offset, stride), f.at(cur), bound));
         };
         for k in spans.clone() {
+            if set == RowSet::Core && !core.contains(&k) {
+                continue;
+            }
             let sp = &self.spans[k - self.lo];
             let h = sp.h;
             let movable = |i: usize| i >= self.first && i <= self.last;
-            let strict = (movable(k) && movable(k + 1)) || core.contains(&k);
+            let both = movable(k) && movable(k + 1);
+            let strict = match set {
+                RowSet::Patch => core.contains(&k) || (both && pole.contains(&k)),
+                RowSet::Core => true,
+                RowSet::NotWorse => false,
+            };
+            // Between movable points beyond the pole's spans: strict row by row.
+            let between = set == RowSet::Patch && both && !strict;
             let room = room.get(k - self.lo).copied().unwrap_or([0.0; 3]);
-            let bound = |f: &Local, limit: f64, r: usize| {
+            // Between movable points beyond the pole's spans, a row that exceeded the
+            // machine's own limit on the values the verification compares with (the span
+            // was below feed on it, by the program's own doing) need only not get worse.
+            let bound = |f: &Local, (limit, machine_limit): (f64, f64), r: usize| {
                 let b = limit - room[r];
-                let b = if strict {
+                let was = f.at(before).abs();
+                let b = if strict || (between && f.at(verified).abs() <= machine_limit) {
                     b
                 } else {
-                    b.max(f.at(before).abs() * (1.0 + NOT_WORSE_SLACK))
+                    b.max(was * (1.0 + NOT_WORSE_SLACK))
                 };
                 // Never below a sliver of the limit: the row stays well posed.
                 b.max(MIN_ROW_BOUND * limit)
@@ -465,17 +498,12 @@ impl Window {
             let hull_now = [m0, b1, m1]
                 .iter()
                 .fold(0.0f64, |m, f| m.max(f.at(before).abs()));
-            if strict || hull_now <= lim.v {
-                // |q'| ≤ v on the whole span through its Bernstein coefficients (a span
-                // within the limit before may only stay within it: "not worse").
-                push(&b1, (lim.v - room[0]).max(MIN_ROW_BOUND * lim.v), out);
-            } else {
-                // Beyond the limit before: "not worse" on q' against the span's exact peak
-                // before (the hull overstates the peak, so it cannot stand for it).
-                crate::spline::span_offsets(h, NOT_WORSE_SAMPLES_PER_SPAN, &mut taus);
-                // Rows at the samples and at the spline's vertex of q' before (its peak
-                // on the span, when inside), against that peak.
-                let d1 = |t: f64| sp.at(t, 1).at(before);
+            // The exact peak of q' over the span on the coefficients `on`: at the samples
+            // and at the spline's vertex of q' (where its peak is, when inside); `taus` gets
+            // them.
+            let peak_on = |on: &[f64], taus: &mut Vec<f64>| {
+                let d1 = |t: f64| sp.at(t, 1).at(on);
+                crate::spline::span_offsets(h, NOT_WORSE_SAMPLES_PER_SPAN, taus);
                 let (qa, qm, qb) = (d1(0.0), d1(0.5 * h), d1(h));
                 // q'(τ) = qa + c1·τ + c2·τ² through the three values.
                 let c2 = 2.0 * (qa - 2.0 * qm + qb) / (h * h);
@@ -486,7 +514,24 @@ impl Window {
                         taus.push(v);
                     }
                 }
-                let peak = taus.iter().fold(0.0f64, |m, &t| m.max(d1(t).abs()));
+                taus.iter().fold(0.0f64, |m, &t| m.max(d1(t).abs()))
+            };
+            let hull_ok = strict
+                || hull_now <= lim.v
+                || (between && peak_on(verified, &mut taus) <= machine_lim.v);
+            if hull_ok {
+                // |q'| ≤ v on the whole span through its Bernstein coefficients (a span
+                // within the limit before may only stay within it: "not worse").
+                let hull_bound = if set == RowSet::NotWorse {
+                    (lim.v - room[0]).max(hull_now * (1.0 + NOT_WORSE_SLACK))
+                } else {
+                    lim.v - room[0]
+                };
+                push(&b1, hull_bound.max(MIN_ROW_BOUND * lim.v), out);
+            } else {
+                // Beyond the limit before: "not worse" on q' against the span's exact peak
+                // before (the hull overstates the peak, so it cannot stand for it).
+                let peak = peak_on(before, &mut taus);
                 let bnd = (lim.v - room[0])
                     .max(peak * (1.0 + NOT_WORSE_SLACK))
                     .max(MIN_ROW_BOUND * lim.v);
@@ -495,19 +540,34 @@ impl Window {
                 }
             }
             for (f, l, r) in [
-                (m0, lim.v, 0),
-                (sp.at(0.0, 2), lim.a, 1),
-                (sp.at(0.0, 3), lim.j, 2),
+                (m0, (lim.v, machine_lim.v), 0),
+                (sp.at(0.0, 2), (lim.a, machine_lim.a), 1),
+                (sp.at(0.0, 3), (lim.j, machine_lim.j), 2),
             ] {
                 push(&f, bound(&f, l, r), out);
             }
             if k + 1 == spans.end {
-                for (f, l, r) in [(m1, lim.v, 0), (sp.at(h, 2), lim.a, 1)] {
+                for (f, l, r) in [
+                    (m1, (lim.v, machine_lim.v), 0),
+                    (sp.at(h, 2), (lim.a, machine_lim.a), 1),
+                ] {
                     push(&f, bound(&f, l, r), out);
                 }
             }
         }
     }
+}
+
+/// Which of a window's Equation-6 rows [`Window::limit_rows`] gives, with which bounds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum RowSet {
+    /// The joint patch's rows: the core reaches feed; rows within their limit between
+    /// movable points stay within it; every other row does not get worse.
+    Patch,
+    /// The core's rows only, at the limits (a capped solve relaxes them by its elastic).
+    Core,
+    /// Every span's rows "not worse" (a capped solve holds them: nothing gets slower).
+    NotWorse,
 }
 
 /// `A⁻¹·B` for `a = [A | B]` (`m × (m + no)`, row-major), `A` square: Gaussian
@@ -725,7 +785,18 @@ mod tests {
         };
         let room = vec![[0.0; 3]; win.hi - win.lo + 1];
         let mut out = Vec::new();
-        win.limit_rows(s.len(), &cur, &y, &lim, &room, 0..59, 0, 1, &mut out);
+        win.limit_rows(
+            s.len(),
+            &cur,
+            &y,
+            &lim,
+            (&y, &lim, &(0..60)),
+            &room,
+            0..59,
+            RowSet::Patch,
+            (0, 1),
+            &mut out,
+        );
         assert!(!out.is_empty());
     }
 }

@@ -24,7 +24,10 @@ pub fn merge_zones(zones: &[Zone], gap: usize) -> Vec<Zone> {
                 if z.kind == ZoneKind::AFlip {
                     m.kind = ZoneKind::AFlip;
                 }
-                m.last = m.last.max(z.last);
+                if z.last > m.last {
+                    m.last = z.last;
+                    m.cut_after = z.cut_after;
+                }
                 m.c_ratio_min = m.c_ratio_min.min(z.c_ratio_min);
             }
             _ => out.push(z),
@@ -33,9 +36,22 @@ pub fn merge_zones(zones: &[Zone], gap: usize) -> Vec<Zone> {
     out
 }
 
-/// The spans a zone's patch must bring to feed: the zone's, ± `margin` points.
+/// The spans a zone's patch must bring to feed: the zone's, ± `margin` points — except on
+/// a side where the zone was cut from a longer stretch below feed ([`Zone::cut_before`],
+/// [`Zone::cut_after`]): the spans beyond are slow by the program's own doing, which the
+/// patch need only not make worse.
 pub fn zone_core(zone: &Zone, n: usize, margin: usize) -> Range<usize> {
-    zone.first.saturating_sub(margin)..(zone.last + margin).min(n - 1)
+    let (before, after) = core_margins(zone, margin);
+    zone.first.saturating_sub(before)..(zone.last + after).min(n - 1)
+}
+
+/// The core margins of `zone` before and after it, points: `margin`, or 0 on a cut side
+/// ([`zone_core`]).
+pub fn core_margins(zone: &Zone, margin: usize) -> (usize, usize) {
+    (
+        if zone.cut_before { 0 } else { margin },
+        if zone.cut_after { 0 } else { margin },
+    )
 }
 
 /// Equation-6 figures over the spans `spans` of a run's span figures.

@@ -442,14 +442,33 @@ pub fn check_patch_only_c(
         // LP below does not model (its answer is no bound on that patch); a flat or
         // bull-nose cutter's zone is held by the surface bound, which it does not know.
         // A zone whose patch cannot be written in the file's words (issue 30: a direction
-        // form, a macro-variable word) is left on purpose.
+        // form, a macro-variable word) is left on purpose. So is one whose patches that
+        // reach feed all turn some tool axis beyond the safety bound near the pole (twice
+        // its distance from the pole, at most the pole reach): the bound LP below knows no
+        // such bound (and is a relaxation: its deviation is a lower bound, not a patch).
+        let reach = opts.reach_deg();
         let keeps_centre = report.zones.iter().any(|z| {
             z.run == k + 1
                 && ((z.tool.starts_with("ball") && z.tool_point == "tip")
                     || matches!(
                         z.reason,
                         "tool_limited" | "direction_form" | "macro_variable"
-                    ))
+                    )
+                    || (z.reason == "safety_bound" && {
+                        assert!(
+                            z.max_deviation_deg <= reach + 1e-3 && z.needed_deviation_deg.is_some(),
+                            "{name}: {z:?}"
+                        );
+                        eprintln!(
+                            "note: {name} on {}: run {} left below feed by the safety bound \
+                             (needs {:?}°, wrote {:.3}°)",
+                            machine.name,
+                            k + 1,
+                            z.needed_deviation_deg,
+                            z.max_deviation_deg
+                        );
+                        true
+                    }))
         });
         if a.1 > 0 && !keeps_centre {
             // Left below feed: acceptable only when no C-only change of the whole run can

@@ -75,8 +75,8 @@ pub struct ZoneRow {
     /// `reached`, `improved` or `unchanged`.
     pub outcome: &'static str,
     /// Why (a fixed set: [`polepatch_patcher::Reason`]): `reached`, `reselected`,
-    /// `end_pinned`, `range`, `deviation_cap`, `proven_unreachable`, `not_found`,
-    /// `not_patched`.
+    /// `end_pinned`, `range`, `deviation_cap`, `safety_bound`, `tip_path`,
+    /// `proven_unreachable`, `not_found`, `not_patched`.
     pub reason: &'static str,
     /// Whether the run's last point could change: `free` or `pinned`
     /// ([`crate::EndPose`]); `-` for a run that was not patched.
@@ -126,8 +126,8 @@ pub struct ZoneRow {
     /// written blocks and the original's, between the points (the controller moving the
     /// tip on a line and the rotary axes linearly), mm; `None` otherwise.
     pub centre_chord_mm: Option<f64>,
-    /// Reason `deviation_cap` or `tool_limited`: the orientation change a patch reaching
-    /// feed needed, degrees.
+    /// Reason `deviation_cap`, `safety_bound` or `tool_limited`: the orientation change a
+    /// patch reaching feed needed, degrees.
     pub needed_deviation_deg: Option<f64>,
     /// On the last zone of a run whose end is free: the positioning move after the run
     /// (the rapid or rotary repositioning that freed it) — its line and its time before
