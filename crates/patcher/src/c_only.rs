@@ -184,9 +184,8 @@ impl Proposer for COnly {
     /// The levels without a cap; when nothing within `max_deviation_deg` and the safety
     /// bound passes, again with the cap imposed in the QPs: the smaller of
     /// `max_deviation_deg` and the pole reach — the safety bound of a C-only change
-    /// (`crate::driver::pole_bound_deg`: a change of C alone keeps each tool axis at its
-    /// distance |P| from the pole, so it never turns it by more than 2|P|; the reach is
-    /// the part of the bound that can bind), imposed when a proposal passed beyond it.
+    /// (`crate::driver::pole_bound_deg`, the pole reach), imposed when a proposal passed
+    /// beyond it.
     fn propose(&mut self, ctx: &ZoneCtx<'_>, sink: &mut dyn Sink) {
         let uncapped = PatchOptions {
             max_deviation_deg: None,
