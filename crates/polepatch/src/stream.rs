@@ -400,23 +400,19 @@ fn survey_once(
         if no_run_why.is_none() {
             no_run_why = NoRunWhy::of(s.block, s.state, incremental_set_line);
         }
-        for (l, letter) in LETTERS.into_iter().enumerate() {
-            let at = |w: &polepatch_nc::Word| {
+        // The first word of each tilting letter, and its first that is not 0: one pass
+        // over the block's words until both letters have turned.
+        if first_turn.iter().any(Option::is_none) {
+            for w in s.words {
+                let Some(l) = LETTERS.iter().position(|&c| c == w.letter) else {
+                    continue;
+                };
                 let column = (w.start as usize).saturating_sub(s.block.span().start) + 1;
-                (s.block.line, column)
-            };
-            if first_word[l].is_none()
-                && let Some(w) = s.words.iter().find(|w| w.letter == letter)
-            {
-                first_word[l] = Some(at(w));
-            }
-            if first_turn[l].is_none()
-                && let Some(w) = s
-                    .words
-                    .iter()
-                    .find(|w| w.letter == letter && w.value != 0.0)
-            {
-                first_turn[l] = Some(at(w));
+                let at = (s.block.line, column);
+                first_word[l].get_or_insert(at);
+                if w.value != 0.0 {
+                    first_turn[l].get_or_insert(at);
+                }
             }
         }
         style.add_block(bytes, s.words);
