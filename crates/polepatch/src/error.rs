@@ -39,13 +39,16 @@ pub enum Error {
     },
     /// No rotary axis words in any G1 run.
     #[error(
-        "{path}: no rotary axis words ({primary} or C) in any G1 run; is this a 5-axis program?"
+        "{path}: no rotary axis words ({primary} or C) in any G1 run; is this a 5-axis program?{vectors}"
     )]
     NoRotary {
         /// File.
         path: String,
         /// The machine's primary letter.
         primary: char,
+        /// Empty, or what the G1 moves' I J K words are: tool-direction vectors, which
+        /// polepatch does not read (with the line of the first).
+        vectors: String,
     },
     /// The program turns a rotary axis the machine does not have (a B-C program given an
     /// A-C machine): its kinematics are not the machine's, so nothing computed for it

@@ -155,6 +155,9 @@ struct Survey {
     blocks: usize,
     /// The first G1 move that cannot start a run, and why ([`NoRunWhy`]).
     no_run_why: Option<NoRunWhy>,
+    /// The line of the first G1 move with an I, J or K word (a tool-direction vector:
+    /// some controllers' 5-axis programs without rotary words).
+    first_vector: Option<usize>,
     /// The first word of each tilting letter (A, B): its line and column; and the first
     /// one that is not 0 (the axis turned, not parked).
     first_word: [Option<(usize, usize)>; 2],
@@ -390,6 +393,7 @@ fn survey_once(
     let mut prev = opts.read.initial();
     let mut i = 0usize;
     let mut no_run_why = None;
+    let mut first_vector = None;
     let mut incremental_set_line = None;
     let mut first_word: [Option<(usize, usize)>; 2] = [None, None];
     let mut first_turn: [Option<(usize, usize)>; 2] = [None, None];
@@ -414,6 +418,17 @@ fn survey_once(
                     first_turn[l].get_or_insert(at);
                 }
             }
+        }
+        // (Only while no tilting word has been read: the hint is for programs without.)
+        if first_vector.is_none()
+            && first_word.iter().all(Option::is_none)
+            && s.block.is_move
+            && s.state.motion == polepatch_nc::Motion::Linear
+            && s.words
+                .iter()
+                .any(|w| matches!(w.letter, b'I' | b'J' | b'K'))
+        {
+            first_vector = Some(s.block.line);
         }
         style.add_block(bytes, s.words);
         notes.push(s.block, s.words, &prev, s.state);
@@ -464,6 +479,7 @@ fn survey_once(
             notes,
             blocks: i,
             no_run_why,
+            first_vector,
             first_word,
             first_turn,
         },
@@ -599,6 +615,19 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
         Some(Error::NoRotary {
             path: rd.name.to_string(),
             primary: machine.primary_letter(),
+            vectors: sv
+                .first_vector
+                .map(|line| {
+                    format!(
+                        " Its G1 moves carry I J K words (first at line {line}): tool-direction \
+                         vectors, which polepatch does not read — it patches the rotary axes' \
+                         values ({} and {}); post the CL data for this machine \
+                         (`polepatch post`) to get them",
+                        machine.primary_letter(),
+                        machine.c_letter()
+                    )
+                })
+                .unwrap_or_default(),
         })
     } else {
         None

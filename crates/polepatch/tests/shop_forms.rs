@@ -217,6 +217,13 @@ fn a_program_with_nothing_to_analyse_is_written_unchanged() {
             "no rotary axis words",
             0,
         ),
+        // A vector program (tool directions as I J K on G1, no rotary words): said so.
+        (
+            "G1 X0 Y0 Z0 F1000\nG1 X1 I0 J0.1 K0.995\nX2\nM30\n",
+            "is this a 5-axis program? Its G1 moves carry I J K words (first at line 2): \
+             tool-direction vectors, which polepatch does not read",
+            0,
+        ),
         (
             "M128\nG1 X0 Y0 Z0 A#1 C0 F1000\nG1 X1 A#2 C#3\nM30\n",
             "expressions or variables",
