@@ -106,7 +106,8 @@ fn json_peak_speed_is_keyed_by_axis_letter() {
         err.contains("fixtures/c17/SING.I:6:5:")
             && err.contains(
                 "A is not an axis of machine mikron-hsm600, whose rotary axes are B and C"
-            ),
+            )
+            && err.contains("; the built-in mikron-ucp710 has A and C"),
         "{err}"
     );
 }

@@ -56,7 +56,7 @@ pub enum Error {
     #[error(
         "{path}:{line}:{column}: {letter} is not an axis of machine {machine}, whose rotary \
          axes are {axes}: the program was posted for another machine; give that machine \
-         (--machine NAME, or a machine file whose rotary axes include {letter})"
+         (--machine NAME, or a machine file whose rotary axes include {letter}){fits}"
     )]
     ForeignAxis {
         /// File.
@@ -71,6 +71,9 @@ pub enum Error {
         machine: String,
         /// The machine's rotary letters (`A and C`).
         axes: String,
+        /// Empty, or the built-in machines whose letters the program uses (`; the built-in
+        /// mikron-ucp710 has A and C`).
+        fits: String,
     },
     /// The program uses something polepatch does not support, at a line.
     #[error("{path}:{line}: {what}")]

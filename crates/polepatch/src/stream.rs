@@ -595,6 +595,18 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
         sv.first_turn[foreign]
     };
     if let Some((line, column)) = at {
+        // The built-ins the program fits: it tilts with the other letter and never turns
+        // this machine's (an A-B trunnion's program fits none).
+        let fits: Vec<String> = if p_idx != [A, B][own] && sv.first_turn[own].is_none() {
+            Machine::builtin_names()
+                .iter()
+                .filter_map(|n| Machine::builtin(n))
+                .filter(|m| m.primary_letter() == LETTERS[foreign] as char)
+                .map(|m| format!("{} has {} and {}", m.name, m.primary_letter(), m.c_letter()))
+                .collect()
+        } else {
+            Vec::new()
+        };
         return Err(Error::ForeignAxis {
             path: rd.name.to_string(),
             line,
@@ -602,6 +614,11 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
             letter: LETTERS[foreign] as char,
             machine: machine.name.clone(),
             axes: format!("{} and {}", machine.primary_letter(), machine.c_letter()),
+            fits: if fits.is_empty() {
+                String::new()
+            } else {
+                format!("; the built-in {}", fits.join(", the built-in "))
+            },
         });
     }
     let why = if sv.runs.is_empty() {

@@ -238,6 +238,8 @@ fn rotary_letters_the_machine_does_not_have_are_named() {
             msg.contains("the program was posted for another machine"),
             "{msg}"
         );
+        // It turns both A and B: no built-in machine is suggested.
+        assert!(!msg.contains("the built-in"), "{msg}");
         // The analysis refuses it the same way.
         let a = polepatch::analyze_nc(&bytes, &m, &polepatch::AnalyzeOptions::default());
         assert!(
