@@ -103,16 +103,11 @@ pub fn analyze_program(
             let n = rp.run.len();
             let mut rep = RunReport {
                 run: lp.run_number(r),
-                lines: [lp.line_of(r, 0), lp.line_of(r, n - 1)],
+                lines: lp.lines_of_run(r),
                 points: n,
                 length_mm: rp.run.length_mm(),
                 // The run's F also when it is not analysed.
-                feed_mm_min: rp
-                    .path
-                    .as_ref()
-                    .ok()
-                    .map(|p| p.feed_mm_min)
-                    .or(rp.run.feed_mm_min),
+                feed_mm_min: lp.run_feed_mm_min(r),
                 feed_mode: crate::report::feed_mode_name(rp.run.feed_mode),
                 error: None,
                 figures: None,

@@ -211,6 +211,16 @@ impl LoadedProgram {
             self.line_of(r, self.runs[r].run.len() - 1),
         ]
     }
+    /// The programmed feed of run `r`, mm/min: its path's, or, for a run that cannot be
+    /// analysed, the F the reader found (`None`: none).
+    pub fn run_feed_mm_min(&self, r: usize) -> Option<f64> {
+        let rp = &self.runs[r];
+        rp.path
+            .as_ref()
+            .ok()
+            .map(|p| p.feed_mm_min)
+            .or(rp.run.feed_mm_min)
+    }
     /// Number of run `r` in the file, from 1 (as reports give it).
     pub fn run_number(&self, r: usize) -> usize {
         r + 1 + self.window.first_run

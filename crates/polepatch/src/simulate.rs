@@ -82,15 +82,10 @@ fn run_inputs(lp: &LoadedProgram, machine: &Machine) -> Vec<RunIn> {
             let n = rp.run.len();
             let mut row = SimRun {
                 run: lp.run_number(r),
-                lines: [lp.line_of(r, 0), lp.line_of(r, n - 1)],
+                lines: lp.lines_of_run(r),
                 points: n,
                 length_mm: rp.run.length_mm(),
-                feed_mm_min: rp
-                    .path
-                    .as_ref()
-                    .ok()
-                    .map(|p| p.feed_mm_min)
-                    .or(rp.run.feed_mm_min),
+                feed_mm_min: lp.run_feed_mm_min(r),
                 error: None,
                 time_s: 0.0,
                 eq6_time_s: 0.0,
