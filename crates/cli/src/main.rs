@@ -415,7 +415,11 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
                 write!(out, "{sep}{}", indented.join("\n"))?;
             } else {
                 let primary = head.as_ref().map_or(b'A', |h| h.primary.as_bytes()[0]);
-                print_run(&mut out, &r, primary)?;
+                let letters = polepatch::nc::RotaryLetters {
+                    tilt: primary,
+                    pole: machine.c_letter() as u8,
+                };
+                print_run(&mut out, &r, letters)?;
             }
             runs += 1;
             if r.error.is_some() {
@@ -467,7 +471,7 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
 fn print_run(
     out: &mut impl Write,
     r: &polepatch::report::RunReport,
-    primary_letter: u8,
+    letters: polepatch::nc::RotaryLetters,
 ) -> std::io::Result<()> {
     {
         let feed = r.feed_mm_min.map_or("no F".to_string(), |f| {
@@ -508,7 +512,7 @@ fn print_run(
         let peaks: Vec<String> = Axis::ALL
             .iter()
             .map(|&a| {
-                let l = axis_letter(a, primary_letter);
+                let l = axis_letter(a, letters);
                 let unit = if a.is_rotary() { "rpm" } else { "m/min" };
                 format!("{l} {:.3} {unit}", f.peak_speed[&l])
             })
@@ -517,7 +521,7 @@ fn print_run(
         let ratios: Vec<String> = Axis::ALL
             .iter()
             .map(|&a| {
-                let l = axis_letter(a, primary_letter);
+                let l = axis_letter(a, letters);
                 format!("{l} {:.3} ({})", f.axis_min_ratio[&l], f.axis_limit[&l])
             })
             .collect();
@@ -544,13 +548,14 @@ fn print_run(
         for z in &f.zones {
             writeln!(
                 out,
-                "  singular zone lines {}–{} ({}), min |{}| {:.3}° at line {}, C ratio {:.3}",
+                "  singular zone lines {}–{} ({}), min |{}| {:.3}° at line {}, {} ratio {:.3}",
                 z.lines[0],
                 z.lines[1],
                 z.kind,
-                primary_letter as char,
+                letters.tilt as char,
                 z.min_abs_primary_deg,
                 z.singular_line,
+                letters.pole as char,
                 z.c_ratio_min
             )?;
         }

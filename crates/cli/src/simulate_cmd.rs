@@ -5,7 +5,7 @@
 use crate::{check_positive, machine, parse_xyz};
 use anyhow::{Context, Result, bail};
 use plotters::prelude::*;
-use polepatch::kinematics::Axis;
+use polepatch::kinematics::{Axis, Machine};
 use polepatch::report::SimulateReport;
 use polepatch::report::axis_letter;
 use polepatch::simulate::{SimState, SimulateOptions, simulate_nc_with};
@@ -28,7 +28,7 @@ pub(crate) struct SimulateArgs {
     #[arg(long)]
     json: bool,
     /// Write the trajectory at the machine's Tcy as CSV (one program only): run, t_s, s_mm,
-    /// X, Y, Z, the primary letter, C, feed_mm_min.
+    /// X, Y, Z, the tilting and the pole axis (by their letters, e.g. A, C), feed_mm_min.
     #[arg(long)]
     trajectory: Option<PathBuf>,
     /// Draw the feed and each axis' share of its limits along s (SVG).
@@ -192,7 +192,11 @@ pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
                     let r = (|| {
                         if !header_written {
                             header_written = true;
-                            writeln!(w, "run,t_s,s_mm,X,Y,Z,{primary_guess},C,feed_mm_min")?;
+                            writeln!(
+                                w,
+                                "run,t_s,s_mm,X,Y,Z,{primary_guess},{},feed_mm_min",
+                                machine.c_letter()
+                            )?;
                         }
                         let q = s.axes;
                         writeln!(
@@ -255,7 +259,7 @@ pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
     drop(out);
     if let Some(target) = plot_target {
         let path = &target.path;
-        let svg = plot(&reports, &plots, &machine.name)
+        let svg = plot(&reports, &plots, &machine)
             .map_err(|e| anyhow::anyhow!("drawing {}: {e}", path.display()))?;
         target
             .write(svg.as_bytes(), None)
@@ -366,7 +370,7 @@ fn print_report(out: &mut impl Write, r: &SimulateReport) -> std::io::Result<()>
 fn plot(
     reports: &[SimulateReport],
     plots: &[Binned],
-    machine: &str,
+    machine: &Machine,
 ) -> Result<String, Box<dyn std::error::Error>> {
     let mut buf = String::new();
     {
@@ -391,7 +395,10 @@ fn plot(
             RGBColor(255, 127, 14),
         ];
         let mut chart = ChartBuilder::on(&areas[0])
-            .caption(format!("feed along s on {machine}"), ("sans-serif", 16))
+            .caption(
+                format!("feed along s on {}", machine.name),
+                ("sans-serif", 16),
+            )
             .margin(10)
             .x_label_area_size(35)
             .y_label_area_size(60)
@@ -431,7 +438,10 @@ fn plot(
                 .x_desc("s, mm")
                 .y_desc("share")
                 .draw()?;
-            let primary = r.primary.as_bytes().first().copied().unwrap_or(b'A');
+            let letters = polepatch::nc::RotaryLetters {
+                tilt: r.primary.as_bytes().first().copied().unwrap_or(b'A'),
+                pole: machine.c_letter() as u8,
+            };
             for axis in Axis::ALL {
                 let c = colors[axis.index()];
                 chart
@@ -439,7 +449,7 @@ fn plot(
                         p.points().map(|(s, b)| (s, b.share_max[axis.index()])),
                         c,
                     ))?
-                    .label(axis_letter(axis, primary))
+                    .label(axis_letter(axis, letters))
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
             }
             chart

@@ -202,8 +202,9 @@ pub struct EmitOptions {
     pub dialect: Dialect,
     /// Program name (Heidenhain `%NAME`, Fanuc comment, Sinumerik comment).
     pub name: String,
-    /// Letter of the primary axis (`b'A'` or `b'B'`).
-    pub primary_letter: u8,
+    /// Letters of the tilting and the pole axis (A or B and C on most machines; A and B on
+    /// an A-B trunnion whose platter is B).
+    pub letters: crate::modal::RotaryLetters,
     /// Decimals of rotary words.
     pub rotary_decimals: usize,
     /// Decimals of linear words.
@@ -365,13 +366,13 @@ impl Writer<'_> {
 
     fn axis_words(&self, xyz: [f64; 3], p_deg: f64, c_deg: f64) -> Vec<String> {
         let rd = self.o.rotary_decimals;
-        let p = self.o.primary_letter as char;
+        let (p, c) = (self.o.letters.tilt as char, self.o.letters.pole as char);
         vec![
             format!("X{}", self.len(xyz[0])),
             format!("Y{}", self.len(xyz[1])),
             format!("Z{}", self.len(xyz[2])),
             format!("{p}{}", self.st.render(p_deg, rd)),
-            format!("C{}", self.st.render(c_deg, rd)),
+            format!("{c}{}", self.st.render(c_deg, rd)),
         ]
     }
 
@@ -825,7 +826,7 @@ mod tests {
         EmitOptions {
             dialect,
             name: "T (1)".into(),
-            primary_letter: b'A',
+            letters: crate::modal::RotaryLetters::AC,
             rotary_decimals: 3,
             linear_decimals: 3,
             comments: vec!["from t.apt".into()],

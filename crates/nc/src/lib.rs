@@ -58,7 +58,7 @@ pub use dialect::Dialect;
 pub use error::ParseError;
 pub use flow::FlowPlan;
 pub use lines::LineEnds;
-pub use modal::{FeedMode, Modal, Motion, Tcpm};
+pub use modal::{FeedMode, Modal, Motion, RotaryLetters, Tcpm};
 pub use plan::{FormConflict, restore_modal, write_direction_forms};
 pub use program::Program;
 pub use reader::{Scanned, Settled, scan, scan_blocks, scan_blocks_with};

@@ -167,6 +167,64 @@ pub const C: usize = 5;
 /// The axis letters in [`Modal::pos`] order.
 pub const AXES: &[u8; 6] = b"XYZABC";
 
+/// Index in [`Modal::pos`] of an axis letter (upper case), `None` for another letter.
+pub fn axis_index(letter: u8) -> Option<usize> {
+    AXES.iter().position(|&l| l == letter)
+}
+
+/// The two rotary letters a program is read with for a machine: its tilting axis and its
+/// pole axis (the one whose turning cannot change a tool axis along it). A and C, or B and
+/// C, on the usual table-table machines; A and B on an A-B trunnion whose platter is B.
+/// Both are among A B C and differ; the third of those letters is one the machine lacks
+/// ([`RotaryLetters::other`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct RotaryLetters {
+    /// The tilting axis' letter.
+    pub tilt: u8,
+    /// The pole axis' letter.
+    pub pole: u8,
+}
+
+impl RotaryLetters {
+    /// A and C: the tilting axis A (about X), the pole axis C.
+    pub const AC: RotaryLetters = RotaryLetters {
+        tilt: b'A',
+        pole: b'C',
+    };
+    /// B and C.
+    pub const BC: RotaryLetters = RotaryLetters {
+        tilt: b'B',
+        pole: b'C',
+    };
+
+    /// The pair, when both letters are among A B C (either case) and differ.
+    pub fn new(tilt: u8, pole: u8) -> Option<RotaryLetters> {
+        let (tilt, pole) = (tilt.to_ascii_uppercase(), pole.to_ascii_uppercase());
+        let rotary = |l: u8| matches!(l, b'A' | b'B' | b'C');
+        (rotary(tilt) && rotary(pole) && tilt != pole).then_some(RotaryLetters { tilt, pole })
+    }
+    /// Index of the tilting letter in [`Modal::pos`].
+    pub fn tilt_index(self) -> usize {
+        axis_index(self.tilt).unwrap_or(A)
+    }
+    /// Index of the pole letter in [`Modal::pos`].
+    pub fn pole_index(self) -> usize {
+        axis_index(self.pole).unwrap_or(C)
+    }
+    /// The letter of A B C that is neither (one the machine does not have).
+    pub fn other(self) -> u8 {
+        [b'A', b'B', b'C']
+            .into_iter()
+            .find(|&l| l != self.tilt && l != self.pole)
+            .unwrap_or(b'B')
+    }
+    /// The same pair with `tilt` as the tilting letter (the pole unchanged): how a program
+    /// that tilts with another letter reads.
+    pub fn with_tilt(self, tilt: u8) -> RotaryLetters {
+        RotaryLetters { tilt, ..self }
+    }
+}
+
 /// Modal state after a block.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Modal {

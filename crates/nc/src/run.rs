@@ -1,6 +1,6 @@
 //! Runs of G1 motion with cumulative tool-tip path length s.
 
-use crate::modal::{A, B, C, Modal, X, Y, Z};
+use crate::modal::{A, B, C, Modal, RotaryLetters, X, Y, Z};
 
 use crate::block::Block;
 use crate::program::Program;
@@ -232,16 +232,17 @@ fn xyz(pos: &[Option<f64>; 6]) -> Option<[f64; 3]> {
 }
 
 impl Run {
-    /// Per point `[X, Y, Z, P, C]` (mm, mm, mm, degrees, degrees), P the tilting axis at
-    /// index `primary` of [`Run::pos`] (`modal::A` or `modal::B`). A value never programmed
-    /// reads as 0.
-    pub fn axes5(&self, primary: usize) -> Vec<[f64; 5]> {
-        use crate::modal::{C, X, Y, Z};
+    /// Per point `[X, Y, Z, P, C]` (mm, mm, mm, degrees, degrees), P the tilting axis and
+    /// C the pole axis of `letters` (A and C, B and C, or another pair). A value never
+    /// programmed reads as 0.
+    pub fn axes5(&self, letters: crate::modal::RotaryLetters) -> Vec<[f64; 5]> {
+        use crate::modal::{X, Y, Z};
+        let (p_idx, c_idx) = (letters.tilt_index(), letters.pole_index());
         self.pos
             .iter()
             .map(|p| {
                 let v = |i: usize| p[i].unwrap_or(0.0);
-                [v(X), v(Y), v(Z), v(primary), v(C)]
+                [v(X), v(Y), v(Z), v(p_idx), v(c_idx)]
             })
             .collect()
     }
@@ -252,9 +253,11 @@ impl Run {
     }
 }
 
-/// The tilting axis the runs use: `preferred` (`modal::A` or `modal::B`, the machine's),
-/// unless the runs never program it but do program the other tilting letter.
-pub fn primary_in_use(runs: &[Run], preferred: usize) -> usize {
+/// The rotary letters the runs use: `preferred` (the machine's), unless the runs never
+/// program its tilting letter but do program the third letter of A B C
+/// ([`RotaryLetters::other`]): then that one is read as the tilting axis (a program posted
+/// for another machine, which the caller refuses or reports).
+pub fn primary_in_use(runs: &[Run], preferred: RotaryLetters) -> RotaryLetters {
     let mut uses = [false; 6];
     for (i, u) in uses.iter_mut().enumerate() {
         *u = runs.iter().any(|r| r.uses(i));
@@ -264,11 +267,11 @@ pub fn primary_in_use(runs: &[Run], preferred: usize) -> usize {
 
 /// [`primary_in_use`] from which of X Y Z A B C the runs use (index as
 /// [`crate::Modal::pos`]), for callers that read runs one at a time.
-pub fn primary_of(uses: &[bool; 6], preferred: usize) -> usize {
-    use crate::modal::{A, B};
-    let other = if preferred == A { B } else { A };
-    if !uses[preferred] && uses[other] {
-        other
+pub fn primary_of(uses: &[bool; 6], preferred: RotaryLetters) -> RotaryLetters {
+    let other = preferred.other();
+    let other_idx = crate::modal::axis_index(other).unwrap_or(crate::modal::B);
+    if !uses[preferred.tilt_index()] && uses[other_idx] {
+        preferred.with_tilt(other)
     } else {
         preferred
     }
@@ -360,10 +363,17 @@ mod tests {
         )
         .unwrap();
         let rs = runs(&prog);
-        assert_eq!(primary_in_use(&rs, crate::modal::A), crate::modal::B);
-        assert_eq!(primary_in_use(&rs, crate::modal::B), crate::modal::B);
+        use crate::modal::RotaryLetters;
+        assert_eq!(primary_in_use(&rs, RotaryLetters::AC), RotaryLetters::BC);
+        assert_eq!(primary_in_use(&rs, RotaryLetters::BC), RotaryLetters::BC);
+        // For an A-B trunnion (pole B) the program tilts with C, the letter it lacks; read
+        // with the machine's letters, B is its pole axis and A, never programmed, 0.
+        let ab = RotaryLetters::new(b'A', b'B').unwrap();
+        assert_eq!(ab.other(), b'C');
+        assert_eq!(primary_in_use(&rs, ab), ab.with_tilt(b'C'));
+        assert_eq!(rs[0].axes5(ab).last().unwrap(), &[2.0, 0.0, 0.0, 0.0, 3.0]);
         assert_eq!(
-            rs[0].axes5(crate::modal::B).last().unwrap(),
+            rs[0].axes5(crate::modal::RotaryLetters::BC).last().unwrap(),
             &[2.0, 0.0, 0.0, 3.0, 20.0]
         );
     }

@@ -57,11 +57,8 @@ fn main() {
         for mname in ["mikron-ucp710", "mikron-hsm600"] {
             let m = Machine::builtin(mname).unwrap();
             let rs = runs(&prog);
-            let own = if m.primary_letter() == 'A' {
-                modal::A
-            } else {
-                modal::B
-            };
+            let own = modal::RotaryLetters::new(m.primary_letter() as u8, m.c_letter() as u8)
+                .expect("a built-in's letters are among A B C");
             let pi = primary_in_use(&rs, own);
             for r in &rs {
                 let Some(feed) = r.feed_mm_min else { continue };

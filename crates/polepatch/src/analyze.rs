@@ -11,7 +11,7 @@ use std::collections::BTreeMap;
 
 /// Summarise one analysed run.
 pub fn run_figures(lp: &LoadedProgram, r: usize, a: &RunAnalysis) -> RunFigures {
-    let pl = lp.primary_letter;
+    let pl = lp.letters();
     let s = &lp.runs[r].run.s_mm;
     let k = s
         .partition_point(|&v| v < a.min_s_mm - 1e-9)
@@ -78,7 +78,7 @@ fn machine_frame_figures(
         axis_limit: BTreeMap::new(),
     };
     for axis in [Axis::X, Axis::Y, Axis::Z] {
-        let l = axis_letter(axis, lp.primary_letter);
+        let l = axis_letter(axis, lp.letters());
         f.peak_speed
             .insert(l.clone(), machine_units(axis, a.peak_speed[axis.index()]));
         f.axis_min_ratio
@@ -126,9 +126,7 @@ pub fn analyze_program(
             rep
         })
         .collect();
-    let (not_analysed, notes_warnings) =
-        lp.notes
-            .finish(lp.primary_index(), opts.reach_deg(), &lp.name);
+    let (not_analysed, notes_warnings) = lp.notes.finish(lp.letters(), opts.reach_deg(), &lp.name);
     AnalyzeReport {
         file: lp.name.clone(),
         machine: machine.name.clone(),

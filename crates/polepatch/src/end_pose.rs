@@ -51,8 +51,8 @@
 //! A run without TCPM is pinned by the pipeline whatever follows (its X Y Z are machine
 //! coordinates: [`crate::patch`]).
 
-use polepatch_nc::modal::{C, X, Y, Z};
-use polepatch_nc::{Flags, Modal, Word};
+use polepatch_nc::modal::{X, Y, Z};
+use polepatch_nc::{Flags, Modal, RotaryLetters, Word};
 
 /// What the blocks after a run say about its last point.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -201,15 +201,11 @@ impl<'a> After<'a> {
 impl After<'_> {
     /// The positioning move this block is, when it freed the end by moving the rotary axes
     /// to known values (`line` its file line).
-    pub fn next_move(&self, primary: u8, line: usize) -> Option<NextMove> {
+    pub fn next_move(&self, letters: RotaryLetters, line: usize) -> Option<NextMove> {
         if !self.is_move {
             return None;
         }
-        let p_idx = if primary == b'A' {
-            polepatch_nc::modal::A
-        } else {
-            polepatch_nc::modal::B
-        };
+        let (p_idx, c_idx) = (letters.tilt_index(), letters.pole_index());
         let (st, prev) = (self.state, self.before);
         let linear = |i: usize| match (prev.pos[i], st.pos[i]) {
             (Some(a), Some(b)) => Some((b - a).abs()),
@@ -218,16 +214,16 @@ impl After<'_> {
         Some(NextMove {
             line,
             p_deg: st.pos[p_idx]?,
-            c_deg: st.pos[C]?,
+            c_deg: st.pos[c_idx]?,
             linear_mm: [linear(X)?, linear(Y)?, linear(Z)?],
         })
     }
 
     /// What this block says about the pose of the run's last point before it, for a
-    /// program whose tilting letter is `primary` (`b'A'` or `b'B'`), given what the scan
+    /// program read with the rotary letters `letters`, given what the scan
     /// saw so far (updated: a retract raises the clearance). Module docs.
-    pub fn verdict(&self, primary: u8, scan: &mut Scan) -> Step {
-        let step = self.verdict_executed(primary, scan);
+    pub fn verdict(&self, letters: RotaryLetters, scan: &mut Scan) -> Step {
+        let step = self.verdict_executed(letters, scan);
         // A block the operator may skip (block delete) cannot free the end: skipped, the
         // blocks after it move from the run's last pose. As a restatement it is still
         // rewritten (executed, it restates the new values; skipped, it does nothing).
@@ -238,7 +234,7 @@ impl After<'_> {
     }
 
     /// [`After::verdict`] for a block that is executed.
-    fn verdict_executed(&self, primary: u8, scan: &mut Scan) -> Step {
+    fn verdict_executed(&self, letters: RotaryLetters, scan: &mut Scan) -> Step {
         if self.flags.has(Flags::TOOL_CHANGE) || self.flags.has(Flags::PROGRAM_END) || self.ends {
             return Step::Free;
         }
@@ -247,13 +243,9 @@ impl After<'_> {
         if st.incremental {
             return Step::Pinned;
         }
-        let p_idx = if primary == b'A' {
-            polepatch_nc::modal::A
-        } else {
-            polepatch_nc::modal::B
-        };
-        let (has_p, has_c) = (has(primary), has(b'C'));
-        let rotary_moves = st.pos[p_idx] != prev.pos[p_idx] || st.pos[C] != prev.pos[C];
+        let (p_idx, c_idx) = (letters.tilt_index(), letters.pole_index());
+        let (has_p, has_c) = (has(letters.tilt), has(letters.pole));
+        let rotary_moves = st.pos[p_idx] != prev.pos[p_idx] || st.pos[c_idx] != prev.pos[c_idx];
         let xy_moves = st.pos[X] != prev.pos[X] || st.pos[Y] != prev.pos[Y];
         let z_moves = st.pos[Z] != prev.pos[Z];
         if !self.is_move {
@@ -277,7 +269,7 @@ impl After<'_> {
             // A Sinumerik direction form (`C=DC(…)`, `C=ACP(…)`, `C=ACN(…)`) moves from
             // where the axis is: from another pose it reaches another unwrapped position,
             // or turns another way.
-            if self.directional & (bit(primary) | bit(b'C')) != 0 {
+            if self.directional & (bit(letters.tilt) | bit(letters.pole)) != 0 {
                 return Step::Pinned;
             }
             if !rotary_moves && (st.tcpm.is_on() || !xy_moves) {

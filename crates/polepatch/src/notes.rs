@@ -20,7 +20,7 @@
 //! not all of it was analysed.
 
 use polepatch_nc::modal::{A, B, C};
-use polepatch_nc::{Block, FeedMode, Flags, Modal, Motion, Word};
+use polepatch_nc::{Block, FeedMode, Flags, Modal, Motion, RotaryLetters, Word};
 use serde::Serialize;
 
 /// Why a stretch of blocks was not analysed.
@@ -53,14 +53,14 @@ pub struct NotAnalysed {
     pub message: String,
 }
 
-/// An item in progress: the smallest |A| and |B| at the start or end of its blocks
+/// An item in progress: the smallest |A|, |B| and |C| at the start or end of its blocks
 /// (unknown counts as 0), since the tilting letter in use and the cone are known only at
 /// the end.
 #[derive(Debug, Clone)]
 struct Item {
     lines: [usize; 2],
     reason: SkipReason,
-    min_abs_deg: [f64; 2],
+    min_abs_deg: [f64; 3],
 }
 
 /// The collector (module docs).
@@ -69,9 +69,9 @@ pub struct Notes {
     items: Vec<Item>,
     /// First line of each letter carried through (E U V W), in `b"EUVW"` order.
     other_letters: [Option<usize>; 4],
-    /// First line of an A word and of a B word: the tilting letter that is not analysed is
+    /// First line of an A, a B and a C word: the rotary letter that is not analysed is
     /// named once.
-    tilt_first: [Option<usize>; 2],
+    tilt_first: [Option<usize>; 3],
     /// Lines of unclosed comments that hide axis-like words (the first few).
     unclosed: Vec<usize>,
     unclosed_count: usize,
@@ -91,14 +91,15 @@ impl Notes {
         Notes::default()
     }
 
-    fn add(&mut self, line: usize, reason: SkipReason, min_abs_deg: [f64; 2]) {
+    fn add(&mut self, line: usize, reason: SkipReason, min_abs_deg: [f64; 3]) {
         if let Some(last) = self.items.last_mut()
             && last.reason == reason
             && line <= last.lines[1] + 1
         {
             last.lines[1] = line;
-            last.min_abs_deg[0] = last.min_abs_deg[0].min(min_abs_deg[0]);
-            last.min_abs_deg[1] = last.min_abs_deg[1].min(min_abs_deg[1]);
+            for (l, m) in last.min_abs_deg.iter_mut().zip(min_abs_deg) {
+                *l = l.min(m);
+            }
             return;
         }
         self.items.push(Item {
@@ -116,8 +117,8 @@ impl Notes {
             let abs = |v: Option<f64>| v.map_or(0.0, f64::abs);
             abs(before.pos[idx]).min(abs(after.pos[idx]))
         };
-        let near = [min_abs(A), min_abs(B)];
-        let always = [0.0, 0.0];
+        let near = [min_abs(A), min_abs(B), min_abs(C)];
+        let always = [0.0; 3];
         self.default_inch.get_or_insert(before.inch);
         if f.has(Flags::UNITS) && self.stated.is_none() {
             self.stated = Some((line, after.inch));
@@ -154,21 +155,27 @@ impl Notes {
             if let Some(k) = b"EUVW".iter().position(|&l| l == w.letter) {
                 self.other_letters[k].get_or_insert(line);
             }
-            if let Some(k) = b"AB".iter().position(|&l| l == w.letter) {
+            if let Some(k) = b"ABC".iter().position(|&l| l == w.letter) {
                 self.tilt_first[k].get_or_insert(line);
             }
         }
     }
 
-    /// The list for a program whose tilting letter is at `p_idx` (`modal::A` or
-    /// `modal::B`) and the singular cone `cone_deg`, and the warnings (named `name`).
+    /// The list for a program read with the rotary letters `letters` and the singular cone
+    /// `cone_deg`, and the warnings (named `name`).
     pub fn finish(
         &self,
-        p_idx: usize,
+        letters: RotaryLetters,
         cone_deg: f64,
         name: &str,
     ) -> (Vec<NotAnalysed>, Vec<String>) {
-        let l = usize::from(p_idx == B);
+        let l = usize::from(letters.tilt - b'A');
+        let (own, other, pole) = (
+            letters.tilt as char,
+            letters.other() as char,
+            letters.pole as char,
+        );
+        let other_slot = usize::from(letters.other() - b'A');
         let items = self
             .items
             .iter()
@@ -190,16 +197,15 @@ impl Notes {
         if !letters.is_empty() {
             warnings.push(format!(
                 "{name}: words {} are carried through as written and not analysed (polepatch \
-                 analyses X Y Z, the tilting axis and C)",
+                 analyses X Y Z, the tilting axis and {pole})",
                 letters.join(", ")
             ));
         }
-        // The other tilting letter (B when A is analysed): an axis of another machine.
-        let (own, other) = if l == 0 { ('A', 'B') } else { ('B', 'A') };
-        if let Some(line) = self.tilt_first[1 - l] {
+        // The other rotary letter (B when A and C are analysed): an axis of another machine.
+        if let Some(line) = self.tilt_first[other_slot] {
             warnings.push(format!(
                 "{name}: words {other} (first at line {line}) are of a rotary axis the machine \
-                 does not have (the program is read with {own} and C); none turns it (each is 0, \
+                 does not have (the program is read with {own} and {pole}); none turns it (each is 0, \
                  or an expression): they are carried through as written, and a run where \
                  {other} is not known to be 0 is not analysed"
             ));
@@ -288,7 +294,12 @@ mod tests {
     use super::*;
     use polepatch_nc::{Dialect, parse};
 
-    fn notes(text: &str, p_idx: usize) -> (Vec<NotAnalysed>, Vec<String>) {
+    fn notes(text: &str, tilt: usize) -> (Vec<NotAnalysed>, Vec<String>) {
+        let letters = if tilt == A {
+            RotaryLetters::AC
+        } else {
+            RotaryLetters::BC
+        };
         let p = parse(text.as_bytes().to_vec(), Dialect::Auto).unwrap();
         let mut n = Notes::new();
         for b in 0..p.blocks.len() {
@@ -299,7 +310,7 @@ mod tests {
                 &p.state(b),
             );
         }
-        n.finish(p_idx, 5.0, "t")
+        n.finish(letters, 5.0, "t")
     }
 
     #[test]

@@ -57,7 +57,7 @@ pub fn patch_program(
             .letter(l)
             .unwrap_or_else(|| NumberStyle::of(program, l))
     };
-    let c_style = style_of(b'C');
+    let c_style = style_of(lp.pole_letter);
     let p_style = style_of(lp.primary_letter);
     let opts = PatchOptions {
         c_decimals: c_style.decimals,
@@ -464,7 +464,12 @@ pub fn patch_program(
                 &result.p_changed,
                 result.p_decimals,
             ),
-            (b'C', &result.c_deg, &result.c_changed, result.c_decimals),
+            (
+                lp.pole_letter,
+                &result.c_deg,
+                &result.c_changed,
+                result.c_decimals,
+            ),
         ];
         for (letter, values, changed, decimals) in letters {
             for k in 0..rp.run.len() {
@@ -476,7 +481,7 @@ pub fn patch_program(
                     debug_assert!(false, "patcher changed the start point of a run");
                     continue;
                 }
-                if letter == b'C' {
+                if letter == lp.pole_letter {
                     written_c = written_c.max(decimals);
                 } else {
                     written_p = written_p.max(decimals);
@@ -507,8 +512,8 @@ pub fn patch_program(
         run_edit_ranges.push((r, first_row, first_edit..edits.len()));
     }
     let file_decimals = |l: u8| match l {
-        b'C' => c_style.decimals,
         b'X' | b'Y' | b'Z' => style_of(l).decimals,
+        l if l == lp.pole_letter => c_style.decimals,
         _ => p_style.decimals,
     };
     // Inside a run, a point that relied on a modal value keeps it; after a run only the
@@ -762,7 +767,7 @@ fn through_chain(
     let after_r = machine_frame::axis_min_ratios(&frame(&after), machine, &aopts)
         .map_err(|e| format!("machine-frame analysis failed after the patch: {e}"))?;
     if let Some(axis) = machine_frame::worse_axis(&before, &after_r) {
-        let l = axis_letter(axis, lp.primary_letter);
+        let l = axis_letter(axis, lp.letters());
         return Err(format!(
             "the patch would slow {l} in the machine frame (its lowest ratio {:.3} → {:.3}; \
              the linear axes follow the table near the pole), so the run keeps its values",
@@ -945,7 +950,7 @@ fn untouched(
 
 /// The report row of zone `z` of run `run` of `lp`, before the tool and end-pose fields.
 fn zone_row(lp: &LoadedProgram, run: usize, z: &ZoneReport) -> ZoneRow {
-    let pl = lp.primary_letter;
+    let pl = lp.letters();
     ZoneRow {
         file: lp.name.clone(),
         run: lp.run_number(run),

@@ -812,24 +812,24 @@ pub fn post_cl(
     for (w, n) in &cl.skipped {
         comments.push(format!("{w} records skipped by --ignore {w}: {n}"));
     }
-    // The writer names the pole axis C and the tilting axis A or B: a machine whose letters
-    // differ (an A-B trunnion) would get words for axes it does not have.
-    if machine.c_letter() != 'C' || !matches!(machine.primary_letter(), 'A' | 'B') {
+    // The writer writes the machine's own letters, among A B C.
+    let (p, c) = (machine.primary_letter(), machine.c_letter());
+    let Some(letters) =
+        polepatch_nc::RotaryLetters::new(p as u8, c as u8).filter(|_| p.is_ascii() && c.is_ascii())
+    else {
         return Err(Error::Options(format!(
-            "machine {}: its rotary axes are called {} and {}; post writes the tilting axis as \
-             A or B and the pole axis as C so far (issue 29), so it would write words for axes \
-             the machine does not have",
+            "machine {}: its rotary axes are called {p} and {c}; post writes rotary words A, B \
+             and C so far (issue 29), so it would write words for axes the machine does not \
+             have",
             machine.name,
-            machine.primary_letter(),
-            machine.c_letter()
         )));
-    }
+    };
     let bytes = emit(
         &items,
         &EmitOptions {
             dialect: opts.dialect,
             name: program_name,
-            primary_letter: machine.primary_letter() as u8,
+            letters,
             rotary_decimals: opts.rotary_decimals,
             linear_decimals: opts.linear_decimals + usize::from(inch),
             comments,

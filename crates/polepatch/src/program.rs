@@ -2,7 +2,7 @@
 
 use crate::error::Error;
 use polepatch_kinematics::Machine;
-use polepatch_nc::{Dialect, FileStyle, Program, Run, modal};
+use polepatch_nc::{Dialect, FileStyle, Program, RotaryLetters, Run, modal};
 use polepatch_patcher::Path;
 
 /// Why one run cannot be analysed (the others still can).
@@ -70,18 +70,17 @@ impl std::fmt::Display for RunProblem {
 
 /// Whether programs for `machine` can be read, analysed and patched: a pair of the
 /// standard form ([`Machine::standard_form`]: the pole axis along Z, the tilting axis about X
-/// or Y, the tool along Z at zero — table-table, head-table and head-head alike) whose
-/// tilting axis is A or B and whose pole axis is C. The kinematics crate computes any
-/// pair's FK and IK; what reads programs (the pole at P = 0, the other branch (−P, C + 180°),
-/// the C words as the pole axis) assumes this form, so another pair is refused by name
+/// or Y, the tool along Z at zero — table-table, head-table and head-head alike) whose two
+/// letters are among A B C (A-C, B-C, an A-B trunnion whose platter is B, …). The
+/// kinematics crate computes any pair's FK and IK; what reads programs (the pole at P = 0,
+/// the other branch (−P, C + 180°)) assumes this form, so another pair is refused by name
 /// rather than patched with the wrong kinematics (issue 29).
-pub fn check_layout(machine: &Machine) -> Result<(), Error> {
+pub fn check_layout(machine: &Machine) -> Result<RotaryLetters, Error> {
     let refuse = |why: String| {
         Err(Error::Options(format!(
             "machine {}: {why}; polepatch reads, analyses and patches programs for pairs with \
-             the pole axis along Z called C and the tilting axis about X or Y called A or B \
-             (table or head) so far — another pair's zones, branches and letters are not \
-             wired yet",
+             the pole axis along Z and the tilting axis about X or Y (table or head), both \
+             called A, B or C, so far — another pair's zones and branches are not wired yet",
             machine.name
         )))
     };
@@ -92,19 +91,14 @@ pub fn check_layout(machine: &Machine) -> Result<(), Error> {
                 .to_string(),
         );
     }
-    if machine.c_letter() != 'C' {
-        return refuse(format!(
-            "its pole axis is called {} (programs are read with C as the pole axis)",
-            machine.c_letter()
-        ));
+    let (p, c) = (machine.primary_letter(), machine.c_letter());
+    match RotaryLetters::new(p as u8, c as u8) {
+        Some(letters) if p.is_ascii() && c.is_ascii() => Ok(letters),
+        _ => refuse(format!(
+            "its rotary axes are called {p} and {c} (programs are read with rotary words A, B \
+             and C)"
+        )),
     }
-    if !matches!(machine.primary_letter(), 'A' | 'B') {
-        return refuse(format!(
-            "its tilting axis is called {}",
-            machine.primary_letter()
-        ));
-    }
-    Ok(())
 }
 
 /// How to read programs for `machine`: the dialect detected, the machine's TCPM codes;
@@ -166,6 +160,9 @@ pub struct LoadedProgram {
     /// Letter used as the primary rotary axis: the machine's (a program tilting with
     /// another letter is refused, `Error::ForeignAxis`).
     pub primary_letter: u8,
+    /// Letter of the pole axis: the machine's (C on the built-ins; B on an A-B trunnion
+    /// whose platter is B).
+    pub pole_letter: u8,
     /// Runs in file order.
     pub runs: Vec<RunPath>,
     /// Things the user should know (e.g. primary-letter substitution).
@@ -248,13 +245,20 @@ impl LoadedProgram {
         self.window.datum_mm[r]
     }
 
+    /// The program's rotary letters: the tilting axis and the pole axis.
+    pub fn letters(&self) -> RotaryLetters {
+        RotaryLetters {
+            tilt: self.primary_letter,
+            pole: self.pole_letter,
+        }
+    }
     /// Index of the primary letter in [`polepatch_nc::Modal::pos`].
     pub fn primary_index(&self) -> usize {
-        if self.primary_letter == b'A' {
-            modal::A
-        } else {
-            modal::B
-        }
+        self.letters().tilt_index()
+    }
+    /// Index of the pole letter in [`polepatch_nc::Modal::pos`].
+    pub fn pole_index(&self) -> usize {
+        self.letters().pole_index()
     }
 }
 
@@ -306,21 +310,21 @@ fn line_number(bytes: &[u8], at: usize) -> usize {
     line
 }
 
-/// A run with its path for the patcher: axes X Y Z, the tilting letter at `p_idx`
-/// (`modal::A` or `modal::B`) and C; the run's feed, else `feed_fallback_mm_min`.
+/// A run with its path for the patcher: axes X Y Z, the tilting and the pole letter of
+/// `letters`; the run's feed, else `feed_fallback_mm_min`.
 pub(crate) fn run_path(
     run: Run,
-    p_idx: usize,
+    letters: RotaryLetters,
     feed_fallback_mm_min: Option<f64>,
     first_line: usize,
 ) -> RunPath {
-    let path = run_check(&run, p_idx, feed_fallback_mm_min, first_line).map(|feed| Path {
+    let path = run_check(&run, letters, feed_fallback_mm_min, first_line).map(|feed| Path {
         s_mm: if run.block_feed_mm_min.is_empty() {
             run.s_mm.clone()
         } else {
             inverse_time_parameter(&run, feed)
         },
-        axes: run.axes5(p_idx),
+        axes: run.axes5(letters),
         feed_mm_min: feed,
     });
     RunPath {
@@ -354,53 +358,47 @@ fn inverse_time_parameter(run: &Run, f_ref: f64) -> Vec<f64> {
     u
 }
 
-/// Whether a run can be analysed with the tilting letter at `p_idx` (`modal::A` or
-/// `modal::B`): its feed ([`run_feed`]), or why not — the one rule every read uses (the
-/// whole program, the stream survey, the no-zone fast path).
+/// Whether a run can be analysed with the rotary letters `letters`: its feed
+/// ([`run_feed`]), or why not — the one rule every read uses (the whole program, the
+/// stream survey, the no-zone fast path).
 pub(crate) fn run_check(
     run: &Run,
-    p_idx: usize,
+    letters: RotaryLetters,
     feed_fallback_mm_min: Option<f64>,
     first_line: usize,
 ) -> Result<f64, RunProblem> {
     let feed = run_feed(run, feed_fallback_mm_min, first_line)?;
-    other_rotary_still(run, p_idx)?;
-    rotary_known(run, p_idx)?;
+    other_rotary_still(run, letters)?;
+    rotary_known(run, letters)?;
     Ok(feed)
 }
 
-/// The tilting letter that is not analysed (B when the program is read with A, and the
-/// other way round) may appear in a run only parked at 0 (module docs of
+/// The rotary letter that is not analysed (B when the program is read with A and C, and
+/// so on: [`RotaryLetters::other`]) may appear in a run only parked at 0 (module docs of
 /// [`RunProblem::OtherRotary`]).
-fn other_rotary_still(run: &Run, p_idx: usize) -> Result<(), RunProblem> {
-    let (other, letter) = if p_idx == modal::A {
-        (modal::B, 'B')
-    } else {
-        (modal::A, 'A')
-    };
+fn other_rotary_still(run: &Run, letters: RotaryLetters) -> Result<(), RunProblem> {
+    let letter = letters.other();
+    let other = modal::axis_index(letter).unwrap_or(modal::B);
     if run.pos.iter().any(|p| p[other].is_some_and(|v| v != 0.0)) {
-        let own = if p_idx == modal::A { 'A' } else { 'B' };
         return Err(RunProblem::OtherRotary {
-            letter,
-            analysed: format!("{own} and C"),
+            letter: letter as char,
+            analysed: format!("{} and {}", letters.tilt as char, letters.pole as char),
         });
     }
     Ok(())
 }
 
-/// A run whose rotary axes (the tilting one at `p_idx`, and C) move may not have a point
-/// where one of them is unknown: [`Run::axes5`] reads an unknown value as 0, which is right
-/// only where the axis is not programmed at all in the run.
-fn rotary_known(run: &Run, p_idx: usize) -> Result<(), RunProblem> {
+/// A run whose rotary axes (the tilting one and the pole axis of `letters`) move may not
+/// have a point where one of them is unknown: [`Run::axes5`] reads an unknown value as 0,
+/// which is right only where the axis is not programmed at all in the run.
+fn rotary_known(run: &Run, letters: RotaryLetters) -> Result<(), RunProblem> {
     let moves = |i: usize| {
         let mut known = run.pos.iter().filter_map(|p| p[i]);
         known.next().is_some_and(|v0| known.any(|v| v != v0))
     };
-    let rotary_moves = moves(p_idx) || moves(modal::C);
-    for (i, letter) in [
-        (p_idx, if p_idx == modal::A { 'A' } else { 'B' }),
-        (modal::C, 'C'),
-    ] {
+    let (p_idx, c_idx) = (letters.tilt_index(), letters.pole_index());
+    let rotary_moves = moves(p_idx) || moves(c_idx);
+    for (i, letter) in [(p_idx, letters.tilt as char), (c_idx, letters.pole as char)] {
         let unknown = run.pos.iter().filter(|p| p[i].is_none()).count();
         if unknown > 0 && (rotary_moves || unknown < run.pos.len()) {
             return Err(RunProblem::UnknownRotary { letter });

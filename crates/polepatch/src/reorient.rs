@@ -46,7 +46,7 @@ use polepatch_kinematics::inverse::unwrap_near_deg;
 use polepatch_kinematics::{
     BranchRule, IkSolution, JigRotation, Machine, forward, inverse, inverse_path_from,
 };
-use polepatch_nc::modal::{C, X, Y, Z};
+use polepatch_nc::modal::{X, Y, Z};
 use polepatch_nc::{Edit, Motion, NumberStyle};
 use polepatch_patcher::AnalysisOptions;
 use serde::Serialize;
@@ -106,11 +106,11 @@ pub struct ProgramFigures {
 
 impl ProgramFigures {
     /// Both rotary axes reach feed everywhere and no zone is left.
-    pub fn reaches_feed_on_rotary_axes(&self, primary_letter: u8) -> bool {
-        let p = (primary_letter as char).to_string();
+    pub fn reaches_feed_on_rotary_axes(&self, letters: polepatch_nc::RotaryLetters) -> bool {
+        let ratio = |l: u8| self.min_ratio.get(&(l as char).to_string()).copied();
         self.zones == 0
-            && self.min_ratio.get(&p).is_none_or(|&r| r >= 1.0)
-            && self.min_ratio.get("C").is_none_or(|&r| r >= 1.0)
+            && ratio(letters.tilt).is_none_or(|r| r >= 1.0)
+            && ratio(letters.pole).is_none_or(|r| r >= 1.0)
     }
 }
 
@@ -170,7 +170,7 @@ pub fn reorient_edits(
     tilt: &Tilt,
 ) -> Result<(Vec<Edit>, Vec<usize>), Error> {
     let program = &lp.program;
-    let p_idx = lp.primary_index();
+    let (p_idx, c_idx) = (lp.primary_index(), lp.pole_index());
     let rot = JigRotation::new(tilt.theta_x_deg, tilt.theta_z_deg);
     // The moves under TCPM, with their full positions.
     let mut moves: Vec<(usize, [f64; 5])> = Vec::new();
@@ -221,7 +221,7 @@ pub fn reorient_edits(
             ));
         }
         let v = |i: usize| st.pos[i];
-        match (v(X), v(Y), v(Z), v(p_idx), v(C)) {
+        match (v(X), v(Y), v(Z), v(p_idx), v(c_idx)) {
             (Some(x), Some(y), Some(z), Some(p), Some(c)) => moves.push((b, [x, y, z, p, c])),
             _ => {
                 return Err(refuse(
@@ -254,7 +254,7 @@ pub fn reorient_edits(
         .collect();
     let ik = continue_branch(machine, &axes, &originals, tilt);
     let (lo, hi) = machine.primary_range_deg;
-    let letters = [b'X', b'Y', b'Z', lp.primary_letter, b'C'];
+    let letters = [b'X', b'Y', b'Z', lp.primary_letter, lp.pole_letter];
     let decimals: Vec<usize> = letters
         .iter()
         .map(|&l| NumberStyle::of(program, l).decimals.max(MIN_DECIMALS))
@@ -538,7 +538,7 @@ pub fn search(
     let opts = analysis_options(cone_deg, pivot_mm)?;
     let lp = load_nc(bytes, name, machine, None)?;
     let before = program_figures(&lp, machine, &opts);
-    let primary = lp.primary_letter;
+    let letters = lp.letters();
     let mut alternatives: Vec<Alternative> = Vec::new();
     let evaluate = |tx: f64, tz: f64, alts: &mut Vec<Alternative>| {
         let tilt = Tilt {
@@ -548,15 +548,18 @@ pub fn search(
         };
         match apply(&lp, machine, &tilt, &opts) {
             Ok((out, after, words, untouched)) => {
-                let ok = after.reaches_feed_on_rotary_axes(primary);
-                let pl = (primary as char).to_string();
+                let ok = after.reaches_feed_on_rotary_axes(letters);
+                let (pl, cl) = (
+                    (letters.tilt as char).to_string(),
+                    (letters.pole as char).to_string(),
+                );
                 alts.push(Alternative {
                     theta_x_deg: tx,
                     theta_z_deg: tz,
                     rejected: (!ok).then(|| "does not reach feed on the rotary axes".to_string()),
                     figures: Some([
                         after.min_ratio.get(&pl).copied().unwrap_or(1.0),
-                        after.min_ratio.get("C").copied().unwrap_or(1.0),
+                        after.min_ratio.get(&cl).copied().unwrap_or(1.0),
                         after.time_s,
                         after.min_pole_distance_deg,
                     ]),
@@ -647,13 +650,13 @@ pub fn search(
 
 /// The tool orientations under TCPM in the part frame (for the sphere plot).
 pub fn tool_axes(lp: &LoadedProgram, machine: &Machine) -> Vec<[f64; 3]> {
-    let pi = lp.primary_index();
+    let (pi, ci) = (lp.primary_index(), lp.pole_index());
     (0..lp.program.blocks.len())
         .filter(|&b| lp.program.blocks[b].is_move)
         .filter_map(|b| {
             let st = lp.program.state(b);
             (st.tcpm.is_on())
-                .then(|| Some(forward(machine, st.pos[pi]?, st.pos[C]?)))
+                .then(|| Some(forward(machine, st.pos[pi]?, st.pos[ci]?)))
                 .flatten()
         })
         .collect()

@@ -55,9 +55,9 @@ use crate::program::{LoadedProgram, RunPath, Window, run_path};
 use crate::report::FileReport;
 use crate::report::{AnalyzeReport, RunReport};
 use polepatch_kinematics::Machine;
-use polepatch_nc::modal::{A, B, C};
 use polepatch_nc::{
-    Dialect, FileStyle, ProgramBuilder, Run, RunBuilder, Scanned, StyleEvidence, scan_blocks_with,
+    Dialect, FileStyle, ProgramBuilder, RotaryLetters, Run, RunBuilder, Scanned, StyleEvidence,
+    scan_blocks_with,
 };
 use std::collections::VecDeque;
 use std::io::Write;
@@ -71,8 +71,19 @@ const BATCH_MIN_BYTES: usize = 16 << 10;
 /// … and at most this many.
 const BATCH_MAX_BYTES: usize = 256 << 10;
 
-/// Index of a tilting letter in the per-letter arrays: 0 for A, 1 for B.
-const LETTERS: [u8; 2] = [b'A', b'B'];
+/// The two readings the survey follows at once, in the per-letter arrays (`l`): the
+/// machine's rotary letters, and the same with the third letter of A B C as the tilting
+/// axis ([`RotaryLetters::other`]) — a program posted for another machine, refused by
+/// name ([`Error::ForeignAxis`]) — in alphabetical order of the tilting letter (A-C and
+/// B-C for both built-ins).
+fn readings(machine: RotaryLetters) -> [RotaryLetters; 2] {
+    let other = machine.with_tilt(machine.other());
+    if machine.tilt < other.tilt {
+        [machine, other]
+    } else {
+        [other, machine]
+    }
+}
 
 /// What the survey keeps of one run.
 #[derive(Debug, Clone)]
@@ -106,14 +117,14 @@ struct EndRec {
 
 impl EndRec {
     /// Let block `i` (on `line`) have its say, when undecided.
-    fn step(&mut self, after: &After<'_>, letter: u8, i: usize, line: usize) {
+    fn step(&mut self, after: &After<'_>, letters: RotaryLetters, i: usize, line: usize) {
         if self.decided.is_some() {
             return;
         }
-        match after.verdict(letter, &mut self.scan) {
+        match after.verdict(letters, &mut self.scan) {
             Step::Free => {
                 self.decided = Some((true, line));
-                self.next = after.next_move(letter, line);
+                self.next = after.next_move(letters, line);
             }
             Step::Pinned => {
                 self.decided = Some((false, line));
@@ -158,10 +169,10 @@ struct Survey {
     /// The line of the first G1 move with an I, J or K word (a tool-direction vector:
     /// some controllers' 5-axis programs without rotary words).
     first_vector: Option<usize>,
-    /// The first word of each tilting letter (A, B): its line and column; and the first
+    /// The first word of each rotary letter (A, B, C): its line and column; and the first
     /// one that is not 0 (the axis turned, not parked).
-    first_word: [Option<(usize, usize)>; 2],
-    first_turn: [Option<(usize, usize)>; 2],
+    first_word: [Option<(usize, usize)>; 3],
+    first_turn: [Option<(usize, usize)>; 3],
 }
 
 /// Why a G1 move cannot start a run: what [`Error`] a program without runs gets, from its
@@ -230,6 +241,8 @@ impl NoRunWhy {
 
 /// The first read in progress.
 struct Surveying {
+    /// The two readings followed ([`readings`]).
+    readings: [RotaryLetters; 2],
     cone_deg: f64,
     fallback: Option<f64>,
     work_offset_mm: Option<[f64; 3]>,
@@ -252,8 +265,8 @@ impl Surveying {
             for (u, v) in self.uses.iter_mut().zip(p) {
                 *u |= v.is_some();
             }
-            for (l, idx) in [A, B].into_iter().enumerate() {
-                near[l] |= crate::program::near_pole(p[idx], self.cone_deg);
+            for (l, letters) in self.readings.iter().enumerate() {
+                near[l] |= crate::program::near_pole(p[letters.tilt_index()], self.cone_deg);
             }
         }
         let first_block = run.blocks[0];
@@ -267,7 +280,9 @@ impl Surveying {
             first_block,
             last_block: *run.blocks.last().unwrap_or(&first_block),
             near,
-            feedless: [A, B].map(|p| crate::program::run_check(&run, p, self.fallback, 0).is_err()),
+            feedless: self
+                .readings
+                .map(|letters| crate::program::run_check(&run, letters, self.fallback, 0).is_err()),
             end: self.first_after.clone(),
             datum_mm: crate::machine_frame::datum_at(
                 &self.datum_shifts,
@@ -281,14 +296,14 @@ impl Surveying {
     /// Block `i` (on `line`) has its say on the end pose of the runs before it, per
     /// letter: the pending ones and, with `open`, the open run's.
     fn decide(&mut self, after: &After<'_>, i: usize, line: usize, open: bool) {
-        for (l, letter) in LETTERS.into_iter().enumerate() {
+        for (l, letters) in self.readings.into_iter().enumerate() {
             let runs = &mut self.runs;
             self.pending[l].retain(|&r| {
-                runs[r].end[l].step(after, letter, i, line);
+                runs[r].end[l].step(after, letters, i, line);
                 runs[r].end[l].decided.is_none()
             });
             if open {
-                self.first_after[l].step(after, letter, i, line);
+                self.first_after[l].step(after, letters, i, line);
             }
         }
     }
@@ -298,6 +313,8 @@ impl Surveying {
 /// patch's or the analysis' options ([`Reading::patch`], [`Reading::analysis`]).
 struct Reading<'a> {
     name: &'a str,
+    /// The machine's rotary letters.
+    letters: RotaryLetters,
     /// How far from the pole a zone can lie (the cone, or the pole reach beyond it).
     cone_deg: f64,
     fallback: Option<f64>,
@@ -315,6 +332,7 @@ impl<'a> Reading<'a> {
     fn patch(opts: &'a crate::PatchOptions, machine: &Machine) -> Result<Self, Error> {
         Ok(Reading {
             name: &opts.name,
+            letters: crate::program::check_layout(machine)?,
             cone_deg: opts.patch.reach_deg(),
             fallback: opts.feed_fallback_mm_min,
             work_offset_mm: opts.work_offset_mm,
@@ -328,6 +346,7 @@ impl<'a> Reading<'a> {
     fn analysis(opts: &'a crate::AnalyzeOptions, machine: &Machine) -> Result<Self, Error> {
         Ok(Reading {
             name: &opts.name,
+            letters: crate::program::check_layout(machine)?,
             cone_deg: opts.analysis.reach_deg(),
             fallback: opts.feed_fallback_mm_min,
             work_offset_mm: opts.work_offset_mm,
@@ -345,10 +364,10 @@ impl Survey {
     fn head(
         &self,
         rd: &Reading<'_>,
-        p_idx: usize,
+        letters: RotaryLetters,
         first: Option<String>,
     ) -> (Vec<crate::notes::NotAnalysed>, Vec<String>) {
-        let (not_analysed, warnings) = self.notes.finish(p_idx, rd.cone_deg, rd.name);
+        let (not_analysed, warnings) = self.notes.finish(letters, rd.cone_deg, rd.name);
         (not_analysed, first.into_iter().chain(warnings).collect())
     }
 }
@@ -377,6 +396,7 @@ fn survey_once(
     read: &polepatch_nc::ReadOptions,
 ) -> Result<(Survey, polepatch_nc::Settled), Error> {
     let mut sv = Surveying {
+        readings: readings(opts.letters),
         cone_deg: opts.cone_deg,
         fallback: opts.fallback,
         work_offset_mm: opts.work_offset_mm,
@@ -395,8 +415,8 @@ fn survey_once(
     let mut no_run_why = None;
     let mut first_vector = None;
     let mut incremental_set_line = None;
-    let mut first_word: [Option<(usize, usize)>; 2] = [None, None];
-    let mut first_turn: [Option<(usize, usize)>; 2] = [None, None];
+    let mut first_word: [Option<(usize, usize)>; 3] = [None; 3];
+    let mut first_turn: [Option<(usize, usize)>; 3] = [None; 3];
     let settled = scan_blocks_with(bytes, read, |s: Scanned<'_>| {
         if s.state.incremental && !prev.incremental {
             incremental_set_line = Some(s.block.line);
@@ -404,11 +424,11 @@ fn survey_once(
         if no_run_why.is_none() {
             no_run_why = NoRunWhy::of(s.block, s.state, incremental_set_line);
         }
-        // The first word of each tilting letter, and its first that is not 0: one pass
-        // over the block's words until both letters have turned.
+        // The first word of each rotary letter, and its first that is not 0: one pass
+        // over the block's words until every letter has turned.
         if first_turn.iter().any(Option::is_none) {
             for w in s.words {
-                let Some(l) = LETTERS.iter().position(|&c| c == w.letter) else {
+                let Some(l) = b"ABC".iter().position(|&c| c == w.letter) else {
                     continue;
                 };
                 let column = (w.start as usize).saturating_sub(s.block.span().start) + 1;
@@ -419,7 +439,7 @@ fn survey_once(
                 }
             }
         }
-        // (Only while no tilting word has been read: the hint is for programs without.)
+        // (Only while no rotary word has been read: the hint is for programs without.)
         if first_vector.is_none()
             && first_word.iter().all(Option::is_none)
             && s.block.is_move
@@ -542,30 +562,18 @@ fn line_end_after(bytes: &[u8], at: usize) -> usize {
         .map_or(bytes.len(), |k| at + k + 1)
 }
 
-/// The tilting letter in use (`modal::A` or `modal::B`), as
-/// [`polepatch_nc::primary_in_use`] picks it from the runs' letters.
-fn tilting_index(sv: &Survey, machine: &Machine) -> usize {
-    let own = if machine.primary_letter() == 'A' {
-        A
-    } else {
-        B
-    };
-    polepatch_nc::primary_of(&sv.uses, own)
-}
-
-/// After the first read: the survey and the tilting letter (0 A, 1 B) for the stretches,
-/// or a program that holds nothing to analyse.
+/// After the first read: the survey and the reading (`l`, of [`readings`]) for the
+/// stretches, or a program that holds nothing to analyse.
 enum Begun {
     Stretches {
         sv: Box<Survey>,
         l: usize,
-        p_idx: usize,
     },
     /// The program was read and holds nothing to analyse
     /// ([`Error::is_nothing_to_analyse`]; `why` says what): the survey for its notes.
     Nothing {
         sv: Box<Survey>,
-        p_idx: usize,
+        l: usize,
         why: Error,
     },
 }
@@ -581,37 +589,48 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
         });
     }
     let sv = survey(bytes, rd)?;
-    let p_idx = tilting_index(&sv, machine);
+    // The letters in use ([`polepatch_nc::primary_of`]): the machine's, or the third
+    // letter of A B C as the tilting axis where the program never programs the machine's.
+    let own = rd.letters;
+    let in_use = polepatch_nc::primary_of(&sv.uses, own);
+    let l = readings(own).iter().position(|r| *r == in_use).unwrap_or(0);
     // A rotary letter the machine does not have is refused (issue 29) where the program
     // uses it as its tilting axis (reading it as the machine's would patch with the
     // wrong kinematics) or turns it beside the machine's (an A-B trunnion's program on an
     // A-C machine): named at its first word. A letter only ever written 0 (a post's
     // `B0` reset) is carried through.
-    let own = usize::from(machine.primary_letter() == 'B');
-    let foreign = 1 - own;
-    let at = if p_idx != [A, B][own] {
-        sv.first_word[foreign]
+    let slot = |letter: u8| usize::from(letter - b'A');
+    let foreign = own.other();
+    let at = if in_use != own {
+        sv.first_word[slot(foreign)]
     } else {
-        sv.first_turn[foreign]
+        sv.first_turn[slot(foreign)]
     };
     if let Some((line, column)) = at {
-        // The built-ins the program fits: it tilts with the other letter and never turns
-        // this machine's (an A-B trunnion's program fits none).
-        let fits: Vec<String> = if p_idx != [A, B][own] && sv.first_turn[own].is_none() {
-            Machine::builtin_names()
-                .iter()
-                .filter_map(|n| Machine::builtin(n))
-                .filter(|m| m.primary_letter() == LETTERS[foreign] as char)
-                .map(|m| format!("{} has {} and {}", m.name, m.primary_letter(), m.c_letter()))
-                .collect()
-        } else {
-            Vec::new()
-        };
+        // The built-ins the program fits: they have every rotary letter it turns, and the
+        // tilting letter it uses (an A-B trunnion's program fits no A-C or B-C machine).
+        let turned: Vec<char> = b"ABC"
+            .iter()
+            .filter(|&&c| sv.first_turn[slot(c)].is_some() || c == in_use.tilt)
+            .map(|&c| c as char)
+            .collect();
+        let fits: Vec<String> = Machine::builtin_names()
+            .iter()
+            .filter_map(|n| Machine::builtin(n))
+            .filter(|m| {
+                m.name != machine.name
+                    && m.primary_letter() == in_use.tilt as char
+                    && turned
+                        .iter()
+                        .all(|&c| c == m.primary_letter() || c == m.c_letter())
+            })
+            .map(|m| format!("{} has {} and {}", m.name, m.primary_letter(), m.c_letter()))
+            .collect();
         return Err(Error::ForeignAxis {
             path: rd.name.to_string(),
             line,
             column,
-            letter: LETTERS[foreign] as char,
+            letter: foreign as char,
             machine: machine.name.clone(),
             axes: format!("{} and {}", machine.primary_letter(), machine.c_letter()),
             fits: if fits.is_empty() {
@@ -628,7 +647,7 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
                 path: rd.name.to_string(),
             }),
         })
-    } else if !sv.uses[p_idx] && !sv.uses[C] {
+    } else if !sv.uses[in_use.tilt_index()] && !sv.uses[in_use.pole_index()] {
         Some(Error::NoRotary {
             path: rd.name.to_string(),
             primary: machine.primary_letter(),
@@ -651,13 +670,12 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
     };
     match why {
         None => Ok(Begun::Stretches {
-            l: usize::from(p_idx == B),
             sv: Box::new(sv),
-            p_idx,
+            l,
         }),
         Some(why) if why.is_nothing_to_analyse() => Ok(Begun::Nothing {
             sv: Box::new(sv),
-            p_idx,
+            l,
             why,
         }),
         Some(e) => Err(e),
@@ -676,15 +694,16 @@ pub fn patch_nc_hooked(
 ) -> Result<FileReport, Error> {
     opts.check()?;
     let rd = Reading::patch(opts, machine)?;
-    let (sv, l, p_idx, first, nothing) = match begin(bytes, machine, &rd)? {
-        Begun::Nothing { sv, p_idx, why } => {
+    let (sv, l, first, nothing) = match begin(bytes, machine, &rd)? {
+        Begun::Nothing { sv, l, why } => {
             let why = format!("{why}: nothing to patch, written unchanged");
-            (sv, usize::from(p_idx == B), p_idx, Some(why), true)
+            (sv, l, Some(why), true)
         }
-        Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx, None, false),
+        Begun::Stretches { sv, l } => (sv, l, None, false),
     };
+    let letters = readings(rd.letters)[l];
     let mut report = FileReport::unchanged(&opts.name, machine, Vec::new());
-    (report.not_analysed, report.warnings) = sv.head(&rd, p_idx, first);
+    (report.not_analysed, report.warnings) = sv.head(&rd, letters, first);
     // A program with nothing to analyse has no run to patch either.
     let todo = if nothing {
         Vec::new()
@@ -814,20 +833,21 @@ fn analyze_each(
 ) -> Result<(), Error> {
     opts.check()?;
     let rd = Reading::analysis(opts, machine)?;
-    let (sv, l, p_idx, first, nothing) = match begin(bytes, machine, &rd)? {
-        Begun::Nothing { sv, p_idx, why } => {
+    let (sv, l, first, nothing) = match begin(bytes, machine, &rd)? {
+        Begun::Nothing { sv, l, why } => {
             let why = format!("{why}: no run analysed");
-            (sv, usize::from(p_idx == B), p_idx, Some(why), true)
+            (sv, l, Some(why), true)
         }
-        Begun::Stretches { sv, l, p_idx } => (sv, l, p_idx, None, false),
+        Begun::Stretches { sv, l } => (sv, l, None, false),
     };
-    let (not_analysed, warnings) = sv.head(&rd, p_idx, first);
+    let letters = readings(rd.letters)[l];
+    let (not_analysed, warnings) = sv.head(&rd, letters, first);
     each(Piece::Head(&AnalyzeReport {
         file: opts.name.clone(),
         machine: machine.name.clone(),
         cone_deg: opts.analysis.cone_deg,
         pole_reach_deg: opts.analysis.pole_reach_deg,
-        primary: (LETTERS[l] as char).to_string(),
+        primary: (letters.tilt as char).to_string(),
         warnings,
         not_analysed,
         runs: Vec::new(),
@@ -868,7 +888,7 @@ pub(crate) fn each_run<T: Send>(
     };
     let todo = stretches(&sv.runs, l, |_| true);
     each_stretch(bytes, &sv, &todo, l, &rd, |lp| work(&lp), |t, _| sink(t))?;
-    Ok(LETTERS[l] as char)
+    Ok(readings(rd.letters)[l].tilt as char)
 }
 
 /// Read `bytes` (named `name` in messages) as one stretch of the one reader
@@ -1076,7 +1096,7 @@ fn loaded(bytes: &[u8], hand: InHand, sv: &Survey, l: usize, rd: &Reading<'_>) -
     let end = hand.end_byte.unwrap_or(bytes.len());
     let program = hand.program.finish(bytes[base..end].to_vec(), sv.dialect);
     let first = hand.stretch.first_block;
-    let p_idx = if l == 0 { A } else { B };
+    let letters = readings(rd.letters)[l];
     let recs = &sv.runs[hand.stretch.runs.clone()];
     let runs: Vec<RunPath> = hand
         .runs
@@ -1086,7 +1106,7 @@ fn loaded(bytes: &[u8], hand: InHand, sv: &Survey, l: usize, rd: &Reading<'_>) -
                 *b -= first;
             }
             let line = program.blocks[run.blocks[0]].line;
-            let mut rp = run_path(run, p_idx, rd.fallback, line);
+            let mut rp = run_path(run, letters, rd.fallback, line);
             rp.found_tool = tool;
             rp
         })
@@ -1094,7 +1114,8 @@ fn loaded(bytes: &[u8], hand: InHand, sv: &Survey, l: usize, rd: &Reading<'_>) -
     LoadedProgram {
         name: rd.name.to_string(),
         program,
-        primary_letter: LETTERS[l],
+        primary_letter: letters.tilt,
+        pole_letter: letters.pole,
         runs,
         warnings: Vec::new(),
         chord_tolerance_mm: rd.chord_tolerance_mm,

@@ -88,7 +88,7 @@ fn chord_errors(
         if ra.run.tcpm.is_on() {
             continue;
         }
-        let p = a.primary_index();
+        let p = a.letters();
         let (qa, qb) = (ra.run.axes5(p), rb.run.axes5(p));
         let tip = |q: &[f64; 5]| chain.part_tip(machine, datum, q[3], q[4], [q[0], q[1], q[2]]);
         for k in 1..qa.len() {

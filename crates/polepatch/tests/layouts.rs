@@ -2,9 +2,9 @@
 //! standard form: pole axis along Z called C, tilting axis about Y) read, analyse and patch
 //! a planted pass 1° from the pole to feed on both rotary axes, and the deviation reported
 //! is the angle an independent forward kinematics of that layout gives for the written
-//! words; pairs whose zones, branches or letters are not wired yet (a 45° nutating table,
-//! an A-B trunnion whose pole axis is B) are refused by name, never patched with the wrong
-//! kinematics.
+//! words; an A-B trunnion whose platter (the pole axis) is called B reads, analyses and
+//! patches its own letters; pairs whose zones and branches are not wired yet (a 45°
+//! nutating table) are refused by name, never patched with the wrong kinematics.
 
 use polepatch::PatchOptions;
 use polepatch::kinematics::Machine;
@@ -98,10 +98,7 @@ fn head_table_and_head_head_patch_a_planted_pass_with_the_right_deviation() {
 #[test]
 fn pairs_not_wired_yet_are_refused_by_name() {
     let input = std::fs::read(root().join("fixtures/generated/heidenhain-bc-swing-d1.I")).unwrap();
-    for (file, says) in [
-        ("example-nutating-table-45.toml", "not of that form"),
-        ("example-trunnion-ab.toml", "pole axis is called B"),
-    ] {
+    for (file, says) in [("example-nutating-table-45.toml", "not of that form")] {
         let m = machine(file);
         let err = polepatch::patch_nc(&input, &m, &PatchOptions::default())
             .err()
@@ -111,11 +108,11 @@ fn pairs_not_wired_yet_are_refused_by_name() {
     }
 }
 
-/// `post` names the tilting axis A or B and the pole axis C: a machine whose pole axis is
-/// called B (an A-B trunnion) is refused rather than given C words; the 45° nutating table,
-/// whose letters are B and C, is posted through its own inverse kinematics.
+/// `post` writes the machine's own letters: A and B for an A-B trunnion whose platter is
+/// B (no C word); the 45° nutating table, whose letters are B and C, is posted through its
+/// own inverse kinematics.
 #[test]
-fn post_refuses_letters_it_cannot_write() {
+fn post_writes_the_machines_letters() {
     use polepatch::post::{PostOptions, post_cl, read_cl};
     let apt = b"UNITS/MM\nFEDRAT/1000\nGOTO/10,0,-5,0.2588190,0,0.9659258\nGOTO/11,0,-5,0.25,0.05,0.9669\nFINI\n";
     let cl = read_cl(apt, "t.apt").unwrap();
@@ -124,13 +121,181 @@ fn post_refuses_letters_it_cannot_write() {
         ..PostOptions::default()
     };
     let ab = machine("example-trunnion-ab.toml");
-    let err = match post_cl(&cl, &ab, &opts) {
-        Ok(_) => panic!("posted for an A-B trunnion"),
-        Err(e) => e.to_string(),
-    };
-    assert!(err.contains("called A and B"), "{err}");
+    let (out, _) = post_cl(&cl, &ab, &opts).unwrap();
+    let text = String::from_utf8(out).unwrap();
+    assert!(
+        text.contains(" A") && text.contains(" B") && !text.contains(" C"),
+        "{text}"
+    );
     let nut = machine("example-nutating-table-45.toml");
     let (out, _) = post_cl(&cl, &nut, &opts).unwrap();
     let text = String::from_utf8(out).unwrap();
     assert!(text.contains(" B") && text.contains(" C"), "{text}");
+}
+
+/// Tool axis in the part frame of a table-table pair: the tilting axis A about X, then the
+/// platter about Z (the pole axis, B on the trunnion). The senses do not matter for the
+/// angle between two orientations: u·v = cos A₁ cos A₂ + sin A₁ sin A₂ cos(B₁ − B₂) for
+/// every sign of A and of B.
+fn reference_fk_ab(a_deg: f64, b_deg: f64) -> [f64; 3] {
+    let (a, b) = (a_deg.to_radians(), b_deg.to_radians());
+    let t = [0.0, -a.sin(), a.cos()];
+    [
+        b.cos() * t[0] - b.sin() * t[1],
+        b.sin() * t[0] + b.cos() * t[1],
+        t[2],
+    ]
+}
+
+/// The (A, B) in force after each line of a Heidenhain ISO program (modal words).
+fn ab_per_line(text: &str) -> Vec<Option<(f64, f64)>> {
+    let (mut a, mut b) = (None, None);
+    text.lines()
+        .map(|line| {
+            for tok in line.split_whitespace() {
+                let (l, v) = tok.split_at(1);
+                if let Ok(v) = v.parse::<f64>() {
+                    match l {
+                        "A" => a = Some(v),
+                        "B" => b = Some(v),
+                        _ => {}
+                    }
+                }
+            }
+            a.zip(b)
+        })
+        .collect()
+}
+
+/// Issue 29: an A-B trunnion (A tilting about X, the platter B about the table's normal,
+/// the pole axis). A planted pass 1° from the pole written with its letters (the A-C
+/// fixture with its C words written as B) is found, patched to feed on both rotary axes
+/// with B as the pole axis, and the deviation reported is the angle of an independent FK;
+/// the result is the A-C machine's with the same axes, letter for letter: the letters are
+/// names, the kinematics are the pair's.
+#[test]
+fn an_a_b_trunnion_patches_its_own_letters() {
+    let ac = std::fs::read_to_string(root().join("fixtures/generated/heidenhain-ac-swing-d1.I"))
+        .unwrap();
+    let ab_text = ac.replace(" C+", " B+").replace(" C-", " B-");
+    assert!(!ab_text.contains(" C"), "every C word written as B");
+    let ab = machine("example-trunnion-ab.toml");
+    assert_eq!((ab.primary_letter(), ab.c_letter()), ('A', 'B'));
+    let (out, report) =
+        polepatch::patch_nc(ab_text.as_bytes(), &ab, &PatchOptions::default()).unwrap();
+    assert_eq!(report.zones.len(), 1, "{report:?}");
+    let z = &report.zones[0];
+    assert_eq!(z.outcome, "reached", "{z:?}");
+    assert!(
+        z.before.overall_ratio < 0.9 && z.after.overall_ratio >= 1.0 - 1e-3,
+        "{z:?}"
+    );
+    let out = String::from_utf8(out).unwrap();
+    assert!(!out.contains(" C"), "no C word written:\n{out}");
+    let (before, after) = (ab_per_line(&ab_text), ab_per_line(&out));
+    assert_eq!(before.len(), after.len());
+    let worst = before
+        .iter()
+        .zip(&after)
+        .filter_map(|(b, a)| {
+            let ((a0, b0), (a1, b1)) = (b.as_ref()?, a.as_ref()?);
+            Some(angle_deg(
+                reference_fk_ab(*a0, *b0),
+                reference_fk_ab(*a1, *b1),
+            ))
+        })
+        .fold(0.0, f64::max);
+    assert!(worst > 0.1, "nothing turned");
+    assert!(
+        (worst - z.max_deviation_deg).abs() < 1e-6,
+        "reference {worst:.9}° vs reported {:.9}°",
+        z.max_deviation_deg
+    );
+    // The same machine with its platter called C patches the A-C program to the same words.
+    let mut ac_machine = ab.clone();
+    ac_machine.rotary.c.letter = 'C';
+    let (out_ac, report_ac) =
+        polepatch::patch_nc(ac.as_bytes(), &ac_machine, &PatchOptions::default()).unwrap();
+    assert_eq!(
+        String::from_utf8(out_ac)
+            .unwrap()
+            .replace(" C+", " B+")
+            .replace(" C-", " B-"),
+        out
+    );
+    assert_eq!(report_ac.zones[0].max_deviation_deg, z.max_deviation_deg);
+    // Analysis names the file's letters.
+    let a = polepatch::analyze_nc(
+        ab_text.as_bytes(),
+        &ab,
+        &polepatch::AnalyzeOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(a.primary, "A");
+    let ratios = &a.runs[0].figures.as_ref().unwrap().axis_min_ratio;
+    assert!(
+        ratios.contains_key("B") && !ratios.contains_key("C"),
+        "{ratios:?}"
+    );
+}
+
+/// A program for an A-C machine on the A-B trunnion: its C words are of an axis the
+/// trunnion does not have — refused at the first C word that turns, naming the built-in
+/// that has A and C.
+#[test]
+fn an_a_c_program_on_the_trunnion_is_refused_at_its_first_c_word() {
+    let ac = std::fs::read(root().join("fixtures/generated/heidenhain-ac-swing-d1.I")).unwrap();
+    let ab = machine("example-trunnion-ab.toml");
+    let e = polepatch::patch_nc(&ac, &ab, &PatchOptions::default()).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        matches!(
+            e,
+            polepatch::Error::ForeignAxis {
+                letter: 'C',
+                line: 7,
+                ..
+            }
+        ),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("C is not an axis of machine example-trunnion-ab")
+            && msg.contains("the built-in mikron-ucp710 has A and C"),
+        "{msg}"
+    );
+}
+
+/// Issue 29's check: a program posted for an A-B trunnion by a CAM system (NX's Haas VF-TR
+/// post form: A tilting, the platter B, no TCPM) is analysed on the trunnion and its
+/// near-pole run found — the B swing where A passes 1° from the pole — with the axes named
+/// by their letters.
+#[test]
+fn a_cam_trunnion_program_is_analysed_and_its_pole_pass_found() {
+    let bytes = std::fs::read(root().join("fixtures/cam/haas-vf2tr-trunnion-ab.nc")).unwrap();
+    let ab = machine("example-trunnion-ab.toml");
+    let opts = polepatch::AnalyzeOptions {
+        inch: true,
+        ..Default::default()
+    };
+    let a = polepatch::analyze_nc(&bytes, &ab, &opts).unwrap();
+    let zones: Vec<_> = a
+        .runs
+        .iter()
+        .filter_map(|r| r.figures.as_ref())
+        .flat_map(|f| f.zones.iter())
+        .collect();
+    assert_eq!(zones.len(), 1, "{a:?}");
+    let z = zones[0];
+    assert!((z.min_abs_primary_deg - 1.0).abs() < 1e-9, "{z:?}");
+    assert!(z.c_ratio_min < 1.0, "{z:?}");
+    // The zone holds the line where A is 1° (`X.3937 A1. B180.`).
+    let text = String::from_utf8(bytes).unwrap();
+    let line = text.lines().position(|l| l.contains("A1. B180.")).unwrap() + 1;
+    assert!(
+        z.lines[0] <= line && line <= z.lines[1],
+        "{z:?}, line {line}"
+    );
+    let f = a.runs[0].figures.as_ref().unwrap();
+    assert_eq!(f.limiting_axis.as_deref(), Some("B"), "{f:?}");
 }

@@ -226,7 +226,7 @@ fn feed_profile<'py>(
                 .collect();
             let axes = Axis::ALL
                 .iter()
-                .map(|&a| polepatch::report::axis_letter(a, lp.primary_letter))
+                .map(|&a| polepatch::report::axis_letter(a, lp.letters()))
                 .collect();
             Ok((runs, axes))
         };

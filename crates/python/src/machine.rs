@@ -2,7 +2,6 @@
 
 use crate::errors::{Failure, to_python};
 use polepatch::kinematics::{Axis, Machine, forward};
-use polepatch::report::axis_letter;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -80,7 +79,7 @@ impl NativeMachine {
     fn limits<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
         for axis in Axis::ALL {
-            let letter = axis_letter(axis, self.0.primary_letter() as u8);
+            let letter = self.0.letter(axis).to_string();
             let l = self.0.limit(axis);
             d.set_item(letter, (l.v, l.a, l.j))?;
         }

@@ -19,16 +19,18 @@ pub use simulate::{RunTimes, SimRun, SimTotals, SimulateReport, SimulatedTimes, 
 pub use crate::notes::{NotAnalysed, SkipReason};
 
 use polepatch_kinematics::{Axis, LimitKind};
+use polepatch_nc::RotaryLetters;
 use polepatch_patcher::ZoneKind;
 
-/// Axis letter as written in the program (primary: the letter in use).
-pub fn axis_letter(axis: Axis, primary_letter: u8) -> String {
+/// Axis letter as written in the program (the rotary axes: the letters in use, e.g. A
+/// and C, or A and B on an A-B trunnion).
+pub fn axis_letter(axis: Axis, letters: RotaryLetters) -> String {
     match axis {
         Axis::X => "X".into(),
         Axis::Y => "Y".into(),
         Axis::Z => "Z".into(),
-        Axis::Primary => (primary_letter as char).to_string(),
-        Axis::C => "C".into(),
+        Axis::Primary => (letters.tilt as char).to_string(),
+        Axis::C => (letters.pole as char).to_string(),
     }
 }
 

@@ -26,12 +26,12 @@ pub struct FiguresRow {
 
 impl FiguresRow {
     /// The report form of `f`, axes named with the program's tilting letter.
-    pub(crate) fn new(f: &ZoneFigures, primary_letter: u8) -> Self {
+    pub(crate) fn new(f: &ZoneFigures, letters: polepatch_nc::RotaryLetters) -> Self {
         FiguresRow {
             c_ratio: f.c_ratio,
             primary_ratio: f.primary_ratio,
             overall_ratio: f.overall_ratio,
-            limiting_axis: f.limiting_axis.map(|a| axis_letter(a, primary_letter)),
+            limiting_axis: f.limiting_axis.map(|a| axis_letter(a, letters)),
             limiting_limit: limit_name(f.limiting_kind),
             time_s: f.time_s,
         }
