@@ -3,7 +3,7 @@
 //! (`ZT_REPS` overrides) and the fastest is kept (wall time, one core, and the thread's CPU
 //! time, which a shared machine's load disturbs less), with the number of solves and IPM
 //! iterations; with `--reference`, each zone's deviation is compared with the bench
-//! reference (`polepatch_patcher::reference::zone_reference`).
+//! reference (`polepatch_patcher::quality::zone_reference`).
 //!
 //! `cargo run --release -p polepatch-benches --example zone_times -- [COUNT] [--reference]
 //! [--only LABEL-TEXT] [--set SETTING=VALUE …]`
@@ -12,7 +12,7 @@
 use polepatch::load_nc;
 use polepatch_benches::held_out_zones;
 use polepatch_kinematics::Machine;
-use polepatch_patcher::reference::{Reference, zone_reference};
+use polepatch_patcher::quality::{Reference, zone_reference};
 use polepatch_patcher::{PatchOptions, Path, analyze_path, patch_path};
 use std::time::Instant;
 

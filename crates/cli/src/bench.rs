@@ -6,7 +6,7 @@
 //! [`BenchStrategy::Polepatch`] is what `polepatch patch` does by default (both rotary
 //! axes); [`BenchStrategy::OnlyC`] is `--only-c` (G16's method); the peers
 //! [`BenchStrategy::Freeze`], [`BenchStrategy::Linearize`], [`BenchStrategy::Smooth`] are
-//! the pole strategies CAM posts and controllers document ([`polepatch_patcher::peers`]),
+//! the pole strategies CAM posts and controllers document (`Strategy::Freeze` and the others of [`polepatch_patcher::Strategy`]),
 //! applied through the same pipeline and scored by the same Equation-6 analysis.
 //!
 //! # The reference of a zone
@@ -32,8 +32,8 @@ use polepatch::load_nc;
 use polepatch::report::AnalyzeReport;
 use polepatch::{Error, FileReport, ZoneRow, patch_nc};
 use polepatch_kinematics::{Axis, Machine};
-use polepatch_patcher::direct::deviation_bound_zone;
-use polepatch_patcher::reference::{Reference, zone_reference};
+use polepatch_patcher::quality::deviation_bound_zone;
+use polepatch_patcher::quality::{Reference, zone_reference};
 use polepatch_patcher::{
     AnalysisOptions, CLimits, PatchAxes, PatchFailure, PatchOptions, Strategy, Zone, analyze_path,
 };
@@ -423,7 +423,7 @@ fn analysis_zones(lp: &LoadedProgram, machine: &Machine, opts: &PatchOptions) ->
         .map(|rp| match &rp.path {
             Ok(p) => analyze_path(p, machine, &aopts)
                 .map(|a| {
-                    polepatch_patcher::driver::merge_zones(&a.zones, opts.solver.merge_gap_points)
+                    polepatch_patcher::quality::merge_zones(&a.zones, opts.solver.merge_gap_points)
                 })
                 .unwrap_or_default(),
             Err(_) => Vec::new(),
@@ -678,7 +678,7 @@ fn reference(
             hi,
             (zone.first, zone.last),
             &lim,
-            polepatch_patcher::direct::BOUND_SAMPLES_PER_SPAN,
+            polepatch_patcher::quality::BOUND_SAMPLES_PER_SPAN,
         );
         out.status = match res {
             Ok((b, _)) => {
@@ -725,8 +725,8 @@ fn plot_data(
     };
     let ab = analyze_path(pb, machine, &aopts).ok()?;
     let aa = analyze_path(pa, machine, &aopts).ok()?;
-    let sb = polepatch_patcher::analysis::axis_splines(pb).ok()?;
-    let sa = polepatch_patcher::analysis::axis_splines(pa).ok()?;
+    let sb = polepatch_patcher::quality::axis_splines(pb).ok()?;
+    let sa = polepatch_patcher::quality::axis_splines(pa).ok()?;
     let (s0, s1) = (s[lo], s[hi]);
     let window = |v: &[polepatch_patcher::Sample]| -> Vec<plot::RatioSample> {
         v.iter()

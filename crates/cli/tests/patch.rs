@@ -134,7 +134,7 @@ fn impossible_zone_keeps_the_best_improvement() {
     let n = path.s_mm.len();
     let p: Vec<f64> = path.axes.iter().map(|q| q[Axis::Primary.index()]).collect();
     let c: Vec<f64> = path.axes.iter().map(|q| q[Axis::C.index()]).collect();
-    let reachable = polepatch::patcher::reference::reachable(
+    let reachable = polepatch::patcher::quality::reachable(
         &path.s_mm,
         &p,
         &c,

@@ -16,8 +16,8 @@
 use polepatch_kinematics::Machine;
 use polepatch_nc::{Dialect, modal, parse, primary_in_use, runs};
 use polepatch_patcher::{
-    CLimits, Outcome, PatchOptions, Path, direct::deviation_bound_sampled,
-    direct::orientation_deviation_deg, patch_path,
+    CLimits, Outcome, PatchOptions, Path, patch_path, quality::deviation_bound_sampled,
+    quality::orientation_deviation_deg,
 };
 use std::time::Instant;
 
@@ -92,7 +92,7 @@ fn main() {
                     1,
                     n - 1,
                     &lim0,
-                    polepatch_patcher::direct::BOUND_SAMPLES_PER_SPAN,
+                    polepatch_patcher::quality::BOUND_SAMPLES_PER_SPAN,
                 )
                 .ok()
                 .map(|b| b.0);

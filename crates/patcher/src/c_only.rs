@@ -291,7 +291,7 @@ mod tests {
                                 z.first,
                                 z.last,
                                 &lim0,
-                                crate::direct::BOUND_SAMPLES_PER_SPAN,
+                                crate::tolerances::BOUND_SAMPLES_PER_SPAN,
                             )
                             .unwrap();
                             assert!(
@@ -376,7 +376,7 @@ mod tests {
                 z.first,
                 z.last,
                 &lim0,
-                crate::direct::BOUND_SAMPLES_PER_SPAN,
+                crate::tolerances::BOUND_SAMPLES_PER_SPAN,
             )
             .unwrap();
             assert!(bound <= z.max_deviation_deg + 1e-6, "{mname}");

@@ -42,9 +42,9 @@
 //!
 //! # The bound
 //!
-//! [`deviation_bound`] is the exact minimax of the *exact* deviation for C-only changes at
+//! [`deviation_bound_sampled`] is the exact minimax of the *exact* deviation for C-only changes at
 //! `first..=last` with the constraints checked on the samples (every `step_mm` on each span
-//! and at every knot, a bounded number per span: [`BOUND_SAMPLES_PER_SPAN`]), no
+//! and at every knot, a bounded number per span: [`crate::tolerances::BOUND_SAMPLES_PER_SPAN`]), no
 //! monotonicity: since the deviation of point i is increasing in
 //! |δ_i| on [0°, 180°], `max_i dev_i ≤ T` ⇔ `|δ_i| ≤ g_i(T) = 2·asin(sin(T/2)/w_i)` (no
 //! bound when `sin(T/2) ≥ w_i`), an LP feasibility problem on the same Hermite rows;
@@ -59,8 +59,6 @@ use crate::{
     spline::{AnalysisSpline, span_offsets},
     tolerances::{BOUND_BISECTIONS, BOUND_REL_TOL, HERMITE_WINDOW_POINTS, NOT_WORSE_SLACK},
 };
-
-pub use crate::tolerances::BOUND_SAMPLES_PER_SPAN;
 
 /// New C values for points `first..=last` (others fixed) minimising the largest orientation
 /// deviation such that the analysis spline of the whole path satisfies `lim` on every
@@ -173,20 +171,7 @@ pub fn orientation_deviation_deg(p_deg: f64, dc_deg: f64) -> f64 {
 
 /// The smallest possible largest orientation deviation (degrees) over C-only changes at
 /// points `first..=last` such that the analysis spline satisfies `lim` (no monotonicity
-/// asked): the bound the bench compares against. [`BOUND_SAMPLES_PER_SPAN`] samples per span; see
-/// [`deviation_bound_sampled`].
-pub fn deviation_bound(
-    s_mm: &[f64],
-    p_deg: &[f64],
-    c_deg: &[f64],
-    first: usize,
-    last: usize,
-    lim: &CLimits,
-) -> Result<(f64, QpStats), PatchFailure> {
-    deviation_bound_sampled(s_mm, p_deg, c_deg, first, last, lim, BOUND_SAMPLES_PER_SPAN)
-}
-
-/// [`deviation_bound`] with the constraints on `samples_per_span + 1` equally spaced
+/// asked), with the constraints on `samples_per_span + 1` equally spaced
 /// samples of each span of the constrained range (spans within
 /// [`crate::tolerances::CONSTRAINED_MARGIN_POINTS`] of the range), knots included: a relaxation of what the
 /// verification checks (every s), hence a lower bound. Bisection (at most [`BOUND_BISECTIONS`] steps, to
@@ -435,9 +420,16 @@ mod tests {
         let dev = (first..=last)
             .map(|i| orientation_deviation_deg(p[i], c2[i] - c[i]))
             .fold(0.0, f64::max);
-        let (bound, _) =
-            deviation_bound_sampled(&s, &p, &c, first, last, &lim0, BOUND_SAMPLES_PER_SPAN)
-                .unwrap();
+        let (bound, _) = deviation_bound_sampled(
+            &s,
+            &p,
+            &c,
+            first,
+            last,
+            &lim0,
+            crate::tolerances::BOUND_SAMPLES_PER_SPAN,
+        )
+        .unwrap();
         assert!(bound <= dev + 1e-6, "bound {bound} vs achieved {dev}");
         assert!(
             dev <= 1.25 * bound + 1e-3,

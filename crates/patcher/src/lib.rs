@@ -12,42 +12,43 @@
 //! [`protocol`] and the [`starts`] the methods share; the methods; the [`driver`]; the
 //! [`strategy`] table. The bench reference ([`reference`]) stands beside the driver.
 
-pub mod analysis;
-pub mod c_only;
-pub mod candidate;
-pub mod centre;
-pub mod direct;
-pub mod driver;
-pub mod error;
-pub mod g16;
+pub(crate) mod analysis;
+pub(crate) mod c_only;
+pub(crate) mod candidate;
+pub(crate) mod centre;
+pub(crate) mod direct;
+pub(crate) mod driver;
+pub(crate) mod error;
+pub(crate) mod g16;
 pub(crate) mod hermite;
-pub mod ipm;
-pub mod joint;
-pub mod joint_method;
-pub mod limits;
-pub mod options;
-pub mod path;
-pub mod peers;
-pub mod proof;
-pub mod protocol;
+pub(crate) mod ipm;
+pub(crate) mod joint;
+pub(crate) mod joint_method;
+pub(crate) mod limits;
+pub(crate) mod options;
+pub(crate) mod path;
+pub(crate) mod peers;
+pub(crate) mod proof;
+pub(crate) mod protocol;
 mod qp;
-pub mod reference;
-pub mod report;
-pub mod reselect;
-pub mod settings;
+pub mod quality;
+pub(crate) mod reference;
+pub(crate) mod report;
+pub(crate) mod reselect;
+pub(crate) mod settings;
 pub mod spline;
-pub mod starts;
-pub mod strategy;
+pub(crate) mod starts;
+pub(crate) mod strategy;
 #[cfg(test)]
 mod testutil;
-pub mod tolerances;
-pub mod verify;
+pub(crate) mod tolerances;
+pub(crate) mod verify;
 pub(crate) mod window;
-pub mod zones;
+pub(crate) mod zones;
 
 pub use analysis::{
     AnalysisOptions, CONE_DEG, POLE_REACH_DEG, RunAnalysis, Sample, Zone, ZoneKind, analyze_path,
-    pole_dominates,
+    pole_dominates, validate,
 };
 pub use candidate::{Candidate, PatchFailure};
 pub use centre::KeepCentre;

@@ -115,7 +115,7 @@ pub const PROOF_SAMPLES_PER_SPAN: usize = 8;
 /// constraints keep it a relaxation; these are where a change still matters).
 pub const PROOF_SPAN_MARGIN: usize = 40;
 
-/// Samples per span of the C-only deviation bound ([`crate::direct::deviation_bound`],
+/// Samples per span of the C-only deviation bound ([`crate::direct::deviation_bound_sampled`],
 /// both ends included): the bound checks the limits there only, a relaxation of the exact
 /// requirement (every s of the span), so it stays a lower bound; more samples tighten it.
 /// Bounded per span whatever the feed.

@@ -104,6 +104,7 @@ fn span_ratios(
 /// within `core_margin` points of the modified range (the driver passes
 /// [`crate::SolverSettings::core_margin_points`]), and no span of the window
 /// may get a ratio below [`not_worse_floor`] of its ratio before on any checked axis.
+#[cfg(test)]
 #[allow(clippy::too_many_arguments)]
 pub fn verify_change(
     s_mm: &[f64],

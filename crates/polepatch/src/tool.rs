@@ -4,7 +4,7 @@
 //! A patch changes the tool's orientation at fixed X Y Z. Where X Y Z are a ball's
 //! **centre** that keeps the contact (G16's premise); where they are its **tip** the centre
 //! moves by 2R·sin(δ/2), so the tip is rewritten to keep the centre
-//! ([`polepatch_patcher::centre`]). A flat or bull-nose cutter turned about its tip moves
+//! ([`polepatch_patcher::KeepCentre`]). A flat or bull-nose cutter turned about its tip moves
 //! its cutting edge: the deviation is capped so that the cutter's surface moves at most a
 //! surface tolerance ([`deviation_cap_deg`]).
 //!

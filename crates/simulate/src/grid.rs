@@ -1,8 +1,8 @@
 //! The path of a motion and its velocity limit curve on a grid of s.
 
 use polepatch_kinematics::{Machine, feed_bound};
-use polepatch_patcher::analysis::validate;
 use polepatch_patcher::spline::{AnalysisSpline, SplineSystem};
+use polepatch_patcher::validate;
 use polepatch_patcher::{Path, PathError};
 
 use crate::caps::Local;

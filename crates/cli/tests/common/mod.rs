@@ -6,9 +6,9 @@ use polepatch::LoadedProgram;
 use polepatch::kinematics::{Axis, Machine};
 use polepatch::load_nc;
 use polepatch::nc::{Dialect, parse};
-use polepatch::patcher::analysis::{SpanFigures, analyze_spans};
-use polepatch::patcher::direct::deviation_bound_zone;
-use polepatch::patcher::verify::NOT_WORSE_REL;
+use polepatch::patcher::quality::NOT_WORSE_REL;
+use polepatch::patcher::quality::deviation_bound_zone;
+use polepatch::patcher::quality::{SpanFigures, analyze_spans};
 use polepatch::patcher::{AnalysisOptions, CLimits, PatchAxes, PatchOptions, analyze_path};
 use std::path::{Path, PathBuf};
 
@@ -337,7 +337,7 @@ pub fn check_patch_both(
 /// Whether the zone of report row `z` is proven unreachable: with every point of its run
 /// but the first (and the last, where `polepatch::end_pose` keeps it) free, no values
 /// bring the zone's original singular zones to feed on both rotary axes (the relaxation
-/// [`polepatch::patcher::reference::reachable`] is infeasible).
+/// [`polepatch::patcher::quality::reachable`] is infeasible).
 pub fn proven_unreachable(
     lp: &LoadedProgram,
     z: &polepatch::ZoneRow,
@@ -375,13 +375,13 @@ pub fn proven_unreachable(
     let end = if lp.end_pose(r).free { n - 1 } else { n - 2 };
     let p: Vec<f64> = path.axes.iter().map(|q| q[Axis::Primary.index()]).collect();
     let c: Vec<f64> = path.axes.iter().map(|q| q[Axis::C.index()]).collect();
-    !polepatch::patcher::reference::reachable(
+    !polepatch::patcher::quality::reachable(
         &path.s_mm,
         &p,
         &c,
         1,
         end,
-        polepatch::patcher::driver::zone_core(&zone, n, opts.solver.core_margin_points),
+        polepatch::patcher::quality::zone_core(&zone, n, opts.solver.core_margin_points),
         machine,
         path.feed_mm_min,
         opts.axes,
@@ -553,7 +553,7 @@ pub fn reachable_bound_deg(lp: &LoadedProgram, r: usize, machine: &Machine) -> O
         end,
         zone,
         &lim,
-        polepatch::patcher::direct::BOUND_SAMPLES_PER_SPAN,
+        polepatch::patcher::quality::BOUND_SAMPLES_PER_SPAN,
     )
     .ok()
     .map(|b| b.0)

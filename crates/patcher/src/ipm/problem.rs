@@ -81,11 +81,6 @@ impl Problem {
         }
     }
 
-    /// Number of unknowns, `nb + k`.
-    pub fn unknowns(&self) -> usize {
-        self.nb + self.k
-    }
-
     /// Add `v` to the linear objective of unknown `i`.
     pub fn add_linear(&mut self, i: usize, v: f64) {
         self.c[i] += v;
