@@ -267,8 +267,30 @@ fn run_analysis(
         }
     }
     let (mut analysis, below) = acc.finish(path);
-    analysis.zones = detect_zones(path, &below, opts.cone_deg, opts.pole_reach_deg);
+    let side = pole_side_deg(path, machine);
+    analysis.zones = detect_zones(&side, &below, opts.cone_deg, opts.pole_reach_deg);
     Ok(analysis)
+}
+
+/// Each point's signed distance from the pole, degrees: its magnitude the angle between the
+/// tool and the pole axis ([`Machine::pole_tilt_deg`]), its sign the side of the pole the
+/// primary axis is on (the sign of P − [`Machine::pole_p_deg`]), so that a sign change is a
+/// pass through the pole onto the other branch. On the standard form (the built-ins, and
+/// every pair with the pole axis along Z and the tilting axis about X or Y) it is P itself,
+/// exactly; a pair that cannot reach the pole is 180° from it everywhere.
+pub fn pole_side_deg(path: &Path, machine: &Machine) -> Vec<f64> {
+    let p = path.axes.iter().map(|q| q[Axis::Primary.index()]);
+    if machine.standard_form().is_some() {
+        return p.collect();
+    }
+    let Some(pole_p) = machine.pole_p_deg() else {
+        return p.map(|_| 180.0).collect();
+    };
+    p.map(|p| {
+        let tilt = machine.pole_tilt_deg(p);
+        if p < pole_p { -tilt } else { tilt }
+    })
+    .collect()
 }
 
 /// A stretch of consecutive spans whose C-limited ratio is below 1.
@@ -606,6 +628,9 @@ fn zone_over(
 
 /// Zones from the stretches where C is below feed (docs/method.md, "What a zone is").
 ///
+/// `pole_side_deg` is each point's signed distance from the pole ([`pole_side_deg`]: the
+/// primary value on the standard form); below, |primary| means its magnitude.
+///
 /// Each stretch covers the points of its spans; overlapping or touching stretches merge. A
 /// stretch holds a zone when a point in it has |primary| ≤ `cone_deg`, or — out to
 /// `pole_reach_deg` — when the pole dominates its slowdown ([`pole_dominates`], on the
@@ -628,12 +653,12 @@ fn zone_over(
 /// within the reach between them (one pass by the pole); zones the cone admits are never
 /// joined to each other here (the driver merges close ones).
 pub fn detect_zones(
-    path: &Path,
+    pole_side_deg: &[f64],
     below: &[BelowFeed],
     cone_deg: f64,
     pole_reach_deg: f64,
 ) -> Vec<Zone> {
-    let p = |i: usize| path.axes[i][Axis::Primary.index()];
+    let p = |i: usize| pole_side_deg[i];
     // Touching stretches merged: first and last point, lowest ratio and its limit, and
     // every span's (ratio, limit) from the first point on.
     struct Stretch {
@@ -750,6 +775,11 @@ pub fn detect_zones(
 mod tests {
     use super::*;
     use crate::testutil::{machine, planted};
+
+    /// The primary column: the signed pole distance on the standard form.
+    fn side(path: &Path) -> Vec<f64> {
+        path.axes.iter().map(|q| q[3]).collect()
+    }
 
     /// A straight line of X only, at any feed: every ratio is 1, the time is exactly L/F,
     /// no zone.
@@ -927,13 +957,13 @@ mod tests {
             BelowFeed::uniform(15, 22, 0.2, LimitKind::Jerk),
             BelowFeed::uniform(30, 31, 0.9, LimitKind::Acceleration),
         ];
-        let zones = detect_zones(&path, &below, 50.0, 50.0);
+        let zones = detect_zones(&side(&path), &below, 50.0, 50.0);
         assert_eq!(zones.len(), 2, "{zones:?}");
         assert_eq!((zones[0].first, zones[0].last), (10, 23));
         assert_eq!(zones[0].c_ratio_min, 0.2);
         assert_eq!((zones[1].first, zones[1].last), (30, 32));
         // With a 0.1° cone neither has a point in it.
-        assert!(detect_zones(&path, &below, 0.1, 0.1).is_empty());
+        assert!(detect_zones(&side(&path), &below, 0.1, 0.1).is_empty());
     }
 
     /// Issue 30 item 12: out to the pole reach, a stretch is a zone where the pole's factor
@@ -976,16 +1006,16 @@ mod tests {
             .fold(f64::INFINITY, f64::min);
         let threshold = least.to_radians().sin();
         assert_eq!(
-            detect_zones(&path, &below(threshold * 1.01), 5.0, 15.0).len(),
+            detect_zones(&side(&path), &below(threshold * 1.01), 5.0, 15.0).len(),
             1
         );
-        assert!(detect_zones(&path, &below(threshold * 0.99), 5.0, 15.0).is_empty());
+        assert!(detect_zones(&side(&path), &below(threshold * 0.99), 5.0, 15.0).is_empty());
         assert!(
-            detect_zones(&path, &below(0.99), 5.0, 5.0).is_empty(),
+            detect_zones(&side(&path), &below(0.99), 5.0, 5.0).is_empty(),
             "beyond the reach"
         );
         assert_eq!(
-            detect_zones(&path, &below(0.01), 12.0, 12.0).len(),
+            detect_zones(&side(&path), &below(0.01), 12.0, 12.0).len(),
             1,
             "in the cone"
         );
@@ -1008,7 +1038,7 @@ mod tests {
         // C at 2 % of feed by its velocity on every span: the pole's while sin²P ≤ 0.02,
         // P ≤ 8.13°: spans 0..=8 (their nearer end ≤ 8°), points 0..=9.
         let zones = detect_zones(
-            &path,
+            &side(&path),
             &[BelowFeed::uniform(0, 39, 0.02, LimitKind::Velocity)],
             5.0,
             10.0,
@@ -1019,7 +1049,7 @@ mod tests {
         assert!(!z.cut_before && z.cut_after);
         // At 50 % the pole dominates out to 45°: the whole stretch, not cut.
         let zones = detect_zones(
-            &path,
+            &side(&path),
             &[BelowFeed::uniform(0, 39, 0.5, LimitKind::Velocity)],
             5.0,
             10.0,
@@ -1031,13 +1061,13 @@ mod tests {
         let mut below = BelowFeed::uniform(0, 39, 0.5, LimitKind::Velocity);
         below.spans[20] = (0.01, LimitKind::Velocity);
         below.min_ratio = 0.01;
-        let zones = detect_zones(&path, &[below], 5.0, 10.0);
+        let zones = detect_zones(&side(&path), &[below], 5.0, 10.0);
         assert_eq!((zones[0].first, zones[0].last), (0, 20), "{zones:?}");
         assert!(zones[0].cut_after && zones[0].c_ratio_min == 0.5);
         // With a fixed cone (the reach at it) and a slowdown the pole dominates nowhere
         // beyond it, the zone is the cone's spans.
         let zones = detect_zones(
-            &path,
+            &side(&path),
             &[BelowFeed::uniform(0, 39, 0.001, LimitKind::Jerk)],
             5.0,
             5.0,

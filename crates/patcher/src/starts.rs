@@ -82,7 +82,9 @@ pub fn tail_shift(
     keep_last: bool,
 ) -> Option<f64> {
     let n = p.len();
-    if k + 1 >= n || keep_last {
+    // The other branch is (−P, C ± 180°) on the standard form only; on another pair (a
+    // 45° nutating table) the points after `k` would turn the tool.
+    if k + 1 >= n || keep_last || machine.standard_form().is_none() {
         return None;
     }
     let (lo, hi) = machine.primary_range_deg;

@@ -47,6 +47,7 @@ pub fn patch_program(
     opts: &PatchOptions,
 ) -> (Vec<Edit>, FileReport) {
     let program = &lp.program;
+    let pole = crate::program::PoleDistance::of(machine);
     // A stretch of a file: what the file says as a whole (its notes, the primary
     // letter's substitution) is the stream's to report.
     let mut report = FileReport::unchanged(&lp.name, machine, Vec::new());
@@ -88,6 +89,7 @@ pub fn patch_program(
             Err(problem) => {
                 report.untouched_runs.push(untouched(
                     lp,
+                    &pole,
                     r,
                     problem_reason(problem),
                     0,
@@ -102,7 +104,7 @@ pub fn patch_program(
         if !path
             .axes
             .iter()
-            .any(|q| crate::program::near_pole(Some(q[pi]), opts.reach_deg()))
+            .any(|q| pole.near(Some(q[pi]), opts.reach_deg()))
         {
             continue;
         }
@@ -180,6 +182,7 @@ pub fn patch_program(
                         }));
                         report.untouched_runs.push(untouched(
                             lp,
+                            &pole,
                             r,
                             reason,
                             zones.len(),
@@ -190,6 +193,7 @@ pub fn patch_program(
                 }
                 Err(e) => report.untouched_runs.push(untouched(
                     lp,
+                    &pole,
                     r,
                     UntouchedReason::Invalid,
                     0,
@@ -302,6 +306,7 @@ pub fn patch_program(
                 Err(e) => {
                     report.untouched_runs.push(untouched(
                         lp,
+                        &pole,
                         r,
                         UntouchedReason::Invalid,
                         0,
@@ -382,6 +387,7 @@ pub fn patch_program(
             }
             report.untouched_runs.push(untouched(
                 lp,
+                &pole,
                 r,
                 UntouchedReason::CentrePath,
                 result.zones.len(),
@@ -415,6 +421,7 @@ pub fn patch_program(
                     }
                     report.untouched_runs.push(untouched(
                         lp,
+                        &pole,
                         r,
                         UntouchedReason::MachineFrame,
                         result.zones.len(),
@@ -531,7 +538,15 @@ pub fn patch_program(
             .is_some_and(|r| run_of.get(&b) == Some(r))
     };
     polepatch_nc::restore_modal(program, &mut edits, &file_decimals, &same_run);
-    let edits = direction_forms(lp, edits, &run_edit_ranges, &run_of, &mut report, &opts);
+    let edits = direction_forms(
+        lp,
+        edits,
+        &run_edit_ranges,
+        &run_of,
+        &mut report,
+        &opts,
+        &pole,
+    );
     let mut edits = edits;
     edits.sort_by_key(|e| (e.block, e.letter));
     report.words_changed = edits.len();
@@ -541,7 +556,7 @@ pub fn patch_program(
         rp.path.as_ref().is_ok_and(|p| {
             p.axes
                 .iter()
-                .any(|q| crate::program::near_pole(Some(q[pi]), opts.reach_deg()))
+                .any(|q| pole.near(Some(q[pi]), opts.reach_deg()))
         })
     });
     if near {
@@ -565,6 +580,7 @@ fn direction_forms(
     run_of: &std::collections::HashMap<usize, usize>,
     report: &mut FileReport,
     opts: &PatchOptions,
+    pole: &crate::program::PoleDistance,
 ) -> Vec<Edit> {
     let program = &lp.program;
     // The run each edit belongs to (words restored by `restore_modal` are in its run).
@@ -623,6 +639,7 @@ fn direction_forms(
         }
         report.untouched_runs.push(untouched(
             lp,
+            pole,
             run,
             reason,
             zones,
@@ -927,6 +944,7 @@ fn problem_reason(p: &RunProblem) -> UntouchedReason {
 
 fn untouched(
     lp: &LoadedProgram,
+    pole: &crate::program::PoleDistance,
     r: usize,
     reason: UntouchedReason,
     zones: usize,
@@ -943,7 +961,7 @@ fn untouched(
             .run
             .pos
             .iter()
-            .any(|p| crate::program::near_pole(p[pi], cone_deg)),
+            .any(|p| pole.near(p[pi], cone_deg)),
         message,
     }
 }

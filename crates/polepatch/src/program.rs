@@ -68,36 +68,22 @@ impl std::fmt::Display for RunProblem {
     }
 }
 
-/// Whether programs for `machine` can be read, analysed and patched: a pair of the
-/// standard form ([`Machine::standard_form`]: the pole axis along Z, the tilting axis about X
-/// or Y, the tool along Z at zero — table-table, head-table and head-head alike) whose two
-/// letters are among A B C (A-C, B-C, an A-B trunnion whose platter is B, …). The
-/// kinematics crate computes any pair's FK and IK; what reads programs (the pole at P = 0,
-/// the other branch (−P, C + 180°)) assumes this form, so another pair is refused by name
-/// rather than patched with the wrong kinematics (issue 29).
+/// The rotary letters programs for `machine` are read with, when it can be read,
+/// analysed and patched: its two letters must be among A B C (A-C, B-C, an A-B trunnion
+/// whose platter is B, …); any other letter is refused by name. Every pair of axes is
+/// read through its own kinematics: the distance from the pole is the angle between the
+/// tool and the pole axis ([`PoleDistance`]), every change is checked through the pair's
+/// forward kinematics, and the other IK branch as (−P, C + 180°) is taken on the standard
+/// form only ([`Machine::standard_form`]; a 45° nutating table has another).
 pub fn check_layout(machine: &Machine) -> Result<RotaryLetters, Error> {
-    let refuse = |why: String| {
-        Err(Error::Options(format!(
-            "machine {}: {why}; polepatch reads, analyses and patches programs for pairs with \
-             the pole axis along Z and the tilting axis about X or Y (table or head), both \
-             called A, B or C, so far — another pair's zones and branches are not wired yet",
-            machine.name
-        )))
-    };
-    if machine.standard_form().is_none() {
-        return refuse(
-            "its rotary axes are not of that form (an inclined axis, or the tool not along Z \
-             at zero)"
-                .to_string(),
-        );
-    }
     let (p, c) = (machine.primary_letter(), machine.c_letter());
     match RotaryLetters::new(p as u8, c as u8) {
         Some(letters) if p.is_ascii() && c.is_ascii() => Ok(letters),
-        _ => refuse(format!(
-            "its rotary axes are called {p} and {c} (programs are read with rotary words A, B \
-             and C)"
-        )),
+        _ => Err(Error::Options(format!(
+            "machine {}: its rotary axes are called {p} and {c}; polepatch reads programs \
+             with rotary words A, B and C so far (issue 29)",
+            machine.name
+        ))),
     }
 }
 
@@ -132,11 +118,44 @@ pub fn read_options_with(
     })
 }
 
-/// Whether a point whose tilting axis is at `primary_deg` lies within `reach_deg` of the
-/// pole, where a zone can be (`patcher::detect_zones`): a value never programmed reads as
-/// 0, as [`Run::axes5`] reads it. The one rule the survey, the patch and the report use.
-pub(crate) fn near_pole(primary_deg: Option<f64>, reach_deg: f64) -> bool {
-    primary_deg.is_none_or(|v| v.abs() <= reach_deg)
+/// How far a point is from the pole of a machine, degrees, from its tilting axis' value:
+/// `|P|` on the standard form, else the angle between the tool and the pole axis
+/// ([`Machine::pole_tilt_deg`]; 180° everywhere on a pair that cannot reach the pole) —
+/// the magnitude of `patcher::analysis::pole_side_deg`.
+#[derive(Debug, Clone)]
+pub(crate) enum PoleDistance {
+    /// The standard form: `|P|`.
+    Standard,
+    /// Another pair: through its kinematics.
+    General(Box<Machine>),
+}
+
+impl PoleDistance {
+    /// The rule of `machine`.
+    pub(crate) fn of(machine: &Machine) -> PoleDistance {
+        if machine.standard_form().is_some() {
+            PoleDistance::Standard
+        } else {
+            PoleDistance::General(Box::new(machine.clone()))
+        }
+    }
+    /// The distance from the pole of a point whose tilting axis is at `primary_deg`.
+    pub(crate) fn deg(&self, primary_deg: f64) -> f64 {
+        match self {
+            PoleDistance::Standard => primary_deg.abs(),
+            PoleDistance::General(m) => match m.pole_p_deg() {
+                Some(_) => m.pole_tilt_deg(primary_deg),
+                None => 180.0,
+            },
+        }
+    }
+    /// Whether a point whose tilting axis is at `primary_deg` lies within `reach_deg` of the
+    /// pole, where a zone can be (`patcher::detect_zones`): a value never programmed reads
+    /// as 0, as [`Run::axes5`] reads it. The one rule the survey, the patch and the report
+    /// use.
+    pub(crate) fn near(&self, primary_deg: Option<f64>, reach_deg: f64) -> bool {
+        self.deg(primary_deg.unwrap_or(0.0)) <= reach_deg
+    }
 }
 
 /// One run of the program with its path for the patcher.

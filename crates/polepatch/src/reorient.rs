@@ -163,6 +163,21 @@ fn refuse(lp: &LoadedProgram, line: usize, what: impl Into<String>) -> Error {
     }
 }
 
+/// The search tilts the jig about X and Z with the pole along the machine's Z, and
+/// continues each branch as (P, C) / (−P, C + 180°): the standard form only
+/// ([`Machine::standard_form`]); another pair is refused by name.
+fn standard_only(machine: &Machine) -> Result<(), Error> {
+    if machine.standard_form().is_some() {
+        return Ok(());
+    }
+    Err(Error::Options(format!(
+        "machine {}: reorient works on pairs with the pole axis along Z and the tilting axis \
+         about X or Y so far (issue 29); this pair has an inclined axis or a tool not along Z \
+         at zero",
+        machine.name
+    )))
+}
+
 /// The edits that reorient `lp` by `tilt`, and the lines of moves with TCPM off.
 pub fn reorient_edits(
     lp: &LoadedProgram,
@@ -170,6 +185,7 @@ pub fn reorient_edits(
     tilt: &Tilt,
 ) -> Result<(Vec<Edit>, Vec<usize>), Error> {
     let program = &lp.program;
+    standard_only(machine)?;
     let (p_idx, c_idx) = (lp.primary_index(), lp.pole_index());
     let rot = JigRotation::new(tilt.theta_x_deg, tilt.theta_z_deg);
     // The moves under TCPM, with their full positions.
@@ -470,6 +486,7 @@ pub fn reorient_nc(
     cone_deg: f64,
 ) -> Result<(Vec<u8>, ReorientReport), Error> {
     check_tilt(tilt)?;
+    standard_only(machine)?;
     let opts = analysis_options(cone_deg, tilt.pivot_mm)?;
     let lp = load_nc(bytes, name, machine, None)?;
     let before = program_figures(&lp, machine, &opts);
@@ -535,6 +552,7 @@ pub fn search(
     name: &str,
     cone_deg: f64,
 ) -> Result<(Vec<u8>, ReorientReport), Error> {
+    standard_only(machine)?;
     let opts = analysis_options(cone_deg, pivot_mm)?;
     let lp = load_nc(bytes, name, machine, None)?;
     let before = program_figures(&lp, machine, &opts);

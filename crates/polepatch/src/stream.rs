@@ -243,6 +243,8 @@ impl NoRunWhy {
 struct Surveying {
     /// The two readings followed ([`readings`]).
     readings: [RotaryLetters; 2],
+    /// The machine's distance from the pole.
+    pole: crate::program::PoleDistance,
     cone_deg: f64,
     fallback: Option<f64>,
     work_offset_mm: Option<[f64; 3]>,
@@ -266,7 +268,7 @@ impl Surveying {
                 *u |= v.is_some();
             }
             for (l, letters) in self.readings.iter().enumerate() {
-                near[l] |= crate::program::near_pole(p[letters.tilt_index()], self.cone_deg);
+                near[l] |= self.pole.near(p[letters.tilt_index()], self.cone_deg);
             }
         }
         let first_block = run.blocks[0];
@@ -315,6 +317,8 @@ struct Reading<'a> {
     name: &'a str,
     /// The machine's rotary letters.
     letters: RotaryLetters,
+    /// The machine's distance from the pole.
+    pole: crate::program::PoleDistance,
     /// How far from the pole a zone can lie (the cone, or the pole reach beyond it).
     cone_deg: f64,
     fallback: Option<f64>,
@@ -333,6 +337,7 @@ impl<'a> Reading<'a> {
         Ok(Reading {
             name: &opts.name,
             letters: crate::program::check_layout(machine)?,
+            pole: crate::program::PoleDistance::of(machine),
             cone_deg: opts.patch.reach_deg(),
             fallback: opts.feed_fallback_mm_min,
             work_offset_mm: opts.work_offset_mm,
@@ -347,6 +352,7 @@ impl<'a> Reading<'a> {
         Ok(Reading {
             name: &opts.name,
             letters: crate::program::check_layout(machine)?,
+            pole: crate::program::PoleDistance::of(machine),
             cone_deg: opts.analysis.reach_deg(),
             fallback: opts.feed_fallback_mm_min,
             work_offset_mm: opts.work_offset_mm,
@@ -397,6 +403,7 @@ fn survey_once(
 ) -> Result<(Survey, polepatch_nc::Settled), Error> {
     let mut sv = Surveying {
         readings: readings(opts.letters),
+        pole: opts.pole.clone(),
         cone_deg: opts.cone_deg,
         fallback: opts.fallback,
         work_offset_mm: opts.work_offset_mm,
