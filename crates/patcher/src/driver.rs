@@ -812,7 +812,7 @@ fn patch_on(
     // 1. Validate; a path with no point near the pole is unchanged.
     validate(path)?;
     opts.validate()?;
-    if !near_pole(path, opts) {
+    if !near_pole(path, machine, opts) {
         return Ok((PatchResult::unchanged(path, opts), None));
     }
     // 2. Analyse the run and find its zones.
@@ -838,9 +838,15 @@ fn patch_on(
 
 /// Whether some point of `path` is near enough the pole to lie in a zone
 /// ([`PatchOptions::reach_deg`]).
-fn near_pole(path: &Path, opts: &PatchOptions) -> bool {
-    let pi = Axis::Primary.index();
-    path.axes.iter().any(|q| q[pi].abs() <= opts.reach_deg())
+fn near_pole(path: &Path, machine: &Machine, opts: &PatchOptions) -> bool {
+    let reach = opts.reach_deg();
+    if machine.standard_form().is_some() {
+        let pi = Axis::Primary.index();
+        return path.axes.iter().any(|q| q[pi].abs() <= reach);
+    }
+    crate::analysis::pole_side_deg(path, machine)
+        .iter()
+        .any(|d| d.abs() <= reach)
 }
 
 /// The rotary axes that must reach feed and may not get worse.
@@ -1356,7 +1362,7 @@ pub fn report_unpatched(
     opts: &PatchOptions,
 ) -> Result<Vec<ZoneReport>, PathError> {
     validate(path)?;
-    if !near_pole(path, opts) {
+    if !near_pole(path, machine, opts) {
         return Ok(Vec::new());
     }
     let n = path.s_mm.len();

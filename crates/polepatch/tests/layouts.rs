@@ -395,3 +395,67 @@ fn a_cam_trunnion_program_is_analysed_and_its_pole_pass_found() {
     let f = a.runs[0].figures.as_ref().unwrap();
     assert_eq!(f.limiting_axis.as_deref(), Some("B"), "{f:?}");
 }
+
+/// Issue 29: the LinuxCNC `xyzab_tdr_kins` table (A about X carried by B about Y, the tool
+/// along Z at zero), read from an INI in the style of LinuxCNC's sim config: its pole is the
+/// tool along X (B = ±90°), where A cannot turn the tool. A pass posted 1° from that pole is
+/// found at its distance from the pole (not |B|), and the patch makes it faster within the
+/// safety bound, its deviation the angle of the module's own forward kinematics,
+/// (sin B, −sin A cos B, cos A cos B), for the written words.
+#[test]
+fn a_linuxcnc_xyzab_tdr_pass_by_its_pole_along_x_is_found_and_patched() {
+    use polepatch::post::{PostOptions, post_cl, read_cl};
+    let ini = root().join("crates/kinematics/tests/linuxcnc/xyzab-tdr/xyzab-tdr.ini");
+    let tdr = Machine::from_file(&ini).unwrap();
+    assert_eq!((tdr.primary_letter(), tdr.c_letter()), ('B', 'A'));
+    let mut apt = String::from("UNITS/MM\nFEDRAT/2000\n");
+    for k in 0..=40 {
+        let t = f64::from(k) / 40.0;
+        let (ay, az) = (
+            (15.0 - 30.0 * t).to_radians().tan(),
+            1f64.to_radians().tan(),
+        );
+        let n = (ay * ay + az * az + 1.0).sqrt();
+        apt += &format!("GOTO/{k},0,-5,{:.9},{:.9},{:.9}\n", 1.0 / n, ay / n, az / n);
+    }
+    apt += "FINI\n";
+    let cl = read_cl(apt.as_bytes(), "tdr.apt").unwrap();
+    let post = PostOptions {
+        patch: false,
+        dialect: polepatch::nc::Dialect::Fanuc,
+        ..PostOptions::default()
+    };
+    let (nc, _) = post_cl(&cl, &tdr, &post).unwrap();
+    let input = String::from_utf8(nc).unwrap();
+    let (out, report) =
+        polepatch::patch_nc(input.as_bytes(), &tdr, &PatchOptions::default()).unwrap();
+    assert_eq!(report.zones.len(), 1, "{report:?}\n{input}");
+    let z = &report.zones[0];
+    assert!((z.min_abs_primary_deg - 1.0).abs() < 0.05, "{z:?}");
+    assert!(
+        z.after.overall_ratio > 2.0 * z.before.overall_ratio,
+        "{z:?}"
+    );
+    assert!(z.max_deviation_deg <= 10.0 + 1e-6, "{z:?}");
+    let fk = |a_deg: f64, b_deg: f64| {
+        let (a, b) = (a_deg.to_radians(), b_deg.to_radians());
+        [b.sin(), -a.sin() * b.cos(), a.cos() * b.cos()]
+    };
+    let out = String::from_utf8(out).unwrap();
+    let (before, after) = (ab_per_line(&input), ab_per_line(&out));
+    assert_eq!(before.len(), after.len());
+    let worst = before
+        .iter()
+        .zip(&after)
+        .filter_map(|(b, a)| {
+            let ((a0, b0), (a1, b1)) = (b.as_ref()?, a.as_ref()?);
+            Some(angle_deg(fk(*a0, *b0), fk(*a1, *b1)))
+        })
+        .fold(0.0, f64::max);
+    assert!(worst > 0.1, "nothing turned");
+    assert!(
+        (worst - z.max_deviation_deg).abs() < 1e-6,
+        "reference {worst:.9}° vs reported {:.9}°",
+        z.max_deviation_deg
+    );
+}
