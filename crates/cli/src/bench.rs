@@ -30,7 +30,8 @@ use polepatch::LoadedProgram;
 use polepatch::analyze_program;
 use polepatch::load_nc;
 use polepatch::report::AnalyzeReport;
-use polepatch::{Error, FileReport, ZoneRow, patch_nc};
+use polepatch::tool::ToolKind;
+use polepatch::{Error, FileReport, ZoneRow, ZoneTool, patch_nc};
 use polepatch_kinematics::{Axis, Machine};
 use polepatch_patcher::direct::deviation_bound_zone;
 use polepatch_patcher::reference::{Reference, zone_reference};
@@ -199,13 +200,12 @@ pub enum BallCentreShift {
 impl BallCentreShift {
     /// The shift of a report row.
     pub fn of(row: &ZoneRow) -> BallCentreShift {
-        if row.tool.starts_with("ball") {
-            row.max_cutter_shift_mm
-                .map_or(BallCentreShift::None, |v| BallCentreShift::Ball(v * 1e3))
-        } else if row.tool == "unknown" {
-            BallCentreShift::PerMmRadius(row.centre_shift_per_mm_radius * 1e3)
-        } else {
-            BallCentreShift::None
+        match row.tool {
+            ZoneTool::Known(t) if t.kind == ToolKind::Ball => row
+                .max_cutter_shift_mm
+                .map_or(BallCentreShift::None, |v| BallCentreShift::Ball(v * 1e3)),
+            ZoneTool::Unknown => BallCentreShift::PerMmRadius(row.centre_shift_per_mm_radius * 1e3),
+            ZoneTool::Known(_) | ZoneTool::NotPatched => BallCentreShift::None,
         }
     }
 

@@ -16,8 +16,8 @@ use crate::machine_frame;
 use crate::program::{LoadedProgram, RunProblem};
 use crate::report::axis_letter;
 use crate::report::{
-    FiguresRow, FileReport, UntouchedReason, UntouchedRun, ZoneRow, feed_mode_name, method_name,
-    outcome_name, zone_kind_name,
+    EndFreedom, FiguresRow, FileReport, UntouchedReason, UntouchedRun, ZoneReason, ZoneRow,
+    ZoneTool,
 };
 use crate::tool::{RunTool, ToolKind, ToolPoint};
 use polepatch_kinematics::Machine;
@@ -316,13 +316,13 @@ pub fn patch_program(
                 let mut row = zone_row(lp, r, z);
                 tool_fields(&mut row, &rt, z, work_path, &result, machine, tool_capped);
                 if centre_capped && z.reason == polepatch_patcher::Reason::DeviationCap {
-                    row.reason = "centre_path";
+                    row.reason = ZoneReason::CentrePath;
                 }
-                row.end_pose = if run_opts.keep_last_point {
-                    "pinned"
+                row.end_pose = Some(if run_opts.keep_last_point {
+                    EndFreedom::Pinned
                 } else {
-                    "free"
-                };
+                    EndFreedom::Free
+                });
                 row.end_pose_line = if rp.run.tcpm.is_on() {
                     end.decided_line
                 } else {
@@ -378,7 +378,7 @@ pub fn patch_program(
             );
             for row in &mut report.zones[first_row..] {
                 row.not_written();
-                row.reason = "centre_path";
+                row.reason = ZoneReason::CentrePath;
             }
             report.untouched_runs.push(untouched(
                 lp,
@@ -411,7 +411,7 @@ pub fn patch_program(
                 Err(why) => {
                     for row in &mut report.zones[first_row..] {
                         row.not_written();
-                        row.reason = polepatch_patcher::Reason::NotPatched.name();
+                        row.reason = ZoneReason::NotPatched;
                     }
                     report.untouched_runs.push(untouched(
                         lp,
@@ -614,7 +614,7 @@ fn direction_forms(
             .count();
         for row in &mut report.zones[*first_row..*first_row + zones] {
             row.not_written();
-            row.reason = reason.zone_reason().unwrap_or("not_patched");
+            row.reason = reason.zone_reason().unwrap_or(ZoneReason::NotPatched);
         }
         report.untouched_runs.push(untouched(
             lp,
@@ -834,12 +834,12 @@ fn tool_fields(
     tool_capped: bool,
 ) {
     use polepatch_kinematics::forward;
-    row.tool = rt.tool.map_or("unknown".to_string(), |t| t.describe());
+    row.tool = rt.tool.map_or(ZoneTool::Unknown, ZoneTool::Known);
     row.tool_source = rt.tool_source.clone();
-    row.tool_point = rt.point.name();
+    row.tool_point = Some(rt.point);
     row.tool_point_source = rt.point_source.clone();
     if tool_capped && z.reason == polepatch_patcher::Reason::DeviationCap {
-        row.reason = "tool_limited";
+        row.reason = ZoneReason::ToolLimited;
     }
     let Some(tool) = rt.tool else { return };
     let at = |k: usize, t: f64| -> ([f64; 3], [f64; 3], [f64; 3], [f64; 3]) {
@@ -950,7 +950,7 @@ fn zone_row(lp: &LoadedProgram, run: usize, z: &ZoneReport) -> ZoneRow {
         file: lp.name.clone(),
         run: lp.run_number(run),
         lines: [lp.line_of(run, z.first), lp.line_of(run, z.last)],
-        kind: zone_kind_name(z.kind),
+        kind: z.kind,
         min_abs_primary_deg: z.min_abs_primary_deg,
         before: FiguresRow::new(&z.before, pl),
         after: FiguresRow::new(&z.after, pl),
@@ -961,11 +961,11 @@ fn zone_row(lp: &LoadedProgram, run: usize, z: &ZoneReport) -> ZoneRow {
         branch_reselected: z.reselected_points > 0 || z.method == Method::Reselect,
         reselected_points: z.reselected_points,
         patch_length_mm: z.patch_length_mm,
-        outcome: outcome_name(z.outcome),
-        reason: z.reason.name(),
-        end_pose: "-",
+        outcome: z.outcome,
+        reason: z.reason.into(),
+        end_pose: None,
         end_pose_line: None,
-        method: method_name(z.method),
+        method: z.method,
         qp_status: z.qp.status,
         qp_iterations: z.qp.iterations,
         qp_solves: z.qp.solves,
@@ -973,10 +973,10 @@ fn zone_row(lp: &LoadedProgram, run: usize, z: &ZoneReport) -> ZoneRow {
         decimals: z.decimals,
         primary_decimals: z.p_decimals,
         c_offset_deg: z.c_offset_deg,
-        feed_mode: feed_mode_name(lp.runs[run].run.feed_mode),
-        tool: "-".to_string(),
+        feed_mode: lp.runs[run].run.feed_mode,
+        tool: ZoneTool::NotPatched,
         tool_source: String::new(),
-        tool_point: "-",
+        tool_point: None,
         tool_point_source: String::new(),
         centre_shift_per_mm_radius: crate::tool::centre_shift_per_mm_radius(z.max_deviation_deg),
         max_cutter_shift_mm: None,
