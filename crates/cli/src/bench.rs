@@ -30,10 +30,11 @@ use polepatch::LoadedProgram;
 use polepatch::analyze_program;
 use polepatch::load_nc;
 use polepatch::report::AnalyzeReport;
-use polepatch::{Error, FileReport, ZoneRow, patch_nc};
+use polepatch::tool::ToolKind;
+use polepatch::{Error, FileReport, ZoneRow, ZoneTool, patch_nc};
 use polepatch_kinematics::{Axis, Machine};
 use polepatch_patcher::quality::deviation_bound_zone;
-use polepatch_patcher::quality::{Reference, zone_reference};
+use polepatch_patcher::quality::{Reference, ReferenceMethod, zone_reference};
 use polepatch_patcher::{
     AnalysisOptions, CLimits, PatchAxes, PatchFailure, PatchOptions, Strategy, Zone, analyze_path,
 };
@@ -133,20 +134,88 @@ impl Default for BenchOptions {
     }
 }
 
+/// Which reference a zone gets ([`ZoneBound::kind`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BoundKind {
+    /// `best-found`: both axes, the best of several exact methods (an upper bound of the
+    /// optimum).
+    BestFound,
+    /// `c-only-lp`: the LP bound for C-only changes (a lower bound).
+    COnlyLp,
+}
+
+impl BoundKind {
+    /// The reference of a strategy that changes both rotary axes (`both`) or C only.
+    pub fn of(both: bool) -> BoundKind {
+        if both {
+            BoundKind::BestFound
+        } else {
+            BoundKind::COnlyLp
+        }
+    }
+    /// `best-found` or `c-only-lp`: its serde form.
+    pub fn name(self) -> &'static str {
+        match self {
+            BoundKind::BestFound => "best-found",
+            BoundKind::COnlyLp => "c-only-lp",
+        }
+    }
+}
+
+impl std::fmt::Display for BoundKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// How a zone's reference ended ([`ZoneBound::status`]); written `ok`, `unreachable`,
+/// `failed`, `skipped` or `error: …` (its `Display`, in the JSON too).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum BoundStatus {
+    /// The reference was found.
+    Ok,
+    /// Proven: no values reach feed.
+    Unreachable,
+    /// Every method failed numerically.
+    Failed,
+    /// Not computed (`--skip-bound`, or no analysis zone under the row).
+    Skipped,
+    /// It could not be computed, and why.
+    Error(String),
+}
+
+impl std::fmt::Display for BoundStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BoundStatus::Ok => f.write_str("ok"),
+            BoundStatus::Unreachable => f.write_str("unreachable"),
+            BoundStatus::Failed => f.write_str("failed"),
+            BoundStatus::Skipped => f.write_str("skipped"),
+            BoundStatus::Error(why) => write!(f, "error: {why}"),
+        }
+    }
+}
+
+impl Serialize for BoundStatus {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}
+
 /// The reference of one zone (module docs).
 #[derive(Debug, Clone, Serialize)]
 pub struct ZoneBound {
-    /// `best-found` (both axes: the best of several exact methods, an upper bound of the
-    /// optimum) or `c-only-lp` (the LP bound for C-only changes, a lower bound).
-    pub kind: &'static str,
+    /// `best-found` or `c-only-lp`.
+    pub kind: BoundKind,
     /// `ok`, `unreachable` (proven: no values reach feed), `failed`, `skipped`, or
     /// `error: …`.
-    pub status: String,
+    pub status: BoundStatus,
     /// The reference deviation, degrees (`ok` only).
     pub bound_deg: Option<f64>,
     /// The method that found it (`best-found` only): `reselect`, `as-is`,
     /// `other-branch`, `freeze`, `linearize`.
-    pub method: Option<&'static str>,
+    pub method: Option<ReferenceMethod>,
     /// File lines of the first and last movable point of the reference's territory.
     pub lines: [usize; 2],
     /// Wall time, ms.
@@ -199,13 +268,12 @@ pub enum BallCentreShift {
 impl BallCentreShift {
     /// The shift of a report row.
     pub fn of(row: &ZoneRow) -> BallCentreShift {
-        if row.tool.starts_with("ball") {
-            row.max_cutter_shift_mm
-                .map_or(BallCentreShift::None, |v| BallCentreShift::Ball(v * 1e3))
-        } else if row.tool == "unknown" {
-            BallCentreShift::PerMmRadius(row.centre_shift_per_mm_radius * 1e3)
-        } else {
-            BallCentreShift::None
+        match row.tool {
+            ZoneTool::Known(t) if t.kind == ToolKind::Ball => row
+                .max_cutter_shift_mm
+                .map_or(BallCentreShift::None, |v| BallCentreShift::Ball(v * 1e3)),
+            ZoneTool::Unknown => BallCentreShift::PerMmRadius(row.centre_shift_per_mm_radius * 1e3),
+            ZoneTool::Known(_) | ZoneTool::NotPatched => BallCentreShift::None,
         }
     }
 
@@ -348,7 +416,7 @@ impl BenchReport {
             at_feed_both: zones.iter().filter(|z| z.at_feed_both).count(),
             unreachable: zones
                 .iter()
-                .filter(|z| z.bound.status == "unreachable")
+                .filter(|z| z.bound.status == BoundStatus::Unreachable)
                 .count(),
             ratios: ratios.len(),
             ratio_median: median,
@@ -547,8 +615,8 @@ pub fn bench_program(
                     .or_insert_with(|| reference(lp, r, z, &zones[r], machine, &opts.patch, both))
                     .clone(),
                 _ => ZoneBound {
-                    kind: if both { "best-found" } else { "c-only-lp" },
-                    status: "skipped".into(),
+                    kind: BoundKind::of(both),
+                    status: BoundStatus::Skipped,
                     bound_deg: None,
                     method: None,
                     lines: row.lines,
@@ -627,17 +695,16 @@ fn reference(
         }
     }
     let lines = [lp.line_of(r, lo), lp.line_of(r, hi)];
-    let kind = if both { "best-found" } else { "c-only-lp" };
     let mut out = ZoneBound {
-        kind,
-        status: "skipped".into(),
+        kind: BoundKind::of(both),
+        status: BoundStatus::Skipped,
         bound_deg: None,
         method: None,
         lines,
         time_ms: 0.0,
     };
     let Ok(path) = &lp.runs[r].path else {
-        out.status = "error: run not analysed".into();
+        out.status = BoundStatus::Error("run not analysed".into());
         return out;
     };
     let p: Vec<f64> = path.axes.iter().map(|q| q[Axis::Primary.index()]).collect();
@@ -662,11 +729,11 @@ fn reference(
             }) => {
                 out.bound_deg = Some(deviation_deg);
                 out.method = Some(method);
-                "ok".into()
+                BoundStatus::Ok
             }
-            Ok(Reference::Unreachable) => "unreachable".into(),
-            Ok(Reference::Failed) => "failed".into(),
-            Err(e) => format!("error: {e:?}"),
+            Ok(Reference::Unreachable) => BoundStatus::Unreachable,
+            Ok(Reference::Failed) => BoundStatus::Failed,
+            Err(e) => BoundStatus::Error(format!("{e:?}")),
         };
     } else {
         let lim = CLimits::new(machine, path.feed_mm_min, 0.0);
@@ -683,10 +750,10 @@ fn reference(
         out.status = match res {
             Ok((b, _)) => {
                 out.bound_deg = Some(b);
-                "ok".into()
+                BoundStatus::Ok
             }
-            Err(PatchFailure::Solver(_)) => "unreachable".into(),
-            Err(e) => format!("error: {e:?}"),
+            Err(PatchFailure::Solver(_)) => BoundStatus::Unreachable,
+            Err(e) => BoundStatus::Error(format!("{e:?}")),
         };
     }
     out.time_ms = t0.elapsed().as_secs_f64() * 1e3;

@@ -6,7 +6,8 @@ use polepatch::kinematics::Machine;
 use polepatch::patcher::PatchOptions;
 use polepatch::report::{FiguresRow, ZoneRow};
 use polepatch_cli::bench::{
-    BallCentreShift, BenchOptions, BenchReport, BenchStrategy, BenchZone, RATIO_TARGET, plot,
+    BallCentreShift, BenchOptions, BenchReport, BenchStrategy, BenchZone, BoundStatus,
+    RATIO_TARGET, plot,
 };
 use polepatch_cli::outputs::{Input, Output, Target, plan};
 use std::path::{Path, PathBuf};
@@ -251,10 +252,10 @@ pub(crate) fn arrow(before: f64, after: f64) -> String {
 }
 
 fn bound_text(z: &BenchZone) -> String {
-    match (z.bound.status.as_str(), z.bound.bound_deg) {
-        ("ok", Some(b)) => format!("{b:.3}"),
-        ("unreachable", _) => "unreachable".into(),
-        ("skipped", _) => "-".into(),
+    match (&z.bound.status, z.bound.bound_deg) {
+        (BoundStatus::Ok, Some(b)) => format!("{b:.3}"),
+        (BoundStatus::Unreachable, _) => "unreachable".into(),
+        (BoundStatus::Skipped, _) => "-".into(),
         _ => "error".into(),
     }
 }
@@ -442,8 +443,8 @@ fn csv_rows(report: &BenchReport) -> Result<Vec<u8>> {
         rec.push(z.at_feed_c.to_string());
         rec.push(z.at_feed_both.to_string());
         rec.push(z.bound.kind.to_string());
-        rec.push(match (z.bound.status.as_str(), z.bound.bound_deg) {
-            ("ok", Some(b)) => format!("{b:.6}"),
+        rec.push(match (&z.bound.status, z.bound.bound_deg) {
+            (BoundStatus::Ok, Some(b)) => format!("{b:.6}"),
             (s, _) => s.to_string(),
         });
         rec.push(z.ratio.map_or(String::new(), |v| format!("{v:.6}")));

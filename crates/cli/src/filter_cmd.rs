@@ -175,7 +175,11 @@ fn summary(rep: &polepatch::FileReport) {
             rep.file, rep.machine
         );
     } else {
-        let reached = rep.zones.iter().filter(|z| z.outcome == "reached").count();
+        let reached = rep
+            .zones
+            .iter()
+            .filter(|z| z.outcome == polepatch::Outcome::Reached)
+            .count();
         let before: f64 = rep.zones.iter().map(|z| z.before.time_s).sum();
         let after: f64 = rep.zones.iter().map(|z| z.after.time_s).sum();
         let dev = rep

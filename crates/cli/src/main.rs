@@ -5,7 +5,7 @@ use clap::{Parser, Subcommand};
 use polepatch::Piece;
 use polepatch::kinematics::{Axis, Machine};
 use polepatch::patcher::{AnalysisOptions, PatchOptions};
-use polepatch::report::{AnalyzeReport, axis_letter};
+use polepatch::report::{AnalyzeReport, LimitKind, axis_letter, limit_name};
 use polepatch_cli::files;
 use std::io::Write;
 use std::path::PathBuf;
@@ -493,9 +493,9 @@ fn print_run(
                 f.min_ratio,
                 axis,
                 match f.limiting_limit {
-                    "V" => "velocity",
-                    "A" => "acceleration",
-                    _ => "jerk",
+                    LimitKind::Velocity => "velocity",
+                    LimitKind::Acceleration => "acceleration",
+                    LimitKind::Jerk | LimitKind::Feed => "jerk",
                 },
                 f.min_at_line,
                 f.min_at_s_mm
@@ -522,7 +522,11 @@ fn print_run(
             .iter()
             .map(|&a| {
                 let l = axis_letter(a, letters);
-                format!("{l} {:.3} ({})", f.axis_min_ratio[&l], f.axis_limit[&l])
+                format!(
+                    "{l} {:.3} ({})",
+                    f.axis_min_ratio[&l],
+                    limit_name(f.axis_limit[&l])
+                )
             })
             .collect();
         writeln!(out, "  min ratio per axis: {}", ratios.join(", "))?;

@@ -355,7 +355,11 @@ fn print_summary(
                 continue;
             }
         };
-        let reached = rep.zones.iter().filter(|z| z.outcome == "reached").count();
+        let reached = rep
+            .zones
+            .iter()
+            .filter(|z| z.outcome == polepatch::Outcome::Reached)
+            .count();
         let min =
             |f: &dyn Fn(&ZoneRow) -> f64| rep.zones.iter().map(f).fold(f64::INFINITY, f64::min);
         let sum = |f: &dyn Fn(&ZoneRow) -> f64| rep.zones.iter().map(f).sum::<f64>();
@@ -372,8 +376,13 @@ fn print_summary(
         }
         // The tools the changed zones were patched for (`-`: none changed).
         let mut tools: Vec<String> = Vec::new();
-        for z in rep.zones.iter().filter(|z| z.tool != "-") {
-            let t = format!("{} at {}", z.tool, z.tool_point);
+        for z in rep
+            .zones
+            .iter()
+            .filter(|z| z.tool != polepatch::ZoneTool::NotPatched)
+        {
+            let point = z.tool_point.map_or("-", polepatch::tool::ToolPoint::name);
+            let t = format!("{} at {point}", z.tool);
             if !tools.contains(&t) {
                 tools.push(t);
             }
@@ -414,9 +423,9 @@ fn print_summary(
         )?;
         // Why each zone ended as it did (a fixed set, docs/user-guide.md), counted: the
         // patcher's reasons in their order, then the library's (tcpm_unknown, …).
-        let mut names: Vec<&str> = polepatch::patcher::Reason::ALL
-            .iter()
-            .map(|r| r.name())
+        let mut names: Vec<polepatch::ZoneReason> = polepatch::patcher::Reason::ALL
+            .into_iter()
+            .map(polepatch::ZoneReason::from)
             .collect();
         for z in &rep.zones {
             if !names.contains(&z.reason) {

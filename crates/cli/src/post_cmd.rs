@@ -155,7 +155,11 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
     let points = cl.point_count();
     match &report {
         Some(r) => {
-            let reached = r.zones.iter().filter(|z| z.outcome == "reached").count();
+            let reached = r
+                .zones
+                .iter()
+                .filter(|z| z.outcome == polepatch::Outcome::Reached)
+                .count();
             println!(
                 "{name} → {}: {points} points, {} zone(s), {reached} reach feed, {} words patched",
                 args.output.display(),

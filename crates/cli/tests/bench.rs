@@ -4,7 +4,9 @@
 //! side by side, the plots are SVG, and the command fails clearly without inputs.
 
 use polepatch::kinematics::Machine;
-use polepatch_cli::bench::{BenchOptions, BenchStrategy, RATIO_TARGET, run};
+use polepatch_cli::bench::{
+    BenchOptions, BenchStrategy, BoundKind, BoundStatus, RATIO_TARGET, run,
+};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -232,11 +234,17 @@ fn references_relate_to_ours() {
     assert!(report.errors.is_empty(), "{:?}", report.errors);
     let mut compared = [0, 0];
     for z in report.zones() {
-        assert_eq!(z.bound.status, "ok", "{}: {:?}", z.row.file, z.bound);
+        assert_eq!(
+            z.bound.status,
+            BoundStatus::Ok,
+            "{}: {:?}",
+            z.row.file,
+            z.bound
+        );
         let b = z.bound.bound_deg.unwrap();
         match z.strategy {
             BenchStrategy::OnlyC => {
-                assert_eq!(z.bound.kind, "c-only-lp");
+                assert_eq!(z.bound.kind, BoundKind::COnlyLp);
                 if !z.at_feed_c {
                     continue;
                 }
@@ -252,7 +260,7 @@ fn references_relate_to_ours() {
                 compared[1] += 1;
             }
             _ => {
-                assert_eq!(z.bound.kind, "best-found");
+                assert_eq!(z.bound.kind, BoundKind::BestFound);
                 assert!(z.at_feed_both, "{}: {:?}", z.row.file, z.row);
                 let r = z.ratio.expect("a zone at feed with a positive reference");
                 assert!(

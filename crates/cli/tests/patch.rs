@@ -152,7 +152,7 @@ fn impossible_zone_keeps_the_best_improvement() {
         let (out, report) = patch_lp(&lp, &m, &opts);
         assert!(!report.zones.is_empty());
         for z in &report.zones {
-            assert_ne!(z.outcome, "reached", "{z:?}");
+            assert_ne!(z.outcome, polepatch::Outcome::Reached, "{z:?}");
             assert!(z.after.c_ratio >= z.before.c_ratio, "{z:?}");
             assert!(z.after.primary_ratio >= z.before.primary_ratio, "{z:?}");
         }
@@ -178,8 +178,8 @@ fn capped_deviation_keeps_the_best_improvement() {
     let (out, report) = patch_lp(&lp, &m, &opts);
     assert_eq!(report.zones.len(), 1);
     let z = &report.zones[0];
-    assert_ne!(z.outcome, "reached", "{z:?}");
-    assert_eq!(z.reason, "deviation_cap", "{z:?}");
+    assert_ne!(z.outcome, polepatch::Outcome::Reached, "{z:?}");
+    assert_eq!(z.reason, polepatch::ZoneReason::DeviationCap, "{z:?}");
     assert!(z.max_deviation_deg <= 0.05 + 1e-9, "{z:?}");
     assert!(z.after.c_ratio >= z.before.c_ratio && z.after.primary_ratio >= z.before.primary_ratio);
     assert_only_rotary_words_differ("SING", &bytes, &out);
@@ -206,7 +206,12 @@ fn a_cap_the_default_meets_changes_nothing() {
                 .iter()
                 .map(|z| z.max_deviation_deg)
                 .fold(0.0, f64::max);
-            if worst <= 0.0 || report.zones.iter().any(|z| z.reason == "tool_limited") {
+            if worst <= 0.0
+                || report
+                    .zones
+                    .iter()
+                    .any(|z| z.reason == polepatch::ZoneReason::ToolLimited)
+            {
                 // The default is itself capped here, by a flat or bull-nose cutter's
                 // surface bound: its best improvement within that cap is not one a lower
                 // cap must reproduce (and a cap of 0 is a different request).
@@ -265,7 +270,7 @@ fn sing_capped_at_one_degree_or_more_reaches_feed() {
         let z = &report.zones[0];
         assert_eq!(
             (z.outcome, z.reason),
-            ("reached", "reached"),
+            (polepatch::Outcome::Reached, polepatch::ZoneReason::Reached),
             "cap {cap}: {z:?}"
         );
         assert!(z.max_deviation_deg <= cap + 1e-9, "cap {cap}: {z:?}");
@@ -321,7 +326,12 @@ fn f4000_on_the_hsm600_with_three_decimals_reaches_feed_by_default() {
         let text = program(&pass, Dialect::Fanuc, "F4K");
         let (rep, _) = check_patch("f4000", text.as_bytes(), &m, &PatchOptions::default());
         assert!(!rep.zones.is_empty());
-        assert!(rep.zones.iter().all(|z| z.outcome == "reached"), "{rep:?}");
+        assert!(
+            rep.zones
+                .iter()
+                .all(|z| z.outcome == polepatch::Outcome::Reached),
+            "{rep:?}"
+        );
         assert_eq!(rep.file_c_decimals, Some(3));
         let written = rep.written_c_decimals.unwrap();
         assert!((3..=6).contains(&written), "{rep:?}");
@@ -374,7 +384,7 @@ fn rapids_after_runs_are_accounted_for() {
                 "{} run {run}: zones and rapid {before:.3} s → {after:.3} s",
                 m.name
             );
-            if last.end_pose == "pinned" {
+            if last.end_pose == Some(polepatch::EndFreedom::Pinned) {
                 assert_eq!(ra, rb, "{last:?}");
             }
         }

@@ -87,6 +87,23 @@ pub enum ZoneKind {
     CSwing,
 }
 
+impl ZoneKind {
+    /// The name used in the reports of `polepatch`: `A-flip`, `C-swing`. (This type's own
+    /// serde form, in [`crate::ZoneReport`]'s JSON, is the variant's name.)
+    pub fn name(self) -> &'static str {
+        match self {
+            ZoneKind::AFlip => "A-flip",
+            ZoneKind::CSwing => "C-swing",
+        }
+    }
+}
+
+impl std::fmt::Display for ZoneKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// A singular zone: where the C-limited ratio is below 1 because the tool axis passes near
 /// the pole ([`detect_zones`]).
 #[derive(Debug, Clone, PartialEq)]

@@ -44,11 +44,46 @@ pub enum Reference {
     Best {
         /// Largest orientation change over the movable points, degrees.
         deviation_deg: f64,
-        /// `reselect`, `as-is`, `other-branch`, `freeze` or `linearize`.
-        method: &'static str,
+        /// The method that found it.
+        method: ReferenceMethod,
     },
     /// Every method failed numerically (reported, never hidden).
     Failed,
+}
+
+/// The method that found a [`Reference::Best`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ReferenceMethod {
+    /// Branch re-selection alone (no orientation change).
+    Reselect,
+    /// The joint solve started from the program's values.
+    AsIs,
+    /// The joint solve started from the other IK branch.
+    OtherBranch,
+    /// The joint solve started from FREEZE across the cone (a peer's rule).
+    Freeze,
+    /// The joint solve started from LINEARIZE across the cone (a peer's rule).
+    Linearize,
+}
+
+impl ReferenceMethod {
+    /// `reselect`, `as-is`, `other-branch`, `freeze` or `linearize`: its serde form.
+    pub fn name(self) -> &'static str {
+        match self {
+            ReferenceMethod::Reselect => "reselect",
+            ReferenceMethod::AsIs => "as-is",
+            ReferenceMethod::OtherBranch => "other-branch",
+            ReferenceMethod::Freeze => "freeze",
+            ReferenceMethod::Linearize => "linearize",
+        }
+    }
+}
+
+impl std::fmt::Display for ReferenceMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// The reference of `zone` on a path given by `s_mm`, `p_deg`, `c_deg` (the program's
@@ -149,15 +184,15 @@ pub fn zone_reference(
         if in_range(&p) && passes(&p, &c, (f + 1, f + 1)) {
             return Ok(Reference::Best {
                 deviation_deg: 0.0,
-                method: "reselect",
+                method: ReferenceMethod::Reselect,
             });
         }
     }
-    let mut starts: Vec<(&'static str, Vec<f64>, Vec<f64>)> =
-        vec![("as-is", p_deg.to_vec(), c_deg.to_vec())];
+    let mut starts: Vec<(ReferenceMethod, Vec<f64>, Vec<f64>)> =
+        vec![(ReferenceMethod::AsIs, p_deg.to_vec(), c_deg.to_vec())];
     let (op, oc) = flipped(k);
     if tail_free && in_range(&op) {
-        starts.push(("other-branch", op, oc));
+        starts.push((ReferenceMethod::OtherBranch, op, oc));
     }
     // FREEZE and LINEARIZE across the cone stretch (the peers' rules, crate::starts).
     let cone = CONE_DEG.max(zone.min_abs_primary_deg);
@@ -165,7 +200,10 @@ pub fn zone_reference(
         cone_stretch(p_deg, zone, cone),
         AnalysisSpline::new(s_mm, c_deg),
     ) {
-        for (name, rule) in [("freeze", Rule::Freeze), ("linearize", Rule::Linearize)] {
+        for (name, rule) in [
+            (ReferenceMethod::Freeze, Rule::Freeze),
+            (ReferenceMethod::Linearize, Rule::Linearize),
+        ] {
             let (mut rp, mut rc) = (p_deg.to_vec(), c_deg.to_vec());
             apply_rule(
                 rule, machine, s_mm, c_deg, &spline, &target, stretch, &mut rp, &mut rc,
@@ -173,7 +211,7 @@ pub fn zone_reference(
             starts.push((name, rp, rc));
         }
     }
-    let mut best: Option<(f64, &'static str)> = None;
+    let mut best: Option<(f64, ReferenceMethod)> = None;
     for (name, sp, sc) in &starts {
         let pr = JointProblem {
             s_mm,
@@ -210,7 +248,7 @@ pub fn zone_reference(
         // Starts other than "as-is" change points outside the range only as a block that
         // keeps the tool axes; the deviation counts the range.
         if passes(&p, &c, (first, last)) && best.is_none_or(|(d, _)| sol.max_deviation_deg < d) {
-            best = Some((sol.max_deviation_deg, name));
+            best = Some((sol.max_deviation_deg, *name));
         }
     }
     Ok(match best {
@@ -276,7 +314,7 @@ mod tests {
             r,
             Reference::Best {
                 deviation_deg: 0.0,
-                method: "reselect"
+                method: ReferenceMethod::Reselect
             }
         );
     }

@@ -32,6 +32,25 @@ pub enum Outcome {
     Unchanged,
 }
 
+impl Outcome {
+    /// The name used in the reports of `polepatch` (its zone rows, the CSV, the summary):
+    /// `reached`, `improved`, `unchanged`. (This type's own serde form, in
+    /// [`ZoneReport`]'s JSON, is the variant's name.)
+    pub fn name(self) -> &'static str {
+        match self {
+            Outcome::Reached => "reached",
+            Outcome::Improved => "improved",
+            Outcome::Unchanged => "unchanged",
+        }
+    }
+}
+
+impl std::fmt::Display for Outcome {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// Why a zone ended as it did: one of a fixed set (Ruckig's `Result` manner), documented
 /// in [`crate::driver`] and `docs/method.md`; the summary table counts them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
@@ -120,6 +139,28 @@ pub enum Method {
     Direct,
     /// Nothing written.
     None,
+}
+
+impl Method {
+    /// The name used in the reports of `polepatch`: `reselect`, `joint`, `peer`,
+    /// `g16-patch`, `direct`, `none`. (This type's own serde form, in [`ZoneReport`]'s
+    /// JSON, is the variant's name.)
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Reselect => "reselect",
+            Method::Joint => "joint",
+            Method::Peer => "peer",
+            Method::G16Patch => "g16-patch",
+            Method::Direct => "direct",
+            Method::None => "none",
+        }
+    }
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// How a solve ended: clarabel's `SolverStatus`, plus polepatch's own outcomes of a solve

@@ -3,7 +3,7 @@
 use crate::program::LoadedProgram;
 use crate::report::{
     AnalyzeReport, MachineFrameFigures, RunFigures, RunReport, ZoneSummary, axis_letter,
-    limit_name, machine_units, zone_kind_name,
+    machine_units,
 };
 use polepatch_kinematics::{Axis, Machine};
 use polepatch_patcher::{AnalysisOptions, RunAnalysis, analyze_path};
@@ -22,13 +22,13 @@ pub fn run_figures(lp: &LoadedProgram, r: usize, a: &RunAnalysis) -> RunFigures 
     for axis in Axis::ALL {
         let l = axis_letter(axis, pl);
         axis_min_ratio.insert(l.clone(), a.axis_min[axis.index()].0);
-        axis_limit.insert(l.clone(), limit_name(a.axis_min[axis.index()].1));
+        axis_limit.insert(l.clone(), a.axis_min[axis.index()].1);
         peak_speed.insert(l, machine_units(axis, a.peak_speed[axis.index()]));
     }
     RunFigures {
         min_ratio: a.min.ratio,
         limiting_axis: a.min.axis.map(|x| axis_letter(x, pl)),
-        limiting_limit: limit_name(a.min.kind),
+        limiting_limit: a.min.kind,
         min_at_s_mm: a.min_s_mm,
         min_at_line: lp.line_of(r, k),
         axis_min_ratio,
@@ -41,7 +41,7 @@ pub fn run_figures(lp: &LoadedProgram, r: usize, a: &RunAnalysis) -> RunFigures 
             .iter()
             .map(|z| ZoneSummary {
                 lines: [lp.line_of(r, z.first), lp.line_of(r, z.last)],
-                kind: zone_kind_name(z.kind),
+                kind: z.kind,
                 singular_line: lp.line_of(r, z.singular),
                 min_abs_primary_deg: z.min_abs_primary_deg,
                 c_ratio_min: z.c_ratio_min,
@@ -83,8 +83,7 @@ fn machine_frame_figures(
             .insert(l.clone(), machine_units(axis, a.peak_speed[axis.index()]));
         f.axis_min_ratio
             .insert(l.clone(), a.axis_min[axis.index()].0);
-        f.axis_limit
-            .insert(l, limit_name(a.axis_min[axis.index()].1));
+        f.axis_limit.insert(l, a.axis_min[axis.index()].1);
     }
     Some(f)
 }
@@ -108,7 +107,7 @@ pub fn analyze_program(
                 length_mm: rp.run.length_mm(),
                 // The run's F also when it is not analysed.
                 feed_mm_min: lp.run_feed_mm_min(r),
-                feed_mode: crate::report::feed_mode_name(rp.run.feed_mode),
+                feed_mode: rp.run.feed_mode,
                 error: None,
                 figures: None,
                 machine_frame: None,

@@ -52,7 +52,8 @@ pub use error::Error;
 pub use hooks::Hooks;
 pub use program::{LoadedProgram, MIN_FEED_MM_MIN, RunPath, RunProblem, Window};
 pub use report::{
-    AnalyzeReport, FileReport, SimulateReport, UntouchedReason, UntouchedRun, ZoneRow,
+    AnalyzeReport, EndFreedom, FileReport, Outcome, SimulateReport, UntouchedReason, UntouchedRun,
+    ZoneReason, ZoneRow, ZoneTool,
 };
 pub use simulate::{SimulateOptions, simulate_nc, simulate_nc_with};
 pub use stream::{Piece, analyze_nc_each, load_nc, load_nc_with};

@@ -4,6 +4,40 @@
 //! the criterion benches, the tests, the C ABI) goes through it, by way of
 //! [`crate::patch_nc`] for bytes or [`crate::stream`] for the stretches of a file.
 //!
+//! # The steps
+//! [`patch_program`] takes them in this order, one function each:
+//!
+//! 1. **The file's styles** (`file_styles`): the decimals the file writes C, the primary
+//!    axis and X Y Z with, and the patcher's options they set.
+//! 2. **Each run**, in file order (`patch_run`):
+//!    1. a run without a path (no feed, a feed too low, an unknown or other rotary value)
+//!       is reported untouched; a run with no point within the pole reach
+//!       (`near_pole`) has nothing to patch or report, and its analysis is skipped;
+//!    2. **a run that may not be patched** (`why_left`: the frame transformed, TCPM not
+//!       settled, uncertain, or off where X Y Z cannot be recomputed, incremental mode)
+//!       has its zones reported only (`report_left`; below);
+//!    3. **the run's options** (`run_options`): its end pose (the last point keeps its
+//!       values unless the blocks after the run free it) and its tool (a ball programmed
+//!       at its tip keeps its centre, a flat or bull-nose cutter caps the orientation
+//!       change: [`crate::tool`]);
+//!    4. **the patch** (`RunPatch::patch`, on the part-frame path for a run without TCPM)
+//!       and **the end's choice** (`RunPatch::pin_end_if_faster`): a free end is pinned
+//!       where the positioning move after the run then makes the whole faster;
+//!    5. **the report rows** (`RunPatch::zone_rows`), solved again with the orientation
+//!       change capped while a kept ball centre would leave its path between the points
+//!       (`RunPatch::rows_within_centre_path`; a run that cannot keep it keeps its values);
+//!    6. **through the kinematic chain**, where the machine has one (`through_chain`): the
+//!       X Y Z edits of a run without TCPM, and the machine-frame check;
+//!    7. **the edits** (`RunPatch::centre_edits`, `RunPatch::rotary_edits`): the tips of a
+//!       kept ball centre, then the primary-axis and C words, each with the blocks after
+//!       the run that restate its last values ([`crate::end_pose`]).
+//! 3. **Modal words** (`restore_modal`): inside a run, a point that relied on a modal
+//!    value keeps it.
+//! 4. **Direction forms** (`direction_forms`): the edits of Sinumerik `DC`/`ACP`/`ACN`
+//!    words are written in their form, or their run keeps its values.
+//! 5. **The report's totals** (`finish_report`): the words changed, the file's decimals
+//!    and those written.
+//!
 //! # What is never patched
 //! A run whose X Y Z are machine coordinates (no TCPM: M128, TRAORI, G43.4 not active) is
 //! analysed and reported but left byte-identical: on a table-table machine without TCPM,
@@ -12,18 +46,23 @@
 //! every later position. Both appear in [`FileReport::untouched_runs`] when they hold a
 //! singular zone.
 
+use crate::end_pose::EndPose;
 use crate::machine_frame;
-use crate::program::{LoadedProgram, RunProblem};
+use crate::program::{LoadedProgram, RunPath, RunProblem};
 use crate::report::axis_letter;
 use crate::report::{
-    FiguresRow, FileReport, UntouchedReason, UntouchedRun, ZoneRow, feed_mode_name, method_name,
-    outcome_name, zone_kind_name,
+    EndFreedom, FiguresRow, FileReport, UntouchedReason, UntouchedRun, ZoneReason, ZoneRow,
+    ZoneTool,
 };
 use crate::tool::{RunTool, ToolKind, ToolPoint};
-use polepatch_kinematics::Machine;
-use polepatch_nc::{Edit, NumberStyle, Tcpm};
-use polepatch_patcher::KeepCentre;
-use polepatch_patcher::{Method, PatchOptions, ZoneReport, patch_path, report_unpatched};
+use polepatch_kinematics::{Chain, Machine};
+use polepatch_nc::{Edit, FileStyle, NumberStyle, Tcpm};
+use polepatch_patcher::{
+    KeepCentre, Method, PatchOptions, PatchResult, Path, PathError, ZoneReport, patch_path,
+    report_unpatched,
+};
+use std::collections::HashMap;
+use std::ops::Range;
 
 /// How many times a run whose kept ball centre would leave its path between the points by
 /// more than the chord tolerance is solved again with its orientation change capped.
@@ -37,7 +76,8 @@ const CENTRE_PATH_CAP_SAFETY: f64 = 0.9;
 /// (what the end's choice ignores), s.
 const RAPID_TIME_TOL_S: f64 = 1e-3;
 
-/// Patch a loaded program: the edits to write and the report.
+/// Patch a loaded program: the edits to write and the report (the steps of the module
+/// docs).
 ///
 /// `opts.c_decimals` and `opts.p_decimals` are taken from the file (its number style);
 /// `opts.max_decimals` is raised to the file's decimals when lower.
@@ -46,324 +86,574 @@ pub fn patch_program(
     machine: &Machine,
     opts: &PatchOptions,
 ) -> (Vec<Edit>, FileReport) {
-    let program = &lp.program;
-    let pole = crate::program::PoleDistance::of(machine);
     // A stretch of a file: what the file says as a whole (its notes, the primary
     // letter's substitution) is the stream's to report.
     let mut report = FileReport::unchanged(&lp.name, machine, Vec::new());
-    let pi = polepatch_kinematics::Axis::Primary.index();
-    let file_style = lp.file_style();
-    let style_of = |l: u8| {
-        file_style
-            .letter(l)
-            .unwrap_or_else(|| NumberStyle::of(program, l))
+    let styles = file_styles(lp, opts);
+    let mut out = Written {
+        edits: Vec::new(),
+        written_c: styles.c.decimals,
+        written_p: styles.p.decimals,
+        run_edit_ranges: Vec::new(),
     };
-    let c_style = style_of(lp.pole_letter);
-    let p_style = style_of(lp.primary_letter);
+    for r in 0..lp.runs.len() {
+        patch_run(lp, r, machine, &styles, &mut report, &mut out);
+    }
+    let run_of = run_of_blocks(lp);
+    restore_modal(lp, &styles, &run_of, &mut out.edits);
+    let mut edits = direction_forms(
+        lp,
+        std::mem::take(&mut out.edits),
+        &out.run_edit_ranges,
+        &run_of,
+        &mut report,
+        &styles.opts,
+    );
+    edits.sort_by_key(|e| (e.block, e.letter));
+    finish_report(lp, &styles, &out, edits.len(), &mut report);
+    (edits, report)
+}
+
+/// The file's number styles and the patcher's options they set (step 1).
+struct Styles {
+    /// What the whole file says of its numbers (a stretch's file).
+    file: FileStyle,
+    /// The style of the C words.
+    c: NumberStyle,
+    /// The style of the primary-axis words.
+    p: NumberStyle,
+    /// The caller's options with the file's decimals.
+    opts: PatchOptions,
+    /// Fewest decimals of X Y Z recomputed through the kinematic chain.
+    xyz_decimals: usize,
+    /// Decimals of X Y Z rewritten to keep a ball's centre.
+    xyz_file_decimals: usize,
+}
+
+impl Styles {
+    /// The style of `letter`'s words ([`style_of`]).
+    fn of(&self, lp: &LoadedProgram, letter: u8) -> NumberStyle {
+        style_of(&self.file, lp, letter)
+    }
+}
+
+/// The style of `letter`'s words: the file's, else the stretch's.
+fn style_of(file: &FileStyle, lp: &LoadedProgram, letter: u8) -> NumberStyle {
+    file.letter(letter)
+        .unwrap_or_else(|| NumberStyle::of(&lp.program, letter))
+}
+
+/// Step 1: the file's styles, and `opts` with the decimals they set.
+fn file_styles(lp: &LoadedProgram, opts: &PatchOptions) -> Styles {
+    let file = lp.file_style();
+    let style = |l: u8| style_of(&file, lp, l);
+    let c = style(lp.pole_letter);
+    let p = style(lp.primary_letter);
     let opts = PatchOptions {
-        c_decimals: c_style.decimals,
-        p_decimals: p_style.decimals,
-        max_decimals: opts
-            .max_decimals
-            .max(c_style.decimals)
-            .max(p_style.decimals),
+        c_decimals: c.decimals,
+        p_decimals: p.decimals,
+        max_decimals: opts.max_decimals.max(c.decimals).max(p.decimals),
         ..opts.clone()
     };
-    let xyz_decimals = style_of(b'X').decimals.max(machine_frame::MIN_XYZ_DECIMALS);
+    let xyz_decimals = style(b'X').decimals.max(machine_frame::MIN_XYZ_DECIMALS);
     // X Y Z rewritten to keep a ball's centre are written as the file writes them, to a
     // micrometre at least (a file of round values, `X0.5 Y0 Z-5`, shows no precision).
     let xyz_file_decimals = [b'X', b'Y', b'Z']
-        .map(|l| style_of(l).decimals)
+        .map(|l| style(l).decimals)
         .into_iter()
         .max()
         .unwrap_or(0)
         .max(machine_frame::MIN_XYZ_DECIMALS);
-    let mut edits: Vec<Edit> = Vec::new();
-    let mut written_c = c_style.decimals;
-    let mut written_p = p_style.decimals;
-    // For each patched run: its index, its first zone row and its edits.
-    let mut run_edit_ranges: Vec<(usize, usize, std::ops::Range<usize>)> = Vec::new();
-    'runs: for (r, rp) in lp.runs.iter().enumerate() {
-        let path = match &rp.path {
-            Ok(p) => p,
-            Err(problem) => {
+    Styles {
+        file,
+        c,
+        p,
+        opts,
+        xyz_decimals,
+        xyz_file_decimals,
+    }
+}
+
+/// What the runs give the file (step 2).
+struct Written {
+    /// The edits, run after run.
+    edits: Vec<Edit>,
+    /// Decimal places written for changed C words (the file's at least).
+    written_c: usize,
+    /// Decimal places written for changed primary-axis words (the file's at least).
+    written_p: usize,
+    /// For each patched run: its index, its first zone row and its edits.
+    run_edit_ranges: Vec<(usize, usize, Range<usize>)>,
+}
+
+/// Whether a point of `path` is within the pole reach: a zone needs one (the patcher's
+/// `detect_zones`).
+fn near_pole(lp: &LoadedProgram, path: &Path, opts: &PatchOptions) -> bool {
+    let pi = polepatch_kinematics::Axis::Primary.index();
+    path.axes
+        .iter()
+        .any(|q| lp.pole.near(Some(q[pi]), opts.reach_deg()))
+}
+
+/// Step 2: run `r` patched, its rows in `report`, its edits in `out` (the sub-steps of
+/// the module docs).
+fn patch_run(
+    lp: &LoadedProgram,
+    r: usize,
+    machine: &Machine,
+    styles: &Styles,
+    report: &mut FileReport,
+    out: &mut Written,
+) {
+    let opts = &styles.opts;
+    let rp = &lp.runs[r];
+    let path = match &rp.path {
+        Ok(p) => p,
+        Err(problem) => {
+            report.untouched_runs.push(untouched(
+                lp,
+                r,
+                problem_reason(problem),
+                0,
+                problem.to_string(),
+                opts.reach_deg(),
+            ));
+            return;
+        }
+    };
+    // A run with no point in the cone has nothing to patch or report, and its analysis is
+    // skipped.
+    if !near_pole(lp, path, opts) {
+        return;
+    }
+    let frame = RunFrame::of(lp, r, machine);
+    if let Some(left) = why_left(rp, &frame, machine) {
+        report_left(lp, r, path, machine, opts, left, report);
+        return;
+    }
+    let mut run = run_options(lp, r, path, machine, styles, &frame);
+    let patched = run.pin_end_if_faster();
+    let Some((result, first_row)) = run.rows_within_centre_path(patched, opts, report) else {
+        return;
+    };
+    let first_edit = out.edits.len();
+    if let Some((ch, d)) = frame.chain {
+        match through_chain(
+            lp,
+            r,
+            path,
+            run.work_path(),
+            &result,
+            machine,
+            ch,
+            d,
+            opts,
+            styles.xyz_decimals,
+            lp.chord_tolerance_mm,
+        ) {
+            Ok(mut xyz) => out.edits.append(&mut xyz),
+            Err(why) => {
+                for row in &mut report.zones[first_row..] {
+                    row.not_written();
+                    row.reason = ZoneReason::NotPatched;
+                }
                 report.untouched_runs.push(untouched(
                     lp,
-                    &pole,
                     r,
-                    problem_reason(problem),
-                    0,
-                    problem.to_string(),
+                    UntouchedReason::MachineFrame,
+                    result.zones.len(),
+                    why,
                     opts.reach_deg(),
                 ));
-                continue;
+                return;
             }
-        };
-        // A zone needs a point in the cone (`detect_zones`): a run with none has nothing to
-        // patch or report, and its analysis is skipped.
-        if !path
-            .axes
-            .iter()
-            .any(|q| pole.near(Some(q[pi]), opts.reach_deg()))
-        {
-            continue;
         }
-        let incremental = rp
-            .run
-            .blocks
-            .iter()
-            .skip(1)
-            .any(|&b| program.state(b).incremental);
-        let chain = machine
-            .chain
-            .as_ref()
-            .and_then(|ch| lp.datum_mm(r).map(|d| (ch, d)));
-        let inch = rp.run.blocks.iter().any(|&b| program.state(b).inch);
-        let leave = if rp.run.transform != 0 {
-            Some((
-                UntouchedReason::FrameTransformed,
-                "a rotation, scaling or mirror image of the frame is in force (G68, G51, G51.1, \
-                 G73/G72/G28 in Heidenhain ISO, CYCL DEF 8/10/11/19/26, PLANE, ROT/SCALE/MIRROR, \
-                 CYCLE800): the program's X Y Z and tool axis are not in the frame polepatch \
-                 computes in, so the run is left as it is",
-            ))
-        } else if rp.run.tcpm == Tcpm::Unknown {
-            Some((
-                UntouchedReason::TcpmUnknown,
-                "whether TCPM is on here is not settled by the file: the run follows a call of \
-                 code outside it, a label or a jump where ways with different TCPM states meet, \
-                 or a code whose effect on TCPM polepatch does not know (TRACON, G43.8); X Y Z \
-                 may be machine coordinates, so the run is left as it is",
-            ))
-        } else if rp.run.tcpm == Tcpm::Uncertain {
-            Some((
-                UntouchedReason::TcpmUncertain,
-                "TCPM is switched by a block that block delete (`/`) may skip: whether X Y Z are \
-                 part or machine coordinates depends on the block-delete switch, so the run is \
-                 left as it is",
-            ))
-        } else if !rp.run.tcpm.is_on() && (chain.is_none() || inch || incremental) {
-            Some((
-                UntouchedReason::NoTcpm,
-                if machine.chain.is_none() {
-                    "no TCPM active (M128, TRAORI or G43.4) — X Y Z are machine coordinates; \
-                     changing rotary words alone would move the part under the tool, so the run is \
-                     left as it is (if the controller switches TCPM with other codes, or always \
-                     runs with it, say so in the machine file's [controller] section: tcpm_on, \
-                     tcpm_always; else give the machine's kinematic chain to patch it)"
-                } else if chain.is_none() {
-                    "no TCPM active and the work offset is unknown (the program states no datum \
-                     with values): X Y Z cannot be recomputed, so the run is left as it is \
-                     (give --work-offset X,Y,Z)"
-                } else {
-                    "no TCPM active, in inch or incremental mode: X Y Z are not recomputed there, \
-                     so the run is left as it is"
-                },
-            ))
-        } else if incremental {
-            Some((
-                UntouchedReason::Incremental,
-                "incremental mode (G91) — a changed value would shift every later position; \
-                 polepatch patches absolute (G90) programs only; left as it is",
-            ))
-        } else {
-            None
-        };
-        if let Some((reason, message)) = leave {
-            match report_unpatched(path, machine, &opts) {
-                Ok(zones) => {
-                    if !zones.is_empty() {
-                        report.zones.extend(zones.iter().map(|z| {
-                            let mut row = zone_row(lp, r, z);
-                            if let Some(why) = reason.zone_reason() {
-                                row.reason = why;
-                            }
-                            row
-                        }));
-                        report.untouched_runs.push(untouched(
-                            lp,
-                            &pole,
-                            r,
-                            reason,
-                            zones.len(),
-                            message.to_string(),
-                            opts.reach_deg(),
-                        ));
-                    }
-                }
-                Err(e) => report.untouched_runs.push(untouched(
-                    lp,
-                    &pole,
-                    r,
-                    UntouchedReason::Invalid,
-                    0,
-                    e.to_string(),
-                    opts.reach_deg(),
-                )),
-            }
-            continue;
+    }
+    run.centre_edits(&result, &mut out.edits);
+    run.rotary_edits(&result, out);
+    out.run_edit_ranges
+        .push((r, first_row, first_edit..out.edits.len()));
+}
+
+/// What decides how run `r`'s X Y Z relate to the machine.
+struct RunFrame<'a> {
+    /// The machine's kinematic chain and the run's work offset, when both are known.
+    chain: Option<(&'a Chain, [f64; 3])>,
+    /// A block of the run is in inch.
+    inch: bool,
+    /// A block of the run (after its start) is in incremental mode (G91).
+    incremental: bool,
+}
+
+impl<'a> RunFrame<'a> {
+    /// Run `r`'s frame on `machine`.
+    fn of(lp: &LoadedProgram, r: usize, machine: &'a Machine) -> RunFrame<'a> {
+        let program = &lp.program;
+        let rp = &lp.runs[r];
+        RunFrame {
+            chain: machine
+                .chain
+                .as_ref()
+                .and_then(|ch| lp.datum_mm(r).map(|d| (ch, d))),
+            inch: rp.run.blocks.iter().any(|&b| program.state(b).inch),
+            incremental: rp
+                .run
+                .blocks
+                .iter()
+                .skip(1)
+                .any(|&b| program.state(b).incremental),
         }
-        let end = lp.end_pose(r);
-        let mut run_opts = PatchOptions {
-            // Without TCPM the moves after the run are in machine coordinates: the last
-            // point keeps its values (X Y Z included).
-            keep_last_point: !rp.run.tcpm.is_on() || !end.free,
-            ..opts.clone()
-        };
-        // The tool, and what it asks of the patch (crate::tool).
-        let rt = run_tool(lp, r, machine);
-        let mut tool_capped = false;
-        match rt.tool {
-            Some(t) if t.kind == ToolKind::Ball && rt.point == ToolPoint::Tip => {
-                run_opts.keep_centre = Some(KeepCentre {
-                    radius_mm: t.diameter_mm / 2.0,
-                    // Without TCPM the part-frame tips go through the chain, not to the
-                    // file: kept exact there.
-                    decimals: match (rp.run.tcpm.is_on(), inch) {
-                        (false, _) => 9,
-                        (true, false) => xyz_file_decimals,
-                        // 10⁻⁴ inch is 2.5 µm: one more.
-                        (true, true) => xyz_file_decimals.max(MIN_INCH_XYZ_DECIMALS),
-                    },
-                    unit_mm: if inch && rp.run.tcpm.is_on() {
-                        25.4
-                    } else {
-                        1.0
-                    },
-                    s_is_length: rp.run.feed_mode != polepatch_nc::FeedMode::InverseTime,
-                });
-            }
-            Some(t) if t.kind != ToolKind::Ball => {
-                let cap = crate::tool::deviation_cap_deg(&t, lp.tool.surface_tolerance_mm);
-                if run_opts.max_deviation_deg.is_none_or(|c| cap <= c) {
-                    run_opts.max_deviation_deg = Some(cap);
-                    tool_capped = true;
-                }
-            }
-            _ => {}
-        }
-        // Without TCPM (and with a chain) the patcher works on the part-frame path.
-        let part_path = match (rp.run.tcpm, chain) {
-            (Tcpm::Off, Some((ch, d))) => {
-                Some(machine_frame::part_frame_path(ch, machine, d, path))
-            }
-            _ => None,
-        };
-        let work_path = part_path.as_ref().unwrap_or(path);
-        let patch_with = |o: &PatchOptions| {
-            if part_path.is_some() {
-                machine_frame::patch_part_frame(work_path, machine, o)
+    }
+}
+
+/// Step 2.2: why run `rp` may not be patched, and the message for people; `None` when it
+/// may.
+fn why_left(
+    rp: &RunPath,
+    frame: &RunFrame,
+    machine: &Machine,
+) -> Option<(UntouchedReason, &'static str)> {
+    if rp.run.transform != 0 {
+        Some((
+            UntouchedReason::FrameTransformed,
+            "a rotation, scaling or mirror image of the frame is in force (G68, G51, G51.1, \
+             G73/G72/G28 in Heidenhain ISO, CYCL DEF 8/10/11/19/26, PLANE, ROT/SCALE/MIRROR, \
+             CYCLE800): the program's X Y Z and tool axis are not in the frame polepatch \
+             computes in, so the run is left as it is",
+        ))
+    } else if rp.run.tcpm == Tcpm::Unknown {
+        Some((
+            UntouchedReason::TcpmUnknown,
+            "whether TCPM is on here is not settled by the file: the run follows a call of \
+             code outside it, a label or a jump where ways with different TCPM states meet, \
+             or a code whose effect on TCPM polepatch does not know (TRACON, G43.8); X Y Z \
+             may be machine coordinates, so the run is left as it is",
+        ))
+    } else if rp.run.tcpm == Tcpm::Uncertain {
+        Some((
+            UntouchedReason::TcpmUncertain,
+            "TCPM is switched by a block that block delete (`/`) may skip: whether X Y Z are \
+             part or machine coordinates depends on the block-delete switch, so the run is \
+             left as it is",
+        ))
+    } else if !rp.run.tcpm.is_on() && (frame.chain.is_none() || frame.inch || frame.incremental) {
+        Some((
+            UntouchedReason::NoTcpm,
+            if machine.chain.is_none() {
+                "no TCPM active (M128, TRAORI or G43.4) — X Y Z are machine coordinates; \
+                 changing rotary words alone would move the part under the tool, so the run is \
+                 left as it is (if the controller switches TCPM with other codes, or always \
+                 runs with it, say so in the machine file's [controller] section: tcpm_on, \
+                 tcpm_always; else give the machine's kinematic chain to patch it)"
+            } else if frame.chain.is_none() {
+                "no TCPM active and the work offset is unknown (the program states no datum \
+                 with values): X Y Z cannot be recomputed, so the run is left as it is \
+                 (give --work-offset X,Y,Z)"
             } else {
-                patch_path(work_path, machine, o)
+                "no TCPM active, in inch or incremental mode: X Y Z are not recomputed there, \
+                 so the run is left as it is"
+            },
+        ))
+    } else if frame.incremental {
+        Some((
+            UntouchedReason::Incremental,
+            "incremental mode (G91) — a changed value would shift every later position; \
+             polepatch patches absolute (G90) programs only; left as it is",
+        ))
+    } else {
+        None
+    }
+}
+
+/// Step 2.2: the zones of run `r`, left as it is for `left` (the reason and its message),
+/// reported only; the run among the untouched when it holds one.
+fn report_left(
+    lp: &LoadedProgram,
+    r: usize,
+    path: &Path,
+    machine: &Machine,
+    opts: &PatchOptions,
+    left: (UntouchedReason, &'static str),
+    report: &mut FileReport,
+) {
+    let (reason, message) = left;
+    match report_unpatched(path, machine, opts) {
+        Ok(zones) => {
+            if !zones.is_empty() {
+                report.zones.extend(zones.iter().map(|z| {
+                    let mut row = zone_row(lp, r, z);
+                    if let Some(why) = reason.zone_reason() {
+                        row.reason = why;
+                    }
+                    row
+                }));
+                report.untouched_runs.push(untouched(
+                    lp,
+                    r,
+                    reason,
+                    zones.len(),
+                    message.to_string(),
+                    opts.reach_deg(),
+                ));
             }
-        };
-        let mut patched = patch_with(&run_opts);
-        // The positioning move after a free end starts from the patched end: where that
-        // costs more time than the patch saves in the run (a re-selected end whose next
-        // rapid turns C by 180° more), the end is pinned instead when that is faster overall
-        // (issue 31: every move the patch changes is accounted for).
-        let rapid = |res: &polepatch_patcher::PatchResult| -> Option<(usize, f64, f64)> {
-            let next = end.next.as_ref()?;
-            let n = path.axes.len();
-            let (p0, c0) = (path.axes[n - 1][3], path.axes[n - 1][4]);
-            let (p1, c1) = (*res.p_deg.last()?, *res.c_deg.last()?);
-            Some((
-                next.line,
-                next.time_s(machine, p0, c0),
-                next.time_s(machine, p1, c1),
-            ))
-        };
-        let run_time = |res: &polepatch_patcher::PatchResult| -> f64 {
-            res.zones.iter().map(|z| z.after.time_s).sum::<f64>()
-                + rapid(res).map_or(0.0, |(_, _, after)| after)
-        };
+        }
+        Err(e) => report.untouched_runs.push(untouched(
+            lp,
+            r,
+            UntouchedReason::Invalid,
+            0,
+            e.to_string(),
+            opts.reach_deg(),
+        )),
+    }
+}
+
+/// Step 2.3: run `r`'s options (its end pose, its tool), and the path the patcher works on.
+fn run_options<'a>(
+    lp: &'a LoadedProgram,
+    r: usize,
+    path: &'a Path,
+    machine: &'a Machine,
+    styles: &Styles,
+    frame: &RunFrame,
+) -> RunPatch<'a> {
+    let rp = &lp.runs[r];
+    let end = lp.end_pose(r);
+    let mut opts = PatchOptions {
+        // Without TCPM the moves after the run are in machine coordinates: the last
+        // point keeps its values (X Y Z included).
+        keep_last_point: !rp.run.tcpm.is_on() || !end.free,
+        ..styles.opts.clone()
+    };
+    // The tool, and what it asks of the patch (crate::tool).
+    let tool = run_tool(lp, r, machine);
+    let mut tool_capped = false;
+    match tool.tool {
+        Some(t) if t.kind == ToolKind::Ball && tool.point == ToolPoint::Tip => {
+            opts.keep_centre = Some(KeepCentre {
+                radius_mm: t.diameter_mm / 2.0,
+                // Without TCPM the part-frame tips go through the chain, not to the
+                // file: kept exact there.
+                decimals: match (rp.run.tcpm.is_on(), frame.inch) {
+                    (false, _) => 9,
+                    (true, false) => styles.xyz_file_decimals,
+                    // 10⁻⁴ inch is 2.5 µm: one more.
+                    (true, true) => styles.xyz_file_decimals.max(MIN_INCH_XYZ_DECIMALS),
+                },
+                unit_mm: if frame.inch && rp.run.tcpm.is_on() {
+                    25.4
+                } else {
+                    1.0
+                },
+                s_is_length: rp.run.feed_mode != polepatch_nc::FeedMode::InverseTime,
+            });
+        }
+        Some(t) if t.kind != ToolKind::Ball => {
+            let cap = crate::tool::deviation_cap_deg(&t, lp.tool.surface_tolerance_mm);
+            if opts.max_deviation_deg.is_none_or(|c| cap <= c) {
+                opts.max_deviation_deg = Some(cap);
+                tool_capped = true;
+            }
+        }
+        _ => {}
+    }
+    // Without TCPM (and with a chain) the patcher works on the part-frame path.
+    let part_path = match (rp.run.tcpm, frame.chain) {
+        (Tcpm::Off, Some((ch, d))) => Some(machine_frame::part_frame_path(ch, machine, d, path)),
+        _ => None,
+    };
+    RunPatch {
+        lp,
+        r,
+        machine,
+        path,
+        part_path,
+        end,
+        tool,
+        tool_capped,
+        opts,
+    }
+}
+
+/// One run being patched: what steps 2.4 to 2.7 share.
+struct RunPatch<'a> {
+    lp: &'a LoadedProgram,
+    r: usize,
+    machine: &'a Machine,
+    /// The run's path, as the file gives it.
+    path: &'a Path,
+    /// The part-frame path of a run without TCPM (with a chain), which the patcher works
+    /// on.
+    part_path: Option<Path>,
+    /// What the blocks after the run allow its end.
+    end: EndPose,
+    /// The run's tool and the point its X Y Z state.
+    tool: RunTool,
+    /// The tool's cap on the orientation change is in force (a flat or bull-nose cutter).
+    tool_capped: bool,
+    /// The run's options.
+    opts: PatchOptions,
+}
+
+impl RunPatch<'_> {
+    /// The path the patcher works on.
+    fn work_path(&self) -> &Path {
+        self.part_path.as_ref().unwrap_or(self.path)
+    }
+
+    /// Step 2.4: the patch of the run with options `o`.
+    fn patch(&self, o: &PatchOptions) -> Result<PatchResult, PathError> {
+        if self.part_path.is_some() {
+            machine_frame::patch_part_frame(self.work_path(), self.machine, o)
+        } else {
+            patch_path(self.work_path(), self.machine, o)
+        }
+    }
+
+    /// The positioning move after a free end: its line and its time from the original end
+    /// and from the end of `res`, s.
+    fn rapid(&self, res: &PatchResult) -> Option<(usize, f64, f64)> {
+        let next = self.end.next.as_ref()?;
+        let path = self.path;
+        let n = path.axes.len();
+        let (p0, c0) = (path.axes[n - 1][3], path.axes[n - 1][4]);
+        let (p1, c1) = (*res.p_deg.last()?, *res.c_deg.last()?);
+        Some((
+            next.line,
+            next.time_s(self.machine, p0, c0),
+            next.time_s(self.machine, p1, c1),
+        ))
+    }
+
+    /// The time of `res`'s zones and of the positioning move after them, s.
+    fn run_time(&self, res: &PatchResult) -> f64 {
+        res.zones.iter().map(|z| z.after.time_s).sum::<f64>()
+            + self.rapid(res).map_or(0.0, |(_, _, after)| after)
+    }
+
+    /// Step 2.4: the patch, and the end's choice. The positioning move after a free end
+    /// starts from the patched end: where that costs more time than the patch saves in
+    /// the run (a re-selected end whose next rapid turns C by 180° more), the end is pinned
+    /// instead when that is faster overall (issue 31: every move the patch changes is
+    /// accounted for).
+    fn pin_end_if_faster(&mut self) -> Result<PatchResult, PathError> {
+        let mut patched = self.patch(&self.opts);
         if let Ok(res) = &patched
-            && !run_opts.keep_last_point
-            && rapid(res).is_some_and(|(_, before, after)| after > before + RAPID_TIME_TOL_S)
+            && !self.opts.keep_last_point
+            && self
+                .rapid(res)
+                .is_some_and(|(_, before, after)| after > before + RAPID_TIME_TOL_S)
         {
             let pinned_opts = PatchOptions {
                 keep_last_point: true,
-                ..run_opts.clone()
+                ..self.opts.clone()
             };
-            if let Ok(pinned) = patch_with(&pinned_opts)
-                && run_time(&pinned) + RAPID_TIME_TOL_S < run_time(res)
+            if let Ok(pinned) = self.patch(&pinned_opts)
+                && self.run_time(&pinned) + RAPID_TIME_TOL_S < self.run_time(res)
             {
                 patched = Ok(pinned);
-                run_opts = pinned_opts;
+                self.opts = pinned_opts;
             }
         }
-        // A ball programmed at its tip keeps its centre at the points; between them its
-        // path may not leave the original's line by more than the chord tolerance (where
-        // the original block stayed within it). Where it would, the patch is solved again
-        // with its orientation change capped in proportion (the centre's excursion between
-        // two points grows with the change), up to CENTRE_PATH_RETRIES times.
+        patched
+    }
+
+    /// Step 2.5: the report rows of `result`'s zones, appended to `report`; `centre_capped`:
+    /// the orientation change was capped for a kept ball centre's path.
+    fn zone_rows(&self, result: &PatchResult, centre_capped: bool, report: &mut FileReport) {
+        let (lp, r) = (self.lp, self.r);
+        let rp = &lp.runs[r];
+        let first_row = report.zones.len();
+        report.zones.extend(result.zones.iter().map(|z| {
+            let mut row = zone_row(lp, r, z);
+            tool_fields(
+                &mut row,
+                &self.tool,
+                z,
+                self.work_path(),
+                result,
+                self.machine,
+                self.tool_capped,
+            );
+            if centre_capped && z.reason == polepatch_patcher::Reason::DeviationCap {
+                row.reason = ZoneReason::CentrePath;
+            }
+            row.end_pose = Some(if self.opts.keep_last_point {
+                EndFreedom::Pinned
+            } else {
+                EndFreedom::Free
+            });
+            row.end_pose_line = if rp.run.tcpm.is_on() {
+                self.end.decided_line
+            } else {
+                None
+            };
+            row
+        }));
+        if rp.run.tcpm.is_on()
+            && let (Some((line, before, after)), Some(last)) =
+                (self.rapid(result), report.zones[first_row..].last_mut())
+        {
+            last.rapid_line = Some(line);
+            last.rapid_time_before_s = Some(before);
+            last.rapid_time_after_s = Some(if self.opts.keep_last_point {
+                before
+            } else {
+                after
+            });
+        }
+    }
+
+    /// Step 2.5: the rows of `patched`, solved again with the orientation change capped
+    /// while a kept ball centre leaves its path between the points by more than the chord
+    /// tolerance (where the original block stayed within it; the centre's excursion
+    /// between two points grows with the change), up to CENTRE_PATH_RETRIES times. The
+    /// patch and the run's first row; `None` when the run keeps its values (reported
+    /// untouched).
+    fn rows_within_centre_path(
+        &mut self,
+        mut patched: Result<PatchResult, PathError>,
+        file_opts: &PatchOptions,
+        report: &mut FileReport,
+    ) -> Option<(PatchResult, usize)> {
+        let (lp, r) = (self.lp, self.r);
         let chord_limit = lp.chord_tolerance_mm + machine_frame::TIP_TOLERANCE_MM;
         let mut centre_capped = false;
         let mut retries = 0;
-        let (result, first_row) = loop {
+        loop {
             let result = match patched {
                 Ok(res) => res,
                 Err(e) => {
                     report.untouched_runs.push(untouched(
                         lp,
-                        &pole,
                         r,
                         UntouchedReason::Invalid,
                         0,
                         e.to_string(),
-                        opts.reach_deg(),
+                        file_opts.reach_deg(),
                     ));
-                    continue 'runs;
+                    return None;
                 }
             };
             let first_row = report.zones.len();
-            report.zones.extend(result.zones.iter().map(|z| {
-                let mut row = zone_row(lp, r, z);
-                tool_fields(&mut row, &rt, z, work_path, &result, machine, tool_capped);
-                if centre_capped && z.reason == polepatch_patcher::Reason::DeviationCap {
-                    row.reason = "centre_path";
-                }
-                row.end_pose = if run_opts.keep_last_point {
-                    "pinned"
-                } else {
-                    "free"
-                };
-                row.end_pose_line = if rp.run.tcpm.is_on() {
-                    end.decided_line
-                } else {
-                    None
-                };
-                row
-            }));
-            if rp.run.tcpm.is_on()
-                && let (Some((line, before, after)), Some(last)) =
-                    (rapid(&result), report.zones[first_row..].last_mut())
-            {
-                last.rapid_line = Some(line);
-                last.rapid_time_before_s = Some(before);
-                last.rapid_time_after_s = Some(if run_opts.keep_last_point {
-                    before
-                } else {
-                    after
-                });
-            }
+            self.zone_rows(&result, centre_capped, report);
             let rows = &report.zones[first_row..];
             let worst_chord = rows
                 .iter()
                 .filter_map(|z| z.centre_chord_mm)
                 .fold(0.0, f64::max);
             if worst_chord <= chord_limit {
-                break (result, first_row);
+                return Some((result, first_row));
             }
             let worst_dev = rows.iter().map(|z| z.max_deviation_deg).fold(0.0, f64::max);
             if retries < CENTRE_PATH_RETRIES && worst_dev > 0.0 {
                 retries += 1;
                 let cap = worst_dev * (chord_limit / worst_chord) * CENTRE_PATH_CAP_SAFETY;
-                run_opts.max_deviation_deg =
-                    Some(run_opts.max_deviation_deg.map_or(cap, |c| c.min(cap)));
+                self.opts.max_deviation_deg =
+                    Some(self.opts.max_deviation_deg.map_or(cap, |c| c.min(cap)));
                 centre_capped = true;
                 report.zones.truncate(first_row);
-                patched = patch_with(&run_opts);
+                patched = self.patch(&self.opts);
                 continue;
             }
             let row = rows
@@ -383,96 +673,73 @@ pub fn patch_program(
             );
             for row in &mut report.zones[first_row..] {
                 row.not_written();
-                row.reason = "centre_path";
+                row.reason = ZoneReason::CentrePath;
             }
             report.untouched_runs.push(untouched(
                 lp,
-                &pole,
                 r,
                 UntouchedReason::CentrePath,
                 result.zones.len(),
                 why,
-                opts.cone_deg,
+                file_opts.cone_deg,
             ));
-            continue 'runs;
-        };
-        let first_edit = edits.len();
-        let mut run_edits: Vec<Edit> = Vec::new();
+            return None;
+        }
+    }
 
-        if let Some((ch, d)) = chain {
-            match through_chain(
-                lp,
-                r,
-                path,
-                work_path,
-                &result,
-                machine,
-                ch,
-                d,
-                &opts,
-                xyz_decimals,
-                lp.chord_tolerance_mm,
-            ) {
-                Ok(xyz) => run_edits = xyz,
-                Err(why) => {
-                    for row in &mut report.zones[first_row..] {
-                        row.not_written();
-                        row.reason = polepatch_patcher::Reason::NotPatched.name();
-                    }
-                    report.untouched_runs.push(untouched(
-                        lp,
-                        &pole,
-                        r,
-                        UntouchedReason::MachineFrame,
-                        result.zones.len(),
-                        why,
-                        opts.reach_deg(),
-                    ));
+    /// Step 2.7: a ball's centre kept under TCPM: the tips the patcher rewrote, in the
+    /// file's unit and decimals; blocks after the run that restate its last point follow
+    /// it.
+    fn centre_edits(&self, result: &PatchResult, edits: &mut Vec<Edit>) {
+        let rp = &self.lp.runs[self.r];
+        let program = &self.lp.program;
+        let (Some(keep), true) = (&self.opts.keep_centre, rp.run.tcpm.is_on()) else {
+            return;
+        };
+        let n = rp.run.len();
+        for k in 1..n {
+            for (i, letter) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
+                if !result.xyz_changed[k][i] {
                     continue;
                 }
-            }
-        }
-        edits.append(&mut run_edits);
-        // A ball's centre kept under TCPM: the tips the patcher rewrote, in the file's unit
-        // and decimals; blocks after the run that restate its last point follow it.
-        if let (Some(keep), true) = (&run_opts.keep_centre, rp.run.tcpm.is_on()) {
-            let n = rp.run.len();
-            for k in 1..n {
-                for (i, letter) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
-                    if !result.xyz_changed[k][i] {
-                        continue;
-                    }
-                    let value = result.xyz_mm[k][i] / keep.unit_mm;
-                    edits.push(Edit {
-                        block: rp.run.blocks[k],
-                        letter,
-                        value,
-                        decimals: result.xyz_decimals,
-                    });
-                    if k == n - 1 && !run_opts.keep_last_point {
-                        for &b in &end.restate {
-                            if program.block_words(b).iter().any(|w| w.letter == letter) {
-                                edits.push(Edit {
-                                    block: b,
-                                    letter,
-                                    value,
-                                    decimals: result.xyz_decimals,
-                                });
-                            }
+                let value = result.xyz_mm[k][i] / keep.unit_mm;
+                edits.push(Edit {
+                    block: rp.run.blocks[k],
+                    letter,
+                    value,
+                    decimals: result.xyz_decimals,
+                });
+                if k == n - 1 && !self.opts.keep_last_point {
+                    for &b in &self.end.restate {
+                        if program.block_words(b).iter().any(|w| w.letter == letter) {
+                            edits.push(Edit {
+                                block: b,
+                                letter,
+                                value,
+                                decimals: result.xyz_decimals,
+                            });
                         }
                     }
                 }
             }
         }
+    }
+
+    /// Step 2.7: the changed primary-axis and C words, and the decimals written for them.
+    /// The run ends on new values: the blocks after it that restated its last values
+    /// restate the new ones ([`crate::end_pose`]).
+    fn rotary_edits(&self, result: &PatchResult, out: &mut Written) {
+        let rp = &self.lp.runs[self.r];
+        let program = &self.lp.program;
         let letters = [
             (
-                lp.primary_letter,
+                self.lp.primary_letter,
                 &result.p_deg,
                 &result.p_changed,
                 result.p_decimals,
             ),
             (
-                lp.pole_letter,
+                self.lp.pole_letter,
                 &result.c_deg,
                 &result.c_changed,
                 result.c_decimals,
@@ -488,25 +755,23 @@ pub fn patch_program(
                     debug_assert!(false, "patcher changed the start point of a run");
                     continue;
                 }
-                if letter == lp.pole_letter {
-                    written_c = written_c.max(decimals);
+                if letter == self.lp.pole_letter {
+                    out.written_c = out.written_c.max(decimals);
                 } else {
-                    written_p = written_p.max(decimals);
+                    out.written_p = out.written_p.max(decimals);
                 }
-                edits.push(Edit {
+                out.edits.push(Edit {
                     block: rp.run.blocks[k],
                     letter,
                     value: values[k],
                     decimals,
                 });
             }
-            // The run ends on new values: the blocks after it that restated its last
-            // values restate the new ones (crate::end_pose).
             let n = rp.run.len();
-            if !run_opts.keep_last_point && changed[n - 1] {
-                for &b in &end.restate {
+            if !self.opts.keep_last_point && changed[n - 1] {
+                for &b in &self.end.restate {
                     if program.block_words(b).iter().any(|w| w.letter == letter) {
-                        edits.push(Edit {
+                        out.edits.push(Edit {
                             block: b,
                             letter,
                             value: values[n - 1],
@@ -516,56 +781,61 @@ pub fn patch_program(
                 }
             }
         }
-        run_edit_ranges.push((r, first_row, first_edit..edits.len()));
     }
-    let file_decimals = |l: u8| match l {
-        b'X' | b'Y' | b'Z' => style_of(l).decimals,
-        l if l == lp.pole_letter => c_style.decimals,
-        _ => p_style.decimals,
-    };
-    // Inside a run, a point that relied on a modal value keeps it; after a run only the
-    // blocks that restate its last values are written: its end point only moves when what
-    // follows does not depend on the pose (crate::end_pose).
-    let run_of: std::collections::HashMap<usize, usize> = lp
-        .runs
+}
+
+/// The run of each block inside a run (its start excluded).
+fn run_of_blocks(lp: &LoadedProgram) -> HashMap<usize, usize> {
+    lp.runs
         .iter()
         .enumerate()
         .flat_map(|(r, rp)| rp.run.blocks.iter().skip(1).map(move |&b| (b, r)))
-        .collect();
+        .collect()
+}
+
+/// Step 3: inside a run, a point that relied on a modal value keeps it; after a run only
+/// the blocks that restate its last values are written: its end point only moves when
+/// what follows does not depend on the pose ([`crate::end_pose`]).
+fn restore_modal(
+    lp: &LoadedProgram,
+    styles: &Styles,
+    run_of: &HashMap<usize, usize>,
+    edits: &mut Vec<Edit>,
+) {
+    let file_decimals = |l: u8| match l {
+        b'X' | b'Y' | b'Z' => styles.of(lp, l).decimals,
+        l if l == lp.pole_letter => styles.c.decimals,
+        _ => styles.p.decimals,
+    };
     let same_run = |edited: usize, b: usize| {
         run_of
             .get(&edited)
             .is_some_and(|r| run_of.get(&b) == Some(r))
     };
-    polepatch_nc::restore_modal(program, &mut edits, &file_decimals, &same_run);
-    let edits = direction_forms(
-        lp,
-        edits,
-        &run_edit_ranges,
-        &run_of,
-        &mut report,
-        &opts,
-        &pole,
-    );
-    let mut edits = edits;
-    edits.sort_by_key(|e| (e.block, e.letter));
-    report.words_changed = edits.len();
-    // The file's decimals are reported where a run of the stretch comes near the pole
-    // (one with only runs that cannot be analysed says nothing of them).
-    let near = lp.runs.iter().any(|rp| {
-        rp.path.as_ref().is_ok_and(|p| {
-            p.axes
-                .iter()
-                .any(|q| pole.near(Some(q[pi]), opts.reach_deg()))
-        })
-    });
+    polepatch_nc::restore_modal(&lp.program, edits, &file_decimals, &same_run);
+}
+
+/// Step 5: the words changed (`words`), and the file's decimals and those written, where a
+/// run of the stretch comes near the pole (one with only runs that cannot be analysed
+/// says nothing of them).
+fn finish_report(
+    lp: &LoadedProgram,
+    styles: &Styles,
+    out: &Written,
+    words: usize,
+    report: &mut FileReport,
+) {
+    report.words_changed = words;
+    let near = lp
+        .runs
+        .iter()
+        .any(|rp| rp.path.as_ref().is_ok_and(|p| near_pole(lp, p, &styles.opts)));
     if near {
-        report.file_c_decimals = Some(c_style.decimals);
-        report.written_c_decimals = Some(written_c);
-        report.file_primary_decimals = Some(p_style.decimals);
-        report.written_primary_decimals = Some(written_p);
+        report.file_c_decimals = Some(styles.c.decimals);
+        report.written_c_decimals = Some(out.written_c);
+        report.file_primary_decimals = Some(styles.p.decimals);
+        report.written_primary_decimals = Some(out.written_p);
     }
-    (edits, report)
 }
 
 /// Rotary words in a Sinumerik direction form (`C=DC(…)`, `C=ACP(…)`, `C=ACN(…)`): the
@@ -580,7 +850,6 @@ fn direction_forms(
     run_of: &std::collections::HashMap<usize, usize>,
     report: &mut FileReport,
     opts: &PatchOptions,
-    pole: &crate::program::PoleDistance,
 ) -> Vec<Edit> {
     let program = &lp.program;
     // The run each edit belongs to (words restored by `restore_modal` are in its run).
@@ -635,11 +904,10 @@ fn direction_forms(
             .count();
         for row in &mut report.zones[*first_row..*first_row + zones] {
             row.not_written();
-            row.reason = reason.zone_reason().unwrap_or("not_patched");
+            row.reason = reason.zone_reason().unwrap_or(ZoneReason::NotPatched);
         }
         report.untouched_runs.push(untouched(
             lp,
-            pole,
             run,
             reason,
             zones,
@@ -856,12 +1124,12 @@ fn tool_fields(
     tool_capped: bool,
 ) {
     use polepatch_kinematics::forward;
-    row.tool = rt.tool.map_or("unknown".to_string(), |t| t.describe());
+    row.tool = rt.tool.map_or(ZoneTool::Unknown, ZoneTool::Known);
     row.tool_source = rt.tool_source.clone();
-    row.tool_point = rt.point.name();
+    row.tool_point = Some(rt.point);
     row.tool_point_source = rt.point_source.clone();
     if tool_capped && z.reason == polepatch_patcher::Reason::DeviationCap {
-        row.reason = "tool_limited";
+        row.reason = ZoneReason::ToolLimited;
     }
     let Some(tool) = rt.tool else { return };
     let at = |k: usize, t: f64| -> ([f64; 3], [f64; 3], [f64; 3], [f64; 3]) {
@@ -944,7 +1212,6 @@ fn problem_reason(p: &RunProblem) -> UntouchedReason {
 
 fn untouched(
     lp: &LoadedProgram,
-    pole: &crate::program::PoleDistance,
     r: usize,
     reason: UntouchedReason,
     zones: usize,
@@ -961,7 +1228,7 @@ fn untouched(
             .run
             .pos
             .iter()
-            .any(|p| pole.near(p[pi], cone_deg)),
+            .any(|p| lp.pole.near(p[pi], cone_deg)),
         message,
     }
 }
@@ -973,7 +1240,7 @@ fn zone_row(lp: &LoadedProgram, run: usize, z: &ZoneReport) -> ZoneRow {
         file: lp.name.clone(),
         run: lp.run_number(run),
         lines: [lp.line_of(run, z.first), lp.line_of(run, z.last)],
-        kind: zone_kind_name(z.kind),
+        kind: z.kind,
         min_abs_primary_deg: z.min_abs_primary_deg,
         before: FiguresRow::new(&z.before, pl),
         after: FiguresRow::new(&z.after, pl),
@@ -984,11 +1251,11 @@ fn zone_row(lp: &LoadedProgram, run: usize, z: &ZoneReport) -> ZoneRow {
         branch_reselected: z.reselected_points > 0 || z.method == Method::Reselect,
         reselected_points: z.reselected_points,
         patch_length_mm: z.patch_length_mm,
-        outcome: outcome_name(z.outcome),
-        reason: z.reason.name(),
-        end_pose: "-",
+        outcome: z.outcome,
+        reason: z.reason.into(),
+        end_pose: None,
         end_pose_line: None,
-        method: method_name(z.method),
+        method: z.method,
         qp_status: z.qp.status,
         qp_iterations: z.qp.iterations,
         qp_solves: z.qp.solves,
@@ -996,10 +1263,10 @@ fn zone_row(lp: &LoadedProgram, run: usize, z: &ZoneReport) -> ZoneRow {
         decimals: z.decimals,
         primary_decimals: z.p_decimals,
         c_offset_deg: z.c_offset_deg,
-        feed_mode: feed_mode_name(lp.runs[run].run.feed_mode),
-        tool: "-".to_string(),
+        feed_mode: lp.runs[run].run.feed_mode,
+        tool: ZoneTool::NotPatched,
         tool_source: String::new(),
-        tool_point: "-",
+        tool_point: None,
         tool_point_source: String::new(),
         centre_shift_per_mm_radius: crate::tool::centre_shift_per_mm_radius(z.max_deviation_deg),
         max_cutter_shift_mm: None,

@@ -197,6 +197,8 @@ pub struct LoadedProgram {
     pub notes: crate::notes::Notes,
     /// The caller's tool options ([`crate::PatchOptions::tool`]).
     pub tool: crate::tool::ToolOptions,
+    /// The machine's distance from the pole.
+    pub(crate) pole: PoleDistance,
 }
 
 /// What a stretch of a file ([`LoadedProgram::window`]) needs from the rest of the file,

@@ -13,7 +13,7 @@
 
 use crate::error::Error;
 use crate::program::LoadedProgram;
-use crate::report::{SimRun, SimTotals, SimulateReport};
+use crate::report::{SimFrame, SimRun, SimTotals, SimulateReport};
 use polepatch_kinematics::Machine;
 use polepatch_nc::RunBreak;
 use polepatch_patcher::Path;
@@ -93,7 +93,7 @@ fn run_inputs(lp: &LoadedProgram, machine: &Machine) -> Vec<RunIn> {
                 min_feed_mm_min: None,
                 min_feed_line: None,
                 joined: false,
-                frame: "program",
+                frame: SimFrame::Program,
             };
             let path = match &rp.path {
                 Err(problem) => {
@@ -114,7 +114,7 @@ fn run_inputs(lp: &LoadedProgram, machine: &Machine) -> Vec<RunIn> {
                         ))
                     });
                     if frame.is_some() {
-                        row.frame = "machine";
+                        row.frame = SimFrame::Machine;
                     }
                     Some(frame.unwrap_or_else(|| path.clone()))
                 }

@@ -1134,6 +1134,7 @@ fn loaded(bytes: &[u8], hand: InHand, sv: &Survey, l: usize, rd: &Reading<'_>) -
         },
         notes: crate::notes::Notes::new(),
         tool: rd.tool.clone(),
+        pole: rd.pole.clone(),
     }
 }
 

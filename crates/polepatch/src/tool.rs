@@ -178,6 +178,12 @@ pub enum ToolPoint {
     Centre,
 }
 
+impl std::fmt::Display for ToolPoint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 impl ToolPoint {
     /// `tip` or `centre` (also `center`).
     pub fn parse(text: &str) -> Result<ToolPoint, String> {

@@ -19,5 +19,10 @@ fn a_utf8_bom_before_the_program_is_read_and_kept() {
     assert_eq!(&out_bom[..3], b"\xEF\xBB\xBF");
     assert_eq!(&out_bom[3..], &out_plain[..]);
     assert_eq!(rep_bom.zones.len(), rep_plain.zones.len());
-    assert!(rep_bom.zones.iter().all(|z| z.outcome == "reached"));
+    assert!(
+        rep_bom
+            .zones
+            .iter()
+            .all(|z| z.outcome == polepatch::Outcome::Reached)
+    );
 }

@@ -66,7 +66,10 @@ fn patches_rotary_words_only(name: &str, bytes: &[u8], m: &Machine, o: &PatchOpt
     let (out, report) = patch_nc(bytes, m, o).unwrap();
     assert!(!report.zones.is_empty(), "{name}: no zone found");
     assert!(
-        report.zones.iter().all(|z| z.outcome == "reached"),
+        report
+            .zones
+            .iter()
+            .all(|z| z.outcome == polepatch::Outcome::Reached),
         "{name}: {:?}",
         report.zones
     );
@@ -365,7 +368,12 @@ fn creo_comments_and_blank_separated_columns_post() {
             let (_, report) = post_cl(&prog, &ucp710(), &o).unwrap();
             let report = report.expect("patched");
             assert!(!report.zones.is_empty());
-            assert!(report.zones.iter().all(|z| z.outcome == "reached"));
+            assert!(
+                report
+                    .zones
+                    .iter()
+                    .all(|z| z.outcome == polepatch::Outcome::Reached)
+            );
         }
     }
 }
@@ -434,7 +442,7 @@ fn corners_near_the_pole_are_zones_by_default() {
         let (_, report) = patch_nc(&bytes, &m, &opts("corners")).unwrap();
         assert!(!report.zones.is_empty(), "{}", m.name);
         for z in &report.zones {
-            assert_eq!(z.outcome, "reached", "{}: {z:?}", m.name);
+            assert_eq!(z.outcome, polepatch::Outcome::Reached, "{}: {z:?}", m.name);
             assert!(z.min_abs_primary_deg > 5.0, "{z:?}");
         }
         patches_rotary_words_only("corners", &bytes, &m, &opts("corners"));

@@ -136,7 +136,7 @@ fn without_tcpm_a_rewrite_that_leaves_the_line_between_points_is_not_written() {
         "{}",
         u.message
     );
-    assert_eq!(report.zones[0].outcome, "unchanged");
+    assert_eq!(report.zones[0].outcome, polepatch::Outcome::Unchanged);
 }
 
 /// The generated near-pole passes (short blocks) written without TCPM for the example
@@ -234,7 +234,12 @@ fn without_tcpm_x_y_z_change_with_the_rotary_axes_and_the_tool_tip_stays() {
         report.untouched_runs
     );
     assert_eq!(report.zones.len(), 1);
-    assert_eq!(report.zones[0].outcome, "reached", "{:?}", report.zones[0]);
+    assert_eq!(
+        report.zones[0].outcome,
+        polepatch::Outcome::Reached,
+        "{:?}",
+        report.zones[0]
+    );
     // X Y Z and C change together, block by block.
     let before = load_nc(&input, "in", &machine, None).unwrap();
     let after = load_nc(&out, "out", &machine, None).unwrap();
@@ -326,7 +331,7 @@ fn without_tcpm_and_without_a_work_offset_the_run_is_left() {
     };
     let (out, report) = patch_nc(text.as_bytes(), &machine, &opts).unwrap();
     assert_ne!(out, text.as_bytes());
-    assert_eq!(report.zones[0].outcome, "reached");
+    assert_eq!(report.zones[0].outcome, polepatch::Outcome::Reached);
 }
 
 /// The set-up: the part 50 mm off the C axis at the zone (the C axis put at
@@ -363,7 +368,7 @@ fn analyze_reports_machine_frame_linear_axes_that_follow_c() {
     assert!(plain.runs[0].machine_frame.is_none());
     // The TCPM patch frees C and, with it, the machine-frame X and Y: accepted.
     let (out, rep) = patch_nc(&sing(), &machine, &PatchOptions::default()).unwrap();
-    assert_eq!(rep.zones[0].outcome, "reached");
+    assert_eq!(rep.zones[0].outcome, polepatch::Outcome::Reached);
     let after = analyze_nc(&out, &machine, &AnalyzeOptions::default()).unwrap();
     let ma = after.runs[0].machine_frame.as_ref().unwrap();
     assert!(ma.axis_min_ratio["Y"] > 0.7, "{:?}", ma.axis_min_ratio);
@@ -395,7 +400,7 @@ fn a_patch_that_slows_a_linear_axis_in_the_machine_frame_is_not_written() {
     let u = &report.untouched_runs[0];
     assert_eq!(u.reason, UntouchedReason::MachineFrame);
     assert!(u.message.contains("in the machine frame"), "{}", u.message);
-    assert_eq!(report.zones[0].outcome, "unchanged");
+    assert_eq!(report.zones[0].outcome, polepatch::Outcome::Unchanged);
 }
 
 /// The work offset is taken only where it is known for certain.
@@ -459,7 +464,10 @@ fn a_transformed_frame_leaves_the_run() {
             let u = &report.untouched_runs[0];
             assert_eq!(u.reason, UntouchedReason::FrameTransformed, "{code}");
             assert!(
-                report.zones.iter().all(|z| z.reason == "frame_transformed"),
+                report
+                    .zones
+                    .iter()
+                    .all(|z| z.reason == polepatch::ZoneReason::FrameTransformed),
                 "{code}"
             );
         }

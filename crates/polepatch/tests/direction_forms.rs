@@ -82,7 +82,10 @@ fn patched_in_form(name: &str, only_c: bool) -> Vec<u8> {
     let (out, report) = patch_nc(&bytes, &ucp710(), &opts(only_c)).unwrap();
     assert!(!report.zones.is_empty(), "{name}: no zone");
     assert!(
-        report.zones.iter().all(|z| z.outcome == "reached"),
+        report
+            .zones
+            .iter()
+            .all(|z| z.outcome == polepatch::Outcome::Reached),
         "{name}: {:?} {:?}",
         report.zones,
         report.untouched_runs
@@ -185,7 +188,12 @@ fn acp_and_acn_keep_their_direction_or_refuse_the_zone() {
     let (out, report) = patch_nc(&bytes, &ucp710(), &opts(false)).unwrap();
     assert_eq!(out, bytes, "a zone ACP/ACN cannot make was written");
     assert_eq!(report.zones.len(), 2);
-    assert!(report.zones.iter().all(|z| z.reason == "direction_form"));
+    assert!(
+        report
+            .zones
+            .iter()
+            .all(|z| z.reason == polepatch::ZoneReason::DirectionForm)
+    );
     let refused: Vec<_> = report
         .untouched_runs
         .iter()

@@ -84,9 +84,9 @@ fn positioning_above_the_clearance_frees_the_end_and_rewrites_the_restating_retr
         let (out, report) = patch_both_ways(&text, &m);
         assert_eq!(report.zones.len(), 1, "{report:?}");
         let z = &report.zones[0];
-        assert_eq!(z.end_pose, "free", "{z:?}");
+        assert_eq!(z.end_pose, Some(polepatch::EndFreedom::Free), "{z:?}");
         assert_eq!(z.end_pose_line, Some(position_line), "{z:?}");
-        assert_eq!(z.reason, "reselected", "{z:?}");
+        assert_eq!(z.reason, polepatch::ZoneReason::Reselected, "{z:?}");
         assert!(z.max_deviation_deg < 1e-3, "{z:?}");
         let out = String::from_utf8(out).unwrap();
         let (before, after) = (
@@ -135,9 +135,9 @@ fn positioning_below_the_clearance_pins_the_end() {
     let (out, report) = patch_both_ways(&text, &m);
     assert_eq!(report.zones.len(), 1, "{report:?}");
     let z = &report.zones[0];
-    assert_eq!(z.end_pose, "pinned", "{z:?}");
+    assert_eq!(z.end_pose, Some(polepatch::EndFreedom::Pinned), "{z:?}");
     assert_eq!(z.end_pose_line, Some(position_line), "{z:?}");
-    assert_ne!(z.reason, "reselected", "{z:?}");
+    assert_ne!(z.reason, polepatch::ZoneReason::Reselected, "{z:?}");
     // Nothing after the run is written.
     let last_run_line = position_line - 2;
     for (a, b) in text

@@ -49,7 +49,10 @@ fn check(label: &str, text: &str, m: &Machine, want: Want) -> FileReport {
         Want::Patched => {
             assert_ne!(out, text.as_bytes(), "{label}: patched");
             assert!(
-                report.zones.iter().all(|z| z.outcome == "reached"),
+                report
+                    .zones
+                    .iter()
+                    .all(|z| z.outcome == polepatch::Outcome::Reached),
                 "{label}: {:#?}",
                 report.zones
             );
@@ -69,12 +72,14 @@ fn check(label: &str, text: &str, m: &Machine, want: Want) -> FileReport {
                 "{label}: {:#?}",
                 report.untouched_runs
             );
-            let zone_reason = reason.zone_reason().unwrap_or("not_patched");
+            let zone_reason = reason
+                .zone_reason()
+                .unwrap_or(polepatch::ZoneReason::NotPatched);
             assert!(
                 report
                     .zones
                     .iter()
-                    .all(|z| z.outcome == "unchanged" && z.reason == zone_reason),
+                    .all(|z| z.outcome == polepatch::Outcome::Unchanged && z.reason == zone_reason),
                 "{label}: {:#?}",
                 report.zones
             );

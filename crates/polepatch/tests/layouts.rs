@@ -73,7 +73,7 @@ fn head_table_and_head_head_patch_a_planted_pass_with_the_right_deviation() {
             polepatch::patch_nc(input.as_bytes(), &m, &PatchOptions::default()).unwrap();
         assert_eq!(report.zones.len(), 1, "{file}");
         let z = &report.zones[0];
-        assert_eq!(z.outcome, "reached", "{file}: {z:?}");
+        assert_eq!(z.outcome, polepatch::Outcome::Reached, "{file}: {z:?}");
         assert!(z.after.overall_ratio >= 1.0 - 1e-3, "{file}: {z:?}");
         let out = String::from_utf8(out).unwrap();
         let (before, after) = (rotary_per_line(&input), rotary_per_line(&out));

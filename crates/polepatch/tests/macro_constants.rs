@@ -54,12 +54,12 @@ fn a_macro_constant_feed_is_analysed_at_its_feed() {
         "{:?}",
         first.lines
     );
-    assert_eq!(first.outcome, "reached", "{first:?}");
+    assert_eq!(first.outcome, polepatch::Outcome::Reached, "{first:?}");
     assert!(first.before.c_ratio < 0.1);
     // The second pass holds `C#105` where the patch would change C: refused by name.
     let second = &report.zones[1];
-    assert_eq!(second.outcome, "unchanged");
-    assert_eq!(second.reason, "macro_variable");
+    assert_eq!(second.outcome, polepatch::Outcome::Unchanged);
+    assert_eq!(second.reason, polepatch::ZoneReason::MacroVariable);
     let refused = report
         .untouched_runs
         .iter()

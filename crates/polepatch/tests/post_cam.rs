@@ -496,7 +496,11 @@ fn posted_cam_programs_patch_like_any_program() {
             let report = report.unwrap();
             let outcomes: Vec<_> = report.zones.iter().map(|z| z.outcome).collect();
             if name.starts_with("nx") {
-                assert_eq!(outcomes, ["reached"], "{name} {dialect:?}");
+                assert_eq!(
+                    outcomes,
+                    [polepatch::Outcome::Reached],
+                    "{name} {dialect:?}"
+                );
             } else {
                 assert!(outcomes.is_empty(), "{name} {dialect:?}: {outcomes:?}");
             }

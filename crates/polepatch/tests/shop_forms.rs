@@ -7,7 +7,7 @@
 
 use polepatch::kinematics::{Controller, Machine};
 use polepatch::nc::modal::{A, C};
-use polepatch::nc::{Dialect, parse};
+use polepatch::nc::{Dialect, FeedMode, parse};
 use polepatch::{FileReport, PatchOptions, UntouchedReason, patch_nc};
 use std::path::PathBuf;
 
@@ -78,7 +78,12 @@ fn every_form_patches_like_its_g94_iso_twin() {
         let twin = shop(&format!("{stem}-fanuc-g94.nc"));
         let (twin_out, twin_report) = patched(&twin, &ucp);
         assert!(!twin_report.zones.is_empty(), "{stem}: the twin has a zone");
-        assert!(twin_report.zones.iter().all(|z| z.outcome == "reached"));
+        assert!(
+            twin_report
+                .zones
+                .iter()
+                .all(|z| z.outcome == polepatch::Outcome::Reached)
+        );
         let want = pass_values(&twin_out);
         for (form, machine) in [
             ("conv-function-tcpm.H", ucp.clone()),
@@ -115,7 +120,15 @@ fn every_form_patches_like_its_g94_iso_twin() {
                     );
                 }
                 let g93 = form.contains("g93");
-                assert_eq!(z.feed_mode, if g93 { "G93" } else { "G94" }, "{name}");
+                assert_eq!(
+                    z.feed_mode,
+                    if g93 {
+                        FeedMode::InverseTime
+                    } else {
+                        FeedMode::PerMinute
+                    },
+                    "{name}"
+                );
             }
             assert_eq!(
                 pass_values(&out),
@@ -187,7 +200,7 @@ fn equation_6_on_g93_is_g94_at_the_block_feeds() {
     let (a, b) = (cut(&g93), cut(&g94));
     assert_eq!(a.len(), 1);
     assert_eq!(b.len(), 1);
-    assert_eq!(a[0].feed_mode, "G93");
+    assert_eq!(a[0].feed_mode, FeedMode::InverseTime);
     assert_eq!(a[0].feed_mm_min, Some(2000.0));
     let (fa, fb) = (
         a[0].figures.as_ref().unwrap(),
@@ -318,7 +331,7 @@ fn a_conversational_fragment_with_an_unstated_start_is_patched() {
         report.untouched_runs
     );
     assert_eq!(report.zones.len(), 1);
-    assert_eq!(report.zones[0].outcome, "reached");
+    assert_eq!(report.zones[0].outcome, polepatch::Outcome::Reached);
     assert_eq!(
         without_rotary_values(&out),
         without_rotary_values(text.as_bytes())

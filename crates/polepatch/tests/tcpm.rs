@@ -45,7 +45,7 @@ fn sing_without_m128_is_left_byte_identical_and_reported() {
         // The zone is still reported, as below feed and unchanged.
         assert!(!report.zones.is_empty());
         for z in &report.zones {
-            assert_eq!(z.outcome, "unchanged");
+            assert_eq!(z.outcome, polepatch::Outcome::Unchanged);
             assert_eq!(z.points_modified, 0);
             assert!(z.before.c_ratio < 1.0);
         }
@@ -64,7 +64,12 @@ fn sing_with_m128_is_patched() {
         "{:?}",
         report.untouched_runs
     );
-    assert!(report.zones.iter().all(|z| z.outcome == "reached"));
+    assert!(
+        report
+            .zones
+            .iter()
+            .all(|z| z.outcome == polepatch::Outcome::Reached)
+    );
 }
 
 /// TCPM switched off inside the program (M129 before the cut) leaves that run alone; the

@@ -15,7 +15,7 @@
 use polepatch::kinematics::{Machine, forward};
 use polepatch::post::{PostOptions, post_cl, read_cl, tool_from_cl};
 use polepatch::tool::{SURFACE_TOLERANCE_MM, Tool, ToolKind, ToolOptions, ToolPoint};
-use polepatch::{FileReport, PatchOptions, patch_nc};
+use polepatch::{FileReport, PatchOptions, ZoneTool, patch_nc};
 use std::path::PathBuf;
 
 fn root() -> PathBuf {
@@ -230,7 +230,13 @@ fn xyz_identical(before: &[u8], after: &[u8], what: &str) {
 fn all_reached(report: &FileReport, what: &str) {
     assert!(!report.zones.is_empty(), "{what}: zones");
     for z in &report.zones {
-        assert_eq!(z.outcome, "reached", "{what}: {:?} {}", z.lines, z.reason);
+        assert_eq!(
+            z.outcome,
+            polepatch::Outcome::Reached,
+            "{what}: {:?} {}",
+            z.lines,
+            z.reason
+        );
         assert!(z.after.c_ratio >= 1.0 - 1e-9 && z.after.primary_ratio >= 1.0 - 1e-9);
     }
 }
@@ -250,7 +256,10 @@ fn sing_with_a_ball_at_its_tip_keeps_the_centre() {
         b[20].xyz_text.clone()
     });
     for z in &report.zones {
-        assert_eq!((z.tool.as_str(), z.tool_point), ("ball D10", "tip"));
+        assert_eq!(
+            (z.tool.to_string(), z.tool_point.map(ToolPoint::name)),
+            ("ball D10".to_string(), Some("tip"))
+        );
         assert_eq!(z.tool_source, "--tool");
         assert_eq!(z.tool_point_source, "--tool-point");
         let shift = z.max_cutter_shift_mm.unwrap();
@@ -274,7 +283,11 @@ fn sing_with_m128_keeps_x_y_z() {
         assert_ne!(out, input, "{what}: patched");
         xyz_identical(&input, &out, what);
         for z in &report.zones {
-            assert_eq!(z.tool_point, "centre", "{what}");
+            assert_eq!(
+                z.tool_point,
+                Some(polepatch::tool::ToolPoint::Centre),
+                "{what}"
+            );
             assert!(
                 z.tool_point_source.contains("M128"),
                 "{}",
@@ -292,7 +305,10 @@ fn refpnt_center_center_keeps_x_y_z_and_tip_tip_the_centre() {
     assert_ne!(out, centre_file, "CENTER-CENTER: patched");
     xyz_identical(&centre_file, &out, "REFPNT CENTER-CENTER");
     for z in report.zones.iter().filter(|z| z.max_deviation_deg > 0.0) {
-        assert_eq!((z.tool.as_str(), z.tool_point), ("ball D10", "centre"));
+        assert_eq!(
+            (z.tool.to_string(), z.tool_point.map(ToolPoint::name)),
+            ("ball D10".to_string(), Some("centre"))
+        );
         assert!(
             z.tool_source.starts_with("line 4: 3 TOOL DEF 1"),
             "{}",
@@ -313,7 +329,10 @@ fn refpnt_center_center_keeps_x_y_z_and_tip_tip_the_centre() {
         "TIP-TIP: X Y Z rewritten"
     );
     for z in report.zones.iter().filter(|z| z.max_deviation_deg > 0.0) {
-        assert_eq!((z.tool.as_str(), z.tool_point), ("ball D10", "tip"));
+        assert_eq!(
+            (z.tool.to_string(), z.tool_point.map(ToolPoint::name)),
+            ("ball D10".to_string(), Some("tip"))
+        );
     }
     println!("REFPNT TIP-TIP: {turned} points turned, largest centre error {worst:.6} mm");
 }
@@ -347,7 +366,10 @@ fn the_camworks_apt_posted_with_the_patch_keeps_the_centres() {
     let (turned, worst) = centres_kept(&m, &raw, &patched, 5.0, "CAMWorks APT");
     assert!(turned > 0);
     for z in report.zones.iter().filter(|z| z.max_deviation_deg > 0.0) {
-        assert_eq!((z.tool.as_str(), z.tool_point), ("ball D10", "tip"));
+        assert_eq!(
+            (z.tool.to_string(), z.tool_point.map(ToolPoint::name)),
+            ("ball D10".to_string(), Some("tip"))
+        );
     }
     // And against the CL file itself: each posted tip + R·o is the GOTO's tip + R·(i j k)
     // within the post's rounding (3 decimals) and 0.001 mm.
@@ -395,16 +417,16 @@ fn a_flat_end_mill_stays_within_the_surface_bound() {
             let (out, report) = patch_nc(&input, &m, &opts).unwrap();
             let mut limited = 0;
             for z in &report.zones {
-                assert_eq!(z.tool, "flat D10");
+                assert_eq!(z.tool.to_string(), "flat D10");
                 let shift = z.max_cutter_shift_mm.unwrap();
                 assert!(shift <= tol * (1.0 + 1e-9), "{rel} {tol}: {shift}");
-                if z.reason == "tool_limited" {
+                if z.reason == polepatch::ZoneReason::ToolLimited {
                     limited += 1;
                     let needed = z.needed_deviation_deg.expect("the deviation needed");
                     let cap =
                         polepatch::tool::deviation_cap_deg(&Tool::parse("flat:10").unwrap(), tol);
                     assert!(needed > cap, "{rel}: needed {needed}° ≤ cap {cap}°");
-                    assert_ne!(z.outcome, "reached");
+                    assert_ne!(z.outcome, polepatch::Outcome::Reached);
                 }
             }
             if tol == SURFACE_TOLERANCE_MM {
@@ -497,7 +519,7 @@ fn each_tool_source_on_its_fixture() {
         };
         assert!(!report.zones.is_empty(), "{file}: zones");
         for z in &report.zones {
-            assert_eq!(z.tool, want.describe(), "{file}: {}", z.tool_source);
+            assert_eq!(z.tool, ZoneTool::Known(want), "{file}: {}", z.tool_source);
             assert!(
                 z.tool_source.starts_with(source),
                 "{file}: source {:?}, expected {source:?}…",
@@ -534,7 +556,7 @@ fn an_unknown_tool_is_never_silent() {
         .collect();
     assert!(!changed.is_empty());
     for z in &changed {
-        assert_eq!(z.tool, "unknown");
+        assert_eq!(z.tool, polepatch::ZoneTool::Unknown);
         assert!(z.tool_source.contains("T5"), "{}", z.tool_source);
         let want = 2.0 * (z.max_deviation_deg.to_radians() / 2.0).sin();
         assert!((z.centre_shift_per_mm_radius - want).abs() < 1e-12);
@@ -573,8 +595,8 @@ fn a_centre_path_beyond_the_chord_tolerance_is_not_written() {
     let (out, report) = patch_nc(&input, &m, &opts).unwrap();
     assert!(!report.zones.is_empty());
     for z in &report.zones {
-        assert_eq!(z.reason, "centre_path", "{z:?}");
-        assert_ne!(z.outcome, "reached", "{z:?}");
+        assert_eq!(z.reason, polepatch::ZoneReason::CentrePath, "{z:?}");
+        assert_ne!(z.outcome, polepatch::Outcome::Reached, "{z:?}");
         assert!(
             z.centre_chord_mm.is_none_or(|c| c <= 0.002 + 1e-12),
             "written beyond the limit: {z:?}"

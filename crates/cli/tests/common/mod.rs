@@ -221,10 +221,13 @@ pub fn check_patch_both(
     // A ball programmed at its tip, known from the program (issue 27): its X Y Z move to
     // keep the centre, and the linear axes may take a span's limit over from the rotary
     // axes the patch freed (the span may not get slower).
-    let keeps_centre = report
-        .zones
-        .iter()
-        .any(|z| z.tool.starts_with("ball") && z.tool_point == "tip" && z.points_modified > 0);
+    let keeps_centre = report.zones.iter().any(|z| {
+        z.tool
+            .tool()
+            .is_some_and(|t| t.kind == polepatch::tool::ToolKind::Ball)
+            && z.tool_point == Some(polepatch::tool::ToolPoint::Tip)
+            && z.points_modified > 0
+    });
     if keeps_centre {
         assert_only_words_differ(name, bytes, &out, b"ABCXYZ");
     } else {
@@ -243,7 +246,7 @@ pub fn check_patch_both(
         }
         // A flat or bull-nose cutter's zone held by the surface bound (issue 27): the
         // cap is the tool's; every written deviation within it.
-        if z.reason == "tool_limited" {
+        if z.reason == polepatch::ZoneReason::ToolLimited {
             // Within the default surface tolerance (0.005 mm) and short of what it needed.
             assert!(
                 z.max_cutter_shift_mm.is_some_and(|s| s <= 0.005 + 1e-6)
@@ -257,15 +260,19 @@ pub fn check_patch_both(
         // A zone whose patch cannot be written in the file's words (issue 30): a
         // Sinumerik direction form that cannot make the patched move, a word whose value
         // is a macro variable (`C#105`). Its run is listed with the reason.
-        if matches!(z.reason, "direction_form" | "macro_variable") {
+        if matches!(
+            z.reason,
+            polepatch::ZoneReason::DirectionForm | polepatch::ZoneReason::MacroVariable
+        ) {
             assert!(
-                z.outcome == "unchanged" && report.untouched_runs.iter().any(|u| u.run == z.run),
+                z.outcome == polepatch::Outcome::Unchanged
+                    && report.untouched_runs.iter().any(|u| u.run == z.run),
                 "{name} on {m}: {z:?}"
             );
             left_on_purpose += 1;
             continue;
         }
-        if z.outcome != "reached" {
+        if z.outcome != polepatch::Outcome::Reached {
             // Left below feed: only where no values at all can reach it (the LP proof).
             assert!(
                 proven_unreachable(&lp, z, machine, opts),
@@ -421,10 +428,13 @@ pub fn check_patch_only_c(
             machine.name
         );
     }
-    let moved_centre = report
-        .zones
-        .iter()
-        .any(|z| z.tool.starts_with("ball") && z.tool_point == "tip" && z.points_modified > 0);
+    let moved_centre = report.zones.iter().any(|z| {
+        z.tool
+            .tool()
+            .is_some_and(|t| t.kind == polepatch::tool::ToolKind::Ball)
+            && z.tool_point == Some(polepatch::tool::ToolPoint::Tip)
+            && z.points_modified > 0
+    });
     if moved_centre {
         // A ball programmed at its tip keeps its centre: X Y Z change with C.
         assert_only_words_differ(name, bytes, &out, b"CXYZ");
@@ -449,12 +459,18 @@ pub fn check_patch_only_c(
         let reach = opts.reach_deg();
         let keeps_centre = report.zones.iter().any(|z| {
             z.run == k + 1
-                && ((z.tool.starts_with("ball") && z.tool_point == "tip")
+                && ((z
+                    .tool
+                    .tool()
+                    .is_some_and(|t| t.kind == polepatch::tool::ToolKind::Ball)
+                    && z.tool_point == Some(polepatch::tool::ToolPoint::Tip))
                     || matches!(
                         z.reason,
-                        "tool_limited" | "direction_form" | "macro_variable"
+                        polepatch::ZoneReason::ToolLimited
+                            | polepatch::ZoneReason::DirectionForm
+                            | polepatch::ZoneReason::MacroVariable
                     )
-                    || (z.reason == "safety_bound" && {
+                    || (z.reason == polepatch::ZoneReason::SafetyBound && {
                         assert!(
                             z.max_deviation_deg <= reach + 1e-3 && z.needed_deviation_deg.is_some(),
                             "{name}: {z:?}"

@@ -1,6 +1,10 @@
 //! The report of an analysis (the JSON of `polepatch analyze --json`): per run its
 //! Equation-6 figures and zones.
 
+use super::{by_name, feed_mode_by_name, limit_by_name, limits_by_name};
+use polepatch_kinematics::LimitKind;
+use polepatch_nc::FeedMode;
+use polepatch_patcher::ZoneKind;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -10,7 +14,8 @@ pub struct ZoneSummary {
     /// File lines of the first and last point of the zone.
     pub lines: [usize; 2],
     /// `A-flip` or `C-swing`.
-    pub kind: &'static str,
+    #[serde(serialize_with = "by_name")]
+    pub kind: ZoneKind,
     /// File line of the singular point.
     pub singular_line: usize,
     /// Smallest |primary| in the zone, degrees.
@@ -26,16 +31,18 @@ pub struct RunFigures {
     pub min_ratio: f64,
     /// Axis limiting there (`null`: the feed itself).
     pub limiting_axis: Option<String>,
-    /// Limit binding there: `V`, `A`, `J` or `F`.
-    pub limiting_limit: &'static str,
+    /// Limit binding there: `V`, `A`, `J` or `F` ([`super::limit_name`]).
+    #[serde(serialize_with = "limit_by_name")]
+    pub limiting_limit: LimitKind,
     /// Where, mm along the run.
     pub min_at_s_mm: f64,
     /// File line of the point at or just after that place.
     pub min_at_line: usize,
     /// Lowest ratio per axis letter.
     pub axis_min_ratio: BTreeMap<String, f64>,
-    /// Binding limit per axis letter at its lowest ratio.
-    pub axis_limit: BTreeMap<String, &'static str>,
+    /// Binding limit per axis letter at its lowest ratio (written `V`, `A`, `J`).
+    #[serde(serialize_with = "limits_by_name")]
+    pub axis_limit: BTreeMap<String, LimitKind>,
     /// Estimated time ∫ds/ṡ, s.
     pub time_s: f64,
     /// L/F, s.
@@ -61,7 +68,8 @@ pub struct RunReport {
     pub feed_mm_min: Option<f64>,
     /// Feed mode: `G94`, or `G93` (inverse time: the feed is each block's length over its
     /// time).
-    pub feed_mode: &'static str,
+    #[serde(serialize_with = "feed_mode_by_name")]
+    pub feed_mode: FeedMode,
     /// Why this run was not analysed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
@@ -83,8 +91,9 @@ pub struct MachineFrameFigures {
     pub peak_speed: BTreeMap<String, f64>,
     /// Lowest ratio of X Y Z.
     pub axis_min_ratio: BTreeMap<String, f64>,
-    /// Binding limit of X Y Z at their lowest ratio.
-    pub axis_limit: BTreeMap<String, &'static str>,
+    /// Binding limit of X Y Z at their lowest ratio (written `V`, `A`, `J`).
+    #[serde(serialize_with = "limits_by_name")]
+    pub axis_limit: BTreeMap<String, LimitKind>,
 }
 
 /// The whole analysis document.

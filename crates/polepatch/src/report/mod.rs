@@ -2,7 +2,21 @@
 //!
 //! Every report type of the library in one place: [`AnalyzeReport`] (what `polepatch analyze`
 //! reports), [`FileReport`] (`polepatch patch --report`), [`SimulateReport`] (`polepatch simulate`),
-//! and the names they print axes, limits, zone kinds, feeds and feed modes with.
+//! and the names they print axes, limits, feeds and feed modes with.
+//!
+//! # Typed fields
+//! What a zone or a run is and how it ended are enums, compared as enums
+//! (`z.outcome == Outcome::Reached`): a zone row's [`ZoneKind`], [`Outcome`],
+//! [`ZoneReason`], [`EndFreedom`], [`Method`], [`FeedMode`](polepatch_nc::FeedMode),
+//! [`ZoneTool`] and [`ToolPoint`](crate::tool::ToolPoint), a figure's [`LimitKind`], a
+//! simulated run's [`SimFrame`]. The JSON, the CSV and the printed summaries write each by
+//! its report name, its `Display` or `name()` (`reached`, `A-flip`, `g16-patch`,
+//! `tool_limited`; `G94` for a feed mode: [`feed_mode_name`]; `V`, `A`, `J`, `F` for a
+//! limit: [`limit_name`]); an optional one (a run not patched has no end pose or tool
+//! point) is written `-`. The patcher's enums keep their own serde form in the patcher's
+//! [`ZoneReport`](polepatch_patcher::ZoneReport) (`Reached`, `AFlip`: the zones
+//! [`crate::joints::patch_joints`] gives the bindings), so the report fields write theirs
+//! with `serialize_with`.
 
 mod analyze;
 mod patch;
@@ -10,17 +24,23 @@ mod simulate;
 
 pub use analyze::{AnalyzeReport, MachineFrameFigures, RunFigures, RunReport, ZoneSummary};
 pub use patch::{
-    FiguresRow, FileReport, UntouchedReason, UntouchedRun, ZoneRow, feed_mode_name, method_name,
-    outcome_name,
+    EndFreedom, FiguresRow, FileReport, UntouchedReason, UntouchedRun, ZoneReason, ZoneRow,
+    ZoneTool, feed_mode_name,
 };
-pub use simulate::{RunTimes, SimRun, SimTotals, SimulateReport, SimulatedTimes, compare};
+pub use polepatch_kinematics::LimitKind;
+pub use polepatch_patcher::{Method, Outcome, ZoneKind};
+pub use simulate::{
+    RunTimes, SimFrame, SimRun, SimTotals, SimulateReport, SimulatedTimes, compare,
+};
 
 /// A line carried through without analysis, and why ([`FileReport::not_analysed`]).
 pub use crate::notes::{NotAnalysed, SkipReason};
 
-use polepatch_kinematics::{Axis, LimitKind};
+use polepatch_kinematics::Axis;
 use polepatch_nc::RotaryLetters;
-use polepatch_patcher::ZoneKind;
+use serde::Serializer;
+use std::collections::BTreeMap;
+use std::fmt::Display;
 
 /// Axis letter as written in the program (the rotary axes: the letters in use, e.g. A
 /// and C, or A and B on an A-B trunnion).
@@ -54,12 +74,38 @@ pub fn machine_units(axis: Axis, internal: f64) -> f64 {
     }
 }
 
-/// Name of a zone kind in reports.
-pub fn zone_kind_name(kind: ZoneKind) -> &'static str {
-    match kind {
-        ZoneKind::AFlip => "A-flip",
-        ZoneKind::CSwing => "C-swing",
+/// Serialise a typed field by its report name, its `Display` (module docs).
+fn by_name<T: Display, S: Serializer>(value: &T, s: S) -> Result<S::Ok, S::Error> {
+    s.collect_str(value)
+}
+
+/// Serialise an optional typed field by its report name, `-` when there is none.
+fn by_name_or_dash<T: Display, S: Serializer>(value: &Option<T>, s: S) -> Result<S::Ok, S::Error> {
+    match value {
+        Some(v) => s.collect_str(v),
+        None => s.serialize_str("-"),
     }
+}
+
+/// Serialise a limit by its short name ([`limit_name`]).
+fn limit_by_name<S: Serializer>(kind: &LimitKind, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(limit_name(*kind))
+}
+
+/// Serialise the limits per axis letter by their short names ([`limit_name`]).
+fn limits_by_name<S: Serializer>(
+    limits: &BTreeMap<String, LimitKind>,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    s.collect_map(limits.iter().map(|(axis, kind)| (axis, limit_name(*kind))))
+}
+
+/// Serialise a feed mode by its G code ([`feed_mode_name`]).
+fn feed_mode_by_name<S: Serializer>(
+    mode: &polepatch_nc::FeedMode,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    s.serialize_str(feed_mode_name(*mode))
 }
 
 /// A feed for people, mm/min: at most 3 decimals, trailing zeros dropped (`248.92`, not

@@ -2,9 +2,14 @@
 //! is ([`UntouchedRun`]) and per file ([`FileReport`], the JSON of `polepatch patch
 //! --report`).
 
-use super::{SimulatedTimes, axis_letter, limit_name};
-use polepatch_kinematics::Machine;
-use polepatch_patcher::{Method, Outcome, QpStatus, ZoneFigures};
+use super::{
+    SimulatedTimes, axis_letter, by_name, by_name_or_dash, feed_mode_by_name, limit_by_name,
+    limit_name,
+};
+use crate::tool::{Tool, ToolPoint};
+use polepatch_kinematics::{LimitKind, Machine};
+use polepatch_nc::FeedMode;
+use polepatch_patcher::{Method, Outcome, QpStatus, Reason, ZoneFigures, ZoneKind};
 use serde::Serialize;
 
 /// Equation-6 figures of a zone, with axis letters (report form of [`ZoneFigures`]).
@@ -18,8 +23,9 @@ pub struct FiguresRow {
     pub overall_ratio: f64,
     /// Limiting axis letter (`null`: the feed).
     pub limiting_axis: Option<String>,
-    /// `V`, `A`, `J` or `F`.
-    pub limiting_limit: &'static str,
+    /// `V`, `A`, `J` or `F` ([`limit_name`]).
+    #[serde(serialize_with = "limit_by_name")]
+    pub limiting_limit: LimitKind,
     /// Estimated time over the zone, s.
     pub time_s: f64,
 }
@@ -32,7 +38,7 @@ impl FiguresRow {
             primary_ratio: f.primary_ratio,
             overall_ratio: f.overall_ratio,
             limiting_axis: f.limiting_axis.map(|a| axis_letter(a, letters)),
-            limiting_limit: limit_name(f.limiting_kind),
+            limiting_limit: f.limiting_kind,
             time_s: f.time_s,
         }
     }
@@ -48,7 +54,8 @@ pub struct ZoneRow {
     /// File lines of the first and last point of the zone/patch.
     pub lines: [usize; 2],
     /// `A-flip` or `C-swing`.
-    pub kind: &'static str,
+    #[serde(serialize_with = "by_name")]
+    pub kind: ZoneKind,
     /// Smallest |primary|, degrees.
     pub min_abs_primary_deg: f64,
     /// Before patching.
@@ -73,19 +80,23 @@ pub struct ZoneRow {
     /// Patched length, mm.
     pub patch_length_mm: f64,
     /// `reached`, `improved` or `unchanged`.
-    pub outcome: &'static str,
-    /// Why (a fixed set: [`polepatch_patcher::Reason`]): `reached`, `reselected`,
-    /// `end_pinned`, `range`, `deviation_cap`, `safety_bound`, `tip_path`,
-    /// `proven_unreachable`, `not_found`, `not_patched`.
-    pub reason: &'static str,
+    #[serde(serialize_with = "by_name")]
+    pub outcome: Outcome,
+    /// Why (a fixed set, [`ZoneReason`]): the patcher's reasons ([`Reason`]: `reached`,
+    /// `reselected`, `end_pinned`, `range`, `deviation_cap`, `safety_bound`, `tip_path`,
+    /// `proven_unreachable`, `not_found`, `not_patched`), then the library's, where the
+    /// run's circumstances decided (`tcpm_unknown`, `centre_path`, `tool_limited`, …).
+    pub reason: ZoneReason,
     /// Whether the run's last point could change: `free` or `pinned`
-    /// ([`crate::EndPose`]); `-` for a run that was not patched.
-    pub end_pose: &'static str,
+    /// ([`crate::EndPose`]); `None`, written `-`, for a run that was not patched.
+    #[serde(serialize_with = "by_name_or_dash")]
+    pub end_pose: Option<EndFreedom>,
     /// File line of the block after the run that decided its end pose (`None`: the end of
     /// the file, or a run without TCPM, whose end is always pinned).
     pub end_pose_line: Option<usize>,
-    /// `reselect`, `joint`, `g16-patch`, `direct` or `none`.
-    pub method: &'static str,
+    /// `reselect`, `joint`, `peer`, `g16-patch`, `direct` or `none`.
+    #[serde(serialize_with = "by_name")]
+    pub method: Method,
     /// Last solver status.
     pub qp_status: QpStatus,
     /// Interior-point iterations, summed.
@@ -102,15 +113,19 @@ pub struct ZoneRow {
     pub c_offset_deg: f64,
     /// Feed mode of the run: `G94` (feed per minute) or `G93` (inverse time: each block
     /// keeps its time, F words untouched).
-    pub feed_mode: &'static str,
-    /// The tool the run was patched for (`ball D10`, `flat D12`, `bull D10 R2`), `unknown`,
-    /// or `-` for a run that was not patched ([`crate::tool`]).
-    pub tool: String,
+    #[serde(serialize_with = "feed_mode_by_name")]
+    pub feed_mode: FeedMode,
+    /// The tool the run was patched for, written `ball D10`, `flat D12`, `bull D10 R2`,
+    /// `unknown`, or `-` for a run that was not patched ([`crate::tool`]).
+    #[serde(serialize_with = "by_name")]
+    pub tool: ZoneTool,
     /// Where the tool was found (`--tool`, `tool table (T5)`, `line 12: TOOL DEF …`), or
     /// why it is unknown.
     pub tool_source: String,
-    /// Which point of the tool X Y Z state: `tip`, `centre`, or `-`.
-    pub tool_point: &'static str,
+    /// Which point of the tool X Y Z state: `tip` or `centre`; `None`, written `-`, for a
+    /// run that was not patched.
+    #[serde(serialize_with = "by_name_or_dash")]
+    pub tool_point: Option<ToolPoint>,
     /// Why that point (`--tool-point`, the machine file, the TCPM code).
     pub tool_point_source: String,
     /// 2·sin(δ/2) for the zone's largest orientation change δ: how far a ball's centre
@@ -141,6 +156,162 @@ pub struct ZoneRow {
     pub rapid_time_after_s: Option<f64>,
 }
 
+/// Why a zone ended as it did (its row's `reason`): one of a fixed set, the patcher's
+/// [`Reason`]s first, then the library's own, where the run's circumstances decided, not
+/// the solve. `polepatch patch` counts them per file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ZoneReason {
+    /// A patch reaches feed ([`Reason::Reached`]).
+    Reached,
+    /// Branch re-selection alone reaches feed ([`Reason::Reselected`]).
+    Reselected,
+    /// Only with the run's last point free would some values reach feed
+    /// ([`Reason::EndPinned`]).
+    EndPinned,
+    /// The machine's axis ranges forbid every values that reach feed ([`Reason::Range`]).
+    Range,
+    /// A patch reaching feed changes the orientation by more than `max_deviation_deg`
+    /// ([`Reason::DeviationCap`]).
+    DeviationCap,
+    /// A patch reaching feed turns some point's tool axis by more than the safety bound
+    /// near the pole allows ([`Reason::SafetyBound`]).
+    SafetyBound,
+    /// With a ball's centre kept, the patch falls short on the tips it writes
+    /// ([`Reason::TipPath`]).
+    TipPath,
+    /// No values of the movable points reach feed ([`Reason::ProvenUnreachable`]).
+    ProvenUnreachable,
+    /// No patch found, and no proof that there is none ([`Reason::NotFound`]).
+    NotFound,
+    /// The run may not be patched: see the untouched runs ([`Reason::NotPatched`]).
+    NotPatched,
+    /// The file does not settle whether TCPM is on ([`UntouchedReason::TcpmUnknown`]).
+    TcpmUnknown,
+    /// A rotation, scaling or mirror image of the frame is in force
+    /// ([`UntouchedReason::FrameTransformed`]).
+    FrameTransformed,
+    /// A Sinumerik direction form cannot make the patched move
+    /// ([`UntouchedReason::DirectionForm`]).
+    DirectionForm,
+    /// The patch would change a word whose value is a macro variable
+    /// ([`UntouchedReason::MacroVariable`]).
+    MacroVariable,
+    /// A ball programmed at its tip, its centre kept: the orientation change was capped to
+    /// keep the centre's path between the points within the chord tolerance and the zone
+    /// stopped at that cap, or no cap did and the run keeps its values
+    /// ([`UntouchedReason::CentrePath`]).
+    CentrePath,
+    /// A flat or bull-nose cutter's surface bound capped the orientation change and
+    /// stopped the zone short of feed ([`crate::tool`]).
+    ToolLimited,
+}
+
+impl ZoneReason {
+    /// The name used in reports (`reached`, `tool_limited`, …): its serde form.
+    pub fn name(self) -> &'static str {
+        match self {
+            ZoneReason::Reached => Reason::Reached.name(),
+            ZoneReason::Reselected => Reason::Reselected.name(),
+            ZoneReason::EndPinned => Reason::EndPinned.name(),
+            ZoneReason::Range => Reason::Range.name(),
+            ZoneReason::DeviationCap => Reason::DeviationCap.name(),
+            ZoneReason::SafetyBound => Reason::SafetyBound.name(),
+            ZoneReason::TipPath => Reason::TipPath.name(),
+            ZoneReason::ProvenUnreachable => Reason::ProvenUnreachable.name(),
+            ZoneReason::NotFound => Reason::NotFound.name(),
+            ZoneReason::NotPatched => Reason::NotPatched.name(),
+            ZoneReason::TcpmUnknown => "tcpm_unknown",
+            ZoneReason::FrameTransformed => "frame_transformed",
+            ZoneReason::DirectionForm => "direction_form",
+            ZoneReason::MacroVariable => "macro_variable",
+            ZoneReason::CentrePath => "centre_path",
+            ZoneReason::ToolLimited => "tool_limited",
+        }
+    }
+}
+
+impl From<Reason> for ZoneReason {
+    fn from(r: Reason) -> ZoneReason {
+        match r {
+            Reason::Reached => ZoneReason::Reached,
+            Reason::Reselected => ZoneReason::Reselected,
+            Reason::EndPinned => ZoneReason::EndPinned,
+            Reason::Range => ZoneReason::Range,
+            Reason::DeviationCap => ZoneReason::DeviationCap,
+            Reason::SafetyBound => ZoneReason::SafetyBound,
+            Reason::TipPath => ZoneReason::TipPath,
+            Reason::ProvenUnreachable => ZoneReason::ProvenUnreachable,
+            Reason::NotFound => ZoneReason::NotFound,
+            Reason::NotPatched => ZoneReason::NotPatched,
+        }
+    }
+}
+
+impl std::fmt::Display for ZoneReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Whether a patched run's last point could change (a zone row's `end_pose`: what the
+/// blocks after the run allow, [`crate::EndPose`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EndFreedom {
+    /// The last point may change.
+    Free,
+    /// The last point keeps its values.
+    Pinned,
+}
+
+impl EndFreedom {
+    /// `free` or `pinned`: its serde form.
+    pub fn name(self) -> &'static str {
+        match self {
+            EndFreedom::Free => "free",
+            EndFreedom::Pinned => "pinned",
+        }
+    }
+}
+
+impl std::fmt::Display for EndFreedom {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The tool a zone's run was patched for (a zone row's `tool`, [`crate::tool`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ZoneTool {
+    /// The run was not patched (written `-`).
+    NotPatched,
+    /// The tool is not known (written `unknown`).
+    Unknown,
+    /// This tool (written as [`Tool::describe`] does: `ball D10`, `bull D10 R2`).
+    Known(Tool),
+}
+
+impl ZoneTool {
+    /// The tool, when known.
+    pub fn tool(self) -> Option<Tool> {
+        match self {
+            ZoneTool::Known(t) => Some(t),
+            ZoneTool::NotPatched | ZoneTool::Unknown => None,
+        }
+    }
+}
+
+impl std::fmt::Display for ZoneTool {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ZoneTool::NotPatched => f.write_str("-"),
+            ZoneTool::Unknown => f.write_str("unknown"),
+            ZoneTool::Known(t) => f.write_str(&t.describe()),
+        }
+    }
+}
+
 /// Report name of a feed mode: `G94`, `G93` or `G95`.
 pub fn feed_mode_name(m: polepatch_nc::FeedMode) -> &'static str {
     match m {
@@ -156,7 +327,7 @@ impl ZoneRow {
     /// before, nothing deviates or moves. The method and solver figures stay: they say what
     /// was tried.
     pub fn not_written(&mut self) {
-        self.outcome = "unchanged";
+        self.outcome = Outcome::Unchanged;
         self.after = self.before.clone();
         self.max_deviation_deg = 0.0;
         self.points_modified = 0;
@@ -169,27 +340,6 @@ impl ZoneRow {
         self.max_cutter_shift_mm = self.max_cutter_shift_mm.map(|_| 0.0);
         self.centre_chord_mm = None;
         self.rapid_time_after_s = self.rapid_time_before_s;
-    }
-}
-
-/// Report name of an outcome.
-pub fn outcome_name(o: Outcome) -> &'static str {
-    match o {
-        Outcome::Reached => "reached",
-        Outcome::Improved => "improved",
-        Outcome::Unchanged => "unchanged",
-    }
-}
-
-/// Report name of a method.
-pub fn method_name(m: Method) -> &'static str {
-    match m {
-        Method::Reselect => "reselect",
-        Method::Joint => "joint",
-        Method::Peer => "peer",
-        Method::G16Patch => "g16-patch",
-        Method::Direct => "direct",
-        Method::None => "none",
     }
 }
 
@@ -248,7 +398,7 @@ impl ZoneRow {
             format!(
                 "{}:{}",
                 f.limiting_axis.as_deref().unwrap_or("-"),
-                f.limiting_limit
+                limit_name(f.limiting_limit)
             )
         };
         vec![
@@ -276,7 +426,7 @@ impl ZoneRow {
             format!("{:.3}", self.patch_length_mm),
             self.outcome.to_string(),
             self.reason.to_string(),
-            self.end_pose.to_string(),
+            self.end_pose.map_or("-", EndFreedom::name).to_string(),
             self.end_pose_line.map_or(String::new(), |l| l.to_string()),
             self.method.to_string(),
             self.qp_status.to_string(),
@@ -286,9 +436,9 @@ impl ZoneRow {
             self.decimals.to_string(),
             self.primary_decimals.to_string(),
             format!("{}", self.c_offset_deg),
-            self.feed_mode.to_string(),
-            self.tool.clone(),
-            self.tool_point.to_string(),
+            feed_mode_name(self.feed_mode).to_string(),
+            self.tool.to_string(),
+            self.tool_point.map_or("-", ToolPoint::name).to_string(),
             format!("{:.6}", self.centre_shift_per_mm_radius),
             self.max_cutter_shift_mm
                 .map_or(String::new(), |v| format!("{:.3}", v * 1e3)),
@@ -352,12 +502,12 @@ pub enum UntouchedReason {
 
 impl UntouchedReason {
     /// The reason a zone of such a run reports, where it says more than `not_patched`.
-    pub fn zone_reason(self) -> Option<&'static str> {
+    pub fn zone_reason(self) -> Option<ZoneReason> {
         match self {
-            UntouchedReason::TcpmUnknown => Some("tcpm_unknown"),
-            UntouchedReason::FrameTransformed => Some("frame_transformed"),
-            UntouchedReason::DirectionForm => Some("direction_form"),
-            UntouchedReason::MacroVariable => Some("macro_variable"),
+            UntouchedReason::TcpmUnknown => Some(ZoneReason::TcpmUnknown),
+            UntouchedReason::FrameTransformed => Some(ZoneReason::FrameTransformed),
+            UntouchedReason::DirectionForm => Some(ZoneReason::DirectionForm),
+            UntouchedReason::MacroVariable => Some(ZoneReason::MacroVariable),
             _ => None,
         }
     }
@@ -439,7 +589,10 @@ impl FileReport {
     }
     /// Zones that stay below feed (including those of untouched runs).
     pub fn zones_below_feed(&self) -> usize {
-        self.zones.iter().filter(|z| z.outcome != "reached").count()
+        self.zones
+            .iter()
+            .filter(|z| z.outcome != Outcome::Reached)
+            .count()
     }
     /// What `--strict` counts as a failure: zones that stay below feed (those of untouched
     /// runs included), runs near the pole that could not be analysed (no feed, a feed too
@@ -456,7 +609,7 @@ impl FileReport {
     pub fn zones_with_unknown_tool(&self) -> usize {
         self.zones
             .iter()
-            .filter(|z| z.tool == "unknown" && z.max_deviation_deg > 0.0)
+            .filter(|z| z.tool == ZoneTool::Unknown && z.max_deviation_deg > 0.0)
             .count()
     }
     /// Add, once, the warning a report with [`FileReport::zones_with_unknown_tool`] needs.
@@ -468,7 +621,7 @@ impl FileReport {
         let worst = self
             .zones
             .iter()
-            .filter(|z| z.tool == "unknown")
+            .filter(|z| z.tool == ZoneTool::Unknown)
             .map(|z| z.centre_shift_per_mm_radius)
             .fold(0.0, f64::max);
         self.warnings.push(format!(

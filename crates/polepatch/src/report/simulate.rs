@@ -32,7 +32,33 @@ pub struct SimRun {
     /// Moves on from the run before without a stop (a feed change between them).
     pub joined: bool,
     /// `machine` (X Y Z through the machine's chain) or `program` (the values as written).
-    pub frame: &'static str,
+    pub frame: SimFrame,
+}
+
+/// The frame a run was simulated in ([`SimRun::frame`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SimFrame {
+    /// X Y Z through the machine's kinematic chain (what the controller moves).
+    Machine,
+    /// The values as written.
+    Program,
+}
+
+impl SimFrame {
+    /// `machine` or `program`: its serde form.
+    pub fn name(self) -> &'static str {
+        match self {
+            SimFrame::Machine => "machine",
+            SimFrame::Program => "program",
+        }
+    }
+}
+
+impl std::fmt::Display for SimFrame {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// Totals of a simulation report.
