@@ -16,6 +16,6 @@
 pub use crate::analysis::{SpanFigures, analyze_spans, axis_splines};
 pub use crate::direct::{deviation_bound_sampled, deviation_bound_zone, orientation_deviation_deg};
 pub use crate::proof::reachable;
-pub use crate::reference::{Reference, zone_reference};
+pub use crate::reference::{Reference, ReferenceMethod, zone_reference};
 pub use crate::tolerances::{BOUND_SAMPLES_PER_SPAN, NOT_WORSE_REL};
 pub use crate::zones::{merge_zones, zone_core};

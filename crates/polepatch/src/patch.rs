@@ -826,10 +826,11 @@ fn finish_report(
     report: &mut FileReport,
 ) {
     report.words_changed = words;
-    let near = lp
-        .runs
-        .iter()
-        .any(|rp| rp.path.as_ref().is_ok_and(|p| near_pole(lp, p, &styles.opts)));
+    let near = lp.runs.iter().any(|rp| {
+        rp.path
+            .as_ref()
+            .is_ok_and(|p| near_pole(lp, p, &styles.opts))
+    });
     if near {
         report.file_c_decimals = Some(styles.c.decimals);
         report.written_c_decimals = Some(out.written_c);

@@ -157,7 +157,7 @@ fn a_45_degree_nutating_table_patches_a_planted_pass() {
     let z = &report.zones[0];
     assert!((z.min_abs_primary_deg - 1.0).abs() < 0.05, "{z:?}");
     assert!(z.before.overall_ratio < 0.9, "{z:?}");
-    assert_eq!(z.outcome, "reached", "{z:?}");
+    assert_eq!(z.outcome, polepatch::Outcome::Reached, "{z:?}");
     assert!(z.after.overall_ratio >= 1.0 - 1e-3, "{z:?}");
     let out = String::from_utf8(out).unwrap();
     let (before, after) = (bc_per_line(&input), bc_per_line(&out));
@@ -281,7 +281,7 @@ fn an_a_b_trunnion_patches_its_own_letters() {
         polepatch::patch_nc(ab_text.as_bytes(), &ab, &PatchOptions::default()).unwrap();
     assert_eq!(report.zones.len(), 1, "{report:?}");
     let z = &report.zones[0];
-    assert_eq!(z.outcome, "reached", "{z:?}");
+    assert_eq!(z.outcome, polepatch::Outcome::Reached, "{z:?}");
     assert!(
         z.before.overall_ratio < 0.9 && z.after.overall_ratio >= 1.0 - 1e-3,
         "{z:?}"
