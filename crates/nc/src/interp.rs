@@ -169,6 +169,20 @@ pub(crate) fn cycle800_rotates(args: &[u8]) -> bool {
     })
 }
 
+/// The index of `letter` in X Y Z A B C F (the axes in [`AXES`] order, then F).
+fn axis_or_feed(letter: u8) -> Option<usize> {
+    match letter {
+        b'X' => Some(X),
+        b'Y' => Some(Y),
+        b'Z' => Some(Z),
+        b'A' => Some(A),
+        b'B' => Some(B),
+        b'C' => Some(C),
+        b'F' => Some(6),
+        _ => None,
+    }
+}
+
 /// Bit of axis index `i` in [`Scan::axes_expr`].
 fn bit(i: usize) -> u8 {
     1 << i
@@ -350,7 +364,7 @@ impl Interpreter {
         let mut seen: [Option<usize>; 7] = [None; 7];
         let col = |at: usize| at - span.start + 1;
         let mut once = |letter: u8, at: usize| -> Result<(), ParseError> {
-            if let Some(k) = b"XYZABCF".iter().position(|&l| l == letter) {
+            if let Some(k) = axis_or_feed(letter) {
                 if let Some(first) = seen[k] {
                     return Err(ParseError::at(
                         line,
@@ -384,8 +398,8 @@ impl Interpreter {
                     value,
                     form,
                 } => {
-                    if let Some(i) = [A, B, C].into_iter().find(|&i| AXES[i] == letter) {
-                        s.axes_form[i - A] = form;
+                    if matches!(letter, b'A' | b'B' | b'C') {
+                        s.axes_form[usize::from(letter - b'A')] = form;
                     }
                     once(letter, wspan.start)?;
                     match letter {

@@ -138,9 +138,10 @@ pub(crate) fn after_lex(bytes: &[u8], span: &Range<usize>, s: &mut Scan) {
         s.breaks = true;
         s.expr_breaks = false;
     }
-    let line = &bytes[span.clone()];
-    if let Some(cr) = line.iter().position(|&b| b == b'\r')
-        && line[cr + 1..].iter().any(|b| !b.is_ascii_whitespace())
+    if let Some(cr) = crate::lines::find_byte(&bytes[..span.end], span.start, b'\r')
+        && bytes[cr + 1..span.end]
+            .iter()
+            .any(|b| !b.is_ascii_whitespace())
     {
         s.tcpm = Some(Switch::Unknown);
         s.flags.set(Flags::NOT_MODELLED);
