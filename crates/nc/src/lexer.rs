@@ -350,7 +350,7 @@ impl<'a> Lexer<'a> {
     /// `f64` — ending at the line end, a blank, `*`, `;`, `(` or a letter other than `E`:
     /// the token [`Lexer::word`] gives for it, in one pass. `None` for anything else
     /// (`Lexer::word` reads it).
-    #[inline]
+    #[inline(always)]
     fn plain_word(&mut self, p: usize, letter: u8) -> Option<Token> {
         let b = &self.bytes[..self.end];
         let ns = p + 1;
@@ -361,20 +361,30 @@ impl<'a> Lexer<'a> {
         };
         let mut e = ds;
         let mut mantissa: u64 = 0;
-        let mut frac = 0usize;
-        let mut point = false;
+        // Digits before the point, then after it. Wraps only past 19 digits, which the
+        // check below refuses.
         while let Some(&c) = b.get(e) {
             let d = c.wrapping_sub(b'0');
-            if d < 10 {
-                // Wraps only past 19 digits, which the check below refuses.
-                mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
-                frac += usize::from(point);
-            } else if c == b'.' && !point {
-                point = true;
-            } else {
+            if d >= 10 {
                 break;
             }
+            mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
             e += 1;
+        }
+        let point = b.get(e) == Some(&b'.');
+        let mut frac = 0usize;
+        if point {
+            e += 1;
+            let fs = e;
+            while let Some(&c) = b.get(e) {
+                let d = c.wrapping_sub(b'0');
+                if d >= 10 {
+                    break;
+                }
+                mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
+                e += 1;
+            }
+            frac = e - fs;
         }
         let digits = e - ds - usize::from(point);
         if digits == 0 || digits > 19 || mantissa >= (1 << 53) || frac >= POW10.len() {
@@ -656,13 +666,14 @@ impl Iterator for Lexer<'_> {
 
     fn next(&mut self) -> Option<Self::Item> {
         let b = self.bytes;
-        while self.pos < self.end && is_blank(b[self.pos]) {
-            self.pos += 1;
+        let mut p = self.pos;
+        while p < self.end && is_blank(b[p]) {
+            p += 1;
         }
-        if self.pos >= self.end {
+        self.pos = p;
+        if p >= self.end {
             return None;
         }
-        let p = self.pos;
         let c = b[p];
         if is_control(c) {
             return self.err(p, control_message(c));
