@@ -11,6 +11,7 @@ use crate::interp::Interpreter;
 use crate::lexed::Scan;
 use crate::lines::LineEnds;
 use crate::modal::Modal;
+use crate::style::StyleEvidence;
 use crate::tcpm::ReadOptions;
 use crate::word::Word;
 use std::ops::Range;
@@ -147,6 +148,32 @@ pub(crate) fn scan_with(
         flow: Some(std::sync::Arc::new(plan)),
         inch: opts.inch,
     }))
+}
+
+/// The [`StyleEvidence`] of the lines of `bytes[..end]` (`end` the start of a line), lexed
+/// as `opts` reads them: the evidence of the words a read gives its visitor for those
+/// blocks, without the modal state. For a reader that counts the file's number style only
+/// once it needs it (`polepatch`'s patch: from the first run it may patch on) and counts the
+/// lines before then afterwards. Errors as a read's (none where a read of the file took
+/// these lines).
+pub fn style_evidence_to(
+    bytes: &[u8],
+    end: usize,
+    opts: &ReadOptions,
+) -> Result<StyleEvidence, ParseError> {
+    let dialect = match opts.dialect {
+        Dialect::Auto => detect(bytes),
+        d => d,
+    };
+    let interp = Interpreter::new(opts, dialect);
+    let mut ev = StyleEvidence::default();
+    let mut words = Vec::with_capacity(32);
+    for (span, line) in LineEnds::of(bytes).lines_from(&bytes[..end.min(bytes.len())], 0) {
+        words.clear();
+        interp.lex(bytes, span, line, &mut words)?;
+        ev.add_block(bytes, &words);
+    }
+    Ok(ev)
 }
 
 /// One read of the file with `interp`: whether `visit` took every block.

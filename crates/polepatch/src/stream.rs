@@ -148,7 +148,12 @@ struct Survey {
     runs: Vec<RunRec>,
     /// Some run point has a value for X Y Z A B C.
     uses: [bool; 6],
+    /// The file's number style; with `partial_style`, only of the lines from there on.
     style: FileStyle,
+    /// A patch counts the style from the first run it may patch on
+    /// ([`Reading::lazy_style`]): the byte where it began (the file's length if no run
+    /// did) and what it counted; [`Survey::complete_style`] counts the lines before.
+    partial_style: Option<(usize, StyleEvidence)>,
     /// What the reader carried through without analysing.
     notes: crate::notes::Notes,
     /// Blocks in the file.
@@ -230,6 +235,11 @@ impl NoRunWhy {
 
 /// The first read in progress.
 struct Surveying {
+    /// [`Reading::lazy_style`].
+    lazy_style: Option<usize>,
+    /// Some run given out may be patched (for the tilting letter it may have): the style
+    /// is counted from then on.
+    may_patch: bool,
     cone_deg: f64,
     fallback: Option<f64>,
     work_offset_mm: Option<[f64; 3]>,
@@ -276,6 +286,19 @@ impl Surveying {
                 self.work_offset_mm,
             ),
         });
+        if let Some(own) = self.lazy_style
+            && !self.may_patch
+        {
+            // A patch patches the runs near the pole or without a feed for the tilting
+            // letter: the machine's own once the runs use it, else either.
+            let rec = &self.runs[r];
+            let wanted = |l: usize| rec.near[l] || rec.feedless[l];
+            self.may_patch = if self.uses[[A, B][own]] {
+                wanted(own)
+            } else {
+                wanted(0) || wanted(1)
+            };
+        }
     }
 
     /// Block `i` (on `line`) has its say on the end pose of the runs before it, per
@@ -308,6 +331,11 @@ struct Reading<'a> {
     chord_tolerance_mm: f64,
     /// The caller's tool options.
     tool: crate::tool::ToolOptions,
+    /// A patch, on a machine whose own tilting letter is A (0) or B (1): the survey counts
+    /// the file's number style only from the first run that may be patched on (a program
+    /// with none is copied; its style is never used), and [`Survey::complete_style`] the
+    /// lines before. `None`: from the start.
+    lazy_style: Option<usize>,
 }
 
 impl<'a> Reading<'a> {
@@ -321,6 +349,7 @@ impl<'a> Reading<'a> {
             read: crate::program::read_options_with(machine, opts.inch)?,
             chord_tolerance_mm: opts.chord_tolerance_mm,
             tool: opts.tool.clone(),
+            lazy_style: Some(usize::from(machine.primary_letter() == 'B')),
         })
     }
 
@@ -334,11 +363,24 @@ impl<'a> Reading<'a> {
             read: crate::program::read_options_with(machine, opts.inch)?,
             chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
             tool: crate::tool::ToolOptions::default(),
+            lazy_style: None,
         })
     }
 }
 
 impl Survey {
+    /// The file's number style from all its lines, where the survey counted it only from
+    /// a point on ([`Reading::lazy_style`]): the lines before it are lexed again.
+    fn complete_style(&mut self, bytes: &[u8], rd: &Reading<'_>) -> Result<(), Error> {
+        if let Some((from, counted)) = self.partial_style.take() {
+            let mut ev = polepatch_nc::style_evidence_to(bytes, from, &self.read)
+                .map_err(|e| Error::Parse(e.with_path(rd.name)))?;
+            ev.merge(&counted);
+            self.style = ev.style();
+        }
+        Ok(())
+    }
+
     /// What the file's report lists besides its runs: the lines carried through without
     /// analysis, and the warnings — `first` (the primary letter's substitution, or why
     /// nothing is analysed) before the notes'.
@@ -377,6 +419,8 @@ fn survey_once(
     read: &polepatch_nc::ReadOptions,
 ) -> Result<(Survey, polepatch_nc::Settled), Error> {
     let mut sv = Surveying {
+        lazy_style: opts.lazy_style,
+        may_patch: false,
         cone_deg: opts.cone_deg,
         fallback: opts.fallback,
         work_offset_mm: opts.work_offset_mm,
@@ -388,6 +432,8 @@ fn survey_once(
         first_after: [EndRec::default(), EndRec::default()],
     };
     let mut style = StyleEvidence::default();
+    // Where the style is counted from: the first block, or (lazy) none yet.
+    let mut style_from = opts.lazy_style.is_none().then_some(0usize);
     let mut notes = crate::notes::Notes::new();
     let mut builder = RunBuilder::default();
     let mut prev = opts.read.initial();
@@ -430,7 +476,9 @@ fn survey_once(
         {
             first_vector = Some(s.block.line);
         }
-        style.add_block(bytes, s.words);
+        if style_from.is_some() {
+            style.add_block(bytes, s.words);
+        }
         notes.push(s.block, s.words, &prev, s.state);
         if let Some(d) = s.stated_datum {
             sv.datum_shifts.push((i, d));
@@ -439,6 +487,10 @@ fn survey_once(
             sv.frame_changes.push(i);
         }
         builder.push(i, s.block, s.state, &mut |run| sv.take(run));
+        if style_from.is_none() && sv.may_patch {
+            style_from = Some(s.block.span().start);
+            style.add_block(bytes, s.words);
+        }
         // Deciding blocks count from the open run's last block on: when this block
         // extended it, or no run is open, the verdicts seen so far are spent (the open run's
         // are not taken; a run this block ended is among the pending ones now).
@@ -476,6 +528,10 @@ fn survey_once(
             runs: sv.runs,
             uses: sv.uses,
             style: style.style(),
+            partial_style: match style_from {
+                Some(0) => None,
+                from => Some((from.unwrap_or(bytes.len()), style)),
+            },
             notes,
             blocks: i,
             no_run_why,
@@ -691,6 +747,10 @@ pub fn patch_nc_hooked(
     } else {
         stretches(&sv.runs, l, |rec| rec.near[l] || rec.feedless[l])
     };
+    let mut sv = sv;
+    if !todo.is_empty() {
+        sv.complete_style(bytes, &rd)?;
+    }
     if todo.is_empty() {
         // No run comes near the pole: no zone, and the output is the input.
         if (hooks.cancelled)() {
