@@ -342,8 +342,8 @@ impl Interpreter {
         words: &mut Vec<Word>,
     ) -> Result<Block, ParseError> {
         let first_word = words.len();
-        let s = self.lex(bytes, span.clone(), line, words)?;
-        Ok(self.apply(s, line, span, first_word..words.len()))
+        let mut s = self.lex(bytes, span.clone(), line, words)?;
+        Ok(self.apply(&mut s, line, span, first_word..words.len()))
     }
 
     /// What a line says (its words appended to `words`), before the modal state: this
@@ -356,10 +356,25 @@ impl Interpreter {
         line: usize,
         words: &mut Vec<Word>,
     ) -> Result<Scan, ParseError> {
-        if self.dialect == Dialect::Conversational {
-            return crate::conversational::lex(&self.controller, bytes, span, line, words);
-        }
         let mut s = Scan::default();
+        self.lex_into(bytes, span, line, words, &mut s)?;
+        Ok(s)
+    }
+
+    /// [`Interpreter::lex`] into `s`, which is `Scan::default()` (a reader that keeps the
+    /// lines of a window fills them in place: a `Scan` is a few hundred bytes).
+    pub(crate) fn lex_into(
+        &self,
+        bytes: &[u8],
+        span: Range<usize>,
+        line: usize,
+        words: &mut Vec<Word>,
+        s: &mut Scan,
+    ) -> Result<(), ParseError> {
+        if self.dialect == Dialect::Conversational {
+            *s = crate::conversational::lex(&self.controller, bytes, span, line, words)?;
+            return Ok(());
+        }
         // X Y Z A B C F seen in this block, with the column of the first.
         let mut seen: [Option<usize>; 7] = [None; 7];
         let col = |at: usize| at - span.start + 1;
@@ -410,8 +425,8 @@ impl Interpreter {
                         b'B' => s.axes[B] = Some(value),
                         b'C' => s.axes[C] = Some(value),
                         b'F' => s.feed = Some(value),
-                        b'G' => self.g(code10(value), &mut s),
-                        b'M' => m_code(self.dialect, &self.controller, code10(value), &mut s),
+                        b'G' => self.g(code10(value), s),
+                        b'M' => m_code(self.dialect, &self.controller, code10(value), s),
                         b'T' => {
                             s.flags.set(Flags::TOOL_CHANGE);
                             s.breaks = true;
@@ -454,7 +469,7 @@ impl Interpreter {
                 Token::Ident { name, span: ispan } => {
                     let is_function = bytes[name.clone()].eq_ignore_ascii_case(b"FUNCTION");
                     if is_function && self.dialect == Dialect::Heidenhain {
-                        function(&bytes[ispan.start..span.end], &mut s);
+                        function(&bytes[ispan.start..span.end], s);
                         break;
                     }
                     let n = &bytes[name.clone()];
@@ -467,7 +482,7 @@ impl Interpreter {
                             sinumerik_frame = Some(name.clone());
                         }
                     }
-                    self.ident(n, &mut s)
+                    self.ident(n, s)
                 }
                 Token::Assign {
                     letter,
@@ -489,9 +504,7 @@ impl Interpreter {
                         s.breaks = true;
                     }
                 }
-                Token::Indexed { letter, .. } => {
-                    crate::millplus::indexed(self.dialect, letter, &mut s)
-                }
+                Token::Indexed { letter, .. } => crate::millplus::indexed(self.dialect, letter, s),
                 Token::Percent { span } => {
                     for w in bytes[span].split(|b| b.is_ascii_whitespace()) {
                         if w.eq_ignore_ascii_case(b"G70") {
@@ -532,7 +545,7 @@ impl Interpreter {
             }
         }
         self.frames_after_words(
-            &mut s,
+            s,
             h_word,
             r_word,
             sinumerik_frame.map(|r| &bytes[r]),
@@ -542,8 +555,8 @@ impl Interpreter {
         if s.maybe_flow {
             s.flow = crate::statements::read_iso(self.dialect, bytes, span.clone());
         }
-        after_lex(bytes, &span, &mut s);
-        Ok(s)
+        after_lex(bytes, &span, s);
+        Ok(())
     }
 
     /// The frame transformations of a block, once its words are read.
@@ -667,12 +680,12 @@ impl Interpreter {
     /// Update the modal state; the block's `state` index is set by the caller.
     pub(crate) fn apply(
         &mut self,
-        mut s: Scan,
+        s: &mut Scan,
         line: usize,
         span: Range<usize>,
         words: Range<usize>,
     ) -> Block {
-        self.constants(&mut s);
+        self.constants(s);
         let always = self.controller.always;
         // Before the block: what program flow settles ([`crate::flow`]).
         if let Some(plan) = &self.plan {

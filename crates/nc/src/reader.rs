@@ -239,10 +239,10 @@ fn read(
             }
         });
         for part in &mut parts {
-            for (k, (span, scan, words)) in part.lines.drain(..).enumerate() {
+            for (k, (span, scan, words)) in part.lines.iter_mut().enumerate() {
                 let line = line_offset + k + 1;
-                let ws = &part.words[words];
-                let block = interp.apply(scan, line, span, 0..ws.len());
+                let ws = &part.words[words.clone()];
+                let block = interp.apply(scan, line, span.clone(), 0..ws.len());
                 if give(interp, &block, ws).is_break() {
                     return Ok(false);
                 }
@@ -290,9 +290,18 @@ impl LexedPart {
                 continue;
             }
             let first = self.words.len();
-            match interp.lex(bytes, span.clone(), self.line_count, &mut self.words) {
-                Ok(scan) => self.lines.push((span, scan, first..self.words.len())),
-                Err(e) => self.error = Some(e),
+            // Lexed in place (a `Scan` is a few hundred bytes).
+            self.lines
+                .push((span.clone(), Scan::default(), first..first));
+            let Some((_, scan, words)) = self.lines.last_mut() else {
+                continue;
+            };
+            match interp.lex_into(bytes, span, self.line_count, &mut self.words, scan) {
+                Ok(()) => *words = first..self.words.len(),
+                Err(e) => {
+                    self.lines.pop();
+                    self.error = Some(e);
+                }
             }
         }
     }

@@ -450,19 +450,22 @@ fn survey_once(
         if no_run_why.is_none() {
             no_run_why = NoRunWhy::of(s.block, s.state, incremental_set_line);
         }
-        // The first word of each tilting letter, and its first that is not 0: one pass
-        // over the block's words until both letters have turned.
-        if first_turn.iter().any(Option::is_none) {
-            for w in s.words {
-                let Some(l) = LETTERS.iter().position(|&c| c == w.letter) else {
-                    continue;
-                };
-                let column = (w.start as usize).saturating_sub(s.block.span().start) + 1;
-                let at = (s.block.line, column);
-                first_word[l].get_or_insert(at);
-                if w.value != 0.0 {
-                    first_turn[l].get_or_insert(at);
-                }
+        // The first word of each tilting letter, and its first that is not 0 (a letter
+        // that has turned has both).
+        for w in s.words {
+            let l = match w.letter {
+                b'A' => 0,
+                b'B' => 1,
+                _ => continue,
+            };
+            if first_turn[l].is_some() {
+                continue;
+            }
+            let column = (w.start as usize).saturating_sub(s.block.span().start) + 1;
+            let at = (s.block.line, column);
+            first_word[l].get_or_insert(at);
+            if w.value != 0.0 {
+                first_turn[l].get_or_insert(at);
             }
         }
         // (Only while no tilting word has been read: the hint is for programs without.)
