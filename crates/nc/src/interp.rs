@@ -402,9 +402,18 @@ impl Interpreter {
         let mut sinumerik_frame: Option<Range<usize>> = None;
         let mut cycle800_level: Option<bool> = None;
         let mut rpl = false;
-        for token in Lexer::new(bytes, span.clone()) {
-            let token =
-                token.map_err(|e| ParseError::at(line, e.at - span.start + 1, e.message))?;
+        let mut lexer = Lexer::new(bytes, span.clone());
+        loop {
+            // Most tokens are plain words: read without the general path.
+            let token = match lexer.next_plain_word() {
+                Some(t) => t,
+                None => match lexer.next() {
+                    Some(t) => {
+                        t.map_err(|e| ParseError::at(line, e.at - span.start + 1, e.message))?
+                    }
+                    None => break,
+                },
+            };
             match token {
                 Token::Word {
                     letter,

@@ -345,6 +345,25 @@ impl<'a> Lexer<'a> {
         (digits_start, e, value)
     }
 
+    /// The next token if it is a common word ([`Lexer::plain_word`]), the blanks before
+    /// it skipped; `None` leaves the rest of the line to [`Iterator::next`]. For a reader
+    /// of every line: most tokens are such words.
+    #[inline(always)]
+    pub(crate) fn next_plain_word(&mut self) -> Option<Token> {
+        let b = self.bytes;
+        let mut p = self.pos;
+        while p < self.end && is_blank(b[p]) {
+            p += 1;
+        }
+        self.pos = p;
+        let c = *b.get(p).filter(|_| p < self.end)?;
+        // A letter followed by a letter or `_` (an identifier) is no plain word either.
+        if !c.is_ascii_alphabetic() {
+            return None;
+        }
+        self.plain_word(p, c.to_ascii_uppercase())
+    }
+
     /// The common word, `letter` at `p` and right after it a plain number — an optional
     /// sign, digits with at most one `.`, at most 19 digits and 22 decimals, exact in an
     /// `f64` — ending at the line end, a blank, `*`, `;`, `(` or a letter other than `E`:
@@ -848,6 +867,49 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    /// Lexing a line with plain words taken first gives the tokens (and errors) of the
+    /// general reader.
+    #[test]
+    fn plain_words_first_give_the_same_tokens() {
+        for line in [
+            "N50 X+0.000 Y+0.000 Z-8 A+35.000 C-360.000 *",
+            "G1X10.Y-.5Z3 F1200.(c) ;x",
+            "  n10 g01 x1 y 2 Z- 5 TRAORI X=R1 A5=15. C=DC(12.5)",
+            "X1e5",
+            "X",
+            "G1 X1,5",
+            "#1=5 X#1 %NAME G71",
+            "/2 N1 G0 X1\x00",
+            "_X_HOME=-365. MSG(\"a\") \"s\" X1. Y2",
+        ] {
+            let bytes = line.as_bytes();
+            // (The lexer does not move past an error: a reader stops there.)
+            let mut general = Vec::new();
+            for t in Lexer::new(bytes, 0..bytes.len()) {
+                let err = t.is_err();
+                general.push(t);
+                if err {
+                    break;
+                }
+            }
+            let mut lx = Lexer::new(bytes, 0..bytes.len());
+            let mut mixed = Vec::new();
+            loop {
+                match lx.next_plain_word() {
+                    Some(t) => mixed.push(Ok(t)),
+                    None => match lx.next() {
+                        Some(t) => mixed.push(t),
+                        None => break,
+                    },
+                }
+                if mixed.last().is_some_and(|t| t.is_err()) {
+                    break;
+                }
+            }
+            assert_eq!(mixed, general, "{line}");
         }
     }
 
