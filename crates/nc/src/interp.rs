@@ -169,6 +169,20 @@ pub(crate) fn cycle800_rotates(args: &[u8]) -> bool {
     })
 }
 
+/// The index of `letter` in X Y Z A B C F (the axes in [`AXES`] order, then F).
+fn axis_or_feed(letter: u8) -> Option<usize> {
+    match letter {
+        b'X' => Some(X),
+        b'Y' => Some(Y),
+        b'Z' => Some(Z),
+        b'A' => Some(A),
+        b'B' => Some(B),
+        b'C' => Some(C),
+        b'F' => Some(6),
+        _ => None,
+    }
+}
+
 /// Bit of axis index `i` in [`Scan::axes_expr`].
 fn bit(i: usize) -> u8 {
     1 << i
@@ -328,8 +342,8 @@ impl Interpreter {
         words: &mut Vec<Word>,
     ) -> Result<Block, ParseError> {
         let first_word = words.len();
-        let s = self.lex(bytes, span.clone(), line, words)?;
-        Ok(self.apply(s, line, span, first_word..words.len()))
+        let mut s = self.lex(bytes, span.clone(), line, words)?;
+        Ok(self.apply(&mut s, line, span, first_word..words.len()))
     }
 
     /// What a line says (its words appended to `words`), before the modal state: this
@@ -342,15 +356,30 @@ impl Interpreter {
         line: usize,
         words: &mut Vec<Word>,
     ) -> Result<Scan, ParseError> {
-        if self.dialect == Dialect::Conversational {
-            return crate::conversational::lex(&self.controller, bytes, span, line, words);
-        }
         let mut s = Scan::default();
+        self.lex_into(bytes, span, line, words, &mut s)?;
+        Ok(s)
+    }
+
+    /// [`Interpreter::lex`] into `s`, which is `Scan::default()` (a reader that keeps the
+    /// lines of a window fills them in place: a `Scan` is a few hundred bytes).
+    pub(crate) fn lex_into(
+        &self,
+        bytes: &[u8],
+        span: Range<usize>,
+        line: usize,
+        words: &mut Vec<Word>,
+        s: &mut Scan,
+    ) -> Result<(), ParseError> {
+        if self.dialect == Dialect::Conversational {
+            *s = crate::conversational::lex(&self.controller, bytes, span, line, words)?;
+            return Ok(());
+        }
         // X Y Z A B C F seen in this block, with the column of the first.
         let mut seen: [Option<usize>; 7] = [None; 7];
         let col = |at: usize| at - span.start + 1;
         let mut once = |letter: u8, at: usize| -> Result<(), ParseError> {
-            if let Some(k) = b"XYZABCF".iter().position(|&l| l == letter) {
+            if let Some(k) = axis_or_feed(letter) {
                 if let Some(first) = seen[k] {
                     return Err(ParseError::at(
                         line,
@@ -373,9 +402,18 @@ impl Interpreter {
         let mut sinumerik_frame: Option<Range<usize>> = None;
         let mut cycle800_level: Option<bool> = None;
         let mut rpl = false;
-        for token in Lexer::new(bytes, span.clone()) {
-            let token =
-                token.map_err(|e| ParseError::at(line, e.at - span.start + 1, e.message))?;
+        let mut lexer = Lexer::new(bytes, span.clone());
+        loop {
+            // Most tokens are plain words: read without the general path.
+            let token = match lexer.next_plain_word() {
+                Some(t) => t,
+                None => match lexer.next() {
+                    Some(t) => {
+                        t.map_err(|e| ParseError::at(line, e.at - span.start + 1, e.message))?
+                    }
+                    None => break,
+                },
+            };
             match token {
                 Token::Word {
                     letter,
@@ -384,8 +422,8 @@ impl Interpreter {
                     value,
                     form,
                 } => {
-                    if let Some(i) = [A, B, C].into_iter().find(|&i| AXES[i] == letter) {
-                        s.axes_form[i - A] = form;
+                    if matches!(letter, b'A' | b'B' | b'C') {
+                        s.axes_form[usize::from(letter - b'A')] = form;
                     }
                     once(letter, wspan.start)?;
                     match letter {
@@ -396,8 +434,8 @@ impl Interpreter {
                         b'B' => s.axes[B] = Some(value),
                         b'C' => s.axes[C] = Some(value),
                         b'F' => s.feed = Some(value),
-                        b'G' => self.g(code10(value), &mut s),
-                        b'M' => m_code(self.dialect, &self.controller, code10(value), &mut s),
+                        b'G' => self.g(code10(value), s),
+                        b'M' => m_code(self.dialect, &self.controller, code10(value), s),
                         b'T' => {
                             s.flags.set(Flags::TOOL_CHANGE);
                             s.breaks = true;
@@ -440,7 +478,7 @@ impl Interpreter {
                 Token::Ident { name, span: ispan } => {
                     let is_function = bytes[name.clone()].eq_ignore_ascii_case(b"FUNCTION");
                     if is_function && self.dialect == Dialect::Heidenhain {
-                        function(&bytes[ispan.start..span.end], &mut s);
+                        function(&bytes[ispan.start..span.end], s);
                         break;
                     }
                     let n = &bytes[name.clone()];
@@ -453,7 +491,7 @@ impl Interpreter {
                             sinumerik_frame = Some(name.clone());
                         }
                     }
-                    self.ident(n, &mut s)
+                    self.ident(n, s)
                 }
                 Token::Assign {
                     letter,
@@ -475,9 +513,7 @@ impl Interpreter {
                         s.breaks = true;
                     }
                 }
-                Token::Indexed { letter, .. } => {
-                    crate::millplus::indexed(self.dialect, letter, &mut s)
-                }
+                Token::Indexed { letter, .. } => crate::millplus::indexed(self.dialect, letter, s),
                 Token::Percent { span } => {
                     for w in bytes[span].split(|b| b.is_ascii_whitespace()) {
                         if w.eq_ignore_ascii_case(b"G70") {
@@ -518,7 +554,7 @@ impl Interpreter {
             }
         }
         self.frames_after_words(
-            &mut s,
+            s,
             h_word,
             r_word,
             sinumerik_frame.map(|r| &bytes[r]),
@@ -528,8 +564,8 @@ impl Interpreter {
         if s.maybe_flow {
             s.flow = crate::statements::read_iso(self.dialect, bytes, span.clone());
         }
-        after_lex(bytes, &span, &mut s);
-        Ok(s)
+        after_lex(bytes, &span, s);
+        Ok(())
     }
 
     /// The frame transformations of a block, once its words are read.
@@ -653,12 +689,12 @@ impl Interpreter {
     /// Update the modal state; the block's `state` index is set by the caller.
     pub(crate) fn apply(
         &mut self,
-        mut s: Scan,
+        s: &mut Scan,
         line: usize,
         span: Range<usize>,
         words: Range<usize>,
     ) -> Block {
-        self.constants(&mut s);
+        self.constants(s);
         let always = self.controller.always;
         // Before the block: what program flow settles ([`crate::flow`]).
         if let Some(plan) = &self.plan {

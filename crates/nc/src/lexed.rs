@@ -139,7 +139,8 @@ pub(crate) fn after_lex(bytes: &[u8], span: &Range<usize>, s: &mut Scan) {
         s.expr_breaks = false;
     }
     let line = &bytes[span.clone()];
-    if let Some(cr) = line.iter().position(|&b| b == b'\r')
+    if has_cr(line)
+        && let Some(cr) = line.iter().position(|&b| b == b'\r')
         && line[cr + 1..].iter().any(|b| !b.is_ascii_whitespace())
     {
         s.tcpm = Some(Switch::Unknown);
@@ -147,6 +148,20 @@ pub(crate) fn after_lex(bytes: &[u8], span: &Range<usize>, s: &mut Scan) {
         s.unknown_after = true;
         s.breaks = true;
     }
+}
+
+/// Whether `line` holds a CR, eight bytes at a time (every line is looked at).
+fn has_cr(line: &[u8]) -> bool {
+    const LO: u64 = 0x0101_0101_0101_0101;
+    const HI: u64 = 0x8080_8080_8080_8080;
+    let mut chunks = line.chunks_exact(8);
+    let mut hit = 0u64;
+    for c in &mut chunks {
+        // A zero byte of `x` (a CR of the chunk) leaves its high bit set here.
+        let x = u64::from_le_bytes(c.try_into().unwrap_or([0; 8])) ^ (LO * u64::from(b'\r'));
+        hit |= x.wrapping_sub(LO) & !x & HI;
+    }
+    hit != 0 || chunks.remainder().contains(&b'\r')
 }
 
 /// A Heidenhain `FUNCTION …` line (`text` from the word `FUNCTION` on): `FUNCTION TCPM …`
@@ -176,5 +191,27 @@ pub(crate) fn function(text: &[u8], s: &mut Scan) {
     match sw {
         Some(sw) => s.tcpm = Some(sw),
         None => s.breaks = true,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// The eight-bytes-at-a-time CR search finds every CR, and nothing else.
+    #[test]
+    fn cr_found_anywhere() {
+        for len in 0..40 {
+            let line = vec![b'X'; len];
+            assert!(!super::has_cr(&line));
+            for at in 0..len {
+                let mut l = line.clone();
+                l[at] = b'\r';
+                assert!(super::has_cr(&l), "{len} {at}");
+                // Bytes near CR in value (0x0c, 0x0e, 0x8d) are not CRs.
+                for other in [0x0c, 0x0e, 0x8d, 0x00, 0xff] {
+                    l[at] = other;
+                    assert!(!super::has_cr(&l), "{len} {at} {other}");
+                }
+            }
+        }
     }
 }

@@ -345,6 +345,88 @@ impl<'a> Lexer<'a> {
         (digits_start, e, value)
     }
 
+    /// The next token if it is a common word ([`Lexer::plain_word`]), the blanks before
+    /// it skipped; `None` leaves the rest of the line to [`Iterator::next`]. For a reader
+    /// of every line: most tokens are such words.
+    #[inline(always)]
+    pub(crate) fn next_plain_word(&mut self) -> Option<Token> {
+        let b = self.bytes;
+        let mut p = self.pos;
+        while p < self.end && is_blank(b[p]) {
+            p += 1;
+        }
+        self.pos = p;
+        let c = *b.get(p).filter(|_| p < self.end)?;
+        // A letter followed by a letter or `_` (an identifier) is no plain word either.
+        if !c.is_ascii_alphabetic() {
+            return None;
+        }
+        self.plain_word(p, c.to_ascii_uppercase())
+    }
+
+    /// The common word, `letter` at `p` and right after it a plain number — an optional
+    /// sign, digits with at most one `.`, at most 19 digits and 22 decimals, exact in an
+    /// `f64` — ending at the line end, a blank, `*`, `;`, `(` or a letter other than `E`:
+    /// the token [`Lexer::word`] gives for it, in one pass. `None` for anything else
+    /// (`Lexer::word` reads it).
+    #[inline(always)]
+    fn plain_word(&mut self, p: usize, letter: u8) -> Option<Token> {
+        let b = &self.bytes[..self.end];
+        let ns = p + 1;
+        let (neg, ds) = match b.get(ns)? {
+            b'-' => (true, ns + 1),
+            b'+' => (false, ns + 1),
+            _ => (false, ns),
+        };
+        let mut e = ds;
+        let mut mantissa: u64 = 0;
+        // Digits before the point, then after it. Wraps only past 19 digits, which the
+        // check below refuses.
+        while let Some(&c) = b.get(e) {
+            let d = c.wrapping_sub(b'0');
+            if d >= 10 {
+                break;
+            }
+            mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
+            e += 1;
+        }
+        let point = b.get(e) == Some(&b'.');
+        let mut frac = 0usize;
+        if point {
+            e += 1;
+            let fs = e;
+            while let Some(&c) = b.get(e) {
+                let d = c.wrapping_sub(b'0');
+                if d >= 10 {
+                    break;
+                }
+                mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
+                e += 1;
+            }
+            frac = e - fs;
+        }
+        let digits = e - ds - usize::from(point);
+        if digits == 0 || digits > 19 || mantissa >= (1 << 53) || frac >= POW10.len() {
+            return None;
+        }
+        if let Some(&t) = b.get(e)
+            && !(is_blank(t)
+                || matches!(t, b'*' | b';' | b'(')
+                || (t.is_ascii_alphabetic() && !matches!(t, b'e' | b'E')))
+        {
+            return None;
+        }
+        let m = mantissa as f64 / POW10[frac];
+        self.pos = e;
+        Some(Token::Word {
+            letter,
+            span: p..e,
+            value_span: ns..e,
+            value: if neg { -m } else { m },
+            form: RotaryForm::Plain,
+        })
+    }
+
     fn word(&mut self, p: usize, letter: u8) -> Option<Result<Token, LexError>> {
         let b = self.bytes;
         let l = letter as char;
@@ -603,13 +685,14 @@ impl Iterator for Lexer<'_> {
 
     fn next(&mut self) -> Option<Self::Item> {
         let b = self.bytes;
-        while self.pos < self.end && is_blank(b[self.pos]) {
-            self.pos += 1;
+        let mut p = self.pos;
+        while p < self.end && is_blank(b[p]) {
+            p += 1;
         }
-        if self.pos >= self.end {
+        self.pos = p;
+        if p >= self.end {
             return None;
         }
-        let p = self.pos;
         let c = b[p];
         if is_control(c) {
             return self.err(p, control_message(c));
@@ -619,6 +702,8 @@ impl Iterator for Lexer<'_> {
                 let next = if p + 1 < self.end { b[p + 1] } else { b' ' };
                 if next.is_ascii_alphabetic() || next == b'_' {
                     self.ident(p)
+                } else if let Some(t) = self.plain_word(p, c.to_ascii_uppercase()) {
+                    Some(Ok(t))
                 } else {
                     self.word(p, c.to_ascii_uppercase())
                 }
@@ -713,6 +798,119 @@ mod tests {
         Lexer::new(s.as_bytes(), 0..s.len())
             .find_map(|t| t.err())
             .expect("an error")
+    }
+
+    /// The one-pass reading of a plain word gives what the general word reader gives, and
+    /// leaves to it every word it does not read.
+    #[test]
+    fn plain_words_read_as_the_general_reader_reads_them() {
+        let numbers = [
+            "0",
+            "-0",
+            "+0",
+            "12",
+            "12.",
+            ".5",
+            "-.5",
+            "+.5",
+            "+148.494",
+            "0.1",
+            "-360.000",
+            "9007199254740991",
+            "9007199254740993",
+            "1234567890123456789",
+            "12345678901234567890",
+            "0.0000000000000000000001",
+            "0.00000000000000000000001",
+            "1..2",
+            "1.2.",
+            ".",
+            "+",
+            "-",
+            "",
+            "+-1",
+            "- 5",
+            " 5",
+            "=5",
+            "=-.5",
+            "#1",
+            "[1]",
+            "1,5",
+            "1e5",
+            "1E5",
+            "1e",
+            "5=3",
+        ];
+        let after = [
+            "", " ", "\t", "\r", "*", " *", ";c", "(c)", "Y1", "E5", "e", "G1", "#", "[", "=", ",",
+            ",5", "+1", "-", "/", "\x00", "\x7f", "\u{e9}", ".", "_",
+        ];
+        for letter in ["X", "c", "G", "N", "F", "E", "R", "H", "Q"] {
+            for n in numbers {
+                for a in after {
+                    let line = format!("{letter}{n}{a}");
+                    let bytes = line.as_bytes();
+                    let mut fast = Lexer::new(bytes, 0..bytes.len());
+                    let up = bytes[0].to_ascii_uppercase();
+                    let Some(t) = fast.plain_word(0, up) else {
+                        continue;
+                    };
+                    let mut general = Lexer::new(bytes, 0..bytes.len());
+                    let g = general.word(0, up);
+                    assert_eq!(Some(Ok(t.clone())), g, "{line:?}");
+                    assert_eq!(fast.pos, general.pos, "{line:?}");
+                    if let Token::Word { value, .. } = t {
+                        let Some(Ok(Token::Word { value: v, .. })) = g else {
+                            unreachable!()
+                        };
+                        assert_eq!(value.to_bits(), v.to_bits(), "{line:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    /// Lexing a line with plain words taken first gives the tokens (and errors) of the
+    /// general reader.
+    #[test]
+    fn plain_words_first_give_the_same_tokens() {
+        for line in [
+            "N50 X+0.000 Y+0.000 Z-8 A+35.000 C-360.000 *",
+            "G1X10.Y-.5Z3 F1200.(c) ;x",
+            "  n10 g01 x1 y 2 Z- 5 TRAORI X=R1 A5=15. C=DC(12.5)",
+            "X1e5",
+            "X",
+            "G1 X1,5",
+            "#1=5 X#1 %NAME G71",
+            "/2 N1 G0 X1\x00",
+            "_X_HOME=-365. MSG(\"a\") \"s\" X1. Y2",
+        ] {
+            let bytes = line.as_bytes();
+            // (The lexer does not move past an error: a reader stops there.)
+            let mut general = Vec::new();
+            for t in Lexer::new(bytes, 0..bytes.len()) {
+                let err = t.is_err();
+                general.push(t);
+                if err {
+                    break;
+                }
+            }
+            let mut lx = Lexer::new(bytes, 0..bytes.len());
+            let mut mixed = Vec::new();
+            loop {
+                match lx.next_plain_word() {
+                    Some(t) => mixed.push(Ok(t)),
+                    None => match lx.next() {
+                        Some(t) => mixed.push(t),
+                        None => break,
+                    },
+                }
+                if mixed.last().is_some_and(|t| t.is_err()) {
+                    break;
+                }
+            }
+            assert_eq!(mixed, general, "{line}");
+        }
     }
 
     #[test]

@@ -11,6 +11,7 @@ use crate::interp::Interpreter;
 use crate::lexed::Scan;
 use crate::lines::LineEnds;
 use crate::modal::Modal;
+use crate::style::StyleEvidence;
 use crate::tcpm::ReadOptions;
 use crate::word::Word;
 use std::ops::Range;
@@ -149,6 +150,32 @@ pub(crate) fn scan_with(
     }))
 }
 
+/// The [`StyleEvidence`] of the lines of `bytes[..end]` (`end` the start of a line), lexed
+/// as `opts` reads them: the evidence of the words a read gives its visitor for those
+/// blocks, without the modal state. For a reader that counts the file's number style only
+/// once it needs it (`polepatch`'s patch: from the first run it may patch on) and counts the
+/// lines before then afterwards. Errors as a read's (none where a read of the file took
+/// these lines).
+pub fn style_evidence_to(
+    bytes: &[u8],
+    end: usize,
+    opts: &ReadOptions,
+) -> Result<StyleEvidence, ParseError> {
+    let dialect = match opts.dialect {
+        Dialect::Auto => detect(bytes),
+        d => d,
+    };
+    let interp = Interpreter::new(opts, dialect);
+    let mut ev = StyleEvidence::default();
+    let mut words = Vec::with_capacity(32);
+    for (span, line) in LineEnds::of(bytes).lines_from(&bytes[..end.min(bytes.len())], 0) {
+        words.clear();
+        interp.lex(bytes, span, line, &mut words)?;
+        ev.add_block(bytes, &words);
+    }
+    Ok(ev)
+}
+
 /// One read of the file with `interp`: whether `visit` took every block.
 fn read(
     bytes: &[u8],
@@ -212,10 +239,10 @@ fn read(
             }
         });
         for part in &mut parts {
-            for (k, (span, scan, words)) in part.lines.drain(..).enumerate() {
+            for (k, (span, scan, words)) in part.lines.iter_mut().enumerate() {
                 let line = line_offset + k + 1;
-                let ws = &part.words[words];
-                let block = interp.apply(scan, line, span, 0..ws.len());
+                let ws = &part.words[words.clone()];
+                let block = interp.apply(scan, line, span.clone(), 0..ws.len());
                 if give(interp, &block, ws).is_break() {
                     return Ok(false);
                 }
@@ -263,9 +290,18 @@ impl LexedPart {
                 continue;
             }
             let first = self.words.len();
-            match interp.lex(bytes, span.clone(), self.line_count, &mut self.words) {
-                Ok(scan) => self.lines.push((span, scan, first..self.words.len())),
-                Err(e) => self.error = Some(e),
+            // Lexed in place (a `Scan` is a few hundred bytes).
+            self.lines
+                .push((span.clone(), Scan::default(), first..first));
+            let Some((_, scan, words)) = self.lines.last_mut() else {
+                continue;
+            };
+            match interp.lex_into(bytes, span, self.line_count, &mut self.words, scan) {
+                Ok(()) => *words = first..self.words.len(),
+                Err(e) => {
+                    self.lines.pop();
+                    self.error = Some(e);
+                }
             }
         }
     }

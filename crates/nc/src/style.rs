@@ -51,6 +51,27 @@ impl ZeroStyle {
     }
 }
 
+/// The offset in `bytes[start..start + len]` (a number: at most one point) of its point.
+fn point_in(bytes: &[u8], start: usize, len: usize) -> Option<usize> {
+    const LO: u64 = 0x0101_0101_0101_0101;
+    const HI: u64 = 0x8080_8080_8080_8080;
+    if len <= 8
+        && let Some(chunk) = bytes.get(start..start + 8)
+    {
+        // Eight bytes at a time: the lowest set bit of `t` marks the first `.` exactly;
+        // bits past `len` are dropped.
+        let x = u64::from_le_bytes(chunk.try_into().unwrap_or([0; 8])) ^ (LO * u64::from(b'.'));
+        let t = x.wrapping_sub(LO) & !x & HI;
+        let t = if len < 8 {
+            t & ((1u64 << (len * 8)) - 1)
+        } else {
+            t
+        };
+        return (t != 0).then(|| (t.trailing_zeros() / 8) as usize);
+    }
+    bytes[start..start + len].iter().position(|&b| b == b'.')
+}
+
 /// What the words of one letter show about their style.
 #[derive(Default)]
 struct Evidence {
@@ -93,28 +114,36 @@ impl Evidence {
 
     /// Count word `w` (its offsets index `bytes`).
     fn add(&mut self, bytes: &[u8], w: &Word) {
+        self.add_after(bytes, w, bytes.get(w.start as usize + 1).copied());
+    }
+
+    /// [`Evidence::add`], `after_letter` the byte after the word's letter.
+    fn add_after(&mut self, bytes: &[u8], w: &Word, after_letter: Option<u8>) {
         let e = self;
-        let text = &bytes[w.value_span()];
+        let body_start = w.value_start as usize;
+        let text = &bytes[body_start..w.end as usize];
         e.words += 1;
-        if bytes.get(w.start as usize + 1) == Some(&b'=') {
+        if after_letter == Some(b'=') {
             e.equals += 1;
         }
-        let (sign, body) = match text.first() {
-            Some(b'+') => (Some(b'+'), &text[1..]),
-            Some(b'-') => (Some(b'-'), &text[1..]),
-            _ => (None, text),
+        let (sign, body_start) = match text.first() {
+            Some(b'+') => (Some(b'+'), body_start + 1),
+            Some(b'-') => (Some(b'-'), body_start + 1),
+            _ => (None, body_start),
         };
+        let body = &bytes[body_start..w.end as usize];
         match sign {
             Some(b'+') => e.plus += 1,
             None => e.unsigned += 1,
             _ => {}
         }
-        let (decimals, has_point) = match body.iter().position(|&b| b == b'.') {
+        let (decimals, has_point) = match point_in(bytes, body_start, body.len()) {
             Some(k) => (body.len() - k - 1, true),
             None => (0, false),
         };
         e.max_decimals = e.max_decimals.max(decimals);
-        if body.iter().all(|&b| b == b'0' || b == b'.') {
+        // Written as zero: its value is the number parsed, so only a zero value can be.
+        if w.value == 0.0 && body.iter().all(|&b| b == b'0' || b == b'.') {
             e.zero_form.get_or_insert((
                 ZeroStyle {
                     leading_zero: body.first() == Some(&b'0'),
@@ -341,26 +370,44 @@ impl Default for StyleEvidence {
 impl StyleEvidence {
     /// Count the words of one block (their offsets index `bytes`).
     pub fn add_block(&mut self, bytes: &[u8], words: &[Word]) {
+        let mut prev_end = None;
         for w in words {
-            if let Some(i) = AXES.iter().position(|&a| a == w.letter) {
-                self.letters[i].add(bytes, w);
-                if bytes
-                    .get(w.start as usize + 1)
-                    .is_some_and(|&b| b == b' ' || b == b'\t')
-                {
-                    self.letter_spaced += 1;
-                } else {
-                    self.letter_tight += 1;
-                }
+            // Two words of the block follow each other directly, or with a gap.
+            match prev_end {
+                Some(end) if end == w.start => self.tight += 1,
+                Some(_) => self.spaced += 1,
+                None => {}
             }
-        }
-        for pair in words.windows(2) {
-            if pair[0].end == pair[1].start {
-                self.tight += 1;
+            prev_end = Some(w.end);
+            let i = match w.letter {
+                b'X' => 0,
+                b'Y' => 1,
+                b'Z' => 2,
+                b'A' => 3,
+                b'B' => 4,
+                b'C' => 5,
+                _ => continue,
+            };
+            debug_assert_eq!(AXES[i], w.letter);
+            let after_letter = bytes.get(w.start as usize + 1).copied();
+            self.letters[i].add_after(bytes, w, after_letter);
+            if matches!(after_letter, Some(b' ' | b'\t')) {
+                self.letter_spaced += 1;
             } else {
-                self.spaced += 1;
+                self.letter_tight += 1;
             }
         }
+    }
+
+    /// Count what `other` counted too (other words of the same file).
+    pub fn merge(&mut self, other: &StyleEvidence) {
+        for (l, o) in self.letters.iter_mut().zip(&other.letters) {
+            *l = l.merged(o);
+        }
+        self.spaced += other.spaced;
+        self.tight += other.tight;
+        self.letter_spaced += other.letter_spaced;
+        self.letter_tight += other.letter_tight;
     }
 
     /// The file's style from what was counted.
@@ -498,6 +545,39 @@ mod tests {
         assert!(!st.strip_trailing_zeros);
         assert_eq!(st.render(2.5, 3), "2.500");
         assert_eq!(st.render(0.0, 3), "0.000");
+    }
+
+    /// The evidence of a file counted in two parts and merged is the evidence of the whole.
+    #[test]
+    fn evidence_merged_from_parts_is_the_wholes() {
+        let src = "N1 G01 X+0 C+126.28 *\nN2 C+148.494 Y0.0 *\nN3 C+180 X 5. *\nG1X1.Y2.Z.5B-.5\nX2.0 A0.\n";
+        let p = parse(src.as_bytes().to_vec(), Dialect::Auto).unwrap();
+        let whole = FileStyle::of(&p);
+        for cut in 0..=p.blocks.len() {
+            let (mut a, mut b) = (StyleEvidence::default(), StyleEvidence::default());
+            for (k, bl) in p.blocks.iter().enumerate() {
+                let ev = if k < cut { &mut a } else { &mut b };
+                ev.add_block(&p.bytes, &p.words[bl.words()]);
+            }
+            b.merge(&a);
+            assert_eq!(b.style(), whole, "{cut}");
+        }
+    }
+
+    /// The point of a number found eight bytes at a time is the one found byte by byte.
+    #[test]
+    fn point_found_eight_bytes_at_a_time() {
+        let text = b"12.5 .5 0. 1234567.8 12345678 1234567. .2345678 123.45678901 5 + ...";
+        for start in 0..text.len() {
+            for len in 0..=(text.len() - start).min(12) {
+                let slow = text[start..start + len].iter().position(|&b| b == b'.');
+                let slice = &text[start..start + len];
+                // Only numbers hold at most one point.
+                if slice.iter().filter(|&&b| b == b'.').count() <= 1 {
+                    assert_eq!(point_in(text, start, len), slow, "{start} {len}");
+                }
+            }
+        }
     }
 
     /// The file style gathered block by block is each letter's [`NumberStyle::of`], and the

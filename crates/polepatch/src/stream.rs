@@ -159,7 +159,12 @@ struct Survey {
     runs: Vec<RunRec>,
     /// Some run point has a value for X Y Z A B C.
     uses: [bool; 6],
+    /// The file's number style; with `partial_style`, only of the lines from there on.
     style: FileStyle,
+    /// A patch counts the style from the first run it may patch on
+    /// ([`Reading::lazy_style`]): the byte where it began (the file's length if no run
+    /// did) and what it counted; [`Survey::complete_style`] counts the lines before.
+    partial_style: Option<(usize, StyleEvidence)>,
     /// What the reader carried through without analysing.
     notes: crate::notes::Notes,
     /// Blocks in the file.
@@ -245,6 +250,11 @@ struct Surveying {
     readings: [RotaryLetters; 2],
     /// The machine's distance from the pole.
     pole: crate::program::PoleDistance,
+    /// [`Reading::lazy_style`].
+    lazy_style: Option<usize>,
+    /// Some run given out may be patched (for the tilting letter it may have): the style
+    /// is counted from then on.
+    may_patch: bool,
     cone_deg: f64,
     fallback: Option<f64>,
     work_offset_mm: Option<[f64; 3]>,
@@ -293,6 +303,19 @@ impl Surveying {
                 self.work_offset_mm,
             ),
         });
+        if let Some(own) = self.lazy_style
+            && !self.may_patch
+        {
+            // A patch patches the runs near the pole or without a feed for the tilting
+            // letter: the machine's own once the runs use it, else either.
+            let rec = &self.runs[r];
+            let wanted = |l: usize| rec.near[l] || rec.feedless[l];
+            self.may_patch = if self.uses[self.readings[own].tilt_index()] {
+                wanted(own)
+            } else {
+                wanted(0) || wanted(1)
+            };
+        }
     }
 
     /// Block `i` (on `line`) has its say on the end pose of the runs before it, per
@@ -329,14 +352,21 @@ struct Reading<'a> {
     chord_tolerance_mm: f64,
     /// The caller's tool options.
     tool: crate::tool::ToolOptions,
+    /// A patch, with the machine's own reading at this index of [`readings`] (0 for A-C, 1
+    /// for B-C): the survey counts
+    /// the file's number style only from the first run that may be patched on (a program
+    /// with none is copied; its style is never used), and [`Survey::complete_style`] the
+    /// lines before. `None`: from the start.
+    lazy_style: Option<usize>,
 }
 
 impl<'a> Reading<'a> {
     /// How a patch with `opts` reads for `machine`.
     fn patch(opts: &'a crate::PatchOptions, machine: &Machine) -> Result<Self, Error> {
+        let letters = crate::program::check_layout(machine)?;
         Ok(Reading {
             name: &opts.name,
-            letters: crate::program::check_layout(machine)?,
+            letters,
             pole: crate::program::PoleDistance::of(machine),
             cone_deg: opts.patch.reach_deg(),
             fallback: opts.feed_fallback_mm_min,
@@ -344,6 +374,7 @@ impl<'a> Reading<'a> {
             read: crate::program::read_options_with(machine, opts.inch)?,
             chord_tolerance_mm: opts.chord_tolerance_mm,
             tool: opts.tool.clone(),
+            lazy_style: readings(letters).iter().position(|r| *r == letters),
         })
     }
 
@@ -359,11 +390,24 @@ impl<'a> Reading<'a> {
             read: crate::program::read_options_with(machine, opts.inch)?,
             chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
             tool: crate::tool::ToolOptions::default(),
+            lazy_style: None,
         })
     }
 }
 
 impl Survey {
+    /// The file's number style from all its lines, where the survey counted it only from
+    /// a point on ([`Reading::lazy_style`]): the lines before it are lexed again.
+    fn complete_style(&mut self, bytes: &[u8], rd: &Reading<'_>) -> Result<(), Error> {
+        if let Some((from, counted)) = self.partial_style.take() {
+            let mut ev = polepatch_nc::style_evidence_to(bytes, from, &self.read)
+                .map_err(|e| Error::Parse(e.with_path(rd.name)))?;
+            ev.merge(&counted);
+            self.style = ev.style();
+        }
+        Ok(())
+    }
+
     /// What the file's report lists besides its runs: the lines carried through without
     /// analysis, and the warnings — `first` (the primary letter's substitution, or why
     /// nothing is analysed) before the notes'.
@@ -404,6 +448,8 @@ fn survey_once(
     let mut sv = Surveying {
         readings: readings(opts.letters),
         pole: opts.pole.clone(),
+        lazy_style: opts.lazy_style,
+        may_patch: false,
         cone_deg: opts.cone_deg,
         fallback: opts.fallback,
         work_offset_mm: opts.work_offset_mm,
@@ -415,6 +461,8 @@ fn survey_once(
         first_after: [EndRec::default(), EndRec::default()],
     };
     let mut style = StyleEvidence::default();
+    // Where the style is counted from: the first block, or (lazy) none yet.
+    let mut style_from = opts.lazy_style.is_none().then_some(0usize);
     let mut notes = crate::notes::Notes::new();
     let mut builder = RunBuilder::default();
     let mut prev = opts.read.initial();
@@ -431,19 +479,23 @@ fn survey_once(
         if no_run_why.is_none() {
             no_run_why = NoRunWhy::of(s.block, s.state, incremental_set_line);
         }
-        // The first word of each rotary letter, and its first that is not 0: one pass
-        // over the block's words until every letter has turned.
-        if first_turn.iter().any(Option::is_none) {
-            for w in s.words {
-                let Some(l) = b"ABC".iter().position(|&c| c == w.letter) else {
-                    continue;
-                };
-                let column = (w.start as usize).saturating_sub(s.block.span().start) + 1;
-                let at = (s.block.line, column);
-                first_word[l].get_or_insert(at);
-                if w.value != 0.0 {
-                    first_turn[l].get_or_insert(at);
-                }
+        // The first word of each rotary letter, and its first that is not 0 (a letter
+        // that has turned has both).
+        for w in s.words {
+            let l = match w.letter {
+                b'A' => 0,
+                b'B' => 1,
+                b'C' => 2,
+                _ => continue,
+            };
+            if first_turn[l].is_some() {
+                continue;
+            }
+            let column = (w.start as usize).saturating_sub(s.block.span().start) + 1;
+            let at = (s.block.line, column);
+            first_word[l].get_or_insert(at);
+            if w.value != 0.0 {
+                first_turn[l].get_or_insert(at);
             }
         }
         // (Only while no rotary word has been read: the hint is for programs without.)
@@ -457,7 +509,9 @@ fn survey_once(
         {
             first_vector = Some(s.block.line);
         }
-        style.add_block(bytes, s.words);
+        if style_from.is_some() {
+            style.add_block(bytes, s.words);
+        }
         notes.push(s.block, s.words, &prev, s.state);
         if let Some(d) = s.stated_datum {
             sv.datum_shifts.push((i, d));
@@ -466,6 +520,10 @@ fn survey_once(
             sv.frame_changes.push(i);
         }
         builder.push(i, s.block, s.state, &mut |run| sv.take(run));
+        if style_from.is_none() && sv.may_patch {
+            style_from = Some(s.block.span().start);
+            style.add_block(bytes, s.words);
+        }
         // Deciding blocks count from the open run's last block on: when this block
         // extended it, or no run is open, the verdicts seen so far are spent (the open run's
         // are not taken; a run this block ended is among the pending ones now).
@@ -503,6 +561,10 @@ fn survey_once(
             runs: sv.runs,
             uses: sv.uses,
             style: style.style(),
+            partial_style: match style_from {
+                Some(0) => None,
+                from => Some((from.unwrap_or(bytes.len()), style)),
+            },
             notes,
             blocks: i,
             no_run_why,
@@ -717,6 +779,10 @@ pub fn patch_nc_hooked(
     } else {
         stretches(&sv.runs, l, |rec| rec.near[l] || rec.feedless[l])
     };
+    let mut sv = sv;
+    if !todo.is_empty() {
+        sv.complete_style(bytes, &rd)?;
+    }
     if todo.is_empty() {
         // No run comes near the pole: no zone, and the output is the input.
         if (hooks.cancelled)() {
