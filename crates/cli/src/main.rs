@@ -419,7 +419,7 @@ fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
                     tilt: primary,
                     pole: machine.c_letter() as u8,
                 };
-                print_run(&mut out, &r, letters)?;
+                print_run(&mut out, &r, letters, machine.standard_form().is_some())?;
             }
             runs += 1;
             if r.error.is_some() {
@@ -472,6 +472,7 @@ fn print_run(
     out: &mut impl Write,
     r: &polepatch::report::RunReport,
     letters: polepatch::nc::RotaryLetters,
+    standard: bool,
 ) -> std::io::Result<()> {
     {
         let feed = r.feed_mm_min.map_or("no F".to_string(), |f| {
@@ -552,11 +553,16 @@ fn print_run(
         for z in &f.zones {
             writeln!(
                 out,
-                "  singular zone lines {}–{} ({}), min |{}| {:.3}° at line {}, {} ratio {:.3}",
+                "  singular zone lines {}–{} ({}), {} {:.3}° at line {}, {} ratio {:.3}",
                 z.lines[0],
                 z.lines[1],
                 z.kind,
-                letters.tilt as char,
+                // |P| is the distance from the pole on the standard form only.
+                if standard {
+                    format!("min |{}|", letters.tilt as char)
+                } else {
+                    "least distance from the pole".to_string()
+                },
                 z.min_abs_primary_deg,
                 z.singular_line,
                 letters.pole as char,

@@ -239,7 +239,8 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
         }
     }
     if failed < reports.len() {
-        print_summary(&names, &reports, &mut table).context("printing the summary")?;
+        print_summary(&names, &reports, machine.c_letter(), &mut table)
+            .context("printing the summary")?;
     }
     for rep in &ok {
         for w in &rep.warnings {
@@ -337,12 +338,22 @@ fn csv_rows(reports: &[&FileReport]) -> Result<Vec<u8>> {
 fn print_summary(
     inputs: &[PathBuf],
     reports: &[Result<FileReport, JobError>],
+    pole_letter: char,
     out: &mut dyn std::io::Write,
 ) -> std::io::Result<()> {
+    // The pole axis' ratio, by its letter (C on the built-ins, B on an A-B trunnion).
     writeln!(
         out,
         "{:<40} {:>5} {:>7} {:>15} {:>15} {:>13} {:>8} {:>6} {:>8}  tool",
-        "file", "zones", "reached", "C ratio", "overall", "time s", "dev °", "points", "words",
+        "file",
+        "zones",
+        "reached",
+        format!("{pole_letter} ratio"),
+        "overall",
+        "time s",
+        "dev °",
+        "points",
+        "words",
     )?;
     for (input, r) in inputs.iter().zip(reports) {
         let rep = match r {
