@@ -18,24 +18,46 @@ fn machine(file: &str) -> Machine {
     Machine::from_file(&root().join("crates/kinematics/machines").join(file)).unwrap()
 }
 
-/// The (B, C) in force after each line of a Heidenhain ISO program (modal words).
-fn rotary_per_line(text: &str) -> Vec<Option<(f64, f64)>> {
-    let (mut b, mut c) = (None, None);
+/// The values of the letters `l0` and `l1` in force after each line of a program (modal
+/// words), once both are known.
+fn pair_per_line(text: &str, l0: &str, l1: &str) -> Vec<Option<(f64, f64)>> {
+    let (mut v0, mut v1) = (None, None);
     text.lines()
         .map(|line| {
             for tok in line.split_whitespace() {
                 let (l, v) = tok.split_at(1);
                 if let Ok(v) = v.parse::<f64>() {
-                    match l {
-                        "B" => b = Some(v),
-                        "C" => c = Some(v),
-                        _ => {}
+                    if l == l0 {
+                        v0 = Some(v);
+                    } else if l == l1 {
+                        v1 = Some(v);
                     }
                 }
             }
-            b.zip(c)
+            v0.zip(v1)
         })
         .collect()
+}
+
+/// The largest angle, degrees, between the tool axes `fk` gives for the values of the
+/// letters `l0`, `l1` in force after each line of `input` and of `output` (the same lines:
+/// a rewrite changes words, never lines).
+fn worst_change_deg(
+    input: &str,
+    output: &str,
+    (l0, l1): (&str, &str),
+    fk: impl Fn(f64, f64) -> [f64; 3],
+) -> f64 {
+    let (before, after) = (pair_per_line(input, l0, l1), pair_per_line(output, l0, l1));
+    assert_eq!(before.len(), after.len());
+    before
+        .iter()
+        .zip(&after)
+        .filter_map(|(b, a)| {
+            let ((b0, b1), (a0, a1)) = (b.as_ref()?, a.as_ref()?);
+            Some(angle_deg(fk(*b0, *b1), fk(*a0, *a1)))
+        })
+        .fold(0.0, f64::max)
 }
 
 /// Tool axis in the part frame of a B head (about +Y) and a C rotation about +Z. Whether C
@@ -76,16 +98,7 @@ fn head_table_and_head_head_patch_a_planted_pass_with_the_right_deviation() {
         assert_eq!(z.outcome, polepatch::Outcome::Reached, "{file}: {z:?}");
         assert!(z.after.overall_ratio >= 1.0 - 1e-3, "{file}: {z:?}");
         let out = String::from_utf8(out).unwrap();
-        let (before, after) = (rotary_per_line(&input), rotary_per_line(&out));
-        assert_eq!(before.len(), after.len());
-        let worst = before
-            .iter()
-            .zip(&after)
-            .filter_map(|(b, a)| {
-                let ((b0, c0), (b1, c1)) = (b.as_ref()?, a.as_ref()?);
-                Some(angle_deg(reference_fk(*b0, *c0), reference_fk(*b1, *c1)))
-            })
-            .fold(0.0, f64::max);
+        let worst = worst_change_deg(&input, &out, ("B", "C"), reference_fk);
         assert!(worst > 0.1, "{file}: nothing turned");
         assert!(
             (worst - z.max_deviation_deg).abs() < 1e-6,
@@ -93,6 +106,28 @@ fn head_table_and_head_head_patch_a_planted_pass_with_the_right_deviation() {
             z.max_deviation_deg
         );
     }
+}
+
+/// A CL pass (APT, F2000): X from 0 to 40 mm at Z −5, the tool axis `axis(sweep, by)`
+/// normalised, with `sweep` going from tan 15° to tan −15° and `by` = tan 1°: the caller
+/// puts the 1 on the pole's direction, so the pass goes by the pole 1° from it.
+fn cl_pass(axis: impl Fn(f64, f64) -> [f64; 3]) -> String {
+    let mut apt = String::from("UNITS/MM\nFEDRAT/2000\n");
+    for k in 0..=40 {
+        let t = f64::from(k) / 40.0;
+        let o = axis(
+            (15.0 - 30.0 * t).to_radians().tan(),
+            1f64.to_radians().tan(),
+        );
+        let n = o.iter().map(|v| v * v).sum::<f64>().sqrt();
+        apt += &format!(
+            "GOTO/{k},0,-5,{:.9},{:.9},{:.9}\n",
+            o[0] / n,
+            o[1] / n,
+            o[2] / n
+        );
+    }
+    apt + "FINI\n"
 }
 
 /// Tool axis in the part frame of the 45° nutating table: B about (0, 1, 1)/√2 carrying
@@ -116,11 +151,6 @@ fn reference_fk_nutating(b_deg: f64, c_deg: f64) -> [f64; 3] {
     ]
 }
 
-/// (B, C) in force after each line of a Heidenhain ISO program.
-fn bc_per_line(text: &str) -> Vec<Option<(f64, f64)>> {
-    rotary_per_line(text)
-}
-
 /// Issue 29: a 45° nutating table (B at 45° between +Y and +Z, carrying the C table). A
 /// pass whose tool axis goes by 1° from the pole, posted for the machine by `post` (its
 /// own inverse kinematics), is found — at its distance from the pole, the angle between the
@@ -133,17 +163,7 @@ fn a_45_degree_nutating_table_patches_a_planted_pass() {
     assert!(nut.standard_form().is_none());
     // X from 0 to 40 mm; the tool axis tilts from +15° to −15° about Y while it stays 1°
     // from the pole in Y.
-    let mut apt = String::from("UNITS/MM\nFEDRAT/2000\n");
-    for k in 0..=40 {
-        let t = f64::from(k) / 40.0;
-        let (ax, ay) = (
-            (15.0 - 30.0 * t).to_radians().tan(),
-            1f64.to_radians().tan(),
-        );
-        let n = (ax * ax + ay * ay + 1.0).sqrt();
-        apt += &format!("GOTO/{k},0,-5,{:.9},{:.9},{:.9}\n", ax / n, ay / n, 1.0 / n);
-    }
-    apt += "FINI\n";
+    let apt = cl_pass(|sweep, by| [sweep, by, 1.0]);
     let cl = read_cl(apt.as_bytes(), "nut.apt").unwrap();
     let post = PostOptions {
         patch: false,
@@ -160,19 +180,7 @@ fn a_45_degree_nutating_table_patches_a_planted_pass() {
     assert_eq!(z.outcome, polepatch::Outcome::Reached, "{z:?}");
     assert!(z.after.overall_ratio >= 1.0 - 1e-3, "{z:?}");
     let out = String::from_utf8(out).unwrap();
-    let (before, after) = (bc_per_line(&input), bc_per_line(&out));
-    assert_eq!(before.len(), after.len());
-    let worst = before
-        .iter()
-        .zip(&after)
-        .filter_map(|(b, a)| {
-            let ((b0, c0), (b1, c1)) = (b.as_ref()?, a.as_ref()?);
-            Some(angle_deg(
-                reference_fk_nutating(*b0, *c0),
-                reference_fk_nutating(*b1, *c1),
-            ))
-        })
-        .fold(0.0, f64::max);
+    let worst = worst_change_deg(&input, &out, ("B", "C"), reference_fk_nutating);
     assert!(worst > 0.1, "nothing turned");
     assert!(
         (worst - z.max_deviation_deg).abs() < 1e-6,
@@ -243,26 +251,6 @@ fn reference_fk_ab(a_deg: f64, b_deg: f64) -> [f64; 3] {
     ]
 }
 
-/// The (A, B) in force after each line of a Heidenhain ISO program (modal words).
-fn ab_per_line(text: &str) -> Vec<Option<(f64, f64)>> {
-    let (mut a, mut b) = (None, None);
-    text.lines()
-        .map(|line| {
-            for tok in line.split_whitespace() {
-                let (l, v) = tok.split_at(1);
-                if let Ok(v) = v.parse::<f64>() {
-                    match l {
-                        "A" => a = Some(v),
-                        "B" => b = Some(v),
-                        _ => {}
-                    }
-                }
-            }
-            a.zip(b)
-        })
-        .collect()
-}
-
 /// Issue 29: an A-B trunnion (A tilting about X, the platter B about the table's normal,
 /// the pole axis). A planted pass 1° from the pole written with its letters (the A-C
 /// fixture with its C words written as B) is found, patched to feed on both rotary axes
@@ -288,19 +276,7 @@ fn an_a_b_trunnion_patches_its_own_letters() {
     );
     let out = String::from_utf8(out).unwrap();
     assert!(!out.contains(" C"), "no C word written:\n{out}");
-    let (before, after) = (ab_per_line(&ab_text), ab_per_line(&out));
-    assert_eq!(before.len(), after.len());
-    let worst = before
-        .iter()
-        .zip(&after)
-        .filter_map(|(b, a)| {
-            let ((a0, b0), (a1, b1)) = (b.as_ref()?, a.as_ref()?);
-            Some(angle_deg(
-                reference_fk_ab(*a0, *b0),
-                reference_fk_ab(*a1, *b1),
-            ))
-        })
-        .fold(0.0, f64::max);
+    let worst = worst_change_deg(&ab_text, &out, ("A", "B"), reference_fk_ab);
     assert!(worst > 0.1, "nothing turned");
     assert!(
         (worst - z.max_deviation_deg).abs() < 1e-6,
@@ -408,17 +384,7 @@ fn a_linuxcnc_xyzab_tdr_pass_by_its_pole_along_x_is_found_and_patched() {
     let ini = root().join("crates/kinematics/tests/linuxcnc/xyzab-tdr/xyzab-tdr.ini");
     let tdr = Machine::from_file(&ini).unwrap();
     assert_eq!((tdr.primary_letter(), tdr.c_letter()), ('B', 'A'));
-    let mut apt = String::from("UNITS/MM\nFEDRAT/2000\n");
-    for k in 0..=40 {
-        let t = f64::from(k) / 40.0;
-        let (ay, az) = (
-            (15.0 - 30.0 * t).to_radians().tan(),
-            1f64.to_radians().tan(),
-        );
-        let n = (ay * ay + az * az + 1.0).sqrt();
-        apt += &format!("GOTO/{k},0,-5,{:.9},{:.9},{:.9}\n", 1.0 / n, ay / n, az / n);
-    }
-    apt += "FINI\n";
+    let apt = cl_pass(|sweep, by| [1.0, sweep, by]);
     let cl = read_cl(apt.as_bytes(), "tdr.apt").unwrap();
     let post = PostOptions {
         patch: false,
@@ -442,16 +408,7 @@ fn a_linuxcnc_xyzab_tdr_pass_by_its_pole_along_x_is_found_and_patched() {
         [b.sin(), -a.sin() * b.cos(), a.cos() * b.cos()]
     };
     let out = String::from_utf8(out).unwrap();
-    let (before, after) = (ab_per_line(&input), ab_per_line(&out));
-    assert_eq!(before.len(), after.len());
-    let worst = before
-        .iter()
-        .zip(&after)
-        .filter_map(|(b, a)| {
-            let ((a0, b0), (a1, b1)) = (b.as_ref()?, a.as_ref()?);
-            Some(angle_deg(fk(*a0, *b0), fk(*a1, *b1)))
-        })
-        .fold(0.0, f64::max);
+    let worst = worst_change_deg(&input, &out, ("A", "B"), fk);
     assert!(worst > 0.1, "nothing turned");
     assert!(
         (worst - z.max_deviation_deg).abs() < 1e-6,
