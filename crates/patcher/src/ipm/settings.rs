@@ -15,6 +15,12 @@ pub struct IpmSettings {
     /// Static regularisation of the KKT matrix (`±δ`, on the equilibrated problem).
     /// Default 1e-9.
     pub regularisation: f64,
+    /// Factor the unregularised KKT matrix first, and add [`IpmSettings::regularisation`]
+    /// only when that meets a zero or non-finite pivot. The joint patch's matrix is
+    /// positive definite (every band unknown has a proximal square in H), so the solves
+    /// are exact to round-off and iterative refinement stops after one residual, where
+    /// with `δ` it took 2–3 more solves per Newton system. Default true.
+    pub unregularised_first: bool,
     /// Most iterative refinement steps per solve (it stops earlier when the residual is
     /// below 1e-13 of the right-hand side). Default 4.
     pub refinement_steps: u32,
@@ -28,6 +34,7 @@ impl Default for IpmSettings {
             tol_gap: 1e-8,
             step_fraction: 0.99,
             regularisation: 1e-9,
+            unregularised_first: true,
             refinement_steps: 4,
         }
     }

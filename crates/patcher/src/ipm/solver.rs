@@ -28,7 +28,6 @@ impl Problem {
         let hmat = sys.h_matrix(w);
         let mut unreg = BorderedBand::new(nb, w, k);
         let mut kkt = BorderedBand::new(nb, w, k);
-        let delta = st.regularisation;
         let blocks: Vec<(usize, usize)> = sys.cones.iter().map(|c| (c.b0, c.q)).collect();
         let mut d = vec![1.0; ml];
         let mut d_sqrt = vec![1.0; ml];
@@ -45,9 +44,16 @@ impl Problem {
         let (mut rhs, mut sol, mut tmp) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         // Start (CVXOPT's): x̂ minimising ½xᵀHx + cᵀx + ½‖G·x − h‖², then ŝ = h − G·x̂ and
         // ẑ = −ŝ, each moved into the cones' interiors.
-        sys.assemble(&hmat, &d, &scal, &mut yscratch, delta, &mut unreg, &mut kkt);
         let mut x = vec![0.0; n];
-        if kkt.factor() {
+        if assemble_factor(
+            &sys,
+            &hmat,
+            (&d, &scal),
+            &mut yscratch,
+            st,
+            &mut unreg,
+            &mut kkt,
+        ) {
             for (r, c) in rhs.iter_mut().zip(&self.c) {
                 *r = -c;
             }
@@ -137,8 +143,15 @@ impl Problem {
             for (bi, &(b0, q)) in blocks.iter().enumerate() {
                 scal[bi] = soc_scaling(&s[b0..b0 + q], &z[b0..b0 + q], &mut lam[b0..b0 + q]);
             }
-            sys.assemble(&hmat, &d, &scal, &mut yscratch, delta, &mut unreg, &mut kkt);
-            if !kkt.factor() {
+            if !assemble_factor(
+                &sys,
+                &hmat,
+                (&d, &scal),
+                &mut yscratch,
+                st,
+                &mut unreg,
+                &mut kkt,
+            ) {
                 return IpmSolution {
                     x,
                     status: IpmStatus::NumericalError,
@@ -284,6 +297,30 @@ impl Problem {
             iterations: st.max_iter,
         }
     }
+}
+
+/// Assemble `H + Gᵀ·V·G` and factor it: unregularised first when
+/// [`IpmSettings::unregularised_first`] (the matrix is positive definite; the solves are then
+/// exact to round-off and the refinement stops after its first residual), else — or when
+/// that factorisation meets a zero or non-finite pivot — with `±δ` on the diagonal
+/// ([`IpmSettings::regularisation`]), refined against the unregularised matrix.
+fn assemble_factor(
+    sys: &Kkt<'_>,
+    hmat: &BorderedBand,
+    (d, scal): (&[f64], &[SocScaling]),
+    y: &mut Vec<f64>,
+    st: &IpmSettings,
+    unreg: &mut BorderedBand,
+    kkt: &mut BorderedBand,
+) -> bool {
+    if st.unregularised_first {
+        sys.assemble(hmat, d, scal, y, 0.0, unreg, kkt);
+        if kkt.factor() {
+            return true;
+        }
+    }
+    sys.assemble(hmat, d, scal, y, st.regularisation, unreg, kkt);
+    kkt.factor()
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
