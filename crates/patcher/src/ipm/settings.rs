@@ -21,6 +21,12 @@ pub struct IpmSettings {
     /// are exact to round-off and iterative refinement stops after one residual, where
     /// with `δ` it took 2–3 more solves per Newton system. Default true.
     pub unregularised_first: bool,
+    /// A warm start ([`super::Problem::solve_warm`]) moves every slack and multiplier at
+    /// least `√warm_mu` inside its cone (on the equilibrated problem), so the products
+    /// start near this complementarity rather than at the previous solve's last one,
+    /// from which the changed problem's residuals could not be reduced in full steps.
+    /// Default 1e-4.
+    pub warm_mu: f64,
     /// Most iterative refinement steps per solve (it stops earlier when the residual is
     /// below 1e-13 of the right-hand side). Default 4.
     pub refinement_steps: u32,
@@ -35,6 +41,7 @@ impl Default for IpmSettings {
             step_fraction: 0.99,
             regularisation: 1e-9,
             unregularised_first: true,
+            warm_mu: 1e-4,
             refinement_steps: 4,
         }
     }

@@ -8,16 +8,24 @@ use super::band::{BorderedBand, refine};
 use super::cones::{MAX_CONE, SocScaling, soc_div, soc_prod, soc_scaling, soc_step};
 use super::kkt::Kkt;
 use super::problem::Problem;
-use super::{IpmSettings, IpmSolution, IpmStatus, inf_norm};
+use super::{IpmSettings, IpmSolution, IpmStatus, IpmWarm, inf_norm};
 
 impl Problem {
     /// Solve (module docs of [`super`]): Mehrotra's predictor–corrector with
     /// Nesterov–Todd scaling from CVXOPT's start, on the equilibrated problem.
+    #[cfg(test)]
     pub fn solve(&self, st: &IpmSettings) -> IpmSolution {
-        self.equilibrated().solve_scaled(st)
+        self.equilibrated().solve_scaled(st, None)
     }
 
-    fn solve_scaled(&self, st: &IpmSettings) -> IpmSolution {
+    /// [`Problem::solve`] from a warm start ([`IpmWarm`]: a previous solve's primal point
+    /// and multipliers, of a problem of the same shape), or cold when `warm` is `None` or
+    /// of another shape.
+    pub fn solve_warm(&self, st: &IpmSettings, warm: Option<&IpmWarm>) -> IpmSolution {
+        self.equilibrated().solve_scaled(st, warm)
+    }
+
+    fn solve_scaled(&self, st: &IpmSettings, warm: Option<&IpmWarm>) -> IpmSolution {
         let sys = Kkt::new(self);
         let (nb, k) = (self.nb, self.k);
         let n = nb + k;
@@ -42,36 +50,8 @@ impl Problem {
         let mut scal: Vec<SocScaling> = vec![ident; blocks.len()];
         let mut yscratch: Vec<f64> = Vec::new();
         let (mut rhs, mut sol, mut tmp) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        // Start (CVXOPT's): x̂ minimising ½xᵀHx + cᵀx + ½‖G·x − h‖², then ŝ = h − G·x̂ and
-        // ẑ = −ŝ, each moved into the cones' interiors.
-        let mut x = vec![0.0; n];
-        if assemble_factor(
-            &sys,
-            &hmat,
-            (&d, &scal),
-            &mut yscratch,
-            st,
-            &mut unreg,
-            &mut kkt,
-        ) {
-            for (r, c) in rhs.iter_mut().zip(&self.c) {
-                *r = -c;
-            }
-            sys.gt_mul_add(hv, &mut rhs);
-            sol.copy_from_slice(&rhs);
-            kkt.solve(&mut sol);
-            refine(&kkt, &unreg, &rhs, &mut sol, &mut tmp, st.refinement_steps);
-            if sol.iter().all(|v| v.is_finite()) {
-                x.copy_from_slice(&sol);
-            }
-        }
-        let mut s = vec![0.0; mi];
-        sys.g_mul(&x, &mut s);
-        for (sr, hr) in s.iter_mut().zip(hv) {
-            *sr = hr - *sr;
-        }
-        let mut z: Vec<f64> = s.iter().map(|v| -v).collect();
-        // Shift into the interior: by 1 + the distance outside (the largest violation).
+        let warm = warm.filter(|w| w.x.len() == n && w.z.len() == mi);
+        let (mut x, mut s, mut z) = (vec![0.0; n], vec![0.0; mi], vec![0.0; mi]);
         let outside = |v: &[f64]| -> f64 {
             let mut a = v[..ml].iter().fold(f64::NEG_INFINITY, |a, x| a.max(-x));
             for &(b0, q) in &blocks {
@@ -80,13 +60,82 @@ impl Problem {
             }
             a
         };
-        for v in [&mut s, &mut z] {
-            let a = outside(v);
-            if a >= -1e-8 || !a.is_finite() {
-                let shift = if a.is_finite() { 1.0 + a } else { 1.0 };
+        if let Some(w) = warm {
+            // Warm (Mehrotra's start heuristic on the previous point, Nocedal & Wright
+            // §14.2): x as given, ŝ = h − G·x and the previous multipliers, each moved
+            // into its cones by 1.5 times its distance outside, then both by the shifts
+            // that balance the products: δs = ½·sᵀz/Σz_e, δz = ½·sᵀz/Σs_e (e: the
+            // cones' identities), so no pair starts far from the others' centrality.
+            x.copy_from_slice(&w.x);
+            sys.g_mul(&x, &mut s);
+            for (sr, hr) in s.iter_mut().zip(hv) {
+                *sr = hr - *sr;
+            }
+            z.copy_from_slice(&w.z);
+            for v in [&mut s, &mut z] {
+                let a = outside(v);
+                let shift = if a.is_finite() { (1.5 * a).max(0.0) } else { 1.0 };
                 v[..ml].iter_mut().for_each(|x| *x += shift);
                 for &(b0, _) in &blocks {
                     v[b0] += shift;
+                }
+            }
+            let sz = dot(&s, &z);
+            let e_sum = |v: &[f64]| {
+                v[..ml].iter().sum::<f64>() + blocks.iter().map(|&(b0, _)| v[b0]).sum::<f64>()
+            };
+            let (ds, dz) = (0.5 * sz / e_sum(&z), 0.5 * sz / e_sum(&s));
+            // At least √warm_mu from each cone's boundary: the products start near
+            // `warm_mu`, where the previous solve was some iterations before its end.
+            let floor = st.warm_mu.sqrt();
+            for (v, d) in [(&mut s, ds), (&mut z, dz)] {
+                let d = if d.is_finite() { d } else { 0.0 };
+                v[..ml].iter_mut().for_each(|x| *x = (*x + d).max(floor));
+                for &(b0, q) in &blocks {
+                    v[b0] += d;
+                    let tail = v[b0 + 1..b0 + q].iter().map(|t| t * t).sum::<f64>().sqrt();
+                    v[b0] = v[b0].max(tail + floor);
+                }
+            }
+        } else {
+            // Start (CVXOPT's): x̂ minimising ½xᵀHx + cᵀx + ½‖G·x − h‖², then ŝ = h − G·x̂ and
+            // ẑ = −ŝ, each moved into the cones' interiors.
+            if assemble_factor(
+                &sys,
+                &hmat,
+                (&d, &scal),
+                &mut yscratch,
+                st,
+                &mut unreg,
+                &mut kkt,
+            ) {
+                for (r, c) in rhs.iter_mut().zip(&self.c) {
+                    *r = -c;
+                }
+                sys.gt_mul_add(hv, &mut rhs);
+                sol.copy_from_slice(&rhs);
+                kkt.solve(&mut sol);
+                refine(&kkt, &unreg, &rhs, &mut sol, &mut tmp, st.refinement_steps);
+                if sol.iter().all(|v| v.is_finite()) {
+                    x.copy_from_slice(&sol);
+                }
+            }
+            sys.g_mul(&x, &mut s);
+            for (sr, hr) in s.iter_mut().zip(hv) {
+                *sr = hr - *sr;
+            }
+            for (zr, sr) in z.iter_mut().zip(&s) {
+                *zr = -sr;
+            }
+            // Shift into the interior: by 1 + the distance outside (the largest violation).
+            for v in [&mut s, &mut z] {
+                let a = outside(v);
+                if a >= -1e-8 || !a.is_finite() {
+                    let shift = if a.is_finite() { 1.0 + a } else { 1.0 };
+                    v[..ml].iter_mut().for_each(|x| *x += shift);
+                    for &(b0, _) in &blocks {
+                        v[b0] += shift;
+                    }
                 }
             }
         }
@@ -114,6 +163,7 @@ impl Problem {
             if !(obj.is_finite() && mu.is_finite()) {
                 return IpmSolution {
                     x,
+                    z: z.clone(),
                     status: IpmStatus::NumericalError,
                     iterations: it,
                 };
@@ -124,6 +174,7 @@ impl Problem {
             {
                 return IpmSolution {
                     x,
+                    z: z.clone(),
                     status: IpmStatus::Solved,
                     iterations: it,
                 };
@@ -154,6 +205,7 @@ impl Problem {
             ) {
                 return IpmSolution {
                     x,
+                    z: z.clone(),
                     status: IpmStatus::NumericalError,
                     iterations: it,
                 };
@@ -275,6 +327,7 @@ impl Problem {
             if !(alpha.is_finite() && dx.iter().all(|v| v.is_finite())) {
                 return IpmSolution {
                     x,
+                    z: z.clone(),
                     status: IpmStatus::NumericalError,
                     iterations: it,
                 };
@@ -293,6 +346,7 @@ impl Problem {
         }
         IpmSolution {
             x,
+            z: z.clone(),
             status: IpmStatus::MaxIterations,
             iterations: st.max_iter,
         }
