@@ -61,42 +61,18 @@ impl Problem {
             a
         };
         if let Some(w) = warm {
-            // Warm (Mehrotra's start heuristic on the previous point, Nocedal & Wright
-            // §14.2): x as given, ŝ = h − G·x and the previous multipliers, each moved
-            // into its cones by 1.5 times its distance outside, then both by the shifts
-            // that balance the products: δs = ½·sᵀz/Σz_e, δz = ½·sᵀz/Σs_e (e: the
-            // cones' identities), so no pair starts far from the others' centrality.
+            // Warm: x as given, ŝ = h − G·x and the previous multipliers, centred by
+            // Mehrotra's heuristic ([`centre`]) at least √warm_mu inside every cone: the
+            // products start near `warm_mu`, where the previous solve was some iterations
+            // before its end, not at its last complementarity (from which the changed
+            // problem's residuals could not be reduced in full steps).
             x.copy_from_slice(&w.x);
             sys.g_mul(&x, &mut s);
             for (sr, hr) in s.iter_mut().zip(hv) {
                 *sr = hr - *sr;
             }
             z.copy_from_slice(&w.z);
-            for v in [&mut s, &mut z] {
-                let a = outside(v);
-                let shift = if a.is_finite() { (1.5 * a).max(0.0) } else { 1.0 };
-                v[..ml].iter_mut().for_each(|x| *x += shift);
-                for &(b0, _) in &blocks {
-                    v[b0] += shift;
-                }
-            }
-            let sz = dot(&s, &z);
-            let e_sum = |v: &[f64]| {
-                v[..ml].iter().sum::<f64>() + blocks.iter().map(|&(b0, _)| v[b0]).sum::<f64>()
-            };
-            let (ds, dz) = (0.5 * sz / e_sum(&z), 0.5 * sz / e_sum(&s));
-            // At least √warm_mu from each cone's boundary: the products start near
-            // `warm_mu`, where the previous solve was some iterations before its end.
-            let floor = st.warm_mu.sqrt();
-            for (v, d) in [(&mut s, ds), (&mut z, dz)] {
-                let d = if d.is_finite() { d } else { 0.0 };
-                v[..ml].iter_mut().for_each(|x| *x = (*x + d).max(floor));
-                for &(b0, q) in &blocks {
-                    v[b0] += d;
-                    let tail = v[b0 + 1..b0 + q].iter().map(|t| t * t).sum::<f64>().sqrt();
-                    v[b0] = v[b0].max(tail + floor);
-                }
-            }
+            centre(&mut s, &mut z, ml, &blocks, st.warm_mu.sqrt());
         } else {
             // Start (CVXOPT's): x̂ minimising ½xᵀHx + cᵀx + ½‖G·x − h‖², then ŝ = h − G·x̂ and
             // ẑ = −ŝ, each moved into the cones' interiors.
@@ -128,6 +104,8 @@ impl Problem {
                 *zr = -sr;
             }
             // Shift into the interior: by 1 + the distance outside (the largest violation).
+            // (Mehrotra's heuristic, as a warm start is centred, took 11 % more
+            // iterations on the held-out-like zones.)
             for v in [&mut s, &mut z] {
                 let a = outside(v);
                 if a >= -1e-8 || !a.is_finite() {
@@ -375,6 +353,43 @@ fn assemble_factor(
     }
     sys.assemble(hmat, d, scal, y, st.regularisation, unreg, kkt);
     kkt.factor()
+}
+
+/// Move `s` and `z` into their cones' interiors (Mehrotra's start heuristic, Nocedal &
+/// Wright §14.2): each by 1.5 times its distance outside, then both by the shifts that
+/// balance the products, `δs = ½·sᵀz/Σz_e` and `δz = ½·sᵀz/Σs_e` (e: the cones'
+/// identities), then at least `floor` inside every cone.
+fn centre(s: &mut [f64], z: &mut [f64], ml: usize, blocks: &[(usize, usize)], floor: f64) {
+    let outside = |v: &[f64]| -> f64 {
+        let mut a = v[..ml].iter().fold(f64::NEG_INFINITY, |a, x| a.max(-x));
+        for &(b0, q) in blocks {
+            let tail = v[b0 + 1..b0 + q].iter().map(|t| t * t).sum::<f64>().sqrt();
+            a = a.max(tail - v[b0]);
+        }
+        a
+    };
+    for v in [&mut *s, &mut *z] {
+        let a = outside(v);
+        let shift = if a.is_finite() { (1.5 * a).max(0.0) } else { 1.0 };
+        v[..ml].iter_mut().for_each(|x| *x += shift);
+        for &(b0, _) in blocks {
+            v[b0] += shift;
+        }
+    }
+    let sz = dot(s, z);
+    let e_sum = |v: &[f64]| {
+        v[..ml].iter().sum::<f64>() + blocks.iter().map(|&(b0, _)| v[b0]).sum::<f64>()
+    };
+    let (ds, dz) = (0.5 * sz / e_sum(z), 0.5 * sz / e_sum(s));
+    for (v, d) in [(s, ds), (z, dz)] {
+        let d = if d.is_finite() { d } else { 0.0 };
+        v[..ml].iter_mut().for_each(|x| *x = (*x + d).max(floor));
+        for &(b0, q) in blocks {
+            v[b0] += d;
+            let tail = v[b0 + 1..b0 + q].iter().map(|t| t * t).sum::<f64>().sqrt();
+            v[b0] = v[b0].max(tail + floor);
+        }
+    }
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
