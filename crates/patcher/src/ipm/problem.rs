@@ -332,7 +332,10 @@ mod tests {
     #[test]
     fn compact_sums_sorts_and_drops_zeros() {
         let mut out = vec![(9, 9.0); 3];
-        compact_into(&[(3, 1.0), (1, 2.0), (3, 0.5), (2, 1.0), (2, -1.0)], &mut out);
+        compact_into(
+            &[(3, 1.0), (1, 2.0), (3, 0.5), (2, 1.0), (2, -1.0)],
+            &mut out,
+        );
         assert_eq!(out, vec![(1, 2.0), (3, 1.5)]);
         compact_into(&[], &mut out);
         assert!(out.is_empty());

@@ -370,16 +370,19 @@ fn centre(s: &mut [f64], z: &mut [f64], ml: usize, blocks: &[(usize, usize)], fl
     };
     for v in [&mut *s, &mut *z] {
         let a = outside(v);
-        let shift = if a.is_finite() { (1.5 * a).max(0.0) } else { 1.0 };
+        let shift = if a.is_finite() {
+            (1.5 * a).max(0.0)
+        } else {
+            1.0
+        };
         v[..ml].iter_mut().for_each(|x| *x += shift);
         for &(b0, _) in blocks {
             v[b0] += shift;
         }
     }
     let sz = dot(s, z);
-    let e_sum = |v: &[f64]| {
-        v[..ml].iter().sum::<f64>() + blocks.iter().map(|&(b0, _)| v[b0]).sum::<f64>()
-    };
+    let e_sum =
+        |v: &[f64]| v[..ml].iter().sum::<f64>() + blocks.iter().map(|&(b0, _)| v[b0]).sum::<f64>();
     let (ds, dz) = (0.5 * sz / e_sum(z), 0.5 * sz / e_sum(s));
     for (v, d) in [(s, ds), (z, dz)] {
         let d = if d.is_finite() { d } else { 0.0 };
