@@ -45,6 +45,10 @@ fn main() {
                     solver.ipm.tol_gap = f;
                 }
                 "ipm_refinement_steps" => solver.ipm.refinement_steps = f as u32,
+                "ipm_regularisation" => solver.ipm.regularisation = f,
+                "ipm_unregularised_first" => solver.ipm.unregularised_first = f != 0.0,
+                "ipm_warm_mu" => solver.ipm.warm_mu = f,
+                "scp_warm_start" => solver.scp_warm_start = f != 0.0,
                 other => panic!("unknown setting {other}"),
             }
         }

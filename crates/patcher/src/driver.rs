@@ -1619,7 +1619,9 @@ mod tests {
         let path = sing_path();
         let default = patch_path(&path, &m, &PatchOptions::default()).unwrap();
         let need = default.zones[0].max_deviation_deg;
-        assert!((1.0..1.01).contains(&need), "{need}");
+        // About 1° (the pass's distance from the pole; 0.999995° with the warm-started,
+        // unregularised interior-point method, 1.0001° before it).
+        assert!((0.99..1.01).contains(&need), "{need}");
         let capped = |cap: f64| {
             let opts = PatchOptions {
                 max_deviation_deg: Some(cap),

@@ -92,7 +92,7 @@
 use crate::{
     candidate::PatchFailure,
     hermite::Aff,
-    ipm::{IpmStatus, Problem},
+    ipm::{IpmStatus, IpmWarm, Problem},
     limits::GeomLimits,
     qp::Row,
     report::{QpStats, QpStatus},
@@ -162,6 +162,11 @@ pub struct JointProblem<'a> {
     pub warm: bool,
     /// Most QP solves.
     pub max_solves: u32,
+    /// Where the first QP's interior-point method starts, when the base is a previous
+    /// solve's solution on the same range ([`JointSolution::ipm_end`]: its last QP's
+    /// multipliers; the rows are the same, only the linearisation point and the trust
+    /// region moved). `None`: cold. Used only with [`SolverSettings::scp_warm_start`].
+    pub ipm_start: Option<&'a IpmWarm>,
     /// Where the rounding room of a window is kept between the solves of one zone
     /// (`None`: computed each time).
     pub memo: Option<&'a WindowMemo>,
@@ -182,6 +187,10 @@ pub struct JointSolution {
     pub excess: f64,
     /// Solver statistics of every solve made.
     pub qp: QpStats,
+    /// The last QP's interior-point state at the solution returned (the band unknowns
+    /// are changes from it: zero), for a later solve from this solution
+    /// ([`JointProblem::ipm_start`]).
+    pub ipm_end: Option<IpmWarm>,
 }
 
 /// The chord of an angle in degrees, `2·sin(d/2)`.
@@ -523,10 +532,13 @@ pub fn solve_joint(pr: &JointProblem) -> Result<JointSolution, PatchFailure> {
     } else {
         pr.max_solves
     };
+    // The next QP starts from the last one's multipliers (its rows are the same, at a
+    // new linearisation point and trust region) and from the iterate.
+    let mut warm: Option<IpmWarm> = pr.ipm_start.cloned();
     for _ in 0..solves {
         let started = Instant::now();
         let qp = model.linearised(&xbar, rho);
-        let sol = qp.solve(&st.ipm);
+        let sol = qp.solve_warm(&st.ipm, warm.as_ref().filter(|_| st.scp_warm_start));
         stats.solves += 1;
         stats.iterations += sol.iterations;
         stats.solve_time_s += started.elapsed().as_secs_f64();
@@ -537,6 +549,7 @@ pub fn solve_joint(pr: &JointProblem) -> Result<JointSolution, PatchFailure> {
         };
         let x = sol.x;
         let usable = sol.status != IpmStatus::NumericalError && x.iter().all(|v| v.is_finite());
+        warm = None;
         if !usable {
             rho = (0.5 * rho.0, 0.5 * rho.1);
             if rho.0 < st.min_trust_deg {
@@ -547,7 +560,12 @@ pub fn solve_joint(pr: &JointProblem) -> Result<JointSolution, PatchFailure> {
         solved_any = true;
         let (d, ex) = (model.deviation(&x), model.excess(&x));
         let m = model.merit(&x, d, ex);
-        if m < merit {
+        let accepted = m < merit;
+        warm = Some(IpmWarm {
+            x: if accepted { x.clone() } else { xbar.clone() },
+            z: sol.z,
+        });
+        if accepted {
             let gain = merit - m;
             let was_infeasible = exc > st.elastic_tol;
             (xbar, dev, exc, merit) = (x, d, ex, m);
@@ -578,6 +596,11 @@ pub fn solve_joint(pr: &JointProblem) -> Result<JointSolution, PatchFailure> {
         max_deviation_deg: dev,
         excess: exc,
         qp: stats,
+        ipm_end: warm.map(|mut w| {
+            // The iterate becomes the next base: its changes are zero.
+            w.x[..model.nb].iter_mut().for_each(|v| *v = 0.0);
+            w
+        }),
     })
 }
 
@@ -684,6 +707,7 @@ mod tests {
             point_cap_deg: None,
             warm: false,
             max_solves: st.scp_max_solves,
+            ipm_start: None,
             memo: None,
             settings: st,
         }

@@ -231,7 +231,8 @@ impl JointMethod {
                        before: Option<(&'_ [f64], &'_ [f64])>,
                        capped: Option<(usize, usize)>,
                        warm: bool,
-                       solves: u32| {
+                       solves: u32,
+                       ipm_start: Option<&'_ crate::ipm::IpmWarm>| {
             let (first, last) = capped.unwrap_or((first, last));
             let capped = capped.is_some();
             let pr = JointProblem {
@@ -255,6 +256,7 @@ impl JointMethod {
                 point_cap_deg: capped.then_some(ctx.bound_deg),
                 warm,
                 max_solves: solves,
+                ipm_start,
                 memo: Some(memo),
                 settings: st,
             };
@@ -272,7 +274,15 @@ impl JointMethod {
             } else {
                 (s0.p.as_slice(), s0.c.as_slice())
             };
-            problem(&wp, &wc, Some(before), None, warm, solves)
+            problem(
+                &wp,
+                &wc,
+                Some(before),
+                None,
+                warm,
+                solves,
+                sol.ipm_end.as_ref(),
+            )
         };
         // Within the limits first (by deviation), then the least excess.
         let key = |s: &JointSolution| {
@@ -309,7 +319,15 @@ impl JointMethod {
             } else {
                 1
             };
-            match problem(&s0.p, &s0.c, s0.rule.then_some((p, c)), None, false, solves) {
+            match problem(
+                &s0.p,
+                &s0.c,
+                s0.rule.then_some((p, c)),
+                None,
+                false,
+                solves,
+                None,
+            ) {
                 Ok(sol) => {
                     let perfect =
                         sol.excess <= st.elastic_tol && sol.max_deviation_deg <= ZERO_DEVIATION_DEG;
@@ -439,6 +457,7 @@ impl JointMethod {
                     Some(range),
                     warm,
                     st.scp_max_solves,
+                    None,
                 );
                 match r {
                     Ok(sol) => {

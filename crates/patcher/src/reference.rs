@@ -238,6 +238,7 @@ pub fn zone_reference(
             point_cap_deg: None,
             warm: false,
             max_solves: st.scp_max_solves,
+            ipm_start: None,
             memo: None,
             settings: &st,
         };

@@ -75,11 +75,25 @@ pub enum IpmStatus {
     NumericalError,
 }
 
+/// A start for [`Problem::solve_warm`]: a previous solve's primal point and multipliers,
+/// for a problem of the same shape (the same rows in the same order; only their
+/// coefficients and right-hand sides changed).
+#[derive(Debug, Clone, PartialEq)]
+pub struct IpmWarm {
+    /// The primal point (every unknown, band then border).
+    pub x: Vec<f64>,
+    /// The multipliers, per slack of the equilibrated problem ([`IpmSolution::z`]).
+    pub z: Vec<f64>,
+}
+
 /// A solve's result.
 #[derive(Debug, Clone, PartialEq)]
 pub struct IpmSolution {
     /// The primal solution (every unknown, band then border).
     pub x: Vec<f64>,
+    /// The multipliers of the equilibrated problem, per slack (pairs' upper and lower
+    /// sides, the one-sided rows, the cones' rows): for a warm start ([`IpmWarm`]).
+    pub z: Vec<f64>,
     /// Status.
     pub status: IpmStatus,
     /// Iterations made.

@@ -50,6 +50,8 @@ pub struct Problem {
     pub(super) crow_val: Vec<f64>,
     pub(super) crow_border: Vec<f64>,
     pub(super) crow_rhs: Vec<f64>,
+    /// A row being compacted (kept between the builder's calls: no allocation per row).
+    scratch: Vec<(usize, f64)>,
 }
 
 impl Problem {
@@ -78,6 +80,7 @@ impl Problem {
             crow_val: Vec::new(),
             crow_border: Vec::new(),
             crow_rhs: Vec::new(),
+            scratch: Vec::new(),
         }
     }
 
@@ -94,21 +97,29 @@ impl Problem {
 
     /// Add `weight·(row·x − target)²` to the objective (its constant dropped).
     pub fn add_square(&mut self, row: &[(usize, f64)], weight: f64, target: f64) {
-        let row = compact(row);
+        let mut row_c = std::mem::take(&mut self.scratch);
+        compact_into(row, &mut row_c);
         // Each unordered pair of r·rᵀ once (add_h puts it on both sides).
-        for (a, &(i, ri)) in row.iter().enumerate() {
+        for (a, &(i, ri)) in row_c.iter().enumerate() {
             self.c[i] -= 2.0 * weight * target * ri;
-            for &(j, rj) in &row[..=a] {
+            for &(j, rj) in &row_c[..=a] {
                 self.add_h(i, j, 2.0 * weight * ri * rj);
             }
         }
+        self.scratch = row_c;
     }
 
     /// Add `lo ≤ row·x ≤ hi` over band unknowns (an infinite bound is no row), each side
     /// relaxed by the border unknown `elastic` when given (`row·x − e ≤ hi`,
     /// `−row·x − e ≤ −lo`; one elastic unknown per problem).
     pub fn add_pair(&mut self, row: &[(usize, f64)], lo: f64, hi: f64, elastic: Option<usize>) {
-        let row = compact(row);
+        let mut row_c = std::mem::take(&mut self.scratch);
+        compact_into(row, &mut row_c);
+        self.add_pair_compact(&row_c, lo, hi, elastic);
+        self.scratch = row_c;
+    }
+
+    fn add_pair_compact(&mut self, row: &[(usize, f64)], lo: f64, hi: f64, elastic: Option<usize>) {
         debug_assert!(
             row.iter().all(|e| e.0 < self.nb),
             "a pair is over band unknowns"
@@ -118,7 +129,7 @@ impl Problem {
             self.elastic = Some(e - self.nb);
         }
         if lo.is_finite() && hi.is_finite() {
-            for (j, v) in row {
+            for &(j, v) in row {
                 self.pair_idx.push(j as u32);
                 self.pair_val.push(v);
             }
@@ -141,18 +152,21 @@ impl Problem {
 
     /// Add the one-sided row `row·x ≤ rhs` (band or border unknowns).
     pub fn add_le(&mut self, row: &[(usize, f64)], rhs: f64) {
-        let mut border = vec![0.0; self.k];
-        for (j, v) in compact(row) {
+        let mut row_c = std::mem::take(&mut self.scratch);
+        compact_into(row, &mut row_c);
+        let b0 = self.one_border.len();
+        self.one_border.resize(b0 + self.k, 0.0);
+        for &(j, v) in &row_c {
             if j < self.nb {
                 self.one_idx.push(j as u32);
                 self.one_val.push(v);
             } else {
-                border[j - self.nb] += v;
+                self.one_border[b0 + j - self.nb] += v;
             }
         }
         self.one_ptr.push(self.one_idx.len() as u32);
-        self.one_border.extend(border);
         self.one_rhs.push(rhs);
+        self.scratch = row_c;
     }
 
     /// Add the second-order cone `‖(rhs_k − row_k·x)_{k≥1}‖₂ ≤ rhs_0 − row_0·x` over the rows
@@ -163,20 +177,23 @@ impl Problem {
             "second-order cones have 2 to {} rows",
             super::MAX_CONE
         );
+        let mut row_c = std::mem::take(&mut self.scratch);
         for (row, rhs) in rows {
-            let mut border = vec![0.0; self.k];
-            for (j, v) in compact(row) {
+            compact_into(row, &mut row_c);
+            let b0 = self.crow_border.len();
+            self.crow_border.resize(b0 + self.k, 0.0);
+            for &(j, v) in &row_c {
                 if j < self.nb {
                     self.crow_idx.push(j as u32);
                     self.crow_val.push(v);
                 } else {
-                    border[j - self.nb] += v;
+                    self.crow_border[b0 + j - self.nb] += v;
                 }
             }
             self.crow_ptr.push(self.crow_idx.len() as u32);
-            self.crow_border.extend(border);
             self.crow_rhs.push(*rhs);
         }
+        self.scratch = row_c;
         self.cone_ptr.push(self.crow_rhs.len() as u32);
     }
 
@@ -234,8 +251,8 @@ impl Problem {
     /// one-sided row and every cone (its rows together) divided by its largest
     /// coefficient, the objective by its largest one. Neither changes the solution, and
     /// the tolerances then mean the same on every row.
-    pub(super) fn equilibrated(&self) -> Problem {
-        let mut p = self.clone();
+    pub(super) fn equilibrated(self) -> Problem {
+        let mut p = self;
         let fin = |m: f64| if m > 0.0 && m.is_finite() { m } else { 1.0 };
         let obj = fin(p
             .c
@@ -286,17 +303,41 @@ impl Problem {
     }
 }
 
-/// `row` with repeated unknowns summed, sorted by unknown, zeros dropped.
-pub(super) fn compact(row: &[(usize, f64)]) -> Vec<(usize, f64)> {
-    let mut r = row.to_vec();
-    r.sort_by_key(|e| e.0);
-    let mut out: Vec<(usize, f64)> = Vec::with_capacity(r.len());
-    for (k, v) in r {
-        match out.last_mut() {
-            Some(last) if last.0 == k => last.1 += v,
-            _ => out.push((k, v)),
+/// `row` with repeated unknowns summed (in the row's order), sorted by unknown, zeros
+/// dropped, into `out` (cleared first: the builder reuses one buffer, no allocation per row).
+pub(super) fn compact_into(row: &[(usize, f64)], out: &mut Vec<(usize, f64)>) {
+    out.clear();
+    out.extend_from_slice(row);
+    out.sort_by_key(|e| e.0);
+    let mut w = 0;
+    for r in 0..out.len() {
+        let (k, v) = out[r];
+        if w > 0 && out[w - 1].0 == k {
+            out[w - 1].1 += v;
+        } else {
+            out[w] = (k, v);
+            w += 1;
         }
     }
+    out.truncate(w);
     out.retain(|e| e.1 != 0.0);
-    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::compact_into;
+
+    /// Repeated unknowns are summed in the row's order, the result sorted by unknown and
+    /// its zeros dropped; the buffer's previous content does not matter.
+    #[test]
+    fn compact_sums_sorts_and_drops_zeros() {
+        let mut out = vec![(9, 9.0); 3];
+        compact_into(
+            &[(3, 1.0), (1, 2.0), (3, 0.5), (2, 1.0), (2, -1.0)],
+            &mut out,
+        );
+        assert_eq!(out, vec![(1, 2.0), (3, 1.5)]);
+        compact_into(&[], &mut out);
+        assert!(out.is_empty());
+    }
 }

@@ -8,16 +8,24 @@ use super::band::{BorderedBand, refine};
 use super::cones::{MAX_CONE, SocScaling, soc_div, soc_prod, soc_scaling, soc_step};
 use super::kkt::Kkt;
 use super::problem::Problem;
-use super::{IpmSettings, IpmSolution, IpmStatus, inf_norm};
+use super::{IpmSettings, IpmSolution, IpmStatus, IpmWarm, inf_norm};
 
 impl Problem {
     /// Solve (module docs of [`super`]): Mehrotra's predictor–corrector with
     /// Nesterov–Todd scaling from CVXOPT's start, on the equilibrated problem.
-    pub fn solve(&self, st: &IpmSettings) -> IpmSolution {
-        self.equilibrated().solve_scaled(st)
+    #[cfg(test)]
+    pub fn solve(self, st: &IpmSettings) -> IpmSolution {
+        self.equilibrated().solve_scaled(st, None)
     }
 
-    fn solve_scaled(&self, st: &IpmSettings) -> IpmSolution {
+    /// [`Problem::solve`] from a warm start ([`IpmWarm`]: a previous solve's primal point
+    /// and multipliers, of a problem of the same shape), or cold when `warm` is `None` or
+    /// of another shape.
+    pub fn solve_warm(self, st: &IpmSettings, warm: Option<&IpmWarm>) -> IpmSolution {
+        self.equilibrated().solve_scaled(st, warm)
+    }
+
+    fn solve_scaled(&self, st: &IpmSettings, warm: Option<&IpmWarm>) -> IpmSolution {
         let sys = Kkt::new(self);
         let (nb, k) = (self.nb, self.k);
         let n = nb + k;
@@ -28,7 +36,6 @@ impl Problem {
         let hmat = sys.h_matrix(w);
         let mut unreg = BorderedBand::new(nb, w, k);
         let mut kkt = BorderedBand::new(nb, w, k);
-        let delta = st.regularisation;
         let blocks: Vec<(usize, usize)> = sys.cones.iter().map(|c| (c.b0, c.q)).collect();
         let mut d = vec![1.0; ml];
         let mut d_sqrt = vec![1.0; ml];
@@ -43,29 +50,8 @@ impl Problem {
         let mut scal: Vec<SocScaling> = vec![ident; blocks.len()];
         let mut yscratch: Vec<f64> = Vec::new();
         let (mut rhs, mut sol, mut tmp) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        // Start (CVXOPT's): x̂ minimising ½xᵀHx + cᵀx + ½‖G·x − h‖², then ŝ = h − G·x̂ and
-        // ẑ = −ŝ, each moved into the cones' interiors.
-        sys.assemble(&hmat, &d, &scal, &mut yscratch, delta, &mut unreg, &mut kkt);
-        let mut x = vec![0.0; n];
-        if kkt.factor() {
-            for (r, c) in rhs.iter_mut().zip(&self.c) {
-                *r = -c;
-            }
-            sys.gt_mul_add(hv, &mut rhs);
-            sol.copy_from_slice(&rhs);
-            kkt.solve(&mut sol);
-            refine(&kkt, &unreg, &rhs, &mut sol, &mut tmp, st.refinement_steps);
-            if sol.iter().all(|v| v.is_finite()) {
-                x.copy_from_slice(&sol);
-            }
-        }
-        let mut s = vec![0.0; mi];
-        sys.g_mul(&x, &mut s);
-        for (sr, hr) in s.iter_mut().zip(hv) {
-            *sr = hr - *sr;
-        }
-        let mut z: Vec<f64> = s.iter().map(|v| -v).collect();
-        // Shift into the interior: by 1 + the distance outside (the largest violation).
+        let warm = warm.filter(|w| w.x.len() == n && w.z.len() == mi);
+        let (mut x, mut s, mut z) = (vec![0.0; n], vec![0.0; mi], vec![0.0; mi]);
         let outside = |v: &[f64]| -> f64 {
             let mut a = v[..ml].iter().fold(f64::NEG_INFINITY, |a, x| a.max(-x));
             for &(b0, q) in &blocks {
@@ -74,13 +60,60 @@ impl Problem {
             }
             a
         };
-        for v in [&mut s, &mut z] {
-            let a = outside(v);
-            if a >= -1e-8 || !a.is_finite() {
-                let shift = if a.is_finite() { 1.0 + a } else { 1.0 };
-                v[..ml].iter_mut().for_each(|x| *x += shift);
-                for &(b0, _) in &blocks {
-                    v[b0] += shift;
+        if let Some(w) = warm {
+            // Warm: x as given, ŝ = h − G·x and the previous multipliers, centred by
+            // Mehrotra's heuristic ([`centre`]) at least √warm_mu inside every cone: the
+            // products start near `warm_mu`, where the previous solve was some iterations
+            // before its end, not at its last complementarity (from which the changed
+            // problem's residuals could not be reduced in full steps).
+            x.copy_from_slice(&w.x);
+            sys.g_mul(&x, &mut s);
+            for (sr, hr) in s.iter_mut().zip(hv) {
+                *sr = hr - *sr;
+            }
+            z.copy_from_slice(&w.z);
+            centre(&mut s, &mut z, ml, &blocks, st.warm_mu.sqrt());
+        } else {
+            // Start (CVXOPT's): x̂ minimising ½xᵀHx + cᵀx + ½‖G·x − h‖², then ŝ = h − G·x̂ and
+            // ẑ = −ŝ, each moved into the cones' interiors.
+            if assemble_factor(
+                &sys,
+                &hmat,
+                (&d, &scal),
+                &mut yscratch,
+                st,
+                &mut unreg,
+                &mut kkt,
+            ) {
+                for (r, c) in rhs.iter_mut().zip(&self.c) {
+                    *r = -c;
+                }
+                sys.gt_mul_add(hv, &mut rhs);
+                sol.copy_from_slice(&rhs);
+                kkt.solve(&mut sol);
+                refine(&kkt, &unreg, &rhs, &mut sol, &mut tmp, st.refinement_steps);
+                if sol.iter().all(|v| v.is_finite()) {
+                    x.copy_from_slice(&sol);
+                }
+            }
+            sys.g_mul(&x, &mut s);
+            for (sr, hr) in s.iter_mut().zip(hv) {
+                *sr = hr - *sr;
+            }
+            for (zr, sr) in z.iter_mut().zip(&s) {
+                *zr = -sr;
+            }
+            // Shift into the interior: by 1 + the distance outside (the largest violation).
+            // (Mehrotra's heuristic, as a warm start is centred, took 11 % more
+            // iterations on the held-out-like zones.)
+            for v in [&mut s, &mut z] {
+                let a = outside(v);
+                if a >= -1e-8 || !a.is_finite() {
+                    let shift = if a.is_finite() { 1.0 + a } else { 1.0 };
+                    v[..ml].iter_mut().for_each(|x| *x += shift);
+                    for &(b0, _) in &blocks {
+                        v[b0] += shift;
+                    }
                 }
             }
         }
@@ -108,6 +141,7 @@ impl Problem {
             if !(obj.is_finite() && mu.is_finite()) {
                 return IpmSolution {
                     x,
+                    z: z.clone(),
                     status: IpmStatus::NumericalError,
                     iterations: it,
                 };
@@ -118,6 +152,7 @@ impl Problem {
             {
                 return IpmSolution {
                     x,
+                    z: z.clone(),
                     status: IpmStatus::Solved,
                     iterations: it,
                 };
@@ -137,10 +172,18 @@ impl Problem {
             for (bi, &(b0, q)) in blocks.iter().enumerate() {
                 scal[bi] = soc_scaling(&s[b0..b0 + q], &z[b0..b0 + q], &mut lam[b0..b0 + q]);
             }
-            sys.assemble(&hmat, &d, &scal, &mut yscratch, delta, &mut unreg, &mut kkt);
-            if !kkt.factor() {
+            if !assemble_factor(
+                &sys,
+                &hmat,
+                (&d, &scal),
+                &mut yscratch,
+                st,
+                &mut unreg,
+                &mut kkt,
+            ) {
                 return IpmSolution {
                     x,
+                    z: z.clone(),
                     status: IpmStatus::NumericalError,
                     iterations: it,
                 };
@@ -262,6 +305,7 @@ impl Problem {
             if !(alpha.is_finite() && dx.iter().all(|v| v.is_finite())) {
                 return IpmSolution {
                     x,
+                    z: z.clone(),
                     status: IpmStatus::NumericalError,
                     iterations: it,
                 };
@@ -280,8 +324,73 @@ impl Problem {
         }
         IpmSolution {
             x,
+            z: z.clone(),
             status: IpmStatus::MaxIterations,
             iterations: st.max_iter,
+        }
+    }
+}
+
+/// Assemble `H + Gᵀ·V·G` and factor it: unregularised first when
+/// [`IpmSettings::unregularised_first`] (the matrix is positive definite; the solves are then
+/// exact to round-off and the refinement stops after its first residual), else — or when
+/// that factorisation meets a zero or non-finite pivot — with `±δ` on the diagonal
+/// ([`IpmSettings::regularisation`]), refined against the unregularised matrix.
+fn assemble_factor(
+    sys: &Kkt<'_>,
+    hmat: &BorderedBand,
+    (d, scal): (&[f64], &[SocScaling]),
+    y: &mut Vec<f64>,
+    st: &IpmSettings,
+    unreg: &mut BorderedBand,
+    kkt: &mut BorderedBand,
+) -> bool {
+    if st.unregularised_first {
+        sys.assemble(hmat, d, scal, y, 0.0, unreg, kkt);
+        if kkt.factor() {
+            return true;
+        }
+    }
+    sys.assemble(hmat, d, scal, y, st.regularisation, unreg, kkt);
+    kkt.factor()
+}
+
+/// Move `s` and `z` into their cones' interiors (Mehrotra's start heuristic, Nocedal &
+/// Wright §14.2): each by 1.5 times its distance outside, then both by the shifts that
+/// balance the products, `δs = ½·sᵀz/Σz_e` and `δz = ½·sᵀz/Σs_e` (e: the cones'
+/// identities), then at least `floor` inside every cone.
+fn centre(s: &mut [f64], z: &mut [f64], ml: usize, blocks: &[(usize, usize)], floor: f64) {
+    let outside = |v: &[f64]| -> f64 {
+        let mut a = v[..ml].iter().fold(f64::NEG_INFINITY, |a, x| a.max(-x));
+        for &(b0, q) in blocks {
+            let tail = v[b0 + 1..b0 + q].iter().map(|t| t * t).sum::<f64>().sqrt();
+            a = a.max(tail - v[b0]);
+        }
+        a
+    };
+    for v in [&mut *s, &mut *z] {
+        let a = outside(v);
+        let shift = if a.is_finite() {
+            (1.5 * a).max(0.0)
+        } else {
+            1.0
+        };
+        v[..ml].iter_mut().for_each(|x| *x += shift);
+        for &(b0, _) in blocks {
+            v[b0] += shift;
+        }
+    }
+    let sz = dot(s, z);
+    let e_sum =
+        |v: &[f64]| v[..ml].iter().sum::<f64>() + blocks.iter().map(|&(b0, _)| v[b0]).sum::<f64>();
+    let (ds, dz) = (0.5 * sz / e_sum(z), 0.5 * sz / e_sum(s));
+    for (v, d) in [(s, ds), (z, dz)] {
+        let d = if d.is_finite() { d } else { 0.0 };
+        v[..ml].iter_mut().for_each(|x| *x = (*x + d).max(floor));
+        for &(b0, q) in blocks {
+            v[b0] += d;
+            let tail = v[b0 + 1..b0 + q].iter().map(|t| t * t).sum::<f64>().sqrt();
+            v[b0] = v[b0].max(tail + floor);
         }
     }
 }
