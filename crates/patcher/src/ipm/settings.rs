@@ -19,10 +19,7 @@ pub struct IpmSettings {
     /// only when that meets a zero or non-finite pivot. The joint patch's matrix is
     /// positive definite (every band unknown has a proximal square in H), so the solves
     /// are exact to round-off and iterative refinement stops after one residual, where
-    /// with `δ` it took 2–3 more solves per Newton system. Default false: on
-    /// `fixtures/generated/sinumerik-ac-swing-d2.mpf` (mikron-ucp710) it led the SCP to a
-    /// deviation 1.096× the reference's (1.000× with it off), for about a fifth of the
-    /// median zone time (docs/performance-patcher.md §4).
+    /// with `δ` it took 2–3 more solves per Newton system. Default true.
     pub unregularised_first: bool,
     /// A warm start ([`super::Problem::solve_warm`]) moves every slack and multiplier at
     /// least `√warm_mu` inside its cone (on the equilibrated problem), so the products
@@ -43,7 +40,7 @@ impl Default for IpmSettings {
             tol_gap: 1e-8,
             step_fraction: 0.99,
             regularisation: 1e-9,
-            unregularised_first: false,
+            unregularised_first: true,
             warm_mu: 1e-4,
             refinement_steps: 4,
         }
