@@ -52,14 +52,6 @@ impl Problem {
         let (mut rhs, mut sol, mut tmp) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         let warm = warm.filter(|w| w.x.len() == n && w.z.len() == mi);
         let (mut x, mut s, mut z) = (vec![0.0; n], vec![0.0; mi], vec![0.0; mi]);
-        let outside = |v: &[f64]| -> f64 {
-            let mut a = v[..ml].iter().fold(f64::NEG_INFINITY, |a, x| a.max(-x));
-            for &(b0, q) in &blocks {
-                let tail = v[b0 + 1..b0 + q].iter().map(|t| t * t).sum::<f64>().sqrt();
-                a = a.max(tail - v[b0]);
-            }
-            a
-        };
         if let Some(w) = warm {
             // Warm: x as given, ŝ = h − G·x and the previous multipliers, centred by
             // Mehrotra's heuristic ([`centre`]) at least √warm_mu inside every cone: the
@@ -107,7 +99,7 @@ impl Problem {
             // (Mehrotra's heuristic, as a warm start is centred, took 11 % more
             // iterations on the held-out-like zones.)
             for v in [&mut s, &mut z] {
-                let a = outside(v);
+                let a = outside(v, ml, &blocks);
                 if a >= -1e-8 || !a.is_finite() {
                     let shift = if a.is_finite() { 1.0 + a } else { 1.0 };
                     v[..ml].iter_mut().for_each(|x| *x += shift);
@@ -355,21 +347,24 @@ fn assemble_factor(
     kkt.factor()
 }
 
+/// How far `v` lies outside its cones: the largest of −v over the `ml` linear entries and
+/// ‖tail‖ − head over each second-order block (negative inside).
+fn outside(v: &[f64], ml: usize, blocks: &[(usize, usize)]) -> f64 {
+    let mut a = v[..ml].iter().fold(f64::NEG_INFINITY, |a, x| a.max(-x));
+    for &(b0, q) in blocks {
+        let tail = v[b0 + 1..b0 + q].iter().map(|t| t * t).sum::<f64>().sqrt();
+        a = a.max(tail - v[b0]);
+    }
+    a
+}
+
 /// Move `s` and `z` into their cones' interiors (Mehrotra's start heuristic, Nocedal &
 /// Wright §14.2): each by 1.5 times its distance outside, then both by the shifts that
 /// balance the products, `δs = ½·sᵀz/Σz_e` and `δz = ½·sᵀz/Σs_e` (e: the cones'
 /// identities), then at least `floor` inside every cone.
 fn centre(s: &mut [f64], z: &mut [f64], ml: usize, blocks: &[(usize, usize)], floor: f64) {
-    let outside = |v: &[f64]| -> f64 {
-        let mut a = v[..ml].iter().fold(f64::NEG_INFINITY, |a, x| a.max(-x));
-        for &(b0, q) in blocks {
-            let tail = v[b0 + 1..b0 + q].iter().map(|t| t * t).sum::<f64>().sqrt();
-            a = a.max(tail - v[b0]);
-        }
-        a
-    };
     for v in [&mut *s, &mut *z] {
-        let a = outside(v);
+        let a = outside(v, ml, blocks);
         let shift = if a.is_finite() {
             (1.5 * a).max(0.0)
         } else {
