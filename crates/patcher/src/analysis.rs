@@ -657,8 +657,9 @@ fn zone_over(
 /// the pole and sweeps C through 1800° while the primary axis goes out to 89° was one zone,
 /// and its patch turned tool axes 60–90° from the pole by up to 94°). From the stretch's
 /// spans in the cone (or, for a stretch the reach admits, the span(s) at its closest
-/// approach) the zone grows outward span by span while each span is the pole's: an end in
-/// the cone, or the pole dominating that span's own slowdown (`pole_span`). It stops at
+/// approach) the zone grows outward span by span while each span is the pole's: an end
+/// within the pole reach (the analysis spline carries a flip's turn of C into the spans
+/// beside it), or the pole dominating that span's own slowdown (`pole_span`). It stops at
 /// the first span that is not: there C crawls by the program's own doing (the table turning
 /// round with the tool far from the pole), which a patch near the pole neither causes nor
 /// can cure at a small change of tool axis. A zone cut so is marked on that side
@@ -731,8 +732,14 @@ pub fn detect_zones(
         }
         // The stretch's spans (k from `first`), which are the pole's, and the seeds.
         let span = |k: usize| st.spans[k - first];
-        let is_pole = |k: usize| pole_span(&p, k, span(k).0, span(k).1, cone_deg);
         let near = |k: usize| p(k).abs().min(p(k + 1).abs());
+        // Within the reach every span below feed is the pole's: the analysis spline carries
+        // a flip's or a swing's turn of C into the spans either side of it (seeded case 36:
+        // spans 5°–8° from the pole at 0.73 → 0.03 of feed before an A flip, which no
+        // span-by-span test of dominance attributes to the pole, yet which the patch of the
+        // flip lifts to 0.98 — and `analyze` of its output then found a zone there).
+        let is_pole =
+            |k: usize| near(k) <= reach || pole_span(&p, k, span(k).0, span(k).1, cone_deg);
         let mut seeds: Vec<usize> = (first..last).filter(|&k| near(k) <= cone_deg).collect();
         if seeds.is_empty() {
             let least = (first..=last)
@@ -1052,8 +1059,9 @@ mod tests {
                 .collect(),
             feed_mm_min: 1000.0,
         };
-        // C at 2 % of feed by its velocity on every span: the pole's while sin²P ≤ 0.02,
-        // P ≤ 8.13°: spans 0..=8 (their nearer end ≤ 8°), points 0..=9.
+        // C at 2 % of feed by its velocity on every span: the pole dominates while
+        // sin²P ≤ 0.02, P ≤ 8.13° (spans 0..=8), and every span within the 10° reach is the
+        // pole's: spans 0..=10 (their nearer end ≤ 10°), points 0..=11.
         let zones = detect_zones(
             &side(&path),
             &[BelowFeed::uniform(0, 39, 0.02, LimitKind::Velocity)],
@@ -1062,8 +1070,16 @@ mod tests {
         );
         assert_eq!(zones.len(), 1, "{zones:?}");
         let z = &zones[0];
-        assert_eq!((z.first, z.last), (0, 9), "{z:?}");
+        assert_eq!((z.first, z.last), (0, 11), "{z:?}");
         assert!(!z.cut_before && z.cut_after);
+        // Beyond the reach only dominance grows it: with a 6° reach, spans 0..=8.
+        let zones = detect_zones(
+            &side(&path),
+            &[BelowFeed::uniform(0, 39, 0.02, LimitKind::Velocity)],
+            5.0,
+            6.0,
+        );
+        assert_eq!((zones[0].first, zones[0].last), (0, 9), "{zones:?}");
         // At 50 % the pole dominates out to 45°: the whole stretch, not cut.
         let zones = detect_zones(
             &side(&path),
