@@ -105,6 +105,55 @@ fn seeded_random_near_pole_passes() {
     }
 }
 
+/// Seeded case 36 above (Sinumerik, an A flip 3.18° from the pole at F800 on the UCP710):
+/// the analysis spline carries the flip's turn of C into the spans before it, 5°–8° from
+/// the pole, at 0.73 → 0.03 of feed, and no span-by-span dominance test attributes them to
+/// the pole. While they were outside the zone (lines 40–57), the patch had only to keep them
+/// "not worse"; with the regularised factorisation first it lifted them to 0.982 and said
+/// `reached`, and `analyze` of its output found a zone there. Within the pole reach they
+/// are the zone's (lines 34–57), so the patch must reach feed over them with either
+/// factorisation (`check_patch` analyses the written program).
+#[test]
+fn spans_a_flip_slows_within_the_reach_are_its_zone() {
+    let pass = Pass {
+        pole_distance_deg: 3.183_191_916_212_654_5,
+        circle_radius_deg: 23.201_020_158_566_607,
+        half_sweep_deg: 52.748_714_207_990_93,
+        azimuth_deg: 223.730_113_551_432_65,
+        length_mm: 40.0,
+        spacing_mm: 0.5,
+        feed_mm_min: 800.0,
+        b_axis: false,
+        domain_rule: true,
+        rotary_decimals: 3,
+    };
+    let text = program(&pass, Dialect::Sinumerik, "CASE");
+    let m = polepatch::kinematics::Machine::builtin("mikron-ucp710").unwrap();
+    // The zone: from the first span below feed (|A| 7.8°) through the flip (|A| 3.18°).
+    let analysis = polepatch::analyze_nc(text.as_bytes(), &m, &Default::default()).unwrap();
+    let zones: Vec<_> = analysis
+        .runs
+        .iter()
+        .filter_map(|r| r.figures.as_ref())
+        .flat_map(|f| f.zones.iter())
+        .collect();
+    assert_eq!(zones.len(), 1, "{zones:?}");
+    assert_eq!(zones[0].lines, [34, 57], "{zones:?}");
+    for unregularised_first in [true, false] {
+        let mut opts = PatchOptions::default();
+        opts.solver.ipm.unregularised_first = unregularised_first;
+        let name = format!("case 36, unregularised first {unregularised_first}");
+        let (report, _) = check_patch(&name, text.as_bytes(), &m, &opts);
+        assert_eq!(report.zones.len(), 1, "{name}: {:?}", report.zones);
+        let z = &report.zones[0];
+        assert_eq!(
+            z.outcome,
+            polepatch::patcher::Outcome::Reached,
+            "{name}: {z:?}"
+        );
+    }
+}
+
 /// A pass 1° from the pole on a 5° circle, 15 mm long at F5000 on the UCP710, followed by
 /// a move that programs the rotary axes with a linear move (so its last point must stay,
 /// `polepatch::end_pose`): the tool axis must turn far more than A and C can in 15 mm.
