@@ -154,6 +154,61 @@ fn spans_a_flip_slows_within_the_reach_are_its_zone() {
     }
 }
 
+/// Seeded case 63 of the sequence above, beyond its first 40 (Heidenhain, B-C on the
+/// HSM600: a flip 0.04° from the pole, and the (−180°, 180°] domain flipping B at 10.0° →
+/// −10.9°, just beyond the pole reach, at 0.095 of feed: not a zone). The patch of the pole
+/// flip reaches feed over its core, but its range ends in the domain flip and leaves B at
+/// 7.7° there with C at 0.388: better than before, yet `analyze` of the written program
+/// finds a zone there. The report said `reached`; it must agree with the analysis of what
+/// it wrote: `reached` only when that finds no zone within the patch's lines, else the
+/// figures cover that zone too.
+#[test]
+fn a_reached_claim_agrees_with_the_analysis_of_the_output() {
+    let pass = Pass {
+        pole_distance_deg: 0.041_260_729_517_458_09,
+        circle_radius_deg: 24.713_642_664_709_464,
+        half_sweep_deg: 74.480_663_728_953_25,
+        azimuth_deg: 192.006_061_848_677_4,
+        length_mm: 35.438_970_353_524_745,
+        spacing_mm: 0.5,
+        feed_mm_min: 800.0,
+        b_axis: true,
+        domain_rule: true,
+        rotary_decimals: 4,
+    };
+    let text = program(&pass, Dialect::Heidenhain, "CASE");
+    let m = polepatch::kinematics::Machine::builtin("mikron-hsm600").unwrap();
+    let zones_of = |bytes: &[u8]| -> Vec<[usize; 2]> {
+        let a = polepatch::analyze_nc(bytes, &m, &Default::default()).unwrap();
+        a.runs
+            .iter()
+            .filter_map(|r| r.figures.as_ref())
+            .flat_map(|f| f.zones.iter().map(|z| z.lines))
+            .collect()
+    };
+    assert_eq!(zones_of(text.as_bytes()).len(), 1);
+    let (out, report) =
+        polepatch::patch_nc(text.as_bytes(), &m, &polepatch::PatchOptions::default()).unwrap();
+    assert_eq!(report.zones.len(), 1, "{:?}", report.zones);
+    let z = &report.zones[0];
+    let left: Vec<_> = zones_of(&out)
+        .into_iter()
+        .filter(|l| l[0] <= z.lines[1] && l[1] >= z.lines[0])
+        .collect();
+    if z.outcome == polepatch::Outcome::Reached {
+        assert!(
+            left.is_empty(),
+            "reached, yet analyze finds {left:?}: {z:?}"
+        );
+    } else {
+        assert!(
+            !left.is_empty() && z.after.overall_ratio < 1.0,
+            "{left:?} {z:?}"
+        );
+        assert!(z.after.overall_ratio > z.before.overall_ratio, "{z:?}");
+    }
+}
+
 /// A pass 1° from the pole on a 5° circle, 15 mm long at F5000 on the UCP710, followed by
 /// a move that programs the rotary axes with a linear move (so its last point must stay,
 /// `polepatch::end_pose`): the tool axis must turn far more than A and C can in 15 mm.

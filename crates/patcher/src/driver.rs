@@ -895,6 +895,8 @@ struct Patched {
 struct Written {
     /// The run's span figures as written (the report's "after").
     spans_after: Vec<SpanFigures>,
+    /// The zones `analyze` finds in the run as written (empty where nothing is written).
+    zones_after: Vec<Zone>,
     /// The path as written (its tips moved where a ball's centre is kept); `None` when the
     /// written tips make no path.
     path: Option<Path>,
@@ -985,19 +987,21 @@ impl<'a> Run<'a> {
             // Written tips that do not make a path (two on one spot) count as worse at the
             // first span.
             let written = written_path(path, &state.p, &state.c, self.f.machine, keep);
-            let (worse, spans_after) = match &written {
+            let (worse, spans_after, zones_after) = match &written {
                 Some(w) => {
-                    let spans_after = analyze_spans(w, self.f.machine, &self.aopts)?.1;
+                    let (analysis, spans_after) = analyze_spans(w, self.f.machine, &self.aopts)?;
                     if !self.f.verify {
                         return Ok(Written {
                             spans_after,
+                            zones_after: analysis.zones,
                             path: written,
                             keep: keep_written,
                         });
                     }
-                    (self.worse_spans(&spans_after, keep.is_some()), spans_after)
+                    let worse = self.worse_spans(&spans_after, keep.is_some());
+                    (worse, spans_after, analysis.zones)
                 }
-                None => (vec![0], self.spans_before.clone()),
+                None => (vec![0], self.spans_before.clone(), Vec::new()),
             };
             // The tips' rounding may also keep a zone the candidate brought to feed below
             // it: more decimals first.
@@ -1011,6 +1015,7 @@ impl<'a> Run<'a> {
             let Some(&k) = worse.first() else {
                 return Ok(Written {
                     spans_after,
+                    zones_after,
                     path: written,
                     keep: keep_written,
                 });
@@ -1021,6 +1026,7 @@ impl<'a> Run<'a> {
                 (state.p, state.c) = (self.p0.clone(), self.c0.clone());
                 return Ok(Written {
                     spans_after: self.spans_before.clone(),
+                    zones_after: Vec::new(),
                     path: Some(path.clone()),
                     keep: keep_written,
                 });
@@ -1155,16 +1161,29 @@ impl<'a> Run<'a> {
                 Method::G16Patch | Method::Direct | Method::Peer
             )
         });
-        let range = if own_range {
+        let mut range = if own_range {
             core.start.min(first.saturating_sub(st.core_margin_points))
                 ..core.end.max((last + st.core_margin_points).min(n - 1))
         } else {
             core.clone()
         };
+        // What `analyze` of the written program finds must agree: a zone there within the
+        // patch's points (its shoulder left crawling within the pole reach, say, where the
+        // program's own slowdown was not the pole's before and is now) means the run is
+        // not at feed there, whatever the core does. The figures then cover it too.
+        let mut left_in_range = false;
+        for z in written
+            .zones_after
+            .iter()
+            .filter(|z| kept.is_some() && z.first <= last && z.last >= first)
+        {
+            left_in_range = true;
+            range = range.start.min(z.first)..range.end.max(z.last.min(n - 1));
+        }
         let before = figures_over(&self.spans_before, range.clone());
         let after = figures_over(&written.spans_after, range.clone());
         let core_after = figures_over(&written.spans_after, core.clone());
-        let reached = worst_ratio(opts.axes, &core_after) >= 1.0 - RATIO_TOL;
+        let reached = worst_ratio(opts.axes, &core_after) >= 1.0 - RATIO_TOL && !left_in_range;
         let core_before = figures_over(&self.spans_before, core.clone());
         let outcome = if reached {
             Outcome::Reached
