@@ -432,18 +432,9 @@ fn print_summary(
             rep.words_changed,
             tools,
         )?;
-        // Why each zone ended as it did (a fixed set, docs/user-guide.md), counted: the
-        // patcher's reasons in their order, then the library's (tcpm_unknown, …).
-        let mut names: Vec<polepatch::ZoneReason> = polepatch::patcher::Reason::ALL
-            .into_iter()
-            .map(polepatch::ZoneReason::from)
-            .collect();
-        for z in &rep.zones {
-            if !names.contains(&z.reason) {
-                names.push(z.reason);
-            }
-        }
-        let counts: Vec<String> = names
+        // Why each zone ended as it did (a fixed set, docs/user-guide.md), counted in the
+        // set's order.
+        let counts: Vec<String> = polepatch::ZoneReason::ALL
             .iter()
             .filter_map(|name| {
                 let k = rep.zones.iter().filter(|z| z.reason == *name).count();

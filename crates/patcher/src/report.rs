@@ -84,11 +84,30 @@ pub enum Reason {
     NotFound,
     /// The run may not be patched (no TCPM, incremental, …): the zone is only reported.
     NotPatched,
+    // The reasons below are set by the library (`polepatch`), where the run's circumstances
+    // decided, not the solve.
+    /// The file does not settle whether TCPM is on (the run is untouched).
+    TcpmUnknown,
+    /// A rotation, scaling or mirror image of the frame is in force (the run is untouched).
+    FrameTransformed,
+    /// A Sinumerik direction form (`C=DC(…)`, `C=ACP(…)`, `C=ACN(…)`) cannot make the
+    /// patched move (the run is untouched).
+    DirectionForm,
+    /// The patch would change a word whose value is a macro variable or an expression (the
+    /// run is untouched).
+    MacroVariable,
+    /// A ball programmed at its tip, its centre kept: the orientation change was capped to
+    /// keep the centre's path between the points within the chord tolerance and the zone
+    /// stopped at that cap, or no cap did and the run keeps its values.
+    CentrePath,
+    /// A flat or bull-nose cutter's surface bound capped the orientation change and stopped
+    /// the zone short of feed.
+    ToolLimited,
 }
 
 impl Reason {
     /// Every reason, in report order.
-    pub const ALL: [Reason; 10] = [
+    pub const ALL: [Reason; 16] = [
         Reason::Reached,
         Reason::Reselected,
         Reason::EndPinned,
@@ -99,6 +118,12 @@ impl Reason {
         Reason::ProvenUnreachable,
         Reason::NotFound,
         Reason::NotPatched,
+        Reason::TcpmUnknown,
+        Reason::FrameTransformed,
+        Reason::DirectionForm,
+        Reason::MacroVariable,
+        Reason::CentrePath,
+        Reason::ToolLimited,
     ];
     /// The name used in reports.
     pub fn name(self) -> &'static str {
@@ -113,6 +138,12 @@ impl Reason {
             Reason::ProvenUnreachable => "proven_unreachable",
             Reason::NotFound => "not_found",
             Reason::NotPatched => "not_patched",
+            Reason::TcpmUnknown => "tcpm_unknown",
+            Reason::FrameTransformed => "frame_transformed",
+            Reason::DirectionForm => "direction_form",
+            Reason::MacroVariable => "macro_variable",
+            Reason::CentrePath => "centre_path",
+            Reason::ToolLimited => "tool_limited",
         }
     }
 }

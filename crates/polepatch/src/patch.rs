@@ -1253,7 +1253,7 @@ fn zone_row(lp: &LoadedProgram, run: usize, z: &ZoneReport) -> ZoneRow {
         reselected_points: z.reselected_points,
         patch_length_mm: z.patch_length_mm,
         outcome: z.outcome,
-        reason: z.reason.into(),
+        reason: z.reason,
         end_pose: None,
         end_pose_line: None,
         method: z.method,

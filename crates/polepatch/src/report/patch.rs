@@ -9,7 +9,7 @@ use super::{
 use crate::tool::{Tool, ToolPoint};
 use polepatch_kinematics::{LimitKind, Machine};
 use polepatch_nc::FeedMode;
-use polepatch_patcher::{Method, Outcome, QpStatus, Reason, ZoneFigures, ZoneKind};
+use polepatch_patcher::{Method, Outcome, QpStatus, ZoneFigures, ZoneKind};
 use serde::Serialize;
 
 /// Equation-6 figures of a zone, with axis letters (report form of [`ZoneFigures`]).
@@ -156,103 +156,10 @@ pub struct ZoneRow {
     pub rapid_time_after_s: Option<f64>,
 }
 
-/// Why a zone ended as it did (its row's `reason`): one of a fixed set, the patcher's
-/// [`Reason`]s first, then the library's own, where the run's circumstances decided, not
-/// the solve. `polepatch patch` counts them per file.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum ZoneReason {
-    /// A patch reaches feed ([`Reason::Reached`]).
-    Reached,
-    /// Branch re-selection alone reaches feed ([`Reason::Reselected`]).
-    Reselected,
-    /// Only with the run's last point free would some values reach feed
-    /// ([`Reason::EndPinned`]).
-    EndPinned,
-    /// The machine's axis ranges forbid every values that reach feed ([`Reason::Range`]).
-    Range,
-    /// A patch reaching feed changes the orientation by more than `max_deviation_deg`
-    /// ([`Reason::DeviationCap`]).
-    DeviationCap,
-    /// A patch reaching feed turns some point's tool axis by more than the safety bound
-    /// near the pole allows ([`Reason::SafetyBound`]).
-    SafetyBound,
-    /// With a ball's centre kept, the patch falls short on the tips it writes
-    /// ([`Reason::TipPath`]).
-    TipPath,
-    /// No values of the movable points reach feed ([`Reason::ProvenUnreachable`]).
-    ProvenUnreachable,
-    /// No patch found, and no proof that there is none ([`Reason::NotFound`]).
-    NotFound,
-    /// The run may not be patched: see the untouched runs ([`Reason::NotPatched`]).
-    NotPatched,
-    /// The file does not settle whether TCPM is on ([`UntouchedReason::TcpmUnknown`]).
-    TcpmUnknown,
-    /// A rotation, scaling or mirror image of the frame is in force
-    /// ([`UntouchedReason::FrameTransformed`]).
-    FrameTransformed,
-    /// A Sinumerik direction form cannot make the patched move
-    /// ([`UntouchedReason::DirectionForm`]).
-    DirectionForm,
-    /// The patch would change a word whose value is a macro variable
-    /// ([`UntouchedReason::MacroVariable`]).
-    MacroVariable,
-    /// A ball programmed at its tip, its centre kept: the orientation change was capped to
-    /// keep the centre's path between the points within the chord tolerance and the zone
-    /// stopped at that cap, or no cap did and the run keeps its values
-    /// ([`UntouchedReason::CentrePath`]).
-    CentrePath,
-    /// A flat or bull-nose cutter's surface bound capped the orientation change and
-    /// stopped the zone short of feed ([`crate::tool`]).
-    ToolLimited,
-}
-
-impl ZoneReason {
-    /// The name used in reports (`reached`, `tool_limited`, …): its serde form.
-    pub fn name(self) -> &'static str {
-        match self {
-            ZoneReason::Reached => Reason::Reached.name(),
-            ZoneReason::Reselected => Reason::Reselected.name(),
-            ZoneReason::EndPinned => Reason::EndPinned.name(),
-            ZoneReason::Range => Reason::Range.name(),
-            ZoneReason::DeviationCap => Reason::DeviationCap.name(),
-            ZoneReason::SafetyBound => Reason::SafetyBound.name(),
-            ZoneReason::TipPath => Reason::TipPath.name(),
-            ZoneReason::ProvenUnreachable => Reason::ProvenUnreachable.name(),
-            ZoneReason::NotFound => Reason::NotFound.name(),
-            ZoneReason::NotPatched => Reason::NotPatched.name(),
-            ZoneReason::TcpmUnknown => "tcpm_unknown",
-            ZoneReason::FrameTransformed => "frame_transformed",
-            ZoneReason::DirectionForm => "direction_form",
-            ZoneReason::MacroVariable => "macro_variable",
-            ZoneReason::CentrePath => "centre_path",
-            ZoneReason::ToolLimited => "tool_limited",
-        }
-    }
-}
-
-impl From<Reason> for ZoneReason {
-    fn from(r: Reason) -> ZoneReason {
-        match r {
-            Reason::Reached => ZoneReason::Reached,
-            Reason::Reselected => ZoneReason::Reselected,
-            Reason::EndPinned => ZoneReason::EndPinned,
-            Reason::Range => ZoneReason::Range,
-            Reason::DeviationCap => ZoneReason::DeviationCap,
-            Reason::SafetyBound => ZoneReason::SafetyBound,
-            Reason::TipPath => ZoneReason::TipPath,
-            Reason::ProvenUnreachable => ZoneReason::ProvenUnreachable,
-            Reason::NotFound => ZoneReason::NotFound,
-            Reason::NotPatched => ZoneReason::NotPatched,
-        }
-    }
-}
-
-impl std::fmt::Display for ZoneReason {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
+/// Why a zone ended as it did (its row's `reason`): the patcher's [`Reason`], one fixed
+/// set; the library sets the last six (`tcpm_unknown` … `tool_limited`) where the run's
+/// circumstances decided, not the solve. `polepatch patch` counts them per file.
+pub use polepatch_patcher::Reason as ZoneReason;
 
 /// Whether a patched run's last point could change (a zone row's `end_pose`: what the
 /// blocks after the run allow, [`crate::EndPose`]).
