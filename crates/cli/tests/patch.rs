@@ -130,15 +130,7 @@ fn spans_a_flip_slows_within_the_reach_are_its_zone() {
     let text = program(&pass, Dialect::Sinumerik, "CASE");
     let m = polepatch::kinematics::Machine::builtin("mikron-ucp710").unwrap();
     // The zone: from the first span below feed (|A| 7.8°) through the flip (|A| 3.18°).
-    let analysis = polepatch::analyze_nc(text.as_bytes(), &m, &Default::default()).unwrap();
-    let zones: Vec<_> = analysis
-        .runs
-        .iter()
-        .filter_map(|r| r.figures.as_ref())
-        .flat_map(|f| f.zones.iter())
-        .collect();
-    assert_eq!(zones.len(), 1, "{zones:?}");
-    assert_eq!(zones[0].lines, [34, 57], "{zones:?}");
+    assert_eq!(analysed_zone_lines(text.as_bytes(), &m), [[34, 57]]);
     for unregularised_first in [true, false] {
         let mut opts = PatchOptions::default();
         opts.solver.ipm.unregularised_first = unregularised_first;
@@ -178,20 +170,12 @@ fn a_reached_claim_agrees_with_the_analysis_of_the_output() {
     };
     let text = program(&pass, Dialect::Heidenhain, "CASE");
     let m = polepatch::kinematics::Machine::builtin("mikron-hsm600").unwrap();
-    let zones_of = |bytes: &[u8]| -> Vec<[usize; 2]> {
-        let a = polepatch::analyze_nc(bytes, &m, &Default::default()).unwrap();
-        a.runs
-            .iter()
-            .filter_map(|r| r.figures.as_ref())
-            .flat_map(|f| f.zones.iter().map(|z| z.lines))
-            .collect()
-    };
-    assert_eq!(zones_of(text.as_bytes()).len(), 1);
+    assert_eq!(analysed_zone_lines(text.as_bytes(), &m).len(), 1);
     let (out, report) =
         polepatch::patch_nc(text.as_bytes(), &m, &polepatch::PatchOptions::default()).unwrap();
     assert_eq!(report.zones.len(), 1, "{:?}", report.zones);
     let z = &report.zones[0];
-    let left: Vec<_> = zones_of(&out)
+    let left: Vec<_> = analysed_zone_lines(&out, &m)
         .into_iter()
         .filter(|l| l[0] <= z.lines[1] && l[1] >= z.lines[0])
         .collect();

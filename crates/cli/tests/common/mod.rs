@@ -575,6 +575,16 @@ pub fn reachable_bound_deg(lp: &LoadedProgram, r: usize, machine: &Machine) -> O
     .map(|b| b.0)
 }
 
+/// The lines of every singular zone `polepatch analyze` finds in `bytes` (default options).
+pub fn analysed_zone_lines(bytes: &[u8], machine: &Machine) -> Vec<[usize; 2]> {
+    let a = polepatch::analyze_nc(bytes, machine, &Default::default()).unwrap();
+    a.runs
+        .iter()
+        .filter_map(|r| r.figures.as_ref())
+        .flat_map(|f| f.zones.iter().map(|z| z.lines))
+        .collect()
+}
+
 pub fn machines() -> Vec<Machine> {
     Machine::builtin_names()
         .iter()
