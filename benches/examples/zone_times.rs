@@ -44,11 +44,16 @@ fn main() {
                     solver.ipm.tol_feas = f;
                     solver.ipm.tol_gap = f;
                 }
+                "ipm_tol_gap" => solver.ipm.tol_gap = f,
+                "ipm_tol_feas" => solver.ipm.tol_feas = f,
                 "ipm_refinement_steps" => solver.ipm.refinement_steps = f as u32,
                 "ipm_regularisation" => solver.ipm.regularisation = f,
                 "ipm_unregularised_first" => solver.ipm.unregularised_first = f != 0.0,
                 "ipm_warm_mu" => solver.ipm.warm_mu = f,
+                "ipm_scale_objective" => solver.ipm.scale_objective = f != 0.0,
                 "scp_warm_start" => solver.scp_warm_start = f != 0.0,
+                "screen_ipm_tol" => solver.screen_ipm_tol = f,
+                "screen_within_tol" => solver.screen_within_tol = f,
                 other => panic!("unknown setting {other}"),
             }
         }

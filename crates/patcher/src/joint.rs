@@ -538,7 +538,12 @@ pub fn solve_joint(pr: &JointProblem) -> Result<JointSolution, PatchFailure> {
     for _ in 0..solves {
         let started = Instant::now();
         let qp = model.linearised(&xbar, rho);
-        let sol = qp.solve_warm(&st.ipm, warm.as_ref().filter(|_| st.scp_warm_start));
+        let ipm = if model.caps.is_some() {
+            &st.capped_ipm
+        } else {
+            &st.ipm
+        };
+        let sol = qp.solve_warm(ipm, warm.as_ref().filter(|_| st.scp_warm_start));
         stats.solves += 1;
         stats.iterations += sol.iterations;
         stats.solve_time_s += started.elapsed().as_secs_f64();

@@ -15,8 +15,10 @@
 //!   the range is wide enough to hold the cone stretch;
 //!   FREEZE's and LINEARIZE's rules across the cone (C held at its entry value, or linear
 //!   in s, P on C's meridian: [`crate::starts`]) pass through the pole inside the range; the
-//!   program's own values are the last start. Every start gets one solve; the
-//!   [`SolverSettings::screen_keep`] best (less excess over the limits, then smaller
+//!   program's own values are the last start. Every start gets one solve, only to rank
+//!   them (to the looser [`SolverSettings::screen_ipm_tol`]); the
+//!   [`SolverSettings::screen_keep`] best (within the limits up to
+//!   [`SolverSettings::screen_within_tol`], then less excess over them; then smaller
 //!   deviation) go on for the rest of [`SolverSettings::screen_solves`], and the best of
 //!   those for the rest of [`SolverSettings::scp_max_solves`]. A start's later solves go on
 //!   from its solution and compare "not worse" with what its first did (the program's
@@ -31,6 +33,7 @@ use crate::joint::{JointProblem, JointSolution, solve_joint};
 use crate::limits::GeomLimits;
 use crate::protocol::{Proposal, Proposer, Sink, Tail, ZoneCtx};
 use crate::report::Method;
+use crate::settings::SolverSettings;
 use crate::starts::{
     Rule, apply_rule, branch_switch, cone_stretch, least_primary, other_branch, tail_shift,
 };
@@ -232,7 +235,8 @@ impl JointMethod {
                        capped: Option<(usize, usize)>,
                        warm: bool,
                        solves: u32,
-                       ipm_start: Option<&'_ crate::ipm::IpmWarm>| {
+                       ipm_start: Option<&'_ crate::ipm::IpmWarm>,
+                       settings: &'_ SolverSettings| {
             let (first, last) = capped.unwrap_or((first, last));
             let capped = capped.is_some();
             let pr = JointProblem {
@@ -258,17 +262,29 @@ impl JointMethod {
                 max_solves: solves,
                 ipm_start,
                 memo: Some(memo),
-                settings: st,
+                settings,
             };
             solve_joint(&pr)
         };
+        // Each start's first solve, when several are screened, only ranks them: to the
+        // screening's tolerance (those that go on are solved again at the full one, from
+        // where it ended), and within the limits up to `screen_within_tol`.
+        let screen_st = SolverSettings {
+            ipm: crate::ipm::IpmSettings {
+                tol_feas: st.ipm.tol_feas.max(st.screen_ipm_tol),
+                tol_gap: st.ipm.tol_gap.max(st.screen_ipm_tol),
+                ..st.ipm
+            },
+            ..st.clone()
+        };
+        let within_tol = st.elastic_tol.max(st.screen_within_tol);
         // More solves from a start's solution, with the same "before" as its first solves:
         // the program's values for a rule's start, else the start's own values.
         let go_on = |s0: &Start, sol: &JointSolution, solves: u32| {
             let (mut wp, mut wc) = (s0.p.clone(), s0.c.clone());
             wp[first..=last].copy_from_slice(&sol.p_deg);
             wc[first..=last].copy_from_slice(&sol.c_deg);
-            let warm = sol.excess <= st.elastic_tol;
+            let warm = sol.excess <= within_tol;
             let before = if s0.rule {
                 (p, c)
             } else {
@@ -282,6 +298,7 @@ impl JointMethod {
                 warm,
                 solves,
                 sol.ipm_end.as_ref(),
+                st,
             )
         };
         // Within the limits first (by deviation), then the least excess.
@@ -309,6 +326,16 @@ impl JointMethod {
                 sol.qp = qp;
             }
         };
+        // Ranked after the screening's first solves: within the limits (up to `within_tol`:
+        // a loosely solved QP may leave a start that meets them just above `elastic_tol`)
+        // first, by deviation, then the least excess.
+        let screen_key = |s: &JointSolution| {
+            if s.excess <= within_tol {
+                (0u8, s.max_deviation_deg)
+            } else {
+                (1u8, s.excess)
+            }
+        };
         // Screen: one solve from every start; the `screen_keep` best go on for the rest of
         // `screen_solves`; then the best is refined up to `scp_max_solves`.
         let screen = st.screen_solves.min(st.scp_max_solves).max(1);
@@ -327,6 +354,11 @@ impl JointMethod {
                 false,
                 solves,
                 None,
+                if solves < st.scp_max_solves {
+                    &screen_st
+                } else {
+                    st
+                },
             ) {
                 Ok(sol) => {
                     let perfect =
@@ -340,7 +372,11 @@ impl JointMethod {
                 Err(_) => {}
             }
         }
-        rank(&mut screened);
+        screened.sort_by(|a, b| {
+            screen_key(&a.1)
+                .partial_cmp(&screen_key(&b.1))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
         let perfect = screened.first().is_some_and(|(_, s)| {
             s.excess <= st.elastic_tol && s.max_deviation_deg <= ZERO_DEVIATION_DEG
         });
@@ -458,6 +494,7 @@ impl JointMethod {
                     warm,
                     st.scp_max_solves,
                     None,
+                    st,
                 );
                 match r {
                     Ok(sol) => {

@@ -57,6 +57,17 @@ pub struct SolverSettings {
     pub screen_solves: u32,
     /// Starts that go on screening after their first solve. Default 2.
     pub screen_keep: usize,
+    /// Tolerance of the interior-point method (feasibility and gap; at least
+    /// [`IpmSettings::tol_feas`] and [`IpmSettings::tol_gap`]) in each start's first solve
+    /// when several are screened: that solve only ranks the starts, and those that go on
+    /// are solved again at the full tolerance from where it ended. Default 1e-4.
+    pub screen_ipm_tol: f64,
+    /// After that first solve a start ranks as within the limits when its relative excess
+    /// over them is at most this (at least [`SolverSettings::elastic_tol`]), and goes on
+    /// with the narrow trust region: a loosely solved QP can leave the excess of a start
+    /// that meets the limits just above `elastic_tol` (one that cannot meet them stays far
+    /// above: 0.1–0.5 on the held-out-like zones). Default 1e-3.
+    pub screen_within_tol: f64,
     /// An accepted step that lowers the exact largest deviation by less than this fraction
     /// ends the SCP. Default 0.01.
     pub scp_rel_tol: f64,
@@ -92,8 +103,17 @@ pub struct SolverSettings {
     /// interior-point method from the previous solve's multipliers and the iterate
     /// (`crate::ipm::Problem::solve_warm`) instead of cold. Default true.
     pub scp_warm_start: bool,
-    /// The interior-point solver's settings ([`crate::ipm`]).
+    /// The interior-point solver's settings ([`crate::ipm`]). Default: the objective not
+    /// scaled ([`IpmSettings::scale_objective`] false) and a gap tolerance of 1e-7 on it;
+    /// the rest [`IpmSettings::default`].
     pub ipm: IpmSettings,
+    /// The interior-point solver's settings in a capped joint solve (`max_deviation_deg`,
+    /// or the safety bound near the pole: the least excess over the limits within the
+    /// caps). Its objective is the excess, weighted by
+    /// [`SolverSettings::elastic_weight`], so the scaled objective's gap is already on
+    /// its scale. Default [`IpmSettings::default`] (the objective scaled, tolerances
+    /// 1e-8).
+    pub capped_ipm: IpmSettings,
     /// Margin on the limits of the reference's joint solves ([`crate::reference`]; the
     /// patcher's is `PatchOptions::margin`): just enough that its solution passes the
     /// verification's round-off tolerances. Default 1e-3.
@@ -158,6 +178,8 @@ impl Default for SolverSettings {
             scp_max_solves: 6,
             screen_solves: 2,
             screen_keep: 2,
+            screen_ipm_tol: 1e-4,
+            screen_within_tol: 1e-3,
             scp_rel_tol: 0.01,
             first_trust_p_deg: 15.0,
             first_trust_c_deg: 180.0,
@@ -170,7 +192,12 @@ impl Default for SolverSettings {
             elastic_tol: 1e-6,
             cap_tie_weight: 1e-6,
             scp_warm_start: true,
-            ipm: IpmSettings::default(),
+            ipm: IpmSettings {
+                scale_objective: false,
+                tol_gap: 1e-7,
+                ..IpmSettings::default()
+            },
+            capped_ipm: IpmSettings::default(),
             reference_margin: 1e-3,
             direct_max_points: 400,
             deviation_improvement_min: 0.05,
@@ -193,15 +220,22 @@ impl SolverSettings {
     /// default against: more solves, more screening, a tighter stopping rule (the range
     /// is the caller's: the whole movable territory). Its interior-point method stays as
     /// it was when the quality figures were first taken (regularised factorisation,
-    /// `unregularised_first` false; every solve cold, `scp_warm_start` false), so that a change of the default's solver is judged
-    /// against the same reference.
+    /// `unregularised_first` false; the objective scaled, tolerances 1e-8; every solve
+    /// cold, `scp_warm_start` false; every start's first solve to the full tolerance), so
+    /// that a change of the default's solver is judged against the same reference.
     pub fn reference() -> SolverSettings {
         SolverSettings {
             scp_max_solves: 24,
             screen_solves: 3,
             scp_rel_tol: 1e-3,
             scp_warm_start: false,
+            screen_ipm_tol: 0.0,
+            screen_within_tol: 0.0,
             ipm: IpmSettings {
+                unregularised_first: false,
+                ..IpmSettings::default()
+            },
+            capped_ipm: IpmSettings {
                 unregularised_first: false,
                 ..IpmSettings::default()
             },

@@ -249,17 +249,22 @@ impl Problem {
 
     /// The problem equilibrated: every pair (both sides, its elastic term included), every
     /// one-sided row and every cone (its rows together) divided by its largest
-    /// coefficient, the objective by its largest one. Neither changes the solution, and
-    /// the tolerances then mean the same on every row.
-    pub(super) fn equilibrated(self) -> Problem {
+    /// coefficient, the objective by its largest one (unless `scale_objective` is false:
+    /// [`super::IpmSettings::scale_objective`]). Neither changes the solution, and the
+    /// tolerances then mean the same on every row.
+    pub(super) fn equilibrated(self, scale_objective: bool) -> Problem {
         let mut p = self;
         let fin = |m: f64| if m > 0.0 && m.is_finite() { m } else { 1.0 };
-        let obj = fin(p
-            .c
-            .iter()
-            .map(|v| v.abs())
-            .chain(p.h.iter().map(|e| e.2.abs()))
-            .fold(0.0f64, f64::max));
+        let obj = if !scale_objective {
+            1.0
+        } else {
+            fin(p
+                .c
+                .iter()
+                .map(|v| v.abs())
+                .chain(p.h.iter().map(|e| e.2.abs()))
+                .fold(0.0f64, f64::max))
+        };
         p.c.iter_mut().for_each(|v| *v /= obj);
         p.h.iter_mut().for_each(|e| e.2 /= obj);
         for q in 0..p.pairs() {

@@ -30,6 +30,14 @@ pub struct IpmSettings {
     /// Most iterative refinement steps per solve (it stops earlier when the residual is
     /// below 1e-13 of the right-hand side). Default 4.
     pub refinement_steps: u32,
+    /// Divide the objective (and `H`) by its largest coefficient before solving, as the
+    /// rows are divided by theirs. The stopping rule's gap (`μ ≤ tol_gap·(1 + |objective|)`)
+    /// is then relative to that coefficient: for the joint patch, whose objective is
+    /// `t + M·e` with `M` = 10⁴, it leaves `t` — the largest orientation change, 10⁻³–10⁻¹
+    /// — unsolved by a few per cent, and the SCP takes more, noisier steps; unscaled, the
+    /// gap is on `t`'s own scale. Default true (the joint patch sets false:
+    /// `SolverSettings::ipm`).
+    pub scale_objective: bool,
 }
 
 impl Default for IpmSettings {
@@ -43,6 +51,7 @@ impl Default for IpmSettings {
             unregularised_first: true,
             warm_mu: 1e-4,
             refinement_steps: 4,
+            scale_objective: true,
         }
     }
 }

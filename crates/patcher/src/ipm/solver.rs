@@ -15,14 +15,14 @@ impl Problem {
     /// Nesterov–Todd scaling from CVXOPT's start, on the equilibrated problem.
     #[cfg(test)]
     pub fn solve(self, st: &IpmSettings) -> IpmSolution {
-        self.equilibrated().solve_scaled(st, None)
+        self.equilibrated(st.scale_objective).solve_scaled(st, None)
     }
 
     /// [`Problem::solve`] from a warm start ([`IpmWarm`]: a previous solve's primal point
     /// and multipliers, of a problem of the same shape), or cold when `warm` is `None` or
     /// of another shape.
     pub fn solve_warm(self, st: &IpmSettings, warm: Option<&IpmWarm>) -> IpmSolution {
-        self.equilibrated().solve_scaled(st, warm)
+        self.equilibrated(st.scale_objective).solve_scaled(st, warm)
     }
 
     fn solve_scaled(&self, st: &IpmSettings, warm: Option<&IpmWarm>) -> IpmSolution {
