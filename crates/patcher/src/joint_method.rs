@@ -301,18 +301,20 @@ impl JointMethod {
                 st,
             )
         };
-        // Within the limits first (by deviation), then the least excess.
-        let key = |s: &JointSolution| {
-            if s.excess <= st.elastic_tol {
+        // Within the limits (an excess up to `tol`) first, by deviation, then the least
+        // excess.
+        let key_within = |s: &JointSolution, tol: f64| {
+            if s.excess <= tol {
                 (0u8, s.max_deviation_deg)
             } else {
                 (1u8, s.excess)
             }
         };
-        let rank = |v: &mut Vec<(usize, JointSolution)>| {
+        let key = |s: &JointSolution| key_within(s, st.elastic_tol);
+        let rank = |v: &mut Vec<(usize, JointSolution)>, tol: f64| {
             v.sort_by(|a, b| {
-                key(&a.1)
-                    .partial_cmp(&key(&b.1))
+                key_within(&a.1, tol)
+                    .partial_cmp(&key_within(&b.1, tol))
                     .unwrap_or(std::cmp::Ordering::Equal)
             })
         };
@@ -324,16 +326,6 @@ impl JointMethod {
                 *sol = JointSolution { qp, ..more };
             } else {
                 sol.qp = qp;
-            }
-        };
-        // Ranked after the screening's first solves: within the limits (up to `within_tol`:
-        // a loosely solved QP may leave a start that meets them just above `elastic_tol`)
-        // first, by deviation, then the least excess.
-        let screen_key = |s: &JointSolution| {
-            if s.excess <= within_tol {
-                (0u8, s.max_deviation_deg)
-            } else {
-                (1u8, s.excess)
             }
         };
         // Screen: one solve from every start; the `screen_keep` best go on for the rest of
@@ -372,11 +364,9 @@ impl JointMethod {
                 Err(_) => {}
             }
         }
-        screened.sort_by(|a, b| {
-            screen_key(&a.1)
-                .partial_cmp(&screen_key(&b.1))
-                .unwrap_or(std::cmp::Ordering::Equal)
-        });
+        // Ranked after the screening's first solves within the limits up to `within_tol`: a
+        // loosely solved QP may leave a start that meets them just above `elastic_tol`.
+        rank(&mut screened, within_tol);
         let perfect = screened.first().is_some_and(|(_, s)| {
             s.excess <= st.elastic_tol && s.max_deviation_deg <= ZERO_DEVIATION_DEG
         });
@@ -387,7 +377,7 @@ impl JointMethod {
                         keep_better(sol, more);
                     }
                 }
-                rank(&mut screened);
+                rank(&mut screened, st.elastic_tol);
             }
             if let Some((i, sol)) = screened.first_mut()
                 && st.scp_max_solves > screen
