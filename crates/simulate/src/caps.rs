@@ -85,8 +85,12 @@ pub struct Caps {
     a: [f64; 5],
     j: [f64; 5],
     qss: [f64; 5],
+    /// 3·|q_ss| (the factor of the jerk cap's v·|a| term, as `3.0 * qss` rounds it).
+    qss3: [f64; 5],
     qsss: [f64; 5],
     inv_qs: [f64; 5],
+    /// Every axis moves (|q_s| > 0): each bounds the caps by its own term, no branches.
+    all_move: bool,
 }
 
 impl Caps {
@@ -96,14 +100,23 @@ impl Caps {
             a: std::array::from_fn(|i| LIMIT_USE * m.limits[i].a),
             j: std::array::from_fn(|i| LIMIT_USE * m.limits[i].j),
             qss: loc.qss,
+            qss3: loc.qss.map(|q| 3.0 * q),
             qsss: loc.qsss,
             inv_qs: loc.qs.map(|q| if q > 0.0 { 1.0 / q } else { 0.0 }),
+            all_move: loc.qs.iter().all(|&q| q > 0.0),
         }
     }
 
     /// [`Local::a_cap`].
+    #[inline]
     pub fn a_cap(&self, v: f64) -> f64 {
         let mut c = f64::INFINITY;
+        if self.all_move {
+            for i in 0..5 {
+                c = c.min((self.a[i] - self.qss[i] * v * v) * self.inv_qs[i]);
+            }
+            return c;
+        }
         for i in 0..5 {
             let room = self.a[i] - self.qss[i] * v * v;
             c = self.bound(c, i, room);
@@ -112,10 +125,18 @@ impl Caps {
     }
 
     /// [`Local::j_cap`].
+    #[inline]
     pub fn j_cap(&self, v: f64, a_abs: f64) -> f64 {
         let mut c = f64::INFINITY;
+        if self.all_move {
+            for i in 0..5 {
+                let room = self.j[i] - self.qsss[i] * v * v * v - self.qss3[i] * v * a_abs;
+                c = c.min(room * self.inv_qs[i]);
+            }
+            return c;
+        }
         for i in 0..5 {
-            let room = self.j[i] - self.qsss[i] * v * v * v - 3.0 * self.qss[i] * v * a_abs;
+            let room = self.j[i] - self.qsss[i] * v * v * v - self.qss3[i] * v * a_abs;
             c = self.bound(c, i, room);
         }
         c

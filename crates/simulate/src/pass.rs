@@ -68,6 +68,7 @@ impl<'a> Ceiling<'a> {
     }
 
     /// Cell index of `x`: `i` with `x[i] ≤ x < x[i+1]`, clamped to the cells; `hint` first.
+    #[inline]
     fn cell(&self, x: f64, hint: usize) -> usize {
         let n = self.x.len();
         let last = n.saturating_sub(2);
@@ -78,10 +79,7 @@ impl<'a> Ceiling<'a> {
         if h + 2 < n && self.x[h + 1] <= x && x < self.x[h + 2] {
             return h + 1;
         }
-        self.x
-            .partition_point(|&p| p <= x)
-            .saturating_sub(1)
-            .min(last)
+        count_at_most_near(self.x, x, h).saturating_sub(1).min(last)
     }
 
     /// (W, a_W) at `x`, and the cell.
@@ -96,6 +94,7 @@ impl<'a> Ceiling<'a> {
 
     /// (P = W^(3/2), dP/dx) at `x`, and the cell: what [`Ceiling::at`] is computed from,
     /// for the comparisons that need no cube root (`above_ceiling`, `accel_within`).
+    #[inline]
     fn at_p(&self, x: f64, hint: usize) -> (f64, f64, usize) {
         let i = self.cell(x, hint);
         if self.x.len() < 2 {
@@ -141,6 +140,46 @@ impl<'a> Ceiling<'a> {
             None => (p0 + u * (p1 - p0), (p1 - p0) * inv_h),
         };
         (p, dp, i)
+    }
+}
+
+/// The number of elements of the sorted `xs` that are ≤ `x` (`xs.partition_point(|&p| p
+/// ≤ x)`), searched outward from index `h` in steps that double (a ramp of the look-ahead
+/// moves a few cells from where the last one was; a search over the whole motion's grid
+/// would miss the cache at every level).
+fn count_at_most_near(xs: &[f64], x: f64, h: usize) -> usize {
+    let n = xs.len();
+    if h < n && xs[h] <= x {
+        // The count is above h: double the step forward until an element is above x.
+        let mut lo = h + 1;
+        let mut step = 1;
+        loop {
+            let probe = lo + step - 1;
+            if probe >= n {
+                return lo + xs[lo..].partition_point(|&p| p <= x);
+            }
+            if xs[probe] <= x {
+                lo = probe + 1;
+                step *= 2;
+            } else {
+                return lo + xs[lo..probe].partition_point(|&p| p <= x);
+            }
+        }
+    } else {
+        // The count is at most h (or x is NaN: 0): double the step backward.
+        let mut hi = h.min(n);
+        let mut step = 1;
+        loop {
+            if hi < step {
+                return xs[..hi].partition_point(|&p| p <= x);
+            }
+            let probe = hi - step;
+            if xs[probe] <= x {
+                return probe + 1 + xs[probe + 1..hi].partition_point(|&p| p <= x);
+            }
+            hi = probe;
+            step *= 2;
+        }
     }
 }
 
@@ -237,6 +276,7 @@ impl Pass<'_> {
         if self.forward { x } else { len - x }
     }
 
+    #[inline]
     fn caps(&self, caps: &Caps, v: f64, a_abs: f64) -> (f64, f64) {
         let ac = caps.a_cap(v) * self.use_caps[0];
         let jc = caps.j_cap(v, a_abs) * self.use_caps[1];
@@ -315,15 +355,16 @@ impl Pass<'_> {
             let loc = Local::from_derivs(&d);
             let vmax = loc.v_cap(self.machine).min(feed);
             let caps = Caps::new(&loc, self.machine);
-            let (w, _, i) = self.ceiling.at(st.x, hint);
+            let (w, aw, i) = self.ceiling.at(st.x, hint);
             hint = i;
+            let (ac, jc) = self.caps(&caps, st.v, st.a.abs());
             let dt = self.dt;
             // A cruise on a flat stretch of the ceiling: jump to the next grid point
             // when the state there is safe (then it is everywhere before it).
             // Within CRUISE_REL of the ceiling, or of one cycle at the jerk cap where the
             // ceiling is below that (the crawl regime, where a cycle's jerk is coarser
             // than the speed).
-            let one_cycle = self.caps(&caps, st.v, st.a.abs()).1.max(0.0) * self.dt * self.dt;
+            let one_cycle = jc.max(0.0) * self.dt * self.dt;
             let near = (CRUISE_REL * w)
                 .max(CRAWL_CRUISE_REL * w.min(one_cycle))
                 .max(CRUISE_ABS_MM_S);
@@ -352,7 +393,6 @@ impl Pass<'_> {
                     continue;
                 }
             }
-            let (ac, jc) = self.caps(&caps, st.v, st.a.abs());
             let jm = jc.max(0.0);
             let ac = ac.max(0.0);
             let mut lo = (-jm).max((-ac - st.a) / dt);
@@ -383,7 +423,7 @@ impl Pass<'_> {
             };
             // On a flat ceiling, just under it: settle (a → 0) rather than take the
             // largest safe jerk, which would overshoot and chatter about the ceiling.
-            let (w0, aw0, _) = self.ceiling.at(st.x, hint);
+            let (w0, aw0) = (w, aw);
             let jz = (-st.a / dt).clamp(lo, hi);
             let settle = aw0 == 0.0 && w0 - st.v <= SETTLE_REL * w0;
             let j = if ok(hi) {
@@ -513,6 +553,36 @@ impl Pass<'_> {
 
 #[cfg(test)]
 mod tests {
+    /// The search from a hint is the partition point, from every hint, with repeated
+    /// elements, outside the elements and at NaN.
+    #[test]
+    fn the_search_from_a_hint_is_the_partition_point() {
+        let xs = [0.0, 1.0, 1.0, 1.5, 4.0, 4.0, 4.0, 9.0, 10.0, 11.0, 20.0];
+        for x in [
+            -1.0,
+            0.0,
+            0.5,
+            1.0,
+            1.2,
+            1.5,
+            3.0,
+            4.0,
+            8.9,
+            9.0,
+            10.5,
+            11.0,
+            20.0,
+            25.0,
+            f64::NAN,
+        ] {
+            let want = xs.partition_point(|&p| p <= x);
+            for h in 0..14 {
+                assert_eq!(super::count_at_most_near(&xs, x, h), want, "x={x} h={h}");
+            }
+        }
+        assert_eq!(super::count_at_most_near(&[], 1.0, 0), 0);
+    }
+
     /// The cube root agrees with the library's to rounding over 600 decades.
     #[test]
     fn cube_root() {
