@@ -43,14 +43,19 @@ pub(crate) struct Ceiling<'a> {
     /// dP/dx = 1.5·a/√v at the points (NaN at rest), when the profile's acceleration is
     /// given.
     m: Option<Vec<f64>>,
+    /// Per cell, what its interpolant needs whatever the position in it, computed once
+    /// as [`Ceiling::at_p`] used to compute it at every call (the same values): 1/h and
+    /// the two end slopes × h (Hermite), or P₁ − P₀ and its slope (linear).
+    cells: Vec<[f64; 3]>,
 }
 
 impl<'a> Ceiling<'a> {
     /// A ceiling through `v` at `x`; with `a`, the acceleration of the profile there.
     pub fn new(x: &'a [f64], v: &'a [f64], a: Option<&[f64]>) -> Ceiling<'a> {
-        Ceiling {
+        let mut c = Ceiling {
             x,
             v,
+            cells: Vec::new(),
             p: v.iter().map(|w| w * w.sqrt()).collect(),
             m: a.map(|a| {
                 v.iter()
@@ -64,6 +69,36 @@ impl<'a> Ceiling<'a> {
                     })
                     .collect()
             }),
+        };
+        c.cells = (0..x.len().saturating_sub(1))
+            .map(|i| c.cell_data(i))
+            .collect();
+        c
+    }
+
+    /// The entry of `cells` for cell `i`.
+    fn cell_data(&self, i: usize) -> [f64; 3] {
+        let (x0, x1) = (self.x[i], self.x[i + 1]);
+        let h = x1 - x0;
+        let inv_h = 1.0 / h;
+        let (p0, p1) = (self.p[i], self.p[i + 1]);
+        match &self.m {
+            Some(m) => {
+                let secant = (p1 - p0) * inv_h;
+                let pick = |a: f64, b: f64| {
+                    if !a.is_nan() {
+                        a
+                    } else if !b.is_nan() {
+                        b
+                    } else {
+                        secant
+                    }
+                };
+                let m0 = pick(m[i], m[i + 1]) * h;
+                let m1 = pick(m[i + 1], m[i]) * h;
+                [inv_h, m0, m1]
+            }
+            None => [inv_h, p1 - p0, (p1 - p0) * inv_h],
         }
     }
 
@@ -100,44 +135,29 @@ impl<'a> Ceiling<'a> {
         if self.x.len() < 2 {
             return (self.p[0], 0.0, 0);
         }
-        let (x0, x1) = (self.x[i], self.x[i + 1]);
-        let h = x1 - x0;
-        let inv_h = 1.0 / h;
+        let [inv_h, m0, m1] = self.cells[i];
+        let (x0, p0, p1) = (self.x[i], self.p[i], self.p[i + 1]);
         let u = ((x - x0) * inv_h).clamp(0.0, 1.0);
-        let (p0, p1) = (self.p[i], self.p[i + 1]);
-        let (p, dp) = match &self.m {
+        let (p, dp) = if self.m.is_some() {
             // P as the cubic Hermite interpolant of the values and slopes of the profile
             // the ceiling was recorded from (C¹: a motion can follow it with a continuous
             // acceleration). At rest the slope is the other end's: P is linear in the jerk
             // phase from rest (x = J·t³/6, P = (J/2)^(3/2)·t³).
-            Some(m) => {
-                let secant = (p1 - p0) * inv_h;
-                let pick = |a: f64, b: f64| {
-                    if !a.is_nan() {
-                        a
-                    } else if !b.is_nan() {
-                        b
-                    } else {
-                        secant
-                    }
-                };
-                let m0 = pick(m[i], m[i + 1]) * h;
-                let m1 = pick(m[i + 1], m[i]) * h;
-                let (u2, u3) = (u * u, u * u * u);
-                let p = (2.0 * u3 - 3.0 * u2 + 1.0) * p0
-                    + (u3 - 2.0 * u2 + u) * m0
-                    + (-2.0 * u3 + 3.0 * u2) * p1
-                    + (u3 - u2) * m1;
-                let dp = ((6.0 * u2 - 6.0 * u) * p0
-                    + (3.0 * u2 - 4.0 * u + 1.0) * m0
-                    + (-6.0 * u2 + 6.0 * u) * p1
-                    + (3.0 * u2 - 2.0 * u) * m1)
-                    * inv_h;
-                (p.max(0.0), dp)
-            }
+            let (u2, u3) = (u * u, u * u * u);
+            let p = (2.0 * u3 - 3.0 * u2 + 1.0) * p0
+                + (u3 - 2.0 * u2 + u) * m0
+                + (-2.0 * u3 + 3.0 * u2) * p1
+                + (u3 - u2) * m1;
+            let dp = ((6.0 * u2 - 6.0 * u) * p0
+                + (3.0 * u2 - 4.0 * u + 1.0) * m0
+                + (-6.0 * u2 + 6.0 * u) * p1
+                + (3.0 * u2 - 2.0 * u) * m1)
+                * inv_h;
+            (p.max(0.0), dp)
+        } else {
             // P linear: exact for the jerk phase from rest, between the two values
-            // elsewhere.
-            None => (p0 + u * (p1 - p0), (p1 - p0) * inv_h),
+            // elsewhere (m0, m1: P₁ − P₀ and its slope).
+            (p0 + u * m0, m1)
         };
         (p, dp, i)
     }
