@@ -129,7 +129,7 @@ impl<'a> Ceiling<'a> {
 
     /// (P = W^(3/2), dP/dx) at `x`, and the cell: what [`Ceiling::at`] is computed from,
     /// for the comparisons that need no cube root (`above_ceiling`, `accel_within`).
-    #[inline]
+    #[inline(always)]
     fn at_p(&self, x: f64, hint: usize) -> (f64, f64, usize) {
         let i = self.cell(x, hint);
         if self.x.len() < 2 {
