@@ -370,12 +370,17 @@ impl Pass<'_> {
         let mut hint = 0usize;
         let mut idle = 0u32;
         let mut cursor = Cursor::default();
+        // The ceiling at the end of the last cycle: where this one starts.
+        let mut at_end: Option<(f64, (f64, f64, usize))> = None;
         while st.x < len - END_MM {
             let (d, feed) = self.geo.derivs_feed_near(self.s_of(st.x, len), &mut cursor);
             let loc = Local::from_derivs(&d);
             let vmax = loc.v_cap(self.machine).min(feed);
             let caps = Caps::new(&loc, self.machine);
-            let (w, aw, i) = self.ceiling.at(st.x, hint);
+            let (w, aw, i) = match at_end {
+                Some((x, c)) if x == st.x => c,
+                _ => self.ceiling.at(st.x, hint),
+            };
             hint = i;
             let (ac, jc) = self.caps(&caps, st.v, st.a.abs());
             let dt = self.dt;
@@ -525,7 +530,9 @@ impl Pass<'_> {
                 // second one at the same time).
                 x1 = len;
             }
-            let (w1, aw1, _) = self.ceiling.at(x1, hint);
+            let end = self.ceiling.at(x1, hint);
+            at_end = Some((x1, end));
+            let (w1, aw1, _) = end;
             let w1 = w1.min(vmax);
             if v1 > w1 * (1.0 + CEILING_REL) {
                 // On the ceiling with its acceleration, within the caps there at that
