@@ -85,25 +85,40 @@ pub struct Caps {
     a: [f64; 5],
     j: [f64; 5],
     qss: [f64; 5],
+    /// 3·|q_ss| (the factor of the jerk cap's v·|a| term, as `3.0 * qss` rounds it).
+    qss3: [f64; 5],
     qsss: [f64; 5],
     inv_qs: [f64; 5],
+    /// Every axis moves (1/|q_s| > 0): each bounds the caps by its own term, with no
+    /// branch (the same minimum as [`Caps::bound`] takes).
+    all_move: bool,
 }
 
 impl Caps {
     /// The caps of `loc` on `m`.
     pub fn new(loc: &Local, m: &Machine) -> Caps {
+        let inv_qs = loc.qs.map(|q| if q > 0.0 { 1.0 / q } else { 0.0 });
         Caps {
             a: std::array::from_fn(|i| LIMIT_USE * m.limits[i].a),
             j: std::array::from_fn(|i| LIMIT_USE * m.limits[i].j),
             qss: loc.qss,
+            qss3: loc.qss.map(|q| 3.0 * q),
             qsss: loc.qsss,
-            inv_qs: loc.qs.map(|q| if q > 0.0 { 1.0 / q } else { 0.0 }),
+            inv_qs,
+            all_move: inv_qs.iter().all(|&i| i > 0.0),
         }
     }
 
     /// [`Local::a_cap`].
+    #[inline]
     pub fn a_cap(&self, v: f64) -> f64 {
         let mut c = f64::INFINITY;
+        if self.all_move {
+            for i in 0..5 {
+                c = c.min((self.a[i] - self.qss[i] * v * v) * self.inv_qs[i]);
+            }
+            return c;
+        }
         for i in 0..5 {
             let room = self.a[i] - self.qss[i] * v * v;
             c = self.bound(c, i, room);
@@ -112,10 +127,18 @@ impl Caps {
     }
 
     /// [`Local::j_cap`].
+    #[inline]
     pub fn j_cap(&self, v: f64, a_abs: f64) -> f64 {
         let mut c = f64::INFINITY;
+        if self.all_move {
+            for i in 0..5 {
+                let room = self.j[i] - self.qsss[i] * v * v * v - self.qss3[i] * v * a_abs;
+                c = c.min(room * self.inv_qs[i]);
+            }
+            return c;
+        }
         for i in 0..5 {
-            let room = self.j[i] - self.qsss[i] * v * v * v - 3.0 * self.qss[i] * v * a_abs;
+            let room = self.j[i] - self.qsss[i] * v * v * v - self.qss3[i] * v * a_abs;
             c = self.bound(c, i, room);
         }
         c
@@ -209,6 +232,35 @@ mod tests {
         // Same signs of the terms as the bound: the binding axis reaches its jerk share.
         let sh = shares(&m, &d, v, a, j);
         assert!((sh[4] - LIMIT_USE).abs() < 1e-9, "{sh:?}");
+    }
+
+    /// Where every axis moves, the caps without branches are the caps with them, to the
+    /// bit.
+    #[test]
+    fn the_branch_free_caps_are_the_caps() {
+        let m = m();
+        let mut d = [[0.0; 4]; 5];
+        d[0] = [0.0, 0.8, 0.01, -0.002];
+        d[1] = [0.0, -0.6, 0.02, 0.001];
+        d[2] = [0.0, 0.1, -0.3, 0.05];
+        d[3] = [0.0, 1.5, 0.7, -4.0];
+        d[4] = [0.0, 2.0, 3.0, 18.0];
+        let fast = Caps::new(&Local::from_derivs(&d), &m);
+        assert!(fast.all_move);
+        let general = Caps {
+            all_move: false,
+            ..fast
+        };
+        for v in [0.0, 0.3, 5.0, 40.0, 1e3] {
+            assert_eq!(fast.a_cap(v).to_bits(), general.a_cap(v).to_bits(), "{v}");
+            for a in [0.0, 2.0, 300.0] {
+                assert_eq!(
+                    fast.j_cap(v, a).to_bits(),
+                    general.j_cap(v, a).to_bits(),
+                    "{v} {a}"
+                );
+            }
+        }
     }
 
     /// At the acceleration `a_for_jerk` gives, the jerk cap is 0 (the binding axis has

@@ -335,6 +335,10 @@ pub fn simulate(
     let bx: Vec<f64> = store.x.iter().rev().map(|x| len - x).collect();
     let bv: Vec<f64> = store.v.iter().rev().copied().collect();
     let ba: Vec<f64> = store.a.iter().rev().map(|a| -a).collect();
+    // What only the backward pass used, freed before the forward pass (peak memory).
+    drop(store);
+    drop(back);
+    drop((xb, wb));
 
     // Forward pass under B: the trajectory.
     let fwd = Pass {

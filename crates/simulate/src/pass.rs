@@ -43,14 +43,19 @@ pub(crate) struct Ceiling<'a> {
     /// dP/dx = 1.5·a/√v at the points (NaN at rest), when the profile's acceleration is
     /// given.
     m: Option<Vec<f64>>,
+    /// Per cell, what its interpolant needs whatever the position in it, computed once
+    /// as [`Ceiling::at_p`] used to compute it at every call (the same values): 1/h and
+    /// the two end slopes × h (Hermite), or P₁ − P₀ and its slope (linear).
+    cells: Vec<[f64; 3]>,
 }
 
 impl<'a> Ceiling<'a> {
     /// A ceiling through `v` at `x`; with `a`, the acceleration of the profile there.
     pub fn new(x: &'a [f64], v: &'a [f64], a: Option<&[f64]>) -> Ceiling<'a> {
-        Ceiling {
+        let mut c = Ceiling {
             x,
             v,
+            cells: Vec::new(),
             p: v.iter().map(|w| w * w.sqrt()).collect(),
             m: a.map(|a| {
                 v.iter()
@@ -64,10 +69,41 @@ impl<'a> Ceiling<'a> {
                     })
                     .collect()
             }),
+        };
+        c.cells = (0..x.len().saturating_sub(1))
+            .map(|i| c.cell_data(i))
+            .collect();
+        c
+    }
+
+    /// The entry of `cells` for cell `i`.
+    fn cell_data(&self, i: usize) -> [f64; 3] {
+        let (x0, x1) = (self.x[i], self.x[i + 1]);
+        let h = x1 - x0;
+        let inv_h = 1.0 / h;
+        let (p0, p1) = (self.p[i], self.p[i + 1]);
+        match &self.m {
+            Some(m) => {
+                let secant = (p1 - p0) * inv_h;
+                let pick = |a: f64, b: f64| {
+                    if !a.is_nan() {
+                        a
+                    } else if !b.is_nan() {
+                        b
+                    } else {
+                        secant
+                    }
+                };
+                let m0 = pick(m[i], m[i + 1]) * h;
+                let m1 = pick(m[i + 1], m[i]) * h;
+                [inv_h, m0, m1]
+            }
+            None => [inv_h, p1 - p0, (p1 - p0) * inv_h],
         }
     }
 
     /// Cell index of `x`: `i` with `x[i] ≤ x < x[i+1]`, clamped to the cells; `hint` first.
+    #[inline]
     fn cell(&self, x: f64, hint: usize) -> usize {
         let n = self.x.len();
         let last = n.saturating_sub(2);
@@ -78,10 +114,7 @@ impl<'a> Ceiling<'a> {
         if h + 2 < n && self.x[h + 1] <= x && x < self.x[h + 2] {
             return h + 1;
         }
-        self.x
-            .partition_point(|&p| p <= x)
-            .saturating_sub(1)
-            .min(last)
+        count_at_most_near(self.x, x, h).saturating_sub(1).min(last)
     }
 
     /// (W, a_W) at `x`, and the cell.
@@ -96,51 +129,77 @@ impl<'a> Ceiling<'a> {
 
     /// (P = W^(3/2), dP/dx) at `x`, and the cell: what [`Ceiling::at`] is computed from,
     /// for the comparisons that need no cube root (`above_ceiling`, `accel_within`).
+    #[inline(always)]
     fn at_p(&self, x: f64, hint: usize) -> (f64, f64, usize) {
         let i = self.cell(x, hint);
         if self.x.len() < 2 {
             return (self.p[0], 0.0, 0);
         }
-        let (x0, x1) = (self.x[i], self.x[i + 1]);
-        let h = x1 - x0;
-        let inv_h = 1.0 / h;
+        let [inv_h, m0, m1] = self.cells[i];
+        let (x0, p0, p1) = (self.x[i], self.p[i], self.p[i + 1]);
         let u = ((x - x0) * inv_h).clamp(0.0, 1.0);
-        let (p0, p1) = (self.p[i], self.p[i + 1]);
-        let (p, dp) = match &self.m {
+        let (p, dp) = if self.m.is_some() {
             // P as the cubic Hermite interpolant of the values and slopes of the profile
             // the ceiling was recorded from (C¹: a motion can follow it with a continuous
             // acceleration). At rest the slope is the other end's: P is linear in the jerk
             // phase from rest (x = J·t³/6, P = (J/2)^(3/2)·t³).
-            Some(m) => {
-                let secant = (p1 - p0) * inv_h;
-                let pick = |a: f64, b: f64| {
-                    if !a.is_nan() {
-                        a
-                    } else if !b.is_nan() {
-                        b
-                    } else {
-                        secant
-                    }
-                };
-                let m0 = pick(m[i], m[i + 1]) * h;
-                let m1 = pick(m[i + 1], m[i]) * h;
-                let (u2, u3) = (u * u, u * u * u);
-                let p = (2.0 * u3 - 3.0 * u2 + 1.0) * p0
-                    + (u3 - 2.0 * u2 + u) * m0
-                    + (-2.0 * u3 + 3.0 * u2) * p1
-                    + (u3 - u2) * m1;
-                let dp = ((6.0 * u2 - 6.0 * u) * p0
-                    + (3.0 * u2 - 4.0 * u + 1.0) * m0
-                    + (-6.0 * u2 + 6.0 * u) * p1
-                    + (3.0 * u2 - 2.0 * u) * m1)
-                    * inv_h;
-                (p.max(0.0), dp)
-            }
+            let (u2, u3) = (u * u, u * u * u);
+            let p = (2.0 * u3 - 3.0 * u2 + 1.0) * p0
+                + (u3 - 2.0 * u2 + u) * m0
+                + (-2.0 * u3 + 3.0 * u2) * p1
+                + (u3 - u2) * m1;
+            let dp = ((6.0 * u2 - 6.0 * u) * p0
+                + (3.0 * u2 - 4.0 * u + 1.0) * m0
+                + (-6.0 * u2 + 6.0 * u) * p1
+                + (3.0 * u2 - 2.0 * u) * m1)
+                * inv_h;
+            (p.max(0.0), dp)
+        } else {
             // P linear: exact for the jerk phase from rest, between the two values
-            // elsewhere.
-            None => (p0 + u * (p1 - p0), (p1 - p0) * inv_h),
+            // elsewhere (m0, m1: P₁ − P₀ and its slope).
+            (p0 + u * m0, m1)
         };
         (p, dp, i)
+    }
+}
+
+/// The number of elements of the sorted `xs` that are ≤ `x` (`xs.partition_point(|&p| p
+/// ≤ x)`), searched outward from index `h` in steps that double (a ramp of the look-ahead
+/// moves a few cells from where the last one was; a search over the whole motion's grid
+/// would miss the cache at every level).
+fn count_at_most_near(xs: &[f64], x: f64, h: usize) -> usize {
+    let n = xs.len();
+    if h < n && xs[h] <= x {
+        // The count is above h: double the step forward until an element is above x.
+        let mut lo = h + 1;
+        let mut step = 1;
+        loop {
+            let probe = lo + step - 1;
+            if probe >= n {
+                return lo + xs[lo..].partition_point(|&p| p <= x);
+            }
+            if xs[probe] <= x {
+                lo = probe + 1;
+                step *= 2;
+            } else {
+                return lo + xs[lo..probe].partition_point(|&p| p <= x);
+            }
+        }
+    } else {
+        // The count is at most h (or x is NaN: 0): double the step backward.
+        let mut hi = h.min(n);
+        let mut step = 1;
+        loop {
+            if hi < step {
+                return xs[..hi].partition_point(|&p| p <= x);
+            }
+            let probe = hi - step;
+            if xs[probe] <= x {
+                return probe + 1 + xs[probe + 1..hi].partition_point(|&p| p <= x);
+            }
+            hi = probe;
+            step *= 2;
+        }
     }
 }
 
@@ -237,6 +296,7 @@ impl Pass<'_> {
         if self.forward { x } else { len - x }
     }
 
+    #[inline]
     fn caps(&self, caps: &Caps, v: f64, a_abs: f64) -> (f64, f64) {
         let ac = caps.a_cap(v) * self.use_caps[0];
         let jc = caps.j_cap(v, a_abs) * self.use_caps[1];
@@ -310,20 +370,26 @@ impl Pass<'_> {
         let mut hint = 0usize;
         let mut idle = 0u32;
         let mut cursor = Cursor::default();
+        // The ceiling at the end of the last cycle: where this one starts.
+        let mut at_end: Option<(f64, (f64, f64, usize))> = None;
         while st.x < len - END_MM {
             let (d, feed) = self.geo.derivs_feed_near(self.s_of(st.x, len), &mut cursor);
             let loc = Local::from_derivs(&d);
             let vmax = loc.v_cap(self.machine).min(feed);
             let caps = Caps::new(&loc, self.machine);
-            let (w, _, i) = self.ceiling.at(st.x, hint);
+            let (w, aw, i) = match at_end {
+                Some((x, c)) if x == st.x => c,
+                _ => self.ceiling.at(st.x, hint),
+            };
             hint = i;
+            let (ac, jc) = self.caps(&caps, st.v, st.a.abs());
             let dt = self.dt;
             // A cruise on a flat stretch of the ceiling: jump to the next grid point
             // when the state there is safe (then it is everywhere before it).
             // Within CRUISE_REL of the ceiling, or of one cycle at the jerk cap where the
             // ceiling is below that (the crawl regime, where a cycle's jerk is coarser
             // than the speed).
-            let one_cycle = self.caps(&caps, st.v, st.a.abs()).1.max(0.0) * self.dt * self.dt;
+            let one_cycle = jc.max(0.0) * self.dt * self.dt;
             let near = (CRUISE_REL * w)
                 .max(CRAWL_CRUISE_REL * w.min(one_cycle))
                 .max(CRUISE_ABS_MM_S);
@@ -352,7 +418,6 @@ impl Pass<'_> {
                     continue;
                 }
             }
-            let (ac, jc) = self.caps(&caps, st.v, st.a.abs());
             let jm = jc.max(0.0);
             let ac = ac.max(0.0);
             let mut lo = (-jm).max((-ac - st.a) / dt);
@@ -383,7 +448,7 @@ impl Pass<'_> {
             };
             // On a flat ceiling, just under it: settle (a → 0) rather than take the
             // largest safe jerk, which would overshoot and chatter about the ceiling.
-            let (w0, aw0, _) = self.ceiling.at(st.x, hint);
+            let (w0, aw0) = (w, aw);
             let jz = (-st.a / dt).clamp(lo, hi);
             let settle = aw0 == 0.0 && w0 - st.v <= SETTLE_REL * w0;
             let j = if ok(hi) {
@@ -465,7 +530,9 @@ impl Pass<'_> {
                 // second one at the same time).
                 x1 = len;
             }
-            let (w1, aw1, _) = self.ceiling.at(x1, hint);
+            let end = self.ceiling.at(x1, hint);
+            at_end = Some((x1, end));
+            let (w1, aw1, _) = end;
             let w1 = w1.min(vmax);
             if v1 > w1 * (1.0 + CEILING_REL) {
                 // On the ceiling with its acceleration, within the caps there at that
@@ -513,6 +580,36 @@ impl Pass<'_> {
 
 #[cfg(test)]
 mod tests {
+    /// The search from a hint is the partition point, from every hint, with repeated
+    /// elements, outside the elements and at NaN.
+    #[test]
+    fn the_search_from_a_hint_is_the_partition_point() {
+        let xs = [0.0, 1.0, 1.0, 1.5, 4.0, 4.0, 4.0, 9.0, 10.0, 11.0, 20.0];
+        for x in [
+            -1.0,
+            0.0,
+            0.5,
+            1.0,
+            1.2,
+            1.5,
+            3.0,
+            4.0,
+            8.9,
+            9.0,
+            10.5,
+            11.0,
+            20.0,
+            25.0,
+            f64::NAN,
+        ] {
+            let want = xs.partition_point(|&p| p <= x);
+            for h in 0..14 {
+                assert_eq!(super::count_at_most_near(&xs, x, h), want, "x={x} h={h}");
+            }
+        }
+        assert_eq!(super::count_at_most_near(&[], 1.0, 0), 0);
+    }
+
     /// The cube root agrees with the library's to rounding over 600 decades.
     #[test]
     fn cube_root() {
