@@ -193,6 +193,35 @@ fn a_reached_claim_agrees_with_the_analysis_of_the_output() {
     }
 }
 
+/// Seeded case 279 of the sequence above, beyond its first 40 (Sinumerik, B-C on the
+/// HSM600, through the pole at F1500): the post's (−180°, 180°] domain switches the branch
+/// at B +10.27° → −11.45° (C 180° round), just beyond the pole reach, and the spans before
+/// it crawl within the reach. The zone stopped at the reach, and no patch of it reached feed
+/// (`not_found`, while the feasibility LP says values that do exist). The switch is the
+/// zone's: re-selecting the branch reaches feed with no change of orientation.
+#[test]
+fn a_branch_switch_just_beyond_the_reach_is_reselected() {
+    let pass = Pass {
+        pole_distance_deg: 0.001_250_637_539_959_201_2,
+        circle_radius_deg: 19.849_896_186_897_936,
+        half_sweep_deg: 70.147_051_961_694_93,
+        azimuth_deg: 194.601_265_055_904_66,
+        length_mm: 39.114_014_431_998_01,
+        spacing_mm: 1.0,
+        feed_mm_min: 1500.0,
+        b_axis: true,
+        domain_rule: true,
+        rotary_decimals: 4,
+    };
+    let text = program(&pass, Dialect::Sinumerik, "CASE");
+    let m = polepatch::kinematics::Machine::builtin("mikron-hsm600").unwrap();
+    let (report, _) = check_patch("case 279", text.as_bytes(), &m, &PatchOptions::default());
+    assert_eq!(report.zones.len(), 1, "{:?}", report.zones);
+    let z = &report.zones[0];
+    assert_eq!(z.reason, polepatch::ZoneReason::Reselected, "{z:?}");
+    assert!(z.max_deviation_deg < 1e-9, "{z:?}");
+}
+
 /// A pass 1° from the pole on a 5° circle, 15 mm long at F5000 on the UCP710, followed by
 /// a move that programs the rotary axes with a linear move (so its last point must stay,
 /// `polepatch::end_pose`): the tool axis must turn far more than A and C can in 15 mm.

@@ -659,7 +659,8 @@ fn zone_over(
 /// spans in the cone (or, for a stretch the reach admits, the span(s) at its closest
 /// approach) the zone grows outward span by span while each span is the pole's: an end
 /// within the pole reach (the analysis spline carries a flip's turn of C into the spans
-/// beside it), or the pole dominating that span's own slowdown (`pole_span`). It stops at
+/// beside it), a branch switch (re-selection undoes it with no change of orientation), or
+/// the pole dominating that span's own slowdown (`pole_span`). It stops at
 /// the first span that is not: there C crawls by the program's own doing (the table turning
 /// round with the tool far from the pole), which a patch near the pole neither causes nor
 /// can cure at a small change of tool axis. A zone cut so is marked on that side
@@ -738,8 +739,13 @@ pub fn detect_zones(
         // spans 5°–8° from the pole at 0.73 → 0.03 of feed before an A flip, which no
         // span-by-span test of dominance attributes to the pole, yet which the patch of the
         // flip lifts to 0.98 — and `analyze` of its output then found a zone there).
-        let is_pole =
-            |k: usize| near(k) <= reach || pole_span(&p, k, span(k).0, span(k).1, cone_deg);
+        // A branch switch (the pole side changes sign across the span) in the stretch is
+        // the zone's too, however far from the pole: re-selecting the branch undoes it with
+        // no change of orientation.
+        let switch = |k: usize| p(k) * p(k + 1) < 0.0;
+        let is_pole = |k: usize| {
+            near(k) <= reach || switch(k) || pole_span(&p, k, span(k).0, span(k).1, cone_deg)
+        };
         let mut seeds: Vec<usize> = (first..last).filter(|&k| near(k) <= cone_deg).collect();
         if seeds.is_empty() {
             let least = (first..=last)
@@ -1043,6 +1049,33 @@ mod tests {
             1,
             "in the cone"
         );
+    }
+
+    /// A branch switch in the stretch is the zone's wherever it lies (re-selection undoes it
+    /// with no change of orientation): a post's own flip just beyond the reach, next to the
+    /// spans within it (seeded case 279: B +10.27° → −11.45°, C 180° round, at 0.10 of feed).
+    #[test]
+    fn a_branch_switch_next_to_the_zone_is_the_zones() {
+        // P = 0, 1, …, 9, then 10.5 → −11.5 (the switch), −12.5, … : 20 points.
+        let p: Vec<f64> = (0..20)
+            .map(|i| match i {
+                0..=9 => f64::from(i),
+                _ => (f64::from(i) + 0.5) * if i == 10 { 1.0 } else { -1.0 },
+            })
+            .collect();
+        let below = [BelowFeed::uniform(0, 18, 0.001, LimitKind::Jerk)];
+        let zones = detect_zones(&p, &below, 5.0, 10.0);
+        assert_eq!(zones.len(), 1, "{zones:?}");
+        // Spans 0..=9 within the reach, span 10 the switch; span 11 is neither.
+        assert_eq!((zones[0].first, zones[0].last), (0, 11), "{zones:?}");
+        assert!(
+            zones[0].cut_after && zones[0].kind == ZoneKind::AFlip,
+            "{zones:?}"
+        );
+        // Without the switch (10.5 → 11.5, on one branch), the zone ends at the reach.
+        let q: Vec<f64> = p.iter().map(|x| x.abs()).collect();
+        let zones = detect_zones(&q, &below, 5.0, 10.0);
+        assert_eq!((zones[0].first, zones[0].last), (0, 10), "{zones:?}");
     }
 
     /// A stretch below feed that starts at the pole and goes on far from it (the shape of a
