@@ -137,20 +137,43 @@ pub struct Cursor {
     knot: usize,
 }
 
-/// The number of elements of the sorted `b` that are ≤ `t`, looked for first at `hint`
-/// and its neighbours.
-fn count_at_most(b: &[f64], t: f64, hint: usize) -> usize {
-    let n = b.len();
-    let fits = |k: usize| (k == 0 || b[k - 1] <= t) && (k == n || t < b[k]);
-    let h = hint.min(n);
-    if fits(h) {
-        h
-    } else if h < n && fits(h + 1) {
-        h + 1
-    } else if h > 0 && fits(h - 1) {
-        h - 1
+/// The number of elements of the sorted `xs` that are ≤ `x` (`xs.partition_point(|&p| p
+/// ≤ x)`), searched outward from index `h` in steps that double: the path's knot from the
+/// last cycle's, a ramp of the look-ahead a few cells from where the last one was (a search
+/// over the whole motion's grid would miss the cache at every level).
+pub(crate) fn count_at_most(xs: &[f64], x: f64, h: usize) -> usize {
+    let n = xs.len();
+    if h < n && xs[h] <= x {
+        // The count is above h: double the step forward until an element is above x.
+        let mut lo = h + 1;
+        let mut step = 1;
+        loop {
+            let probe = lo + step - 1;
+            if probe >= n {
+                return lo + xs[lo..].partition_point(|&p| p <= x);
+            }
+            if xs[probe] <= x {
+                lo = probe + 1;
+                step *= 2;
+            } else {
+                return lo + xs[lo..probe].partition_point(|&p| p <= x);
+            }
+        }
     } else {
-        b.partition_point(|&v| v <= t)
+        // The count is at most h (or x is NaN: 0): double the step backward.
+        let mut hi = h.min(n);
+        let mut step = 1;
+        loop {
+            if hi < step {
+                return xs[..hi].partition_point(|&p| p <= x);
+            }
+            let probe = hi - step;
+            if xs[probe] <= x {
+                return probe + 1 + xs[probe + 1..hi].partition_point(|&p| p <= x);
+            }
+            hi = probe;
+            step *= 2;
+        }
     }
 }
 
@@ -258,12 +281,12 @@ pub fn local_at(geo: &Geometry, s: f64) -> (Local, [[f64; 4]; 5]) {
 
 #[cfg(test)]
 mod tests {
-    /// The hinted count is the partition point from every hint, at and between the
-    /// elements, outside them and at NaN.
+    /// The search from a hint is the partition point, from every hint, with repeated
+    /// elements, outside the elements and at NaN.
     #[test]
-    fn the_hinted_count_is_the_partition_point() {
-        let b = [0.0, 1.0, 1.5, 4.0, 9.0];
-        for t in [
+    fn the_search_from_a_hint_is_the_partition_point() {
+        let xs = [0.0, 1.0, 1.0, 1.5, 4.0, 4.0, 4.0, 9.0, 10.0, 11.0, 20.0];
+        for x in [
             -1.0,
             0.0,
             0.5,
@@ -274,13 +297,17 @@ mod tests {
             4.0,
             8.9,
             9.0,
-            10.0,
+            10.5,
+            11.0,
+            20.0,
+            25.0,
             f64::NAN,
         ] {
-            let want = b.partition_point(|&v| v <= t);
-            for hint in 0..8 {
-                assert_eq!(super::count_at_most(&b, t, hint), want, "t={t} hint={hint}");
+            let want = xs.partition_point(|&p| p <= x);
+            for h in 0..14 {
+                assert_eq!(super::count_at_most(&xs, x, h), want, "x={x} h={h}");
             }
         }
+        assert_eq!(super::count_at_most(&[], 1.0, 0), 0);
     }
 }

@@ -26,7 +26,7 @@
 use polepatch_kinematics::Machine;
 
 use crate::caps::{Caps, Local};
-use crate::grid::{Cursor, Geometry};
+use crate::grid::{Cursor, Geometry, count_at_most};
 use crate::tolerances::{
     CEILING_REL, CRAWL_CRUISE_REL, CRAWL_JERK_SHARE, CRUISE_ABS_MM_S, CRUISE_REL, END_MM,
     JERK_BISECTIONS, SETTLE_REL,
@@ -114,7 +114,7 @@ impl<'a> Ceiling<'a> {
         if h + 2 < n && self.x[h + 1] <= x && x < self.x[h + 2] {
             return h + 1;
         }
-        count_at_most_near(self.x, x, h).saturating_sub(1).min(last)
+        count_at_most(self.x, x, h).saturating_sub(1).min(last)
     }
 
     /// (W, a_W) at `x`, and the cell.
@@ -160,46 +160,6 @@ impl<'a> Ceiling<'a> {
             (p0 + u * m0, m1)
         };
         (p, dp, i)
-    }
-}
-
-/// The number of elements of the sorted `xs` that are ≤ `x` (`xs.partition_point(|&p| p
-/// ≤ x)`), searched outward from index `h` in steps that double (a ramp of the look-ahead
-/// moves a few cells from where the last one was; a search over the whole motion's grid
-/// would miss the cache at every level).
-fn count_at_most_near(xs: &[f64], x: f64, h: usize) -> usize {
-    let n = xs.len();
-    if h < n && xs[h] <= x {
-        // The count is above h: double the step forward until an element is above x.
-        let mut lo = h + 1;
-        let mut step = 1;
-        loop {
-            let probe = lo + step - 1;
-            if probe >= n {
-                return lo + xs[lo..].partition_point(|&p| p <= x);
-            }
-            if xs[probe] <= x {
-                lo = probe + 1;
-                step *= 2;
-            } else {
-                return lo + xs[lo..probe].partition_point(|&p| p <= x);
-            }
-        }
-    } else {
-        // The count is at most h (or x is NaN: 0): double the step backward.
-        let mut hi = h.min(n);
-        let mut step = 1;
-        loop {
-            if hi < step {
-                return xs[..hi].partition_point(|&p| p <= x);
-            }
-            let probe = hi - step;
-            if xs[probe] <= x {
-                return probe + 1 + xs[probe + 1..hi].partition_point(|&p| p <= x);
-            }
-            hi = probe;
-            step *= 2;
-        }
     }
 }
 
@@ -580,36 +540,6 @@ impl Pass<'_> {
 
 #[cfg(test)]
 mod tests {
-    /// The search from a hint is the partition point, from every hint, with repeated
-    /// elements, outside the elements and at NaN.
-    #[test]
-    fn the_search_from_a_hint_is_the_partition_point() {
-        let xs = [0.0, 1.0, 1.0, 1.5, 4.0, 4.0, 4.0, 9.0, 10.0, 11.0, 20.0];
-        for x in [
-            -1.0,
-            0.0,
-            0.5,
-            1.0,
-            1.2,
-            1.5,
-            3.0,
-            4.0,
-            8.9,
-            9.0,
-            10.5,
-            11.0,
-            20.0,
-            25.0,
-            f64::NAN,
-        ] {
-            let want = xs.partition_point(|&p| p <= x);
-            for h in 0..14 {
-                assert_eq!(super::count_at_most_near(&xs, x, h), want, "x={x} h={h}");
-            }
-        }
-        assert_eq!(super::count_at_most_near(&[], 1.0, 0), 0);
-    }
-
     /// The cube root agrees with the library's to rounding over 600 decades.
     #[test]
     fn cube_root() {
