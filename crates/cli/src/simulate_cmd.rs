@@ -48,6 +48,12 @@ pub(crate) struct SimulateArgs {
     /// half the acceleration; docs/linuxcnc.md, docs/validation.md).
     #[arg(long, value_enum, default_value_t = crate::lcnc_planner::Planner::Jerk)]
     planner: crate::lcnc_planner::Planner,
+    /// Experimental: where the motion would be put on its velocity limit within one
+    /// cycle (the note's "cycles put on the velocity limit"), go back and brake in time
+    /// instead — a trajectory within the axes' jerk on more programs, somewhat slower,
+    /// at up to 2.4× the computing (docs/simulation.md, "Jerk at every cycle").
+    #[arg(long)]
+    rewind: bool,
 }
 
 /// Largest number of bins of the plot along s (the bins double in width when full, so
@@ -121,6 +127,11 @@ pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
                 "--planner linuxcnc gives times only: no --trajectory or --plot",
             ));
         }
+        if args.rewind {
+            return Err(crate::usage(
+                "--rewind is for the jerk-limited planner, not --planner linuxcnc",
+            ));
+        }
         let tcy_s = args.tcy_ms.map(|ms| ms / 1000.0);
         return crate::lcnc_planner::run(
             &args.programs,
@@ -168,6 +179,7 @@ pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
         };
         opts.sim.tcy_s = args.tcy_ms.map(|ms| ms / 1000.0);
         opts.sim.every_cycle = args.trajectory.is_some();
+        opts.sim.rewind = args.rewind;
         let mut binned = Binned::new();
         let want_plot = args.plot.is_some();
         let report = if let Some(target) = trajectory_target {

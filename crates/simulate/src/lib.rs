@@ -79,6 +79,14 @@ pub struct SimOptions {
     /// trajectory at Tcy); default `false`: a cruise at a flat limit is one step. The
     /// backward pass jumps its cruises either way.
     pub every_cycle: bool,
+    /// Where the trajectory would be put on its ceiling (a *clip*, which jumps speed and
+    /// acceleration within one cycle), go back and brake in time instead (`pass.rs`,
+    /// "Rewinds instead of clips"); default `false`. Experimental (issue 32): on the
+    /// fixtures it takes the runs within every axis' V, A and J by finite differences
+    /// from 2 to 80 of 132 at a median +0.9 % of time, but costs up to 2.4× the work
+    /// and lands up to 0.1 mm short of a run's end before creeping to it
+    /// (docs/simulation.md, "Jerk at every cycle").
+    pub rewind: bool,
 }
 
 impl Default for SimOptions {
@@ -87,6 +95,7 @@ impl Default for SimOptions {
             tcy_s: None,
             max_cells_per_span: tolerances::MAX_CELLS_PER_SPAN,
             every_cycle: false,
+            rewind: false,
         }
     }
 }
@@ -177,7 +186,7 @@ impl Store<'_> {
 }
 
 impl Sink for Store<'_> {
-    fn step(&mut self, from: &State, to: &State, j: f64, _d: &[[f64; 4]; 5], _c: bool) {
+    fn step(&mut self, from: &State, to: &State, j: f64, _c: bool) {
         if (j - self.prev_j).abs() > tolerances::JERK_SWITCH * j.abs().max(self.prev_j.abs()) {
             self.push(from.x, from.v, from.a);
         }
@@ -218,7 +227,7 @@ impl Forward<'_> {
 }
 
 impl Sink for Forward<'_> {
-    fn step(&mut self, from: &State, to: &State, j: f64, _d: &[[f64; 4]; 5], cycle: bool) {
+    fn step(&mut self, from: &State, to: &State, j: f64, cycle: bool) {
         if !self.started {
             self.started = true;
             (self.user)(
@@ -317,6 +326,7 @@ pub fn simulate(
         // modes (the same profile for the report and the trajectory, and a long cruise
         // records nothing per cycle: memory bounded by the points).
         every_cycle: false,
+        rewind: false,
     };
     let mut store = Store {
         grid: &xb,
@@ -350,6 +360,7 @@ pub fn simulate(
         dt: tcy_s,
         use_caps: [1.0, 1.0],
         every_cycle: opts.every_cycle,
+        rewind: opts.rewind,
     };
     let mut out = Forward {
         geo: &geo,

@@ -22,6 +22,37 @@
 //! J (`j_cap < 0`, the 3·|q_ss|·v·|a| term), nothing could bring |a| back, and the pass
 //! would brake under W until the speed made room. A state that is there anyway brings
 //! |a| back at the jerk cap of a = 0.
+//!
+//! **Rewinds instead of clips** (optional, [`Pass::rewind`]: the forward pass, whose states
+//! are the trajectory; issue 32). A clip jumps the speed and the acceleration within one
+//! cycle: a finite difference
+//! of the trajectory sees a jerk many times the axes' (142× J on one fixture). Where the
+//! forward pass finds itself above its ceiling at x_c, it records a *dip* (x_c, W(x_c))
+//! and goes back over the steps it has not handed out yet ([`REWIND_STEPS`]; 1, 2, 4, …
+//! steps) to the latest state from which the hardest braking passes every dip ahead at
+//! or under its speed, and goes on from there with that as one more condition of *safe*:
+//!
+//! ```text
+//! braking from (x, v, a): j = −j_b until a = −a_b, then a = −a_b held, in pieces of
+//! max(4·Tcy, time to the next dip / 8) with the caps where each piece starts
+//! (a_b = min(a_cap(v), 0.8·a_for_jerk(v)), j_b = j_cap(v, a_b)); where v ≤ a²/(2·j_b)
+//! it lands (a back to 0 as v reaches 0): v(x_d) ≤ v_d at every dip d ahead.
+//! ```
+//!
+//! A motion found above the ceiling at the same dip again lowers its speed by 3 % (at
+//! most 40 times), since the braking is computed coarser than the motion. Work is
+//! bounded: a pass undoes at most a quarter of its steps plus 100 000
+//! ([`REWIND_BUDGET_STEPS`]); past that, and where no kept state can brake in time, it
+//! clips as before (counted). A forward state up to 0.2 % above the backward profile
+//! but under the velocity limit itself stands: it turns towards the profile's
+//! acceleration from the next cycle, within the caps. And a decelerating motion keeps
+//! v ≥ a²/(2·j_cap) (it can still bring a to 0 before it stops: the smallest jerk that
+//! keeps it, when the chosen one does not). Why this is not the default:
+//! `docs/simulation.md`, "Jerk at every cycle".
+//!
+//! In both modes the last nanometres to the end ([`END_MM`]) are taken after the last
+//! cycle — at the speed there, or from rest in the rest-to-rest time at the jerk cap —
+//! not jumped within it.
 
 use polepatch_kinematics::Machine;
 
@@ -211,9 +242,9 @@ pub(crate) struct State {
 
 /// What a pass hands out.
 pub(crate) trait Sink {
-    /// One step from `from` to `to` under jerk `j` (mm/s³); `d` are the derivatives at
-    /// the start (geometric s), `cycle` is false for a step that jumped a cruise.
-    fn step(&mut self, from: &State, to: &State, j: f64, d: &[[f64; 4]; 5], cycle: bool);
+    /// One step from `from` to `to` under jerk `j` (mm/s³); `cycle` is false for a step
+    /// that jumped a cruise.
+    fn step(&mut self, from: &State, to: &State, j: f64, cycle: bool);
 }
 
 /// Outcome of a pass.
@@ -243,6 +274,30 @@ pub(crate) struct Pass<'a> {
     pub use_caps: [f64; 2],
     /// Every step is one cycle (no cruise jumps): for a trajectory at Tcy.
     pub every_cycle: bool,
+    /// Instead of a clip, go back to where braking still reaches the ceiling there and
+    /// take that motion ([`Dip`]); a clip only when that fails.
+    pub rewind: bool,
+}
+
+/// Where a pass found itself above its ceiling: the speed `v` it must pass `x` at or
+/// under. After a rewind every state must be able to brake down to it in time
+/// ([`Pass::clears_dips`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Dip {
+    x: f64,
+    v: f64,
+    tries: u32,
+}
+
+/// A step taken and not yet handed out: what a rewind needs to start again from it.
+struct Pending {
+    from: State,
+    to: State,
+    j: f64,
+    cycle: bool,
+    hint: usize,
+    cursor: Cursor,
+    clipped: bool,
 }
 
 /// Pieces of the look-ahead ramp (module docs).
@@ -250,6 +305,33 @@ const RAMP_STEPS: usize = 8;
 
 /// Steps without progress after which a pass gives up (the limits allow no motion).
 const STALL_STEPS: u32 = 1_000_000;
+
+/// Steps a pass keeps before handing them out: how far back a rewind can go.
+const REWIND_STEPS: usize = 16_384;
+/// How far a forward pass may be above the backward profile (under the velocity limit)
+/// and go on braking, relative.
+const OVER_PROFILE_REL: f64 = 2e-3;
+/// Steps a pass may undo by rewinds: one per this many steps taken, plus
+/// [`REWIND_BUDGET_STEPS`]; past it, clips (the work stays within a small multiple of
+/// the motion's cycles where the profile is clipped at almost every cycle).
+const REWIND_BUDGET_PER_STEP_INV: u64 = 4;
+/// See [`REWIND_BUDGET_PER_STEP_INV`].
+const REWIND_BUDGET_STEPS: u64 = 100_000;
+/// Tries per dip: each lowers its speed by the factor [`DIP_TIGHTEN`].
+const DIP_TRIES: u32 = 40;
+/// Factor on a dip's speed when the motion is above the ceiling there again.
+const DIP_TIGHTEN: f64 = 0.97;
+/// Dips kept at once, at most (beyond: clips).
+const DIPS_MAX: usize = 4096;
+/// Cycles per piece of the braking of [`Pass::clears_dips`].
+const BRAKE_PIECE_CYCLES: f64 = 4.0;
+/// The braking of [`Pass::clears_dips`] in pieces of this fraction of the time to the next
+/// dip at the speed where each starts.
+const BRAKE_PIECES_TO_GO: f64 = 8.0;
+/// Pieces of that braking, at most.
+const BRAKE_PIECES_MAX: usize = 100_000;
+/// Share of the |a| at which the jerk cap runs out that the braking holds.
+const BRAKE_A_SHARE: f64 = 0.8;
 
 impl Pass<'_> {
     fn s_of(&self, x: f64, len: f64) -> f64 {
@@ -267,6 +349,106 @@ impl Pass<'_> {
     /// here.
     #[allow(clippy::too_many_arguments)]
     fn safe(
+        &self,
+        caps: &Caps,
+        vmax: f64,
+        x1: f64,
+        v1: f64,
+        a1: f64,
+        hint: usize,
+        len: f64,
+        dips: &[Dip],
+    ) -> bool {
+        self.safe_under_ceiling(caps, vmax, x1, v1, a1, hint, len)
+            && (dips.is_empty() || self.clears_dips(x1, v1, a1, dips, len))
+    }
+
+    /// The hardest braking from (x0, v0, a0) — a down at the jerk cap to the largest
+    /// deceleration the caps allow along it, then held — passes every dip ahead at or
+    /// under its speed. The caps are taken where each piece of the braking starts.
+    fn clears_dips(&self, x0: f64, v0: f64, a0: f64, dips: &[Dip], len: f64) -> bool {
+        let mut v_min = f64::INFINITY;
+        let mut x_last = x0;
+        for d in dips.iter().filter(|d| d.x > x0) {
+            v_min = v_min.min(d.v);
+            x_last = x_last.max(d.x);
+        }
+        if x_last <= x0 || (v0 <= v_min && a0 <= 0.0) {
+            return true;
+        }
+        let mut cur = Cursor::default();
+        let (mut x, mut v, mut a) = (x0, v0, a0);
+        for _ in 0..BRAKE_PIECES_MAX {
+            // Pieces of BRAKE_PIECES_TO_GO of the time to the last dip at this speed, at
+            // least BRAKE_PIECE_CYCLES cycles.
+            let x_next = dips
+                .iter()
+                .filter(|d| d.x > x)
+                .fold(x_last, |m, d| m.min(d.x));
+            let h = (BRAKE_PIECE_CYCLES * self.dt)
+                .max((x_next - x) / (v.max(1e-12) * BRAKE_PIECES_TO_GO));
+            let (d, _) = self
+                .geo
+                .derivs_feed_near(self.s_of(x.min(len), len), &mut cur);
+            let caps = Caps::new(&Local::from_derivs(&d), self.machine);
+            let ab = (caps.a_cap(v) * self.use_caps[0])
+                .min(BRAKE_A_SHARE * caps.a_for_jerk(v))
+                .max(0.0);
+            let jb = (caps.j_cap(v, a.abs().min(ab)) * self.use_caps[1]).max(0.0);
+            if a < 0.0 && jb > 0.0 && v <= a * a / (2.0 * jb) {
+                // Landing: a back to 0 at the jerk cap, v falling all the way; every dip
+                // it reaches is passed at most at v.
+                // v reaches 0 at the first root of v + a·τ + jb·τ²/2 (it has one here).
+                let disc = (a * a - 2.0 * jb * v).max(0.0);
+                let tau = ((-a - disc.sqrt()) / jb).max(0.0);
+                let x_stop = x + v * tau + 0.5 * a * tau * tau + jb * tau * tau * tau / 6.0;
+                return dips
+                    .iter()
+                    .all(|d| d.x <= x || d.x > x_stop.max(x) || v <= d.v * (1.0 + CEILING_REL));
+            }
+            // Towards −ab at the jerk cap for up to `h`, then held for the rest of `h`.
+            let target = -ab;
+            let j = if jb <= 0.0 {
+                0.0
+            } else {
+                (target - a).signum() * jb
+            };
+            let t_ramp = if j == 0.0 {
+                0.0
+            } else {
+                ((target - a) / j).clamp(0.0, h)
+            };
+            let xr = x + v * t_ramp + 0.5 * a * t_ramp * t_ramp + j * t_ramp.powi(3) / 6.0;
+            let vr = v + a * t_ramp + 0.5 * j * t_ramp * t_ramp;
+            let ar = a + j * t_ramp;
+            let th = h - t_ramp;
+            let x1 = xr + vr * th + 0.5 * ar * th * th;
+            let v1 = vr + ar * th;
+            let a1 = ar;
+            if v1 <= 0.0 {
+                // At rest within the piece, before x1 (if the speed rose first, not
+                // above the larger of v and vr on the way).
+                let v_up = v.max(vr);
+                return dips
+                    .iter()
+                    .all(|d| d.x <= x || d.x > x1.max(xr) || v_up <= d.v * (1.0 + CEILING_REL));
+            }
+            for dp in dips.iter().filter(|d| d.x > x && d.x <= x1) {
+                let u = (dp.x - x) / (x1 - x);
+                if v + u * (v1 - v) > dp.v * (1.0 + CEILING_REL) {
+                    return false;
+                }
+            }
+            (x, v, a) = (x1, v1, a1);
+            if x >= x_last || (a <= 0.0 && dips.iter().all(|d| d.x <= x || v <= d.v)) {
+                return true;
+            }
+        }
+        false
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn safe_under_ceiling(
         &self,
         caps: &Caps,
         vmax: f64,
@@ -332,7 +514,40 @@ impl Pass<'_> {
         let mut cursor = Cursor::default();
         // The ceiling at the end of the last cycle: where this one starts.
         let mut at_end: Option<(f64, (f64, f64, usize))> = None;
+        let mut buf: std::collections::VecDeque<Pending> = std::collections::VecDeque::new();
+        let mut dips: Vec<Dip> = Vec::new();
+        // Steps undone by rewinds: past a budget, clips again.
+        let mut undone: u64 = 0;
+        let emit =
+            |buf: &mut std::collections::VecDeque<Pending>, sink: &mut dyn Sink, keep: usize| {
+                while buf.len() > keep {
+                    let p = buf.pop_front().expect("non-empty");
+                    sink.step(&p.from, &p.to, p.j, p.cycle);
+                }
+            };
+        // A step taken: kept for a rewind (handed out when it is REWIND_STEPS old), or
+        // handed out at once.
+        let rewind = self.rewind;
+        let keep =
+            |buf: &mut std::collections::VecDeque<Pending>, sink: &mut dyn Sink, p: Pending| {
+                if rewind {
+                    buf.push_back(p);
+                    emit(buf, sink, REWIND_STEPS);
+                } else {
+                    sink.step(&p.from, &p.to, p.j, p.cycle);
+                }
+            };
         while st.x < len - END_MM {
+            let (hint0, cursor0) = (hint, cursor);
+            if !dips.is_empty() {
+                // A dip no rewind can reach any more is done with.
+                let oldest = buf.front().map_or(st.x, |p| p.from.x);
+                let n = dips.partition_point(|d| d.x < oldest);
+                dips.drain(..n);
+            }
+            // Dips (sorted by x) ahead of this state: the only ones a check looks at.
+            let ahead_from = dips.partition_point(|d| d.x <= st.x);
+            let ahead = &dips[ahead_from..];
             let (d, feed) = self.geo.derivs_feed_near(self.s_of(st.x, len), &mut cursor);
             let loc = Local::from_derivs(&d);
             let vmax = loc.v_cap(self.machine).min(feed);
@@ -363,7 +578,7 @@ impl Pass<'_> {
                         .m
                         .as_ref()
                         .is_none_or(|m| m[i] == 0.0 && m[nx] == 0.0)
-                    && self.safe(&caps, vmax, xn, st.v, 0.0, i, len)
+                    && self.safe(&caps, vmax, xn, st.v, 0.0, i, len, ahead)
                 {
                     let xn = if xn >= len - END_MM { len } else { xn };
                     let to = State {
@@ -372,7 +587,16 @@ impl Pass<'_> {
                         v: st.v,
                         a: 0.0,
                     };
-                    sink.step(&st, &to, 0.0, &d, false);
+                    let p = Pending {
+                        from: st,
+                        to,
+                        j: 0.0,
+                        cycle: false,
+                        hint: hint0,
+                        cursor: cursor0,
+                        clipped: false,
+                    };
+                    keep(&mut buf, sink, p);
                     st = to;
                     stats.steps += 1;
                     continue;
@@ -404,7 +628,7 @@ impl Pass<'_> {
             };
             let ok = |j: f64| {
                 let (x1, v1, a1) = next(j);
-                self.safe(&caps, vmax, x1, v1, a1, hint, len)
+                self.safe(&caps, vmax, x1, v1, a1, hint, len, ahead)
             };
             // On a flat ceiling, just under it: settle (a → 0) rather than take the
             // largest safe jerk, which would overshoot and chatter about the ceiling.
@@ -416,12 +640,43 @@ impl Pass<'_> {
             } else if settle && ok(jz) {
                 jz
             } else if !ok(lo) {
-                lo
+                if self.rewind && st.v > w0 {
+                    // Above the profile already (a state let stand, below): towards its
+                    // acceleration, not the hardest braking, which would leave it with
+                    // more deceleration than it can bring back to 0 before it stops.
+                    ((aw0 - st.a) / dt).clamp(lo, hi)
+                } else {
+                    lo
+                }
             } else {
                 let (mut good, mut bad) = (lo, hi);
                 for _ in 0..JERK_BISECTIONS {
                     let mid = 0.5 * (good + bad);
                     if ok(mid) {
+                        good = mid;
+                    } else {
+                        bad = mid;
+                    }
+                }
+                good
+            };
+            // A motion that decelerates must be able to bring a to 0 before it stops
+            // (v ≥ a²/(2·j_cap)): the smallest jerk that keeps this, when the one above
+            // does not (then the ceiling may be left: a rewind or a clip follows).
+            let lands = |j: f64| {
+                let (_, v1, a1) = next(j);
+                a1 >= 0.0 || {
+                    let jf = self.caps(&caps, v1.max(0.0), a1.abs()).1;
+                    jf > 0.0 && v1 >= a1 * a1 / (2.0 * jf)
+                }
+            };
+            let j = if !self.rewind || lands(j) || !lands(hi) || st.v <= 0.0 {
+                j
+            } else {
+                let (mut bad, mut good) = (j, hi);
+                for _ in 0..JERK_BISECTIONS {
+                    let mid = 0.5 * (good + bad);
+                    if lands(mid) {
                         good = mid;
                     } else {
                         bad = mid;
@@ -447,6 +702,7 @@ impl Pass<'_> {
                 v1 = 0.0;
                 a1 = 0.0;
             }
+            let mut clipped = false;
             if x1 <= st.x && st.v <= 0.0 {
                 // At rest where the ceiling is below what one cycle at the jerk cap makes
                 // (W < j_cap·Tcy²): go on at a crawl whose step from rest is a part of the
@@ -463,6 +719,7 @@ impl Pass<'_> {
                 x1 = x1.max(st.x) + v1 * dt;
                 if v1 > 0.0 {
                     stats.clips += 1;
+                    clipped = true;
                 }
             }
             // Never backwards (a cycle in which the speed dips below 0 and back).
@@ -485,16 +742,109 @@ impl Pass<'_> {
                 a1 = st.a + j * tm;
                 t1 = st.t + tm;
             }
-            if x1 >= len - END_MM {
+            if x1 >= len - END_MM && x1 < len {
                 // Within END_MM of the end: this state is the end (one state, not a
-                // second one at the same time).
+                // second one at the same time), reached after the cycle — the last
+                // nanometres at the speed there, or from rest in the rest-to-rest time
+                // at the jerk cap, 4·(d/(2·j))^(1/3) — so that no cycle of the
+                // trajectory jumps them.
+                let d = len - x1;
+                t1 += if v1 > 0.0 {
+                    (d / v1).min(dt)
+                } else if jm > 0.0 {
+                    4.0 * (d / (2.0 * jm)).cbrt()
+                } else {
+                    dt
+                };
                 x1 = len;
             }
             let end = self.ceiling.at(x1, hint);
             at_end = Some((x1, end));
             let (w1, aw1, _) = end;
             let w1 = w1.min(vmax);
-            if v1 > w1 * (1.0 + CEILING_REL) {
+            // Just above a profile that is not itself the limit (the forward pass under
+            // the backward profile), and under the velocity limit: go on, braking at the
+            // caps from the next cycle (no state is safe above the ceiling) — a motion
+            // within the limits, where a clip or a rewind would jump it.
+            let over_ok = self.rewind
+                && v1 <= w1 * (1.0 + OVER_PROFILE_REL)
+                && self
+                    .limit
+                    .as_ref()
+                    .is_some_and(|l| v1 <= l.at(x1, 0).0.min(vmax) * (1.0 + CEILING_REL));
+            if over_ok {
+                // (nothing: the state stands)
+            } else if v1 > w1 * (1.0 + CEILING_REL)
+                && self.rewind
+                && x1 < len
+                && undone < stats.steps / REWIND_BUDGET_PER_STEP_INV + REWIND_BUDGET_STEPS
+            {
+                // Above the ceiling: go back to where braking still passes here at or
+                // under it, instead of a clip.
+                let near = 2.0 * st.v.max(v1) * dt + 1e-9;
+                let lo_k = dips.partition_point(|d| d.x < x1 - near);
+                let k = match (lo_k < dips.len() && dips[lo_k].x <= x1 + near).then_some(lo_k) {
+                    Some(k) => {
+                        dips[k].v *= DIP_TIGHTEN;
+                        dips[k].tries += 1;
+                        Some(k).filter(|&k| dips[k].tries <= DIP_TRIES)
+                    }
+                    None if dips.len() < DIPS_MAX => {
+                        let at = dips.partition_point(|d| d.x < x1);
+                        dips.insert(
+                            at,
+                            Dip {
+                                x: x1,
+                                v: w1,
+                                tries: 0,
+                            },
+                        );
+                        Some(at)
+                    }
+                    None => None,
+                };
+                if k.is_some() {
+                    let mut m = 1usize;
+                    let mut back = None;
+                    while m <= buf.len() {
+                        let p = &buf[buf.len() - m];
+                        if self.clears_dips(p.from.x, p.from.v, p.from.a, &dips, len) {
+                            back = Some(m);
+                            break;
+                        }
+                        m *= 2;
+                    }
+                    if back.is_none() && !buf.is_empty() {
+                        let p = &buf[0];
+                        if self.clears_dips(p.from.x, p.from.v, p.from.a, &dips, len) {
+                            back = Some(buf.len());
+                        }
+                    }
+                    if let Some(m) = back {
+                        let keep = buf.len() - m;
+                        let first = &buf[keep];
+                        st = first.from;
+                        hint = first.hint;
+                        cursor = first.cursor;
+                        at_end = None;
+                        idle = 0;
+                        for p in buf.drain(keep..) {
+                            stats.steps -= 1;
+                            if p.clipped {
+                                stats.clips -= 1;
+                            }
+                        }
+                        undone += m as u64;
+                        continue;
+                    }
+                    if let Some(k) = k {
+                        // No state kept can brake to it: the dip is of no use.
+                        dips.remove(k);
+                    }
+                }
+            }
+            if !over_ok && v1 > w1 * (1.0 + CEILING_REL) {
+                clipped = true;
                 // On the ceiling with its acceleration, within the caps there at that
                 // speed: |a| also where some jerk is left (`Caps::a_for_jerk`) — above it
                 // no jerk could bring |a| back, and the pass would hold it, braking, far
@@ -522,15 +872,24 @@ impl Pass<'_> {
                 v: v1,
                 a: a1,
             };
-            sink.step(&st, &to, j, &d, t1 - st.t == self.dt);
+            let p = Pending {
+                from: st,
+                to,
+                j,
+                cycle: t1 - st.t == self.dt,
+                hint: hint0,
+                cursor: cursor0,
+                clipped,
+            };
+            keep(&mut buf, sink, p);
             st = to;
             stats.steps += 1;
         }
+        emit(&mut buf, sink, 0);
         if st.x < len {
             // A path shorter than END_MM: its end is reached at once.
             let to = State { x: len, ..st };
-            let d = self.geo.derivs(self.s_of(st.x, len));
-            sink.step(&st, &to, 0.0, &d, false);
+            sink.step(&st, &to, 0.0, false);
             st = to;
         }
         stats.time_s = st.t;
