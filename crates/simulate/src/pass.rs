@@ -25,12 +25,12 @@
 //!
 //! **Rewinds instead of clips** (optional, [`Pass::rewind`]: the forward pass, whose states
 //! are the trajectory; issue 32). A clip jumps the speed and the acceleration within one
-//! cycle: a finite difference
-//! of the trajectory sees a jerk many times the axes' (142× J on one fixture). Where the
-//! forward pass finds itself above its ceiling at x_c, it records a *dip* (x_c, W(x_c))
-//! and goes back over the steps it has not handed out yet ([`REWIND_STEPS`]; 1, 2, 4, …
-//! steps) to the latest state from which the hardest braking passes every dip ahead at
-//! or under its speed, and goes on from there with that as one more condition of *safe*:
+//! cycle: a finite difference of the trajectory sees a jerk many times the axes' (142× J
+//! on one fixture). Where the forward pass finds itself above its ceiling at x_c, it
+//! records a *dip* (x_c, W(x_c)) and goes back over the steps it has not handed out yet
+//! ([`REWIND_STEPS`]; 1, 2, 4, … steps) to the latest state from which the hardest braking
+//! passes every dip ahead at or under its speed, and goes on from there with that as one
+//! more condition of *safe*:
 //!
 //! ```text
 //! braking from (x, v, a): j = −j_b until a = −a_b, then a = −a_b held, in pieces of
