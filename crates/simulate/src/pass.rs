@@ -212,6 +212,20 @@ fn accel_within(a: f64, p: f64, dp: f64) -> bool {
     a * a * a <= p * (r * r * r)
 }
 
+/// The boundary of `pred` between `good` (where it holds) and `bad` (where it does not),
+/// [`JERK_BISECTIONS`] halvings: the last point found to hold, from `good`'s side.
+fn bisect(mut good: f64, mut bad: f64, pred: impl Fn(f64) -> bool) -> f64 {
+    for _ in 0..JERK_BISECTIONS {
+        let mid = 0.5 * (good + bad);
+        if pred(mid) {
+            good = mid;
+        } else {
+            bad = mid;
+        }
+    }
+    good
+}
+
 /// Cube root of a non-negative `p` (the library's is a slow software routine on this
 /// target): exponent-halving first guess, then three Halley steps (cubic convergence: far
 /// below rounding after the third).
@@ -649,16 +663,7 @@ impl Pass<'_> {
                     lo
                 }
             } else {
-                let (mut good, mut bad) = (lo, hi);
-                for _ in 0..JERK_BISECTIONS {
-                    let mid = 0.5 * (good + bad);
-                    if ok(mid) {
-                        good = mid;
-                    } else {
-                        bad = mid;
-                    }
-                }
-                good
+                bisect(lo, hi, ok)
             };
             // A motion that decelerates must be able to bring a to 0 before it stops
             // (v ≥ a²/(2·j_cap)): the smallest jerk that keeps this, when the one above
@@ -673,16 +678,7 @@ impl Pass<'_> {
             let j = if !self.rewind || lands(j) || !lands(hi) || st.v <= 0.0 {
                 j
             } else {
-                let (mut bad, mut good) = (j, hi);
-                for _ in 0..JERK_BISECTIONS {
-                    let mid = 0.5 * (good + bad);
-                    if lands(mid) {
-                        good = mid;
-                    } else {
-                        bad = mid;
-                    }
-                }
-                good
+                bisect(hi, j, lands)
             };
             let (mut x1, mut v1, mut a1) = next(j);
             let mut t1 = st.t + dt;
