@@ -373,8 +373,47 @@ impl Pass<'_> {
         len: f64,
         dips: &[Dip],
     ) -> bool {
-        self.safe_under_ceiling(caps, vmax, x1, v1, a1, hint, len)
-            && (dips.is_empty() || self.clears_dips(x1, v1, a1, dips, len))
+        // Under the ceiling (below), and then, with dips ahead, able to brake to them.
+        let dips_ok = || dips.is_empty() || self.clears_dips(x1, v1, a1, dips, len);
+        if v1 > vmax {
+            return false;
+        }
+        let (ac, jc) = self.caps(caps, v1.max(0.0), a1.abs());
+        if a1.abs() > ac.max(0.0) * (1.0 + 1e-12) + 1e-12 || jc < 0.0 {
+            return false;
+        }
+        // The comparisons with W and a_W in P = W^(3/2) (no cube root: see
+        // `above_ceiling` and `accel_within`).
+        let (p, dp, i) = self.ceiling.at_p(x1, hint);
+        if above_ceiling(v1, p) {
+            return false;
+        }
+        if accel_within(a1, p, dp) {
+            return dips_ok();
+        }
+        // The ramp of a down at the jerk cap, in RAMP_STEPS pieces, until it meets the
+        // ceiling's acceleration: under the ceiling all the way.
+        let aw = cbrt(p) * dp / 1.5;
+        let jb = jc.max(1e-300);
+        let dtau = (a1 - aw) / jb / RAMP_STEPS as f64;
+        let (mut x, mut v, mut a, mut c) = (x1, v1, a1, i);
+        for _ in 0..4 * RAMP_STEPS {
+            x += v * dtau + 0.5 * a * dtau * dtau - jb * dtau * dtau * dtau / 6.0;
+            v += a * dtau - 0.5 * jb * dtau * dtau;
+            a -= jb * dtau;
+            if v <= 0.0 || x >= len {
+                return (v <= 0.0 || !above_ceiling(v, self.ceiling.at_p(len, c).0)) && dips_ok();
+            }
+            let (p, dp, k) = self.ceiling.at_p(x, c);
+            c = k;
+            if above_ceiling(v, p) {
+                return false;
+            }
+            if accel_within(a, p, dp) {
+                return dips_ok();
+            }
+        }
+        dips_ok()
     }
 
     /// The hardest braking from (x0, v0, a0) — a down at the jerk cap to the largest
@@ -459,58 +498,6 @@ impl Pass<'_> {
             }
         }
         false
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn safe_under_ceiling(
-        &self,
-        caps: &Caps,
-        vmax: f64,
-        x1: f64,
-        v1: f64,
-        a1: f64,
-        hint: usize,
-        len: f64,
-    ) -> bool {
-        if v1 > vmax {
-            return false;
-        }
-        let (ac, jc) = self.caps(caps, v1.max(0.0), a1.abs());
-        if a1.abs() > ac.max(0.0) * (1.0 + 1e-12) + 1e-12 || jc < 0.0 {
-            return false;
-        }
-        // The comparisons with W and a_W in P = W^(3/2) (no cube root: see
-        // `above_ceiling` and `accel_within`).
-        let (p, dp, i) = self.ceiling.at_p(x1, hint);
-        if above_ceiling(v1, p) {
-            return false;
-        }
-        if accel_within(a1, p, dp) {
-            return true;
-        }
-        // The ramp of a down at the jerk cap, in RAMP_STEPS pieces, until it meets the
-        // ceiling's acceleration: under the ceiling all the way.
-        let aw = cbrt(p) * dp / 1.5;
-        let jb = jc.max(1e-300);
-        let dtau = (a1 - aw) / jb / RAMP_STEPS as f64;
-        let (mut x, mut v, mut a, mut c) = (x1, v1, a1, i);
-        for _ in 0..4 * RAMP_STEPS {
-            x += v * dtau + 0.5 * a * dtau * dtau - jb * dtau * dtau * dtau / 6.0;
-            v += a * dtau - 0.5 * jb * dtau * dtau;
-            a -= jb * dtau;
-            if v <= 0.0 || x >= len {
-                return v <= 0.0 || !above_ceiling(v, self.ceiling.at_p(len, c).0);
-            }
-            let (p, dp, k) = self.ceiling.at_p(x, c);
-            c = k;
-            if above_ceiling(v, p) {
-                return false;
-            }
-            if accel_within(a, p, dp) {
-                return true;
-            }
-        }
-        true
     }
 
     /// Run the pass from rest at x = 0 to x = L; `sink` gets every step.
