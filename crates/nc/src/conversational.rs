@@ -377,10 +377,21 @@ pub(crate) fn lex(
         }
         b"RND" | b"CHF" => s.breaks = true,
         b"TOOL" => {
+            // `TOOL CALL 5 Z S12000`, `TOOL CALL "BALL6" Z`: a tool change. A call that
+            // names no tool (`TOOL CALL Z S10000`, `TOOL CALL S10000`: a new spindle speed
+            // or axis for the tool in use) changes nothing that moves: it ends no run.
             if second == b"CALL" {
-                s.flags.set(Flags::TOOL_CHANGE);
+                let third = rest.get(1).map(|t| upper(bytes, t)).unwrap_or_default();
+                let names_tool = third
+                    .first()
+                    .is_some_and(|c| c.is_ascii_digit() || matches!(c, b'"' | b'\'' | b'Q'));
+                if names_tool {
+                    s.flags.set(Flags::TOOL_CHANGE);
+                    s.breaks = true;
+                }
+            } else {
+                s.breaks = true;
             }
-            s.breaks = true;
         }
         b"CYCL" => {
             if second == b"DEF" {

@@ -436,10 +436,14 @@ impl Interpreter {
                         b'F' => s.feed = Some(value),
                         b'G' => self.g(code10(value), s),
                         b'M' => m_code(self.dialect, &self.controller, code10(value), s),
-                        b'T' => {
+                        // Heidenhain ISO `T5 G17` calls the tool; elsewhere a T word
+                        // alone selects the next tool (the change is `M6`): a preselect
+                        // moves nothing and ends no run.
+                        b'T' if self.dialect == Dialect::Heidenhain => {
                             s.flags.set(Flags::TOOL_CHANGE);
                             s.breaks = true;
                         }
+                        b'T' => {}
                         b'N' => {
                             s.number = (value >= 0.0 && value.fract() == 0.0 && value < 1e15)
                                 .then_some(value as u64);

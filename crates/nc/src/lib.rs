@@ -54,6 +54,7 @@ pub mod writer;
 
 pub use block::{Block, Flags};
 pub use builder::{ProgramBuilder, parse, parse_with};
+pub use detect::detect as detect_dialect;
 pub use dialect::Dialect;
 pub use error::ParseError;
 pub use flow::FlowPlan;

@@ -31,7 +31,8 @@
 //!   `G79`, conversational `CYCL CALL`/`M99` call a cycle (positions unknown after).
 //!
 //! A block breaks runs ([`crate::Block::breaks_run`]) if it moves other than by G1, has
-//! a T, D, H, U, V, W, P, Q, L or E word, an M code other than spindle/coolant
+//! a D, H, U, V, W, P, Q, L or E word (a T word only where it calls the tool: Heidenhain
+//! ISO `T5 G17`, conversational `TOOL CALL` naming a tool; elsewhere it preselects), an M code other than spindle/coolant
 //! (`M3 M4 M5 M7 M8 M9 M13 M14`) and TCPM, a G code outside motion, plane, units,
 //! absolute/incremental, `G40 G60 G61 G64 G641`…`G645 G80 G94`, an identifier other than
 //! `MSG` (e.g. `CYCLE800`), a non-numeric `T=`/`D=`… assignment, a `/` block-delete

@@ -19,15 +19,15 @@ pub use crate::writer::inserted_form;
 /// the restored value with (the file's).
 ///
 /// Only axis letters (X Y Z A B C) are restored; linear values are written back in the
-/// units of the file (inch programs are read in mm). `allow(edited_block, block)` says
-/// whether a restoring word may go into `block` for an edit of `edited_block` (a caller
-/// may forbid words outside the stretch it rewrote). Edits are appended; the order of
+/// units of the file (inch programs are read in mm). `allow(edited_block, block, letter)`
+/// says whether a restoring word of `letter` may go into `block` for an edit of
+/// `edited_block` (a caller may forbid words outside the stretch it rewrote). Edits are appended; the order of
 /// `edits` is otherwise kept.
 pub fn restore_modal(
     program: &Program,
     edits: &mut Vec<Edit>,
     decimals_of: &dyn Fn(u8) -> usize,
-    allow: &dyn Fn(usize, usize) -> bool,
+    allow: &dyn Fn(usize, usize, u8) -> bool,
 ) {
     use std::collections::HashSet;
     let edited: HashSet<(usize, u8)> = edits.iter().map(|e| (e.block, e.letter)).collect();
@@ -44,7 +44,7 @@ pub fn restore_modal(
         let Some(b) = next else { continue };
         if edited.contains(&(b, e.letter))
             || program.word(b, e.letter).is_some()
-            || !allow(e.block, b)
+            || !allow(e.block, b, e.letter)
             || !added.insert((b, e.letter))
         {
             continue;
@@ -284,7 +284,7 @@ mod tests {
         let src = "G1 X0 Y0 Z0 A1 C10.5 F100\nX1 C20.25\nX2\nX3 C40.125\n";
         let p = parse(src.as_bytes().to_vec(), Dialect::Auto).unwrap();
         let mut edits = vec![c(1, 25.0)];
-        restore_modal(&p, &mut edits, &|_| 3, &|_, _| true);
+        restore_modal(&p, &mut edits, &|_| 3, &|_, _, _| true);
         assert_eq!(edits.len(), 2);
         let out = String::from_utf8(write(&p, &edits)).unwrap();
         assert_eq!(
@@ -293,11 +293,11 @@ mod tests {
         );
         // Consecutive edits: only the block after the last one is restored.
         let mut edits = vec![c(1, 25.0), c(2, 30.0)];
-        restore_modal(&p, &mut edits, &|_| 3, &|_, _| true);
+        restore_modal(&p, &mut edits, &|_| 3, &|_, _, _| true);
         assert_eq!(edits.len(), 2, "block 3 has its own C");
         // A caller that forbids words outside its stretch gets none.
         let mut edits = vec![c(1, 25.0)];
-        restore_modal(&p, &mut edits, &|_| 3, &|_, b| b <= 1);
+        restore_modal(&p, &mut edits, &|_| 3, &|_, b, _| b <= 1);
         assert_eq!(edits.len(), 1);
     }
 
@@ -321,7 +321,7 @@ mod tests {
                 decimals: 3,
             },
         ];
-        restore_modal(&p, &mut edits, &|_| 1, &|_, _| true);
+        restore_modal(&p, &mut edits, &|_| 1, &|_, _, _| true);
         let out = String::from_utf8(write(&p, &edits)).unwrap();
         assert_eq!(
             out,

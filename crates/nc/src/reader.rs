@@ -393,7 +393,7 @@ pub(crate) mod tests {
     fn run_breakers() {
         let breaks = |s: &str| p(&format!("G1 X0 Y0 Z0 F100\n{s}\n")).blocks[1].breaks_run;
         for s in [
-            "T5",
+            "T5 M6",
             "M6",
             "M06",
             "M0",
@@ -437,9 +437,14 @@ pub(crate) mod tests {
             "R1=5",
             "G90",
             "G17",
+            // A T word alone preselects the next tool: `M6` changes it (issue 39).
+            "T5",
         ] {
             assert!(!breaks(s), "{s} should not break a run");
         }
+        // Heidenhain ISO `T5 G17` calls the tool.
+        let prog = p("%P G71 *\nN10 G01 X+1 Y+2 Z+3 A+5 F100 *\nN20 T5 G17 S3000 *\nN30 X+4 *\n");
+        assert!(prog.blocks[2].breaks_run && prog.blocks[2].flags.has(crate::Flags::TOOL_CHANGE));
     }
 
     #[test]

@@ -221,6 +221,11 @@ impl RunBuilder {
             .and_then(|r| r.blocks.last().copied())
     }
 
+    /// The first block of the run in progress (its point 0), if one is open.
+    pub fn open_run_first_block(&self) -> Option<usize> {
+        self.cur.as_ref().and_then(|r| r.blocks.first().copied())
+    }
+
     /// The end of the program: `emit` gets the run in progress, if any.
     pub fn finish(&mut self, emit: &mut impl FnMut(Run)) {
         self.finish_run(RunBreak::End, emit);
