@@ -45,6 +45,10 @@ enum Command {
     /// LinuxCNC program filter ([FILTER] in the INI): the patched program on standard
     /// output, FILTER_PROGRESS=N and the summary on standard error (docs/linuxcnc.md).
     Filter(filter_cmd::FilterArgs),
+    /// Hold a patched program against its original: line for line, the tool's reference
+    /// point (a ball's centre), positioning targets, orientation changes, Equation 6 and
+    /// the estimated time of every run; exit 1 naming each line that does not hold.
+    Verify(verify_cmd::VerifyArgs),
 }
 
 /// Exit status with `--strict` when a zone stays below feed or something near the pole
@@ -244,6 +248,7 @@ fn main() -> ExitCode {
         Command::Post(args) => post_cmd::run(args),
         Command::Simulate(args) => simulate_cmd::run(args),
         Command::Filter(args) => filter_cmd::run(args),
+        Command::Verify(args) => verify_cmd::run(args),
     };
     match result {
         Ok(code) => code,
@@ -281,6 +286,7 @@ mod patch;
 mod post_cmd;
 mod reorient_cmd;
 mod simulate_cmd;
+mod verify_cmd;
 
 /// `--units`: what a program that states no units is read in.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

@@ -103,11 +103,15 @@ pub enum Reason {
     /// A flat or bull-nose cutter's surface bound capped the orientation change and stopped
     /// the zone short of feed.
     ToolLimited,
+    /// The written program failed the check of the written bytes against the input
+    /// (`polepatch::verify`) where this zone's run was patched: the run keeps its values,
+    /// and the report's warnings say which line and which check.
+    Verification,
 }
 
 impl Reason {
     /// Every reason, in report order.
-    pub const ALL: [Reason; 16] = [
+    pub const ALL: [Reason; 17] = [
         Reason::Reached,
         Reason::Reselected,
         Reason::EndPinned,
@@ -124,6 +128,7 @@ impl Reason {
         Reason::MacroVariable,
         Reason::CentrePath,
         Reason::ToolLimited,
+        Reason::Verification,
     ];
     /// The name used in reports.
     pub fn name(self) -> &'static str {
@@ -144,6 +149,7 @@ impl Reason {
             Reason::MacroVariable => "macro_variable",
             Reason::CentrePath => "centre_path",
             Reason::ToolLimited => "tool_limited",
+            Reason::Verification => "verification",
         }
     }
 }

@@ -68,6 +68,12 @@ pub struct EndPose {
     /// the clearance), when it is one: a changed last point changes how far it turns the
     /// rotary axes (`NextMove::time_s`).
     pub next: Option<NextMove>,
+    /// Before the deciding block, a move under TCPM without rotary words moved X or Y
+    /// below the clearance: it carries the last point's orientation along the part. The
+    /// tool tip's path is the same from either pose, but a ball programmed at its tip moves
+    /// its centre by R·|Δo| there (issue 39: 15 µm on a lead-out at cutting depth), so a
+    /// run whose ball centre is kept keeps its end ([`crate::patch`]).
+    pub carried_xy: bool,
 }
 
 /// The move after a run that freed its end: where it takes the rotary axes, and how far it
@@ -104,6 +110,22 @@ impl NextMove {
     }
 }
 
+/// A positioning move's time from the values `from` to `to` (`[X, Y, Z, P, C]`, mm and
+/// degrees), s: every axis at its velocity and acceleration limits (a trapezoid, jerk left
+/// out), the slowest axis setting the time ([`NextMove::time_s`]'s estimate; X Y Z as
+/// the program states them).
+pub fn positioning_time_s(
+    machine: &polepatch_kinematics::Machine,
+    from: [f64; 5],
+    to: [f64; 5],
+) -> f64 {
+    from.iter()
+        .zip(&to)
+        .zip(&machine.limits)
+        .map(|((a, b), lim)| trapezoid_time_s((b - a).abs(), lim.v, lim.a))
+        .fold(0.0, f64::max)
+}
+
 /// The time to travel `d` from rest to rest at velocity `v` and acceleration `a` at most.
 fn trapezoid_time_s(d: f64, v: f64, a: f64) -> f64 {
     if [d, v, a].iter().any(|x| x.is_nan() || *x <= 0.0) {
@@ -136,6 +158,9 @@ pub struct Scan {
     /// The highest part-frame Z a retract (a Z-only move up under TCPM) reached since the
     /// run's last point, mm.
     pub clearance_mm: Option<f64>,
+    /// A move under TCPM without rotary words moved X or Y below the clearance
+    /// ([`EndPose::carried_xy`]).
+    pub carried_xy: bool,
 }
 
 /// One block after a run's last point, for [`After::verdict`]: what the verdicts of both
@@ -156,7 +181,7 @@ pub struct After<'a> {
     letters: u32,
     /// Letters it has a word of in a Sinumerik direction form (`C=DC(…)`, …).
     directional: u32,
-    /// It has a T word or M6, M2 or M30.
+    /// It has M6, M2 or M30.
     ends: bool,
 }
 
@@ -183,8 +208,10 @@ impl<'a> After<'a> {
             if w.form.is_directional() {
                 directional |= bit(w.letter);
             }
-            ends |= w.letter == b'T'
-                || (w.letter == b'M' && (w.value == 6.0 || w.value == 2.0 || w.value == 30.0));
+            // A T word alone selects the next tool (Fanuc, Sinumerik, LinuxCNC): the
+            // change is `M6` (or the reader's tool change: Heidenhain ISO `T5 G17`,
+            // `TOOL CALL 5`), and only that frees the end.
+            ends |= w.letter == b'M' && (w.value == 6.0 || w.value == 2.0 || w.value == 30.0);
         }
         After {
             is_move,
@@ -286,6 +313,8 @@ impl After<'_> {
             return Step::Pinned;
         }
         if st.tcpm.is_on() {
+            let above = matches!((st.pos[Z], scan.clearance_mm), (Some(z), Some(c)) if z >= c);
+            scan.carried_xy |= xy_moves && !above;
             return Step::Continue;
         }
         if xy_moves {

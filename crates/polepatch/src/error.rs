@@ -130,6 +130,19 @@ pub enum Error {
         /// Which axis, its value and the range.
         message: String,
     },
+    /// The written program failed the check against its input ([`crate::verify`]) even with
+    /// every zone that failed put back: nothing is written.
+    #[error(
+        "{path}: the patched program fails its verification against the input, so it is not \
+         written: {}",
+        .violations.iter().take(5).map(|v| format!("line {}: {}: {}", v.line, v.check.name(), v.message)).collect::<Vec<_>>().join("; ")
+    )]
+    Unverified {
+        /// File.
+        path: String,
+        /// What does not hold.
+        violations: Vec<crate::verify::Violation>,
+    },
     /// The caller's [`crate::Hooks::cancelled`] asked the patch to stop.
     #[error("cancelled")]
     Cancelled,

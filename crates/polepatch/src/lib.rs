@@ -35,6 +35,7 @@ pub mod reorient;
 pub mod report;
 pub mod simulate;
 pub mod tool;
+pub mod verify;
 
 // The pipeline's rooms, private: what callers need of them is re-exported here.
 mod analyze;

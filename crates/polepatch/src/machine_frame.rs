@@ -17,8 +17,10 @@
 //!   its original values. (Inserting intermediate points instead is not done.)
 //! - **Every run with a chain** is checked in the machine frame after the patch: Equation 6
 //!   on the machine-frame X Y Z (C17 eq. 6: near the pole the linear axes follow the
-//!   table), before and after; a run whose patch would make any axis's lowest ratio worse
-//!   than `min(before, 1)` keeps its original values, and the report says why.
+//!   table), before and after, span by span with the written program's rule
+//!   ([`crate::verify::worse_spans`]: a span at feed stays at feed, one below it gets no
+//!   lower); a run whose patch would make a span worse keeps its original values, and the
+//!   report says where and why.
 //!
 //! # The path parameter s
 //! Equation 6 needs the path the programmed feed refers to. With TCPM the controller
@@ -37,8 +39,8 @@
 //! unknown — the run is left as it is, with a message asking for `--work-offset`, and no
 //! machine-frame check is made.
 
-use polepatch_kinematics::{Axis, Chain, Machine};
-use polepatch_patcher::{AnalysisOptions, Path, analyze_path};
+use polepatch_kinematics::{Chain, Machine};
+use polepatch_patcher::Path;
 
 /// The part-frame tool tip of a rewritten block without TCPM must be within this of the
 /// original, mm (issue 10: "to the file's precision", 1 µm).
@@ -47,10 +49,6 @@ pub const TIP_TOLERANCE_MM: f64 = 1e-3;
 /// Fewest decimals written for X Y Z recomputed through the chain: rounding to 3 decimals
 /// moves a point by at most 0.0005·√3 ≈ 0.00087 mm < [`TIP_TOLERANCE_MM`].
 pub const MIN_XYZ_DECIMALS: usize = 3;
-
-/// A machine-frame ratio may be this much below `min(before, 1)` (relative) and still
-/// count as not worse: the analysis's own resolution.
-pub const NOT_WORSE_REL: f64 = 1e-4;
 
 /// The work offset of a run whose first block is `first` ([`crate::program::LoadedProgram::datum_mm`]), from the program's stated datum
 /// shifts and other frame changes (block indices in file order, as in
@@ -144,24 +142,6 @@ pub fn machine_frame_path(
     }
 }
 
-/// Lowest Equation-6 ratio per axis ([`Axis`] order) of a machine-frame path.
-pub fn axis_min_ratios(
-    path: &Path,
-    machine: &Machine,
-    opts: &AnalysisOptions,
-) -> Result<[f64; 5], String> {
-    let a = analyze_path(path, machine, opts).map_err(|e| e.to_string())?;
-    Ok(std::array::from_fn(|i| a.axis_min[i].0))
-}
-
-/// The first axis whose lowest ratio `after` is worse than `min(before, 1)`, if any.
-pub fn worse_axis(before: &[f64; 5], after: &[f64; 5]) -> Option<Axis> {
-    Axis::ALL.into_iter().find(|a| {
-        let i = a.index();
-        after[i] < before[i].min(1.0) * (1.0 - NOT_WORSE_REL)
-    })
-}
-
 /// Default chord tolerance, mm: how far the part-frame tool tip of a block rewritten
 /// through the chain may leave the programmed line between its points (issue 19 §2).
 pub const CHORD_TOLERANCE_MM: f64 = 0.005;
@@ -251,9 +231,14 @@ pub fn patch_part_frame(
                 out.p_changed[a + k] = r.p_changed[k];
                 out.c_deg[a + k] = r.c_deg[k];
                 out.c_changed[a + k] = r.c_changed[k];
+                // A ball's centre kept: the tips moved with the orientation (issue 39
+                // class 4: without them the chain kept the tip, not the centre).
+                out.xyz_mm[a + k] = r.xyz_mm[k];
+                out.xyz_changed[a + k] = r.xyz_changed[k];
             }
             out.p_decimals = out.p_decimals.max(r.p_decimals);
             out.c_decimals = out.c_decimals.max(r.c_decimals);
+            out.xyz_decimals = out.xyz_decimals.max(r.xyz_decimals);
             out.zones.extend(r.zones.into_iter().map(|mut z| {
                 z.first += a;
                 z.last += a;

@@ -430,6 +430,9 @@ fn run_options<'a>(
     let mut tool_capped = false;
     match tool.tool {
         Some(t) if t.kind == ToolKind::Ball && tool.point == ToolPoint::Tip => {
+            // A move after the run carries the last point's orientation along the part
+            // (crate::end_pose): the ball's centre would move there.
+            opts.keep_last_point |= end.carried_xy;
             opts.keep_centre = Some(KeepCentre {
                 radius_mm: t.diameter_mm / 2.0,
                 // Without TCPM the part-frame tips go through the chain, not to the
@@ -688,11 +691,9 @@ impl RunPatch<'_> {
     }
 
     /// Step 2.7: a ball's centre kept under TCPM: the tips the patcher rewrote, in the
-    /// file's unit and decimals; blocks after the run that restate its last point follow
-    /// it.
+    /// file's unit and decimals (a block after the run keeps its own X Y Z: step 3).
     fn centre_edits(&self, result: &PatchResult, edits: &mut Vec<Edit>) {
         let rp = &self.lp.runs[self.r];
-        let program = &self.lp.program;
         let (Some(keep), true) = (&self.opts.keep_centre, rp.run.tcpm.is_on()) else {
             return;
         };
@@ -702,25 +703,14 @@ impl RunPatch<'_> {
                 if !result.xyz_changed[k][i] {
                     continue;
                 }
-                let value = result.xyz_mm[k][i] / keep.unit_mm;
+                // A block after the run that restates its last rotary values keeps its
+                // own X Y Z (a retract's target): only its rotary words follow the run.
                 edits.push(Edit {
                     block: rp.run.blocks[k],
                     letter,
-                    value,
+                    value: result.xyz_mm[k][i] / keep.unit_mm,
                     decimals: result.xyz_decimals,
                 });
-                if k == n - 1 && !self.opts.keep_last_point {
-                    for &b in &self.end.restate {
-                        if program.block_words(b).iter().any(|w| w.letter == letter) {
-                            edits.push(Edit {
-                                block: b,
-                                letter,
-                                value,
-                                decimals: result.xyz_decimals,
-                            });
-                        }
-                    }
-                }
             }
         }
     }
@@ -795,7 +785,10 @@ fn run_of_blocks(lp: &LoadedProgram) -> HashMap<usize, usize> {
 
 /// Step 3: inside a run, a point that relied on a modal value keeps it; after a run only
 /// the blocks that restate its last values are written: its end point only moves when
-/// what follows does not depend on the pose ([`crate::end_pose`]).
+/// what follows does not depend on the pose ([`crate::end_pose`]). Where the run's last
+/// point got new X Y Z (a ball's centre kept), the first move after the run that relies on
+/// them gets the original values back: a positioning move keeps its target (its rotary
+/// words carry the run's new pose, by design, and are never restored).
 fn restore_modal(
     lp: &LoadedProgram,
     styles: &Styles,
@@ -807,12 +800,21 @@ fn restore_modal(
         l if l == lp.pole_letter => styles.c.decimals,
         _ => styles.p.decimals,
     };
-    let same_run = |edited: usize, b: usize| {
-        run_of
-            .get(&edited)
-            .is_some_and(|r| run_of.get(&b) == Some(r))
+    let allow = |edited: usize, b: usize, letter: u8| {
+        let Some(&r) = run_of.get(&edited) else {
+            return false;
+        };
+        if run_of.get(&b) == Some(&r) {
+            return true;
+        }
+        // The first move after the run, outside every run: X Y Z only.
+        let last = *lp.runs[r].run.blocks.last().unwrap_or(&edited);
+        matches!(letter, b'X' | b'Y' | b'Z')
+            && edited == last
+            && !run_of.contains_key(&b)
+            && (last + 1..b).all(|k| !lp.program.blocks[k].is_move)
     };
-    polepatch_nc::restore_modal(&lp.program, edits, &file_decimals, &same_run);
+    polepatch_nc::restore_modal(&lp.program, edits, &file_decimals, &allow);
 }
 
 /// Step 5: the words changed (`words`), and the file's decimals and those written, where a
@@ -1048,17 +1050,27 @@ fn through_chain(
             path.feed_mm_min,
         )
     };
-    let before = machine_frame::axis_min_ratios(&frame(&path.axes), machine, &aopts)
-        .map_err(|e| format!("machine-frame analysis failed before the patch: {e}"))?;
-    let after_r = machine_frame::axis_min_ratios(&frame(&after), machine, &aopts)
-        .map_err(|e| format!("machine-frame analysis failed after the patch: {e}"))?;
-    if let Some(axis) = machine_frame::worse_axis(&before, &after_r) {
-        let l = axis_letter(axis, lp.letters());
+    let spans = |values: &[[f64; 5]], when: &str| {
+        polepatch_patcher::quality::analyze_spans(&frame(values), machine, &aopts)
+            .map(|(_, spans)| spans)
+            .map_err(|e| format!("machine-frame analysis failed {when} the patch: {e}"))
+    };
+    let (before, after_s) = (spans(&path.axes, "before")?, spans(&after, "after")?);
+    // The written program's check, on the machine-frame path (crate::verify).
+    if let Some(w) = crate::verify::slower(&before, &after_s) {
+        let letters = polepatch_kinematics::Axis::ALL.map(|a| axis_letter(a, lp.letters()));
         return Err(format!(
-            "the patch would slow {l} in the machine frame (its lowest ratio {:.3} → {:.3}; \
-             the linear axes follow the table near the pole), so the run keeps its values",
-            before[axis.index()],
-            after_r[axis.index()]
+            "the patch would slow the machine between lines {} and {} in the machine frame: {} \
+             (the linear axes follow the table near the pole), so the run keeps its values",
+            lp.line_of(r, w.span),
+            lp.line_of(r, w.span + 1),
+            w.describe([
+                &letters[0],
+                &letters[1],
+                &letters[2],
+                &letters[3],
+                &letters[4]
+            ])
         ));
     }
     Ok(edits)

@@ -101,6 +101,9 @@ struct RunRec {
     end: [EndRec; 2],
     /// Work offset for this run ([`crate::machine_frame::datum_at`]).
     datum_mm: Option<[f64; 3]>,
+    /// The first move after the run's last block: where its X Y Z are restored when the
+    /// run's last point gets new ones ([`crate::patch`], step 3).
+    next_move: Option<usize>,
 }
 
 /// The end pose of a run as the survey finds it ([`crate::end_pose`]).
@@ -147,6 +150,7 @@ impl EndRec {
                 Vec::new()
             },
             next: if free { self.next } else { None },
+            carried_xy: self.scan.carried_xy,
         }
     }
 }
@@ -264,6 +268,8 @@ struct Surveying {
     frame_changes: Vec<usize>,
     /// Runs given out whose end pose is not decided yet, per letter.
     pending: [Vec<usize>; 2],
+    /// Runs given out that no move has followed yet ([`RunRec::next_move`]).
+    awaiting_move: Vec<usize>,
     /// The end pose of the open run so far, from the blocks after its last block, per
     /// letter.
     first_after: [EndRec; 2],
@@ -302,7 +308,9 @@ impl Surveying {
                 first_block,
                 self.work_offset_mm,
             ),
+            next_move: None,
         });
+        self.awaiting_move.push(r);
         if let Some(own) = self.lazy_style
             && !self.may_patch
         {
@@ -458,6 +466,7 @@ fn survey_once(
         datum_shifts: Vec::new(),
         frame_changes: Vec::new(),
         pending: [Vec::new(), Vec::new()],
+        awaiting_move: Vec::new(),
         first_after: [EndRec::default(), EndRec::default()],
     };
     let mut style = StyleEvidence::default();
@@ -520,6 +529,11 @@ fn survey_once(
             sv.frame_changes.push(i);
         }
         builder.push(i, s.block, s.state, &mut |run| sv.take(run));
+        if s.block.is_move {
+            for r in sv.awaiting_move.drain(..) {
+                sv.runs[r].next_move = Some(i);
+            }
+        }
         if style_from.is_none() && sv.may_patch {
             style_from = Some(s.block.span().start);
             style.add_block(bytes, s.words);
@@ -590,22 +604,26 @@ struct Stretch {
 
 /// The stretches (module docs, step 2): one per run `wanted` picks.
 /// A stretch reaches to the last block that restates its run's last values (for the
-/// tilting letter `l`), when the run's end is free: those blocks are rewritten with it.
+/// tilting letter `l`), when the run's end is free: those blocks are rewritten with it —
+/// and to the first move after the run, where X Y Z the last point relied on are restored
+/// (a ball's centre kept moves its tips; [`crate::patch`], step 3), unless that move
+/// belongs to the next run.
 fn stretches(runs: &[RunRec], l: usize, wanted: impl Fn(&RunRec) -> bool) -> Vec<Stretch> {
     runs.iter()
         .enumerate()
         .filter(|(_, rec)| wanted(rec))
         .map(|(r, rec)| {
             let end = &rec.end[l];
-            let restated = end
-                .restate
-                .iter()
-                .map(|&(b, _)| b)
-                .max()
-                .filter(|_| end.decided.is_none_or(|(free, _)| free));
+            let free = end.decided.is_none_or(|(free, _)| free);
+            let restated = end.restate.iter().map(|&(b, _)| b).max().filter(|_| free);
+            let next_first = runs.get(r + 1).map_or(usize::MAX, |n| n.first_block);
+            let next_move = rec.next_move.filter(|&b| free && b < next_first);
             Stretch {
                 first_block: rec.first_block,
-                last_block: rec.last_block.max(restated.unwrap_or(0)),
+                last_block: rec
+                    .last_block
+                    .max(restated.unwrap_or(0))
+                    .max(next_move.unwrap_or(0)),
                 runs: r..r + 1,
                 whole: false,
             }
@@ -792,7 +810,6 @@ pub fn patch_nc_hooked(
         (hooks.progress)(bytes.len(), bytes.len());
         return Ok(report);
     }
-    let mut copied_to = 0usize;
     // Set when a stretch was skipped because the caller cancelled: its part is not
     // written, and the patch ends with `Error::Cancelled`.
     let stopped = std::sync::atomic::AtomicBool::new(false);
@@ -803,6 +820,7 @@ pub fn patch_nc_hooked(
         }
         c
     };
+    let mut parts: Vec<Part> = Vec::new();
     let result = each_stretch(
         bytes,
         &sv,
@@ -822,24 +840,21 @@ pub fn patch_nc_hooked(
             } else {
                 polepatch_nc::write_styled(&lp.program, &edits, &sv.style)
             };
+            #[cfg(test)]
+            let output = tests::planted(output);
             (output, part)
         },
         |(output, part), replaced| {
             if cancelled() {
                 return Err(std::io::Error::other("cancelled"));
             }
-            // A stretch that starts at the block the previous one ended at: that block was
-            // written with the previous stretch (a run never changes its first point).
-            let shared = copied_to.saturating_sub(replaced.start);
-            assert!(
-                output.get(..shared) == bytes.get(replaced.start..replaced.start + shared),
-                "a run changed its first point (line shared with the run before it)"
-            );
-            out.write_all(&bytes[copied_to.min(replaced.start)..replaced.start])?;
-            out.write_all(&output[shared..])?;
-            copied_to = replaced.end;
-            merge(&mut report, part);
-            (hooks.progress)(copied_to, bytes.len());
+            (hooks.progress)(replaced.end, bytes.len());
+            parts.push(Part {
+                replaced,
+                output,
+                report: part,
+                put_back: None,
+            });
             Ok(())
         },
     );
@@ -847,10 +862,166 @@ pub fn patch_nc_hooked(
         return Err(Error::Cancelled);
     }
     result?;
-    out.write_all(&bytes[copied_to..]).map_err(Error::Output)?;
+    let output = verified_output(bytes, machine, opts, &mut parts, &cancelled)?;
+    if cancelled() {
+        return Err(Error::Cancelled);
+    }
+    for part in parts {
+        if let Some(why) = &part.put_back {
+            report.warnings.push(why.clone());
+        }
+        merge(&mut report, part.report);
+    }
+    out.write_all(&output).map_err(Error::Output)?;
     (hooks.progress)(bytes.len(), bytes.len());
     report.warn_unknown_tool();
     Ok(report)
+}
+
+/// A stretch as patched: the input bytes it replaces, its output, its report, and — when
+/// the written program failed its verification there — why it was put back.
+struct Part {
+    replaced: std::ops::Range<usize>,
+    output: Vec<u8>,
+    report: FileReport,
+    put_back: Option<String>,
+}
+
+/// The program as the parts write it: the input, with each part's range replaced by its
+/// output (by its input where it was put back). A part that starts at the block the
+/// previous one ended at (two runs sharing a point) has that block written with the
+/// previous part: a run never changes its first point.
+fn assemble(bytes: &[u8], parts: &[Part]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(bytes.len() + bytes.len() / 64);
+    let mut copied_to = 0usize;
+    for part in parts {
+        let replaced = &part.replaced;
+        let shared = copied_to.saturating_sub(replaced.start);
+        let output: &[u8] = if part.put_back.is_some() {
+            &bytes[replaced.clone()]
+        } else {
+            &part.output
+        };
+        assert!(
+            output.get(..shared) == bytes.get(replaced.start..replaced.start + shared),
+            "a run changed its first point (line shared with the run before it)"
+        );
+        out.extend_from_slice(&bytes[copied_to.min(replaced.start)..replaced.start]);
+        out.extend_from_slice(&output[shared.min(output.len())..]);
+        copied_to = copied_to.max(replaced.end);
+    }
+    out.extend_from_slice(&bytes[copied_to.min(bytes.len())..]);
+    out
+}
+
+/// The output of `parts`, verified against the input ([`crate::verify`]): where the written
+/// program fails, the part that wrote the failing lines (or the last part before them: a
+/// later line relies on what it changed) is put back, its zones marked
+/// [`crate::ZoneReason::Verification`], and the program verified again. A program that
+/// still fails with nothing left to put back is [`Error::Unverified`].
+fn verified_output(
+    bytes: &[u8],
+    machine: &Machine,
+    opts: &crate::PatchOptions,
+    parts: &mut [Part],
+    cancelled: &dyn Fn() -> bool,
+) -> Result<Vec<u8>, Error> {
+    // The file lines each part covers.
+    let mut lines = Vec::with_capacity(parts.len());
+    let (mut at, mut line) = (0usize, 1usize);
+    for part in parts.iter() {
+        let count = |from: usize, to: usize| crate::verify::lines_in(&bytes[from..to]);
+        // Parts are in file order; one may start at the line the one before ended at.
+        if part.replaced.start >= at {
+            line += count(at, part.replaced.start);
+        } else {
+            line -= count(part.replaced.start, at);
+        }
+        at = part.replaced.start;
+        let first = line;
+        let last = first + count(part.replaced.start, part.replaced.end).max(1) - 1;
+        lines.push([first, last]);
+    }
+    loop {
+        let output = assemble(bytes, parts);
+        if output == bytes || cancelled() {
+            return Ok(output);
+        }
+        let claims: Vec<crate::verify::Claim> = parts
+            .iter()
+            .filter(|p| p.put_back.is_none())
+            .flat_map(|p| p.report.zones.iter())
+            .filter(|z| z.outcome == crate::Outcome::Reached)
+            .map(|z| crate::verify::Claim {
+                lines: z.lines,
+                both_axes: opts.patch.axes == polepatch_patcher::PatchAxes::Both,
+            })
+            .collect();
+        let check =
+            crate::verify::verify_claims(bytes, &output, machine, opts, &opts.name, &claims)?;
+        if check.passed() {
+            return Ok(output);
+        }
+        let mut put = false;
+        for v in &check.violations {
+            // The parts that wrote the line (two when runs share it), else the last one
+            // before it (a later line relies on what it changed), else — the program as a
+            // whole, or a part already put back — the last changed one before.
+            let changed = |k: &usize| {
+                parts[*k].put_back.is_none()
+                    && parts[*k].output != bytes[parts[*k].replaced.clone()]
+            };
+            let mut blame: Vec<usize> = (0..parts.len())
+                .filter(|&k| lines[k][0] <= v.line && v.line <= lines[k][1])
+                .filter(changed)
+                .collect();
+            if blame.is_empty() {
+                let before = if v.line == 0 {
+                    parts.len()
+                } else {
+                    lines
+                        .iter()
+                        .position(|r| r[0] > v.line)
+                        .unwrap_or(parts.len())
+                };
+                blame.extend((0..before).rev().find(changed));
+            }
+            for k in blame {
+                let why = format!(
+                    "{}: lines {}–{} keep their values: the written program failed its \
+                     verification at line {} ({}: {})",
+                    opts.name,
+                    lines[k][0],
+                    lines[k][1],
+                    v.line,
+                    v.check.name(),
+                    v.message
+                );
+                put_back(&mut parts[k], why);
+                put = true;
+            }
+        }
+        if !put {
+            return Err(Error::Unverified {
+                path: opts.name.clone(),
+                violations: check.violations,
+            });
+        }
+    }
+}
+
+/// Part `p` keeps the input's values: its zones say why ([`crate::ZoneReason::Verification`]).
+fn put_back(p: &mut Part, why: String) {
+    for row in &mut p.report.zones {
+        if row.outcome != crate::Outcome::Unchanged || row.points_modified > 0 {
+            row.not_written();
+        }
+        row.reason = crate::ZoneReason::Verification;
+    }
+    p.report.words_changed = 0;
+    p.report.written_c_decimals = p.report.file_c_decimals;
+    p.report.written_primary_decimals = p.report.file_primary_decimals;
+    p.put_back = Some(why);
 }
 
 /// Equation 6 along every run of an NC program held in memory, a stretch at a time
@@ -1218,4 +1389,94 @@ fn merge(report: &mut FileReport, part: FileReport) {
     report.untouched_runs.extend(part.untouched_runs);
     report.warnings.extend(part.warnings);
     report.zones.extend(part.zones);
+}
+
+#[cfg(test)]
+mod tests {
+    /// A defect to plant in the output of every stretch that holds the marker (the stretches
+    /// are patched on worker threads): the marker, the bytes to find and what to write
+    /// instead.
+    static PLANT: std::sync::Mutex<Option<(String, String, String)>> = std::sync::Mutex::new(None);
+
+    /// A stretch's output with the planted defect, if any.
+    pub(super) fn planted(output: Vec<u8>) -> Vec<u8> {
+        let plant = PLANT.lock().map(|p| p.clone()).unwrap_or(None);
+        match plant {
+            Some((marker, find, with)) => {
+                let text = String::from_utf8_lossy(&output).into_owned();
+                if text.contains(&marker) {
+                    text.replacen(&find, &with, 1).into_bytes()
+                } else {
+                    output
+                }
+            }
+            None => output,
+        }
+    }
+
+    /// A zone whose written values fail the check of the written program is put back with
+    /// reason `verification`, the line and the check in the warnings; the rest is written.
+    /// Planted: the stretch's output with its retract lowered to cutting depth (the crash of
+    /// issue 39 class 1), on a program of two passes of which only the first is planted.
+    #[test]
+    fn a_zone_that_fails_the_check_is_put_back() {
+        let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let pass =
+            std::fs::read_to_string(root.join("fixtures/verify/fanuc-g434-retract-restated.nc"))
+                .unwrap();
+        // The pass twice: the second's retract at Z60 (not planted).
+        let body = pass
+            .trim_end_matches("%\n")
+            .trim_end_matches("M30\n")
+            .trim_end_matches("G49\n")
+            .replacen("G1 X0.5 ", "G1 X0.5 (PLANTED) ", 1);
+        let second: String = pass
+            .lines()
+            .skip_while(|l| !l.starts_with("G0 X0 Y0 Z50."))
+            .map(|l| format!("{}\n", l.replace("Z50.", "Z60.")))
+            .collect();
+        let program = format!("{body}{second}");
+        let machine = polepatch_kinematics::Machine::builtin("mikron-ucp710").unwrap();
+        let opts = crate::PatchOptions {
+            name: "planted.nc".into(),
+            ..crate::PatchOptions::default()
+        };
+        let (clean, clean_report) = crate::patch_nc(program.as_bytes(), &machine, &opts).unwrap();
+        assert_eq!(clean_report.zones.len(), 2);
+        assert!(
+            clean_report
+                .zones
+                .iter()
+                .all(|z| z.outcome == crate::Outcome::Reached)
+        );
+        let set = |v| *PLANT.lock().unwrap() = v;
+        set(Some(("(PLANTED)".into(), "Z50. A".into(), "Z-4. A".into())));
+        let result = crate::patch_nc(program.as_bytes(), &machine, &opts);
+        set(None);
+        let (out, report) = result.unwrap();
+        let (first, second) = (&report.zones[0], &report.zones[1]);
+        assert_eq!(first.outcome, crate::Outcome::Unchanged, "{first:?}");
+        assert_eq!(first.reason, crate::ZoneReason::Verification);
+        assert_eq!(second.outcome, crate::Outcome::Reached, "{second:?}");
+        let retract = program
+            .lines()
+            .position(|l| l.starts_with("G0 Z50."))
+            .unwrap()
+            + 1;
+        assert!(
+            report.warnings.iter().any(|w| w.contains(&format!(
+                "failed its verification at line {retract} (positioning_target"
+            ))),
+            "{:?}",
+            report.warnings
+        );
+        // The first pass as read, the second as patched without the plant.
+        let text = String::from_utf8(out).unwrap();
+        let clean = String::from_utf8(clean).unwrap();
+        let split = retract + 1;
+        let head = |t: &str| t.lines().take(split).collect::<Vec<_>>().join("\n");
+        let tail = |t: &str| t.lines().skip(split).collect::<Vec<_>>().join("\n");
+        assert_eq!(head(&text), head(&program));
+        assert_eq!(tail(&text), tail(&clean));
+    }
 }

@@ -26,10 +26,32 @@ fn example_machine() -> Machine {
 /// SING's datum (`N60 G54 Y-7.1 Z+38.054`).
 const SING_DATUM: [f64; 3] = [-30.489, -7.1, 38.054];
 
+/// SING's part zero put on the C axis (`N60 G54 X+0 Y+0 Z+38.054`): without TCPM the
+/// linear axes then follow the table little near the pole. With SING's own datum the chain
+/// patch slows the machine in the machine frame (the patcher solves on the part-frame
+/// path), and the written program's rule refuses it:
+/// `with_sings_datum_the_chain_patch_slows_the_machine_and_is_not_written`.
+const ON_AXIS_DATUM: [f64; 3] = [0.0, 0.0, 38.054];
+
+/// `N60 G54 …` of a datum.
+fn datum_line(d: [f64; 3]) -> String {
+    format!("N60 G54 X{:+} Y{:+} Z{:+} *\n", d[0], d[1], d[2])
+}
+
 /// `%SING` as a post without TCPM writes it for `machine`'s chain: every point of its TCPM
-/// run with X Y Z through the chain (3 decimals), `M128` removed. Returns the program and, per block,
-/// the part-frame tool tip it was made from.
+/// run with X Y Z through the chain (3 decimals), `M128` removed, the approach (N70–N100)
+/// at rapid and the pass from N110 at F. Returns the program and, per block, the part-frame
+/// tool tip it was made from.
+///
+/// (With the approach in the run, at F, the patch slows the first span in the machine
+/// frame — C, 1.000 → 0.882 of the feed: the not-a-knot spline couples the spans — and the
+/// written program's rule refuses it: `a_patch_that_slows_a_span_in_the_machine_frame_is_not_written`.)
 fn sing_without_tcpm(machine: &Machine) -> (Vec<u8>, Vec<Option<[f64; 3]>>) {
+    sing_without_tcpm_at(machine, ON_AXIS_DATUM)
+}
+
+/// [`sing_without_tcpm`] with the part zero at `datum`.
+fn sing_without_tcpm_at(machine: &Machine, datum: [f64; 3]) -> (Vec<u8>, Vec<Option<[f64; 3]>>) {
     let chain = machine.chain.unwrap();
     let lp = load_nc(&sing(), "SING.I", machine, None).unwrap();
     let program = &lp.program;
@@ -41,7 +63,7 @@ fn sing_without_tcpm(machine: &Machine) -> (Vec<u8>, Vec<Option<[f64; 3]>>) {
             let v = |i: usize| st.pos[i].unwrap_or(0.0);
             let tip = [v(modal::X), v(modal::Y), v(modal::Z)];
             tips[b] = Some(tip);
-            let x = chain.program_xyz(machine, SING_DATUM, v(modal::A), v(modal::C), tip);
+            let x = chain.program_xyz(machine, datum, v(modal::A), v(modal::C), tip);
             for (i, letter) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
                 let value = (x[i] * 1000.0).round() / 1000.0;
                 if program.word(b, letter).is_some() && value != tip[i] {
@@ -58,7 +80,12 @@ fn sing_without_tcpm(machine: &Machine) -> (Vec<u8>, Vec<Option<[f64; 3]>>) {
     edits.sort_by_key(|e| (e.block, e.letter));
     let text = String::from_utf8(polepatch::nc::write(program, &edits)).unwrap();
     assert!(text.contains("N65 M128 *\n"));
-    (text.replace("N65 M128 *\n", "").into_bytes(), {
+    let text = text
+        .replace("N65 M128 *\n", "")
+        .replace(&datum_line(SING_DATUM), &datum_line(datum))
+        .replace("N70 G01 ", "N70 G00 ")
+        .replace("N110 X", "N110 G01 X");
+    (text.into_bytes(), {
         // One line fewer: block indices after line 11 shift by one.
         let mut t = tips;
         t.remove(10);
@@ -263,7 +290,7 @@ fn without_tcpm_x_y_z_change_with_the_rotary_axes_and_the_tool_tip_stays() {
                 let v = |i: usize| st.pos[i].unwrap();
                 chain.part_tip(
                     &machine,
-                    SING_DATUM,
+                    ON_AXIS_DATUM,
                     v(modal::A),
                     v(modal::C),
                     [v(modal::X), v(modal::Y), v(modal::Z)],
@@ -286,7 +313,7 @@ fn without_tcpm_x_y_z_change_with_the_rotary_axes_and_the_tool_tip_stays() {
     );
     assert!(worst_mm <= TIP_TOLERANCE_MM, "tool tip moved {worst_mm} mm");
     // Between the points: within the tolerance given (or the input block's).
-    let (worst, checked) = chord_errors(&machine, SING_DATUM, &input, &out, 1.0);
+    let (worst, checked) = chord_errors(&machine, ON_AXIS_DATUM, &input, &out, 1.0);
     assert!(
         checked >= 10 && worst > 0.5,
         "{checked} blocks, worst {worst} mm"
@@ -313,7 +340,7 @@ fn without_tcpm_and_without_a_work_offset_the_run_is_left() {
     let machine = example_machine();
     let (input, _) = sing_without_tcpm(&machine);
     let text = String::from_utf8(input).unwrap();
-    let text = text.replace("N60 G54 X-30.489 Y-7.1 Z+38.054 *\n", "");
+    let text = text.replace(&datum_line(ON_AXIS_DATUM), "");
     let (out, report) = patch_nc(text.as_bytes(), &machine, &PatchOptions::default()).unwrap();
     assert_eq!(out, text.as_bytes());
     assert_eq!(report.untouched_runs[0].reason, UntouchedReason::NoTcpm);
@@ -325,7 +352,7 @@ fn without_tcpm_and_without_a_work_offset_the_run_is_left() {
     // Given on the command line, the run is patched (with a chord tolerance that admits
     // SING's long blocks).
     let opts = PatchOptions {
-        work_offset_mm: Some(SING_DATUM),
+        work_offset_mm: Some(ON_AXIS_DATUM),
         chord_tolerance_mm: 1.0,
         ..PatchOptions::default()
     };
@@ -441,14 +468,14 @@ fn a_transformed_frame_leaves_the_run() {
     let machine = example_machine();
     let (input, _) = sing_without_tcpm(&machine);
     let text = String::from_utf8(input).unwrap();
-    let datum = "N60 G54 X-30.489 Y-7.1 Z+38.054 *\n";
+    let datum = &datum_line(ON_AXIS_DATUM);
     assert!(text.contains(datum));
     let opts = PatchOptions {
         chord_tolerance_mm: 1.0,
         ..PatchOptions::default()
     };
     let given = PatchOptions {
-        work_offset_mm: Some(SING_DATUM),
+        work_offset_mm: Some(ON_AXIS_DATUM),
         ..opts.clone()
     };
     for code in [
@@ -486,4 +513,133 @@ fn a_transformed_frame_leaves_the_run() {
         report.untouched_runs
     );
     assert_ne!(out, t.as_bytes());
+}
+
+/// G16 eq. 1 (the UCP710's senses): the tool axis in the part frame, written here apart
+/// from the library's forward kinematics.
+fn tool_axis(a_deg: f64, c_deg: f64) -> [f64; 3] {
+    let (a, c) = (a_deg.to_radians(), c_deg.to_radians());
+    [c.sin() * a.sin(), -c.cos() * a.sin(), a.cos()]
+}
+
+/// Issue 39 class 4: a ball programmed at its tip, without TCPM, patched through the chain:
+/// its centre in the part frame (the chain's part-frame tip + R·o) stays where it was at
+/// every point, within 1 µm plus the rounding of the written X Y Z (3 decimals) and rotary
+/// words (4). Before the fix the chain kept the tip: the centre moved 0.2255 mm at N110.
+#[test]
+fn without_tcpm_a_ball_at_its_tip_keeps_its_centre_through_the_chain() {
+    let machine = example_machine();
+    let chain = machine.chain.unwrap();
+    let (input, _) = sing_without_tcpm(&machine);
+    let opts = PatchOptions {
+        name: "SING_noM128_ball.I".into(),
+        chord_tolerance_mm: 1.0,
+        tool: polepatch::tool::ToolOptions {
+            tool: Some(polepatch::tool::Tool::parse("ball:10").unwrap()),
+            ..Default::default()
+        },
+        ..PatchOptions::default()
+    };
+    let (out, report) = patch_nc(&input, &machine, &opts).unwrap();
+    assert_eq!(report.zones.len(), 1);
+    assert_eq!(
+        report.zones[0].outcome,
+        polepatch::Outcome::Reached,
+        "{:?}",
+        report.zones[0]
+    );
+    assert!(report.zones[0].max_deviation_deg > 1.0);
+    let before = load_nc(&input, "in", &machine, None).unwrap();
+    let after = load_nc(&out, "out", &machine, None).unwrap();
+    let centre = |st: &polepatch::nc::Modal| {
+        let v = |i: usize| st.pos[i].unwrap();
+        let tip = chain.part_tip(
+            &machine,
+            ON_AXIS_DATUM,
+            v(modal::A),
+            v(modal::C),
+            [v(modal::X), v(modal::Y), v(modal::Z)],
+        );
+        let o = tool_axis(v(modal::A), v(modal::C));
+        [
+            tip[0] + 5.0 * o[0],
+            tip[1] + 5.0 * o[1],
+            tip[2] + 5.0 * o[2],
+        ]
+    };
+    let rounding = 3f64.sqrt() * 0.5e-3 + 5.0 * (2.0 * 0.5e-4f64).to_radians();
+    let mut moved = 0;
+    for rp in before.runs.iter().filter(|rp| !rp.run.tcpm.is_on()) {
+        for &b in &rp.run.blocks[1..] {
+            let (s0, s1) = (before.program.state(b), after.program.state(b));
+            if s0.pos == s1.pos {
+                continue;
+            }
+            moved += 1;
+            let (c0, c1) = (centre(&s0), centre(&s1));
+            let d = (0..3).map(|i| (c0[i] - c1[i]).powi(2)).sum::<f64>().sqrt();
+            assert!(
+                d <= TIP_TOLERANCE_MM + rounding,
+                "line {}: the ball's centre moved {d} mm",
+                before.program.blocks[b].line
+            );
+        }
+    }
+    assert!(moved >= 10, "{moved} points changed");
+}
+
+/// With SING's approach in the run at F, the chain patch slows the first span's C in the
+/// machine frame (the written program's rule, span by span): the run keeps its values and
+/// the report says where.
+#[test]
+fn a_patch_that_slows_a_span_in_the_machine_frame_is_not_written() {
+    let machine = example_machine();
+    let (input, _) = sing_without_tcpm(&machine);
+    let text = String::from_utf8(input)
+        .unwrap()
+        .replace("N70 G00 ", "N70 G01 ")
+        .replace("N110 G01 X", "N110 X");
+    let opts = PatchOptions {
+        chord_tolerance_mm: 1.0,
+        ..PatchOptions::default()
+    };
+    let (out, report) = patch_nc(text.as_bytes(), &machine, &opts).unwrap();
+    assert_eq!(out, text.as_bytes());
+    let u = &report.untouched_runs[0];
+    assert_eq!(u.reason, UntouchedReason::MachineFrame, "{}", u.message);
+    assert!(
+        u.message.contains("would slow the machine between lines"),
+        "{}",
+        u.message
+    );
+    assert!(
+        report
+            .zones
+            .iter()
+            .all(|z| z.outcome == polepatch::Outcome::Unchanged)
+    );
+}
+
+/// With SING's own datum the part is 30 mm off the C axis: the chain patch, solved on the
+/// part-frame path, slows the machine in the machine frame at the zone's end (a span at
+/// feed drops to about 0.9 of it, C limiting: without TCPM the feed is along the machine's
+/// X Y Z path, which the table's swing shortens there). The run keeps its values and the
+/// report says where (issue 39: the written program is never slower anywhere).
+#[test]
+fn with_sings_datum_the_chain_patch_slows_the_machine_and_is_not_written() {
+    let machine = example_machine();
+    let (input, _) = sing_without_tcpm_at(&machine, SING_DATUM);
+    let opts = PatchOptions {
+        chord_tolerance_mm: 1.0,
+        ..PatchOptions::default()
+    };
+    let (out, report) = patch_nc(&input, &machine, &opts).unwrap();
+    assert_eq!(out, input);
+    let u = &report.untouched_runs[0];
+    assert_eq!(u.reason, UntouchedReason::MachineFrame, "{}", u.message);
+    assert!(
+        u.message.contains("where the original reaches feed"),
+        "{}",
+        u.message
+    );
 }
