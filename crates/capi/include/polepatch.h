@@ -38,6 +38,12 @@ typedef enum PpStatus {
    the point, the axis, the value and the range.
    */
   PP_OUT_OF_RANGE = 5,
+  /*
+   The patched program failed its check against the input even with every failing
+   zone put back ([`pp_patch_nc`]; `polepatch verify`): nothing is written; the message
+   names the lines and the checks.
+   */
+  PP_UNVERIFIED = 6,
 } PpStatus;
 
 /*

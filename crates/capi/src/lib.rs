@@ -40,6 +40,10 @@ pub enum PpStatus {
     /// A joint value outside the machine's range ([`pp_cl_to_joints`]); the message names
     /// the point, the axis, the value and the range.
     PpOutOfRange = 5,
+    /// The patched program failed its check against the input even with every failing
+    /// zone put back ([`pp_patch_nc`]; `polepatch verify`): nothing is written; the message
+    /// names the lines and the checks.
+    PpUnverified = 6,
 }
 
 /// Branch rule of the inverse kinematics ([`pp_cl_to_joints`]).
@@ -529,8 +533,10 @@ pub unsafe extern "C" fn pp_patch_nc(
         let opts = unsafe { options(opts) }?;
         // SAFETY: non-NULL, a live machine (header contract).
         let machine = unsafe { &(*m).0 };
-        let (out, report) =
-            polepatch::patch_nc(bytes, machine, &opts).map_err(|e| bad(e.to_string()))?;
+        let (out, report) = polepatch::patch_nc(bytes, machine, &opts).map_err(|e| match e {
+            polepatch::Error::Unverified { .. } => Fail(PpStatus::PpUnverified, e.to_string()),
+            e => bad(e.to_string()),
+        })?;
         let json = serde_json::to_string_pretty(&report)
             .map_err(|e| Fail(PpStatus::PpInternal, e.to_string()))?;
         // SAFETY: non-NULL, writable (header contract).

@@ -11,6 +11,7 @@
 //! | `Error::Cancelled` (Ctrl-C during the call) | `KeyboardInterrupt` | — |
 //! | `Error::Path` (joint arrays) | `InputError` | — |
 //! | `Error::Options` | `ValueError` | — |
+//! | `Error::Unverified` (the patched program fails its check against the input) | `VerificationError` | `path`, `line` (the first failing line) |
 //! | `MachineError` | `MachineError` | — |
 //! | a panic | `InternalError` | — |
 //!
@@ -193,6 +194,16 @@ pub(crate) fn to_python(py: Python<'_>, failure: Failure) -> PyErr {
                 Error::Options(_) => PyValueError::new_err(message),
                 Error::Output(_) => PyOSError::new_err(message),
                 Error::OutOfMemory { .. } => pyo3::exceptions::PyMemoryError::new_err(message),
+                Error::Unverified {
+                    path: p,
+                    violations,
+                } => {
+                    let line = violations.first().map(|v| v.line).filter(|&l| l > 0);
+                    exception(py, "VerificationError", message, |kw| {
+                        kw.set_item("path", path(p))?;
+                        kw.set_item("line", line)
+                    })
+                }
             }
         }
     }

@@ -27,7 +27,7 @@ import os
 from typing import TYPE_CHECKING, Any, Dict, List, Optional, Tuple, Union
 
 from . import _polepatch as _native
-from ._errors import InputError, InternalError, MachineError
+from ._errors import InputError, InternalError, MachineError, VerificationError
 
 if TYPE_CHECKING:  # numpy is imported by the array calls only
     import os
@@ -49,6 +49,7 @@ __all__ = [
     "InputError",
     "MachineError",
     "InternalError",
+    "VerificationError",
 ]
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Optional
 
-__all__ = ["InputError", "MachineError", "InternalError"]
+__all__ = ["InputError", "MachineError", "InternalError", "VerificationError"]
 
 
 class InputError(ValueError):
@@ -44,3 +44,15 @@ class MachineError(ValueError):
 class InternalError(RuntimeError):
     """A bug in polepatch (a Rust panic, caught before it reached Python). Please report
     it with the input that caused it."""
+
+
+class VerificationError(RuntimeError):
+    """The patched program failed its check against the input (``polepatch verify``) even
+    with every failing zone put back, so nothing is returned. ``str(error)`` names the lines
+    and the checks; ``path`` is the input's name (``None`` when none was given) and
+    ``line`` the first failing line (``None`` for the program as a whole)."""
+
+    def __init__(self, message: str, *, path: Optional[str] = None, line: Optional[int] = None) -> None:
+        super().__init__(message)
+        self.path = path
+        self.line = line
