@@ -362,8 +362,21 @@ impl Interpreter {
     }
 
     /// [`Interpreter::lex`] into `s`, which is `Scan::default()` (a reader that keeps the
-    /// lines of a window fills them in place: a `Scan` is a few hundred bytes).
+    /// lines of a window fills them in place: a `Scan` is a few hundred bytes). An error
+    /// after a lone CR in the line names the CR ([`crate::lines::explain_lone_cr`]).
     pub(crate) fn lex_into(
+        &self,
+        bytes: &[u8],
+        span: Range<usize>,
+        line: usize,
+        words: &mut Vec<Word>,
+        s: &mut Scan,
+    ) -> Result<(), ParseError> {
+        self.lex_line(bytes, span.clone(), line, words, s)
+            .map_err(|e| crate::lines::explain_lone_cr(bytes, &span, e))
+    }
+
+    fn lex_line(
         &self,
         bytes: &[u8],
         span: Range<usize>,
