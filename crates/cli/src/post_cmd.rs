@@ -76,6 +76,10 @@ pub(crate) struct PostArgs {
     /// 1STPECK/SUBPECK) with the smaller peck throughout (default: refused).
     #[arg(long)]
     uniform_peck: bool,
+    /// The cutter and the point X Y Z state (as `patch`; default: the CL file's CUTTER/ or
+    /// TLDATA/, at the tip).
+    #[command(flatten)]
+    tool: crate::ToolArgs,
 }
 
 pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
@@ -90,6 +94,7 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
     let name = args.cl.display().to_string();
     let mut inputs = vec![Input::new("the CL input", &args.cl)];
     inputs.extend(crate::machine_input(&args.machine));
+    inputs.extend(args.tool.inputs());
     let mut outputs = vec![Output::new("-o", &args.output)];
     if let Some(path) = &args.report {
         outputs.push(Output::new("--report", path));
@@ -120,6 +125,7 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
         patch_options: polepatch::PatchOptions {
             name: name.clone(),
             feed_fallback_mm_min: args.feed,
+            tool: args.tool.options()?,
             ..polepatch::PatchOptions::default()
         },
         rotary_decimals: args.rotary_decimals,
@@ -166,6 +172,7 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
                 r.zones.len(),
                 r.words_changed
             );
+            crate::patch::print_warnings(r);
             if let Some(target) = targets.get(1) {
                 target
                     .write(serde_json::to_string_pretty(r)?.as_bytes(), None)

@@ -667,11 +667,35 @@ pub fn post_items(
 /// `TLDATA/` ([`crate::tool::cl_tool`]), and the tool tip as the point (APT's `GOTO/` states
 /// the tip). The patch then keeps a ball's centre and caps a flat or bull-nose cutter's
 /// orientation change ([`crate::tool`]). `cl_bytes` are the CL file's bytes, `cl` as read.
+///
+/// The order is [`crate::tool::resolve`]'s: `--tool` first, then the tool table by the
+/// number `LOADTL` calls, then the CL file's own description — which, in a file whose tools
+/// are called by number, stands for the numbers the table does not hold, and in one that
+/// calls none (a CSV file, an APT file without `LOADTL`) for the whole program.
 pub fn tool_from_cl(cl_bytes: &[u8], cl: &ClProgram, opts: &mut PostOptions) {
     let t = &mut opts.patch_options.tool;
     if t.tool.is_none() {
         let unit_mm = if cl.units == Units::Inch { 25.4 } else { 1.0 };
-        t.tool = crate::tool::cl_tool(cl_bytes, unit_mm).map(|(tool, _)| tool);
+        if let Some((tool, _)) = crate::tool::cl_tool(cl_bytes, unit_mm) {
+            let called: Vec<u32> = cl
+                .items
+                .iter()
+                .filter_map(|i| match i {
+                    ClItem::ToolChange { tool, .. } => Some(*tool),
+                    _ => None,
+                })
+                .collect();
+            if t.table.tools.is_empty() || called.is_empty() {
+                t.tool = Some(tool);
+            } else {
+                for n in called {
+                    t.table
+                        .tools
+                        .entry(crate::tool::ToolId::Number(u64::from(n)))
+                        .or_insert(tool);
+                }
+            }
+        }
     }
     if t.point.is_none() {
         t.point = Some(crate::tool::ToolPoint::Tip);
