@@ -134,13 +134,19 @@ fn unknown_records_stop_the_post_unless_ignored_by_name() {
     assert!(err.contains("THREAD 1 (skipped, --ignore)"), "{err}");
     let text = std::fs::read_to_string(&out).unwrap();
     assert!(
-        text.contains("(THREAD records skipped by --ignore THREAD: 1)"),
+        text.contains("(THREAD records skipped by --ignore THREAD: 1, the first at line 4)"),
         "{text}"
     );
-    let (code, _, err) = args(&["--ignore", "GOTO"]);
+    assert!(
+        err.contains("1 THREAD record(s) skipped (--ignore THREAD), the first at line 4"),
+        "{err}"
+    );
+    // GOTO records are posted here (the THREAD one still stops the read first).
+    let (code, _, err) = args(&["--ignore", "GOTO", "--ignore", "THREAD"]);
     assert_eq!(code, 1);
     assert!(
-        err.contains("--ignore GOTO: polepatch posts GOTO records"),
+        err.contains("--ignore GOTO: polepatch posts the 2 GOTO record(s) of")
+            && err.contains("only records it refuses in the file can be skipped"),
         "{err}"
     );
 }
@@ -415,4 +421,134 @@ fn post_takes_the_tool_and_keeps_a_tip_programmed_balls_centre() {
     ]);
     assert_ne!(code, 0, "{err}");
     assert!(err.contains("tool table"), "{err}");
+}
+
+/// Issue 42 item 2: `post` refused `CUTCOM/LEFT` with the tool along X, and then refused
+/// `--ignore CUTCOM` because it posts CUTCOM records. One rule now: a record refused in
+/// this file may be skipped; the moves are posted without compensation and the note says
+/// which records, how many and the first line. A kind posted everywhere in the file may not
+/// be skipped.
+#[test]
+fn a_refused_record_can_be_ignored_and_the_note_says_so() {
+    let dir = temp_dir("post-ignore-cutcom");
+    // CAMWorks style: a side wall machined with the tool along +X, under compensation.
+    let side = "$$ Side wall, SolidWorks CAM style\n\
+PARTNO/SIDE_WALL\n\
+UNIT/MM\n\
+MULTAX/ON\n\
+CUTTER/6.,0,3.,0,0,0,51.\n\
+LOADTL/3\n\
+SPINDL/6000,CLW\n\
+COOLNT/FLOOD\n\
+RAPID\n\
+GOTO/-30.0000,0.0000,10.0000,1.000000,0.000000,0.000000\n\
+FEDRAT/400.,MMPM\n\
+GOTO/-30.0000,0.0000,-5.0000,1.000000,0.000000,0.000000\n\
+CUTCOM/LEFT\n\
+GOTO/-30.0000,10.0000,-5.0000,1.000000,0.000000,0.000000\n\
+GOTO/-30.0000,40.0000,-5.0000,1.000000,0.000000,0.000000\n\
+GOTO/-30.0000,40.0000,-15.0000,1.000000,0.000000,0.000000\n\
+CUTCOM/OFF\n\
+GOTO/-30.0000,50.0000,-15.0000,1.000000,0.000000,0.000000\n\
+RAPID\n\
+GOTO/-30.0000,50.0000,10.0000,1.000000,0.000000,0.000000\n\
+COOLNT/OFF\n\
+FINI\n";
+    let cl = dir.join("side.apt");
+    std::fs::write(&cl, side).unwrap();
+    let out = dir.join("side.mpf");
+    let report = dir.join("side.json");
+    let post_with = |extra: &[&str]| {
+        let mut a = vec![
+            "post",
+            cl.to_str().unwrap(),
+            "--machine",
+            "mikron-ucp710",
+            "--dialect",
+            "sinumerik",
+            "-o",
+            out.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+        ];
+        a.extend_from_slice(extra);
+        polepatch(&a)
+    };
+    let (code, _, err) = post_with(&[]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("side.apt:13:1: CUTCOM/LEFT (line 13): the tool axis (1.000000, 0.000000, 0.000000) at line 14 is not +Z")
+            && err.contains("--ignore CUTCOM posts the moves at the CL points without compensation"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let (code, _, err) = post_with(&["--ignore", "cutcom"]);
+    assert_eq!(code, 0, "{err}");
+    let note = "side.apt: 2 CUTCOM record(s) skipped (--ignore CUTCOM), the first at line 13; \
+                without it the post refused line 13, col 1: CUTCOM/LEFT (line 13)";
+    assert!(err.contains(note), "{err}");
+    assert!(
+        err.contains("the moves are posted at the CL points without cutter compensation"),
+        "{err}"
+    );
+    let program = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        program.contains("; CUTCOM records skipped by --ignore CUTCOM: 2, the first at line 13"),
+        "{program}"
+    );
+    assert!(
+        !program.contains("G41") && !program.contains("G42"),
+        "{program}"
+    );
+    // Every feed move of the CL is a move of the program, with the tool along +X (A 90,
+    // C 90): the compensated contour at the CL points.
+    assert_eq!(posted_points(&program).len(), 5, "{program}");
+    assert!(program.contains("X-30 Y40 Z-15 A90 C90"), "{program}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert!(
+        json["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| w.as_str().unwrap().contains(note)),
+        "{json}"
+    );
+    // Where every CUTCOM is posted (the tool along +Z), skipping them is refused: it would
+    // drop them, not answer a refusal. So is skipping a kind posted everywhere (COOLNT).
+    std::fs::write(
+        &cl,
+        side.replace("1.000000,0.000000,0.000000", "0.000000,0.000000,1.000000"),
+    )
+    .unwrap();
+    let (code, _, err) = post_with(&["--ignore", "CUTCOM"]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("--ignore CUTCOM: polepatch posts the 2 CUTCOM record(s) of")
+            && err.contains("only records it refuses in the file can be skipped"),
+        "{err}"
+    );
+    let (code, _, err) = post_with(&["--ignore", "COOLNT"]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("--ignore COOLNT: polepatch posts the 2 COOLNT"),
+        "{err}"
+    );
+    // A form the reader refuses (COOLNT/THRU) is answered by --ignore COOLNT, which its
+    // message names.
+    std::fs::write(&cl, side.replace("COOLNT/FLOOD", "COOLNT/THRU")).unwrap();
+    let (code, _, err) = post_with(&[]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("side.apt:8:8: COOLNT/THRU is not posted") && err.contains("--ignore COOLNT"),
+        "{err}"
+    );
+    let (code, _, err) = post_with(&["--ignore", "COOLNT", "--ignore", "CUTCOM"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("2 COOLNT record(s) skipped (--ignore COOLNT), the first at line 8")
+            && err.contains("no coolant words are written for them")
+            && err.contains(note),
+        "{err}"
+    );
 }
