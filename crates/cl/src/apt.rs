@@ -54,7 +54,8 @@ pub const PASSIVE: &[&str] = &[
     "CSI_SET_EXTENSION_LENGTH",
 ];
 
-/// Records polepatch posts (they cannot be skipped with `--ignore`).
+/// Records polepatch posts: `--ignore` skips them only where one of them is refused in the
+/// file (`polepatch::post::read_cl_for_post`).
 pub const POSTED: &[&str] = &[
     "GOTO", "FROM", "GOHOME", "GODLTA", "RAPID", "FEDRAT", "CIRCLE", "MOVARC", "CYCLE", "LOADTL",
     "LOAD", "SPINDL", "COOLNT", "CUTCOM", "DELAY", "STOP", "OPSTOP", "TLAXIS", "UNITS", "UNIT",
@@ -306,7 +307,8 @@ impl Reader<'_> {
                         format!(
                             "'{other},{word}' is not posted (a motion statement polepatch does not read); give --ignore {other} to skip it"
                         ),
-                    ));
+                    )
+                    .refusing(other));
                 }
             }
         }
@@ -338,7 +340,15 @@ impl Reader<'_> {
             .iter()
             .any(|w| w.eq_ignore_ascii_case(&word))
         {
-            *self.prog.skipped.entry(word).or_default() += 1;
+            let skipped = self
+                .prog
+                .skipped
+                .entry(word)
+                .or_insert_with(|| crate::Skipped {
+                    first: at0,
+                    ..crate::Skipped::default()
+                });
+            skipped.count += 1;
             return Ok(());
         }
         let args = args_from.map_or("", |p| &rec.text[p..]);
@@ -382,7 +392,8 @@ impl Reader<'_> {
                     format!(
                         "{other} records are not posted (their effect on the motion is not read by polepatch); give --ignore {other} to skip them"
                     ),
-                ));
+                )
+                .refusing(other));
             }
         }
         Ok(())
@@ -622,7 +633,8 @@ impl Reader<'_> {
                         format!(
                             "COOLNT/{other} is not posted (ON, FLOOD, MIST, OFF are); give --ignore COOLNT to skip every COOLNT record"
                         ),
-                    ));
+                    )
+                    .refusing("COOLNT"));
                 }
             });
         }
@@ -637,10 +649,11 @@ impl Reader<'_> {
             return Err(e(
                 f.first().map_or(at, |x| x.1),
                 format!(
-                    "DELAY needs one value (seconds); got '{}' (DELAY/REV is not posted)",
+                    "DELAY needs one value (seconds); got '{}' (DELAY/REV is not posted; --ignore DELAY skips every DELAY record)",
                     args.trim()
                 ),
-            ));
+            )
+            .refusing("DELAY"));
         }
         let s = number(f[0].0, f[0].1, "DELAY seconds")?;
         if !(0.0..=1e5).contains(&s) {
@@ -960,8 +973,11 @@ impl Reader<'_> {
                 "YZPLAN" | "ZXPLAN" => {
                     return Err(e(
                         a,
-                        format!("CUTCOM/…,{t}: compensation outside the XY plane is not posted"),
-                    ));
+                        format!(
+                            "CUTCOM/…,{t}: compensation outside the XY plane is not posted (--ignore CUTCOM posts the moves at the CL points without compensation)"
+                        ),
+                    )
+                    .refusing("CUTCOM"));
                 }
                 _ if t.parse::<f64>().is_ok() => {
                     let v = number(t, a, "CUTCOM register")?;
@@ -1397,7 +1413,7 @@ mod tests {
             },
         )
         .unwrap();
-        assert_eq!(q.skipped["INSERT"], 1);
+        assert_eq!(q.skipped["INSERT"].count, 1);
         assert_eq!(q.items.len(), 1);
     }
 
@@ -1418,7 +1434,7 @@ mod tests {
         };
         let p = parse_with(text.as_bytes(), &opts).unwrap();
         assert_eq!(p.point_count(), 2);
-        assert_eq!(p.skipped["THREAD"], 2);
+        assert_eq!(p.skipped["THREAD"].count, 2);
         assert_eq!(p.records["THREAD"], 2);
         for w in [
             "AUXFUN/10",
@@ -1431,16 +1447,35 @@ mod tests {
             assert_eq!(e.line, 2, "{w}");
             let name = w.split(['/', ',']).next().unwrap();
             assert!(e.message.contains(name), "{w}: {e}");
+            // The refusal names the record kind `--ignore` would skip.
+            assert_eq!(e.refused_record.as_deref(), Some(name), "{w}");
         }
-        let e = parse_with(
-            b"GOTO/0,0,0\n",
+        // The reader skips what it is told, posted kinds too (which of those may be
+        // skipped is the post's rule: a record refused in the file).
+        let p = parse_with(
+            b"GOTO/0,0,0\n  COOLNT/FLOOD\nGOTO/1,0,0\nCOOLNT/OFF\n",
             &ParseOptions {
-                ignore: vec!["GOTO".into()],
+                ignore: vec!["coolnt".into()],
                 ..ParseOptions::default()
             },
         )
-        .unwrap_err();
-        assert!(e.message.contains("posts GOTO"), "{e}");
+        .unwrap();
+        assert_eq!(p.point_count(), 2);
+        assert_eq!(p.items.len(), 2);
+        assert_eq!(p.skipped["COOLNT"].count, 2);
+        assert_eq!(p.skipped["COOLNT"].first, crate::At { line: 2, column: 3 });
+        // A bad value is not a refusal of the record: nothing to skip.
+        let e = parse(b"GOTO/0,0,0\nGOTO/1,2,3.5.1\n").unwrap_err();
+        assert_eq!(e.refused_record, None, "{e}");
+        // Forms of posted records polepatch does not post are refusals of them.
+        for (text, name) in [
+            ("COOLNT/THRU\n", "COOLNT"),
+            ("DELAY/REV,2\n", "DELAY"),
+            ("CUTCOM/LEFT,YZPLAN\n", "CUTCOM"),
+        ] {
+            let e = parse(format!("GOTO/0,0,0\n{text}").as_bytes()).unwrap_err();
+            assert_eq!(e.refused_record.as_deref(), Some(name), "{text}: {e}");
+        }
     }
 
     /// The file's first units record is where an inch refusal points.

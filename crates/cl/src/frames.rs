@@ -118,7 +118,8 @@ impl Frames {
             return Err(e(
                 at,
                 "TRNTYP other than WORLD,0,0,0 is not posted (the values after it would not be world coordinates, and in which frame they are is not stated); give --ignore TRNTYP only if the values are in the frame the program is run in",
-            ));
+            )
+            .refusing("TRNTYP"));
         }
         self.world = Some(at);
         Ok(())
@@ -224,12 +225,15 @@ pub(crate) fn refused_frame_record(word: &str, at: At) -> Option<ClError> {
         "TRANS" | "ORIGIN" => "it moves the program zero of the values after it",
         _ => return None,
     };
-    Some(e(
-        at,
-        format!(
-            "{word} records are not posted: {why}; refused rather than post a moved part (give --ignore {word} only if the values are already in the frame the program is run in)"
-        ),
-    ))
+    Some(
+        e(
+            at,
+            format!(
+                "{word} records are not posted: {why}; refused rather than post a moved part (give --ignore {word} only if the values are already in the frame the program is run in)"
+            ),
+        )
+        .refusing(word),
+    )
 }
 
 #[cfg(test)]
@@ -391,7 +395,7 @@ mod tests {
             ..Default::default()
         };
         let p = parse_with(b"TRACUT/NOMORE\nGOTO/0,0,0\n", &opts).unwrap();
-        assert_eq!(p.skipped["TRACUT"], 1);
+        assert_eq!(p.skipped["TRACUT"].count, 1);
         assert!(matches!(p.items[0], ClItem::Move(_)));
     }
 }

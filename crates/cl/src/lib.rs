@@ -29,7 +29,9 @@ pub mod write;
 
 pub use arcs::{Arc, Plane};
 pub use cycles::{Cycle, CycleKind};
-pub use records::{ClItem, ClPoint, ClProgram, CompSide, Coolant, MoveKind, SpindleDir, Units};
+pub use records::{
+    ClItem, ClPoint, ClProgram, CompSide, Coolant, MoveKind, Skipped, SpindleDir, Units,
+};
 pub use write::{to_apt, to_csv};
 
 /// A tool axis may differ from unit length by this much (CAM files round to 4–7
@@ -69,6 +71,22 @@ pub struct ClError {
     pub column: usize,
     /// What is wrong, naming the value.
     pub message: String,
+    /// The major word of the record this error refuses (`CUTCOM`, `THREAD`), where the
+    /// refusal is of a record whose skipping (`--ignore WORD`, [`ParseOptions::ignore`])
+    /// leaves every other record meaning what it says: records polepatch does not post,
+    /// frame records, and forms of `COOLNT`, `DELAY` and `CUTCOM` it does not post (the
+    /// moves are then posted at the CL points without the controller's compensation).
+    /// `None` for bad values and for refusals no skipping can answer (a tool axis out of
+    /// range, a tilted hole, a move polepatch cannot read).
+    pub refused_record: Option<String>,
+}
+
+impl ClError {
+    /// This error, as the refusal of the record `word` ([`ClError::refused_record`]).
+    pub fn refusing(mut self, word: &str) -> Self {
+        self.refused_record = Some(word.to_ascii_uppercase());
+        self
+    }
 }
 
 pub(crate) fn err(line: usize, column: usize, message: impl Into<String>) -> ClError {
@@ -76,6 +94,7 @@ pub(crate) fn err(line: usize, column: usize, message: impl Into<String>) -> ClE
         line,
         column,
         message: message.into(),
+        refused_record: None,
     }
 }
 
@@ -83,8 +102,9 @@ pub(crate) fn err(line: usize, column: usize, message: impl Into<String>) -> ClE
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ParseOptions {
     /// APT records to skip, by major word (`THREAD`, `INSERT`, …), case-insensitive: each
-    /// is counted in [`ClProgram::skipped`] instead of stopping the read. Records polepatch
-    /// posts ([`apt::POSTED`]) cannot be skipped ([`ParseOptions::check`]). Default none.
+    /// is counted in [`ClProgram::skipped`] instead of being read. The reader skips what it
+    /// is told; which records may be skipped is the post's rule (a record refused in the
+    /// file: `polepatch::post::read_cl_for_post`). Default none.
     pub ignore: Vec<String>,
     /// Peck cycles whose first peck differs from the following ones (CAMWorks'
     /// `1STPECK,p1,SUBPECK,p2`) are drilled with the smaller peck throughout instead of
@@ -93,18 +113,10 @@ pub struct ParseOptions {
 }
 
 impl ParseOptions {
-    /// An error naming the first record of `ignore` that polepatch posts.
+    /// An error for an empty record name in `ignore`.
     pub fn check(&self) -> Result<(), String> {
-        for w in &self.ignore {
-            let u = w.trim().to_ascii_uppercase();
-            if apt::POSTED.contains(&u.as_str()) {
-                return Err(format!(
-                    "--ignore {w}: polepatch posts {u} records; only records it would refuse can be skipped"
-                ));
-            }
-            if u.is_empty() {
-                return Err("--ignore needs a record name".into());
-            }
+        if self.ignore.iter().any(|w| w.trim().is_empty()) {
+            return Err("--ignore needs a record name".into());
         }
         Ok(())
     }

@@ -192,8 +192,21 @@ pub struct ClProgram {
     /// How many records of each kind the file has (APT major word → count), every record
     /// counted, whatever became of it.
     pub records: BTreeMap<String, usize>,
-    /// Records skipped on request (`ParseOptions::ignore`), with their counts.
-    pub skipped: BTreeMap<String, usize>,
+    /// Records skipped on request (`ParseOptions::ignore`), by major word.
+    pub skipped: BTreeMap<String, Skipped>,
+}
+
+/// The records of one kind skipped on request.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Skipped {
+    /// How many.
+    pub count: usize,
+    /// Where the first one is.
+    pub first: At,
+    /// Why they may be skipped, where they are records polepatch posts: the refusal of one
+    /// of them in this file (`line L, col C: message`), filled in by the post's rule.
+    /// `None` for records polepatch never posts.
+    pub refused: Option<String>,
 }
 
 impl ClProgram {

@@ -54,18 +54,9 @@ pub(crate) struct FilterArgs {
     /// Also write the per-zone report as JSON to this file (replaced on every open).
     #[arg(long)]
     report: Option<PathBuf>,
-    /// The cutter (as `patch`): ball:D, flat:D or bull:D,R.
-    #[arg(long, value_parser = polepatch::tool::Tool::parse, value_name = "KIND:D[,R]")]
-    tool: Option<polepatch::tool::Tool>,
-    /// A tool table (as `patch`).
-    #[arg(long, value_name = "FILE")]
-    tools: Option<PathBuf>,
-    /// Which point of the tool X Y Z are (as `patch`): tip or centre.
-    #[arg(long, value_parser = polepatch::tool::ToolPoint::parse, value_name = "tip|centre")]
-    tool_point: Option<polepatch::tool::ToolPoint>,
-    /// How far a flat or bull-nose cutter's surface may move, mm (as `patch`).
-    #[arg(long, value_name = "MM", default_value_t = polepatch::tool::SURFACE_TOLERANCE_MM)]
-    surface_tolerance: f64,
+    /// The cutter and the point X Y Z state (as `patch`).
+    #[command(flatten)]
+    tool: crate::ToolArgs,
 }
 
 impl FilterArgs {
@@ -94,10 +85,7 @@ impl FilterArgs {
             simulate: false,
             work_offset: self.work_offset,
             chord_tolerance: polepatch::machine_frame::CHORD_TOLERANCE_MM,
-            tool: self.tool,
-            tools: self.tools.clone(),
-            tool_point: self.tool_point,
-            surface_tolerance: self.surface_tolerance,
+            tool: self.tool.clone(),
         }
     }
 }
@@ -108,9 +96,7 @@ pub(crate) fn run(args: FilterArgs) -> Result<ExitCode> {
     let machine = machine(&args.machine)?;
     let mut inputs = vec![polepatch_cli::outputs::Input::new("the input", &args.file)];
     inputs.extend(crate::machine_input(&args.machine));
-    if let Some(t) = &args.tools {
-        inputs.push(polepatch_cli::outputs::Input::new("the tool table", t));
-    }
+    inputs.extend(args.tool.inputs());
     let report_target = match &args.report {
         Some(p) => Some(
             polepatch_cli::outputs::plan(

@@ -152,10 +152,25 @@ pub(crate) struct PatchArgs {
     /// original block — keeps its values.
     #[arg(long, value_name = "MM", default_value_t = polepatch::machine_frame::CHORD_TOLERANCE_MM)]
     pub(crate) chord_tolerance: f64,
+    /// The cutter and the point X Y Z state.
+    #[command(flatten)]
+    pub(crate) tool: ToolArgs,
+    /// Units of a program that states none (no G20/G21, G70/G71, BEGIN PGM … MM|INCH):
+    /// nothing in the file tells inches from mm, so say it (default mm; the report says
+    /// which was assumed).
+    #[arg(long, value_enum)]
+    pub(crate) units: Option<UnitsArg>,
+}
+
+/// The cutter and the point of it X Y Z state: one group of flags, declared once, which
+/// `patch`, `post` and `filter` flatten into their arguments.
+#[derive(clap::Args, Clone)]
+pub(crate) struct ToolArgs {
     /// The cutter for the whole program: ball:D, flat:D or bull:D,R (diameter and corner
     /// radius, mm). Default: per run, from --tools or the program (TOOL DEF, CAM tool
-    /// comments); a ball programmed at its tip keeps its centre (X Y Z rewritten), a flat or
-    /// bull-nose cutter's orientation change is capped by --surface-tolerance.
+    /// comments; a CL file's CUTTER/ or TLDATA/); a ball programmed at its tip keeps its
+    /// centre (X Y Z rewritten), a flat or bull-nose cutter's orientation change is capped
+    /// by --surface-tolerance.
     #[arg(long, value_parser = polepatch::tool::Tool::parse, value_name = "KIND:D[,R]")]
     pub(crate) tool: Option<polepatch::tool::Tool>,
     /// A tool table (TOML: [tool.5] kind = "ball", diameter_mm = 10, corner_radius_mm = …),
@@ -164,18 +179,48 @@ pub(crate) struct PatchArgs {
     pub(crate) tools: Option<PathBuf>,
     /// Which point of the tool the program's X Y Z are: tip or centre (of a ball).
     /// Default: the machine file's [controller] tool_point, else the TCPM code's (M128 and
-    /// FUNCTION TCPM … REFPNT CENTER-CENTER: centre; the others: tip).
+    /// FUNCTION TCPM … REFPNT CENTER-CENTER: centre; the others: tip); for `post`, the tip
+    /// (a CL file states the tool tip).
     #[arg(long, value_parser = polepatch::tool::ToolPoint::parse, value_name = "tip|centre")]
     pub(crate) tool_point: Option<polepatch::tool::ToolPoint>,
     /// How far a flat or bull-nose cutter's surface may move at a CL point when the patch
     /// turns it about its tip, mm.
     #[arg(long, value_name = "MM", default_value_t = polepatch::tool::SURFACE_TOLERANCE_MM)]
     pub(crate) surface_tolerance: f64,
-    /// Units of a program that states none (no G20/G21, G70/G71, BEGIN PGM … MM|INCH):
-    /// nothing in the file tells inches from mm, so say it (default mm; the report says
-    /// which was assumed).
-    #[arg(long, value_enum)]
-    pub(crate) units: Option<UnitsArg>,
+}
+
+impl ToolArgs {
+    /// The library's tool options: the tool table read from its file, the surface
+    /// tolerance checked (a bad value is a usage error).
+    pub(crate) fn options(&self) -> Result<polepatch::tool::ToolOptions> {
+        check_positive("--surface-tolerance", Some(self.surface_tolerance))?;
+        let table = match &self.tools {
+            Some(path) => {
+                let bytes = files::read(path)?;
+                let text = String::from_utf8(bytes).map_err(|_| {
+                    anyhow::anyhow!("tool table {}: not UTF-8 text", path.display())
+                })?;
+                polepatch::tool::ToolTable::from_toml_str(&text, &path.display().to_string())
+                    .map_err(|e| anyhow::anyhow!("{e}"))?
+            }
+            None => polepatch::tool::ToolTable::default(),
+        };
+        Ok(polepatch::tool::ToolOptions {
+            tool: self.tool,
+            table,
+            point: self.tool_point,
+            surface_tolerance_mm: self.surface_tolerance,
+        })
+    }
+
+    /// The file these flags make the command read (the tool table), for the output-path
+    /// checks.
+    pub(crate) fn inputs(&self) -> Vec<polepatch_cli::outputs::Input> {
+        self.tools
+            .iter()
+            .map(|t| polepatch_cli::outputs::Input::new("the tool table", t))
+            .collect()
+    }
 }
 
 #[derive(clap::Args)]

@@ -100,31 +100,35 @@ fn expand(inputs: &[PathBuf], skip: Option<&Path>) -> Result<Vec<(PathBuf, PathB
 /// The library's options for `args` (checked: a bad value is a usage error).
 pub(crate) fn file_options(args: &PatchArgs) -> Result<polepatch::PatchOptions> {
     check_positive("--chord-tolerance", Some(args.chord_tolerance))?;
-    check_positive("--surface-tolerance", Some(args.surface_tolerance))?;
-    let table = match &args.tools {
-        Some(path) => {
-            let bytes = crate::files::read(path)?;
-            let text = String::from_utf8(bytes)
-                .map_err(|_| anyhow::anyhow!("tool table {}: not UTF-8 text", path.display()))?;
-            polepatch::tool::ToolTable::from_toml_str(&text, &path.display().to_string())
-                .map_err(|e| anyhow::anyhow!("{e}"))?
-        }
-        None => polepatch::tool::ToolTable::default(),
-    };
     Ok(polepatch::PatchOptions {
         patch: options(args)?,
         feed_fallback_mm_min: args.feed,
         work_offset_mm: args.work_offset,
         chord_tolerance_mm: args.chord_tolerance,
-        tool: polepatch::tool::ToolOptions {
-            tool: args.tool,
-            table,
-            point: args.tool_point,
-            surface_tolerance_mm: args.surface_tolerance,
-        },
+        tool: args.tool.options()?,
         inch: args.units == Some(crate::UnitsArg::Inch),
         ..polepatch::PatchOptions::default()
     })
+}
+
+/// A report's warnings, the runs it left and the lines it did not analyse, on standard error
+/// (`patch` and `post`).
+pub(crate) fn print_warnings(rep: &FileReport) {
+    for w in &rep.warnings {
+        eprintln!("polepatch: warning: {w}");
+    }
+    for u in &rep.untouched_runs {
+        eprintln!(
+            "polepatch: warning: {}: run {}, lines {}–{}: {}",
+            rep.file, u.run, u.lines[0], u.lines[1], u.message
+        );
+    }
+    for n in &rep.not_analysed {
+        eprintln!(
+            "polepatch: warning: {}: not analysed: {}",
+            rep.file, n.message
+        );
+    }
 }
 
 pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
@@ -158,9 +162,7 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
         .map(|(input, _)| Input::new("the input", input))
         .collect();
     inputs.extend(crate::machine_input(&args.machine));
-    if let Some(t) = &args.tools {
-        inputs.push(Input::new("the tool table", t));
-    }
+    inputs.extend(args.tool.inputs());
     let mut planned: Vec<Output> = Vec::new();
     for (input, rel) in &files {
         planned.push(match (&args.output, &args.out_dir) {
@@ -243,21 +245,7 @@ pub(crate) fn run(args: PatchArgs) -> Result<ExitCode> {
             .context("printing the summary")?;
     }
     for rep in &ok {
-        for w in &rep.warnings {
-            eprintln!("polepatch: warning: {w}");
-        }
-        for u in &rep.untouched_runs {
-            eprintln!(
-                "polepatch: warning: {}: run {}, lines {}–{}: {}",
-                rep.file, u.run, u.lines[0], u.lines[1], u.message
-            );
-        }
-        for n in &rep.not_analysed {
-            eprintln!(
-                "polepatch: warning: {}: not analysed: {}",
-                rep.file, n.message
-            );
-        }
+        print_warnings(rep);
     }
     if let Some(target) = report_target {
         let doc = if ok.len() == 1 && args.output.is_some() {

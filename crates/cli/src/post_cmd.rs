@@ -5,7 +5,7 @@ use anyhow::{Context, Result, bail};
 use polepatch::cl::{ParseOptions, Units};
 use polepatch::kinematics::BranchRule;
 use polepatch::nc::Dialect;
-use polepatch::post::{ARC_TOLERANCE_MM, PostOptions, post_cl, read_cl_with};
+use polepatch::post::{ARC_TOLERANCE_MM, PostOptions, post_cl, read_cl_for_post};
 use polepatch_cli::files::read;
 use polepatch_cli::outputs::{Input, Output, plan};
 use std::path::PathBuf;
@@ -76,6 +76,10 @@ pub(crate) struct PostArgs {
     /// 1STPECK/SUBPECK) with the smaller peck throughout (default: refused).
     #[arg(long)]
     uniform_peck: bool,
+    /// The cutter and the point X Y Z state (as `patch`; default: the CL file's CUTTER/ or
+    /// TLDATA/, at the tip).
+    #[command(flatten)]
+    tool: crate::ToolArgs,
 }
 
 pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
@@ -90,6 +94,7 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
     let name = args.cl.display().to_string();
     let mut inputs = vec![Input::new("the CL input", &args.cl)];
     inputs.extend(crate::machine_input(&args.machine));
+    inputs.extend(args.tool.inputs());
     let mut outputs = vec![Output::new("-o", &args.output)];
     if let Some(path) = &args.report {
         outputs.push(Output::new("--report", path));
@@ -102,8 +107,6 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
     if let Err(m) = parse.check() {
         bail!("{m}");
     }
-    let cl_bytes = read(&args.cl)?;
-    let cl = read_cl_with(&cl_bytes, &name, &parse)?;
     let mut opts = PostOptions {
         dialect: match args.dialect {
             DialectArg::Heidenhain => Dialect::Heidenhain,
@@ -120,6 +123,7 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
         patch_options: polepatch::PatchOptions {
             name: name.clone(),
             feed_fallback_mm_min: args.feed,
+            tool: args.tool.options()?,
             ..polepatch::PatchOptions::default()
         },
         rotary_decimals: args.rotary_decimals,
@@ -131,13 +135,26 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
         linearize: args.linearize,
         arc_tolerance_mm: args.arc_tolerance,
     };
+    let cl_bytes = read(&args.cl)?;
+    // `--ignore`'s one rule: a record refused in this file may be skipped.
+    let cl = read_cl_for_post(&cl_bytes, &name, &parse, &machine, &opts)?;
     polepatch::post::tool_from_cl(&cl_bytes, &cl, &mut opts);
     let (bytes, report) = post_cl(&cl, &machine, &opts)?;
     targets[0]
         .write(&bytes, None)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
     for n in &cl.notes {
+        // (A report's warnings name each INSERT with the program line it was written at.)
+        if report.is_some() && n.contains(": INSERT/") {
+            continue;
+        }
         eprintln!("polepatch: note: {name}: {n}");
+    }
+    // Skipped records (the report's warnings say it too).
+    if report.is_none() {
+        for n in polepatch::post::skip_notes(&cl, &name) {
+            eprintln!("polepatch: note: {n}");
+        }
     }
     // Every record kind read, once, with its count (and what was skipped on request).
     if !cl.records.is_empty() {
@@ -166,6 +183,7 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
                 r.zones.len(),
                 r.words_changed
             );
+            crate::patch::print_warnings(r);
             if let Some(target) = targets.get(1) {
                 target
                     .write(serde_json::to_string_pretty(r)?.as_bytes(), None)

@@ -27,6 +27,9 @@ pub(crate) struct Interpreter {
     pub(crate) stated_datum: Option<[f64; 3]>,
     /// The last block changed the frame without stating it, taken by the caller.
     pub(crate) frame_changed: bool,
+    /// Where the last block holds a word that looks like a TCPM code, taken by the caller
+    /// ([`crate::tcpm::lookalike`]).
+    pub(crate) lookalike: Option<Range<usize>>,
     /// Fanuc macro variables whose value is a constant here ([`Interpreter::constants`]).
     consts: std::collections::HashMap<u32, f64>,
 }
@@ -209,6 +212,7 @@ impl Interpreter {
             recorder: (opts.flow.is_none() && !always).then(crate::flow::Recorder::default),
             stated_datum: None,
             frame_changed: false,
+            lookalike: None,
             consts: std::collections::HashMap::new(),
         }
     }
@@ -309,7 +313,8 @@ impl Interpreter {
         }
     }
 
-    fn ident(&self, name: &[u8], s: &mut Scan) {
+    /// An identifier (`name`, its bytes at `at`).
+    fn ident(&self, name: &[u8], at: Range<usize>, s: &mut Scan) {
         if let Some(sw) = self.controller.ident(self.dialect, name) {
             s.tcpm = Some(sw);
             return;
@@ -330,6 +335,10 @@ impl Interpreter {
             s.breaks = true;
             // Sinumerik: a label, or a subprogram called by its name; Fanuc: `END 1`.
             s.maybe_flow |= self.dialect == Dialect::Sinumerik || is(b"END");
+            // A word the reader does not know that looks like a TCPM code: warned about.
+            if s.lookalike.is_none() && crate::tcpm::lookalike(name, &self.controller).is_some() {
+                s.lookalike = Some(at);
+            }
         }
     }
 
@@ -362,8 +371,21 @@ impl Interpreter {
     }
 
     /// [`Interpreter::lex`] into `s`, which is `Scan::default()` (a reader that keeps the
-    /// lines of a window fills them in place: a `Scan` is a few hundred bytes).
+    /// lines of a window fills them in place: a `Scan` is a few hundred bytes). An error
+    /// after a lone CR in the line names the CR ([`crate::lines::explain_lone_cr`]).
     pub(crate) fn lex_into(
+        &self,
+        bytes: &[u8],
+        span: Range<usize>,
+        line: usize,
+        words: &mut Vec<Word>,
+        s: &mut Scan,
+    ) -> Result<(), ParseError> {
+        self.lex_line(bytes, span.clone(), line, words, s)
+            .map_err(|e| crate::lines::explain_lone_cr(bytes, &span, e))
+    }
+
+    fn lex_line(
         &self,
         bytes: &[u8],
         span: Range<usize>,
@@ -495,7 +517,7 @@ impl Interpreter {
                             sinumerik_frame = Some(name.clone());
                         }
                     }
-                    self.ident(n, s)
+                    self.ident(n, name, s)
                 }
                 Token::Assign {
                     letter,
@@ -780,6 +802,7 @@ impl Interpreter {
         }
         m.inverse_time_per_min = None;
         let scale = if m.inch { 25.4 } else { 1.0 };
+        self.lookalike = s.lookalike.take();
         if s.stated_datum {
             let v = |i: usize| s.axes[i].unwrap_or(0.0) * scale;
             self.stated_datum = Some([v(X), v(Y), v(Z)]);

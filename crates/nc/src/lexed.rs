@@ -79,6 +79,9 @@ pub(crate) struct Scan {
     pub(crate) transform_on: u8,
     /// … and off.
     pub(crate) transform_off: u8,
+    /// The first identifier the reader does not know that looks like a TCPM code (its
+    /// bytes; [`crate::tcpm::lookalike`]).
+    pub(crate) lookalike: Option<std::ops::Range<usize>>,
 }
 
 /// What M code `code` (× 10) says in `dialect` on a machine with `controller`'s codes (ISO and

@@ -62,7 +62,9 @@ pub use lines::LineEnds;
 pub use modal::{FeedMode, Modal, Motion, RotaryLetters, Tcpm};
 pub use plan::{FormConflict, restore_modal, write_direction_forms};
 pub use program::Program;
-pub use reader::{Scanned, Settled, scan, scan_blocks, scan_blocks_with, style_evidence_to};
+pub use reader::{
+    Lookalike, Scanned, Settled, scan, scan_blocks, scan_blocks_with, style_evidence_to,
+};
 pub use run::{Run, RunBreak, RunBuilder, primary_in_use, primary_of, runs};
 pub use style::{FileStyle, NumberStyle, StyleEvidence};
 pub use tcpm::{Code, ControllerCodes, ReadOptions};

@@ -3,8 +3,19 @@
 //! A file ends its lines with `\n` (a `\r` before it belongs to the line ending: CR LF),
 //! or — when it holds no `\n` at all but does hold a `\r` — with `\r` alone (the classic
 //! Mac convention some old controllers and editors still write). In a file with `\n`
-//! endings a lone `\r` inside a line is a blank, as controllers read it. A final line
-//! without an ending is a line; a final empty segment after the last ending is not.
+//! endings a lone `\r` inside a line is a blank, as controllers read it; an error in such a
+//! line after the `\r` says where it is ([`explain_lone_cr`]): most editors show the line
+//! as two. A final line without an ending is a line; a final empty segment after the last
+//! ending is not.
+//!
+//! A UTF-8 byte-order mark ([`BOM`]) at the start of the file, as some Windows editors
+//! write it, belongs to no line: the first line starts after it, so every reader of lines
+//! (the dialect's detection, the lexer, conversational lines) sees the program's first
+//! line as the controller does, and its columns as an editor shows them. The mark is
+//! copied to the output like every byte outside the words polepatch changes.
+
+/// The UTF-8 byte-order mark.
+pub const BOM: &[u8] = b"\xEF\xBB\xBF";
 
 use std::ops::Range;
 
@@ -49,14 +60,19 @@ impl LineEnds {
     }
 
     /// The lines of `bytes` from byte `start` (a line start), numbered from 1 there: each
-    /// line's span without its ending, and its number.
+    /// line's span without its ending, and its number. From the start of the file, the
+    /// first line starts after a byte-order mark (module docs).
     pub(crate) fn lines_from(
         self,
         bytes: &[u8],
         start: usize,
     ) -> impl Iterator<Item = (Range<usize>, usize)> + '_ {
         let n = bytes.len();
-        let mut start = start;
+        let mut start = if start == 0 && bytes.starts_with(BOM) {
+            BOM.len()
+        } else {
+            start
+        };
         let mut line = 0;
         std::iter::from_fn(move || {
             if start >= n {
@@ -79,6 +95,30 @@ impl LineEnds {
             Some((span, line))
         })
     }
+}
+
+/// `e`, an error in the line `span` of `bytes`, with what a lone carriage return before its
+/// column does to that line (module docs): an LF-terminated controller reads one block
+/// there, where most editors show two lines, so a message about "this block" needs the CR
+/// named and placed. Unchanged when no CR stands before the error's column.
+pub(crate) fn explain_lone_cr(
+    bytes: &[u8],
+    span: &Range<usize>,
+    mut e: crate::ParseError,
+) -> crate::ParseError {
+    let line = &bytes[span.clone()];
+    let before = &line[..e.column.saturating_sub(1).min(line.len())];
+    if let Some(cr) = before.iter().position(|&b| b == b'\r') {
+        e.message.push_str(&format!(
+            " — line {} holds a carriage return (CR) at col {} that does not end it: the file \
+             ends its lines with LF, so an LF-terminated controller reads all of line {} as one \
+             block, where most editors show it as two lines",
+            e.line,
+            cr + 1,
+            e.line
+        ));
+    }
+    e
 }
 
 /// Offset of the first `needle` at or after `from`, eight bytes at a time.
@@ -141,5 +181,46 @@ mod tests {
         );
         // With LF endings a lone CR stays inside its line (a blank to the lexer).
         assert_eq!(lines(b"G1 X1\rY2\nZ3\n"), vec![(0..8, 1), (9..11, 2)]);
+    }
+
+    /// Issue 42 item 5: a byte-order mark belongs to no line; a file that only starts with
+    /// its first bytes, or holds them later, is read as it is.
+    #[test]
+    fn a_byte_order_mark_is_before_the_first_line() {
+        assert_eq!(
+            lines(b"\xEF\xBB\xBF%T G71 *\nN10 G90 *\n"),
+            vec![(3..11, 1), (12..21, 2)]
+        );
+        assert_eq!(lines(b"\xEF\xBB\xBF"), vec![]);
+        assert_eq!(lines(b"\xEF\xBB\xBF\rX1\r"), vec![(3..3, 1), (4..6, 2)]);
+        // Not a mark: a part of one, or one after the start.
+        assert_eq!(lines(b"\xEF\xBBX1\n"), vec![(0..4, 1)]);
+        assert_eq!(lines(b"X1\n\xEF\xBB\xBFX2\n"), vec![(0..2, 1), (3..8, 2)]);
+        // A read from a later line start is not the file's start.
+        let text = b"X1\n\xEF\xBB\xBFX2\n";
+        let from: Vec<_> = LineEnds::Lf.lines_from(text, 3).collect();
+        assert_eq!(from, vec![(3..8, 1)]);
+    }
+
+    /// Issue 42 item 1: an error after a lone CR says where the CR is and why the line is
+    /// one block; one before it, or in a line without one, is left as it is.
+    #[test]
+    fn a_lone_cr_before_an_error_is_named() {
+        let text = b"N80 G1 X1\nN84 X55.455\rN85X56 Y2\n";
+        let span = 10..31;
+        let e = crate::ParseError::at(2, 16, "X appears twice in this block");
+        let e = explain_lone_cr(text, &span, e);
+        assert!(
+            e.message.starts_with(
+                "X appears twice in this block — line 2 holds a carriage \
+                                   return (CR) at col 12"
+            ) && e.message.contains("editors show it as two lines"),
+            "{}",
+            e.message
+        );
+        let before = crate::ParseError::at(2, 5, "X value 'y' is not a number");
+        assert_eq!(explain_lone_cr(text, &span, before.clone()), before);
+        let plain = crate::ParseError::at(1, 8, "m");
+        assert_eq!(explain_lone_cr(text, &(0..9), plain.clone()), plain);
     }
 }

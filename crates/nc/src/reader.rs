@@ -77,6 +77,21 @@ pub struct Scanned<'a> {
     pub frame_changed: bool,
     /// The file's line ending.
     pub line_ends: LineEnds,
+    /// A word of the block that looks like a TCPM code without being one
+    /// ([`crate::tcpm::lookalike`]), for a warning.
+    pub lookalike: Option<&'a Lookalike>,
+}
+
+/// An identifier the reader does not know that looks like a TCPM code: a post's typo
+/// (`TRAOOF` for `TRAFOOF`) leaves TCPM as it was where the program meant to switch it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Lookalike {
+    /// 1-based byte column in its line.
+    pub column: usize,
+    /// The word as written.
+    pub word: String,
+    /// The code it looks like.
+    pub code: String,
 }
 
 /// [`scan`], with what the block does to the coordinate frame.
@@ -185,12 +200,21 @@ fn read(
 ) -> Result<bool, ParseError> {
     let ends = LineEnds::of(bytes);
     let mut give = |interp: &mut Interpreter, block: &Block, words: &[Word]| {
+        let lookalike = interp.lookalike.take().and_then(|at| {
+            let word = &bytes[at.clone()];
+            Some(Lookalike {
+                column: at.start - block.span().start + 1,
+                word: String::from_utf8_lossy(word).into_owned(),
+                code: crate::tcpm::lookalike(word, &interp.controller)?,
+            })
+        });
         visit(Scanned {
             block,
             words,
             state: &interp.modal,
             stated_datum: interp.stated_datum.take(),
             frame_changed: std::mem::take(&mut interp.frame_changed),
+            lookalike: lookalike.as_ref(),
             line_ends: ends,
         })
     };

@@ -212,6 +212,68 @@ impl ControllerCodes {
     }
 }
 
+/// The TCPM codes that are identifiers, of every dialect (module docs' table), and `TCPM`
+/// itself (Heidenhain's `FUNCTION TCPM`, and what posts call it in comments and macros).
+pub const TCPM_IDENTIFIERS: &[&str] = &[
+    "TRAORI", "TRAFOOF", "TRANSMIT", "TRACYL", "TRAANG", "TRACON", "TCPM",
+];
+
+/// The TCPM code identifier `name` looks like without being it — a post's typo such as
+/// `TRAOOF` for `TRAFOOF` —, if any: an identifier the reader does not know, of four or more
+/// characters, with the code's first letter, within an edit distance (insertions,
+/// deletions, substitutions, swaps of neighbours) of 1 of a code of up to six characters
+/// and of 2 of a longer one (`TRAFOOF`, `TRANSMIT`). The codes are [`TCPM_IDENTIFIERS`] and the machine's own
+/// identifiers; the nearest is named. The reader does not read such a word as a switch (a controller would reject
+/// it, or run something else); the report warns with its line and column, since a program
+/// that was meant to switch TCPM there is read with the state it had.
+pub fn lookalike(name: &[u8], controller: &ControllerCodes) -> Option<String> {
+    if name.len() < 4 {
+        return None;
+    }
+    let upper = name.to_ascii_uppercase();
+    let own = controller
+        .on
+        .iter()
+        .chain(&controller.off)
+        .filter_map(|c| match c {
+            Code::Ident(s) => Some(s.as_str()),
+            _ => None,
+        });
+    TCPM_IDENTIFIERS
+        .iter()
+        .copied()
+        .chain(own)
+        .filter(|code| code.as_bytes()[0] == upper[0])
+        .map(|code| (edit_distance(&upper, code.as_bytes()), code))
+        .filter(|&(d, code)| d >= 1 && d <= if code.len() <= 6 { 1 } else { 2 })
+        .min_by_key(|&(d, _)| d)
+        .map(|(_, code)| code.to_string())
+}
+
+/// The edit distance of `a` and `b` with swaps of neighbouring characters (optimal string
+/// alignment): the fewest insertions, deletions, substitutions and swaps from one to the
+/// other.
+fn edit_distance(a: &[u8], b: &[u8]) -> usize {
+    let (n, m) = (a.len(), b.len());
+    // Rows i − 2, i − 1 and i of the table.
+    let mut rows = [vec![0; m + 1], (0..=m).collect::<Vec<_>>(), vec![0; m + 1]];
+    for i in 1..=n {
+        rows[2][0] = i;
+        for j in 1..=m {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            let mut d = (rows[1][j] + 1)
+                .min(rows[2][j - 1] + 1)
+                .min(rows[1][j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                d = d.min(rows[0][j - 2] + 1);
+            }
+            rows[2][j] = d;
+        }
+        rows.rotate_left(1);
+    }
+    rows[1][m]
+}
+
 /// The state before a program's first block on a machine with `controller`'s codes (TCPM
 /// on from the start where the kinematics are always TCP).
 pub fn initial(controller: &ControllerCodes) -> Modal {
@@ -278,6 +340,57 @@ mod tests {
         for t in ["M428", "G43.4", "G234", "TRAORI"] {
             assert_eq!(Code::parse(t).unwrap().to_string(), t);
         }
+    }
+
+    #[test]
+    fn edit_distances() {
+        assert_eq!(edit_distance(b"TRAOOF", b"TRAFOOF"), 1);
+        assert_eq!(edit_distance(b"TRAFOOF", b"TRAFOOF"), 0);
+        assert_eq!(edit_distance(b"TARORI", b"TRAORI"), 1, "a swap");
+        assert_eq!(edit_distance(b"TRAOR", b"TRAORI"), 1);
+        assert_eq!(edit_distance(b"TRAFO", b"TRAFOOF"), 2);
+        assert_eq!(edit_distance(b"", b"TCPM"), 4);
+        assert_eq!(edit_distance(b"CYCLE800", b"TRAORI"), 8);
+    }
+
+    /// Issue 42 item 5: a word that looks like a TCPM code is found; the codes themselves,
+    /// short words and the identifiers real programs write are not.
+    #[test]
+    fn tcpm_lookalikes() {
+        let c = ControllerCodes::default();
+        for (typo, code) in [
+            ("TRAOOF", "TRAFOOF"),
+            ("traoof", "TRAFOOF"),
+            ("TRAFOF", "TRAFOOF"),
+            ("TRAFFOOF", "TRAFOOF"),
+            ("TARORI", "TRAORI"),
+            ("TRAOR", "TRAORI"),
+            ("TRAORII", "TRAORI"),
+            ("TCMP", "TCPM"),
+            ("TRACYLL", "TRACYL"),
+        ] {
+            assert_eq!(
+                lookalike(typo.as_bytes(), &c).as_deref(),
+                Some(code),
+                "{typo}"
+            );
+        }
+        for fine in [
+            "TRAORI", "TRAFOOF", "Traori", "TRACON", "TCPM", "TRA", "MSG", "SOFT", "FFWON",
+            "ORIWKS", "ORIAXES", "CYCLE800", "CYCLE832", "SUPA", "TRANS", "ATRANS", "CTRANS",
+            "TOFRAME", "TOROT", "GOTOF", "ENDIF", "DIAMOF", "COMPCAD", "BRISK", "G64", "TEMP",
+            "TOOL", "TCP", "STOPRE", "WHEN",
+        ] {
+            assert_eq!(lookalike(fine.as_bytes(), &c), None, "{fine}");
+        }
+        // The machine's own identifiers count too.
+        let own = ControllerCodes {
+            on: vec![Code::parse("RTCPON").unwrap()],
+            off: vec![Code::parse("RTCPOFF").unwrap()],
+            always: false,
+        };
+        assert_eq!(lookalike(b"RTCP_OFF", &own).as_deref(), Some("RTCPOFF"));
+        assert_eq!(lookalike(b"RTCP_OFF", &c), None);
     }
 
     #[test]

@@ -12,7 +12,8 @@
 //! - conversational lines polepatch does not model;
 //! - moves with a feed per revolution (G95), which has no time base;
 //! - and, as warnings: letters carried through without analysis (`E`, `U`, `V`, `W`),
-//!   `(` comments without `)` that hide what looks like axis words, and the length units
+//!   `(` comments without `)` that hide what looks like axis words, words that look like a
+//!   TCPM code without being one (`TRAOOF` for `TRAFOOF`: [`Notes::lookalike`]), and the length units
 //!   assumed when the program states none (nothing in a Haas program without `G20` tells
 //!   its inches from mm: the report says which was read, `--units` says which to read).
 //!
@@ -20,7 +21,7 @@
 //! not all of it was analysed.
 
 use polepatch_nc::modal::{A, B, C};
-use polepatch_nc::{Block, FeedMode, Flags, Modal, Motion, RotaryLetters, Word};
+use polepatch_nc::{Block, FeedMode, Flags, Lookalike, Modal, Motion, RotaryLetters, Word};
 use serde::Serialize;
 
 /// Why a stretch of blocks was not analysed.
@@ -75,6 +76,9 @@ pub struct Notes {
     /// Lines of unclosed comments that hide axis-like words (the first few).
     unclosed: Vec<usize>,
     unclosed_count: usize,
+    /// Words that look like a TCPM code (the first few, with their lines), and how many.
+    lookalikes: Vec<(usize, Lookalike)>,
+    lookalike_count: usize,
     /// The units a program is read in until it states them (`None` before the first
     /// block): inches when true.
     default_inch: Option<bool>,
@@ -161,6 +165,16 @@ impl Notes {
         }
     }
 
+    /// Take a word of the block at `line` that looks like a TCPM code without being one
+    /// ([`polepatch_nc::Scanned::lookalike`]).
+    pub fn lookalike(&mut self, line: usize, word: Option<&Lookalike>) {
+        let Some(w) = word else { return };
+        self.lookalike_count += 1;
+        if self.lookalikes.len() < NAMED_LINES {
+            self.lookalikes.push((line, w.clone()));
+        }
+    }
+
     /// The list for a program read with the rotary letters `letters` and the singular cone
     /// `cone_deg`, and the warnings (named `name`).
     pub fn finish(
@@ -235,6 +249,30 @@ impl Notes {
                 lines.join(", "),
                 if self.unclosed_count > lines.len() {
                     ", …"
+                } else {
+                    ""
+                }
+            ));
+        }
+        if self.lookalike_count > 0 {
+            let words: Vec<String> = self
+                .lookalikes
+                .iter()
+                .map(|(line, w)| {
+                    format!(
+                        "line {line}, col {}: {} looks like the TCPM code {}",
+                        w.column, w.word, w.code
+                    )
+                })
+                .collect();
+            warnings.push(format!(
+                "{name}: {} word(s) that look like a TCPM code are not one ({}{}); polepatch does \
+                 not read them as a TCPM switch, and a controller would reject them or run \
+                 something else — check the program",
+                self.lookalike_count,
+                words.join("; "),
+                if self.lookalike_count > words.len() {
+                    "; …"
                 } else {
                     ""
                 }

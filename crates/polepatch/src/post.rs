@@ -95,6 +95,113 @@ pub fn read_cl(bytes: &[u8], name: &str) -> Result<ClProgram, Error> {
     read_cl_with(bytes, name, &ParseOptions::default())
 }
 
+/// Read a CL file to post it on `machine` with `opts`, skipping the records `parse.ignore`
+/// names by the one rule of `--ignore`: **a record refused in this file may be skipped**.
+///
+/// A kind polepatch never posts (`THREAD`, `TRACUT`, …: every one is refused) or does not
+/// count as posted (`INSERT`) is skipped wherever it is. A kind it posts
+/// ([`polepatch_cl::apt::POSTED`]: `CUTCOM`, `COOLNT`, …) is skipped only where the file
+/// holds one that is refused — the reader's or the post's refusal naming that kind
+/// ([`ClError::refused_record`]: `CUTCOM/LEFT` with the tool along X) — and then every
+/// record of the kind is skipped (the moves are posted at the CL points without
+/// compensation), with the refusal kept in [`polepatch_cl::Skipped::refused`] for
+/// [`skip_notes`]. Asking to skip a posted kind of which every record here is posted is
+/// an error naming it: those records would be dropped, not refused.
+///
+/// Where a posted kind is asked for, the file is read and its items posted (without the
+/// patch) once, plus once per posted kind whose refusal is found; else it is read once.
+pub fn read_cl_for_post(
+    bytes: &[u8],
+    name: &str,
+    parse: &ParseOptions,
+    machine: &Machine,
+    opts: &PostOptions,
+) -> Result<ClProgram, Error> {
+    parse.check().map_err(Error::Options)?;
+    let asked: Vec<String> = parse
+        .ignore
+        .iter()
+        .map(|w| w.trim().to_ascii_uppercase())
+        .collect();
+    let posted = |w: &str| polepatch_cl::apt::POSTED.contains(&w);
+    // The kinds skipped so far, and the refusals that let the posted ones be skipped.
+    let mut skip: Vec<String> = asked.iter().filter(|w| !posted(w)).cloned().collect();
+    if skip.len() == asked.len() {
+        // Nothing to prove: the post reads the file once.
+        let attempt = ParseOptions {
+            ignore: skip,
+            ..parse.clone()
+        };
+        return read_cl_with(bytes, name, &attempt);
+    }
+    let mut refusals: Vec<(String, String)> = Vec::new();
+    loop {
+        let attempt = ParseOptions {
+            ignore: skip.clone(),
+            ..parse.clone()
+        };
+        let read = read_cl_with(bytes, name, &attempt);
+        let result = read.and_then(|cl| post_items(&cl, machine, opts).map(|_| cl));
+        match result {
+            Ok(mut cl) => {
+                if let Some(w) = asked
+                    .iter()
+                    .find(|w| posted(w) && !skip.contains(w) && cl.records.contains_key(*w))
+                {
+                    return Err(Error::Options(format!(
+                        "--ignore {w}: polepatch posts the {} {w} record(s) of {name}; only records it refuses in the file can be skipped",
+                        cl.records[w]
+                    )));
+                }
+                for (w, why) in refusals {
+                    if let Some(s) = cl.skipped.get_mut(&w) {
+                        s.refused = Some(why);
+                    }
+                }
+                return Ok(cl);
+            }
+            Err(Error::Cl { path, record }) => match &record.refused_record {
+                Some(w) if asked.contains(w) && !skip.contains(w) => {
+                    // The refusal, without its hint of the way out just taken.
+                    let message = record.message.split(" (--ignore ").next().unwrap_or("");
+                    refusals.push((
+                        w.clone(),
+                        format!("line {}, col {}: {message}", record.line, record.column),
+                    ));
+                    skip.push(w.clone());
+                }
+                _ => return Err(Error::Cl { path, record }),
+            },
+            Err(e) => return Err(e),
+        }
+    }
+}
+
+/// What became of the records `--ignore` skipped, one line per kind for the report and the
+/// user: how many, where the first is, why they could be skipped (the refusal of a kind
+/// polepatch posts) and what the program then does without them.
+pub fn skip_notes(cl: &ClProgram, name: &str) -> Vec<String> {
+    cl.skipped
+        .iter()
+        .map(|(w, s)| {
+            let why = s.refused.as_ref().map_or(String::new(), |r| {
+                format!("; without it the post refused {r}")
+            });
+            let then = match w.as_str() {
+                "CUTCOM" => "; the moves are posted at the CL points without cutter compensation",
+                "COOLNT" => "; no coolant words are written for them",
+                "DELAY" => "; no dwells are written for them",
+                "INSERT" => "; their text is not written into the program",
+                _ => "",
+            };
+            format!(
+                "{name}: {} {w} record(s) skipped (--ignore {w}), the first at line {}{why}{then}",
+                s.count, s.first.line
+            )
+        })
+        .collect()
+}
+
 /// What is being written: 5-axis under TCPM, or with the tool along +Z and TCPM off
 /// (holes, cutter compensation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -140,6 +247,24 @@ fn cl_error(name: &str, line: usize, column: usize, message: String) -> Error {
             line,
             column,
             message,
+            refused_record: None,
+        },
+    }
+}
+
+/// The refusal of a form of cutter compensation polepatch does not post, at `at`: a refusal
+/// of the `CUTCOM` records ([`ClError::refused_record`]), which `--ignore CUTCOM` answers by
+/// posting the moves at the CL points without compensation.
+fn comp_refusal(name: &str, line: usize, column: usize, message: String) -> Error {
+    Error::Cl {
+        path: name.to_string(),
+        record: ClError {
+            line,
+            column,
+            message: format!(
+                "{message} (--ignore CUTCOM posts the moves at the CL points without compensation)"
+            ),
+            refused_record: Some("CUTCOM".into()),
         },
     }
 }
@@ -186,23 +311,24 @@ impl Poster<'_> {
         if inverse(self.machine, axis).is_none() && axis[2] > 0.0 {
             return Ok(());
         }
-        Err(cl_error(
-            self.name(),
-            why.line,
-            why.column,
-            format!(
-                "{}: the tool axis ({:.6}, {:.6}, {:.6}) at line {line} is not +Z; polepatch posts {} with the tool along +Z only (no tilted working plane — PLANE, CYCLE800, G68.2 — and no 3D compensation is written): refused",
-                why.what,
-                axis[0],
-                axis[1],
-                axis[2],
-                if why.what.starts_with("CUTCOM") {
-                    "cutter compensation"
-                } else {
-                    "canned cycles"
-                }
-            ),
-        ))
+        let comp = why.what.starts_with("CUTCOM");
+        let message = format!(
+            "{}: the tool axis ({:.6}, {:.6}, {:.6}) at line {line} is not +Z; polepatch posts {} with the tool along +Z only (no tilted working plane — PLANE, CYCLE800, G68.2 — and no 3D compensation is written): refused",
+            why.what,
+            axis[0],
+            axis[1],
+            axis[2],
+            if comp {
+                "cutter compensation"
+            } else {
+                "canned cycles"
+            }
+        );
+        Err(if comp {
+            comp_refusal(self.name(), why.line, why.column, message)
+        } else {
+            cl_error(self.name(), why.line, why.column, message)
+        })
     }
 
     /// Into the vertical frame: the rotary axes to P 0, C 0 under TCPM at the current tool
@@ -301,7 +427,7 @@ impl Poster<'_> {
             .principal_plane(tol)
             .filter(|pl| !heidenhain || (*pl == Plane::Xy && a.lead_mm.abs() <= tol));
         if let Some(why) = &self.comp_cancel_pending {
-            return Err(cl_error(
+            return Err(comp_refusal(
                 self.name(),
                 why.line,
                 why.column,
@@ -315,7 +441,7 @@ impl Poster<'_> {
         if let Some(why) = &comp
             && self.comp_start_pending.is_some()
         {
-            return Err(cl_error(
+            return Err(comp_refusal(
                 self.name(),
                 why.line,
                 why.column,
@@ -330,7 +456,7 @@ impl Poster<'_> {
                 if let Some(why) = &comp
                     && pl != Plane::Xy
                 {
-                    return Err(cl_error(
+                    return Err(comp_refusal(
                         self.name(),
                         why.line,
                         why.column,
@@ -417,7 +543,7 @@ impl Poster<'_> {
             column: c.at.column,
         };
         if let Some(comp) = &self.comp {
-            return Err(cl_error(
+            return Err(comp_refusal(
                 self.name(),
                 c.at.line,
                 c.at.column,
@@ -494,7 +620,7 @@ impl Poster<'_> {
                 at,
             } => {
                 if let Some(why) = &self.comp {
-                    return Err(cl_error(
+                    return Err(comp_refusal(
                         self.name(),
                         at.line,
                         at.column,
@@ -597,7 +723,7 @@ impl Poster<'_> {
             && !fanuc
             && Some(r) != self.tool
         {
-            return Err(cl_error(
+            return Err(comp_refusal(
                 self.name(),
                 at.line,
                 at.column,
@@ -650,7 +776,7 @@ pub fn post_items(
         p.item(item)?;
     }
     if let Some(why) = &p.comp_start_pending {
-        return Err(cl_error(
+        return Err(comp_refusal(
             p.name(),
             why.line,
             why.column,
@@ -667,11 +793,35 @@ pub fn post_items(
 /// `TLDATA/` ([`crate::tool::cl_tool`]), and the tool tip as the point (APT's `GOTO/` states
 /// the tip). The patch then keeps a ball's centre and caps a flat or bull-nose cutter's
 /// orientation change ([`crate::tool`]). `cl_bytes` are the CL file's bytes, `cl` as read.
+///
+/// The order is [`crate::tool::resolve`]'s: `--tool` first, then the tool table by the
+/// number `LOADTL` calls, then the CL file's own description — which, in a file whose tools
+/// are called by number, stands for the numbers the table does not hold, and in one that
+/// calls none (a CSV file, an APT file without `LOADTL`) for the whole program.
 pub fn tool_from_cl(cl_bytes: &[u8], cl: &ClProgram, opts: &mut PostOptions) {
     let t = &mut opts.patch_options.tool;
     if t.tool.is_none() {
         let unit_mm = if cl.units == Units::Inch { 25.4 } else { 1.0 };
-        t.tool = crate::tool::cl_tool(cl_bytes, unit_mm).map(|(tool, _)| tool);
+        if let Some((tool, _)) = crate::tool::cl_tool(cl_bytes, unit_mm) {
+            let called: Vec<u32> = cl
+                .items
+                .iter()
+                .filter_map(|i| match i {
+                    ClItem::ToolChange { tool, .. } => Some(*tool),
+                    _ => None,
+                })
+                .collect();
+            if t.table.tools.is_empty() || called.is_empty() {
+                t.tool = Some(tool);
+            } else {
+                for n in called {
+                    t.table
+                        .tools
+                        .entry(crate::tool::ToolId::Number(u64::from(n)))
+                        .or_insert(tool);
+                }
+            }
+        }
     }
     if t.point.is_none() {
         t.point = Some(crate::tool::ToolPoint::Tip);
@@ -810,7 +960,10 @@ pub fn post_cl(
         machine.name, opts.patch_options.name
     )];
     for (w, n) in &cl.skipped {
-        comments.push(format!("{w} records skipped by --ignore {w}: {n}"));
+        comments.push(format!(
+            "{w} records skipped by --ignore {w}: {}, the first at line {}",
+            n.count, n.first.line
+        ));
     }
     // The writer writes the machine's own letters, among A B C.
     let (p, c) = (machine.primary_letter(), machine.c_letter());
@@ -841,6 +994,9 @@ pub fn post_cl(
     }
     match crate::patch_nc(&bytes, machine, &opts.patch_options) {
         Ok((out, mut report)) => {
+            report
+                .warnings
+                .extend(skip_notes(cl, &opts.patch_options.name));
             list_inserts(
                 cl,
                 &items,

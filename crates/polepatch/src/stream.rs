@@ -522,6 +522,7 @@ fn survey_once(
             style.add_block(bytes, s.words);
         }
         notes.push(s.block, s.words, &prev, s.state);
+        notes.lookalike(s.block.line, s.lookalike);
         if let Some(d) = s.stated_datum {
             sv.datum_shifts.push((i, d));
         }

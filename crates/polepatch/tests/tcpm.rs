@@ -268,3 +268,62 @@ fn arcs_and_skippable_blocks_inside_a_zone_are_listed() {
         assert!(report.not_analysed.is_empty(), "{:?}", report.not_analysed);
     }
 }
+
+/// Issue 42 item 5: `TRAOOF` (a post's typo of `TRAFOOF`) passed in silence: an unknown
+/// word. A word within an edit or two of a TCPM code is warned about, with its line and
+/// column; no fixture of the repository holds one.
+#[test]
+fn a_word_that_looks_like_a_tcpm_code_is_warned_about() {
+    let sin = generated("sinumerik-ac-flip-d0.5.mpf");
+    let typo = sin.replacen("\nTRAFOOF", "\nN9 TRAOOF", 1);
+    assert_ne!(typo, sin);
+    let line = typo[..typo.find("TRAOOF").unwrap()].matches('\n').count() + 1;
+    let m = Machine::builtin("mikron-ucp710").unwrap();
+    let warned = |text: &str| -> Vec<String> {
+        let (_, report) = patch_nc(text.as_bytes(), &m, &PatchOptions::default()).unwrap();
+        report
+            .warnings
+            .into_iter()
+            .filter(|w| w.contains("look like a TCPM code"))
+            .collect()
+    };
+    let w = warned(&typo);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].contains(&format!(
+            "line {line}, col 4: TRAOOF looks like the TCPM code TRAFOOF"
+        )),
+        "{w:?}"
+    );
+    assert!(warned(&sin).is_empty());
+    // No false alarm on the repository's programs.
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures");
+    let mut stack = vec![root];
+    let mut read = 0;
+    while let Some(dir) = stack.pop() {
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+                continue;
+            }
+            let ext = p.extension().and_then(|e| e.to_str()).unwrap_or("");
+            if ["apt", "cls", "csv", "toml", "json", "md", "ini"].contains(&ext) {
+                continue;
+            }
+            let bytes = std::fs::read(&p).unwrap();
+            let mut found = Vec::new();
+            let r = polepatch::nc::scan_blocks(&bytes, polepatch::nc::Dialect::Auto, |s| {
+                if let Some(l) = s.lookalike {
+                    found.push((s.block.line, l.clone()));
+                }
+                std::ops::ControlFlow::Continue(())
+            });
+            if r.is_ok() {
+                read += 1;
+            }
+            assert!(found.is_empty(), "{}: {found:?}", p.display());
+        }
+    }
+    assert!(read > 100, "{read} programs read");
+}
