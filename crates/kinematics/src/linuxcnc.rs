@@ -652,10 +652,10 @@ pub fn machine_from_ini_text(
     };
     if module == Module::FiveAxis {
         warnings.push(format!(
-            "{origin}: 5axiskins moves the tool along its axis by W (5axiskins.c: X Y Z are the \
-             tip at W = 0, the tool's tip is W further along the tool): polepatch carries W \
-             words through, and where a block at W ≠ 0 has its B or C changed the tip moves by \
-             W times the change of orientation (radians)"
+            "{origin}: 5axiskins moves the tool along its axis by W (5axiskins.c: the tool's \
+             tip is at X Y Z + W·o, o the tool axis from the tip towards the spindle; W < 0 \
+             drills): polepatch carries W words through, and where a block at W ≠ 0 has its B \
+             or C changed the tip moves by |W| times the change of orientation (radians)"
         ));
     }
     check_pair(
