@@ -13,9 +13,9 @@
 //!   the tool; switchable types as the trt modules'). Each module's conventions are its
 //!   source's: for the tables the tool axis in the part frame is the third row of the
 //!   rotation in its inverse kinematics (joints = M·(world − pivot) + …); for 5axiskins the
-//!   direction from the tip to the pivot in its forward kinematics (tip = joints + (0, 0, L)
-//!   + s2r(L + W, C, 180° − B), `s2r(r, t, p) = r·(sin p cos t, sin p sin t, cos p)`, L the
-//!   `pivot-length` pin). That gives
+//!   direction from the tip to the pivot in its forward kinematics, `tip = joints +
+//!   (0, 0, L) + s2r(L + W, C, 180° − B)` with `s2r(r, t, p) = r·(sin p cos t, sin p sin t,
+//!   cos p)` and L the `pivot-length` pin. That gives
 //!
 //!   | module | tool axis `o_wp` | as a chain (`crate::rotary`) |
 //!   |---|---|---|
