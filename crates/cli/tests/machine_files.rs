@@ -186,3 +186,38 @@ fn linuxcncs_bridgemill_demo_is_carried_through() {
     );
     assert!(err.contains("W (first at line 18)"), "{err}");
 }
+
+/// Issue 39, class 6: a C range `[100, 200]` with SING at C 245° was patched as if the
+/// program's values had to be brought into the range: the joint patch's range rows
+/// (`crates/patcher/src/joint.rs`, "the machine's ranges as bounds on each point's
+/// changes") force every point beyond 200° down to it, and the tool turned 6.25° in
+/// silence. The program cannot run on that machine: it is an error at the first word
+/// beyond the range (line 42, column 27: `C+211.506`). Ignored until the survey checks the
+/// ranges (`crates/polepatch/src/stream.rs`, another engineer's file: see the report of
+/// branch h-kin).
+#[test]
+#[ignore = "needs the range check in polepatch's survey (stream.rs)"]
+fn a_program_beyond_the_machines_c_range_is_refused_at_its_word() {
+    let dir = temp_dir("c-range");
+    let m = ucp710_edited(
+        &dir,
+        "c-range.toml",
+        "# No range_deg: C is an endless rotary table.",
+        "range_deg = [100.0, 200.0]",
+    );
+    let out = dir.join("out.I");
+    let (code, _, err) = polepatch(&[
+        "patch",
+        "fixtures/c17/SING.I",
+        "--machine",
+        &m,
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("SING.I:42:27") && err.contains("211.506"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
