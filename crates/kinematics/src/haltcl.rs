@@ -13,8 +13,8 @@
 //! - Words in braces (`{1}`, no substitution) and plain words.
 //! - Commands that set no value: `loadrt`, `loadusr`, `addf`, `delf`, `start`, `stop`,
 //!   `waitusr`, `newsig`, `puts`, `show`, `package`, `getp`, `ptype`, `stype`, `help`,
-//!   `status`, `lock`, `unlock`, `save`, and `set NAME VALUE` of a plain Tcl variable (using
-//!   it later is a variable, not read).
+//!   `status`, `lock`, `unlock`, `save`, `hal list`, `hal gets`, and `set NAME VALUE` of a
+//!   plain Tcl variable (using it later is a variable, not read).
 //! - Comments: `#` where a command begins (also after `;`); `\` at a line's end continues
 //!   it.
 //!
@@ -292,7 +292,8 @@ fn resolve(w: &Word, ini: &Ini) -> Result<String, String> {
 /// Commands that set no HAL value (module docs).
 const PASSIVE: &[&str] = &[
     "loadrt", "loadusr", "addf", "delf", "start", "stop", "waitusr", "newsig", "puts", "show",
-    "package", "getp", "ptype", "stype", "help", "status", "lock", "unlock", "save",
+    "package", "getp", "ptype", "stype", "help", "status", "lock", "unlock", "save", "list",
+    "gets",
 ];
 
 /// What a command polepatch does not follow is, for a message.
@@ -487,7 +488,8 @@ mod tests {
              set gain 3\n\
              net :z-off xyzac-trt-kins.z-offset\n\
              sets :z-off ${::KINS(PIVOT)}\n\
-             puts \"kinematics set\"\n",
+             puts \"kinematics set\"\n\
+             hal list pin xyzac-trt-kins\n",
         );
         let v = |p: &str| hal.value(&format!("xyzac-trt-kins.{p}"));
         assert_eq!(v("conventional-directions"), Ok(Some(1.0)));
