@@ -25,7 +25,7 @@ pub use crate::angles::{unwrap_near_deg, wrap_deg};
 use crate::forward::StandardForm;
 use crate::machine::{Machine, PrimaryAxis};
 pub use crate::rotary::IkSolution;
-use crate::rotary::{Ik, inverse_general, pole_p_general, pole_tilt_general};
+use crate::rotary::{Ik, PoleAt, inverse_general, pole_general, pole_tilt_general};
 use crate::tolerances::POLE_SIN_TOL;
 
 /// How [`inverse_path`] picks between the two solutions ((P, C) and (−P, C+180°) on the
@@ -129,23 +129,33 @@ fn inverse_standard(f: StandardForm, o_wp: [f64; 3]) -> Option<[IkSolution; 2]> 
 }
 
 impl Machine {
-    /// The primary angle at which the tool lies along the pole axis, degrees: 0 on the
+    /// The primary angle at which the tool lies along the pole axis line, degrees: 0 on the
     /// built-ins and on every pair whose tool at zero lies along the pole axis; `None` when
-    /// the pair cannot reach the pole (then it has no singularity to patch).
+    /// the pair cannot reach the pole (then it has no singularity to patch). Of the two
+    /// poles a pair may reach (the tool with the pole axis or against it), the one within
+    /// the primary range (module docs of [`crate::rotary`], `pole_general`).
     pub fn pole_p_deg(&self) -> Option<f64> {
         match self.standard_form() {
             Some(_) => Some(0.0),
-            None => pole_p_general(&self.rotary, self.primary_sense),
+            None => self.pole().map(|p| p.p_deg),
         }
+    }
+    /// The pole of a pair that is not of the standard form ([`Machine::pole_p_deg`]).
+    pub(crate) fn pole(&self) -> Option<PoleAt> {
+        pole_general(&self.rotary, self.primary_sense, self.primary_range_deg)
     }
     /// The angle between the tool and the pole when the primary axis is at `p_deg`,
     /// degrees in [0, 180] (C turns the tool about the pole at this angle): `|P|` (folded
-    /// into [0, 180]) on the built-ins. The distance from the pole is this angle; a change
-    /// ΔC moves the tool by `2·asin(sin(tilt)·|sin(ΔC/2)|)`.
+    /// into [0, 180]) on the built-ins; measured from the pole [`Machine::pole_p_deg`]
+    /// names (the tool along the pole axis or against it). The distance from the pole is
+    /// this angle; a change ΔC moves the tool by `2·asin(sin(tilt)·|sin(ΔC/2)|)`.
     pub fn pole_tilt_deg(&self, p_deg: f64) -> f64 {
         match self.standard_form() {
             Some(_) => wrap_deg(p_deg).abs(),
-            None => pole_tilt_general(&self.rotary, self.primary_sense, p_deg),
+            None => {
+                let opposite = self.pole().is_some_and(|p| p.opposite);
+                pole_tilt_general(&self.rotary, self.primary_sense, p_deg, opposite)
+            }
         }
     }
     /// The other joint solution of the tool axis at (`p_deg`, `c_deg`): `(−P, C + 180°)`

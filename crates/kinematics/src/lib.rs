@@ -29,6 +29,8 @@ pub mod chain;
 pub mod feed;
 pub mod forward;
 mod frames;
+mod hal;
+mod haltcl;
 pub mod inverse;
 pub mod linuxcnc;
 mod load;

@@ -8,15 +8,26 @@
 //!   switchable type 0 is identity and type 1 the TCP kinematics, else type 0 is TCP and
 //!   type 1 identity; type 2 is the user kinematics), and `xyzab_tdr_kins`
 //!   (`src/hal/components/xyzab_tdr_kins.comp`: an A table about X carried by a B table
-//!   about Y; type 0 identity, type 1 TCP). Each module's conventions are its source's:
-//!   the tool axis in the part frame is the third row of the rotation in its inverse
-//!   kinematics (joints = M·(world − pivot) + …), which gives
+//!   about Y; type 0 identity, type 1 TCP), and `5axiskins` (`src/emc/kinematics/
+//!   5axiskins.c`: the bridge mill's fork head, C about Z carrying B, with a W quill along
+//!   the tool; switchable types as the trt modules'). Each module's conventions are its
+//!   source's: for the tables the tool axis in the part frame is the third row of the
+//!   rotation in its inverse kinematics (joints = M·(world − pivot) + …); for 5axiskins the
+//!   direction from the tip to the pivot in its forward kinematics, `tip = joints +
+//!   (0, 0, L) + s2r(L + W, C, 180° − B)` with `s2r(r, t, p) = r·(sin p cos t, sin p sin t,
+//!   cos p)` and L the `pivot-length` pin. That gives
 //!
 //!   | module | tool axis `o_wp` | as a chain (`crate::rotary`) |
 //!   |---|---|---|
 //!   | `xyzac-trt-kins` | `(sin C sin A, −con cos C sin A, cos A)` | C table `ẑ`, A table `x̂`, senses `con` |
 //!   | `xyzbc-trt-kins` | `(con cos C sin B, sin C sin B, cos B)` | C table `ẑ`, B table `ŷ`, senses `con` |
 //!   | `xyzab_tdr_kins` | `(sin B, −sin A cos B, cos A cos B)` | A table `x̂`, B table `ŷ`, senses +1 |
+//!   | `5axiskins` | `(−sin B cos C, −sin B sin C, cos B)` | C head `ẑ`, B head `ŷ`, senses C +1, B −1 |
+//!
+//!   5axiskins' W moves the tool along its axis inside the motion of X Y Z: its X Y Z are
+//!   the tip at W = 0, the tool's tip is at X Y Z + W·o. W is not an axis of the model: its
+//!   words are carried through, and a warning says that an orientation changed at W ≠ 0
+//!   moves the tip.
 //!
 //!   with `con` = +1 when the HAL pin `<module>.conventional-directions` is set, −1 (the
 //!   module's default: "the directions of the rotational axes are the opposite of the
@@ -24,16 +35,26 @@
 //!   by default (C17's senses), the built-in UCP710 j = −cos C·sin A (G16's).
 //!   Any other module is refused by name: describe such a machine in a TOML file.
 //! - The pivot parameters, from the HAL pins `<module>.x-rot-point`, `y-rot-point`,
-//!   `z-rot-point`, `x-offset`, `y-offset`, `z-offset` as `setp` (or `sets` on the signal a
-//!   pin is netted to) in the INI's `[HAL] HALCMD` lines and the `HALFILE` /
-//!   `POSTGUI_HALFILE` files (`[SECTION]KEY` substituted; `LIB:` files are LinuxCNC's own
-//!   and skipped); a pin never set is 0, as in HAL. They give the chain (points on the two
-//!   axes): the pole axis through the rotation point `r`, the tilting axis through `r`
-//!   plus the offsets (`xyzac`: `(0, y-offset, z-offset)`; `xyzbc`: `(x-offset, 0,
-//!   z-offset)`), and for `xyzab_tdr` the A axis through `r + (x-offset, 0, z-offset)`, the
-//!   B axis through `r`. The tool-offset pin (the current tool's length, a run-time value)
-//!   is taken as 0. A pin driven at run time by another component gives no chain, with a
-//!   warning.
+//!   `z-rot-point`, `x-offset`, `y-offset`, `z-offset` (5axiskins: `pivot-length`) as
+//!   `setp` (or `sets` on the signal a pin is netted to) in the INI's `[HAL] HALFILE` files,
+//!   `HALCMD` lines and `POSTGUI_HALFILE` files, in that order (`hal.rs`). A `HALFILE`'s
+//!   first word is the file (the rest are a `.tcl` file's arguments), found in the INI's
+//!   folder; `LIB:` files and names of LinuxCNC's own library (`lib/hallib`) not in that
+//!   folder are LinuxCNC's and passed over; any other file that cannot be found or read is
+//!   an error naming it. `.tcl` files are read by `haltcl.rs` (haltcl's `setp`, `sets`,
+//!   `net`, `$::SECTION(KEY)`; a form it does not evaluate — an expression, a variable, a
+//!   loop — makes the pins it may set unknown, named with its file, line and column);
+//!   other files as halcmd lines (`[SECTION]KEY` substituted). A pin never set has the
+//!   module's value (0; 5axiskins' `pivot-length` 250); one on a signal that nothing sets
+//!   or drives is 0. They give the chain (points on the two axes): the pole axis through
+//!   the rotation point `r`, the tilting axis through `r` plus the offsets (`xyzac`:
+//!   `(0, y-offset, z-offset)`; `xyzbc`: `(x-offset, 0, z-offset)`), for `xyzab_tdr` the A
+//!   axis through `r + (x-offset, 0, z-offset)`, the B axis through `r`, and for 5axiskins
+//!   both head axes through the pivot, `(0, 0, pivot-length)` from the tip of a tool of
+//!   length 0. The tool-offset pin (the current tool's length, a run-time value) is taken
+//!   as 0. A pivot pin that cannot be known (driven at run time by another component, a
+//!   Tcl form) gives no chain, with a warning; `conventional-directions` that cannot be
+//!   known is an error (the senses depend on it).
 //! - The limits: `MAX_VELOCITY`, `MAX_ACCELERATION` and `MAX_JERK` of `[AXIS_L]` and of the
 //!   `[JOINT_n]` of that letter (joints numbered in the order of `[TRAJ] COORDINATES`, or
 //!   the module's `coordinates=` parameter); where both give a value the smaller counts,
@@ -51,6 +72,7 @@
 //! - The name: `[EMC] MACHINE`, else the file's name.
 
 use crate::chain::Chain;
+use crate::hal::Hal;
 use crate::machine::{AxisLimits, Controller, Machine, MachineError, num, read_bounded};
 use crate::machine_file::{
     DEG_PER_REV, DEG_S_PER_RPM, MM_PER_M, MM_S_PER_M_MIN, check_pair, positive, range,
@@ -140,6 +162,13 @@ impl Ini {
             .find(|e| e.section == section && e.key == key)
     }
 
+    /// Every entry of `key` in `[section]`, in file order.
+    fn entries_of<'a>(&'a self, section: &'a str, key: &'a str) -> impl Iterator<Item = &'a Entry> {
+        self.entries
+            .iter()
+            .filter(move |e| e.section == section && e.key == key)
+    }
+
     /// Every value of `key` in `[section]`, in file order.
     pub fn all<'a>(&'a self, section: &'a str, key: &'a str) -> impl Iterator<Item = &'a str> {
         self.entries
@@ -162,6 +191,8 @@ enum Module {
     XyzacTrt,
     XyzbcTrt,
     XyzabTdr,
+    /// `5axiskins`: the bridge mill's head-head C-B (with a W quill along the tool).
+    FiveAxis,
 }
 
 impl Module {
@@ -170,6 +201,7 @@ impl Module {
             "xyzac-trt-kins" => Some(Module::XyzacTrt),
             "xyzbc-trt-kins" => Some(Module::XyzbcTrt),
             "xyzab-tdr-kins" => Some(Module::XyzabTdr),
+            "5axiskins" => Some(Module::FiveAxis),
             _ => None,
         }
     }
@@ -179,6 +211,7 @@ impl Module {
             Module::XyzacTrt => "xyzac-trt-kins",
             Module::XyzbcTrt => "xyzbc-trt-kins",
             Module::XyzabTdr => "xyzab_tdr_kins",
+            Module::FiveAxis => "5axiskins",
         }
     }
     /// The letters it requires, in its joints' default order.
@@ -187,6 +220,7 @@ impl Module {
             Module::XyzacTrt => "XYZAC",
             Module::XyzbcTrt => "XYZBC",
             Module::XyzabTdr => "XYZAB",
+            Module::FiveAxis => "XYZBCW",
         }
     }
     /// (pole axis letter and direction, tilting axis letter and direction).
@@ -195,6 +229,30 @@ impl Module {
             Module::XyzacTrt => (('C', [0.0, 0.0, 1.0]), ('A', [1.0, 0.0, 0.0])),
             Module::XyzbcTrt => (('C', [0.0, 0.0, 1.0]), ('B', [0.0, 1.0, 0.0])),
             Module::XyzabTdr => (('A', [1.0, 0.0, 0.0]), ('B', [0.0, 1.0, 0.0])),
+            Module::FiveAxis => (('C', [0.0, 0.0, 1.0]), ('B', [0.0, 1.0, 0.0])),
+        }
+    }
+    /// What its two rotary axes turn.
+    fn carrier(self) -> Carrier {
+        match self {
+            Module::FiveAxis => Carrier::Head,
+            _ => Carrier::Table,
+        }
+    }
+    /// The HAL pins of its parameters polepatch reads, with the module's value for a pin
+    /// never set (in the INI's linear units): 5axiskins.c creates `pivot-length` with
+    /// `DEFAULT_PIVOT_LENGTH` 250; the other modules' pins start at HAL's 0.
+    fn parameter_pins(self) -> &'static [(&'static str, f64)] {
+        match self {
+            Module::FiveAxis => &[("pivot-length", 250.0)],
+            _ => &[
+                ("x-rot-point", 0.0),
+                ("y-rot-point", 0.0),
+                ("z-rot-point", 0.0),
+                ("x-offset", 0.0),
+                ("y-offset", 0.0),
+                ("z-offset", 0.0),
+            ],
         }
     }
     /// The switchable kinematics type that is TCP, given the module's `sparm`.
@@ -205,101 +263,6 @@ impl Module {
             _ => 0,
         }
     }
-}
-
-/// HAL values set by `setp` and `sets`, and the nets, in the order LinuxCNC runs them.
-#[derive(Debug, Default)]
-struct Hal {
-    /// pin → value from `setp`.
-    pins: HashMap<String, String>,
-    /// signal → value from `sets`.
-    signals: HashMap<String, String>,
-    /// pin → signal it is netted to.
-    pin_signal: HashMap<String, String>,
-    /// signal → every pin on it.
-    signal_pins: HashMap<String, Vec<String>>,
-}
-
-impl Hal {
-    /// One HAL command line (comments after `#` removed, `[SECTION]KEY` substituted).
-    fn command(&mut self, line: &str, ini: &Ini) {
-        let line = line.split('#').next().unwrap_or("");
-        let words: Vec<String> = line
-            .split_whitespace()
-            .map(|w| substitute(w, ini))
-            .collect();
-        let Some(cmd) = words.first() else {
-            return;
-        };
-        let mut link = |sig: &str, pin: &str| {
-            self.pin_signal.insert(pin.to_string(), sig.to_string());
-            self.signal_pins
-                .entry(sig.to_string())
-                .or_default()
-                .push(pin.to_string());
-        };
-        match (cmd.as_str(), &words[1..]) {
-            ("setp", [pin, value, ..]) => {
-                self.pins.insert(pin.clone(), value.clone());
-            }
-            ("sets", [sig, value, ..]) => {
-                self.signals.insert(sig.clone(), value.clone());
-            }
-            ("net", [sig, rest @ ..]) => {
-                for pin in rest
-                    .iter()
-                    .filter(|w| !matches!(w.as_str(), "=>" | "<=" | "<=>"))
-                {
-                    link(sig, pin);
-                }
-            }
-            ("linksp", [sig, pin, ..]) => link(sig, pin),
-            ("linkps", [pin, sig, ..]) => link(sig, pin),
-            _ => {}
-        }
-    }
-
-    /// The value of an input pin: `Ok(Some)` when set, `Ok(None)` when never set (HAL's
-    /// default 0), `Err(why)` when another component drives it at run time.
-    fn value(&self, pin: &str) -> Result<Option<f64>, String> {
-        let text = if let Some(v) = self.pins.get(pin) {
-            v
-        } else if let Some(sig) = self.pin_signal.get(pin) {
-            match self.signals.get(sig) {
-                Some(v) => v,
-                None => {
-                    let others: Vec<&str> = self.signal_pins[sig]
-                        .iter()
-                        .map(String::as_str)
-                        .filter(|p| *p != pin)
-                        .collect();
-                    if others.is_empty() {
-                        return Ok(None);
-                    }
-                    return Err(format!(
-                        "{pin} is netted to {sig} with {} and no value set: it is set at run time",
-                        others.join(", ")
-                    ));
-                }
-            }
-        } else {
-            return Ok(None);
-        };
-        text.parse::<f64>()
-            .map(Some)
-            .map_err(|_| format!("{pin} = '{text}' is not a number"))
-    }
-}
-
-/// `[SECTION]KEY` in a HAL word replaced by the INI value (as LinuxCNC's halcmd does).
-fn substitute(word: &str, ini: &Ini) -> String {
-    if let Some(rest) = word.strip_prefix('[')
-        && let Some((section, key)) = rest.split_once(']')
-        && let Some(v) = ini.get(section, key)
-    {
-        return v.to_string();
-    }
-    word.to_string()
 }
 
 /// Units: mm per the INI's linear unit, degrees per its angular unit.
@@ -365,7 +328,7 @@ pub fn machine_from_ini_text(
     let module = Module::from_name(module_name).ok_or_else(|| {
         err(format!(
             "line {}: [KINS] KINEMATICS = {module_name}: polepatch reads the 5-axis modules \
-             xyzac-trt-kins, xyzbc-trt-kins and xyzab_tdr_kins; describe this machine in a \
+             xyzac-trt-kins, xyzbc-trt-kins, xyzab_tdr_kins and 5axiskins; describe this machine in a \
              TOML file (its two rotary axes as [[rotary]], see the README)",
             kins.line
         ))
@@ -539,38 +502,22 @@ pub fn machine_from_ini_text(
     };
 
     // HAL: the pivot parameters and conventional-directions.
-    let mut hal = Hal::default();
     let read_dir = |rel: &str| -> Option<PathBuf> { dir.map(|d| d.join(rel)) };
-    let hal_files = |key: &str, hal: &mut Hal, warnings: &mut Vec<String>| {
-        for f in ini.all("HAL", key) {
-            let f = f.trim();
-            if f.starts_with("LIB:") || f.ends_with(".tcl") {
-                continue;
-            }
-            let Some(p) = read_dir(f) else {
-                warnings.push(format!(
-                    "{origin}: [HAL] {key} = {f} not read (no directory)"
-                ));
-                continue;
-            };
-            match read_bounded(&p) {
-                Ok(text) => text.lines().for_each(|l| hal.command(l, &ini)),
-                Err(e) => warnings.push(format!(
-                    "{origin}: [HAL] {key} = {f} could not be read ({e}); its pins are not known"
-                )),
+    let mut hal = Hal::default();
+    for key in ["HALFILE", "HALCMD", "POSTGUI_HALFILE"] {
+        for e in ini.entries_of("HAL", key) {
+            if key == "HALCMD" {
+                hal.halcmd_line(&e.value, &ini);
+            } else {
+                hal_file(&ini, origin, dir, e, &mut hal)?;
             }
         }
-    };
-    hal_files("HALFILE", &mut hal, &mut warnings);
-    for cmd in ini.all("HAL", "HALCMD") {
-        hal.command(cmd, &ini);
     }
-    hal_files("POSTGUI_HALFILE", &mut hal, &mut warnings);
 
     let prefix = module.hal_prefix();
     let pin = |name: &str| hal.value(&format!("{prefix}.{name}"));
     let con = match module {
-        Module::XyzabTdr => 1.0,
+        Module::XyzabTdr | Module::FiveAxis => 1.0,
         _ => match pin("conventional-directions") {
             Ok(Some(v)) if v != 0.0 => 1.0,
             Ok(_) => -1.0,
@@ -583,17 +530,10 @@ pub fn machine_from_ini_text(
     };
     let mut pivot = HashMap::new();
     let mut unknown = Vec::new();
-    for name in [
-        "x-rot-point",
-        "y-rot-point",
-        "z-rot-point",
-        "x-offset",
-        "y-offset",
-        "z-offset",
-    ] {
+    for &(name, default) in module.parameter_pins() {
         match pin(name) {
             Ok(v) => {
-                pivot.insert(name, v.unwrap_or(0.0) * mm);
+                pivot.insert(name, v.unwrap_or(default) * mm);
             }
             Err(why) => unknown.push(why),
         }
@@ -604,6 +544,15 @@ pub fn machine_from_ini_text(
             unknown.join("; ")
         ));
         None
+    } else if module == Module::FiveAxis {
+        // Both head axes through the pivot, `pivot-length` above the tip of a tool of
+        // length 0 at B = 0 (the tool-offset part of the pin taken as 0, as for the trt
+        // modules' tool-offset pin).
+        let pivot = [0.0, 0.0, pivot["pivot-length"]];
+        Some(Chain {
+            c_axis_point_mm: pivot,
+            primary_axis_point_mm: pivot,
+        })
     } else {
         let r = [
             pivot["x-rot-point"],
@@ -632,6 +581,7 @@ pub fn machine_from_ini_text(
                 c_axis_point_mm: add(r, [dx, 0.0, dz]),
                 primary_axis_point_mm: r,
             }),
+            Module::FiveAxis => unreachable!("read above"),
         }
     };
 
@@ -684,16 +634,30 @@ pub fn machine_from_ini_text(
     let rotary = Rotaries {
         primary: RotaryAxis {
             letter: tilt_letter,
-            carrier: Carrier::Table,
+            carrier: module.carrier(),
             direction: tilt_dir,
         },
         c: RotaryAxis {
             letter: pole_letter,
-            carrier: Carrier::Table,
+            carrier: module.carrier(),
             direction: pole_dir,
         },
         tool_direction: [0.0, 0.0, 1.0],
     };
+    // The senses (module docs): the trt modules' `con` on both axes; 5axiskins' B turns
+    // the tool against the conventional direction (its note 10), its C with it.
+    let (primary_sense, c_sense) = match module {
+        Module::FiveAxis => (-1.0, 1.0),
+        _ => (con, con),
+    };
+    if module == Module::FiveAxis {
+        warnings.push(format!(
+            "{origin}: 5axiskins moves the tool along its axis by W (5axiskins.c: the tool's \
+             tip is at X Y Z + W·o, o the tool axis from the tip towards the spindle; W < 0 \
+             drills): polepatch carries W words through, and where a block at W ≠ 0 has its B \
+             or C changed the tip moves by |W| times the change of orientation (radians)"
+        ));
+    }
     check_pair(
         &rotary,
         [&pole_letter.to_string(), &tilt_letter.to_string()],
@@ -710,8 +674,8 @@ pub fn machine_from_ini_text(
     Ok(Machine {
         name,
         rotary,
-        primary_sense: con,
-        c_sense: con,
+        primary_sense,
+        c_sense,
         primary_range_deg,
         c_range_deg,
         tcy_s: tcy_ms / 1000.0,
@@ -720,6 +684,95 @@ pub fn machine_from_ini_text(
         controller,
         warnings,
     })
+}
+
+/// The files of LinuxCNC's own HAL library (`lib/hallib`), which `linuxcnc` finds there
+/// when the configuration's folder has no file of that name (`HALLIB_PATH = .:HALLIB_DIR`).
+/// They set no parameter of the kinematics modules polepatch reads.
+const LINUXCNC_HALLIB: &[&str] = &[
+    "axis_manualtoolchange.hal",
+    "basic_sim.tcl",
+    "check_xyz_constraints.hal",
+    "core_servo.hal",
+    "core_sim.hal",
+    "core_sim9.hal",
+    "core_stepper.hal",
+    "gantrysim.hal",
+    "hal_procs_lib.tcl",
+    "halcheck.tcl",
+    "hookup_moveoff.tcl",
+    "lathe.hal",
+    "lh_chart.tcl",
+    "locking_indexer.hal",
+    "moveoff_external.hal",
+    "plasmac.tcl",
+    "qtplasmac_comp.hal",
+    "servo_sim.hal",
+    "sim_lib.tcl",
+    "sim_spindle_encoder.hal",
+    "simulated-gantry-home.hal",
+    "simulated-xyyz-home.hal",
+    "simulated_home.hal",
+    "simulated_limits.hal",
+    "tripodsim.hal",
+    "util_lib.tcl",
+    "var_show.tcl",
+    "wheeljogpins.tcl",
+    "xhc-hb04.tcl",
+];
+
+/// One `[HAL] HALFILE` or `POSTGUI_HALFILE` entry read into `hal`, as LinuxCNC runs it: the
+/// file name is the first word (the rest are arguments of a `.tcl` file); `LIB:NAME` and a
+/// name of LinuxCNC's library not in the configuration's folder are LinuxCNC's own files
+/// (passed over); a `.tcl` file is read by `haltcl.rs`, any other as halcmd lines. A file
+/// that cannot be found or read is an error naming it: its commands could set the
+/// kinematics' parameters, and LinuxCNC itself does not start without it.
+fn hal_file(
+    ini: &Ini,
+    origin: &str,
+    dir: Option<&Path>,
+    e: &Entry,
+    hal: &mut Hal,
+) -> Result<(), MachineError> {
+    let name = e.value.split_whitespace().next().unwrap_or("");
+    if name.is_empty() || name.starts_with("LIB:") {
+        return Ok(());
+    }
+    let refuse = |why: String| {
+        invalid(
+            origin,
+            format!(
+                "line {}: [HAL] {} = {}: {why}; its commands may set the kinematics' \
+                 parameters, which are then not known",
+                e.line, e.key, e.value
+            ),
+        )
+    };
+    let path = match dir {
+        Some(d) => d.join(name),
+        None if Path::new(name).is_absolute() => PathBuf::from(name),
+        None => return Err(refuse("not read (no folder to find it in)".into())),
+    };
+    if !path.is_file() {
+        if !name.contains('/') && LINUXCNC_HALLIB.contains(&name) {
+            return Ok(());
+        }
+        return Err(refuse(format!(
+            "{} is not there (nor is it one of LinuxCNC's library files)",
+            path.display()
+        )));
+    }
+    let text = read_bounded(&path).map_err(|e| refuse(format!("{}: {e}", path.display())))?;
+    let shown = path.display().to_string();
+    if Path::new(name)
+        .extension()
+        .is_some_and(|x| x.eq_ignore_ascii_case("tcl"))
+    {
+        crate::haltcl::read(&text, &shown, ini, hal);
+    } else {
+        text.lines().for_each(|l| hal.halcmd_line(l, ini));
+    }
+    Ok(())
 }
 
 /// A number as LinuxCNC's INI reader takes it.
@@ -1028,12 +1081,24 @@ mod tests {
             con: 1.0,
         };
         check_against_source(&m, |pos, p, c| xyzbc_inverse(pins, pos, p, c), true);
-        // The postgui file that is not there is said.
-        assert!(
-            m.warnings.iter().any(|w| w.contains("missing_postgui.hal")),
-            "{:?}",
-            m.warnings
-        );
+        // A HAL file that is not there is refused by name (issue 39: it could set
+        // conventional-directions; LinuxCNC does not start without it either).
+        let dir = config("xyzbc-trt");
+        let text = std::fs::read_to_string(dir.join("xyzbc-trt.ini")).unwrap();
+        for (from, to) in [
+            ("= xyzbc-postgui.hal", "= missing_postgui.hal"),
+            ("= xyzbc-pivot.hal", "= pivot.hal"),
+        ] {
+            let err = machine_from_ini_text(&text.replace(from, to), "t.ini", Some(&dir))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains(&format!("HALFILE {to}"))
+                    && err.contains("is not there")
+                    && err.contains("may set the kinematics' parameters"),
+                "{err}"
+            );
+        }
         // conventional-directions 0 with offsets: the source turns its offsets the other way
         // than the table (dpx, dpz carry no `con`), which no pair of fixed axes does: the
         // orientation is still the source's, but no chain is taken, with a warning.
@@ -1044,6 +1109,7 @@ mod tests {
         let tmp = std::env::temp_dir().join(format!("polepatch-lcnc-{}", std::process::id()));
         std::fs::create_dir_all(&tmp).unwrap();
         std::fs::write(tmp.join("xyzbc-pivot.hal"), hal).unwrap();
+        std::fs::copy(dir.join("xyzbc-postgui.hal"), tmp.join("xyzbc-postgui.hal")).unwrap();
         let text = std::fs::read_to_string(dir.join("xyzbc-trt.ini")).unwrap();
         let m0 = machine_from_ini_text(&text, "t.ini", Some(&tmp)).unwrap();
         assert_eq!((m0.primary_sense, m0.c_sense), (-1.0, -1.0));
@@ -1105,6 +1171,245 @@ mod tests {
         assert_eq!(m.c_range_deg, Some((-3600.0, 3600.0)));
         assert_eq!(m.primary_range_deg, (-180.0, 180.0));
         assert_eq!(m.limit(Axis::C).v, 30.0);
+    }
+
+    /// A folder for one test: the fixture folder `rel` copied, then `edits` (file name,
+    /// text) written over it.
+    fn edited_config(rel: &str, tag: &str, edits: &[(&str, &str)]) -> PathBuf {
+        let tmp = std::env::temp_dir().join(format!("polepatch-lcnc-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&tmp);
+        std::fs::create_dir_all(&tmp).unwrap();
+        for f in std::fs::read_dir(config(rel)).unwrap() {
+            let f = f.unwrap().path();
+            if f.is_file() {
+                std::fs::copy(&f, tmp.join(f.file_name().unwrap())).unwrap();
+            }
+        }
+        for (name, text) in edits {
+            std::fs::write(tmp.join(name), text).unwrap();
+        }
+        tmp
+    }
+
+    /// Issue 39, class 5: `HALFILE = kins.tcl` holding `setp
+    /// xyzac-trt-kins.conventional-directions 1` was passed over, the default senses taken,
+    /// and the tip rewrite mirrored. It is read as the same lines in `[HAL] HALCMD` are.
+    #[test]
+    fn a_tcl_hal_file_is_read_as_halcmd_lines_are() {
+        let m = load("xyzac-trt-tcl/xyzac-trt-tcl.ini");
+        assert_eq!((m.primary_sense, m.c_sense), (1.0, 1.0));
+        let ucp = Machine::builtin("mikron-ucp710").unwrap();
+        for (a, c) in [(25.0, 40.0), (-3.0, 200.0)] {
+            assert_eq!(forward(&m, a, c), forward(&ucp, a, c));
+        }
+        let chain = m.chain.unwrap();
+        assert_eq!(chain.c_axis_point_mm, [0.0, -5.0, -60.0]);
+        assert_eq!(chain.primary_axis_point_mm, [0.0, 10.0, -35.0]);
+        // The same parameters as halcmd lines: the same machine.
+        let dir = config("xyzac-trt-tcl");
+        let text = std::fs::read_to_string(dir.join("xyzac-trt-tcl.ini")).unwrap();
+        let halcmd = text.replace(
+            "HALFILE = kins.tcl\n",
+            "HALCMD = setp xyzac-trt-kins.y-rot-point -5\n\
+             HALCMD = setp xyzac-trt-kins.z-rot-point -60\n\
+             HALCMD = setp xyzac-trt-kins.y-offset [KINS]Y_OFFSET\n\
+             HALCMD = setp xyzac-trt-kins.z-offset [KINS]Z_OFFSET\n\
+             HALCMD = setp xyzac-trt-kins.conventional-directions 1\n",
+        );
+        assert_ne!(halcmd, text);
+        let origin = dir.join("xyzac-trt-tcl.ini").display().to_string();
+        let h = machine_from_ini_text(&halcmd, &origin, None).unwrap();
+        assert_eq!(h, m);
+        let pins = Pins {
+            rot: [0.0, -5.0, -60.0],
+            dx: 0.0,
+            dy: 15.0,
+            dz: 25.0,
+            con: 1.0,
+        };
+        check_against_source(&m, |pos, p, c| xyzac_inverse(pins, pos, p, c), true);
+    }
+
+    /// A form of a haltcl file polepatch does not evaluate: refused, naming the file, line,
+    /// column and the form, where the senses depend on it; where only the chain does, no
+    /// chain, said. Never a default in silence.
+    #[test]
+    fn a_tcl_form_that_is_not_read_is_refused_where_it_matters() {
+        let kins = std::fs::read_to_string(config("xyzac-trt-tcl/kins.tcl")).unwrap();
+        let ini = config("xyzac-trt-tcl/xyzac-trt-tcl.ini");
+        let ini_text = std::fs::read_to_string(&ini).unwrap();
+        let load_with = |tag: &str, tcl: &str| {
+            let dir = edited_config("xyzac-trt-tcl", tag, &[("kins.tcl", tcl)]);
+            let r = machine_from_ini_text(&ini_text, "t.ini", Some(&dir));
+            std::fs::remove_dir_all(&dir).unwrap();
+            r
+        };
+        let line = "setp xyzac-trt-kins.conventional-directions 1";
+        assert!(kins.contains(line));
+        let refused: &[(&str, &str)] = &[
+            (
+                "foreach p {conventional-directions} {\n  setp $kins.$p 1\n}",
+                "kins.tcl:14:1: a Tcl loop (foreach)",
+            ),
+            (
+                "setp xyzac-trt-kins.conventional-directions [expr {1}]",
+                "kins.tcl:14:45: '[expr {1}]', a Tcl command substitution",
+            ),
+            (
+                "setp xyzac-trt-kins.conventional-directions $on",
+                "kins.tcl:14:45: '$on', a Tcl variable",
+            ),
+            (
+                "if {$::KINS(JOINTS) == 5} {setp xyzac-trt-kins.conventional-directions 1}",
+                "kins.tcl:14:1: a Tcl condition (if)",
+            ),
+            (
+                "setp $kins.conventional-directions 1",
+                "kins.tcl:14:6: setp of '$kins.conventional-directions', a Tcl variable",
+            ),
+        ];
+        for (tag, (form, want)) in refused.iter().enumerate() {
+            let err = load_with(&format!("r{tag}"), &kins.replace(line, form))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("t.ini")
+                    && err.contains(want)
+                    && err.contains("the senses of the rotary axes depend on it"),
+                "{form}: {err}"
+            );
+        }
+        // An expression on a pivot pin: the senses are known, the chain is not.
+        let m = load_with(
+            "pivot",
+            &kins.replace(
+                "setp xyzac-trt-kins.z-rot-point -60",
+                "setp xyzac-trt-kins.z-rot-point -50-10",
+            ),
+        )
+        .unwrap();
+        assert_eq!((m.primary_sense, m.c_sense), (1.0, 1.0));
+        assert_eq!(m.chain, None);
+        assert!(
+            m.warnings.iter().any(|w| w.contains("no kinematic chain")
+                && w.contains("kins.tcl:7:33: '-50-10' is a Tcl expression")),
+            "{:?}",
+            m.warnings
+        );
+    }
+
+    /// `fiveaxis_KinematicsForward` of 5axiskins.c, transcribed: joints (x, y, z, B, C, W)
+    /// → the tool position, `s2r(r, t, p) = r·(sin p cos t, sin p sin t, cos p)`.
+    fn five_axis_forward(pivot_length: f64, j: [f64; 6]) -> [f64; 3] {
+        let s2r = |r: f64, t_deg: f64, p_deg: f64| {
+            let (t, p) = (t_deg.to_radians(), p_deg.to_radians());
+            [r * p.sin() * t.cos(), r * p.sin() * t.sin(), r * p.cos()]
+        };
+        let [x, y, z, b, c, w] = j;
+        let r = s2r(pivot_length + w, c, 180.0 - b);
+        [x + r[0], y + r[1], z + pivot_length + r[2]]
+    }
+
+    /// Issue 42 item 3: LinuxCNC's bridge mill, `5axiskins`: a head-head C-B machine.
+    #[test]
+    fn five_axis_bridge_follows_5axiskins() {
+        let m = load("5axis-bridge/5axis-bridge.ini");
+        assert_eq!(m.name, "test-5axis-bridge (xyzbcw)");
+        assert_eq!((m.primary_letter(), m.c_letter()), ('B', 'C'));
+        assert_eq!(m.layout(), crate::Layout::HeadHead);
+        assert_eq!((m.primary_sense, m.c_sense), (-1.0, 1.0));
+        assert!(m.standard_form().is_some());
+        assert!(m.controller.tcpm_always);
+        // Y's second joint (JOINT_6, coordinates=xyzbcwy) is the slower.
+        assert_eq!(m.limit(Axis::Y).v, 140.0);
+        assert_eq!(m.limit(Axis::Y).a, 550.0);
+        assert_eq!(m.limit(Axis::Primary).v, 45.0);
+        assert_eq!(m.limit(Axis::C).a, 240.0);
+        assert_eq!(m.primary_range_deg, (-110.0, 110.0));
+        assert_eq!(m.c_range_deg, Some((-36000.0, 36000.0)));
+        let l = 180.0;
+        assert_eq!(
+            m.chain,
+            Some(Chain {
+                c_axis_point_mm: [0.0, 0.0, l],
+                primary_axis_point_mm: [0.0, 0.0, l],
+            })
+        );
+        assert!(
+            m.warnings
+                .iter()
+                .any(|w| w.contains("moves the tool along its axis by W")),
+            "{:?}",
+            m.warnings
+        );
+        let chain = m.chain.unwrap();
+        let mut rng = crate::testutil::SplitMix64(42);
+        for _ in 0..500 {
+            let (b, c) = (rng.uniform(-110.0, 110.0), rng.uniform(-400.0, 400.0));
+            let w = rng.uniform(-60.0, 60.0);
+            let x = [
+                rng.uniform(-300.0, 300.0),
+                rng.uniform(-300.0, 300.0),
+                rng.uniform(-300.0, 50.0),
+            ];
+            // The tool axis: from the tip (W = 0) to the pivot, L above the joints.
+            let tip = five_axis_forward(l, [x[0], x[1], x[2], b, c, 0.0]);
+            let pivot = [x[0], x[1], x[2] + l];
+            let o_src = std::array::from_fn(|k| (pivot[k] - tip[k]) / l);
+            let o = forward(&m, b, c);
+            assert!(close(o, o_src, 1e-12), "B={b} C={c}: {o:?} {o_src:?}");
+            // W: the position the module gives is the tool's tip moved by −W·o, so the
+            // tip is X Y Z + W·o (what the warning says).
+            let pos_w = five_axis_forward(l, [x[0], x[1], x[2], b, c, w]);
+            let moved = std::array::from_fn(|k| pos_w[k] + w * o[k]);
+            assert!(close(moved, tip, 1e-9), "W={w}: {moved:?} {tip:?}");
+            // Without TCP (identity kinematics) the program's X Y Z are the joints: the
+            // chain puts the tip where the module does.
+            let datum = [12.0, -4.0, 30.0];
+            let x_w = std::array::from_fn(|k| tip[k] - datum[k]);
+            let p = chain.program_xyz(&m, datum, b, c, x_w);
+            let joints = std::array::from_fn(|k| p[k] + datum[k]);
+            assert!(close(joints, x, 1e-9), "{joints:?} {x:?}");
+        }
+        // pivot-length never set: the module's 250; driven at run time as in LinuxCNC's
+        // sample (the GUI's length plus the tool's): no chain, said; the tool axis the same.
+        let hal = std::fs::read_to_string(config("5axis-bridge/5axis-bridge.hal")).unwrap();
+        let set = "setp 5axiskins.pivot-length [KINS]PIVOT_LENGTH\n";
+        assert!(hal.contains(set));
+        let ini = std::fs::read_to_string(config("5axis-bridge/5axis-bridge.ini")).unwrap();
+        let with = |tag: &str, hal: &str| {
+            let dir = edited_config("5axis-bridge", tag, &[("5axis-bridge.hal", hal)]);
+            let m = machine_from_ini_text(&ini, "b.ini", Some(&dir)).unwrap();
+            std::fs::remove_dir_all(&dir).unwrap();
+            m
+        };
+        let m250 = with("default", &hal.replace(set, ""));
+        assert_eq!(m250.chain.unwrap().c_axis_point_mm, [0.0, 0.0, 250.0]);
+        let run_time = hal.replace(
+            set,
+            "loadrt sum2 names=pivotsum\naddf pivotsum servo-thread\n\
+             net :gui-pivot-len <= 5axisgui.pivot_len => pivotsum.in0\n\
+             net :tool-len <= motion.tooloffset.z => pivotsum.in1\n\
+             net :pivot-len <= pivotsum.out => 5axiskins.pivot-length\n",
+        );
+        let mrt = with("runtime", &run_time);
+        assert_eq!(mrt.chain, None);
+        assert!(
+            mrt.warnings
+                .iter()
+                .any(|w| w.contains("5axiskins.pivot-length is netted to :pivot-len")),
+            "{:?}",
+            mrt.warnings
+        );
+        assert_eq!(forward(&mrt, 30.0, 70.0), forward(&m, 30.0, 70.0));
+        // sparm=identityfirst: type 1 is 5axiskins; without remaps it never switches to it.
+        let ident = ini.replace(
+            "coordinates=xyzbcwy",
+            "coordinates=xyzbcwy sparm=identityfirst",
+        );
+        let mi = machine_from_ini_text(&ident, "b.ini", Some(&config("5axis-bridge"))).unwrap();
+        assert!(!mi.controller.tcpm_always);
+        assert!(mi.warnings.iter().any(|w| w.contains("start as identity")));
     }
 
     #[test]

@@ -94,7 +94,8 @@ pub struct Machine {
     pub controller: Controller,
     /// What the loader assumed where the source did not say (a LinuxCNC INI without jerk
     /// limits, a HAL pin it could not follow, …), one sentence each, for the caller to
-    /// print. Empty for TOML files.
+    /// print. For TOML files only a `tool_direction` pointing down (the spindle below the
+    /// tip) is said.
     pub warnings: Vec<String>,
 }
 
@@ -190,10 +191,20 @@ impl Machine {
     pub fn layout(&self) -> Layout {
         self.rotary.layout()
     }
-    /// The pole: the tool axis (unit, part frame) along the C (pole) axis, where turning C
-    /// does not change the tool axis. `[0, 0, 1]` on the built-ins.
+    /// The pole: the tool axis (unit, part frame) along the C (pole) axis line where the
+    /// machine meets it ([`Machine::pole_p_deg`]), where turning C does not change the
+    /// tool axis. `[0, 0, 1]` on the built-ins; the reverse of the pole axis' direction on
+    /// a pair whose pole in range has the tool against it; the pole axis' direction on a
+    /// pair that reaches no pole.
     pub fn pole_direction(&self) -> [f64; 3] {
-        self.rotary.c.direction
+        let a = self.rotary.c.direction;
+        if self.standard_form().is_some() {
+            return [0.0, 0.0, 1.0];
+        }
+        match self.pole() {
+            Some(p) if p.opposite => [-a[0], -a[1], -a[2]],
+            _ => a,
+        }
     }
 }
 

@@ -17,7 +17,7 @@ use crate::machine::{
     check_tcy_ms, num,
 };
 use crate::rotary::{Carrier, Rotaries, RotaryAxis, angle_rad, norm, scale};
-use crate::tolerances::MIN_AXIS_SIN;
+use crate::tolerances::{MIN_AXIS_SIN, MIN_DIRECTION_NORM};
 use serde::Deserialize;
 
 /// mm/s per m/min.
@@ -179,7 +179,8 @@ pub(crate) fn range(field: &str, r: &[f64]) -> Result<(f64, f64), String> {
     Ok((lo, hi))
 }
 
-/// A direction: three finite values, not all zero; returned as a unit vector.
+/// A direction: three finite values of length at least [`MIN_DIRECTION_NORM`]; returned
+/// as a unit vector.
 fn direction(field: &str, d: &[f64]) -> Result<[f64; 3], String> {
     let v: [f64; 3] = exactly(field, d)?;
     let n = norm(v);
@@ -188,8 +189,24 @@ fn direction(field: &str, d: &[f64]) -> Result<[f64; 3], String> {
             "{field} must be a direction (three finite values, not all zero), got {v:?}"
         ));
     }
+    if n < MIN_DIRECTION_NORM {
+        return Err(format!(
+            "{field} = [{}, {}, {}] is too short to be a direction (length {}, below {}): \
+             write it as a unit vector or in small numbers, such as [0, 1, 1]",
+            num(v[0]),
+            num(v[1]),
+            num(v[2]),
+            num(n),
+            num(MIN_DIRECTION_NORM)
+        ));
+    }
     // [0, 0, 1] and [0, 0, 2] both give exactly [0, 0, 1].
-    Ok(scale(1.0 / n, v))
+    let u = scale(1.0 / n, v);
+    // Held by the bound above; kept so that no NaN direction can ever leave here.
+    if (norm(u) - 1.0).abs().is_nan() || (norm(u) - 1.0).abs() >= 1e-12 {
+        return Err(format!("{field} = {v:?} cannot be normalised"));
+    }
+    Ok(u)
 }
 
 /// A point: three finite values, mm.
@@ -308,6 +325,24 @@ pub(crate) fn check_pair(rot: &Rotaries, names: [&str; 2]) -> Result<(), String>
         ));
     }
     Ok(())
+}
+
+/// A tool direction that points down: the spindle below the tip. A machine built so is
+/// read as written (its pole is where its geometry puts it, [`Machine::pole_p_deg`]), but
+/// the direction is from the tip towards the spindle, and a vertical spindle above the
+/// table written `[0, 0, -1]` (the way the tool points) would mirror every tip rewrite of a
+/// ball: said.
+fn tool_direction_warning(t0: [f64; 3]) -> Option<String> {
+    (t0[2] < 0.0).then(|| {
+        format!(
+            "tool_direction = [{}, {}, {}] points from the tip down to the spindle (a spindle \
+             below the part, the tool pointing up): tool_direction is from the tip towards the \
+             spindle, [0, 0, 1] for a vertical spindle above the table",
+            num(t0[0]),
+            num(t0[1]),
+            num(t0[2])
+        )
+    })
 }
 
 impl MachineFile {
@@ -434,7 +469,7 @@ impl MachineFile {
                     ],
                     chain,
                     controller,
-                    warnings: Vec::new(),
+                    warnings: tool_direction_warning(tool_direction).into_iter().collect(),
                 })
             }
             (None, None, None) => Err(
@@ -660,6 +695,23 @@ j_rev_s3 = 2
                 "direction = [0, 0, 0]",
                 "rotary[0].direction must be a direction",
             ),
+            // Issue 39: a subnormal direction was normalised to NaN and every kinematics
+            // after it was NaN ("no singular zone", "needs ANaN").
+            (
+                "direction = [0, 1, 0]",
+                "direction = [1e-320, 0, 0]",
+                "rotary[1].direction = [1e-320, 0, 0] is too short to be a direction",
+            ),
+            (
+                "direction = [0, 0, 1]",
+                "direction = [0, 0, 1e-9]",
+                "rotary[0].direction = [0, 0, 1e-9] is too short",
+            ),
+            (
+                "name = \"test-head-table\"",
+                "name = \"t\"\ntool_direction = [0, 5e-324, 0]",
+                "tool_direction = [0, 5e-324, 0] is too short",
+            ),
             (
                 "name = \"test-head-table\"",
                 "name = \"t\"\ntool_direction = [0, 1, 0]",
@@ -738,6 +790,55 @@ j_rev_s3 = 2
         let ucp = include_str!("../machines/mikron-ucp710.toml")
             .replace("tcy_ms = 1.0", "tcy_ms = 1.0\ntool_direction = [0, 0, 1]");
         assert!(invalid_message(&ucp).contains("tool_direction belongs to the [[rotary]] form"));
+    }
+
+    /// Issue 39: `tool_direction = [0, 0, -1]` (the spindle below the tip) under an A-C
+    /// table. Its tool at zero points against the C axis, so its pole in range is P = 0
+    /// with the tool against C (the tool along C needs A = 180°, beyond the travel): C
+    /// turns the tool at |A| from it there. It was measured from the pole along C, 180°
+    /// away, and SING had "no singular zone".
+    #[test]
+    fn a_tool_pointing_up_meets_its_pole_against_the_c_axis() {
+        let ucp = include_str!("../machines/mikron-ucp710-chain-form.toml");
+        let up = ucp.replace(
+            "tool_direction = [0.0, 0.0, 1.0]",
+            "tool_direction = [0.0, 0.0, -1.0]",
+        );
+        assert_ne!(up, ucp);
+        let m = Machine::from_toml_str(&up, "up.toml").unwrap();
+        assert!(m.standard_form().is_none());
+        assert_eq!(m.pole_p_deg(), Some(0.0));
+        assert_eq!(m.pole_direction(), [0.0, 0.0, -1.0]);
+        assert_eq!(forward(&m, 0.0, 77.0), [0.0, 0.0, -1.0]);
+        // The distance from the pole is |A| on both sides, as on the upright machine.
+        for a in [1.0, -1.0, 4.5, -30.0, 100.0] {
+            assert!((m.pole_tilt_deg(a) - f64::abs(a)).abs() < 1e-12, "{a}");
+        }
+        // And C cannot turn the tool there: the pole is where the geometry is singular.
+        let j = crate::forward_jacobian(&m, 0.0, 40.0);
+        assert!(j[2].iter().all(|x| x.abs() < 1e-15), "{j:?}");
+        // The tool is the upright machine's, reversed.
+        let std = Machine::builtin("mikron-ucp710").unwrap();
+        for (a, c) in [(10.0, 20.0), (-50.0, 190.0)] {
+            let (o, s) = (forward(&m, a, c), forward(&std, a, c));
+            assert!((0..3).all(|k| (o[k] + s[k]).abs() < 1e-15), "{o:?} {s:?}");
+        }
+        // Said, for a file that meant the tool's pointing direction.
+        assert!(
+            m.warnings.len() == 1 && m.warnings[0].contains("tool_direction = [0, 0, -1]"),
+            "{:?}",
+            m.warnings
+        );
+        // With a travel that holds A = 180° instead, the pole along C is the one in range.
+        let turned = up.replace("range_deg = [-100.0, 120.0]", "range_deg = [100.0, 260.0]");
+        let m = Machine::from_toml_str(&turned, "t").unwrap();
+        assert_eq!(m.pole_p_deg(), Some(180.0));
+        assert_eq!(m.pole_direction(), [0.0, 0.0, 1.0]);
+        assert!((m.pole_tilt_deg(175.0) - 5.0).abs() < 1e-12);
+        // With neither pole in range: the pole along C, as the geometry first reaches it.
+        let neither = up.replace("range_deg = [-100.0, 120.0]", "range_deg = [20.0, 60.0]");
+        let m = Machine::from_toml_str(&neither, "t").unwrap();
+        assert_eq!(m.pole_p_deg(), Some(180.0));
     }
 
     /// A pole axis along −Z with sense +1 is the standard form with sense −1: one machine.

@@ -402,20 +402,60 @@ pub(crate) fn inverse_general(rot: &Rotaries, sp: f64, sc: f64, o_wp: [f64; 3]) 
     Ik::Two(sols)
 }
 
-/// The primary angle at which the tool lies along the pole axis, degrees, if the pair
-/// reaches the pole (`δ = τ` within [`REACH_TOL_RAD`]).
-pub(crate) fn pole_p_general(rot: &Rotaries, sp: f64) -> Option<f64> {
-    let g = PairGeometry::new(rot);
-    g.betas(0.0)
-        .map(|b| crate::angles::wrap_deg(sp * b[0].to_degrees()))
+/// A pole of a pair: the primary angle, degrees, where the tool lies along the pole axis
+/// line — with it (`opposite = false`) or against it (`opposite = true`). Turning the pole
+/// axis does not change the tool axis at either.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PoleAt {
+    /// The primary angle there, degrees.
+    pub p_deg: f64,
+    /// Whether the tool there points against the pole axis' direction.
+    pub opposite: bool,
 }
 
-/// The angle between the pole axis and the tool turned by the primary axis alone,
-/// `∠(a, R(b, sp·P)·t0)`, degrees in [0, 180]; C turns the tool about the pole axis at
-/// this constant angle.
-pub(crate) fn pole_tilt_general(rot: &Rotaries, sp: f64, p_deg: f64) -> f64 {
+/// The pole a machine's programs pass near, of the two a pair may reach: the tool along the
+/// pole axis (`γ = 0`, reachable where `δ = τ`) and the tool against it (`γ = π`, reachable
+/// where `δ + τ = π`). The first whose primary angle lies within `range_deg` (a turn added
+/// where that brings it in; `γ = 0` first), else the first the geometry reaches (its P
+/// wrapped to (−180°, 180°]), else `None`: the pair has no pole.
+///
+/// A pair whose tool at zero points against the pole axis (`tool_direction = [0, 0, −1]`
+/// under a C table along `+Z`: the spindle below the tip) has its `γ = 0` pole at P = 180°,
+/// usually beyond the range, and the `γ = π` one at P = 0°, where its programs are.
+pub(crate) fn pole_general(rot: &Rotaries, sp: f64, range_deg: (f64, f64)) -> Option<PoleAt> {
+    let g = PairGeometry::new(rot);
+    let poles: Vec<PoleAt> = [(0.0, false), (std::f64::consts::PI, true)]
+        .into_iter()
+        .filter_map(|(gamma, opposite)| {
+            g.betas(gamma).map(|b| PoleAt {
+                p_deg: crate::angles::wrap_deg(sp * b[0].to_degrees()),
+                opposite,
+            })
+        })
+        .collect();
+    let (lo, hi) = range_deg;
+    let in_range = |pole: &PoleAt| {
+        let turns = ((lo - pole.p_deg) / 360.0).ceil();
+        let p = pole.p_deg + 360.0 * turns;
+        (p <= hi).then_some(PoleAt { p_deg: p, ..*pole })
+    };
+    poles
+        .iter()
+        .find_map(in_range)
+        .or_else(|| poles.first().copied())
+}
+
+/// The angle between the tool turned by the primary axis alone, `v = R(b, sp·P)·t0`, and
+/// the pole axis' direction (`opposite = false`) or its reverse (`opposite = true`),
+/// degrees in [0, 180]; C turns the tool about the pole axis at this constant angle.
+pub(crate) fn pole_tilt_general(rot: &Rotaries, sp: f64, p_deg: f64, opposite: bool) -> f64 {
     let v = rotate_deg(rot.primary.direction, sp * p_deg, rot.tool_direction);
-    angle_rad(rot.c.direction, v).to_degrees()
+    let pole = if opposite {
+        scale(-1.0, rot.c.direction)
+    } else {
+        rot.c.direction
+    };
+    angle_rad(pole, v).to_degrees()
 }
 
 #[cfg(test)]
@@ -514,10 +554,17 @@ mod tests {
                     other => panic!("P={p} C={c}: {other:?}"),
                 }
                 // The tilt from the pole is |P|.
-                let tilt = pole_tilt_general(&m.rotary, sp, p);
+                let tilt = pole_tilt_general(&m.rotary, sp, p, false);
                 assert!((tilt - wrap_deg(p).abs()).abs() < 1e-12, "{p}: {tilt}");
             }
-            assert_eq!(pole_p_general(&m.rotary, sp), Some(0.0));
+            let pole = pole_general(&m.rotary, sp, m.primary_range_deg);
+            assert_eq!(
+                pole,
+                Some(PoleAt {
+                    p_deg: 0.0,
+                    opposite: false
+                })
+            );
         }
     }
 

@@ -16,3 +16,10 @@ pub const REACH_TOL_RAD: f64 = 1e-9;
 /// the tool, that a machine file may give: below it the two axes (or the tilting axis and
 /// the tool) are parallel to within 0.0002° and cannot orient the tool.
 pub const MIN_AXIS_SIN: f64 = 1e-6;
+
+/// Smallest length a direction in a machine file may have before it is normalised
+/// (`[[rotary]] direction`, `tool_direction`). Directions are written as unit vectors or
+/// small integers (`[0, 1, 1]`); one shorter than this is a typo or garbage, and one of
+/// subnormal values (`[1e-320, 0, 0]`) cannot even be normalised (1/1e-320 overflows and
+/// the kinematics turn NaN).
+pub const MIN_DIRECTION_NORM: f64 = 1e-6;
