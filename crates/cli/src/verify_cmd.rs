@@ -39,18 +39,9 @@ pub(crate) struct VerifyArgs {
     /// Work offset X,Y,Z (mm) for a machine with a kinematic chain (as `patch`).
     #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z", allow_hyphen_values = true)]
     work_offset: Option<[f64; 3]>,
-    /// The cutter (as `patch`): ball:D, flat:D or bull:D,R.
-    #[arg(long, value_parser = polepatch::tool::Tool::parse, value_name = "KIND:D[,R]")]
-    tool: Option<polepatch::tool::Tool>,
-    /// A tool table (as `patch`).
-    #[arg(long, value_name = "FILE")]
-    tools: Option<PathBuf>,
-    /// Which point of the tool X Y Z are (as `patch`): tip or centre.
-    #[arg(long, value_parser = polepatch::tool::ToolPoint::parse, value_name = "tip|centre")]
-    tool_point: Option<polepatch::tool::ToolPoint>,
-    /// How far a flat or bull-nose cutter's surface may move, mm (as `patch`).
-    #[arg(long, value_name = "MM", default_value_t = polepatch::tool::SURFACE_TOLERANCE_MM)]
-    surface_tolerance: f64,
+    /// The cutter and the point X Y Z state (as `patch`): give them as `patch` was given.
+    #[command(flatten)]
+    tool: crate::ToolArgs,
 }
 
 impl VerifyArgs {
@@ -78,10 +69,7 @@ impl VerifyArgs {
             simulate: false,
             work_offset: self.work_offset,
             chord_tolerance: polepatch::machine_frame::CHORD_TOLERANCE_MM,
-            tool: self.tool,
-            tools: self.tools.clone(),
-            tool_point: self.tool_point,
-            surface_tolerance: self.surface_tolerance,
+            tool: self.tool.clone(),
             units: self.units,
         }
     }
