@@ -192,11 +192,9 @@ fn linuxcncs_bridgemill_demo_is_carried_through() {
 /// (`crates/patcher/src/joint.rs`, "the machine's ranges as bounds on each point's
 /// changes") force every point beyond 200° down to it, and the tool turned 6.25° in
 /// silence. The program cannot run on that machine: it is an error at the first word
-/// beyond the range (line 42, column 27: `C+211.506`). Ignored until the survey checks the
-/// ranges (`crates/polepatch/src/stream.rs`, another engineer's file: see the report of
-/// branch h-kin).
+/// beyond the range (line 42, column 27: `C+211.506`), found by the survey
+/// (`Error::BeyondRange`).
 #[test]
-#[ignore = "needs the range check in polepatch's survey (stream.rs)"]
 fn a_program_beyond_the_machines_c_range_is_refused_at_its_word() {
     let dir = temp_dir("c-range");
     let m = ucp710_edited(

@@ -75,6 +75,31 @@ pub enum Error {
         /// mikron-ucp710 has A and C`).
         fits: String,
     },
+    /// A move takes a rotary axis beyond the machine's range: the program cannot run on
+    /// that machine as written (its controller refuses it at that block), and a patch
+    /// would pull the values into the range by turning the tool (issue 39: 6.25° on SING
+    /// with C ending at 200°).
+    #[error(
+        "{path}:{line}:{column}: {letter}{value_deg} is beyond machine {machine}'s {letter} range \
+         {range} (degrees): the program was posted for another machine or range; give the \
+         machine it runs on (--machine NAME or a machine file)"
+    )]
+    BeyondRange {
+        /// File.
+        path: String,
+        /// 1-based line of the move.
+        line: usize,
+        /// 1-based column of the word.
+        column: usize,
+        /// The rotary letter.
+        letter: char,
+        /// The value the axis would reach, degrees.
+        value_deg: f64,
+        /// The machine's name.
+        machine: String,
+        /// Its range, `[lo, hi]`.
+        range: String,
+    },
     /// The program uses something polepatch does not support, at a line.
     #[error("{path}:{line}: {what}")]
     Unsupported {

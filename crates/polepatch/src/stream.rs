@@ -63,6 +63,10 @@ use std::collections::VecDeque;
 use std::io::Write;
 use std::ops::ControlFlow;
 
+/// A rotary value this far beyond the machine's range still counts as in it, degrees (the
+/// range's own round-off).
+const RANGE_SLACK_DEG: f64 = 1e-9;
+
 /// Stretches are patched in batches of about this part of the file's bytes (so that the
 /// batch's parsed programs, ~10× their bytes, stay a small part of the file's size) …
 const BATCH_FRACTION: usize = 256;
@@ -182,6 +186,19 @@ struct Survey {
     /// one that is not 0 (the axis turned, not parked).
     first_word: [Option<(usize, usize)>; 3],
     first_turn: [Option<(usize, usize)>; 3],
+    /// The first move that takes a rotary axis beyond the machine's range: the program
+    /// cannot run on it as written ([`Error::BeyondRange`]).
+    beyond_range: Option<BeyondRange>,
+}
+
+/// A rotary value beyond the machine's range, where it is programmed.
+#[derive(Debug, Clone, Copy)]
+struct BeyondRange {
+    line: usize,
+    column: usize,
+    letter: u8,
+    value_deg: f64,
+    range_deg: (f64, f64),
 }
 
 /// Why a G1 move cannot start a run: what [`Error`] a program without runs gets, from its
@@ -348,6 +365,9 @@ struct Reading<'a> {
     name: &'a str,
     /// The machine's rotary letters.
     letters: RotaryLetters,
+    /// The machine's bounded rotary ranges, degrees, by letter (the tilting axis always;
+    /// the pole axis unless it turns endlessly).
+    ranges: Vec<(u8, (f64, f64))>,
     /// The machine's distance from the pole.
     pole: crate::program::PoleDistance,
     /// How far from the pole a zone can lie (the cone, or the pole reach beyond it).
@@ -368,6 +388,13 @@ struct Reading<'a> {
     lazy_style: Option<usize>,
 }
 
+/// The machine's bounded rotary ranges by letter ([`Reading::ranges`]).
+fn ranges(machine: &Machine, letters: RotaryLetters) -> Vec<(u8, (f64, f64))> {
+    std::iter::once((letters.tilt, machine.primary_range_deg))
+        .chain(machine.c_range_deg.map(|r| (letters.pole, r)))
+        .collect()
+}
+
 impl<'a> Reading<'a> {
     /// How a patch with `opts` reads for `machine`.
     fn patch(opts: &'a crate::PatchOptions, machine: &Machine) -> Result<Self, Error> {
@@ -375,6 +402,7 @@ impl<'a> Reading<'a> {
         Ok(Reading {
             name: &opts.name,
             letters,
+            ranges: ranges(machine, letters),
             pole: crate::program::PoleDistance::of(machine),
             cone_deg: opts.patch.reach_deg(),
             fallback: opts.feed_fallback_mm_min,
@@ -388,9 +416,11 @@ impl<'a> Reading<'a> {
 
     /// How an analysis (and [`load_nc`], [`each_run`]) with `opts` reads for `machine`.
     fn analysis(opts: &'a crate::AnalyzeOptions, machine: &Machine) -> Result<Self, Error> {
+        let letters = crate::program::check_layout(machine)?;
         Ok(Reading {
             name: &opts.name,
-            letters: crate::program::check_layout(machine)?,
+            letters,
+            ranges: ranges(machine, letters),
             pole: crate::program::PoleDistance::of(machine),
             cone_deg: opts.analysis.reach_deg(),
             fallback: opts.feed_fallback_mm_min,
@@ -481,7 +511,30 @@ fn survey_once(
     let mut incremental_set_line = None;
     let mut first_word: [Option<(usize, usize)>; 3] = [None; 3];
     let mut first_turn: [Option<(usize, usize)>; 3] = [None; 3];
+    let mut beyond_range: Option<BeyondRange> = None;
     let settled = scan_blocks_with(bytes, read, |s: Scanned<'_>| {
+        // A move to a rotary value beyond the machine's range (as the controller reaches
+        // it: the unwrapped position of a direction form).
+        if beyond_range.is_none() && s.block.is_move {
+            for w in s.words {
+                let Some(&(letter, (lo, hi))) = opts.ranges.iter().find(|r| r.0 == w.letter) else {
+                    continue;
+                };
+                let idx = polepatch_nc::modal::axis_index(letter).unwrap_or(0);
+                if let Some(v) = s.state.pos[idx]
+                    && !(lo - RANGE_SLACK_DEG..=hi + RANGE_SLACK_DEG).contains(&v)
+                {
+                    beyond_range = Some(BeyondRange {
+                        line: s.block.line,
+                        column: (w.start as usize).saturating_sub(s.block.span().start) + 1,
+                        letter,
+                        value_deg: v,
+                        range_deg: (lo, hi),
+                    });
+                    break;
+                }
+            }
+        }
         if s.state.incremental && !prev.incremental {
             incremental_set_line = Some(s.block.line);
         }
@@ -586,6 +639,7 @@ fn survey_once(
             first_vector,
             first_word,
             first_turn,
+            beyond_range,
         },
         settled,
     ))
@@ -726,6 +780,17 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
             } else {
                 format!("; the built-in {}", fits.join(", the built-in "))
             },
+        });
+    }
+    if let Some(b) = sv.beyond_range.filter(|_| in_use == own) {
+        return Err(Error::BeyondRange {
+            path: rd.name.to_string(),
+            line: b.line,
+            column: b.column,
+            letter: b.letter as char,
+            value_deg: b.value_deg,
+            machine: machine.name.clone(),
+            range: format!("[{}, {}]", b.range_deg.0, b.range_deg.1),
         });
     }
     let why = if sv.runs.is_empty() {

@@ -4,7 +4,7 @@
 //!
 //! | Rust | Python | attributes |
 //! |---|---|---|
-//! | `Error::Parse`, `Error::Cl`, `Error::ForeignAxis` | `InputError` | `path`, `line`, `column` |
+//! | `Error::Parse`, `Error::Cl`, `Error::ForeignAxis`, `Error::BeyondRange` | `InputError` | `path`, `line`, `column` |
 //! | `Error::Unsupported` | `InputError` | `path`, `line` (`column` None) |
 //! | `Error::Empty`, `NoRuns`, `NoRotary` (only where a call needs motion: `reorient`, `simulate`) | `InputError` | `path` |
 //! | `Error::Point`, `Error::OutOfRange` | `InputError` | `index` (the array row) |
@@ -174,6 +174,12 @@ pub(crate) fn to_python(py: Python<'_>, failure: Failure) -> PyErr {
                     input_error(py, message, path(p), Some(record.line), Some(record.column))
                 }
                 Error::ForeignAxis {
+                    path: p,
+                    line,
+                    column,
+                    ..
+                }
+                | Error::BeyondRange {
                     path: p,
                     line,
                     column,
