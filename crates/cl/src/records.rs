@@ -126,6 +126,10 @@ pub enum ClItem {
         /// Where the record is.
         at: At,
     },
+    /// `CUTTER/…`, `TLDATA/…` (Creo also writes `$$-> CUTTER / d`): the cutter of the
+    /// moves after it ([`Cutter`]). It does not move the machine; `post` reads it for the
+    /// tool the patch keeps on the part.
+    Cutter(Cutter),
     /// `SPINDL/…`: speed and/or direction.
     Spindle {
         /// Speed, rpm (`None`: unchanged).
@@ -174,6 +178,21 @@ pub enum ClItem {
         /// Where the record is.
         at: At,
     },
+}
+
+/// A cutter description: APT `CUTTER/d[,r[,e,f[,α[,β[,h]]]]]` (d the diameter, r the corner
+/// radius, e f the corner's centre, α the base angle, β the side angle, h the height), NX
+/// `TLDATA/MILL,d,r,l,taper,tip[,…]`, Creo's `$$-> CUTTER / d`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cutter {
+    /// Diameter and corner radius, mm, of an end mill (flat, bull-nose or ball: no base,
+    /// side, taper or tip angle); `None` for a cutter of another shape (a drill, a chamfer
+    /// or tapered mill) or values not read.
+    pub end_mill_mm: Option<(f64, f64)>,
+    /// The record as written (its first line, trimmed), for messages.
+    pub text: String,
+    /// Where the record is.
+    pub at: At,
 }
 
 /// A CL file read.

@@ -561,6 +561,8 @@ impl Poster<'_> {
                 self.items.push(Item::Raw(text.clone()));
                 Ok(())
             }
+            // Nothing to write (it does not move the machine).
+            ClItem::Cutter(_) => Ok(()),
         }
     }
 
