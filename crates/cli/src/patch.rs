@@ -121,6 +121,7 @@ pub(crate) fn file_options(args: &PatchArgs) -> Result<polepatch::PatchOptions> 
             table,
             point: args.tool_point,
             surface_tolerance_mm: args.surface_tolerance,
+            ..polepatch::tool::ToolOptions::default()
         },
         inch: args.units == Some(crate::UnitsArg::Inch),
         ..polepatch::PatchOptions::default()

@@ -849,7 +849,7 @@ pub fn patch_nc_hooked(
     result?;
     out.write_all(&bytes[copied_to..]).map_err(Error::Output)?;
     (hooks.progress)(bytes.len(), bytes.len());
-    report.warn_unknown_tool();
+    report.warn_tools();
     Ok(report)
 }
 
@@ -1128,10 +1128,10 @@ fn each_stretch<T: Send>(
         // After the runs this block ends: a tool change is the next run's.
         tracker.block(
             sv.dialect,
-            s.block.line,
+            s.block,
             &bytes[s.block.span()],
             s.words,
-            s.state.inch,
+            s.state,
         );
         while done
             .front()
