@@ -25,7 +25,8 @@ use crate::arcs::Arc;
 use crate::cycles::{Cycle, CycleContext, CycleRecord, parse_cycle};
 use crate::frames::{Frames, refused_frame_record};
 use crate::records::{
-    At, ClItem, ClPoint, ClProgram, CompSide, Coolant, Cutter, MoveKind, SpindleDir, Units,
+    At, ClItem, ClPoint, ClProgram, CompSide, Coolant, Cutter, CutterShape, MoveKind, SpindleDir,
+    Units,
 };
 use crate::values::{coordinate, number};
 use crate::{ClError, MAX_FEED_MM_MIN, MAX_SPINDLE_RPM, MM_PER_INCH, ParseOptions, err, unit_axis};
@@ -65,6 +66,8 @@ pub const POSTED: &[&str] = &[
 
 /// One record: its text (continuation lines joined) and where each piece came from.
 struct Record {
+    /// Read from a comment (Creo's `$$-> CUTTER / d`).
+    from_comment: bool,
     text: String,
     /// (offset in `text`, line, column of that byte): one entry per joined line.
     pieces: Vec<(usize, usize, usize)>,
@@ -126,6 +129,7 @@ fn records(text: &str) -> Result<Vec<Record>, ClError> {
                 if let Some(k) = creo_cutter(&raw[p..]) {
                     comment_continues = false;
                     out.push(Record {
+                        from_comment: true,
                         text: raw[p + k..].trim_end().to_string(),
                         pieces: vec![(0, line_no, p + k + 1)],
                     });
@@ -143,6 +147,7 @@ fn records(text: &str) -> Result<Vec<Record>, ClError> {
         };
         let lead = body.len() - body.trim_start().len();
         let rec = cur.get_or_insert_with(|| Record {
+            from_comment: false,
             text: String::new(),
             pieces: Vec::new(),
         });
@@ -846,25 +851,31 @@ impl Reader<'_> {
             "TLDATA" => None,
             _ => f.iter().map(|(t, _)| t.parse().ok()).collect(),
         };
-        let end_mill = nums.and_then(|v| {
+        let s = self.scale();
+        let shape = nums.map_or(CutterShape::Other, |v| {
             let zero = |x: Option<&f64>| x.is_none_or(|&a| a == 0.0);
-            let ok = match word {
+            let end_mill = match word {
                 // d, r, length, taper angle, tip angle.
                 "TLDATA" => v.len() >= 2 && zero(v.get(3)) && zero(v.get(4)),
                 // d, r, e, f, base angle α, side angle β, height.
                 _ => !v.is_empty() && zero(v.get(4)) && zero(v.get(5)),
             };
-            ok.then(|| (v[0], v.get(1).copied().unwrap_or(0.0)))
+            match v.as_slice() {
+                // Creo writes its comment with the diameter alone for every tool.
+                [d] if rec.from_comment => CutterShape::DiameterOnly { diameter_mm: d * s },
+                [d, ..] if end_mill => CutterShape::EndMill {
+                    diameter_mm: d * s,
+                    corner_radius_mm: v.get(1).copied().unwrap_or(0.0) * s,
+                },
+                _ => CutterShape::Other,
+            }
         });
-        let s = self.scale();
         if !self.units_seen {
             self.cutters_before_units.push(self.prog.items.len());
         }
-        self.prog.items.push(ClItem::Cutter(Cutter {
-            end_mill_mm: end_mill.map(|(d, r)| (d * s, r * s)),
-            text,
-            at,
-        }));
+        self.prog
+            .items
+            .push(ClItem::Cutter(Cutter { shape, text, at }));
     }
 
     fn loadtl(&mut self, word: &str, f: &[(&str, At)], at: At) -> Result<(), ClError> {
@@ -1095,13 +1106,18 @@ pub fn parse_apt(text: &str, opts: &ParseOptions) -> Result<ClProgram, ClError> 
     // A cutter described before the units record is in the file's units.
     if r.prog.units == Units::Inch {
         for &k in &r.cutters_before_units {
-            if let ClItem::Cutter(Cutter {
-                end_mill_mm: Some((d, cr)),
-                ..
-            }) = &mut r.prog.items[k]
-            {
-                *d *= MM_PER_INCH;
-                *cr *= MM_PER_INCH;
+            if let ClItem::Cutter(c) = &mut r.prog.items[k] {
+                match &mut c.shape {
+                    CutterShape::EndMill {
+                        diameter_mm,
+                        corner_radius_mm,
+                    } => {
+                        *diameter_mm *= MM_PER_INCH;
+                        *corner_radius_mm *= MM_PER_INCH;
+                    }
+                    CutterShape::DiameterOnly { diameter_mm } => *diameter_mm *= MM_PER_INCH,
+                    CutterShape::Other => {}
+                }
             }
         }
     }
@@ -1116,7 +1132,7 @@ pub fn parse_apt(text: &str, opts: &ParseOptions) -> Result<ClProgram, ClError> 
 
 #[cfg(test)]
 mod tests {
-    use crate::records::Cutter;
+    use crate::records::{Cutter, CutterShape};
     use crate::{
         ClItem, CompSide, Coolant, CycleKind, MoveKind, ParseOptions, SpindleDir, Units, parse,
         parse_with, to_apt, to_csv,
@@ -1147,7 +1163,10 @@ mod tests {
         assert!(matches!(
             p.items[1],
             ClItem::Cutter(Cutter {
-                end_mill_mm: Some((6.0, 0.0)),
+                shape: CutterShape::EndMill {
+                    diameter_mm: 6.0,
+                    corner_radius_mm: 0.0
+                },
                 ..
             })
         ));
@@ -1358,28 +1377,32 @@ mod tests {
             .items
             .iter()
             .filter_map(|i| match i {
-                ClItem::Cutter(c) => Some((c.end_mill_mm, c.at.line, c.at.column)),
+                ClItem::Cutter(c) => Some((c.shape, c.at.line, c.at.column)),
                 _ => None,
             })
             .collect();
+        let mill = |d: f64, r: f64| CutterShape::EndMill {
+            diameter_mm: d,
+            corner_radius_mm: r,
+        };
         assert_eq!(
             cutters,
             [
-                (Some((10.0, 5.0)), 2, 1),
-                (None, 3, 1),
-                (Some((32.0, 5.0)), 4, 1),
-                (None, 5, 1),
-                (Some((6.0, 0.0)), 6, 8),
+                (mill(10.0, 5.0), 2, 1),
+                (CutterShape::Other, 3, 1),
+                (mill(32.0, 5.0), 4, 1),
+                (CutterShape::Other, 5, 1),
+                (CutterShape::DiameterOnly { diameter_mm: 6.0 }, 6, 8),
                 // A side angle: tapered.
-                (None, 7, 1),
-                (None, 8, 1),
+                (CutterShape::Other, 7, 1),
+                (CutterShape::Other, 8, 1),
             ]
         );
         assert_eq!(p.records["CUTTER"], 5);
         let inch = parse(b"CUTTER/.5,.25\nUNITS/INCHES\nGOTO/0,0,0\n").unwrap();
         assert!(matches!(
             inch.items[0],
-            ClItem::Cutter(Cutter { end_mill_mm: Some((d, r)), .. }) if (d - 12.7).abs() < 1e-12 && (r - 6.35).abs() < 1e-12
+            ClItem::Cutter(Cutter { shape: CutterShape::EndMill { diameter_mm: d, corner_radius_mm: r }, .. }) if (d - 12.7).abs() < 1e-12 && (r - 6.35).abs() < 1e-12
         ));
     }
 
@@ -1408,7 +1431,7 @@ mod tests {
                 ClItem::Stop { optional, .. } => format!("stop {optional}"),
                 ClItem::Comment(c) => c.clone(),
                 ClItem::Insert { text, .. } => format!("insert {text}"),
-                ClItem::Cutter(c) => format!("cutter {:?}", c.end_mill_mm),
+                ClItem::Cutter(c) => format!("cutter {:?}", c.shape),
                 ClItem::Move(_) => unreachable!(),
             })
             .collect();

@@ -29,7 +29,9 @@ pub mod write;
 
 pub use arcs::{Arc, Plane};
 pub use cycles::{Cycle, CycleKind};
-pub use records::{ClItem, ClPoint, ClProgram, CompSide, Coolant, MoveKind, SpindleDir, Units};
+pub use records::{
+    ClItem, ClPoint, ClProgram, CompSide, Coolant, Cutter, CutterShape, MoveKind, SpindleDir, Units,
+};
 pub use write::{to_apt, to_csv};
 
 /// A tool axis may differ from unit length by this much (CAM files round to 4–7

@@ -185,14 +185,33 @@ pub enum ClItem {
 /// `TLDATA/MILL,d,r,l,taper,tip[,…]`, Creo's `$$-> CUTTER / d`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Cutter {
-    /// Diameter and corner radius, mm, of an end mill (flat, bull-nose or ball: no base,
-    /// side, taper or tip angle); `None` for a cutter of another shape (a drill, a chamfer
-    /// or tapered mill) or values not read.
-    pub end_mill_mm: Option<(f64, f64)>,
+    /// Its shape, mm.
+    pub shape: CutterShape,
     /// The record as written (its first line, trimmed), for messages.
     pub text: String,
     /// Where the record is.
     pub at: At,
+}
+
+/// What a [`Cutter`] record says of the cutter's shape, lengths in mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum CutterShape {
+    /// An end mill (flat, bull-nose or ball: no base, side, taper or tip angle); APT's
+    /// `CUTTER/d` is a flat end mill of diameter d.
+    EndMill {
+        /// Diameter, mm.
+        diameter_mm: f64,
+        /// Corner radius, mm.
+        corner_radius_mm: f64,
+    },
+    /// A diameter without the shape of the end: Creo's `$$-> CUTTER / d`, which Creo writes
+    /// for every kind of tool.
+    DiameterOnly {
+        /// Diameter, mm.
+        diameter_mm: f64,
+    },
+    /// Another shape (a drill, a chamfer or tapered mill), or values not read.
+    Other,
 }
 
 /// A CL file read.

@@ -48,7 +48,7 @@
 //! | Mastercam | `( TOOL - 12 3/16 BALL ENDMILL DIA. OFF. - 12 LEN. - 12 DIA. - .1875 )`, `( T1 \| 1/4 BALL ENDMILL \| H1 \| D1 \| TOOL DIA. - .25 )` (`D1` the offset register) | DIA., `BALL`/`FLAT`/`ENDMILL` in the name | number |
 //! | PowerMill | `( NO. \| ID \| DIA.\| TIP RAD\|LENGTH)` … `(    1\|name\| 4.0 \|  0.0 \| 75.0 )` | DIA., TIP RAD | number |
 //! | `TOOL: Tn = d dia.` (LinuxCNC's boat demos) | `( TOOL: T1 = 10.0 dia. ENDMILLM1000:REG )` | dia., the type text | number |
-//! | APT / NX CL (`post`) | `CUTTER/10,5,0,5,0,0,75`, `TLDATA/MILL,10,5,75,0,0`, Creo's `$$-> CUTTER / 6` | d, r (no base, side, taper or tip angle) | the `LOADTL/` after it, or before it with no move between |
+//! | APT / NX CL (`post`) | `CUTTER/10,5,0,5,0,0,75`, `TLDATA/MILL,10,5,75,0,0` (Creo's `$$-> CUTTER / 6` is read and said: a diameter without its end's shape, no tool) | d, r (no base, side, taper or tip angle) | the `LOADTL/` after it, or before it with no move between |
 //!
 //! Forms seen in real programs and not read (they state no diameter, or only inside a
 //! name): NX's `;TOOL NO. :8` / `;TOOL TYPE :Milling Tool-5 Parameters`, `( *** TOOL CHANGE:
@@ -76,7 +76,7 @@
 //! A CL file's `CUTTER/` is in the file's units likewise.
 
 use crate::error::Error;
-use polepatch_cl::{ClItem, ClProgram};
+use polepatch_cl::{ClItem, ClProgram, CutterShape};
 use polepatch_nc::{Block, Dialect, Flags, Modal, Word};
 use std::collections::HashMap;
 
@@ -407,7 +407,7 @@ impl ClTools {
 /// The cutters of a CL file's `CUTTER/` and `TLDATA/` records ([`polepatch_cl::Cutter`]),
 /// by the tool each describes: the cutter in force (the last record before) at the first
 /// move after each `LOADTL/` — so one written before its `LOADTL/` (CAMWorks, NX) or after
-/// it (Creo: `LOADTL / 2` then `$$-> CUTTER / 6`) — and, before any `LOADTL/`, at the first
+/// it (Creo's order: `LOADTL / 2`, then the cutter) — and, before any `LOADTL/`, at the first
 /// move. A cutter that changes between the moves of one tool, or a number loaded again with
 /// another cutter, leaves that tool unknown (its source says why).
 pub fn cl_tools(cl: &ClProgram) -> ClTools {
@@ -419,11 +419,23 @@ pub fn cl_tools(cl: &ClProgram) -> ClTools {
     for item in &cl.items {
         match item {
             ClItem::Cutter(c) => {
-                let tool = c.end_mill_mm.and_then(|(d, r)| Tool::from_geometry(d, r));
                 let src = format!("CL line {}: {}", c.at.line, c.text);
-                current = Some(match tool {
-                    Some(_) => (tool, src),
-                    None => (None, format!("{src} (no end mill polepatch models)")),
+                current = Some(match c.shape {
+                    CutterShape::EndMill {
+                        diameter_mm,
+                        corner_radius_mm,
+                    } => match Tool::from_geometry(diameter_mm, corner_radius_mm) {
+                        Some(t) => (Some(t), src),
+                        None => (None, format!("{src} (no cutter polepatch models)")),
+                    },
+                    CutterShape::DiameterOnly { diameter_mm } => (
+                        None,
+                        format!(
+                            "{src} (a diameter, {diameter_mm} mm, without the shape of its end: \
+                             Creo writes this comment for every kind of tool)"
+                        ),
+                    ),
+                    CutterShape::Other => (None, format!("{src} (no end mill polepatch models)")),
                 });
                 fresh = true;
             }
@@ -1923,8 +1935,8 @@ mod tests {
     }
 
     /// Several cutters: each for the tool whose moves it comes before, written before its
-    /// LOADTL (CAMWorks) or after it (Creo's commented form); a cutter changing between one
-    /// tool's moves leaves it unknown.
+    /// LOADTL (CAMWorks) or after it (Creo's order); Creo's commented diameter is no
+    /// shape; a cutter changing between one tool's moves leaves it unknown.
     #[test]
     fn cl_cutters_per_tool() {
         let camworks = "CUTTER/10,5,0,5,0,0,75\nLOADTL/1\nGOTO/0,0,0\nGOTO/1,0,0\n\
@@ -1933,13 +1945,20 @@ mod tests {
         assert_eq!(cl_tool(&c, 1), Some(Tool::parse("ball:10").unwrap()));
         assert_eq!(cl_tool(&c, 2), Some(Tool::parse("flat:12").unwrap()));
         assert!(c.by_tool[&2].1.starts_with("CL line 5:"), "{:?}", c.by_tool);
-        let after =
-            "LOADTL/1\nCUTTER/10,5\nGOTO/0,0,0\nLOADTL/2\n$$-> CUTTER / 12.000000\nGOTO/0,0,0\n";
+        let after = "LOADTL/1\nCUTTER/10,5\nGOTO/0,0,0\nLOADTL/2\nCUTTER / 12.000000\nGOTO/0,0,0\n";
         let c = cl(after);
         assert_eq!(cl_tool(&c, 1), Some(Tool::parse("ball:10").unwrap()));
         assert_eq!(cl_tool(&c, 2), Some(Tool::parse("flat:12").unwrap()));
         assert!(
             c.by_tool[&2].1.starts_with("CL line 5: CUTTER / 12"),
+            "{:?}",
+            c.by_tool
+        );
+        // Creo's comment: the diameter, not the kind: said, no tool.
+        let c = cl("LOADTL / 2\n$$-> CUTTER / 6.000000\nGOTO / 0, 0, 0\n");
+        assert_eq!(cl_tool(&c, 2), None);
+        assert!(
+            c.by_tool[&2].1.contains("without the shape of its end"),
             "{:?}",
             c.by_tool
         );
