@@ -9,7 +9,9 @@
 //!   `TLAXIS`, `UNITS`/`UNIT`, `PARTNO`/`PPRINT`/`TPRINT` (comments), `INSERT` (its text
 //!   written into the program as it is, and listed in [`ClProgram::notes`]; it can still be
 //!   skipped with `--ignore INSERT`);
-//! - read, no effect on the motion (counted): [`PASSIVE`];
+//! - read, no effect on the motion (counted): [`PASSIVE`]; of them `CUTTER` and `TLDATA`
+//!   (and Creo's `$$-> CUTTER / d`, a comment Creo writes for it) become
+//!   [`ClItem::Cutter`], the cutter of the moves after it;
 //! - frames ([`crate::frames`]): `TRNTYP/WORLD,0,0,0` and `CSYS` (CAMWorks: the values
 //!   stay world coordinates; `CSYS` gives the setup's tool axis for 3-value `GOTO`s),
 //!   `MSYS` (NX: the values are in that MCS; another MCS later is refused); `TRACUT`,
@@ -23,7 +25,8 @@ use crate::arcs::Arc;
 use crate::cycles::{Cycle, CycleContext, CycleRecord, parse_cycle};
 use crate::frames::{Frames, refused_frame_record};
 use crate::records::{
-    At, ClItem, ClPoint, ClProgram, CompSide, Coolant, MoveKind, SpindleDir, Units,
+    At, ClItem, ClPoint, ClProgram, CompSide, Coolant, Cutter, CutterShape, MoveKind, SpindleDir,
+    Units,
 };
 use crate::values::{coordinate, number};
 use crate::{ClError, MAX_FEED_MM_MIN, MAX_SPINDLE_RPM, MM_PER_INCH, ParseOptions, err, unit_axis};
@@ -64,6 +67,8 @@ pub const POSTED: &[&str] = &[
 
 /// One record: its text (continuation lines joined) and where each piece came from.
 struct Record {
+    /// Read from a comment (Creo's `$$-> CUTTER / d`).
+    from_comment: bool,
     text: String,
     /// (offset in `text`, line, column of that byte): one entry per joined line.
     pieces: Vec<(usize, usize, usize)>,
@@ -118,7 +123,24 @@ fn records(text: &str) -> Result<Vec<Record>, ClError> {
         if let Some(p) = raw.find("$$") {
             comment_continues = raw[p + 2..].trim_end().ends_with('$');
         }
-        let code = raw.find("$$").map_or(raw, |p| &raw[..p]);
+        let code = match raw.find("$$") {
+            // Creo states the cutter in a comment of its own, `$$-> CUTTER / 6.000000`: read
+            // as the record it names (its columns the file's).
+            Some(p) if cur.is_none() && raw[..p].trim().is_empty() => {
+                if let Some(k) = creo_cutter(&raw[p..]) {
+                    comment_continues = false;
+                    out.push(Record {
+                        from_comment: true,
+                        text: raw[p + k..].trim_end().to_string(),
+                        pieces: vec![(0, line_no, p + k + 1)],
+                    });
+                    continue;
+                }
+                &raw[..p]
+            }
+            Some(p) => &raw[..p],
+            None => raw,
+        };
         let trimmed = code.trim_end();
         let (body, continued) = match trimmed.strip_suffix('$') {
             Some(b) => (b, true),
@@ -126,6 +148,7 @@ fn records(text: &str) -> Result<Vec<Record>, ClError> {
         };
         let lead = body.len() - body.trim_start().len();
         let rec = cur.get_or_insert_with(|| Record {
+            from_comment: false,
             text: String::new(),
             pieces: Vec::new(),
         });
@@ -154,6 +177,16 @@ fn records(text: &str) -> Result<Vec<Record>, ClError> {
         ));
     }
     Ok(out)
+}
+
+/// Where the record starts in a Creo `$$-> CUTTER / d` comment (`comment` from its `$$`).
+fn creo_cutter(comment: &str) -> Option<usize> {
+    let rest = comment.strip_prefix("$$->")?;
+    let lead = rest.len() - rest.trim_start().len();
+    let body = rest.trim_start();
+    let word = body.get(..6)?;
+    (word.eq_ignore_ascii_case("CUTTER") && body[6..].trim_start().starts_with('/'))
+        .then_some(4 + lead)
 }
 
 /// A `CIRCLE`/`MOVARC` record waiting for the `GOTO` of its end point.
@@ -194,6 +227,9 @@ struct Reader<'o> {
     spindle_dir: Option<SpindleDir>,
     /// `CUTCOM/ON` waiting for its side.
     cutcom_on: Option<At>,
+    /// Items of cutters read before the first units record: in the file's units, scaled
+    /// when they are known (a CL file's values are all in its units).
+    cutters_before_units: Vec<usize>,
 }
 
 /// Whether `w` can be an APT major word: a letter, then letters, digits, `_`, `-` or
@@ -365,6 +401,7 @@ impl Reader<'_> {
             "CIRCLE" | "MOVARC" => self.circle(&word, &f, at0)?,
             "CYCLE" => self.cycle(&f, at0)?,
             "LOADTL" | "LOAD" => self.loadtl(&word, &f, at0)?,
+            "CUTTER" | "TLDATA" => self.cutter(&word, &f, rec, at0),
             "SPINDL" => self.spindl(&f, at0)?,
             "COOLNT" => self.coolnt(&f, at0)?,
             "CUTCOM" => self.cutcom(&f, at0)?,
@@ -811,6 +848,49 @@ impl Reader<'_> {
         Ok(())
     }
 
+    /// `CUTTER/…` or `TLDATA/…`: the cutter's shape, where it is an end mill
+    /// ([`Cutter`]). Never an error: the record does not move the machine, and a cutter
+    /// polepatch cannot read is an unknown tool to the patch.
+    fn cutter(&mut self, word: &str, f: &[(&str, At)], rec: &Record, at: At) {
+        let text = rec.text.trim();
+        let text: String = text.chars().take(80).collect();
+        let kind = f
+            .first()
+            .map(|(t, _)| t.to_ascii_uppercase())
+            .unwrap_or_default();
+        let nums: Option<Vec<f64>> = match word {
+            // `TLDATA/MILL,d,r,l,taper,tip,…`.
+            "TLDATA" if kind == "MILL" => f[1..].iter().map(|(t, _)| t.parse().ok()).collect(),
+            "TLDATA" => None,
+            _ => f.iter().map(|(t, _)| t.parse().ok()).collect(),
+        };
+        let s = self.scale();
+        let shape = nums.map_or(CutterShape::Other, |v| {
+            let zero = |x: Option<&f64>| x.is_none_or(|&a| a == 0.0);
+            let end_mill = match word {
+                // d, r, length, taper angle, tip angle.
+                "TLDATA" => v.len() >= 2 && zero(v.get(3)) && zero(v.get(4)),
+                // d, r, e, f, base angle α, side angle β, height.
+                _ => !v.is_empty() && zero(v.get(4)) && zero(v.get(5)),
+            };
+            match v.as_slice() {
+                // Creo writes its comment with the diameter alone for every tool.
+                [d] if rec.from_comment => CutterShape::DiameterOnly { diameter_mm: d * s },
+                [d, ..] if end_mill => CutterShape::EndMill {
+                    diameter_mm: d * s,
+                    corner_radius_mm: v.get(1).copied().unwrap_or(0.0) * s,
+                },
+                _ => CutterShape::Other,
+            }
+        });
+        if !self.units_seen {
+            self.cutters_before_units.push(self.prog.items.len());
+        }
+        self.prog
+            .items
+            .push(ClItem::Cutter(Cutter { shape, text, at }));
+    }
+
     fn loadtl(&mut self, word: &str, f: &[(&str, At)], at: At) -> Result<(), ClError> {
         // `LOAD/TOOL,n,…` (NX) is `LOADTL/n,…`.
         let f = if word == "LOAD" {
@@ -1034,9 +1114,28 @@ pub fn parse_apt(text: &str, opts: &ParseOptions) -> Result<ClProgram, ClError> 
         spindle_rpm: None,
         spindle_dir: None,
         cutcom_on: None,
+        cutters_before_units: Vec::new(),
     };
     for rec in records(text)? {
         r.record(&rec)?;
+    }
+    // A cutter described before the units record is in the file's units.
+    if r.prog.units == Units::Inch {
+        for &k in &r.cutters_before_units {
+            if let ClItem::Cutter(c) = &mut r.prog.items[k] {
+                match &mut c.shape {
+                    CutterShape::EndMill {
+                        diameter_mm,
+                        corner_radius_mm,
+                    } => {
+                        *diameter_mm *= MM_PER_INCH;
+                        *corner_radius_mm *= MM_PER_INCH;
+                    }
+                    CutterShape::DiameterOnly { diameter_mm } => *diameter_mm *= MM_PER_INCH,
+                    CutterShape::Other => {}
+                }
+            }
+        }
     }
     if let Some(c) = r.circle {
         return Err(e(c.at, "CIRCLE without the GOTO of its end point"));
@@ -1049,6 +1148,7 @@ pub fn parse_apt(text: &str, opts: &ParseOptions) -> Result<ClProgram, ClError> 
 
 #[cfg(test)]
 mod tests {
+    use crate::records::{Cutter, CutterShape};
     use crate::{
         ClItem, CompSide, Coolant, CycleKind, MoveKind, ParseOptions, SpindleDir, Units, parse,
         parse_with, to_apt, to_csv,
@@ -1075,8 +1175,19 @@ mod tests {
         assert_eq!(p.records["CUTTER"], 1);
         assert_eq!(p.records["GOTO"], 3);
         assert!(p.notes.iter().any(|n| n.contains("PPRINT END OF PASS")));
+        // `CUTTER/6.0`: a flat end mill, for the tool loaded after it.
         assert!(matches!(
             p.items[1],
+            ClItem::Cutter(Cutter {
+                shape: CutterShape::EndMill {
+                    diameter_mm: 6.0,
+                    corner_radius_mm: 0.0
+                },
+                ..
+            })
+        ));
+        assert!(matches!(
+            p.items[2],
             ClItem::ToolChange {
                 tool: 5,
                 length_offset: 5,
@@ -1268,6 +1379,49 @@ mod tests {
         assert_eq!((c.kind, c.feed_mm_min), (CycleKind::Tap, 1250.0));
     }
 
+    /// `CUTTER/` and `TLDATA/` as end mills (mm, the file's units), other shapes as none,
+    /// Creo's commented `$$-> CUTTER / d` read at its own column; none is an error.
+    #[test]
+    fn cutters() {
+        let p = parse(
+            b"UNITS/MM\nCUTTER/10,5,0,5,0,0,75\nCUTTER/6.5,0,3.25,1.95,31.,0,105.\n\
+              TLDATA/MILL,32.0,5.0,75.0,0.0,0.0\nTLDATA/DRILL,8,118\n  $$-> CUTTER / 6.000000\n\
+              CUTTER/10,0,5,0,0,10,60\nCUTTER/x\nGOTO/0,0,0\n",
+        )
+        .unwrap();
+        let cutters: Vec<_> = p
+            .items
+            .iter()
+            .filter_map(|i| match i {
+                ClItem::Cutter(c) => Some((c.shape, c.at.line, c.at.column)),
+                _ => None,
+            })
+            .collect();
+        let mill = |d: f64, r: f64| CutterShape::EndMill {
+            diameter_mm: d,
+            corner_radius_mm: r,
+        };
+        assert_eq!(
+            cutters,
+            [
+                (mill(10.0, 5.0), 2, 1),
+                (CutterShape::Other, 3, 1),
+                (mill(32.0, 5.0), 4, 1),
+                (CutterShape::Other, 5, 1),
+                (CutterShape::DiameterOnly { diameter_mm: 6.0 }, 6, 8),
+                // A side angle: tapered.
+                (CutterShape::Other, 7, 1),
+                (CutterShape::Other, 8, 1),
+            ]
+        );
+        assert_eq!(p.records["CUTTER"], 5);
+        let inch = parse(b"CUTTER/.5,.25\nUNITS/INCHES\nGOTO/0,0,0\n").unwrap();
+        assert!(matches!(
+            inch.items[0],
+            ClItem::Cutter(Cutter { shape: CutterShape::EndMill { diameter_mm: d, corner_radius_mm: r }, .. }) if (d - 12.7).abs() < 1e-12 && (r - 6.35).abs() < 1e-12
+        ));
+    }
+
     #[test]
     fn set_up_records() {
         let p = parse(
@@ -1293,6 +1447,7 @@ mod tests {
                 ClItem::Stop { optional, .. } => format!("stop {optional}"),
                 ClItem::Comment(c) => c.clone(),
                 ClItem::Insert { text, .. } => format!("insert {text}"),
+                ClItem::Cutter(c) => format!("cutter {:?}", c.shape),
                 ClItem::Move(_) => unreachable!(),
             })
             .collect();

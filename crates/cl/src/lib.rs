@@ -30,7 +30,8 @@ pub mod write;
 pub use arcs::{Arc, Plane};
 pub use cycles::{Cycle, CycleKind};
 pub use records::{
-    ClItem, ClPoint, ClProgram, CompSide, Coolant, MoveKind, Skipped, SpindleDir, Units,
+    ClItem, ClPoint, ClProgram, CompSide, Coolant, Cutter, CutterShape, MoveKind, Skipped,
+    SpindleDir, Units,
 };
 pub use write::{to_apt, to_csv};
 

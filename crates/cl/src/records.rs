@@ -126,6 +126,10 @@ pub enum ClItem {
         /// Where the record is.
         at: At,
     },
+    /// `CUTTER/…`, `TLDATA/…` (Creo also writes `$$-> CUTTER / d`): the cutter of the
+    /// moves after it ([`Cutter`]). It does not move the machine; `post` reads it for the
+    /// tool the patch keeps on the part.
+    Cutter(Cutter),
     /// `SPINDL/…`: speed and/or direction.
     Spindle {
         /// Speed, rpm (`None`: unchanged).
@@ -174,6 +178,40 @@ pub enum ClItem {
         /// Where the record is.
         at: At,
     },
+}
+
+/// A cutter description: APT `CUTTER/d[,r[,e,f[,α[,β[,h]]]]]` (d the diameter, r the corner
+/// radius, e f the corner's centre, α the base angle, β the side angle, h the height), NX
+/// `TLDATA/MILL,d,r,l,taper,tip[,…]`, Creo's `$$-> CUTTER / d`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cutter {
+    /// Its shape, mm.
+    pub shape: CutterShape,
+    /// The record as written (its first line, trimmed), for messages.
+    pub text: String,
+    /// Where the record is.
+    pub at: At,
+}
+
+/// What a [`Cutter`] record says of the cutter's shape, lengths in mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum CutterShape {
+    /// An end mill (flat, bull-nose or ball: no base, side, taper or tip angle); APT's
+    /// `CUTTER/d` is a flat end mill of diameter d.
+    EndMill {
+        /// Diameter, mm.
+        diameter_mm: f64,
+        /// Corner radius, mm.
+        corner_radius_mm: f64,
+    },
+    /// A diameter without the shape of the end: Creo's `$$-> CUTTER / d`, which Creo writes
+    /// for every kind of tool.
+    DiameterOnly {
+        /// Diameter, mm.
+        diameter_mm: f64,
+    },
+    /// Another shape (a drill, a chamfer or tapered mill), or values not read.
+    Other,
 }
 
 /// A CL file read.

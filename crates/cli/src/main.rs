@@ -210,6 +210,7 @@ impl ToolArgs {
             table,
             point: self.tool_point,
             surface_tolerance_mm: self.surface_tolerance,
+            ..polepatch::tool::ToolOptions::default()
         })
     }
 

@@ -54,7 +54,7 @@ use crate::report::{
     EndFreedom, FiguresRow, FileReport, UntouchedReason, UntouchedRun, ZoneReason, ZoneRow,
     ZoneTool,
 };
-use crate::tool::{RunTool, ToolKind, ToolPoint};
+use crate::tool::{RunTool, ToolDemand, ToolKind};
 use polepatch_kinematics::{Chain, Machine};
 use polepatch_nc::{Edit, FileStyle, NumberStyle, Tcpm};
 use polepatch_patcher::{
@@ -428,13 +428,13 @@ fn run_options<'a>(
     // The tool, and what it asks of the patch (crate::tool).
     let tool = run_tool(lp, r, machine);
     let mut tool_capped = false;
-    match tool.tool {
-        Some(t) if t.kind == ToolKind::Ball && tool.point == ToolPoint::Tip => {
+    match tool.demand() {
+        ToolDemand::KeepCentre { offset_mm } => {
             // A move after the run carries the last point's orientation along the part
             // (crate::end_pose): the ball's centre would move there.
             opts.keep_last_point |= end.carried_xy;
             opts.keep_centre = Some(KeepCentre {
-                radius_mm: t.diameter_mm / 2.0,
+                radius_mm: offset_mm,
                 // Without TCPM the part-frame tips go through the chain, not to the
                 // file: kept exact there.
                 decimals: match (rp.run.tcpm.is_on(), frame.inch) {
@@ -451,14 +451,14 @@ fn run_options<'a>(
                 s_is_length: rp.run.feed_mode != polepatch_nc::FeedMode::InverseTime,
             });
         }
-        Some(t) if t.kind != ToolKind::Ball => {
-            let cap = crate::tool::deviation_cap_deg(&t, lp.tool.surface_tolerance_mm);
+        ToolDemand::Cap { reach_mm } => {
+            let cap = crate::tool::cap_for_reach_deg(reach_mm, lp.tool.surface_tolerance_mm);
             if opts.max_deviation_deg.is_none_or(|c| cap <= c) {
                 opts.max_deviation_deg = Some(cap);
                 tool_capped = true;
             }
         }
-        _ => {}
+        ToolDemand::Nothing => {}
     }
     // Without TCPM (and with a chain) the patcher works on the part-frame path.
     let part_path = match (rp.run.tcpm, frame.chain) {
@@ -1079,24 +1079,12 @@ fn through_chain(
 /// Run `r`'s tool and the point its X Y Z state ([`crate::tool::resolve`]).
 fn run_tool(lp: &LoadedProgram, r: usize, machine: &Machine) -> RunTool {
     let rp = &lp.runs[r];
-    let machine_point = machine
-        .controller
-        .tool_point
-        .as_deref()
-        .and_then(|p| ToolPoint::parse(p).ok());
-    let code = if !rp.run.tcpm.is_on() {
-        "no TCPM: X Y Z through the kinematic chain are the tool tip's"
-    } else if rp.run.tcpm_centre {
-        "M128 or FUNCTION TCPM … REFPNT CENTER-CENTER: the tool length refers to the ball's centre"
-    } else {
-        "the TCPM code in force (FUNCTION TCPM, TRAORI, G43.4, G234, …) refers to the tool tip"
-    };
-    crate::tool::resolve(
+    crate::tool::for_run(
         &lp.tool,
         &rp.found_tool,
-        machine_point,
+        machine,
+        rp.run.tcpm.is_on(),
         rp.run.tcpm_centre,
-        code,
     )
 }
 
@@ -1141,6 +1129,7 @@ fn tool_fields(
     row.tool_source = rt.tool_source.clone();
     row.tool_point = Some(rt.point);
     row.tool_point_source = rt.point_source.clone();
+    row.tool_disagreement = rt.disagreement.clone();
     if tool_capped && z.reason == polepatch_patcher::Reason::DeviationCap {
         row.reason = ZoneReason::ToolLimited;
     }
@@ -1170,11 +1159,9 @@ fn tool_fields(
     let dist = |a: [f64; 3], b: [f64; 3]| (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>().sqrt();
     match tool.kind {
         ToolKind::Ball => {
-            let reach = if rt.point == ToolPoint::Tip {
-                tool.diameter_mm / 2.0
-            } else {
-                0.0
-            };
+            // The centre's height above the point X Y Z state; X Y Z rewritten to keep it.
+            let reach = rt.centre_offset_mm().unwrap_or(0.0);
+            let keeps = matches!(rt.demand(), ToolDemand::KeepCentre { .. });
             let centre = |tip: [f64; 3], o: [f64; 3]| -> [f64; 3] {
                 std::array::from_fn(|i| tip[i] + reach * o[i])
             };
@@ -1184,7 +1171,7 @@ fn tool_fields(
             for k in z.first.max(1)..=z.last {
                 let (t0, o0, t1, o1) = at(k, 1.0);
                 at_points = at_points.max(dist(centre(t0, o0), centre(t1, o1)));
-                if rt.point != ToolPoint::Tip {
+                if !keeps {
                     continue;
                 }
                 // Between the points: how far the centre leaves the line between the
@@ -1204,11 +1191,12 @@ fn tool_fields(
                 }
             }
             row.max_cutter_shift_mm = Some(at_points);
-            row.centre_chord_mm = (rt.point == ToolPoint::Tip).then_some(between);
+            row.centre_chord_mm = keeps.then_some(between);
         }
         ToolKind::Flat | ToolKind::Bull => {
             row.max_cutter_shift_mm = Some(
-                tool.end_reach_mm() * crate::tool::centre_shift_per_mm_radius(z.max_deviation_deg),
+                tool.reach_from_mm(rt.height_mm)
+                    * crate::tool::centre_shift_per_mm_radius(z.max_deviation_deg),
             );
         }
     }
@@ -1281,6 +1269,7 @@ fn zone_row(lp: &LoadedProgram, run: usize, z: &ZoneReport) -> ZoneRow {
         tool_source: String::new(),
         tool_point: None,
         tool_point_source: String::new(),
+        tool_disagreement: None,
         centre_shift_per_mm_radius: crate::tool::centre_shift_per_mm_radius(z.max_deviation_deg),
         max_cutter_shift_mm: None,
         centre_chord_mm: None,

@@ -687,6 +687,8 @@ impl Poster<'_> {
                 self.items.push(Item::Raw(text.clone()));
                 Ok(())
             }
+            // Read for the patch ([`crate::tool::cl_tools`]); nothing to write.
+            ClItem::Cutter(_) => Ok(()),
         }
     }
 
@@ -789,40 +791,14 @@ pub fn post_items(
     Ok(p.items)
 }
 
-/// The tool of a posted program where the caller did not say it: the CL file's `CUTTER/` or
-/// `TLDATA/` ([`crate::tool::cl_tool`]), and the tool tip as the point (APT's `GOTO/` states
-/// the tip). The patch then keeps a ball's centre and caps a flat or bull-nose cutter's
-/// orientation change ([`crate::tool`]). `cl_bytes` are the CL file's bytes, `cl` as read.
-///
-/// The order is [`crate::tool::resolve`]'s: `--tool` first, then the tool table by the
-/// number `LOADTL` calls, then the CL file's own description — which, in a file whose tools
-/// are called by number, stands for the numbers the table does not hold, and in one that
-/// calls none (a CSV file, an APT file without `LOADTL`) for the whole program.
-pub fn tool_from_cl(cl_bytes: &[u8], cl: &ClProgram, opts: &mut PostOptions) {
+/// The point of the tool a posted program's X Y Z state, where the caller did not say it:
+/// the tip (APT's `GOTO/` states the tip). The patch then keeps a ball's centre and caps a
+/// flat or bull-nose cutter's orientation change ([`crate::tool`]). The cutters themselves
+/// are the CL file's `CUTTER/` and `TLDATA/` records, each for the tool loaded after it,
+/// which [`post_cl`] reads ([`crate::tool::cl_tools`]): not a tool for the whole program,
+/// and never reported as `--tool`. `_cl_bytes` (the CL file's bytes) is kept for callers.
+pub fn tool_from_cl(_cl_bytes: &[u8], _cl: &ClProgram, opts: &mut PostOptions) {
     let t = &mut opts.patch_options.tool;
-    if t.tool.is_none() {
-        let unit_mm = if cl.units == Units::Inch { 25.4 } else { 1.0 };
-        if let Some((tool, _)) = crate::tool::cl_tool(cl_bytes, unit_mm) {
-            let called: Vec<u32> = cl
-                .items
-                .iter()
-                .filter_map(|i| match i {
-                    ClItem::ToolChange { tool, .. } => Some(*tool),
-                    _ => None,
-                })
-                .collect();
-            if t.table.tools.is_empty() || called.is_empty() {
-                t.tool = Some(tool);
-            } else {
-                for n in called {
-                    t.table
-                        .tools
-                        .entry(crate::tool::ToolId::Number(u64::from(n)))
-                        .or_insert(tool);
-                }
-            }
-        }
-    }
     if t.point.is_none() {
         t.point = Some(crate::tool::ToolPoint::Tip);
     }
@@ -992,7 +968,16 @@ pub fn post_cl(
     if !opts.patch {
         return Ok((bytes, None));
     }
-    match crate::patch_nc(&bytes, machine, &opts.patch_options) {
+    // The CL file's cutters, by the tool each is for, as the program's own description
+    // (the written program does not carry them).
+    let mut patch_options = std::borrow::Cow::Borrowed(&opts.patch_options);
+    if patch_options.tool.cl.is_empty() {
+        let tools = crate::tool::cl_tools(cl);
+        if !tools.is_empty() {
+            patch_options.to_mut().tool.cl = tools;
+        }
+    }
+    match crate::patch_nc(&bytes, machine, &patch_options) {
         Ok((out, mut report)) => {
             report
                 .warnings

@@ -940,7 +940,7 @@ pub fn patch_nc_hooked(
     }
     out.write_all(&output).map_err(Error::Output)?;
     (hooks.progress)(bytes.len(), bytes.len());
-    report.warn_unknown_tool();
+    report.warn_tools();
     Ok(report)
 }
 
@@ -1365,10 +1365,10 @@ fn each_stretch<T: Send>(
         // After the runs this block ends: a tool change is the next run's.
         tracker.block(
             sv.dialect,
-            s.block.line,
+            s.block,
             &bytes[s.block.span()],
             s.words,
-            s.state.inch,
+            s.state,
         );
         while done
             .front()

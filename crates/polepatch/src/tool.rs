@@ -9,35 +9,75 @@
 //! surface tolerance ([`deviation_cap_deg`]).
 //!
 //! **The tool of a run** (the first that says it): `--tool ball:10` for the whole program;
-//! a tool table file (`--tools FILE`) by the active tool's number or name; the program,
-//! where it describes the tool in use ([`Tracker`]). **The point X Y Z refer to**:
-//! `--tool-point`; the machine file's `[controller] tool_point`; the TCPM code in force —
-//! Heidenhain `M128` (its manuals: the tool length refers to the ball's centre) and
-//! `FUNCTION TCPM … REFPNT CENTER-CENTER` the centre, every other (`FUNCTION TCPM`'s default
-//! `TIP-TIP`, `TRAORI`, `G43.4`, `G234`, a machine's own codes) and APT's `GOTO/` the tip.
+//! the program's own description of the tool in use ([`Tracker`]; for `post`, the CL
+//! file's `CUTTER/` or `TLDATA/` for the tool loaded after it, [`ClTools`]); a tool table
+//! file (`--tools FILE`) by the active tool's number or name. The program's description
+//! comes before the table: it is written by the CAM system that computed the path, for this
+//! program's tool numbers, while a table is keyed by numbers and names shared between
+//! programs, so an entry that disagrees with the program is more likely another program's
+//! tool. Any source that disagrees with the one used is said: the zone's
+//! `tool_disagreement` and a warning ([`RunTool::disagreement`]).
+//!
+//! **The point X Y Z refer to**: `--tool-point`; the machine file's `[controller]
+//! tool_point`; the TCPM code in force — Heidenhain `M128` (its manuals: the tool length
+//! refers to the ball's centre) and `FUNCTION TCPM … REFPNT CENTER-CENTER` the centre, every
+//! other (`FUNCTION TCPM`'s default `TIP-TIP`, `TRAORI`, `G43.4`, `G234`, a machine's own
+//! codes) and APT's `GOTO/` the tip.
+//!
+//! **Length deltas** (Heidenhain `TOOL CALL 5 Z S12000 DL-5`, ISO `T5 G17 DL-5`, in force until
+//! the next tool call): the controller takes the tool as DL longer than its table says
+//! (its manuals: DL > 0 an oversize, DL < 0 an undersize), so the point it brings to X Y Z
+//! lies h = h₀ − DL above the tip along the tool axis (h₀ = 0 for the tip, R2 for the
+//! centre): with `DL-5` under `TIP-TIP` a D10 ball's X Y Z state its centre. Honoured: a
+//! ball's centre lies R − h above the point X Y Z state ([`RunTool::centre_offset_mm`]) —
+//! kept by rewriting X Y Z where that is above 0, nothing to rewrite where it is 0, and
+//! where it is below 0 (the point above the centre) the orientation change is capped so
+//! the centre moves at most the surface tolerance; a flat or bull-nose cutter's cap is taken
+//! about that point ([`Tool::reach_from_mm`]).
 //!
 //! Program forms read (each as real posts write it; the fixtures under `fixtures/tools/`):
 //!
-//! | form | example | tool |
-//! |---|---|---|
-//! | Heidenhain `TOOL DEF` | `TOOL DEF 5 L+0 R+5 R2+5` (then `TOOL CALL 5 Z`) | R radius, R2 corner radius |
-//! | Heidenhain ISO `G99` | `N10 G99 T5 L+0 R+5 R2+5 *` (then `T5 G17`) | the same |
-//! | Fusion / HSM / Inventor CAM | `(T1 D=10. CR=5. - ZMIN=-5. - ball end mill)`, `;  #31 D=10 CR=5 - ZMIN=… - ball end mill` | D, CR, the type text |
-//! | hyperMILL | `* - TOOL: T313 \| BALL_D10 / DM=10 CR=5 TL=90` (before `TOOL CALL`), `; T1554 \| … / DM=20 CR=2 TL=106` | DM, CR |
-//! | Siemens NX tool list | `(TOOL-NO. TOOL-NAME DIAMETER OFFSET)` … `(   3   BALL_MILL   0.236   0  )` | a name with `BALL`: a ball of that diameter |
-//! | Mastercam | `( TOOL - 12 3/16 BALL ENDMILL DIA. OFF. - 12 LEN. - 12 DIA. - .1875 )` | DIA., `BALL`/`FLAT` in the name |
-//! | PowerMill | `( NO. \| ID \| DIA.\| TIP RAD\|LENGTH)` … `(    1\|name\| 4.0 \|  0.0 \| 75.0 )` | DIA., TIP RAD |
+//! | form | example | tool | names its tool by |
+//! |---|---|---|---|
+//! | Heidenhain `TOOL DEF` | `TOOL DEF 5 L+0 R+5 R2+5` (then `TOOL CALL 5 Z`); without `R2` a flat end mill | R radius, R2 corner radius | number or name |
+//! | Heidenhain ISO `G99` | `N10 G99 T5 L+0 R+5 R2+5 *` (then `T5 G17`) | the same | number |
+//! | Fusion / HSM / Inventor CAM | `(T1 D=10. CR=5. - ZMIN=-5. - ball end mill)`, `;  #31 D=10 CR=5 - ZMIN=… - ball end mill` | D, CR, the type text | number |
+//! | `D=` and a type text (CUQ) | `N2(Ball cutter D=10.00)` (then `N4T006M06`) | D, the type text | — |
+//! | hyperMILL | `* - TOOL: T313 \| BALL_D10 / DM=10 CR=5 TL=90` or `* - T313 \| …` before `TOOL CALL`; its `TOOLLIST`: `; T1554 \| … / DM=20 CR=2 TL=106` | DM, CR | its own T number and name (the call may use neither) |
+//! | Siemens NX tool list | `(TOOL-NO. TOOL-NAME DIAMETER OFFSET)` … `(   3   BALL_MILL   0.236   0  )` | a name with `BALL`: a ball of that diameter | number |
+//! | Mastercam | `( TOOL - 12 3/16 BALL ENDMILL DIA. OFF. - 12 LEN. - 12 DIA. - .1875 )`, `( T1 \| 1/4 BALL ENDMILL \| H1 \| D1 \| TOOL DIA. - .25 )` (`D1` the offset register) | DIA., `BALL`/`FLAT`/`ENDMILL` in the name | number |
+//! | PowerMill | `( NO. \| ID \| DIA.\| TIP RAD\|LENGTH)` … `(    1\|name\| 4.0 \|  0.0 \| 75.0 )` | DIA., TIP RAD | number |
+//! | `TOOL: Tn = d dia.` (LinuxCNC's boat demos) | `( TOOL: T1 = 10.0 dia. ENDMILLM1000:REG )` | dia., the type text | number |
+//! | APT / NX CL (`post`) | `CUTTER/10,5,0,5,0,0,75`, `TLDATA/MILL,10,5,75,0,0` (Creo's `$$-> CUTTER / 6` is read and said: a diameter without its end's shape, no tool) | d, r (no base, side, taper or tip angle) | the `LOADTL/` after it, or before it with no move between |
+//!
+//! Forms seen in real programs and not read (they state no diameter, or only inside a
+//! name): NX's `;TOOL NO. :8` / `;TOOL TYPE :Milling Tool-5 Parameters`, `( *** TOOL CHANGE:
+//! T03: BALL_MILL *** )`, `; TOOL NAME PLANFRAS_D80`, `(Current Tool: 8)`, `T02 M06 (BALL
+//! 6MM)`, FreeCAD's `(TC: 5mm Endmill)`. Where a call's tool stays unknown, the report names
+//! such a comment before it (`tool_source`: `… line 4: (BALL 6MM) is no form polepatch reads`).
+//!
+//! **Which description is a call's**: the latest that gives the number or name the call
+//! uses; else, of the descriptions that give no number the call could contradict (none, or
+//! the CAM's own: hyperMILL's), the one in the group just before the call (descriptions and
+//! comments with no other block between them and the call) — several there is a list, not
+//! the call's, and the tool stays unknown with the list named. A description that gives
+//! another number is never the call's (`(T2 D=12 …)` before `T1 M6`).
 //!
 //! Kinds from geometry: a corner radius of half the diameter (within
 //! [`CORNER_TOLERANCE_MM`]) is a ball, none a flat end mill, between a bull-nose; a type
 //! text that says `ball`, `bull` or `flat` must agree, and one that names another kind
-//! (drill, chamfer, probe, face mill, lollipop, tapered) gives no tool. Values are in the
-//! program's unit (inch programs converted). A description belongs to the tool that the
-//! next tool change calls (by number, by name, or the description just before the change
-//! when it has neither).
+//! (drill, chamfer, probe, face mill, lollipop, tapered) gives no tool (said in the report).
+//!
+//! **Units**: a description's values are in the program's unit at the line it is written.
+//! One written before the program first states its unit (`G20`/`G21`, `G70`/`G71`, a
+//! `%NAME G71` header, `BEGIN PGM … MM`) is in the unit the program then states: posts write
+//! their tool list in the header, before the unit code (Fusion's `(T1 D=0.5 …)` comes before
+//! `G20`), in the unit of the program that follows. A program that never states one is in mm.
+//! A CL file's `CUTTER/` is in the file's units likewise.
 
 use crate::error::Error;
-use polepatch_nc::{Dialect, Word};
+use polepatch_cl::{ClItem, ClProgram, CutterShape};
+use polepatch_nc::{Block, Dialect, Flags, Modal, Word};
 use std::collections::HashMap;
 
 /// Two radii closer than this are equal when a corner radius is compared with half a
@@ -143,8 +183,28 @@ impl Tool {
     /// its bottom face and corner, where a flat or bull-nose cutter cuts on a 5-axis
     /// surface — mm: `√(R² + r²)` (R the radius, r the corner radius; R for a flat).
     pub fn end_reach_mm(&self) -> f64 {
+        self.reach_from_mm(0.0)
+    }
+
+    /// The largest distance of a point of the cutter's end (its bottom face and corner)
+    /// from the point on its axis `height_mm` above the tip (towards the spindle; below
+    /// it where negative), mm: every such point lies within R of the axis and between the
+    /// tip and the corner's top (r above it), so at most √(R² + max(|h|, |r − h|)²) — exact
+    /// at the corner's edge. At h = 0 that is [`Tool::end_reach_mm`].
+    pub fn reach_from_mm(&self, height_mm: f64) -> f64 {
         let r_tool = self.diameter_mm / 2.0;
-        (r_tool * r_tool + self.corner_radius_mm * self.corner_radius_mm).sqrt()
+        let dz = height_mm
+            .abs()
+            .max((self.corner_radius_mm - height_mm).abs());
+        (r_tool * r_tool + dz * dz).sqrt()
+    }
+
+    /// Whether `other` is the same cutter: the same kind, diameter and corner radius within
+    /// [`CORNER_TOLERANCE_MM`] (one in inches converted and one in mm are the same).
+    pub fn same_as(&self, other: &Tool) -> bool {
+        self.kind == other.kind
+            && (self.diameter_mm - other.diameter_mm).abs() <= CORNER_TOLERANCE_MM
+            && (self.corner_radius_mm - other.corner_radius_mm).abs() <= CORNER_TOLERANCE_MM
     }
 }
 
@@ -157,8 +217,14 @@ impl Tool {
 /// δ = 2·asin(ε / (2D)) (docs/method.md has the proof and its assumption: the cutter cuts
 /// with its end, not its flank).
 pub fn deviation_cap_deg(tool: &Tool, surface_tolerance_mm: f64) -> f64 {
-    let reach = tool.end_reach_mm();
-    let x = (surface_tolerance_mm / (2.0 * reach)).min(1.0);
+    cap_for_reach_deg(tool.end_reach_mm(), surface_tolerance_mm)
+}
+
+/// The largest change of tool orientation, degrees, that moves no point within `reach_mm`
+/// of the point the tool turns about by more than `surface_tolerance_mm`:
+/// δ = 2·asin(ε / (2·reach)) ([`deviation_cap_deg`] for a cutter turned about its tip).
+pub fn cap_for_reach_deg(reach_mm: f64, surface_tolerance_mm: f64) -> f64 {
+    let x = (surface_tolerance_mm / (2.0 * reach_mm)).min(1.0);
     2.0 * x.asin().to_degrees()
 }
 
@@ -235,6 +301,9 @@ impl std::fmt::Display for ToolId {
 /// kind = "ball"
 /// diameter_mm = 6.0
 /// ```
+///
+/// An entry that contradicts itself (`kind = "ball"` with a corner radius other than half
+/// the diameter, `kind = "flat"` with one other than 0) is refused with its key.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ToolTable {
     /// The tools.
@@ -262,8 +331,12 @@ impl ToolTable {
     pub fn from_toml_str(text: &str, origin: &str) -> Result<ToolTable, String> {
         let file: TableFile = toml::from_str(text).map_err(|e| format!("{origin}: {e}"))?;
         let mut tools = HashMap::new();
-        for (key, e) in file.tool {
-            let spec = match e.kind.to_ascii_lowercase().as_str() {
+        // In key order, so that the first error is the same every time.
+        let mut entries: Vec<(String, TableEntry)> = file.tool.into_iter().collect();
+        entries.sort_by(|a, b| a.0.cmp(&b.0));
+        for (key, e) in entries {
+            let kind = e.kind.to_ascii_lowercase();
+            let spec = match kind.as_str() {
                 "bull" => format!(
                     "bull:{},{}",
                     e.diameter_mm,
@@ -272,23 +345,159 @@ impl ToolTable {
                 k => format!("{k}:{}", e.diameter_mm),
             };
             let tool = Tool::parse(&spec).map_err(|m| format!("{origin}: tool {key}: {m}"))?;
+            if let Some(r) = e.corner_radius_mm
+                && (r - tool.corner_radius_mm).abs() > CORNER_TOLERANCE_MM
+            {
+                let should = match tool.kind {
+                    ToolKind::Ball => format!(
+                        "a ball's corner radius is half its diameter ({} mm)",
+                        tool.corner_radius_mm
+                    ),
+                    _ => "a flat end mill has none (a bull-nose is kind = \"bull\")".to_string(),
+                };
+                return Err(format!(
+                    "{origin}: tool {key}: kind = \"{kind}\" with corner_radius_mm = {r}: {should}; \
+                     say which the tool is"
+                ));
+            }
             let id = key
                 .parse::<u64>()
                 .map_or_else(|_| ToolId::Name(key.to_ascii_uppercase()), ToolId::Number);
-            tools.insert(id, tool);
+            if tools.insert(id.clone(), tool).is_some() {
+                return Err(format!(
+                    "{origin}: tool {key}: a second entry for {id} (names are compared in upper \
+                     case, as programs call them)"
+                ));
+            }
         }
         Ok(ToolTable { tools })
+    }
+}
+
+/// The cutters a CL file describes, for the program `post` writes from it
+/// ([`cl_tools`]): the CAM system's own description of each tool, which the written program
+/// does not carry.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ClTools {
+    /// By the tool number its `LOADTL/` loads: the tool (`None`: a cutter polepatch does not
+    /// model, or two different cutters for one number) and where it is said (`CL line 9:
+    /// CUTTER/10,5,…`, or why it is not known).
+    pub by_tool: HashMap<u64, (Option<Tool>, String)>,
+    /// The cutter of the moves before the first `LOADTL/`, where one is described.
+    pub before_first_load: Option<(Option<Tool>, String)>,
+}
+
+impl ClTools {
+    /// No cutter described.
+    pub fn is_empty(&self) -> bool {
+        self.by_tool.is_empty() && self.before_first_load.is_none()
+    }
+
+    /// What the CL file says of the tool a run of the written program uses (`id`: the tool
+    /// its last tool change called, `None` before the first).
+    fn of(&self, id: Option<&ToolId>) -> Option<(Option<Tool>, String)> {
+        match id {
+            None => self.before_first_load.clone(),
+            Some(ToolId::Number(n)) => self.by_tool.get(n).cloned(),
+            Some(ToolId::Name(_)) => None,
+        }
+    }
+}
+
+/// The cutters of a CL file's `CUTTER/` and `TLDATA/` records ([`polepatch_cl::Cutter`]),
+/// by the tool each describes: the cutter in force (the last record before) at the first
+/// move after each `LOADTL/` — so one written before its `LOADTL/` (CAMWorks, NX) or after
+/// it (Creo's order: `LOADTL / 2`, then the cutter) — and, before any `LOADTL/`, at the first
+/// move. A cutter that changes between the moves of one tool, or a number loaded again with
+/// another cutter, leaves that tool unknown (its source says why).
+pub fn cl_tools(cl: &ClProgram) -> ClTools {
+    let mut out = ClTools::default();
+    let mut current: Option<(Option<Tool>, String)> = None;
+    let mut loaded: Option<u64> = None;
+    // A move since the last LOADTL (or the start); a cutter read since the last move.
+    let (mut moved, mut fresh) = (false, false);
+    for item in &cl.items {
+        match item {
+            ClItem::Cutter(c) => {
+                let src = format!("CL line {}: {}", c.at.line, c.text);
+                current = Some(match c.shape {
+                    CutterShape::EndMill {
+                        diameter_mm,
+                        corner_radius_mm,
+                    } => match Tool::from_geometry(diameter_mm, corner_radius_mm) {
+                        Some(t) => (Some(t), src),
+                        None => (None, format!("{src} (no cutter polepatch models)")),
+                    },
+                    CutterShape::DiameterOnly { diameter_mm } => (
+                        None,
+                        format!(
+                            "{src} (a diameter, {diameter_mm} mm, without the shape of its end: \
+                             Creo writes this comment for every kind of tool)"
+                        ),
+                    ),
+                    CutterShape::Other => (None, format!("{src} (no end mill polepatch models)")),
+                });
+                fresh = true;
+            }
+            ClItem::ToolChange { tool, .. } => {
+                loaded = Some(u64::from(*tool));
+                moved = false;
+            }
+            ClItem::Move(_) => {
+                if (!moved || fresh)
+                    && let Some(c) = &current
+                {
+                    match loaded {
+                        Some(n) => {
+                            let mut slot = out.by_tool.remove(&n);
+                            settle(&mut slot, c, &format!("tool {n}"));
+                            out.by_tool.extend(slot.map(|s| (n, s)));
+                        }
+                        None => settle(
+                            &mut out.before_first_load,
+                            c,
+                            "the moves before its first LOADTL",
+                        ),
+                    }
+                }
+                moved = true;
+                fresh = false;
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+/// The start of a [`ClTools`] source whose tool the CL file gives two cutters.
+const CL_TWO_CUTTERS: &str = "the CL file gives";
+
+/// Record cutter `c` for `what`, whose cutter so far is `slot`.
+fn settle(slot: &mut Option<(Option<Tool>, String)>, c: &(Option<Tool>, String), what: &str) {
+    match slot {
+        None => *slot = Some(c.clone()),
+        Some(old) if old.1.starts_with(CL_TWO_CUTTERS) => {}
+        Some(old) if !differ(old.0.as_ref(), c.0.as_ref()) => {}
+        Some(old) => {
+            *old = (
+                None,
+                format!("{CL_TWO_CUTTERS} {what} two cutters: {}; {}", old.1, c.1),
+            )
+        }
     }
 }
 
 /// How the caller says the tool: [`crate::PatchOptions::tool`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct ToolOptions {
-    /// The tool for the whole program (`--tool ball:10`); `None`: per run, from the table
-    /// or the program. Default `None`.
+    /// The tool for the whole program (`--tool ball:10`); `None`: per run, from the program
+    /// or the table. Default `None`.
     pub tool: Option<Tool>,
     /// A tool table (`--tools FILE`). Default empty.
     pub table: ToolTable,
+    /// The cutters of the CL file a program was posted from (`post` fills it: [`cl_tools`]),
+    /// the program's own description. Default empty.
+    pub cl: ClTools,
     /// Which point X Y Z state (`--tool-point`); `None`: from the machine file or the TCPM
     /// code. Default `None`.
     pub point: Option<ToolPoint>,
@@ -302,6 +511,7 @@ impl Default for ToolOptions {
         ToolOptions {
             tool: None,
             table: ToolTable::default(),
+            cl: ClTools::default(),
             point: None,
             surface_tolerance_mm: SURFACE_TOLERANCE_MM,
         }
@@ -326,8 +536,16 @@ impl ToolOptions {
 pub struct FoundTool {
     /// The tool the last tool change called, if it named one.
     pub id: Option<ToolId>,
-    /// The program's description of it, and where (`line 12: TOOL DEF 5 L+0 R+5 R2+5`).
-    pub described: Option<(Tool, String)>,
+    /// The program's description of it: the tool (`None`: a cutter polepatch does not
+    /// model) and where (`line 12: TOOL DEF 5 L+0 R+5 R2+5`, with why where it gives no
+    /// tool).
+    pub described: Option<(Option<Tool>, String)>,
+    /// Why no description was taken where the program has something like one: a list
+    /// before the call that does not name it, a comment polepatch does not read.
+    pub note: Option<String>,
+    /// The tool call's length delta (Heidenhain `DL`), mm, and where (`line 3, col 28:
+    /// DL-5`); `None` where the call gives none.
+    pub delta_length: Option<(f64, String)>,
 }
 
 /// The tool, the point and where they came from, for one run.
@@ -335,12 +553,109 @@ pub struct FoundTool {
 pub struct RunTool {
     /// The tool, if known.
     pub tool: Option<Tool>,
-    /// Where it was found (`--tool`, `tool table (T5)`, `line 12: …`), or why unknown.
+    /// Where it was found (`--tool`, `tool table (T5)`, `line 12: …`, `CL line 9: …`), or
+    /// why unknown.
     pub tool_source: String,
-    /// The point X Y Z state.
+    /// The point X Y Z state: the tip or the ball's centre (a length delta may put it
+    /// elsewhere on the axis: [`RunTool::height_mm`]).
     pub point: ToolPoint,
-    /// Why that point (`--tool-point`, `machine file`, `M128`, `G43.4`, …).
+    /// Why that point (`--tool-point`, `machine file`, `M128`, `G43.4`, a `DL`, …).
     pub point_source: String,
+    /// How far above the tool tip, along the tool axis towards the spindle, the point X Y Z
+    /// state lies, mm: 0 at the tip, the corner radius at a ball's or torus' centre, minus
+    /// the tool call's DL (module docs).
+    pub height_mm: f64,
+    /// What another source says of the tool where it disagrees with the one used (the
+    /// report's `tool_disagreement` and a warning); `None` where none does.
+    pub disagreement: Option<String>,
+}
+
+/// What a run's tool asks of the patch ([`RunTool::demand`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ToolDemand {
+    /// Keep the ball's centre, `offset_mm` above the point X Y Z state along the tool
+    /// axis: X Y Z are rewritten ([`polepatch_patcher::KeepCentre`]).
+    KeepCentre {
+        /// The centre's height above the point X Y Z state, mm (> 0).
+        offset_mm: f64,
+    },
+    /// Cap the change of orientation: no point of the cutter that cuts lies farther than
+    /// `reach_mm` from the point the tool turns about ([`cap_for_reach_deg`]).
+    Cap {
+        /// mm.
+        reach_mm: f64,
+    },
+    /// Nothing: X Y Z are the ball's centre, or the tool is unknown.
+    Nothing,
+}
+
+/// Two points on the tool axis closer than this are the same point, mm.
+const SAME_POINT_MM: f64 = 1e-9;
+
+impl RunTool {
+    /// For a ball: the height of its centre above the point X Y Z state, mm (R − h; R at
+    /// the tip, 0 at the centre).
+    pub fn centre_offset_mm(&self) -> Option<f64> {
+        self.tool
+            .filter(|t| t.kind == ToolKind::Ball)
+            .map(|t| t.corner_radius_mm - self.height_mm)
+    }
+
+    /// What the tool asks of the patch (module docs).
+    pub fn demand(&self) -> ToolDemand {
+        let Some(t) = self.tool else {
+            return ToolDemand::Nothing;
+        };
+        match self.centre_offset_mm() {
+            Some(off) if off > SAME_POINT_MM => ToolDemand::KeepCentre { offset_mm: off },
+            // The point above the centre: the centre (and the ball's surface with it) moves
+            // by 2·|off|·sin(δ/2).
+            Some(off) if off < -SAME_POINT_MM => ToolDemand::Cap { reach_mm: -off },
+            Some(_) => ToolDemand::Nothing,
+            None => ToolDemand::Cap {
+                reach_mm: t.reach_from_mm(self.height_mm),
+            },
+        }
+    }
+}
+
+/// How two sources' tools compare, for [`RunTool::disagreement`]: `None` where they agree.
+fn differ(a: Option<&Tool>, b: Option<&Tool>) -> bool {
+    match (a, b) {
+        (Some(a), Some(b)) => !a.same_as(b),
+        (None, None) => false,
+        _ => true,
+    }
+}
+
+fn said(t: Option<&Tool>) -> String {
+    t.map_or("no tool polepatch models".to_string(), Tool::describe)
+}
+
+/// The tool and point of X Y Z where the program stands at a run (or a block): what the
+/// program says of its tool (`found`), the caller's options, the machine file's tool point
+/// and the TCPM code in force ([`resolve`], with the TCPM code named for the report). The
+/// one rule the patch and the check of the written program ([`crate::verify`]) use.
+pub fn for_run(
+    opts: &ToolOptions,
+    found: &FoundTool,
+    machine: &polepatch_kinematics::Machine,
+    tcpm_on: bool,
+    tcpm_centre: bool,
+) -> RunTool {
+    let machine_point = machine
+        .controller
+        .tool_point
+        .as_deref()
+        .and_then(|p| ToolPoint::parse(p).ok());
+    let code = if !tcpm_on {
+        "no TCPM: X Y Z through the kinematic chain are the tool tip's"
+    } else if tcpm_centre {
+        "M128 or FUNCTION TCPM … REFPNT CENTER-CENTER: the tool length refers to the ball's centre"
+    } else {
+        "the TCPM code in force (FUNCTION TCPM, TRAORI, G43.4, G234, …) refers to the tool tip"
+    };
+    resolve(opts, found, machine_point, tcpm_on && tcpm_centre, code)
 }
 
 /// Resolve a run's tool and point (module docs' order).
@@ -351,24 +666,65 @@ pub fn resolve(
     tcpm_centre: bool,
     tcpm_code: &str,
 ) -> RunTool {
-    let from_table = found
+    // The program's own word: its text, or the CL file it was posted from.
+    let program = found
+        .described
+        .clone()
+        .or_else(|| opts.cl.of(found.id.as_ref()));
+    let table = found
         .id
         .as_ref()
         .and_then(|id| opts.table.tools.get(id).map(|t| (*t, id)));
+    let mut disagree = Vec::new();
     let (tool, tool_source) = if let Some(t) = opts.tool {
+        if let Some((p, src)) = &program
+            && differ(Some(&t), p.as_ref())
+        {
+            disagree.push(format!(
+                "--tool says {}, the program's description says {} ({src}): --tool is used",
+                t.describe(),
+                said(p.as_ref())
+            ));
+        }
+        if let Some((tt, id)) = table
+            && !t.same_as(&tt)
+        {
+            disagree.push(format!(
+                "--tool says {}, the tool table's entry for {id} says {}: --tool is used",
+                t.describe(),
+                tt.describe()
+            ));
+        }
         (Some(t), "--tool".to_string())
-    } else if let Some((t, id)) = from_table {
+    } else if let Some((p, src)) = &program {
+        let src = match p {
+            Some(_) => src.clone(),
+            None => format!("unknown: {src}"),
+        };
+        if let Some((tt, id)) = table
+            && differ(Some(&tt), p.as_ref())
+        {
+            disagree.push(format!(
+                "the tool table's entry for {id} says {}, the program's description says {} \
+                 ({src}): the program's is used",
+                tt.describe(),
+                said(p.as_ref())
+            ));
+        }
+        (*p, src)
+    } else if let Some((t, id)) = table {
         (Some(t), format!("tool table ({id})"))
-    } else if let Some((t, src)) = &found.described {
-        (Some(*t), src.clone())
     } else {
-        let why = match &found.id {
+        let mut why = match &found.id {
             Some(id) => format!("unknown: the program calls {id} without describing it"),
             None => "unknown: the program names no tool".to_string(),
         };
+        if let Some(n) = &found.note {
+            why = format!("{why} ({n})");
+        }
         (None, why)
     };
-    let (point, point_source) = if let Some(p) = opts.point {
+    let (mut point, mut point_source) = if let Some(p) = opts.point {
         (p, "--tool-point".to_string())
     } else if let Some(p) = machine_point {
         (p, "machine file [controller] tool_point".to_string())
@@ -377,36 +733,172 @@ pub fn resolve(
     } else {
         (ToolPoint::Tip, tcpm_code.to_string())
     };
+    // A length delta the program gives by a parameter: the point is not known.
+    let (tool, tool_source) = match &found.delta_length {
+        Some((dl, src)) if dl.is_nan() => (
+            None,
+            format!(
+                "unknown: {src} is a parameter polepatch does not evaluate, so the point of the \
+                 tool X Y Z state is not known"
+            ),
+        ),
+        _ => (tool, tool_source),
+    };
+    let base = match (point, tool) {
+        (ToolPoint::Centre, Some(t)) => t.corner_radius_mm,
+        _ => 0.0,
+    };
+    let mut height_mm = base;
+    if let Some((dl, src)) = &found.delta_length
+        && *dl != 0.0
+        && !dl.is_nan()
+    {
+        if opts.point.is_some() {
+            point_source.push_str(&format!(
+                " (the program's {src} not applied: --tool-point says the point)"
+            ));
+        } else {
+            height_mm = base - dl;
+            let at = if base == 0.0 { "tip" } else { "centre" };
+            point_source = format!(
+                "{point_source}; {src}: the controller takes the tool as {} mm {}, so X Y Z state \
+             the point {} mm {} its {at}",
+                dl.abs(),
+                if *dl < 0.0 { "shorter" } else { "longer" },
+                dl.abs(),
+                if *dl < 0.0 { "above" } else { "below" }
+            );
+            if let Some(t) = tool
+                && t.kind == ToolKind::Ball
+                && (t.corner_radius_mm - height_mm).abs() <= SAME_POINT_MM
+            {
+                point = ToolPoint::Centre;
+                point_source.push_str(": the ball's centre");
+            } else if height_mm.abs() <= SAME_POINT_MM {
+                point = ToolPoint::Tip;
+                point_source.push_str(": the tip");
+            }
+        }
+    }
     RunTool {
         tool,
         tool_source,
         point,
         point_source,
+        height_mm,
+        disagreement: (!disagree.is_empty()).then(|| disagree.join("; ")),
+    }
+}
+
+/// One description of a tool in the program (module docs' table).
+#[derive(Debug, Clone)]
+struct Desc {
+    /// What it says, in the program's unit.
+    shape: Shape,
+    /// mm per unit of its values; `None` while the program has stated no unit.
+    unit: Option<f64>,
+    /// `line N: text`.
+    source: String,
+}
+
+/// What a description says of its cutter, in the program's unit.
+#[derive(Debug, Clone, Copy)]
+enum Shape {
+    /// An end mill: diameter, corner radius (where stated), the kind its text names.
+    Mill {
+        d: f64,
+        cr: Option<f64>,
+        named: Option<ToolKind>,
+    },
+    /// A cutter polepatch does not model (its text names a drill, a chamfer mill, …).
+    Other,
+}
+
+impl Desc {
+    /// The tool and its source (with why where it gives none); values of a description
+    /// written before the program stated its unit are in `unit_now` (mm per unit).
+    fn tool(&self, unit_now: f64) -> (Option<Tool>, String) {
+        let u = self.unit.unwrap_or(unit_now);
+        match self.shape {
+            Shape::Other => (
+                None,
+                format!("{} (a cutter polepatch does not model)", self.source),
+            ),
+            Shape::Mill { d, cr, named } => match mill(d * u, cr.map(|r| r * u), named) {
+                Ok(t) => (Some(t), self.source.clone()),
+                Err(why) => (None, format!("{} ({why})", self.source)),
+            },
+        }
+    }
+
+    fn line(&self) -> &str {
+        self.source.split(':').next().unwrap_or("")
+    }
+}
+
+/// An end mill from a diameter and a corner radius (mm; where stated) and the kind a text
+/// names: the geometry's kind, which the text must not contradict.
+fn mill(d_mm: f64, cr_mm: Option<f64>, named: Option<ToolKind>) -> Result<Tool, String> {
+    let cr = match (cr_mm, named) {
+        (Some(r), _) => r,
+        (None, Some(ToolKind::Ball)) => d_mm / 2.0,
+        (None, Some(ToolKind::Flat)) => 0.0,
+        (None, Some(ToolKind::Bull)) => return Err("a bull-nose without its corner radius".into()),
+        (None, None) => return Err("neither a corner radius nor a kind".into()),
+    };
+    let t = Tool::from_geometry(d_mm, cr).ok_or_else(|| {
+        format!("diameter {d_mm} mm with corner radius {cr} mm is no cutter polepatch models")
+    })?;
+    match named {
+        Some(k) if k != t.kind => Err(format!(
+            "its text says {} but diameter {d_mm} mm with corner radius {cr} mm is a {}",
+            kind_name(k),
+            kind_name(t.kind)
+        )),
+        _ => Ok(t),
+    }
+}
+
+fn kind_name(k: ToolKind) -> &'static str {
+    match k {
+        ToolKind::Ball => "ball",
+        ToolKind::Flat => "flat end mill",
+        ToolKind::Bull => "bull-nose",
     }
 }
 
 /// Reads the tool in use from a program, block by block in file order (module docs).
 #[derive(Debug, Default, Clone)]
 pub struct Tracker {
-    /// Descriptions by tool id.
-    defs: HashMap<ToolId, (Tool, String)>,
-    /// A description that names no tool, for the next tool change (hyperMILL's `* - TOOL:`).
-    pending: Option<(Tool, String)>,
+    /// Every description read, in file order.
+    descs: Vec<Desc>,
+    /// The latest description giving each number or name.
+    by_id: HashMap<ToolId, usize>,
+    /// The current group's descriptions that give no number a call could contradict
+    /// (module docs).
+    group: Vec<usize>,
+    /// The current group's last comment that looks like a tool's and that no form reads.
+    unread: Option<String>,
     /// The tool a `T` word selected, for the next `M6`.
     selected: Option<ToolId>,
     /// An `M6` was seen (before it, a bare `T` is the change: Grbl-style files).
     any_m6: bool,
     /// The tool in use.
     active: Option<ToolId>,
-    /// The description of the tool in use (taken at its change).
-    active_desc: Option<(Tool, String)>,
+    /// The description its change took, or why none.
+    taken: Option<usize>,
+    note: Option<String>,
+    /// The tool call's length delta: value in the program's unit, mm per unit (`None`
+    /// while no unit is stated), where.
+    delta: Option<(f64, Option<f64>, String)>,
     /// Inside an NX tool list (its header seen): rows are `( n NAME diameter offset )`.
     nx_table: bool,
     /// Inside a PowerMill tool table (its header seen).
     powermill_table: bool,
-    /// The program is in inches now (descriptions are kept in the program's unit and
-    /// converted at the tool change: posts write their tool list before `G20`).
+    /// The program is in inches now.
     inch: bool,
+    /// The program has stated its unit.
+    unit_stated: bool,
     /// Counts the changes of what [`Tracker::found`] gives (a caller keeps one copy per
     /// revision, not one per run).
     revision: u64,
@@ -466,22 +958,35 @@ fn kind_from_text(text: &str) -> Option<Option<ToolKind>> {
     }
 }
 
-/// A tool from a diameter, a corner radius (if given) and a type text (if any): the
-/// geometry's kind, which the text must not contradict.
-fn tool_of(d_mm: f64, cr_mm: Option<f64>, text: Option<&str>) -> Option<Tool> {
-    let named = text.and_then(kind_from_text);
-    let cr = match (cr_mm, named) {
-        (Some(r), _) => r,
-        (None, Some(Some(ToolKind::Ball))) => d_mm / 2.0,
-        (None, Some(Some(ToolKind::Flat))) => 0.0,
-        _ => return None,
-    };
-    let t = Tool::from_geometry(d_mm, cr)?;
-    match named {
-        Some(None) => None,
-        Some(Some(k)) if k != t.kind => None,
-        _ => Some(t),
+/// A description's shape from a diameter, a corner radius (where stated) and a type text.
+fn shape(d: f64, cr: Option<f64>, text: Option<&str>) -> Shape {
+    match text.and_then(kind_from_text) {
+        Some(None) => Shape::Other,
+        named => Shape::Mill {
+            d,
+            cr,
+            named: named.flatten(),
+        },
     }
+}
+
+/// A description read from a line: what it names its tool by, and its shape.
+struct Read {
+    /// The numbers or names it gives its tool.
+    ids: Vec<ToolId>,
+    /// Its number is the program's tool number (`TOOL DEF 5`, Fusion's `T5`, a list's
+    /// row): a call of another number is another tool's. False where the id is the CAM
+    /// system's own (hyperMILL's `T1554880489`) or it gives none.
+    strict: bool,
+    shape: Shape,
+}
+
+/// What a block does to the tool in use.
+enum Call {
+    /// No tool change.
+    None,
+    /// A change to the tool it names (`None`: it names none, or by a parameter, `note`).
+    Change(Option<ToolId>, Option<String>),
 }
 
 impl Tracker {
@@ -490,71 +995,145 @@ impl Tracker {
         self.revision
     }
 
+    /// mm per unit of the program's values now.
+    fn unit(&self) -> f64 {
+        if self.inch { 25.4 } else { 1.0 }
+    }
+
     /// The program's tool at this point (the next run's, when called between runs).
     pub fn found(&self) -> FoundTool {
+        let unit = self.unit();
+        // A description naming the tool in use, written after its change, is its too.
+        let named = self
+            .active
+            .as_ref()
+            .and_then(|id| self.by_id.get(id).copied());
+        let k = match (self.taken, named) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            (a, b) => a.or(b),
+        };
         FoundTool {
             id: self.active.clone(),
-            described: self.active_desc.clone().or_else(|| {
-                self.active
-                    .as_ref()
-                    .and_then(|id| self.defs.get(id).cloned())
-                    .map(|(t, src)| (self.in_mm(t), src))
-            }),
+            described: k.map(|k| self.descs[k].tool(unit)),
+            note: if k.is_none() { self.note.clone() } else { None },
+            delta_length: self
+                .delta
+                .as_ref()
+                .map(|(v, u, src)| (v * u.unwrap_or(unit), src.clone())),
         }
     }
 
-    fn change_to(&mut self, id: Option<ToolId>) {
-        let desc = self
-            .pending
-            .take()
-            .or_else(|| id.as_ref().and_then(|i| self.defs.get(i).cloned()));
+    /// The tool change to `id`: the description it takes (module docs).
+    fn change_to(&mut self, id: Option<ToolId>, note: Option<String>) {
+        let by = id.as_ref().and_then(|i| self.by_id.get(i).copied());
+        let (taken, why) = match (by, self.group.as_slice()) {
+            (Some(k), _) => (Some(k), None),
+            (None, [k]) => (Some(*k), None),
+            (None, []) => (
+                None,
+                note.or_else(|| {
+                    self.unread
+                        .as_ref()
+                        .map(|u| format!("{u} is no form polepatch reads"))
+                }),
+            ),
+            (None, many) => {
+                let lines: Vec<&str> = many.iter().map(|&k| self.descs[k].line()).collect();
+                (
+                    None,
+                    Some(format!(
+                        "{} describe tools just before the call, none by the number or name it \
+                         calls: a list, not the call's",
+                        lines.join(", ")
+                    )),
+                )
+            }
+        };
         self.active = id;
-        self.active_desc = desc.map(|(t, src)| (self.in_mm(t), src));
+        self.taken = taken;
+        self.note = why;
+        self.end_group();
         self.revision += 1;
     }
 
-    fn define(&mut self, id: ToolId, desc: (Tool, String)) {
-        self.defs.insert(id, desc);
-        self.revision += 1;
+    /// A block that is neither a comment nor a description ends the group before it.
+    fn end_group(&mut self) {
+        self.group.clear();
+        self.unread = None;
     }
 
-    /// A tool described in the program's unit, in mm.
-    fn in_mm(&self, t: Tool) -> Tool {
-        let u = if self.inch { 25.4 } else { 1.0 };
-        Tool {
-            diameter_mm: t.diameter_mm * u,
-            corner_radius_mm: t.corner_radius_mm * u,
-            ..t
+    fn define(&mut self, line: usize, raw: &str, read: Read) {
+        let k = self.descs.len();
+        for id in &read.ids {
+            self.by_id.insert(id.clone(), k);
         }
+        if !read.strict {
+            self.group.push(k);
+        }
+        self.descs.push(Desc {
+            shape: read.shape,
+            unit: self.unit_stated.then(|| self.unit()),
+            source: source(line, raw),
+        });
+        self.revision += 1;
     }
 
-    /// Take the block on `line` (`text`: its bytes; `words` its words; `inch`: its unit).
+    /// Take the block (`text`: its bytes; `words` its words; `state` the modal state
+    /// after it).
     pub fn block(
         &mut self,
         dialect: Dialect,
-        line: usize,
+        block: &Block,
         text: &[u8],
         words: &[Word],
-        inch: bool,
+        state: &Modal,
     ) {
-        if self.inch != inch {
+        if self.inch != state.inch {
             self.revision += 1;
         }
-        self.inch = inch;
+        self.inch = state.inch;
+        // The first unit the program states is the unit of what it wrote before.
+        if block.flags.has(Flags::UNITS) && !self.unit_stated {
+            self.unit_stated = true;
+            let u = self.unit();
+            for d in self.descs.iter_mut().filter(|d| d.unit.is_none()) {
+                d.unit = Some(u);
+            }
+            if let Some(dl) = &mut self.delta {
+                dl.1.get_or_insert(u);
+            }
+            self.revision += 1;
+        }
+        let code = !comment_only(text);
         if !may_name_tool(text, words) {
-            // What a block without a T, a comment or M6 does (below): it ends a table.
+            // What a block without a T, a comment or M6 does (below): it ends a table and
+            // the group.
             self.nx_table = false;
             self.powermill_table = false;
+            if code {
+                self.end_group();
+            }
             return;
         }
-        let unit = 1.0;
+        let line = block.line;
         let raw = String::from_utf8_lossy(text);
         let up = raw.to_ascii_uppercase();
-        self.descriptions(line, &raw, &up, unit);
-        if dialect == Dialect::Conversational {
-            self.conversational(line, &raw, &up, unit);
-            return;
+        let call = if dialect == Dialect::Conversational {
+            self.conversational(line, &raw, &up)
+        } else {
+            self.iso(dialect, line, &raw, &up, words)
+        };
+        if code && matches!(call, Call::None) {
+            self.end_group();
         }
+        self.descriptions(line, &raw, &up);
+        if let Call::Change(id, note) = call {
+            self.change_to(id, note);
+        }
+    }
+
+    /// An ISO block: Heidenhain `G99` definitions, `T`/`M6` changes, `T="NAME"`.
+    fn iso(&mut self, dialect: Dialect, line: usize, raw: &str, up: &str, words: &[Word]) -> Call {
         let word = |l: u8| words.iter().rev().find(|w| w.letter == l).map(|w| w.value);
         let g = |c: f64| {
             words
@@ -564,18 +1143,25 @@ impl Tracker {
         let m6 = words
             .iter()
             .any(|w| w.letter == b'M' && (w.value - 6.0).abs() < 1e-9);
-        // Heidenhain ISO `G99 T5 L+0 R+5 R2+5`: a tool definition.
+        // Heidenhain ISO `G99 T5 L+0 R+5 R2+5`: a tool definition (no R2: a flat end mill).
         if dialect == Dialect::Heidenhain && g(99.0) {
-            if let (Some(t), Some(r)) = (word(b'T'), value_after(&up, "R")) {
-                let r2 = value_after(&up, "R2");
-                if let (Some(n), Some(tool)) = (
-                    whole(t),
-                    r2.and_then(|r2| Tool::from_geometry(2.0 * r * unit, r2 * unit)),
-                ) {
-                    self.define(ToolId::Number(n), (tool, source(line, &raw)));
-                }
+            if let (Some(n), Some(r)) = (word(b'T').and_then(whole), value_after(up, "R")) {
+                let r2 = value_after(up, "R2").unwrap_or(0.0);
+                self.define(
+                    line,
+                    raw,
+                    Read {
+                        ids: vec![ToolId::Number(n)],
+                        strict: true,
+                        shape: Shape::Mill {
+                            d: 2.0 * r,
+                            cr: Some(r2),
+                            named: None,
+                        },
+                    },
+                );
             }
-            return;
+            return Call::None;
         }
         // `T="NAME"` (Sinumerik).
         let named = up.find("T=\"").and_then(|k| {
@@ -583,58 +1169,121 @@ impl Tracker {
             rest.find('"').map(|e| ToolId::Name(rest[..e].to_string()))
         });
         let selected = named.or_else(|| word(b'T').and_then(whole).map(ToolId::Number));
-        // Heidenhain ISO `T5 G17`: the tool call.
+        // Heidenhain ISO `T5 G17`: the tool call (with its `DL`).
         let heidenhain_call = dialect == Dialect::Heidenhain && (g(17.0) || g(18.0) || g(19.0));
-        if let Some(id) = selected {
-            if m6 || heidenhain_call || !self.any_m6 {
-                self.change_to(Some(id.clone()));
+        let call = if let Some(id) = selected {
+            let change = m6 || heidenhain_call || !self.any_m6;
+            self.selected = Some(id.clone());
+            if change {
+                Call::Change(Some(id), None)
+            } else {
+                Call::None
             }
-            self.selected = Some(id);
         } else if m6 {
-            let id = self.selected.clone();
-            self.change_to(id);
-        }
+            Call::Change(self.selected.clone(), None)
+        } else {
+            Call::None
+        };
         self.any_m6 |= m6;
+        if heidenhain_call && matches!(call, Call::Change(..)) {
+            self.set_delta(line, raw, up);
+        }
+        call
     }
 
-    fn conversational(&mut self, line: usize, raw: &str, up: &str, unit: f64) {
-        let toks: Vec<&str> = up.split_whitespace().collect();
-        let start = usize::from(
-            toks.first()
-                .is_some_and(|t| t.bytes().all(|b| b.is_ascii_digit())),
-        );
-        let toks = &toks[start..];
-        if toks.len() < 2 || toks[0] != "TOOL" {
-            return;
-        }
-        let id = toks.get(2).and_then(|t| {
-            let t = t.trim_matches('"');
-            if t.is_empty() || t.starts_with('S') && t.len() > 1 && t[1..].parse::<f64>().is_ok() {
-                None
-            } else {
-                Some(
-                    t.parse::<u64>()
-                        .map_or_else(|_| ToolId::Name(t.to_string()), ToolId::Number),
-                )
+    /// The `DL` of a tool call (none: 0): in force until the next call.
+    fn set_delta(&mut self, line: usize, raw: &str, up: &str) {
+        let unit = self.unit_stated.then(|| self.unit());
+        self.delta = delta_length(up).map(|(v, at, len)| {
+            let word: String = raw[at..at + len].to_string();
+            let src = format!("line {line}, col {}: {word}", at + 1);
+            match v {
+                Some(v) => (v, unit, src),
+                // A parameter: the controlled point is not known.
+                None => (f64::NAN, unit, src),
             }
         });
-        match toks[1] {
-            "DEF" => {
-                let r = value_after(up, "R");
-                let r2 = value_after(up, "R2");
-                if let (Some(id), Some(r), Some(r2)) = (id, r, r2)
-                    && let Some(tool) = Tool::from_geometry(2.0 * r * unit, r2 * unit)
-                {
-                    self.define(id, (tool, source(line, raw)));
-                }
+        self.revision += 1;
+    }
+
+    /// A conversational block: `TOOL DEF` definitions, `TOOL CALL` changes.
+    fn conversational(&mut self, line: usize, raw: &str, up: &str) -> Call {
+        let t = up.trim_start();
+        let t = t
+            .trim_start_matches(|c: char| c.is_ascii_digit())
+            .trim_start();
+        let Some(rest) = t.strip_prefix("TOOL") else {
+            return Call::None;
+        };
+        let rest = rest.trim_start();
+        let (def, args) = if let Some(a) = rest.strip_prefix("DEF") {
+            (true, a.trim_start())
+        } else if let Some(a) = rest.strip_prefix("CALL") {
+            (false, a.trim_start())
+        } else {
+            return Call::None;
+        };
+        // The tool: a number (`5`, an indexed `5.1`), a name in quotes, a parameter
+        // (`QS1`, `Q5`); else none (`TOOL CALL Z S10000`: the tool in use, a new speed).
+        enum Named {
+            Id(ToolId),
+            Parameter(String),
+            None,
+        }
+        let first = args.split_whitespace().next().unwrap_or("");
+        let named = if let Some(q) = args.strip_prefix('"') {
+            match q.find('"') {
+                Some(e) => Named::Id(ToolId::Name(q[..e].to_string())),
+                None => Named::None,
             }
-            "CALL" if id.is_some() => self.change_to(id),
-            _ => {}
+        } else if first.starts_with(|c: char| c.is_ascii_digit()) {
+            match first.parse::<u64>() {
+                Ok(n) => Named::Id(ToolId::Number(n)),
+                Err(_) => Named::Id(ToolId::Name(first.to_string())),
+            }
+        } else if first.starts_with('Q') {
+            Named::Parameter(first.to_string())
+        } else {
+            Named::None
+        };
+        if def {
+            // `TOOL DEF 5 L+0 R+5 R2+5`; without R2 a flat end mill; without R (`TOOL DEF
+            // 5`, a preselection) no description.
+            if let (Named::Id(id), Some(r)) = (named, value_after(up, "R")) {
+                let r2 = value_after(up, "R2").unwrap_or(0.0);
+                self.define(
+                    line,
+                    raw,
+                    Read {
+                        ids: vec![id],
+                        strict: true,
+                        shape: Shape::Mill {
+                            d: 2.0 * r,
+                            cr: Some(r2),
+                            named: None,
+                        },
+                    },
+                );
+            }
+            return Call::None;
+        }
+        self.set_delta(line, raw, up);
+        match named {
+            Named::Id(id) => Call::Change(Some(id), None),
+            Named::Parameter(p) => Call::Change(
+                None,
+                Some(format!(
+                    "line {line}: TOOL CALL names its tool by the parameter {p}, which polepatch \
+                     does not evaluate"
+                )),
+            ),
+            // The tool in use, called again: its DL is the new call's.
+            Named::None => Call::None,
         }
     }
 
     /// Tool descriptions in comments (module docs' table).
-    fn descriptions(&mut self, line: usize, raw: &str, up: &str, unit: f64) {
+    fn descriptions(&mut self, line: usize, raw: &str, up: &str) {
         // NX tool list and PowerMill table headers.
         if up.contains("TOOL-NO.") && up.contains("DIAMETER") {
             self.nx_table = true;
@@ -644,30 +1293,105 @@ impl Tracker {
             self.powermill_table = true;
             return;
         }
-        let comment = comment_text(up);
-        let Some(c) = comment else {
+        let Some(c) = comment_text(up) else {
             self.nx_table = false;
             self.powermill_table = false;
             return;
         };
-        // Fusion: `T1 D=10. CR=5. - ZMIN=-5. - ball end mill`; its Heidenhain form
-        // `#31 D=10 CR=5 - … - ball end mill`.
-        if let Some(d) = value_after(c, "D=") {
-            let id = fusion_id(c);
-            let cr = value_after(c, "CR=");
-            let text = c.rsplit(" - ").next();
-            if let (Some(id), Some(tool)) = (id, tool_of(d * unit, cr.map(|r| r * unit), text)) {
-                self.define(id, (tool, source(line, raw)));
-            }
-            return;
+        if let Some(read) = self.read_comment(c) {
+            self.define(line, raw, read);
+        } else if looks_like_a_tool(c) {
+            self.unread = Some(source(line, raw));
         }
-        // hyperMILL: `TOOL: T313 | NAME / DM=10 CR=5 TL=90`.
+    }
+
+    /// A comment's description, where it is one of the forms read (module docs' table).
+    fn read_comment(&mut self, c: &str) -> Option<Read> {
+        // PowerMill table row: `1|NAME| 4.0 | 0.0 | 75.0`.
+        if self.powermill_table {
+            let cols: Vec<&str> = c.split('|').map(str::trim).collect();
+            if let [n, _name, d, r, ..] = cols.as_slice()
+                && let (Ok(n), Ok(d), Ok(r)) =
+                    (n.parse::<u64>(), d.parse::<f64>(), r.parse::<f64>())
+            {
+                return Some(Read {
+                    ids: vec![ToolId::Number(n)],
+                    strict: true,
+                    shape: Shape::Mill {
+                        d,
+                        cr: Some(r),
+                        named: None,
+                    },
+                });
+            }
+            self.powermill_table = false;
+        }
+        // NX tool list row: `3 BALL_MILL 0.236 0`.
+        if self.nx_table {
+            let cols: Vec<&str> = c.split_whitespace().collect();
+            if let [n, name, d, ..] = cols.as_slice()
+                && let (Ok(n), Ok(d)) = (n.parse::<u64>(), d.parse::<f64>())
+            {
+                return Some(Read {
+                    ids: vec![ToolId::Number(n)],
+                    strict: true,
+                    shape: shape(d, None, Some(name)),
+                });
+            }
+            if !c.trim_start().starts_with('-') {
+                self.nx_table = false;
+            }
+        }
+        // hyperMILL: `TOOL: T313 | NAME / DM=10 CR=5 TL=90`, `T313 | NAME / DM=…`: its own
+        // T number and name.
         if let Some(d) = value_after(c, "DM=") {
             let cr = value_after(c, "CR=").unwrap_or(0.0);
-            if let Some(tool) = Tool::from_geometry(d * unit, cr * unit) {
-                self.pending = Some((tool, source(line, raw)));
+            let head = c.split('/').next().unwrap_or("");
+            let head = head.trim_start().trim_start_matches("TOOL:").trim_start();
+            let mut ids = Vec::new();
+            if let Some(n) = head
+                .split_whitespace()
+                .next()
+                .and_then(|t| t.strip_prefix('T'))
+                .and_then(|t| t.parse::<u64>().ok())
+            {
+                ids.push(ToolId::Number(n));
             }
-            return;
+            if let Some((_, name)) = head.split_once('|')
+                && !name.trim().is_empty()
+            {
+                ids.push(ToolId::Name(name.trim().to_string()));
+            }
+            return Some(Read {
+                ids,
+                strict: false,
+                shape: Shape::Mill {
+                    d,
+                    cr: Some(cr),
+                    named: None,
+                },
+            });
+        }
+        // Mastercam, fields between `|`: `T1 | 1/4 BALL ENDMILL | H1 | D1 | TOOL DIA. - .25`.
+        let fields: Vec<&str> = c.split('|').map(str::trim).collect();
+        if fields.len() >= 3
+            && let Some(n) = fields[0]
+                .strip_prefix('T')
+                .and_then(|t| t.trim().parse::<u64>().ok())
+            && let Some(d) = fields
+                .iter()
+                .filter(|f| f.contains("DIA"))
+                .find_map(|f| number_after_dash(f))
+        {
+            let cr = fields
+                .iter()
+                .filter(|f| f.contains("RAD"))
+                .find_map(|f| number_after_dash(f));
+            return Some(Read {
+                ids: vec![ToolId::Number(n)],
+                strict: true,
+                shape: shape(d, cr, Some(fields[1])),
+            });
         }
         // Mastercam: `TOOL - 12 3/16 BALL ENDMILL DIA. OFF. - 12 LEN. - 12 DIA. - .1875`.
         if c.contains("TOOL -") && c.contains("DIA. -") {
@@ -682,43 +1406,96 @@ impl Tracker {
                     .and_then(|t| t.trim_end_matches(')').parse::<f64>().ok())
             });
             let name = c.split("DIA. OFF.").next().unwrap_or("");
-            if let (Some(n), Some(d)) = (n, d)
-                && let Some(tool) = tool_of(d * unit, None, Some(name))
-            {
-                self.define(ToolId::Number(n), (tool, source(line, raw)));
-            }
-            return;
-        }
-        // PowerMill table row: `1|NAME| 4.0 | 0.0 | 75.0`.
-        if self.powermill_table {
-            let cols: Vec<&str> = c.split('|').map(str::trim).collect();
-            if let [n, _name, d, r, ..] = cols.as_slice()
-                && let (Ok(n), Ok(d), Ok(r)) =
-                    (n.parse::<u64>(), d.parse::<f64>(), r.parse::<f64>())
-            {
-                if let Some(tool) = Tool::from_geometry(d * unit, r * unit) {
-                    self.define(ToolId::Number(n), (tool, source(line, raw)));
-                }
-                return;
-            }
-            self.powermill_table = false;
-        }
-        // NX tool list row: `3 BALL_MILL 0.236 0`.
-        if self.nx_table {
-            let cols: Vec<&str> = c.split_whitespace().collect();
-            if let [n, name, d, ..] = cols.as_slice()
-                && let (Ok(n), Ok(d)) = (n.parse::<u64>(), d.parse::<f64>())
-            {
-                if let Some(tool) = tool_of(d * unit, None, Some(name)) {
-                    self.define(ToolId::Number(n), (tool, source(line, raw)));
-                }
-                return;
-            }
-            if !c.trim_start().starts_with('-') {
-                self.nx_table = false;
+            if let (Some(n), Some(d)) = (n, d) {
+                return Some(Read {
+                    ids: vec![ToolId::Number(n)],
+                    strict: true,
+                    shape: shape(d, None, Some(name)),
+                });
             }
         }
+        // `TOOL: T1 = 10.0 dia. ENDMILL…` (LinuxCNC's boat demos).
+        if let Some(rest) = c.trim_start().strip_prefix("TOOL:") {
+            let toks: Vec<&str> = rest.split_whitespace().collect();
+            if let [t, "=", d, dia, ..] = toks.as_slice()
+                && dia.starts_with("DIA")
+                && let (Some(n), Ok(d)) = (
+                    t.strip_prefix('T').and_then(|n| n.parse::<u64>().ok()),
+                    d.parse::<f64>(),
+                )
+            {
+                let text = rest.split_once("DIA").map_or("", |(_, r)| r);
+                return Some(Read {
+                    ids: vec![ToolId::Number(n)],
+                    strict: true,
+                    shape: shape(d, None, Some(text)),
+                });
+            }
+        }
+        // Fusion: `T1 D=10. CR=5. - ZMIN=-5. - ball end mill`; its Heidenhain form
+        // `#31 D=10 CR=5 - … - ball end mill`; without a number and with a type text,
+        // `Ball cutter D=10.00` (CUQ).
+        if let Some(d) = value_after(c, "D=") {
+            let cr = value_after(c, "CR=");
+            let text = c.rsplit(" - ").next();
+            return match fusion_id(c) {
+                Some(id) => Some(Read {
+                    ids: vec![id],
+                    strict: true,
+                    shape: shape(d, cr, text),
+                }),
+                None if text.and_then(kind_from_text).is_some() => Some(Read {
+                    ids: Vec::new(),
+                    strict: false,
+                    shape: shape(d, cr, text),
+                }),
+                None => None,
+            };
+        }
+        None
     }
+}
+
+/// The number after the last `-` of a Mastercam field (`TOOL DIA. - .25`).
+fn number_after_dash(field: &str) -> Option<f64> {
+    field
+        .rsplit('-')
+        .next()
+        .and_then(|r| r.split_whitespace().next())
+        .and_then(|t| t.trim_end_matches(')').parse::<f64>().ok())
+}
+
+/// A comment that may describe a tool in a form polepatch does not read: a tool word and
+/// a number.
+fn looks_like_a_tool(c: &str) -> bool {
+    ["TOOL", "CUTTER", "BALL", "MILL", "DIA"]
+        .iter()
+        .any(|w| c.contains(w))
+        && c.bytes().any(|b| b.is_ascii_digit())
+}
+
+/// The `DL` word of a tool call in upper-case `up`: its value (`None`: a parameter,
+/// `DL+Q5`), byte offset and length.
+fn delta_length(up: &str) -> Option<(Option<f64>, usize, usize)> {
+    let b = up.as_bytes();
+    let mut from = 0;
+    while let Some(k) = up[from..].find("DL") {
+        let at = from + k;
+        from = at + 2;
+        if at > 0 && b[at - 1].is_ascii_alphanumeric() {
+            continue;
+        }
+        let rest = &up[at + 2..];
+        let len = rest
+            .find(|c: char| c.is_ascii_whitespace() || c == '*' || c == ';')
+            .unwrap_or(rest.len());
+        let value = &rest[..len];
+        if value.is_empty() {
+            continue;
+        }
+        return Some((value.parse::<f64>().ok(), at, 2 + len));
+    }
+    None
 }
 
 /// The tool number of a Fusion description: `T1 D=…` or `#31 D=…`.
@@ -729,8 +1506,6 @@ fn fusion_id(c: &str) -> Option<ToolId> {
     digits.parse::<u64>().ok().map(ToolId::Number)
 }
 
-/// The text of a line's comment, upper case: inside `( )` or after `;` (also a
-/// conversational `* -` line).
 /// Whether a block (`text`, `words`) may say anything of the tool: a T in any case (`T`
 /// words, `TOOL DEF`/`TOOL CALL`, `T="…"`, the tables' headers), a comment
 /// ([`comment_text`]'s forms) or M6. Most blocks do not, and [`Tracker::block`] skips them
@@ -749,6 +1524,31 @@ fn may_name_tool(text: &[u8], words: &[Word]) -> bool {
         .any(|w| w.letter == b'M' && (w.value - 6.0).abs() < 1e-9)
 }
 
+/// Whether a block holds nothing but comments (and a block number): `(…)`, `; …`, a
+/// conversational `* - …` line, or nothing.
+fn comment_only(text: &[u8]) -> bool {
+    let mut t = text.trim_ascii();
+    if let Some(r) = t.strip_prefix(b"N").or_else(|| t.strip_prefix(b"n"))
+        && r.first().is_some_and(u8::is_ascii_digit)
+    {
+        t = r;
+    }
+    let digits = t.iter().take_while(|b| b.is_ascii_digit()).count();
+    t = t[digits..].trim_ascii_start();
+    loop {
+        match t.first() {
+            None | Some(b';' | b'*') => return true,
+            Some(b'(') => match t.iter().position(|&b| b == b')') {
+                Some(k) => t = t[k + 1..].trim_ascii_start(),
+                None => return true,
+            },
+            _ => return false,
+        }
+    }
+}
+
+/// The text of a line's comment, upper case: inside `( )` or after `;` (also a
+/// conversational `* -` line).
 fn comment_text(up: &str) -> Option<&str> {
     if let Some(k) = up.find('(') {
         let rest = &up[k + 1..];
@@ -767,66 +1567,6 @@ fn comment_text(up: &str) -> Option<&str> {
 fn whole(v: f64) -> Option<u64> {
     (v >= 0.0 && v.fract() == 0.0 && v < 1e15).then_some(v as u64)
 }
-
-/// The tool of a CL file (APT `CUTTER/d[,r,e,f,α,β,h]`, NX `TLDATA/MILL,d,r,…`), the last
-/// one before the first `GOTO/`, mm (`unit_mm` per unit of the file), with where it was.
-pub fn cl_tool(bytes: &[u8], unit_mm: f64) -> Option<(Tool, String)> {
-    let text = String::from_utf8_lossy(bytes);
-    let mut found = None;
-    for (k, line) in text.lines().enumerate() {
-        let up = line.trim().to_ascii_uppercase();
-        if up.starts_with("GOTO") {
-            break;
-        }
-        let args = |key: &str| -> Option<Vec<f64>> {
-            let rest = up.strip_prefix(key)?.trim_start().strip_prefix('/')?;
-            Some(
-                rest.split(',')
-                    .map(|v| v.trim().trim_end_matches('$').trim().parse::<f64>())
-                    .take_while(Result::is_ok)
-                    .flatten()
-                    .collect(),
-            )
-        };
-        let tool = if let Some(v) = args("CUTTER") {
-            match v.as_slice() {
-                // `CUTTER/d`: a flat end mill; `CUTTER/d,r[,e,f,α…]`: r the corner radius
-                // (a base angle α ≠ 0 is a drill or a cone, no mill).
-                [d] => Tool::from_geometry(d * unit_mm, 0.0),
-                [d, r] => Tool::from_geometry(d * unit_mm, r * unit_mm),
-                [d, r, _e, _f, alpha, ..] if *alpha == 0.0 => {
-                    Tool::from_geometry(d * unit_mm, r * unit_mm)
-                }
-                [d, r, _, _] | [d, r, _] => Tool::from_geometry(d * unit_mm, r * unit_mm),
-                _ => None,
-            }
-        } else if let Some(v) = up
-            .strip_prefix("TLDATA")
-            .and_then(|r| r.trim_start().strip_prefix('/'))
-            .and_then(|r| r.strip_prefix("MILL,"))
-            .map(|r| {
-                r.split(',')
-                    .map(|v| v.trim().parse::<f64>())
-                    .take_while(Result::is_ok)
-                    .flatten()
-                    .collect::<Vec<f64>>()
-            })
-        {
-            match v.as_slice() {
-                [d, r, _len, _taper, tip, ..] if *tip == 0.0 => {
-                    Tool::from_geometry(d * unit_mm, r * unit_mm)
-                }
-                [d, r] | [d, r, _] => Tool::from_geometry(d * unit_mm, r * unit_mm),
-                _ => None,
-            }
-        } else {
-            continue;
-        };
-        found = tool.map(|t| (t, source(k + 1, line)));
-    }
-    found
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -886,10 +1626,10 @@ mod tests {
                 let blk = &prog.blocks[b];
                 t.block(
                     prog.dialect,
-                    blk.line,
+                    blk,
                     &prog.bytes[blk.span()],
                     prog.block_words(b),
-                    prog.state(b).inch,
+                    &prog.state(b),
                 );
                 t.found()
             })
@@ -897,7 +1637,8 @@ mod tests {
     }
 
     fn last_tool(f: &[FoundTool]) -> Option<Tool> {
-        f.last().and_then(|x| x.described.as_ref().map(|d| d.0))
+        f.last()
+            .and_then(|x| x.described.as_ref().and_then(|d| d.0))
     }
 
     #[test]
@@ -908,7 +1649,10 @@ mod tests {
             Dialect::Auto,
             "(T1  D=10. CR=5. - ZMIN=-5. - ball end mill)\n(T2 D=12 CR=0 - ZMIN=-1 - flat end mill)\nT2 M6\nT1 M6\n",
         );
-        assert_eq!(f[2].described.as_ref().unwrap().0.kind, ToolKind::Flat);
+        assert_eq!(
+            f[2].described.as_ref().unwrap().0.unwrap().kind,
+            ToolKind::Flat
+        );
         assert_eq!(last_tool(&f), Some(ball10));
         assert!(
             f[3].described
@@ -971,39 +1715,289 @@ mod tests {
         assert_eq!(last_tool(&f), Some(ball10));
     }
 
+    /// The unit of a description: the program's where it is written; before the program
+    /// states one, the one it states first (posts write the header first); mm if none.
     #[test]
-    fn cl_cutters() {
-        let (t, src) = cl_tool(
-            b"CUTTER/14.,7.,0,7.,0,0,73.\nLOAD/TOOL,5\nGOTO/0,0,0\n",
-            1.0,
-        )
-        .unwrap();
-        assert_eq!((t.kind, t.diameter_mm), (ToolKind::Ball, 14.0));
-        assert!(src.starts_with("line 1"));
+    fn description_units() {
+        let d = |text: &str| last_tool(&track(Dialect::Auto, text)).map(|t| t.diameter_mm);
+        let ball = "(T1 D=0.5 CR=0.25 - ball end mill)\n";
+        assert_eq!(d(&format!("{ball}G20\nT1 M6\n")), Some(12.7));
+        // The change before G20 as well: the list is still the inch program's.
+        assert_eq!(d(&format!("{ball}T1 M6\nG20\n")), Some(12.7));
+        assert_eq!(d(&format!("{ball}T1 M6\n")), Some(0.5), "no unit: mm");
+        // Written under G21, read in mm whatever follows.
         assert_eq!(
-            cl_tool(b"CUTTER/10,5\nGOTO/1,2,3\n", 1.0).unwrap().0.kind,
-            ToolKind::Ball
+            d("G21\n(T1 D=12 CR=6 - ball end mill)\nG20\nT1 M6\n"),
+            Some(12.0)
+        );
+        // Heidenhain's BEGIN PGM states it first.
+        assert_eq!(
+            d("0 BEGIN PGM T INCH\n1 TOOL DEF 5 L+0 R+0.25 R2+0.25\n2 TOOL CALL 5 Z\n"),
+            Some(12.7)
+        );
+    }
+
+    /// `TOOL CALL`: the tool by number, name or parameter; an axis letter or `S` is none;
+    /// `DL` read with its column and in force until the next call.
+    #[test]
+    fn tool_calls() {
+        let f = track(
+            Dialect::Conversational,
+            "0 BEGIN PGM T MM\n1 TOOL DEF 5 L+0 R+5\n2 TOOL CALL 5 Z S12000 DL-0.5 DR+0\n\
+             3 TOOL CALL Z S10000\n4 TOOL CALL QS1 Z\n5 TOOL CALL \"BALL D6\" Z S1 DL+Q5\n",
+        );
+        assert_eq!(f[2].id, Some(ToolId::Number(5)));
+        assert_eq!(
+            f[2].described.as_ref().unwrap().0,
+            Some(Tool::parse("flat:10").unwrap()),
+            "no R2: a flat end mill"
         );
         assert_eq!(
-            cl_tool(b"CUTTER/20.,0,10.,0,0,0,100.\n", 1.0)
-                .unwrap()
-                .0
-                .kind,
-            ToolKind::Flat
+            f[2].delta_length,
+            Some((-0.5, "line 3, col 24: DL-0.5".to_string()))
+        );
+        // `Z S10000`: the same tool, its DL the new call's (none).
+        assert_eq!(f[3].id, Some(ToolId::Number(5)));
+        assert_eq!(f[3].delta_length, None);
+        assert_eq!(f[4].id, None);
+        assert!(f[4].note.as_deref().unwrap().contains("parameter QS1"));
+        assert_eq!(f[5].id, Some(ToolId::Name("BALL D6".into())));
+        assert!(f[5].delta_length.as_ref().unwrap().0.is_nan());
+        // Heidenhain ISO: the DL of the `T5 G17` block.
+        let f = track(
+            Dialect::Heidenhain,
+            "%T G71 *\nN10 G99 T5 L+0 R+5 R2+5 *\nN20 T5 G17 S1000 DL-5 *\n",
+        );
+        assert_eq!(f[2].delta_length.as_ref().map(|d| d.0), Some(-5.0));
+    }
+
+    /// The forms of issue 42 and which description a call takes.
+    #[test]
+    fn more_forms_and_matching() {
+        let ball10 = Some(Tool::parse("ball:10").unwrap());
+        // CUQ: no number, before the change.
+        let f = track(
+            Dialect::Auto,
+            "N1(File : t.nc)\nN2(Ball cutter D=10.00)\nN3(Offset=0.00 LACE CENTER)\nN4T006M06F800\n",
+        );
+        assert_eq!(last_tool(&f), ball10);
+        // ... but not across a block of code, nor as another number's.
+        let f = track(Dialect::Auto, "(Ball cutter D=10.00)\nG90 G21\nT6 M6\n");
+        assert_eq!(last_tool(&f), None);
+        let f = track(Dialect::Auto, "(T2 D=10 CR=5 - ball end mill)\nT1 M6\n");
+        assert_eq!(last_tool(&f), None);
+        // Mastercam's fields: D1 the offset register, TOOL DIA. the diameter.
+        let f = track(
+            Dialect::Auto,
+            "( T3 | 1/4 BALL ENDMILL | H3 | D3 | TOOL DIA. - .25 )\nG20\nT3 M6\n",
+        );
+        assert!((last_tool(&f).unwrap().diameter_mm - 6.35).abs() < 1e-9);
+        // `TOOL: T1 = 10.0 dia. …`.
+        let f = track(Dialect::Auto, "( TOOL: T1 = 10.0 dia. BALLMILL )\nT1 M6\n");
+        assert_eq!(last_tool(&f), ball10);
+        // hyperMILL: the list before the call, none named by it: no tool, the list said.
+        let f = track(
+            Dialect::Conversational,
+            "0 BEGIN PGM T MM\n1 * - TOOL: T1 | A / DM=12 CR=0\n2 * - TOOL: T2 | B / DM=10 CR=5\n\
+             3 TOOL CALL \"C\" Z\n",
+        );
+        assert_eq!(f[3].described, None);
+        assert!(
+            f[3].note.as_deref().unwrap().contains("line 2, line 3"),
+            "{f:?}"
+        );
+        // A type text that contradicts the geometry gives no tool, said.
+        let f = track(Dialect::Auto, "(T1 D=10 CR=2 - ball end mill)\nT1 M6\n");
+        let (t, src) = f[1].described.clone().unwrap();
+        assert_eq!(t, None);
+        assert!(src.contains("its text says ball"), "{src}");
+        // NX's `TOOL NO.`: no diameter, named.
+        let f = track(
+            Dialect::Sinumerik,
+            "N10 ;TOOL NO. :8\nN20 ;TOOL TYPE :Milling Tool-5 Parameters\nN30 T8 M6\n",
         );
         assert!(
-            cl_tool(b"CUTTER/6.5,0,3.25,1.95,31.,0,105.\n", 1.0).is_none(),
-            "a drill"
+            f[2].note
+                .as_deref()
+                .unwrap()
+                .contains("line 2: N20 ;TOOL TYPE :Milling Tool-5"),
+            "{f:?}"
+        );
+    }
+
+    /// What a tool asks of the patch with a length delta (module docs): the centre's height
+    /// above the point X Y Z state is R − h, h = h₀ − DL.
+    #[test]
+    fn delta_length_demands() {
+        let run = |tool: &str, centre: bool, dl: Option<f64>| {
+            let found = FoundTool {
+                delta_length: dl.map(|v| (v, format!("DL{v}"))),
+                ..FoundTool::default()
+            };
+            let opts = ToolOptions {
+                tool: Some(Tool::parse(tool).unwrap()),
+                ..ToolOptions::default()
+            };
+            resolve(&opts, &found, None, centre, "code")
+        };
+        let keep = |off: f64| ToolDemand::KeepCentre { offset_mm: off };
+        assert_eq!(run("ball:10", false, None).demand(), keep(5.0));
+        let centred = run("ball:10", false, Some(-5.0));
+        assert_eq!(centred.demand(), ToolDemand::Nothing);
+        assert_eq!(centred.point, ToolPoint::Centre);
+        assert!(
+            centred.point_source.contains("DL-5"),
+            "{}",
+            centred.point_source
+        );
+        assert_eq!(run("ball:10", false, Some(-2.0)).demand(), keep(3.0));
+        assert_eq!(run("ball:10", false, Some(1.0)).demand(), keep(6.0));
+        // Above the centre: the centre moves with the turn, capped.
+        assert_eq!(
+            run("ball:10", false, Some(-7.0)).demand(),
+            ToolDemand::Cap { reach_mm: 2.0 }
+        );
+        // M128 (the centre) with an oversize: the centre 1 mm above X Y Z.
+        assert_eq!(run("ball:10", true, None).demand(), ToolDemand::Nothing);
+        assert_eq!(run("ball:10", true, Some(1.0)).demand(), keep(1.0));
+        // A flat D10 turned about a point 3 mm up its axis: its edge √(5² + 3²) away.
+        assert_eq!(
+            run("flat:10", false, Some(-3.0)).demand(),
+            ToolDemand::Cap {
+                reach_mm: 34f64.sqrt()
+            }
         );
         assert_eq!(
-            cl_tool(b"TLDATA/MILL,32.0000,5.0000,75.0000,0.0000,0.0000\n", 1.0)
-                .unwrap()
-                .0
-                .kind,
-            ToolKind::Bull
+            run("bull:10,2", false, None).demand(),
+            ToolDemand::Cap {
+                reach_mm: Tool::parse("bull:10,2").unwrap().end_reach_mm()
+            }
         );
-        let inch = cl_tool(b"CUTTER/.5,.25\n", 25.4).unwrap().0;
-        assert!((inch.diameter_mm - 12.7).abs() < 1e-9);
+        // A DL by parameter: the point is not known, nor then the tool's demand.
+        let q = run("ball:10", false, Some(f64::NAN));
+        assert_eq!((q.tool, q.demand()), (None, ToolDemand::Nothing));
+        assert!(q.tool_source.contains("parameter"), "{}", q.tool_source);
+    }
+
+    /// `--tool` over the program over the table, every disagreement said.
+    #[test]
+    fn sources_and_disagreements() {
+        let found = FoundTool {
+            id: Some(ToolId::Number(5)),
+            described: Some((Tool::parse("ball:10").ok(), "line 4: TOOL DEF 5".into())),
+            ..FoundTool::default()
+        };
+        let table =
+            ToolTable::from_toml_str("[tool.5]\nkind = \"flat\"\ndiameter_mm = 10\n", "t").unwrap();
+        let mut opts = ToolOptions {
+            table,
+            ..ToolOptions::default()
+        };
+        let r = resolve(&opts, &found, None, false, "code");
+        assert_eq!(r.tool, Tool::parse("ball:10").ok());
+        assert_eq!(r.tool_source, "line 4: TOOL DEF 5");
+        assert!(r.disagreement.unwrap().contains("the program's is used"));
+        opts.tool = Tool::parse("ball:10").ok();
+        let r = resolve(&opts, &found, None, false, "code");
+        assert_eq!(r.tool_source, "--tool");
+        assert!(
+            r.disagreement
+                .unwrap()
+                .contains("tool table's entry for T5 says flat D10")
+        );
+        // Agreeing sources: nothing said.
+        opts.table = ToolTable::default();
+        assert_eq!(
+            resolve(&opts, &found, None, false, "code").disagreement,
+            None
+        );
+        // The table alone.
+        let described = FoundTool {
+            described: None,
+            ..found.clone()
+        };
+        opts.tool = None;
+        opts.table
+            .tools
+            .insert(ToolId::Number(5), Tool::parse("flat:6").unwrap());
+        assert_eq!(
+            resolve(&opts, &described, None, false, "code").tool_source,
+            "tool table (T5)"
+        );
+    }
+
+    fn cl(text: &str) -> ClTools {
+        cl_tools(&polepatch_cl::parse(text.as_bytes()).unwrap())
+    }
+
+    fn cl_tool(c: &ClTools, n: u64) -> Option<Tool> {
+        c.by_tool.get(&n).and_then(|x| x.0)
+    }
+
+    #[test]
+    fn cl_cutters() {
+        let c = cl("CUTTER/14.,7.,0,7.,0,0,73.\nLOAD/TOOL,5\nGOTO/0,0,0\n");
+        assert_eq!(cl_tool(&c, 5), Some(Tool::parse("ball:14").unwrap()));
+        assert!(c.by_tool[&5].1.starts_with("CL line 1: CUTTER/14."));
+        // No LOADTL: the cutter of the first moves.
+        let c = cl("CUTTER/10,5\nGOTO/1,2,3\n");
+        assert_eq!(c.before_first_load.unwrap().0.unwrap().kind, ToolKind::Ball);
+        let c = cl("CUTTER/20.,0,10.,0,0,0,100.\nLOADTL/1\nGOTO/0,0,0\n");
+        assert_eq!(cl_tool(&c, 1).unwrap().kind, ToolKind::Flat);
+        // A drill (base angle 31°) is no end mill: said, no tool.
+        let c = cl("CUTTER/6.5,0,3.25,1.95,31.,0,105.\nLOADTL/1\nGOTO/0,0,0\n");
+        assert_eq!(cl_tool(&c, 1), None);
+        assert!(c.by_tool[&1].1.contains("no end mill"), "{:?}", c.by_tool);
+        let c = cl("TLDATA/MILL,32.0000,5.0000,75.0000,0.0000,0.0000\nLOAD/TOOL,3\nGOTO/0,0,0\n");
+        assert_eq!(cl_tool(&c, 3).unwrap().kind, ToolKind::Bull);
+        // Inches, the units record before or after the cutter.
+        for text in [
+            "UNITS/INCHES\nCUTTER/.5,.25\nLOADTL/1\nGOTO/0,0,0\n",
+            "CUTTER/.5,.25\nUNITS/INCHES\nLOADTL/1\nGOTO/0,0,0\n",
+        ] {
+            let d = cl_tool(&cl(text), 1).unwrap().diameter_mm;
+            assert!((d - 12.7).abs() < 1e-9, "{text}: {d}");
+        }
+    }
+
+    /// Several cutters: each for the tool whose moves it comes before, written before its
+    /// LOADTL (CAMWorks) or after it (Creo's order); Creo's commented diameter is no
+    /// shape; a cutter changing between one tool's moves leaves it unknown.
+    #[test]
+    fn cl_cutters_per_tool() {
+        let camworks = "CUTTER/10,5,0,5,0,0,75\nLOADTL/1\nGOTO/0,0,0\nGOTO/1,0,0\n\
+                        CUTTER/12,0,6,0,0,0,80\nLOADTL/2\nGOTO/0,0,0\nGOTO/1,0,0\n";
+        let c = cl(camworks);
+        assert_eq!(cl_tool(&c, 1), Some(Tool::parse("ball:10").unwrap()));
+        assert_eq!(cl_tool(&c, 2), Some(Tool::parse("flat:12").unwrap()));
+        assert!(c.by_tool[&2].1.starts_with("CL line 5:"), "{:?}", c.by_tool);
+        let after = "LOADTL/1\nCUTTER/10,5\nGOTO/0,0,0\nLOADTL/2\nCUTTER / 12.000000\nGOTO/0,0,0\n";
+        let c = cl(after);
+        assert_eq!(cl_tool(&c, 1), Some(Tool::parse("ball:10").unwrap()));
+        assert_eq!(cl_tool(&c, 2), Some(Tool::parse("flat:12").unwrap()));
+        assert!(
+            c.by_tool[&2].1.starts_with("CL line 5: CUTTER / 12"),
+            "{:?}",
+            c.by_tool
+        );
+        // Creo's comment: the diameter, not the kind: said, no tool.
+        let c = cl("LOADTL / 2\n$$-> CUTTER / 6.000000\nGOTO / 0, 0, 0\n");
+        assert_eq!(cl_tool(&c, 2), None);
+        assert!(
+            c.by_tool[&2].1.contains("without the shape of its end"),
+            "{:?}",
+            c.by_tool
+        );
+        let changed = "CUTTER/10,5\nLOADTL/1\nGOTO/0,0,0\nCUTTER/12\nGOTO/1,0,0\n";
+        let c = cl(changed);
+        assert_eq!(cl_tool(&c, 1), None);
+        assert!(c.by_tool[&1].1.contains("two cutters"), "{:?}", c.by_tool);
+        // The same cutter again for the same tool is no conflict.
+        let again = "CUTTER/10,5\nLOADTL/1\nGOTO/0,0,0\nCUTTER/10,5\nLOADTL/1\nGOTO/1,0,0\n";
+        assert_eq!(
+            cl_tool(&cl(again), 1),
+            Some(Tool::parse("ball:10").unwrap())
+        );
     }
 
     #[test]
@@ -1018,5 +2012,31 @@ mod tests {
         let e = ToolTable::from_toml_str("[tool.5]\nkind = \"bull\"\ndiameter_mm = 6\n", "t")
             .unwrap_err();
         assert!(e.contains("tool 5"), "{e}");
+        // Entries that contradict themselves, or name one tool twice.
+        for (text, key) in [
+            (
+                "[tool.5]\nkind = \"ball\"\ndiameter_mm = 10\ncorner_radius_mm = 2\n",
+                "tool 5",
+            ),
+            (
+                "[tool.7]\nkind = \"flat\"\ndiameter_mm = 10\ncorner_radius_mm = 1\n",
+                "tool 7",
+            ),
+            (
+                "[tool.ab]\nkind = \"flat\"\ndiameter_mm = 10\n[tool.AB]\nkind = \"flat\"\ndiameter_mm = 10\n",
+                "tool ab",
+            ),
+        ] {
+            let e = ToolTable::from_toml_str(text, "t").unwrap_err();
+            assert!(e.starts_with(&format!("t: {key}")), "{e}");
+        }
+        // Agreeing values are fine.
+        assert!(
+            ToolTable::from_toml_str(
+                "[tool.5]\nkind = \"ball\"\ndiameter_mm = 10\ncorner_radius_mm = 5\n",
+                "t"
+            )
+            .is_ok()
+        );
     }
 }

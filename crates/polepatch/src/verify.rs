@@ -54,7 +54,7 @@
 //! its own and handed over in batches), plus the runs in hand.
 
 use crate::error::Error;
-use crate::tool::{RunTool, ToolKind, ToolOptions, ToolPoint};
+use crate::tool::{RunTool, ToolDemand, ToolKind, ToolPoint};
 use polepatch_kinematics::{Machine, angle_between_deg, forward};
 use polepatch_nc::{
     Block, Dialect, Flags, Modal, Motion, ReadOptions, RotaryLetters, Run, RunBuilder, Scanned,
@@ -645,7 +645,7 @@ impl<'a> Comparison<'a> {
         self.pair_runs();
         // After the runs this block ends: a tool change is the next run's.
         self.tracker
-            .block(self.dialect, line, text_o, o.words, o.state.inch);
+            .block(self.dialect, o.block, text_o, o.words, o.state);
         self.prev_o = *o.state;
         self.prev_p = p.state;
         self.i += 1;
@@ -770,31 +770,23 @@ impl<'a> Comparison<'a> {
         ])
     }
 
-    /// The tool at block `line` and the bound on its orientation change.
+    /// The tool at a block in state `st` and the bound on its orientation change.
     fn block_tool(&self, st: &Modal) -> BlockTool {
-        let machine_point = self
-            .machine
-            .controller
-            .tool_point
-            .as_deref()
-            .and_then(|p| ToolPoint::parse(p).ok());
-        let tool = crate::tool::resolve(
+        let tool = crate::tool::for_run(
             &self.opts.tool,
             &self.tracker.found(),
-            machine_point,
-            st.tcpm.is_on() && st.tcpm_centre,
-            "",
+            self.machine,
+            st.tcpm.is_on(),
+            st.tcpm_centre,
         );
         let mut bound_deg = self.opts.patch.reach_deg();
         if let Some(cap) = self.opts.patch.max_deviation_deg {
             bound_deg = bound_deg.min(cap);
         }
-        if let Some(t) = tool.tool
-            && t.kind != ToolKind::Ball
-        {
-            bound_deg = bound_deg.min(crate::tool::deviation_cap_deg(
-                &t,
-                tool_surface(&self.opts.tool),
+        if let ToolDemand::Cap { reach_mm } = tool.demand() {
+            bound_deg = bound_deg.min(crate::tool::cap_for_reach_deg(
+                reach_mm,
+                self.opts.tool.surface_tolerance_mm,
             ));
         }
         BlockTool { tool, bound_deg }
@@ -848,11 +840,14 @@ impl<'a> Comparison<'a> {
             let (chain, d) = self.chain_datum(i)?;
             chain.part_tip(self.machine, d, q[3], q[4], xyz)
         };
-        Some(match tool.tool {
-            Some(t) if t.kind == ToolKind::Ball && tool.point == ToolPoint::Tip => {
+        Some(match tool.demand() {
+            ToolDemand::KeepCentre { offset_mm } => {
                 let o = forward(self.machine, q[3], q[4]);
-                let r = t.diameter_mm / 2.0;
-                [tip[0] + r * o[0], tip[1] + r * o[1], tip[2] + r * o[2]]
+                [
+                    tip[0] + offset_mm * o[0],
+                    tip[1] + offset_mm * o[1],
+                    tip[2] + offset_mm * o[2],
+                ]
             }
             _ => tip,
         })
@@ -995,17 +990,16 @@ impl<'a> Comparison<'a> {
         ) else {
             return;
         };
-        let radius = bt
-            .tool
-            .tool
-            .filter(|t| t.kind == ToolKind::Ball && bt.tool.point == ToolPoint::Tip)
-            .map_or(0.0, |t| t.diameter_mm / 2.0);
+        let radius = match bt.tool.demand() {
+            ToolDemand::KeepCentre { offset_mm } => offset_mm,
+            _ => 0.0,
+        };
         let d = norm(sub(ro, rp));
         self.report.max_reference_shift_mm = self.report.max_reference_shift_mm.max(d);
         let what = match bt.tool.tool {
             Some(t) if radius > 0.0 => format!("the {}'s centre (tip + R·o)", t.describe()),
             _ if bt.tool.point == ToolPoint::Centre => "the ball's centre".to_string(),
-            _ => "the tool tip".to_string(),
+            _ => "the point X Y Z state".to_string(),
         };
         self.pending.push(Pending {
             line,
@@ -1360,11 +1354,6 @@ impl Slower {
             )
         }
     }
-}
-
-/// The surface tolerance of the caller's tool options, mm.
-fn tool_surface(t: &ToolOptions) -> f64 {
-    t.surface_tolerance_mm
 }
 
 /// Equation 6 over every span of a path.

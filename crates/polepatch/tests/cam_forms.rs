@@ -311,7 +311,26 @@ fn conversational_blanks_after_the_letter() {
         .find(|&b| String::from_utf8_lossy(&p.bytes[p.blocks[b].span()]).contains("L Z 25.000"))
         .unwrap();
     assert_eq!(p.state(b).pos[Z], Some(25.0));
-    patches_rotary_words_only("apt post", &bytes, &ucp710(), &opts("apt post"));
+    // Its tool, `TOOL DEF 102 L+1.000 R+3.000`, has no R2: a flat D6 to the controller and
+    // to polepatch (its comment names a 6 mm ball, in no form read). The zone stops at the
+    // flat's cap (`tool_limited`), and only rotary words change.
+    let (out, report) = patch_nc(&bytes, &ucp710(), &opts("apt post")).unwrap();
+    assert!(!report.zones.is_empty());
+    for z in &report.zones {
+        assert_eq!(z.tool.to_string(), "flat D6", "{}", z.tool_source);
+        assert_eq!(z.reason, polepatch::ZoneReason::ToolLimited);
+    }
+    assert!(out != bytes && without_rotary_words(&out) == without_rotary_words(&bytes));
+    // Told it is a ball with X Y Z at its centre, the pass reaches feed.
+    let ball = PatchOptions {
+        tool: polepatch::tool::ToolOptions {
+            tool: polepatch::tool::Tool::parse("ball:6").ok(),
+            point: Some(polepatch::tool::ToolPoint::Centre),
+            ..Default::default()
+        },
+        ..opts("apt post")
+    };
+    patches_rotary_words_only("apt post", &bytes, &ucp710(), &ball);
     let e = parse(b"0 BEGIN PGM 1 MM\n1 L Z FMAX\n".to_vec(), Dialect::Auto).unwrap_err();
     assert_eq!((e.line, e.column), (2, 5));
     assert!(e.message.contains("a blank after the letter"), "{e}");

@@ -60,20 +60,20 @@ struct Point {
     rapid: bool,
 }
 
-/// The moves between the TCPM switch (`M128`, `FUNCTION TCPM`) and its end of a
-/// Heidenhain program (ISO or conversational), read word by word: a small reader of the
-/// fixtures' forms, independent of the library's.
+/// The moves between the TCPM switch (`M128`, `FUNCTION TCPM`, `G43.4`) and its end of a
+/// Heidenhain program (ISO or conversational) or a Fanuc-style one, read word by word: a
+/// small reader of the fixtures' forms, independent of the library's.
 fn points(text: &str) -> Vec<Point> {
     let mut on = false;
     let mut axes: [Option<Word>; 5] = [None; 5];
     let mut out = Vec::new();
     for (k, line) in text.lines().enumerate() {
         let up = line.to_ascii_uppercase();
-        if up.contains("M129") || up.contains("RESET TCPM") {
+        if up.contains("M129") || up.contains("RESET TCPM") || up.contains("G49") {
             on = false;
             continue;
         }
-        if up.contains("M128") || up.contains("FUNCTION TCPM") {
+        if up.contains("M128") || up.contains("FUNCTION TCPM") || up.contains("G43.4") {
             on = true;
             continue;
         }
@@ -177,11 +177,23 @@ fn pairs(before: &[u8], after: &[u8]) -> (Vec<Point>, Vec<Point>) {
 /// the run — `L Z+100 R0 FMAX` — keeps its own Z and the modal X Y of the rewritten last
 /// point: its centre may move by R·|Δo|, above the part; it is not checked.)
 fn centres_kept(m: &Machine, before: &[u8], after: &[u8], radius: f64, what: &str) -> (usize, f64) {
+    centres_kept_in(m, before, after, radius, what, 0..=usize::MAX)
+}
+
+/// [`centres_kept`] on the moves whose lines are in `lines`.
+fn centres_kept_in(
+    m: &Machine,
+    before: &[u8],
+    after: &[u8],
+    radius: f64,
+    what: &str,
+    lines: std::ops::RangeInclusive<usize>,
+) -> (usize, f64) {
     let (b, a) = pairs(before, after);
     let rounding = xyz_rounding(&b, &a);
     let mut turned = 0;
     let mut worst: f64 = 0.0;
-    for (p, q) in b.iter().zip(&a) {
+    for (p, q) in b.iter().zip(&a).filter(|(p, _)| lines.contains(&p.line)) {
         let turn = turn_deg(m, p, q);
         if turn > 0.0 {
             turned += 1;
@@ -349,11 +361,8 @@ fn the_camworks_apt_posted_with_the_patch_keeps_the_centres() {
             ..PostOptions::default()
         };
         tool_from_cl(&bytes, &cl, &mut opts);
-        assert_eq!(
-            opts.patch_options.tool.tool,
-            Some(Tool::parse("ball:10").unwrap()),
-            "CUTTER/10,5"
-        );
+        // The CL file's cutter is the program's, not a tool for the whole program.
+        assert_eq!(opts.patch_options.tool.tool, None);
         assert_eq!(opts.patch_options.tool.point, Some(ToolPoint::Tip));
         post_cl(&cl, &m, &opts).unwrap()
     };
@@ -369,6 +378,12 @@ fn the_camworks_apt_posted_with_the_patch_keeps_the_centres() {
         assert_eq!(
             (z.tool.to_string(), z.tool_point.map(ToolPoint::name)),
             ("ball D10".to_string(), Some("tip"))
+        );
+        assert!(
+            z.tool_source
+                .starts_with("CL line 9: CUTTER/10.000000,5.000000"),
+            "{}",
+            z.tool_source
         );
     }
     // And against the CL file itself: each posted tip + R·o is the GOTO's tip + R·(i j k)
@@ -451,7 +466,7 @@ fn a_flat_end_mill_stays_within_the_surface_bound() {
 #[test]
 fn each_tool_source_on_its_fixture() {
     let m = ucp710();
-    let cases: [(&str, ToolKind, f64, f64, &str); 8] = [
+    let cases: [(&str, ToolKind, f64, f64, &str); 15] = [
         (
             "fusion-ac-swing-d0.5-ball.nc",
             ToolKind::Ball,
@@ -508,6 +523,57 @@ fn each_tool_source_on_its_fixture() {
             5.0,
             "line 4: 3 TOOL DEF 1 L+0 R+5 R2+5",
         ),
+        // Issue 42's forms.
+        (
+            "cuq-ac-swing-d0.5-ball.nc",
+            ToolKind::Ball,
+            10.0,
+            5.0,
+            "line 2: N2(Ball cutter D=10.00)",
+        ),
+        (
+            "mastercam-pipe-ac-swing-d0.5-ball.nc",
+            ToolKind::Ball,
+            10.0,
+            5.0,
+            "line 5: ( T1 | 10. BALL ENDMILL | H1 | D1 | TOOL DIA. - 10. )",
+        ),
+        (
+            "tooldia-ac-swing-d0.5-flat.nc",
+            ToolKind::Flat,
+            10.0,
+            0.0,
+            "line 3: ( TOOL: T1 = 10.0 dia. ENDMILLM1000:REG )",
+        ),
+        (
+            "hypermill-toollist-ac-swing-d1-ball.H",
+            ToolKind::Ball,
+            10.0,
+            5.0,
+            "line 9: 3 * - T313732062 | KUG-D10-L90 / DM=10 CR=5",
+        ),
+        // Issue 39's.
+        (
+            "fusion-inch-ac-swing-d0.5-ball.nc",
+            ToolKind::Ball,
+            12.7,
+            6.35,
+            "line 3: (T1  D=0.5 CR=0.25",
+        ),
+        (
+            "conv-tooldef-no-r2-flat.H",
+            ToolKind::Flat,
+            10.0,
+            0.0,
+            "line 4: 3 TOOL DEF 1 L+0 R+5",
+        ),
+        (
+            "conv-toolcall-speed-only.H",
+            ToolKind::Ball,
+            10.0,
+            5.0,
+            "line 4: 3 TOOL DEF 1 L+0 R+5 R2+5",
+        ),
     ];
     for (file, kind, d, r, source) in cases {
         let rel = format!("fixtures/tools/{file}");
@@ -519,7 +585,10 @@ fn each_tool_source_on_its_fixture() {
         };
         assert!(!report.zones.is_empty(), "{file}: zones");
         for z in &report.zones {
-            assert_eq!(z.tool, ZoneTool::Known(want), "{file}: {}", z.tool_source);
+            let ZoneTool::Known(got) = z.tool else {
+                panic!("{file}: no tool: {}", z.tool_source);
+            };
+            assert!(got.same_as(&want), "{file}: {got:?}, {}", z.tool_source);
             assert!(
                 z.tool_source.starts_with(source),
                 "{file}: source {:?}, expected {source:?}…",
@@ -528,12 +597,13 @@ fn each_tool_source_on_its_fixture() {
         }
         assert_eq!(report.zones_with_unknown_tool(), 0, "{file}");
     }
-    // APT CUTTER (read by `post`).
+    // APT CUTTER (read by `post`), for the tool its LOADTL loads.
     let apt = fixture("fixtures/tools/camworks_ball_swing.apt");
-    let (tool, source) = polepatch::tool::cl_tool(&apt, 1.0).unwrap();
-    assert_eq!(tool, Tool::parse("ball:10").unwrap());
+    let tools = polepatch::tool::cl_tools(&read_cl(&apt, "camworks_ball_swing.apt").unwrap());
+    let (tool, source) = tools.by_tool[&1].clone();
+    assert_eq!(tool, Some(Tool::parse("ball:10").unwrap()));
     assert!(
-        source.starts_with("line 9: CUTTER/10.000000,5.000000"),
+        source.starts_with("CL line 9: CUTTER/10.000000,5.000000"),
         "{source}"
     );
 }
@@ -609,6 +679,296 @@ fn a_centre_path_beyond_the_chord_tolerance_is_not_written() {
             u.message.contains("chord tolerance 0.001 mm"),
             "{}",
             u.message
+        );
+    }
+}
+
+/// Issue 42: the ball forms added, each under its tip-referring TCPM code: every written
+/// centre (tip + R·o, o from the written A C) kept within 1 µm plus rounding — which fails
+/// where the description is not read (the zones then change the orientation with X Y Z
+/// left) or read with the wrong size.
+#[test]
+fn new_ball_forms_keep_the_centre() {
+    let m = ucp710();
+    for (file, radius) in [
+        ("cuq-ac-swing-d0.5-ball.nc", 5.0),
+        ("mastercam-pipe-ac-swing-d0.5-ball.nc", 5.0),
+        ("hypermill-toollist-ac-swing-d1-ball.H", 5.0),
+        // Inches: the tip and R in the file's unit (0.25 in).
+        ("fusion-inch-ac-swing-d0.5-ball.nc", 0.25),
+    ] {
+        let input = fixture(&format!("fixtures/tools/{file}"));
+        let (out, report) = patch_nc(&input, &m, &PatchOptions::default()).unwrap();
+        all_reached(&report, file);
+        let (turned, worst) = centres_kept(&m, &input, &out, radius, file);
+        assert!(turned > 0, "{file}: the orientation changed somewhere");
+        for z in &report.zones {
+            assert_eq!(z.tool_point, Some(ToolPoint::Tip), "{file}");
+            assert_eq!(z.tool_disagreement, None, "{file}");
+        }
+        println!("{file}: {turned} points turned, largest centre error {worst:.7}");
+    }
+}
+
+/// Issue 39: Fusion writes its tool list before `G20`; the list is in inches, wherever the
+/// tool change is (here moved before `G20` as well).
+#[test]
+fn a_tool_list_before_g20_is_in_inches() {
+    let m = ucp710();
+    let text =
+        String::from_utf8(fixture("fixtures/tools/fusion-inch-ac-swing-d0.5-ball.nc")).unwrap();
+    let moved = text.replace("G20\n", "").replace("T1 M6\n", "T1 M6\nG20\n");
+    assert_ne!(moved, text);
+    for (what, input) in [("as posted", text), ("change before G20", moved)] {
+        let (out, report) = patch_nc(input.as_bytes(), &m, &PatchOptions::default()).unwrap();
+        for z in &report.zones {
+            assert_eq!(
+                z.tool.to_string(),
+                "ball D12.7",
+                "{what}: {}",
+                z.tool_source
+            );
+        }
+        let (turned, _) = centres_kept(&m, input.as_bytes(), &out, 0.25, what);
+        assert!(turned > 0, "{what}");
+    }
+}
+
+/// Issue 39: a list of hyperMILL descriptions just before the call (a flat D12, then a ball
+/// D10) and `TOOL CALL "FLAT-D12"`: the flat, so every zone stays within the flat's cap
+/// (2·asin(0.005/12) = 0.0477°); a call that names neither leaves the tool unknown, the list
+/// named.
+#[test]
+fn a_list_before_the_call_gives_the_tool_it_names() {
+    let m = ucp710();
+    let input = fixture("fixtures/tools/hypermill-list-call-flat-d12.H");
+    let (_, report) = patch_nc(&input, &m, &PatchOptions::default()).unwrap();
+    let cap =
+        polepatch::tool::deviation_cap_deg(&Tool::parse("flat:12").unwrap(), SURFACE_TOLERANCE_MM);
+    assert!((cap - 0.0477).abs() < 1e-3, "{cap}");
+    assert!(!report.zones.is_empty());
+    for z in &report.zones {
+        assert_eq!(z.tool.to_string(), "flat D12", "{}", z.tool_source);
+        assert!(
+            z.tool_source
+                .starts_with("line 4: 3 * - TOOL: T1 | FLAT-D12"),
+            "{}",
+            z.tool_source
+        );
+        assert!(
+            z.max_deviation_deg <= cap * (1.0 + 1e-6),
+            "{} > {cap}",
+            z.max_deviation_deg
+        );
+    }
+    let other = String::from_utf8(input)
+        .unwrap()
+        .replace("\"FLAT-D12\" Z", "\"GB02\" Z");
+    let (_, report) = patch_nc(other.as_bytes(), &m, &PatchOptions::default()).unwrap();
+    for z in &report.zones {
+        assert_eq!(z.tool, ZoneTool::Unknown);
+        assert!(
+            z.tool_source
+                .contains("line 4, line 5 describe tools just before the call"),
+            "{}",
+            z.tool_source
+        );
+    }
+}
+
+/// Issue 39: `TOOL CALL Z S10000` calls no tool 'Z' (the tool in use, a new speed), and a
+/// `TOOL DEF` without R2 is a flat end mill (held to its cap).
+#[test]
+fn tool_call_axis_and_tool_def_without_r2() {
+    let m = ucp710();
+    let (out, report) = patch_nc(
+        &fixture("fixtures/tools/conv-toolcall-speed-only.H"),
+        &m,
+        &PatchOptions::default(),
+    )
+    .unwrap();
+    all_reached(&report, "TOOL CALL Z S10000");
+    for z in &report.zones {
+        assert_eq!(z.tool.to_string(), "ball D10", "{}", z.tool_source);
+        assert!(!z.tool_source.contains("'Z'") && !z.tool_source.contains("\"Z\""));
+    }
+    centres_kept(
+        &m,
+        &fixture("fixtures/tools/conv-toolcall-speed-only.H"),
+        &out,
+        5.0,
+        "TOOL CALL Z",
+    );
+    let flat = fixture("fixtures/tools/conv-tooldef-no-r2-flat.H");
+    let (out, report) = patch_nc(&flat, &m, &PatchOptions::default()).unwrap();
+    let cap =
+        polepatch::tool::deviation_cap_deg(&Tool::parse("flat:10").unwrap(), SURFACE_TOLERANCE_MM);
+    for z in &report.zones {
+        assert_eq!(z.tool.to_string(), "flat D10", "{}", z.tool_source);
+        assert!(z.max_deviation_deg <= cap * (1.0 + 1e-6));
+    }
+    let (b, a) = pairs(&flat, &out);
+    for (p, q) in b.iter().zip(&a) {
+        assert!(turn_deg(&m, p, q) <= cap + 1e-6, "line {}", p.line);
+        assert_eq!(p.xyz_text, q.xyz_text, "a flat end mill's X Y Z stay");
+    }
+}
+
+/// Issue 39: a tool table entry that contradicts itself is refused with its key; one that
+/// disagrees with the program's own description is said (the zone's field and a warning)
+/// and the program's is used: the centres of its D10 ball are kept.
+#[test]
+fn tool_tables_that_contradict() {
+    use polepatch::tool::ToolTable;
+    let e = ToolTable::from_toml_str(
+        "[tool.5]\nkind = \"ball\"\ndiameter_mm = 10\ncorner_radius_mm = 2\n",
+        "tools.toml",
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("tools.toml: tool 5") && e.contains("corner_radius_mm = 2"),
+        "{e}"
+    );
+    let e = ToolTable::from_toml_str(
+        "[tool.flat]\nkind = \"flat\"\ndiameter_mm = 10\ncorner_radius_mm = 1\n",
+        "t",
+    )
+    .unwrap_err();
+    assert!(e.contains("tool flat"), "{e}");
+    let m = ucp710();
+    let input = fixture("fixtures/tools/ac-swing-d1-conv-refpnt-tip.H");
+    let mut opts = PatchOptions::default();
+    opts.tool.table =
+        ToolTable::from_toml_str("[tool.1]\nkind = \"flat\"\ndiameter_mm = 10\n", "t").unwrap();
+    let (out, report) = patch_nc(&input, &m, &opts).unwrap();
+    all_reached(&report, "table disagrees");
+    for z in &report.zones {
+        assert_eq!(z.tool.to_string(), "ball D10");
+        let d = z.tool_disagreement.as_deref().unwrap();
+        assert!(d.contains("tool table's entry for T1 says flat D10"), "{d}");
+    }
+    let said: Vec<_> = report
+        .warnings
+        .iter()
+        .filter(|w| w.contains("sources disagree"))
+        .collect();
+    assert_eq!(said.len(), 1, "{:?}", report.warnings);
+    centres_kept(&m, &input, &out, 5.0, "table disagrees");
+}
+
+/// Issue 39: `DL` in a `TOOL CALL` under `FUNCTION TCPM … TIP-TIP`. DL−5 on a D10 ball: the
+/// controlled point is the ball's centre, so X Y Z stay as they are; DL−2: the centre is
+/// 3 mm above the point X Y Z state, and it is kept there (a patch that ignored DL keeps
+/// it 5 mm up and fails this by 2 mm × |Δo|).
+#[test]
+fn a_tool_call_delta_length() {
+    let m = ucp710();
+    let centre = fixture("fixtures/tools/conv-tip-dl-minus-r.H");
+    let (out, report) = patch_nc(&centre, &m, &PatchOptions::default()).unwrap();
+    assert_ne!(out, centre, "patched");
+    xyz_identical(&centre, &out, "DL-5");
+    for z in &report.zones {
+        assert_eq!(z.tool_point, Some(ToolPoint::Centre));
+        assert!(
+            z.tool_point_source.contains("line 5, col 24: DL-5"),
+            "{}",
+            z.tool_point_source
+        );
+    }
+    let between = fixture("fixtures/tools/conv-tip-dl-minus-2.H");
+    let (out, report) = patch_nc(&between, &m, &PatchOptions::default()).unwrap();
+    all_reached(&report, "DL-2");
+    let (turned, worst) = centres_kept(&m, &between, &out, 3.0, "DL-2");
+    assert!(turned > 0);
+    assert!(
+        points(&String::from_utf8_lossy(&out))
+            .iter()
+            .zip(points(&String::from_utf8_lossy(&between)))
+            .any(|(a, b)| a.xyz_text != b.xyz_text),
+        "DL-2: X Y Z rewritten"
+    );
+    println!("DL-2: {turned} points turned, largest centre error {worst:.6} mm");
+}
+
+/// Issue 39: an APT file with a second `CUTTER/` after `LOADTL/2`, posted and patched:
+/// the first pass is the ball's (centres kept), the second the flat's (within its cap), each
+/// source the CL line of its cutter — never `--tool`.
+#[test]
+fn post_reads_each_cutter_for_the_tool_loaded() {
+    let m = ucp710();
+    let name = "fixtures/tools/apt-two-cutters-swing.apt";
+    let bytes = fixture(name);
+    let cl = read_cl(&bytes, name).unwrap();
+    let post = |patch: bool| {
+        let mut opts = PostOptions {
+            patch,
+            ..PostOptions::default()
+        };
+        tool_from_cl(&bytes, &cl, &mut opts);
+        post_cl(&cl, &m, &opts).unwrap()
+    };
+    let (raw, _) = post(false);
+    let (patched, report) = post(true);
+    let report = report.unwrap();
+    let text = String::from_utf8_lossy(&raw).into_owned();
+    // The second tool change of the written program.
+    let second = text
+        .lines()
+        .position(|l| l.contains("T2 "))
+        .expect("the second tool change")
+        + 1;
+    let cap =
+        polepatch::tool::deviation_cap_deg(&Tool::parse("flat:12").unwrap(), SURFACE_TOLERANCE_MM);
+    let (mut balls, mut flats) = (0, 0);
+    for z in &report.zones {
+        assert_ne!(z.tool_source, "--tool");
+        if z.lines[0] < second {
+            balls += 1;
+            assert_eq!(z.tool.to_string(), "ball D10", "{}", z.tool_source);
+            assert!(
+                z.tool_source.starts_with("CL line 10: CUTTER/10."),
+                "{}",
+                z.tool_source
+            );
+        } else {
+            flats += 1;
+            assert_eq!(z.tool.to_string(), "flat D12", "{}", z.tool_source);
+            assert!(
+                z.tool_source.starts_with("CL line 73: CUTTER/12."),
+                "{}",
+                z.tool_source
+            );
+            assert!(
+                z.max_deviation_deg <= cap * (1.0 + 1e-6),
+                "{}",
+                z.max_deviation_deg
+            );
+        }
+    }
+    assert!(balls > 0 && flats > 0, "{balls} {flats}");
+    let (turned, _) = centres_kept_in(&m, &raw, &patched, 5.0, "APT ball pass", 0..=second);
+    assert!(turned > 0);
+}
+
+/// Issue 42: a tool comment in no form polepatch reads is named where the tool stays
+/// unknown.
+#[test]
+fn an_unread_tool_comment_is_named() {
+    let m = ucp710();
+    let text = String::from_utf8(fixture("fixtures/tools/fusion-ac-swing-d0.5-ball.nc"))
+        .unwrap()
+        .replace("(T1  D=10. CR=5. - ZMIN=-5. - ball end mill)\n", "")
+        .replace("T1 M6", "T3 M06 (BALL 6MM)");
+    let (_, report) = patch_nc(text.as_bytes(), &m, &PatchOptions::default()).unwrap();
+    assert!(!report.zones.is_empty());
+    for z in &report.zones {
+        assert_eq!(z.tool, ZoneTool::Unknown);
+        assert!(
+            z.tool_source.contains("T3")
+                && z.tool_source
+                    .contains("(BALL 6MM) is no form polepatch reads"),
+            "{}",
+            z.tool_source
         );
     }
 }

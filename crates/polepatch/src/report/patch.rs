@@ -119,9 +119,14 @@ pub struct ZoneRow {
     /// `unknown`, or `-` for a run that was not patched ([`crate::tool`]).
     #[serde(serialize_with = "by_name")]
     pub tool: ZoneTool,
-    /// Where the tool was found (`--tool`, `tool table (T5)`, `line 12: TOOL DEF …`), or
-    /// why it is unknown.
+    /// Where the tool was found (`--tool`, `tool table (T5)`, `line 12: TOOL DEF …`,
+    /// `CL line 9: CUTTER/…`), or why it is unknown.
     pub tool_source: String,
+    /// What another source says of the tool where it disagrees with the one used (`the
+    /// tool table's entry for T5 says ball D10, the program's description says flat D10
+    /// (line 4: …): the program's is used`); `None` where none does
+    /// ([`crate::tool::RunTool::disagreement`]).
+    pub tool_disagreement: Option<String>,
     /// Which point of the tool X Y Z state: `tip` or `centre`; `None`, written `-`, for a
     /// run that was not patched.
     #[serde(serialize_with = "by_name_or_dash")]
@@ -519,6 +524,26 @@ impl FileReport {
             .filter(|z| z.tool == ZoneTool::Unknown && z.max_deviation_deg > 0.0)
             .count()
     }
+    /// Add the tool warnings a report needs: each disagreement between the sources of a
+    /// tool once ([`ZoneRow::tool_disagreement`]), and once the warning a report with
+    /// [`FileReport::zones_with_unknown_tool`] needs.
+    pub fn warn_tools(&mut self) {
+        let mut said: Vec<&str> = Vec::new();
+        for z in &self.zones {
+            if let Some(d) = &z.tool_disagreement
+                && !said.contains(&d.as_str())
+            {
+                said.push(d);
+            }
+        }
+        let said: Vec<String> = said
+            .into_iter()
+            .map(|d| format!("{}: the tool's sources disagree: {d}", self.file))
+            .collect();
+        self.warnings.extend(said);
+        self.warn_unknown_tool();
+    }
+
     /// Add, once, the warning a report with [`FileReport::zones_with_unknown_tool`] needs.
     pub fn warn_unknown_tool(&mut self) {
         let n = self.zones_with_unknown_tool();
