@@ -8,7 +8,7 @@
 //! command the reader cannot follow at all (a Tcl loop, a procedure, a variable in a pin's
 //! name) may set any pin: after it every pin says so ([`Hal::opaque`]).
 
-use crate::linuxcnc::Ini;
+use crate::ini::Ini;
 use std::collections::HashMap;
 
 /// A value as read: its text, or why it is not known (with its file, line and column).

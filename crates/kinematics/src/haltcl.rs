@@ -26,7 +26,7 @@
 //! own pin or signal unknown.
 
 use crate::hal::{Hal, Value};
-use crate::linuxcnc::Ini;
+use crate::ini::Ini;
 
 /// One word of a Tcl command: its text as written (without the braces or quotes that
 /// delimit it), how it is delimited, and its 1-based line and column.

@@ -31,6 +31,7 @@ pub mod forward;
 mod frames;
 mod hal;
 mod haltcl;
+mod ini;
 pub mod inverse;
 pub mod linuxcnc;
 mod load;

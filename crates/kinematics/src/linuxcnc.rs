@@ -73,6 +73,8 @@
 
 use crate::chain::Chain;
 use crate::hal::Hal;
+use crate::ini::Entry;
+pub use crate::ini::Ini;
 use crate::machine::{AxisLimits, Controller, Machine, MachineError, num, read_bounded};
 use crate::machine_file::{
     DEG_PER_REV, DEG_S_PER_RPM, MM_PER_M, MM_S_PER_M_MIN, check_pair, positive, range,
@@ -91,92 +93,6 @@ pub fn default_jerk(max_acceleration: f64, servo_period_s: f64) -> f64 {
 
 /// LinuxCNC's default servo period when `[EMCMOT] SERVO_PERIOD` is absent, seconds.
 pub const DEFAULT_SERVO_PERIOD_S: f64 = 1e-3;
-
-/// One `KEY = VALUE` of an INI file, with its 1-based line.
-#[derive(Debug, Clone)]
-struct Entry {
-    section: String,
-    key: String,
-    value: String,
-    line: usize,
-}
-
-/// An INI file as LinuxCNC reads it: `[SECTION]` headers, `KEY = VALUE` lines, `#` and `;`
-/// comment lines; a key may repeat (`REMAP`, `HALCMD`, `HALFILE`), and a look-up takes the
-/// first, as LinuxCNC's `IniFile::Find` does.
-#[derive(Debug, Default)]
-pub struct Ini {
-    entries: Vec<Entry>,
-    /// `#INCLUDE` lines (expanded by LinuxCNC's start script, not here): 1-based lines.
-    includes: Vec<usize>,
-}
-
-impl Ini {
-    /// Parse INI text; `origin` names it in errors.
-    pub fn parse(text: &str, origin: &str) -> Result<Ini, MachineError> {
-        let mut section = String::new();
-        let mut entries = Vec::new();
-        let mut includes = Vec::new();
-        for (n, raw) in text.lines().enumerate() {
-            let line = raw.trim();
-            if line.starts_with("#INCLUDE") {
-                includes.push(n + 1);
-            }
-            if line.is_empty() || line.starts_with('#') || line.starts_with(';') {
-                continue;
-            }
-            if let Some(rest) = line.strip_prefix('[') {
-                let Some(name) = rest.strip_suffix(']') else {
-                    return Err(invalid(
-                        origin,
-                        format!("line {}: a section header must end with ']': {line}", n + 1),
-                    ));
-                };
-                section = name.trim().to_string();
-                continue;
-            }
-            let Some((key, value)) = line.split_once('=') else {
-                return Err(invalid(
-                    origin,
-                    format!("line {}: expected KEY = VALUE, got '{line}'", n + 1),
-                ));
-            };
-            entries.push(Entry {
-                section: section.clone(),
-                key: key.trim().to_string(),
-                value: value.trim().to_string(),
-                line: n + 1,
-            });
-        }
-        Ok(Ini { entries, includes })
-    }
-
-    /// The first value of `key` in `[section]`.
-    pub fn get(&self, section: &str, key: &str) -> Option<&str> {
-        self.entry(section, key).map(|e| e.value.as_str())
-    }
-
-    fn entry(&self, section: &str, key: &str) -> Option<&Entry> {
-        self.entries
-            .iter()
-            .find(|e| e.section == section && e.key == key)
-    }
-
-    /// Every entry of `key` in `[section]`, in file order.
-    fn entries_of<'a>(&'a self, section: &'a str, key: &'a str) -> impl Iterator<Item = &'a Entry> {
-        self.entries
-            .iter()
-            .filter(move |e| e.section == section && e.key == key)
-    }
-
-    /// Every value of `key` in `[section]`, in file order.
-    pub fn all<'a>(&'a self, section: &'a str, key: &'a str) -> impl Iterator<Item = &'a str> {
-        self.entries
-            .iter()
-            .filter(move |e| e.section == section && e.key == key)
-            .map(|e| e.value.as_str())
-    }
-}
 
 fn invalid(origin: &str, message: String) -> MachineError {
     MachineError::Invalid {

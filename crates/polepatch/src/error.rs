@@ -166,7 +166,7 @@ pub enum Error {
         /// File.
         path: String,
         /// What does not hold.
-        violations: Vec<crate::verify::Violation>,
+        violations: Vec<crate::violation::Violation>,
     },
     /// The caller's [`crate::Hooks::cancelled`] asked the patch to stop.
     #[error("cancelled")]

@@ -46,6 +46,7 @@ mod notes;
 mod patch;
 mod program;
 mod stream;
+mod violation;
 
 pub use analyze::analyze_program;
 pub use end_pose::EndPose;

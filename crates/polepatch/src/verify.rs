@@ -55,6 +55,7 @@
 
 use crate::error::Error;
 use crate::tool::{RunTool, ToolDemand, ToolKind, ToolPoint};
+pub use crate::violation::{Check, Violation};
 use polepatch_kinematics::{Machine, angle_between_deg, forward};
 use polepatch_nc::{
     Block, Dialect, Flags, Modal, Motion, ReadOptions, RotaryLetters, Run, RunBuilder, Scanned,
@@ -84,68 +85,6 @@ pub const TIME_TOL_REL: f64 = 1e-3;
 
 /// Batches of blocks handed from the patched program's reader to the comparison.
 const BATCH_BLOCKS: usize = 512;
-
-/// What a check is about ([`Violation::check`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Check {
-    /// The programs have different numbers of lines (a line added or deleted).
-    Lines,
-    /// A line differs outside the words a patch may change.
-    Text,
-    /// The modal state after a line differs (feed, motion, TCPM, units, …).
-    State,
-    /// The tool's reference point moved (a ball's centre, else the programmed point).
-    ReferencePoint,
-    /// A positioning move's X Y Z target moved, or its rotary values changed without TCPM.
-    PositioningTarget,
-    /// The orientation change exceeds its bound.
-    Deviation,
-    /// Values changed where nothing may change (no TCPM and no chain, TCPM unknown, an arc,
-    /// incremental mode, …).
-    Untouchable,
-    /// The runs of the two programs do not pair (a block's motion changed).
-    RunStructure,
-    /// Equation 6 lower on a span of a run of the written program.
-    FeedRatio,
-    /// A run's estimated time greater.
-    RunTime,
-    /// The program's estimated time (runs and positioning moves) greater.
-    ProgramTime,
-    /// A zone the report calls reached does not reach feed in the written program.
-    ReportedReached,
-}
-
-impl Check {
-    /// The name in reports: `reference_point`, `feed_ratio`, ….
-    pub fn name(self) -> &'static str {
-        match self {
-            Check::Lines => "lines",
-            Check::Text => "text",
-            Check::State => "state",
-            Check::ReferencePoint => "reference_point",
-            Check::PositioningTarget => "positioning_target",
-            Check::Deviation => "deviation",
-            Check::Untouchable => "untouchable",
-            Check::RunStructure => "run_structure",
-            Check::FeedRatio => "feed_ratio",
-            Check::RunTime => "run_time",
-            Check::ProgramTime => "program_time",
-            Check::ReportedReached => "reported_reached",
-        }
-    }
-}
-
-/// One thing that does not hold.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct Violation {
-    /// 1-based line of the patched program it is about (0: the program as a whole).
-    pub line: usize,
-    /// Which check.
-    pub check: Check,
-    /// What, for people (values in mm and degrees).
-    pub message: String,
-}
 
 /// A zone the patch reports reached, to be held against the written program
 /// ([`verify_claims`]).
