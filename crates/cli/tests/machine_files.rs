@@ -192,8 +192,8 @@ fn linuxcncs_bridgemill_demo_is_carried_through() {
 /// (`crates/patcher/src/joint.rs`, "the machine's ranges as bounds on each point's
 /// changes") force every point beyond 200° down to it, and the tool turned 6.25° in
 /// silence. The program cannot run on that machine: it is an error at the first word
-/// beyond the range (line 42, column 27: `C+211.506`), found by the survey
-/// (`Error::BeyondRange`).
+/// beyond the range — SING's `N36 A+0 C+0` (line 6, column 9), before its pass reaches
+/// `C+211.506` — found by the survey (`Error::BeyondRange`).
 #[test]
 fn a_program_beyond_the_machines_c_range_is_refused_at_its_word() {
     let dir = temp_dir("c-range");
@@ -214,7 +214,7 @@ fn a_program_beyond_the_machines_c_range_is_refused_at_its_word() {
     ]);
     assert_eq!(code, 1, "{err}");
     assert!(
-        err.contains("SING.I:42:27") && err.contains("211.506"),
+        err.contains("SING.I:6:9: C0 is beyond") && err.contains("[100, 200]"),
         "{err}"
     );
     assert!(!out.exists());

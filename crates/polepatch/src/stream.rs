@@ -928,10 +928,11 @@ pub fn patch_nc_hooked(
         return Err(Error::Cancelled);
     }
     result?;
-    let output = verified_output(bytes, machine, opts, &mut parts, &cancelled)?;
+    let (output, unverified) = verified_output(bytes, machine, opts, &mut parts, &cancelled)?;
     if cancelled() {
         return Err(Error::Cancelled);
     }
+    report.warnings.extend(unverified);
     for part in parts {
         if let Some(why) = &part.put_back {
             report.warnings.push(why.clone());
@@ -985,13 +986,18 @@ fn assemble(bytes: &[u8], parts: &[Part]) -> Vec<u8> {
 /// later line relies on what it changed) is put back, its zones marked
 /// [`crate::ZoneReason::Verification`], and the program verified again. A program that
 /// still fails with nothing left to put back is [`Error::Unverified`].
+///
+/// The bench's peers ([`polepatch_patcher::Strategy`] other than polepatch: methods shown
+/// for comparison, unverified by design) are not put back: what fails is returned as
+/// warnings, so that the bench shows what the peer does.
 fn verified_output(
     bytes: &[u8],
     machine: &Machine,
     opts: &crate::PatchOptions,
     parts: &mut [Part],
     cancelled: &dyn Fn() -> bool,
-) -> Result<Vec<u8>, Error> {
+) -> Result<(Vec<u8>, Vec<String>), Error> {
+    let peer = opts.patch.strategy != polepatch_patcher::Strategy::Polepatch;
     // The file lines each part covers.
     let mut lines = Vec::with_capacity(parts.len());
     let (mut at, mut line) = (0usize, 1usize);
@@ -1011,7 +1017,7 @@ fn verified_output(
     loop {
         let output = assemble(bytes, parts);
         if output == bytes || cancelled() {
-            return Ok(output);
+            return Ok((output, Vec::new()));
         }
         let claims: Vec<crate::verify::Claim> = parts
             .iter()
@@ -1026,7 +1032,21 @@ fn verified_output(
         let check =
             crate::verify::verify_claims(bytes, &output, machine, opts, &opts.name, &claims)?;
         if check.passed() {
-            return Ok(output);
+            return Ok((output, Vec::new()));
+        }
+        if peer {
+            let said = check.violations.iter().map(|v| {
+                format!(
+                    "{}: the {} peer's output fails its verification at line {} ({}: {}): \
+                     peers are shown for comparison, not to be run",
+                    opts.name,
+                    opts.patch.strategy.name(),
+                    v.line,
+                    v.check.name(),
+                    v.message
+                )
+            });
+            return Ok((output, said.collect()));
         }
         let mut put = false;
         for v in &check.violations {

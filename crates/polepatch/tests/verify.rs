@@ -186,7 +186,7 @@ fn a_restated_retract_keeps_its_height() {
                 .lines()
                 .find(|l| (l.contains("Z50.") || l.contains("Z+100")) && l.contains('C'))
                 .unwrap_or_else(|| panic!("{what}: no retract in\n{text}"));
-            let last = moves(&out).into_iter().filter(|m| !m.rapid).last().unwrap();
+            let last = moves(&out).into_iter().rfind(|m| !m.rapid).unwrap();
             let m = moves(&out)
                 .into_iter()
                 .find(|m| m.rapid && m.q[2] > 0.0 && m.line > last.line)
