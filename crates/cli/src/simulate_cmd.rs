@@ -226,6 +226,14 @@ pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
                 if let Some(e) = failure {
                     return Err(e);
                 }
+                if !header_written {
+                    // Nothing simulated: the columns alone (a CSV with no rows).
+                    writeln!(
+                        w,
+                        "run,t_s,s_mm,X,Y,Z,{primary_guess},{},feed_mm_min",
+                        machine.c_letter()
+                    )?;
+                }
                 report = Some(r);
                 buffered.flush()
             })();
@@ -256,12 +264,12 @@ pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
         if let [a, b] = &reports[..] {
             writeln!(
                 out,
-                "\n{} against {}: simulated {:.3} s → {:.3} s ({:+.1} %), Equation 6 {:.3} s → {:.3} s",
+                "\n{} against {}: simulated {:.3} s → {:.3} s ({}), Equation 6 {:.3} s → {:.3} s",
                 b.file,
                 a.file,
                 a.total.time_s,
                 b.total.time_s,
-                pct(b.total.time_s, a.total.time_s),
+                pct_text(b.total.time_s, a.total.time_s),
                 a.total.eq6_time_s,
                 b.total.eq6_time_s
             )?;
@@ -305,8 +313,36 @@ fn pct(x: f64, of: f64) -> f64 {
     100.0 * (x / of - 1.0)
 }
 
+/// `x` against `of` in per cent for people: `+1.3 %`, or `-` where `of` is 0 (no NaN).
+fn pct_text(x: f64, of: f64) -> String {
+    if of > 0.0 && x.is_finite() {
+        format!("{:+.1} %", pct(x, of))
+    } else {
+        "-".to_string()
+    }
+}
+
+/// The lowest feed of a run for the table, mm/min: whole numbers from 10 up, else the
+/// digits that say it (a feed of 0.4 mm/min is not "0").
+fn lowest_feed_text(f: f64) -> String {
+    if f >= 10.0 {
+        format!("{f:.0}")
+    } else {
+        format!("{:.2e}", f)
+            .parse::<f64>()
+            .map_or_else(|_| "-".into(), polepatch::report::feed_text)
+    }
+}
+
 /// The table of one report.
 fn print_report(out: &mut impl Write, r: &SimulateReport) -> std::io::Result<()> {
+    if let Some(why) = &r.nothing_to_simulate {
+        return writeln!(
+            out,
+            "{} on {}: nothing to simulate: {why}",
+            r.file, r.machine
+        );
+    }
     writeln!(
         out,
         "{} on {} (Tcy {} ms)\n{:>5} {:>13} {:>11} {:>9} {:>9} {:>10} {:>10} {:>18}",
@@ -336,7 +372,7 @@ fn print_report(out: &mut impl Write, r: &SimulateReport) -> std::io::Result<()>
             continue;
         }
         let low = match (run.min_feed_mm_min, run.min_feed_line) {
-            (Some(f), Some(l)) => format!("{f:.0} ({l})"),
+            (Some(f), Some(l)) => format!("{} ({l})", lowest_feed_text(f)),
             _ => "-".into(),
         };
         writeln!(
@@ -351,16 +387,20 @@ fn print_report(out: &mut impl Write, r: &SimulateReport) -> std::io::Result<()>
         )?;
     }
     let t = &r.total;
-    writeln!(
-        out,
-        "total over {} runs: L/F {:.3} s, Equation 6 {:.3} s ({:+.1} %), simulated {:.3} s ({:+.1} %)",
-        t.runs,
-        t.ideal_time_s,
-        t.eq6_time_s,
-        pct(t.eq6_time_s, t.ideal_time_s),
-        t.time_s,
-        pct(t.time_s, t.ideal_time_s)
-    )?;
+    if t.runs == 0 {
+        writeln!(out, "total: no run simulated (each run above says why)")?;
+    } else {
+        writeln!(
+            out,
+            "total over {} runs: L/F {:.3} s, Equation 6 {:.3} s ({}), simulated {:.3} s ({})",
+            t.runs,
+            t.ideal_time_s,
+            t.eq6_time_s,
+            pct_text(t.eq6_time_s, t.ideal_time_s),
+            t.time_s,
+            pct_text(t.time_s, t.ideal_time_s)
+        )?;
+    }
     if r.runs.iter().any(|x| x.joined) {
         writeln!(
             out,

@@ -160,3 +160,80 @@ fn rewind_puts_fewer_cycles_on_the_limit() {
     assert_eq!(code, 64, "{err}");
     assert!(err.contains("--rewind"), "{err}");
 }
+
+/// Issue 43, "one answer": a program with nothing to simulate says so, whatever output
+/// was asked for (before: "error: writing the trajectory /dev/null: … no G1 motion"), and
+/// the trajectory is its columns alone.
+#[test]
+fn a_program_of_rapid_moves_has_nothing_to_simulate() {
+    let dir = temp_dir("simulate-cli-rapids");
+    let prog = dir.join("rapids.I");
+    std::fs::write(
+        &prog,
+        "%L G71 *\nN10 G90 *\nN20 G00 X+0 Y+0 Z+0 A+20 C+30 *\nN30 X+10 *\nN40 M30 *\n",
+    )
+    .unwrap();
+    let csv = dir.join("t.csv");
+    for extra in [vec![], vec!["--trajectory", csv.to_str().unwrap()]] {
+        let mut args = vec!["simulate", prog.to_str().unwrap(), "-m", "mikron-ucp710"];
+        args.extend(extra);
+        let (code, out, err) = polepatch(&args);
+        assert_eq!(code, 0, "{err}");
+        assert!(
+            out.contains("nothing to simulate: the program has no G1 motion"),
+            "{out}"
+        );
+        assert!(!err.contains("error"), "{err}");
+    }
+    assert_eq!(
+        std::fs::read_to_string(&csv).unwrap(),
+        "run,t_s,s_mm,X,Y,Z,A,C,feed_mm_min\n"
+    );
+    let (code, out, _) = polepatch(&[
+        "simulate",
+        prog.to_str().unwrap(),
+        "-m",
+        "mikron-ucp710",
+        "--json",
+    ]);
+    assert_eq!(code, 0);
+    let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(doc[0]["nothing_to_simulate"].is_string(), "{out}");
+}
+
+/// Issue 43: feeds print as numbers a person can use (F0.0001 was printed "F0") and the
+/// totals of a program whose runs all fail are not "(NaN %)".
+#[test]
+fn tiny_feeds_and_empty_totals_print_as_numbers() {
+    let dir = temp_dir("simulate-cli-tiny-feed");
+    let prog = dir.join("slow.I");
+    std::fs::write(
+        &prog,
+        "%L G71 *\nN10 G90 *\nN20 G01 X+0 Y+0 Z+0 A+20 C+30 F0.0001 *\nN30 X+0.001 *\nN40 M30 *\n",
+    )
+    .unwrap();
+    let (code, out, err) = polepatch(&["simulate", prog.to_str().unwrap(), "-m", "mikron-ucp710"]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(out.contains("F0.0001 mm/min"), "{out}");
+    assert!(!out.contains("NaN") && !err.contains("NaN"), "{out}{err}");
+    assert!(out.contains("no run simulated"), "{out}");
+}
+
+/// Issue 43: a G93 block's F0 is named at its own line (7), as the inverse-time feed it
+/// is — not at the run's first line in mm/min.
+#[test]
+fn an_inverse_time_f0_is_named_at_its_line() {
+    let dir = temp_dir("simulate-cli-g93");
+    let prog = dir.join("g93.ngc");
+    std::fs::write(
+        &prog,
+        "G21 G90\nG94\nG1 X0 Y0 Z0 A20 C30 F1000\nX1\nX2\nG93\nG1 X3 F0\nX4 F1\nM30\n",
+    )
+    .unwrap();
+    let (code, _, err) = polepatch(&["simulate", prog.to_str().unwrap(), "-m", "mikron-ucp710"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("line 7: inverse-time feed F0 (G93, 1/min)"),
+        "{err}"
+    );
+}

@@ -10,12 +10,19 @@ use polepatch_patcher::Path;
 pub enum RunProblem {
     /// No F in force and no fallback feed given.
     NoFeed,
-    /// The feed is below [`MIN_FEED_MM_MIN`] (at the run's first block's line).
+    /// The feed is below [`MIN_FEED_MM_MIN`]: the run's F, or under G93 its slowest
+    /// block's.
     FeedTooLow {
-        /// The feed, mm/min.
+        /// The feed along the tool tip, mm/min.
         feed_mm_min: f64,
-        /// File line of the block with that feed.
+        /// File line of the block with that feed (the run's first point's until the
+        /// reader sets it from `point`).
         line: usize,
+        /// The run's point whose block has that feed (0: the run's F, stated before or
+        /// at its first point).
+        point: usize,
+        /// Under G93: the block's F as written, 1/min.
+        inverse_time_per_min: Option<f64>,
     },
     /// A rotary axis moves in the run while its value at some point is unknown (after an
     /// expression, a datum change or a call): reading it as anything would guess.
@@ -47,7 +54,22 @@ impl std::fmt::Display for RunProblem {
             RunProblem::NoFeed => {
                 write!(f, "no feed (F) in force for this run; give one with --feed")
             }
-            RunProblem::FeedTooLow { feed_mm_min, line } => write!(
+            RunProblem::FeedTooLow {
+                feed_mm_min,
+                line,
+                inverse_time_per_min: Some(per_min),
+                ..
+            } => write!(
+                f,
+                "line {line}: inverse-time feed F{} (G93, 1/min) moves the tool tip at {} \
+                 mm/min, below polepatch's minimum of {MIN_FEED_MM_MIN} mm/min; the run is \
+                 left as it is",
+                crate::report::feed_text(*per_min),
+                crate::report::feed_text(*feed_mm_min)
+            ),
+            RunProblem::FeedTooLow {
+                feed_mm_min, line, ..
+            } => write!(
                 f,
                 "line {line}: feed F{} mm/min is below polepatch's minimum of \
                  {MIN_FEED_MM_MIN} mm/min; the run is left as it is",
@@ -444,9 +466,20 @@ fn run_feed(
         inverse_time_feed(run)
     };
     if feed < MIN_FEED_MM_MIN {
+        // Under G93 the slowest block, named at its own line with its F as written.
+        let slowest = (!run.block_feed_mm_min.is_empty()).then(|| {
+            let feeds = &run.block_feed_mm_min;
+            let k = (0..feeds.len())
+                .min_by(|&a, &b| feeds[a].total_cmp(&feeds[b]))
+                .unwrap_or(0);
+            let d = run.s_mm[k + 1] - run.s_mm[k];
+            (k + 1, feeds[k] / d)
+        });
         return Err(RunProblem::FeedTooLow {
             feed_mm_min: feed,
             line: first_line,
+            point: slowest.map_or(0, |(p, _)| p),
+            inverse_time_per_min: slowest.map(|(_, f)| f),
         });
     }
     Ok(feed)

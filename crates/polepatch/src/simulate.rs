@@ -19,6 +19,10 @@ use polepatch_nc::RunBreak;
 use polepatch_patcher::Path;
 use polepatch_simulate::{Geometry, SimOptions, Step, simulate};
 
+/// What a program without G1 motion reports ([`SimulateReport::nothing_to_simulate`]).
+pub const NO_G1_MOTION: &str = "the program has no G1 motion: rapid moves (G0), arcs and \
+     blocks without tool-tip motion are not simulated";
+
 /// Options of [`simulate_nc`]. Plain struct; see each field for its default.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimulateOptions {
@@ -267,6 +271,7 @@ pub fn simulate_nc_with(
             tcy_s,
             primary: String::new(),
             warnings: Vec::new(),
+            nothing_to_simulate: None,
             runs: Vec::new(),
             total: SimTotals::default(),
         },
@@ -280,7 +285,7 @@ pub fn simulate_nc_with(
         work_offset_mm: opts.work_offset_mm,
         ..crate::AnalyzeOptions::default()
     };
-    let primary = crate::stream::each_run(
+    let read = crate::stream::each_run(
         bytes,
         machine,
         &reading,
@@ -291,7 +296,18 @@ pub fn simulate_nc_with(
             }
             Ok(())
         },
-    )?;
+    );
+    let primary = match read {
+        Ok(p) => p,
+        // A program without G1 motion has nothing to simulate: said as the result, not
+        // as a failure of whatever output was asked for.
+        Err(Error::NoRuns { .. }) => {
+            sim.report.primary = machine.primary_letter().to_string();
+            sim.report.nothing_to_simulate = Some(NO_G1_MOTION.to_string());
+            return Ok(sim.report);
+        }
+        Err(e) => return Err(e),
+    };
     sim.flush();
     sim.report.primary = primary.to_string();
     Ok(sim.report)

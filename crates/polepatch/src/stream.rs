@@ -1437,6 +1437,10 @@ fn loaded(bytes: &[u8], hand: InHand, sv: &Survey, l: usize, rd: &Reading<'_>) -
             }
             let line = program.blocks[run.blocks[0]].line;
             let mut rp = run_path(run, letters, rd.fallback, line);
+            // A G93 block too slow to analyse is named at its own line.
+            if let Err(crate::program::RunProblem::FeedTooLow { line, point, .. }) = &mut rp.path {
+                *line = program.blocks[rp.run.blocks[*point]].line;
+            }
             rp.found_tool = tool;
             rp
         })

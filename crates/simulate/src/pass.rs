@@ -569,9 +569,11 @@ impl Pass<'_> {
             let near = (CRUISE_REL * w)
                 .max(CRAWL_CRUISE_REL * w.min(one_cycle))
                 .max(CRUISE_ABS_MM_S);
+            let mut cruise = None;
             if !self.every_cycle && st.a.abs() * self.dt <= near && st.v > 0.0 && st.v >= w - near {
                 let nx = (i + 1).min(self.ceiling.x.len() - 1);
                 let xn = self.ceiling.x[nx].min(len);
+
                 if xn > st.x
                     && self.ceiling.v[i] == self.ceiling.v[nx]
                     && self
@@ -581,27 +583,56 @@ impl Pass<'_> {
                         .is_none_or(|m| m[i] == 0.0 && m[nx] == 0.0)
                     && self.safe(&caps, vmax, xn, st.v, 0.0, i, len, ahead)
                 {
-                    let xn = if xn >= len - END_MM { len } else { xn };
-                    let to = State {
-                        t: st.t + (xn - st.x) / st.v,
-                        x: xn,
-                        v: st.v,
-                        a: 0.0,
+                    // The forward pass jumps whole cycles (to within one cycle of the
+                    // grid point; the rest is an ordinary cycle), so that its states stay
+                    // on the cycle grid and a trajectory is the same states with each
+                    // jump cut into its cycles: one answer with or without a trajectory
+                    // (issue 43). The end of the path keeps its last, partial cycle.
+                    let to = if xn >= len - END_MM {
+                        State {
+                            t: st.t + (len - st.x) / st.v,
+                            x: len,
+                            v: st.v,
+                            a: 0.0,
+                        }
+                    } else if self.forward {
+                        // Cycle by cycle as an ordinary cycle at j = 0 computes them
+                        // (x + v·dt, t + dt: the same bits), up to the grid point; a
+                        // state that still accelerates a little settles first (below).
+                        let mut to = st;
+                        if st.a == 0.0 {
+                            let step = st.v * dt;
+                            while to.x + step < xn {
+                                to.x += step;
+                                to.t += dt;
+                            }
+                        }
+                        to
+                    } else {
+                        State {
+                            t: st.t + (xn - st.x) / st.v,
+                            x: xn,
+                            v: st.v,
+                            a: 0.0,
+                        }
                     };
-                    let p = Pending {
-                        from: st,
-                        to,
-                        j: 0.0,
-                        cycle: false,
-                        hint: hint0,
-                        cursor: cursor0,
-                        clipped: false,
-                    };
-                    keep(&mut buf, sink, p);
-                    st = to;
-                    stats.steps += 1;
-                    continue;
+                    cruise = (to.x > st.x).then_some(to);
                 }
+            }
+            if let Some(to) = cruise {
+                let p = Pending {
+                    from: st,
+                    to,
+                    j: 0.0,
+                    cycle: false,
+                    hint: hint0,
+                    cursor: cursor0,
+                    clipped: false,
+                };
+                keep(&mut buf, sink, p);
+                st = to;
+                stats.steps += 1;
+                continue;
             }
             let jm = jc.max(0.0);
             let ac = ac.max(0.0);
@@ -686,13 +717,18 @@ impl Pass<'_> {
                 a1 = 0.0;
             }
             let mut clipped = false;
-            if x1 <= st.x && st.v <= 0.0 {
-                // At rest where the ceiling is below what one cycle at the jerk cap makes
-                // (W < j_cap·Tcy²): go on at a crawl whose step from rest is a part of the
-                // jerk cap (counted as a clip).
+            let crawl = x1 <= st.x;
+            if crawl {
+                // No progress: at rest where the ceiling is below what one cycle at the
+                // jerk cap makes (W < j_cap·Tcy²), or where the ceiling (the backward
+                // profile) has come to a near standstill with a deceleration that would
+                // take the motion back: go on at a crawl under the velocity limit, whose
+                // step is a part of the jerk cap (counted as a clip). Before 2026-11-28 a
+                // forward state on such a profile with v > 0 was put back on it every cycle
+                // and never moved ("the limits allow no motion", issue 43).
                 let xc = x1.max(st.x);
                 let w0 = match &self.limit {
-                    Some(l) if st.v <= 0.0 => l.at(xc, 0).0,
+                    Some(l) => l.at(xc, 0).0,
                     _ => self.ceiling.at(xc, hint).0,
                 };
                 v1 = (w0.min(vmax) * (1.0 - 1e-9))
@@ -826,7 +862,7 @@ impl Pass<'_> {
                     }
                 }
             }
-            if !over_ok && v1 > w1 * (1.0 + CEILING_REL) {
+            if !over_ok && !(crawl && v1 > 0.0) && v1 > w1 * (1.0 + CEILING_REL) {
                 clipped = true;
                 // On the ceiling with its acceleration, within the caps there at that
                 // speed: |a| also where some jerk is left (`Caps::a_for_jerk`) — above it
@@ -859,7 +895,7 @@ impl Pass<'_> {
                 from: st,
                 to,
                 j,
-                cycle: t1 - st.t == self.dt,
+                cycle: (t1 - st.t - self.dt).abs() <= 1e-9 * self.dt,
                 hint: hint0,
                 cursor: cursor0,
                 clipped,

@@ -108,10 +108,19 @@ fn feed_mode_by_name<S: Serializer>(
     s.serialize_str(feed_mode_name(*mode))
 }
 
-/// A feed for people, mm/min: at most 3 decimals, trailing zeros dropped (`248.92`, not
-/// `248.92000000000002`, the inch feed F9.8 × 25.4 as computed).
+/// A feed for people, mm/min: 3 decimals (below 1, enough to keep its first significant
+/// digits: `0.0001`), trailing zeros dropped (`248.92`, not `248.92000000000002`, the inch
+/// feed F9.8 × 25.4 as computed).
 pub fn feed_text(feed_mm_min: f64) -> String {
-    let s = format!("{feed_mm_min:.3}");
+    // Three decimals, and below 1 as many more as keep its first significant digits (F0.0001
+    // is not "0").
+    let a = feed_mm_min.abs();
+    let decimals = if a > 0.0 && a < 1.0 {
+        (3.0 - a.log10().floor()).min(15.0) as usize
+    } else {
+        3
+    };
+    let s = format!("{feed_mm_min:.decimals$}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
     if s == "-0" { "0".into() } else { s.to_string() }
 }
@@ -125,6 +134,10 @@ mod tests {
     fn feeds_for_people() {
         assert_eq!(feed_text(9.8 * 25.4), "248.92");
         assert_eq!(feed_text(2000.0), "2000");
+        // Issue 43: a feed below 1 keeps its significant digits.
+        assert_eq!(feed_text(0.0001), "0.0001");
+        assert_eq!(feed_text(0.123456), "0.1235");
+        assert_eq!(feed_text(0.0), "0");
         assert_eq!(feed_text(78.7 * 2.54), "199.898");
         assert_eq!(feed_text(0.0004), "0");
         assert_eq!(feed_text(1500.5), "1500.5");

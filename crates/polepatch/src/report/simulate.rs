@@ -90,6 +90,10 @@ pub struct SimulateReport {
     pub primary: String,
     /// Notes for the user.
     pub warnings: Vec<String>,
+    /// Why nothing was simulated, for a program with no G1 motion at all (`None`
+    /// otherwise; runs that cannot be simulated say why in their `error`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nothing_to_simulate: Option<String>,
     /// Runs in file order.
     pub runs: Vec<SimRun>,
     /// Totals over the simulated runs.

@@ -116,3 +116,4 @@ pub fn line(axis: usize, len: f64, spacing: f64, feed_mm_min: f64) -> Path {
         feed_mm_min,
     }
 }
+pub mod reference;
