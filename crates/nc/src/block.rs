@@ -30,6 +30,13 @@ impl Flags {
     /// The block states the length units (G20/G21, G70/G71, G700/G710, a `%NAME G71`
     /// header, `BEGIN PGM … MM|INCH`).
     pub const UNITS: Flags = Flags(256);
+    /// A feed move with tool-tip motion whose plain absolute word turns a rotary axis by
+    /// more than half a turn, on an axis that turns without end
+    /// ([`crate::ReadOptions::endless`]) or under Heidenhain `M126`: a controller that takes
+    /// the shorter way turns it the other way round (359.857° → 7.501° is +7.644°, not
+    /// −352.356°). Which one the machine does is not in the program: the block ends runs,
+    /// belongs to none and is never changed.
+    pub const ROTARY_WRAP: Flags = Flags(512);
 
     /// Whether every bit of `other` is set.
     pub fn has(self, other: Flags) -> bool {

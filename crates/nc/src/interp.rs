@@ -32,7 +32,38 @@ pub(crate) struct Interpreter {
     pub(crate) lookalike: Option<Range<usize>>,
     /// Fanuc macro variables whose value is a constant here ([`Interpreter::constants`]).
     consts: std::collections::HashMap<u32, f64>,
+    /// The rotary axes A B C that turn without end ([`ReadOptions::endless`]).
+    endless: [bool; 3],
 }
+
+/// The rotary axis (index into [`crate::Modal::pos`]) that the block's plain absolute word
+/// turns by more than half a turn in a move that also moves the tool tip, on an axis for
+/// which `endless` holds: a wrap ([`Flags::ROTARY_WRAP`]), if there is one. A move of half
+/// a turn exactly is read as written.
+fn wrap_axis(
+    s: &Scan,
+    before: &[Option<f64>; 6],
+    after: &[Option<f64>; 6],
+    endless: impl Fn(usize) -> bool,
+) -> Option<usize> {
+    let tip = |p: &[Option<f64>; 6]| Some([p[X]?, p[Y]?, p[Z]?]);
+    let (t0, t1) = (tip(before)?, tip(after)?);
+    let d2: f64 = t0.iter().zip(t1).map(|(a, b)| (b - a) * (b - a)).sum();
+    if d2.sqrt() <= crate::run::ZERO_LENGTH_MM {
+        return None;
+    }
+    (A..=C).find(|&k| {
+        s.axes[k].is_some()
+            && s.axes_form[k - A] == RotaryForm::Plain
+            && s.axes_incremental & bit(k) == 0
+            && endless(k)
+            && matches!((before[k], after[k]), (Some(p), Some(q)) if (q - p).abs() > HALF_TURN_DEG)
+    })
+}
+
+/// Half a turn, degrees, and the round-off a written value may carry: a plain rotary move
+/// larger than this is a wrap on an axis that may take the shorter way.
+pub(crate) const HALF_TURN_DEG: f64 = 180.0 + 1e-9;
 
 /// `#100`, `-#100`, `+#100`: a macro variable's number (below 1000) and whether it is
 /// negated.
@@ -214,6 +245,7 @@ impl Interpreter {
             frame_changed: false,
             lookalike: None,
             consts: std::collections::HashMap::new(),
+            endless: opts.endless,
         }
     }
 
@@ -747,9 +779,18 @@ impl Interpreter {
                 number: s.number,
             });
         }
+        let endless_axes = self.endless;
         let m = &mut self.modal;
+        let pos_before = m.pos;
         let mut breaks = s.breaks;
         let mut flags = s.flags;
+        if let Some(sp) = s.shortest_path {
+            m.shortest_path = sp;
+        }
+        if flags.has(Flags::PROGRAM_END) {
+            // "At the end of program, M126 is automatically canceled" (Heidenhain).
+            m.shortest_path = false;
+        }
         if let Some(mo) = s.motion {
             m.motion = mo;
             // A motion code ends a canned cycle (Fanuc group 01 over group 09).
@@ -902,6 +943,13 @@ impl Interpreter {
             flags.set(Flags::INCREMENTAL_WORDS);
             breaks = true;
         }
+        if is_move && !breaks && m.motion == Motion::Linear && !m.incremental {
+            let endless = |k: usize| endless_axes[k - A] || m.shortest_path;
+            if wrap_axis(s, &pos_before, &m.pos, endless).is_some() {
+                flags.set(Flags::ROTARY_WRAP);
+                breaks = true;
+            }
+        }
         // Offsets fit: files are at most 4 GiB.
         Block {
             line,
@@ -972,5 +1020,87 @@ mod tests {
             assert!(p.blocks[b].flags.has(Flags::NOT_ANALYSABLE), "{src}");
             assert_eq!(p.state(b).feed_mm_min, None, "{src}");
         }
+    }
+
+    fn read_endless(src: &str, endless: [bool; 3]) -> crate::Program {
+        let opts = crate::ReadOptions {
+            endless,
+            ..crate::ReadOptions::default()
+        };
+        crate::parse_with(src.as_bytes().to_vec(), &opts).unwrap()
+    }
+
+    fn wraps(p: &crate::Program) -> Vec<usize> {
+        (0..p.blocks.len())
+            .filter(|&b| p.blocks[b].flags.has(Flags::ROTARY_WRAP))
+            .map(|b| p.blocks[b].line)
+            .collect()
+    }
+
+    /// Issue 42's closing check: NX's Haas VF2 TR post writes the platter modulo 360
+    /// (`B359.857` then `B7.501` in one cutting move). A controller that takes the shorter
+    /// way turns +7.644°; read as written it is −352.356°. On an axis that turns without
+    /// end the block is a wrap: it ends runs and belongs to none.
+    #[test]
+    fn a_feed_move_over_half_a_turn_on_an_endless_axis_is_a_wrap() {
+        let src =
+            "G1 X0 Y0 Z0 A-2.5 B352.158 F10\nX1 A-2.6 B359.857\nX2 A-2.7 B7.501\nX3 B15.092\n";
+        let p = read_endless(src, [false, true, false]);
+        assert_eq!(wraps(&p), vec![3]);
+        assert!(p.blocks[2].breaks_run && p.blocks[2].is_move);
+        // The value after it is the one written (the same pose either way).
+        assert_eq!(p.state(2).pos[crate::modal::B], Some(7.501));
+        let runs = crate::runs(&p);
+        assert_eq!(runs.len(), 2);
+        assert_eq!(runs[0].blocks, vec![0, 1]);
+        assert_eq!(runs[1].blocks, vec![2, 3]);
+        // An axis with a range (no endless axis) is read as written: one run.
+        let p = read_endless(src, [false; 3]);
+        assert!(wraps(&p).is_empty());
+        assert_eq!(crate::runs(&p).len(), 1);
+        // Only the endless axis counts: A turning 352° on the same read is read as written.
+        let p = read_endless("G1 X0 Y0 Z0 A-176 B0 F10\nX1 A176\n", [false, true, false]);
+        assert!(wraps(&p).is_empty());
+    }
+
+    /// What is not a wrap: half a turn exactly (either way the same), a move without
+    /// tool-tip motion (a rotary-only repositioning: in no run), a rapid, incremental words,
+    /// and a Sinumerik direction form (its direction is written).
+    #[test]
+    fn what_is_not_a_wrap() {
+        let c = [false, false, true];
+        for src in [
+            "G1 X0 Y0 Z0 A2 C10 F100\nX1 C190\n",
+            "G1 X0 Y0 Z0 A2 C10 F100\nA0 C350\n",
+            "G1 X0 Y0 Z0 A2 C10 F100\nG0 X1 C350\n",
+            "G1 X0 Y0 Z0 A2 C10 F100\nG91 X1 C340\n",
+            "N1 G1 X0 Y0 Z0 A2 C10 F100\nN2 TRAORI\nN3 X1 C=ACP(350)\n",
+        ] {
+            assert!(wraps(&read_endless(src, c)).is_empty(), "{src}");
+        }
+        assert_eq!(
+            wraps(&read_endless("G1 X0 Y0 Z0 A2 C10 F100\nX1 C190.001\n", c)),
+            vec![2]
+        );
+    }
+
+    /// Heidenhain `M126` (shortest-path traverse): under it a plain move over half a turn is
+    /// a wrap on any rotary axis; `M127` and the program's end switch it off. Not a Fanuc
+    /// code.
+    #[test]
+    fn heidenhain_m126_makes_every_rotary_axis_take_the_shorter_way() {
+        let conv = "0 BEGIN PGM W MM\n1 L X+0 Y+0 Z+0 B+5 C+350 R0 F1000\n2 M126\n\
+                    3 L X+0 Y+0 Z+0 R0 F1000\n4 L X+1 C+10\n5 M127\n6 L X+2 C+350\n\
+                    7 END PGM W MM\n";
+        let p = read_endless(conv, [false; 3]);
+        assert_eq!(wraps(&p), vec![5]);
+        assert!(p.state(3).shortest_path && !p.state(5).shortest_path);
+        let iso = "%W G71 *\nN10 G01 X+0 Y+0 Z+0 B+5 C+350 F1000 *\nN20 M126 *\n\
+                   N30 X+1 C+10 *\nN40 M30 *\nN50 G01 X+0 C+350 F1000 *\n";
+        let p = read_endless(iso, [false; 3]);
+        assert_eq!(wraps(&p), vec![4]);
+        assert!(!p.state(5).shortest_path);
+        let fanuc = "G1 X0 Y0 Z0 B5 C350 F1000\nM126\nX1 C10\n";
+        assert!(wraps(&read_endless(fanuc, [false; 3])).is_empty());
     }
 }

@@ -82,6 +82,9 @@ pub(crate) struct Scan {
     /// The first identifier the reader does not know that looks like a TCPM code (its
     /// bytes; [`crate::tcpm::lookalike`]).
     pub(crate) lookalike: Option<std::ops::Range<usize>>,
+    /// Heidenhain `M126` (true) or `M127` (false): shortest-path traverse of rotary axes on
+    /// or off.
+    pub(crate) shortest_path: Option<bool>,
 }
 
 /// What M code `code` (× 10) says in `dialect` on a machine with `controller`'s codes (ISO and
@@ -111,6 +114,15 @@ pub(crate) fn m_code(
         }
         Some(20 | 300) => {
             s.flags.set(Flags::PROGRAM_END);
+            s.breaks = true;
+        }
+        // Heidenhain M126/M127: rotary axes turn the shorter way to a plain absolute value,
+        // or as written ([`crate::Modal::shortest_path`]). A change of how moves are read
+        // ends runs.
+        Some(c @ (1260 | 1270))
+            if matches!(dialect, Dialect::Heidenhain | Dialect::Conversational) =>
+        {
+            s.shortest_path = Some(c == 1260);
             s.breaks = true;
         }
         // Subprogram call and return, cycle call (Heidenhain M99): other blocks run.

@@ -257,6 +257,10 @@ pub struct Modal {
     /// (Heidenhain `M128`, `FUNCTION TCPM … REFPNT CENTER-CENTER`); false: to the tool tip
     /// (`FUNCTION TCPM` by default, `TRAORI`, `G43.4`, `G234`, a machine's own codes).
     pub tcpm_centre: bool,
+    /// Heidenhain `M126` is in force (until `M127` or the program's end): the controller
+    /// turns a rotary axis the shorter way to a plain absolute value, so a feed move written
+    /// as more than half a turn is not the move it reads as ([`crate::Flags::ROTARY_WRAP`]).
+    pub shortest_path: bool,
 }
 
 impl Default for Modal {
@@ -273,6 +277,7 @@ impl Default for Modal {
             inch: false,
             transform: 0,
             tcpm_centre: false,
+            shortest_path: false,
         }
     }
 }
@@ -292,7 +297,7 @@ pub(crate) struct PackedModal {
     /// bit 6 TCPM uncertain; bit 7 canned cycle.
     flags: u8,
     /// Bits 0–1: feed mode (0 G94, 1 G93, 2 G95); bits 2–4: [`transform`] bits; bit 5:
-    /// TCPM unknown; bit 6: TCPM refers to the ball's centre.
+    /// TCPM unknown; bit 6: TCPM refers to the ball's centre; bit 7: shortest path (M126).
     feed_mode: u8,
 }
 
@@ -342,7 +347,8 @@ impl PackedModal {
                 FeedMode::PerRevolution => 2,
             } | (m.transform & transform::ALL) << 2
                 | u8::from(m.tcpm == Tcpm::Unknown) << 5
-                | u8::from(m.tcpm_centre) << 6,
+                | u8::from(m.tcpm_centre) << 6
+                | u8::from(m.shortest_path) << 7,
         }
     }
 
@@ -375,6 +381,7 @@ impl PackedModal {
             },
             transform: (self.feed_mode >> 2) & transform::ALL,
             tcpm_centre: self.feed_mode & 64 != 0,
+            shortest_path: self.feed_mode & 128 != 0,
             incremental: self.flags & 16 != 0,
             inch: self.flags & 32 != 0,
             canned_cycle: self.flags & 128 != 0,
@@ -414,6 +421,7 @@ mod tests {
             m.tcpm = [Tcpm::Off, Tcpm::On, Tcpm::Uncertain, Tcpm::Unknown][k % 4];
             m.transform = (k as u8 * 3) & transform::ALL;
             m.tcpm_centre = k % 2 == 1;
+            m.shortest_path = k % 3 != 1;
             m.canned_cycle = k % 2 == 0;
             m.incremental = k % 3 == 1;
             m.inch = k >= 3;

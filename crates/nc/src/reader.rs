@@ -162,6 +162,7 @@ pub(crate) fn scan_with(
         controller: opts.controller.clone(),
         flow: Some(std::sync::Arc::new(plan)),
         inch: opts.inch,
+        endless: opts.endless,
     }))
 }
 
@@ -714,6 +715,7 @@ pub(crate) mod tests {
                     controller: c.clone(),
                     flow: None,
                     inch: false,
+                    endless: [false; 3],
                 },
             )
             .unwrap();

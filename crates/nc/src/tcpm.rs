@@ -302,6 +302,12 @@ pub struct ReadOptions {
     /// G70/G71, G700/G710, `%NAME G71`, `BEGIN PGM … MM|INCH`): what a controller set to
     /// inches does with a program that states none. Default false: mm.
     pub inch: bool,
+    /// The rotary axes A, B, C (in that order) that turn without end on the machine (no
+    /// travel range): a controller may take the shorter way to a plain absolute value on
+    /// them (Haas and Fanuc rollover, a Sinumerik modulo axis), so a feed move that turns one
+    /// by more than half a turn is read as a wrap ([`crate::Flags::ROTARY_WRAP`]). Default:
+    /// none (every rotary value read as written).
+    pub endless: [bool; 3],
 }
 
 impl ReadOptions {
@@ -312,6 +318,7 @@ impl ReadOptions {
             controller: ControllerCodes::default(),
             flow: None,
             inch: false,
+            endless: [false; 3],
         }
     }
 

@@ -11,6 +11,10 @@
 //!   them is not analysed, so a slowdown there would go unseen;
 //! - conversational lines polepatch does not model;
 //! - moves with a feed per revolution (G95), which has no time base;
+//! - feed moves that turn a rotary axis by more than half a turn with a plain absolute word
+//!   on an axis that turns without end, or under Heidenhain `M126`
+//!   ([`polepatch_nc::Flags::ROTARY_WRAP`]): a controller that takes the shorter way turns
+//!   it the other way round, and which one the machine does is not in the program;
 //! - and, as warnings: letters carried through without analysis (`E`, `U`, `V`, `W`),
 //!   `(` comments without `)` that hide what looks like axis words, words that look like a
 //!   TCPM code without being one (`TRAOOF` for `TRAFOOF`: [`Notes::lookalike`]), and the length units
@@ -41,6 +45,9 @@ pub enum SkipReason {
     /// A posted CL file's `INSERT/` text, written as it is between two moves near the pole
     /// (`post`): polepatch does not read what it does to the motion.
     Insert,
+    /// A feed move that turns an endless rotary axis by more than half a turn (or any
+    /// rotary axis under Heidenhain `M126`): the shorter way is the other way round.
+    RotaryWrap,
 }
 
 /// Lines carried through without analysis, and why.
@@ -62,6 +69,8 @@ struct Item {
     lines: [usize; 2],
     reason: SkipReason,
     min_abs_deg: [f64; 3],
+    /// The message, where it says more than the reason and the lines.
+    message: Option<String>,
 }
 
 /// The collector (module docs).
@@ -110,6 +119,7 @@ impl Notes {
             lines: [line, line],
             reason,
             min_abs_deg,
+            message: None,
         });
     }
 
@@ -142,6 +152,14 @@ impl Notes {
             if f.has(Flags::SKIPPABLE) {
                 self.add(line, SkipReason::SkippableNearPole, near);
             }
+        }
+        if f.has(Flags::ROTARY_WRAP) {
+            self.items.push(Item {
+                lines: [line, line],
+                reason: SkipReason::RotaryWrap,
+                min_abs_deg: always,
+                message: Some(wrap_message(block, words, before, after)),
+            });
         }
         if block.is_move
             && after.feed_mode == FeedMode::PerRevolution
@@ -197,7 +215,10 @@ impl Notes {
             .map(|it| NotAnalysed {
                 lines: it.lines,
                 reason: it.reason,
-                message: message(it.reason, it.lines),
+                message: it
+                    .message
+                    .clone()
+                    .unwrap_or_else(|| message(it.reason, it.lines)),
             })
             .collect();
         let mut warnings = Vec::new();
@@ -310,6 +331,67 @@ fn message(reason: SkipReason, lines: [usize; 2]) -> String {
             format!("{at}: feed per revolution (G95) has no time base for Equation 6; not analysed")
         }
         SkipReason::Insert => insert_message(lines[0], 0),
+        SkipReason::RotaryWrap => format!(
+            "{at}: a feed move turns a rotary axis by more than half a turn; a controller that \
+             takes the shorter way turns it the other way round: not analysed"
+        ),
+    }
+}
+
+/// What a block flagged [`Flags::ROTARY_WRAP`] does, both ways: its line and the column of
+/// the word, the axis, the move as written and the shorter one.
+fn wrap_message(block: &Block, words: &[Word], before: &Modal, after: &Modal) -> String {
+    let turn = [A, B, C].into_iter().find_map(|k| {
+        let (p, q) = (before.pos[k]?, after.pos[k]?);
+        let letter = b'A' + (k - A) as u8;
+        let w = words.iter().find(|w| w.letter == letter)?;
+        ((q - p).abs() > 180.0).then_some((letter as char, w, p, q))
+    });
+    let Some((letter, w, p, q)) = turn else {
+        return message(SkipReason::RotaryWrap, [block.line, block.line]);
+    };
+    let col = (w.start as usize).saturating_sub(block.span().start) + 1;
+    let d = q - p;
+    let shorter = d - 360.0 * (d / 360.0).round();
+    let why = if after.shortest_path {
+        "under M126 the controller turns it the shorter way"
+    } else {
+        "a controller that takes the shorter way on an axis that turns without end (Haas or \
+         Fanuc rollover, a Sinumerik modulo axis, Heidenhain M126) turns it"
+    };
+    format!(
+        "line {}, col {col}: a feed move turns {letter} from {} to {} — {:+} as written; {why} \
+         {:+} instead. Which one the machine does is not in the program: the move is kept as \
+         written and no run is analysed across it (a machine whose {letter} never takes the \
+         shorter way can say so with a range_deg for {letter} in its machine file)",
+        block.line,
+        fmt_deg(p),
+        fmt_deg(q),
+        Deg(d),
+        Deg(shorter),
+    )
+}
+
+/// Degrees with up to 3 decimals, no trailing zeros (`7.501°`, `-352.356°`, `180°`).
+fn fmt_deg(v: f64) -> String {
+    format!("{}°", Deg(v))
+}
+
+struct Deg(f64);
+
+impl std::fmt::Display for Deg {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let r = (self.0 * 1000.0).round() / 1000.0;
+        let r = if r == 0.0 { 0.0 } else { r };
+        let text = format!("{r:.3}");
+        let text = text.trim_end_matches('0').trim_end_matches('.');
+        if f.sign_plus() && r >= 0.0 {
+            write!(f, "+{text}°")
+        } else if f.sign_plus() {
+            write!(f, "{text}°")
+        } else {
+            f.write_str(text)
+        }
     }
 }
 

@@ -109,6 +109,18 @@ pub fn check_layout(machine: &Machine) -> Result<RotaryLetters, Error> {
     }
 }
 
+/// The rotary letters A B C of `machine` that turn without end (its pole axis without a
+/// `range_deg`; the tilting axis always has a range): a feed move that turns one by more
+/// than half a turn is a wrap ([`polepatch_nc::ReadOptions::endless`]).
+pub fn endless_letters(machine: &Machine) -> [bool; 3] {
+    let mut endless = [false; 3];
+    let c = machine.c_letter();
+    if machine.c_range_deg.is_none() && ('A'..='C').contains(&c) {
+        endless[c as usize - 'A' as usize] = true;
+    }
+    endless
+}
+
 /// How to read programs for `machine`: the dialect detected, the machine's TCPM codes;
 /// in inches when the program states no units and `inch` is true, else mm.
 pub fn read_options_with(
@@ -137,6 +149,7 @@ pub fn read_options_with(
         },
         flow: None,
         inch,
+        endless: endless_letters(machine),
     })
 }
 
