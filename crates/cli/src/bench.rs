@@ -308,7 +308,8 @@ pub struct BenchCase {
     pub patch_time_ms: f64,
     /// Estimated machining time of the runs that hold a zone, before and after, s (∫ds/ṡ
     /// over the whole runs, the written program analysed), and their ideal L/F: the same
-    /// stretch for every strategy.
+    /// stretch for every strategy. After is not a number (JSON `null`) where the output
+    /// reads as other runs than the input (a warning says so).
     pub time_s: [f64; 3],
     /// Simulated time of the same runs (`polepatch simulate`: a jerk-limited controller),
     /// before and after, s.
@@ -362,6 +363,9 @@ pub struct Summary {
     pub time_s: [f64; 3],
     /// Simulated time of the same runs before and after, s.
     pub sim_time_s: [f64; 2],
+    /// Cases left out of `time_s` and `sim_time_s`: their output reads as other runs than
+    /// the input ([`BenchCase::time_s`]).
+    pub not_compared: usize,
 }
 
 /// SPEC §6: ours within this factor of the reference.
@@ -402,7 +406,16 @@ impl BenchReport {
         });
         let mut time_s = [0.0; 3];
         let mut sim_time_s = [0.0; 2];
-        for c in self.cases.iter().filter(|c| c.strategy == strategy) {
+        // Cases whose output reads as other runs have no times after: left out of the
+        // totals, before and after alike, and counted.
+        let compared = |c: &&BenchCase| c.time_s[1].is_finite() && c.sim_time_s[1].is_finite();
+        let cases: Vec<&BenchCase> = self
+            .cases
+            .iter()
+            .filter(|c| c.strategy == strategy)
+            .collect();
+        let not_compared = cases.iter().filter(|c| !compared(c)).count();
+        for c in cases.into_iter().filter(compared) {
             for (t, v) in time_s.iter_mut().zip(c.time_s) {
                 *t += v;
             }
@@ -428,6 +441,7 @@ impl BenchReport {
                 .fold(0.0, f64::max),
             time_s,
             sim_time_s,
+            not_compared,
         }
     }
 }
@@ -581,6 +595,25 @@ pub fn bench_program(
         // The time of every run with a zone, before and after (XYZ never change, so runs
         // match one to one).
         let after_analysis = after.as_ref().map(|a| analyze_program(a, machine, &aopts));
+        // A strategy whose output reads as other runs (a peer's C swing of more than half a
+        // turn in a feed move is a wrap on an endless axis, issue 42: it ends a run) has no
+        // run-for-run times: said, and its times are not a number ("—" in the table).
+        let mut warnings = report.warnings.clone();
+        let runs_differ = after_analysis.as_ref().is_some_and(|a| {
+            a.runs.len() != analysis.runs.len()
+                || a.runs
+                    .iter()
+                    .zip(&analysis.runs)
+                    .any(|(x, y)| x.lines != y.lines)
+        });
+        if runs_differ {
+            warnings.push(format!(
+                "{}: the output reads as other runs than the input (a rotary move it wrote \
+                 ends a run, e.g. a wrap on an endless axis): its times are not compared",
+                strategy.name()
+            ));
+        }
+        let sim_after = if runs_differ { f64::NAN } else { sim_after };
         let mut time_s = [0.0; 3];
         for (r, rr) in analysis.runs.iter().enumerate() {
             let (Some(fb), false) = (&rr.figures, zones[r].is_empty()) else {
@@ -592,7 +625,7 @@ pub fn bench_program(
                 .and_then(|x| x.figures.as_ref())
                 .unwrap_or(fb);
             time_s[0] += fb.time_s;
-            time_s[1] += fa.time_s;
+            time_s[1] += if runs_differ { f64::NAN } else { fa.time_s };
             time_s[2] += fb.ideal_time_s;
         }
         let after = if opts.plots { after } else { None };
@@ -652,7 +685,7 @@ pub fn bench_program(
             zones_analyzed,
             words_changed: report.words_changed,
             untouched_runs: report.untouched_runs,
-            warnings: report.warnings,
+            warnings,
             patch_time_ms,
             time_s,
             sim_time_s: [sim_before, sim_after],

@@ -373,10 +373,10 @@ pub(crate) fn table(report: &BenchReport) -> String {
                     line,
                     " {:>36}",
                     format!(
-                        "{zc}/{zb} of {} {dev:.3}° {:.3}s sim {:.3}s",
+                        "{zc}/{zb} of {} {dev:.3}° {}s sim {}s",
                         c.zones.len(),
-                        c.time_s[1],
-                        c.sim_time_s[1]
+                        seconds_text(c.time_s[1]),
+                        seconds_text(c.sim_time_s[1])
                     )
                 );
                 k += 1;
@@ -394,7 +394,7 @@ pub(crate) fn table(report: &BenchReport) -> String {
         };
         let _ = writeln!(
             out,
-            "\n{}: {} zone(s): {} at feed on C, {} on both rotary axes; reference unreachable for {}; largest deviation {:.3}°; time of the runs with zones {:.3} → {:.3} s (L/F {:.3} s), simulated {:.3} → {:.3} s.",
+            "\n{}: {} zone(s): {} at feed on C, {} on both rotary axes; reference unreachable for {}; largest deviation {:.3}°; time of the runs with zones {:.3} → {:.3} s (L/F {:.3} s), simulated {:.3} → {:.3} s{}.",
             strategy.name(),
             s.zones,
             s.at_feed_c,
@@ -405,7 +405,15 @@ pub(crate) fn table(report: &BenchReport) -> String {
             s.time_s[1],
             s.time_s[2],
             s.sim_time_s[0],
-            s.sim_time_s[1]
+            s.sim_time_s[1],
+            if s.not_compared > 0 {
+                format!(
+                    " ({} program(s) left out: the output reads as other runs than the input)",
+                    s.not_compared
+                )
+            } else {
+                String::new()
+            }
         );
         let _ = writeln!(
             out,
@@ -497,4 +505,14 @@ fn plot_files<'a>(
         }
     }
     out
+}
+
+/// Seconds with 3 decimals, "—" where there is no number (a strategy whose output reads as
+/// other runs: `BenchCase::time_s`).
+fn seconds_text(t_s: f64) -> String {
+    if t_s.is_finite() {
+        format!("{t_s:.3}")
+    } else {
+        "—".to_string()
+    }
 }

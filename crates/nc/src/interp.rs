@@ -779,7 +779,14 @@ impl Interpreter {
                 number: s.number,
             });
         }
-        let endless_axes = self.endless;
+        // A Heidenhain control (ISO or conversational) turns a plain rotary word the way it
+        // is written unless M126 is active; the machine's endless axes count elsewhere.
+        let endless_axes = if matches!(self.dialect, Dialect::Heidenhain | Dialect::Conversational)
+        {
+            [false; 3]
+        } else {
+            self.endless
+        };
         let m = &mut self.modal;
         let pos_before = m.pos;
         let mut breaks = s.breaks;
@@ -1102,5 +1109,13 @@ mod tests {
         assert!(!p.state(5).shortest_path);
         let fanuc = "G1 X0 Y0 Z0 B5 C350 F1000\nM126\nX1 C10\n";
         assert!(wraps(&read_endless(fanuc, [false; 3])).is_empty());
+        // Without M126 a Heidenhain control turns as written, even on a machine whose C
+        // turns without end (the bench's SINGW.I): no wrap; with it, the wrap.
+        let plain = "%W G71 *\nN10 G01 X+0 Y+0 Z+0 B+5 C+350 F1000 *\nN20 X+1 C+10 *\n";
+        assert!(wraps(&read_endless(plain, [false, false, true])).is_empty());
+        let conv = "0 BEGIN PGM W MM\n1 L X+0 Y+0 Z+0 B+5 C+350 R0 F1000\n\
+                    2 L X+1 C+10\n3 END PGM W MM\n";
+        assert!(wraps(&read_endless(conv, [false, false, true])).is_empty());
+        assert_eq!(wraps(&read_endless(iso, [false, false, true])), vec![4]);
     }
 }

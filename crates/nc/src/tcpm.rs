@@ -305,8 +305,10 @@ pub struct ReadOptions {
     /// The rotary axes A, B, C (in that order) that turn without end on the machine (no
     /// travel range): a controller may take the shorter way to a plain absolute value on
     /// them (Haas and Fanuc rollover, a Sinumerik modulo axis), so a feed move that turns one
-    /// by more than half a turn is read as a wrap ([`crate::Flags::ROTARY_WRAP`]). Default:
-    /// none (every rotary value read as written).
+    /// by more than half a turn is read as a wrap ([`crate::Flags::ROTARY_WRAP`]). Not in a
+    /// Heidenhain program (ISO or conversational): that control turns as written unless
+    /// `M126` is active, which the program says. Default: none (every rotary value read as
+    /// written).
     pub endless: [bool; 3],
 }
 

@@ -862,7 +862,7 @@ impl Pass<'_> {
                     }
                 }
             }
-            if !over_ok && !(crawl && v1 > 0.0) && v1 > w1 * (1.0 + CEILING_REL) {
+            if !(over_ok || (crawl && v1 > 0.0)) && v1 > w1 * (1.0 + CEILING_REL) {
                 clipped = true;
                 // On the ceiling with its acceleration, within the caps there at that
                 // speed: |a| also where some jerk is left (`Caps::a_for_jerk`) — above it

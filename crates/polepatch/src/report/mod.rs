@@ -139,7 +139,7 @@ mod tests {
         assert_eq!(feed_text(0.123456), "0.1235");
         assert_eq!(feed_text(0.0), "0");
         assert_eq!(feed_text(78.7 * 2.54), "199.898");
-        assert_eq!(feed_text(0.0004), "0");
+        assert_eq!(feed_text(0.0004), "0.0004");
         assert_eq!(feed_text(1500.5), "1500.5");
     }
 }
