@@ -530,6 +530,15 @@ fn print_run(
         let feed = r.feed_mm_min.map_or("no F".to_string(), |f| {
             format!("F{}", polepatch::report::feed_text(f))
         });
+        // A pass whose blocks have their own F: the reference and the range.
+        let feed = match r.block_feeds_mm_min {
+            Some([lo, hi]) => format!(
+                "{feed} (the blocks' own F{}–{})",
+                polepatch::report::feed_text(lo),
+                polepatch::report::feed_text(hi)
+            ),
+            None => feed,
+        };
         writeln!(
             out,
             "\nrun {}: lines {}–{}, {} points, {:.3} mm at {}",

@@ -78,6 +78,8 @@ impl Machine {
     /// tcpm_always = false              # true: kinematics always TCP
     /// tool_point = "tip"               # optional: X Y Z under TCPM are the tool tip or
     ///                                  # the ball's "centre" (default: the TCPM code's)
+    /// auxiliary_axes = ["A"]           # optional: letters carried as they are (an
+    ///                                  # extruder), not the machine's axes
     /// ```
     ///
     /// Every limit must lie within [`LIMIT_MIN`, `LIMIT_MAX`] = 0.001 to 10⁶ in the file's

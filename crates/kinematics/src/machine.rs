@@ -120,6 +120,11 @@ pub struct Controller {
     /// own (M128: centre; the others: tip).
     #[serde(default)]
     pub tool_point: Option<String>,
+    /// Letters of auxiliary axes the programs carry that are not the machine's rotary axes
+    /// (an extruder on `A` of a B-C printer, a quill): their words are carried through like
+    /// `E`, never read as a rotary axis. Default none.
+    #[serde(default)]
+    pub auxiliary_axes: Vec<String>,
 }
 
 /// Errors of machine loading.

@@ -329,7 +329,8 @@ impl Interpreter {
                 s.datum_shift = true;
                 s.transform_off |= MIRROR;
             }
-            Some(920 | 100 | 520) => s.datum_shift = true,
+            Some(920) => s.g92 = true,
+            Some(100 | 520) => s.datum_shift = true,
             Some(530 | 280 | 300) => s.reference = true,
             Some(40) => {
                 s.no_move = true;
@@ -480,7 +481,13 @@ impl Interpreter {
                         s.axes_form[usize::from(letter - b'A')] = form;
                     }
                     once(letter, wspan.start)?;
-                    match letter {
+                    // An auxiliary axis of the machine (an extruder on `A`): carried like `E`.
+                    let read_as = if self.controller.auxiliary.contains(&letter) {
+                        b'E'
+                    } else {
+                        letter
+                    };
+                    match read_as {
                         b'X' => s.axes[X] = Some(value),
                         b'Y' => s.axes[Y] = Some(value),
                         b'Z' => s.axes[Z] = Some(value),
@@ -753,6 +760,8 @@ impl Interpreter {
         words: Range<usize>,
     ) -> Block {
         self.constants(s);
+        // G92 shifts the axes it names: a datum shift of ours only where it names one.
+        s.datum_shift |= s.g92 && (s.axes.iter().any(Option::is_some) || s.axes_expr != 0);
         let always = self.controller.always;
         // Before the block: what program flow settles ([`crate::flow`]).
         if let Some(plan) = &self.plan {

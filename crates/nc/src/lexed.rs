@@ -47,6 +47,10 @@ pub(crate) struct Scan {
     pub(crate) feed_mode: Option<FeedMode>,
     /// Axis words define a datum/frame (Heidenhain G54, G92, G10, G52, TRANS…): not a move.
     pub(crate) datum_shift: bool,
+    /// `G92` (Fanuc, LinuxCNC): a shift of the axes it names — a datum shift when it names
+    /// one polepatch follows (X Y Z A B C); `G92 E0` (an extruder reset) shifts none of them
+    /// and changes nothing polepatch reads.
+    pub(crate) g92: bool,
     /// Heidenhain ISO `G54`: the block's X Y Z are the new datum.
     pub(crate) stated_datum: bool,
     /// Work offset selection (Fanuc/Sinumerik G54…G59, G500): positions re-based.

@@ -16,7 +16,8 @@
 //!   `None` until the next F;
 //! - axis words X Y Z A B C set positions in moves (and in a block without any motion mode
 //!   yet, which is then not counted as a move);
-//! - datum shifts — Heidenhain `G54`/`G53` with or without axis words, `G92`, `G10`, `G52`,
+//! - datum shifts — Heidenhain `G54`/`G53` with or without axis words, `G92` naming an
+//!   axis polepatch follows (`G92 E0`, an extruder reset, is not one), `G10`, `G52`,
 //!   `G68`/`G69`, `G50`/`G51`, Sinumerik `TRANS`/`ATRANS`/`ROT`/`SCALE`/`MIRROR`… — are not
 //!   moves; afterwards X Y Z are unknown, and so is every rotary axis named in the block;
 //! - reference and machine-coordinate moves (`G28`, `G30`, Fanuc/Sinumerik `G53`, `SUPA`)

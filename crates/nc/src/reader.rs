@@ -706,6 +706,7 @@ pub(crate) mod tests {
             on: vec![Code::parse("M428").unwrap()],
             off: vec![Code::parse("M429").unwrap()],
             always: false,
+            auxiliary: Vec::new(),
         };
         let read = |text: &str, c: &ControllerCodes| {
             let prog = parse_with(

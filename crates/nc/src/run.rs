@@ -34,8 +34,10 @@ pub struct Run {
     pub feed_mm_min: Option<f64>,
     /// Feed mode of the run (a change of feed mode ends runs).
     pub feed_mode: crate::FeedMode,
-    /// Under G93 (inverse time): the feed of each block along the tool tip, mm/min — its
-    /// tool-tip length times its F (1/min) — for blocks `1..len()`; empty otherwise.
+    /// The feed of each block along the tool tip, mm/min, for blocks `1..len()`, where the
+    /// blocks have their own: under G93 (inverse time) a block's tool-tip length times its
+    /// F (1/min); in a pass whose F changes under G94 ([`RunBuilder::passes`]) each block's
+    /// F. Empty otherwise (every block at [`Run::feed_mm_min`]).
     pub block_feed_mm_min: Vec<f64>,
     /// TCPM state during the run (only [`crate::Tcpm::On`] allows changing rotary words
     /// alone).
@@ -106,9 +108,22 @@ pub struct RunBuilder {
     cur: Option<Run>,
     prev: Modal,
     last_pos: Option<usize>,
+    /// A change of F under G94 does not end the run ([`RunBuilder::passes`]).
+    passes: bool,
 }
 
 impl RunBuilder {
+    /// A walk whose runs are **passes**: a change of F under G94 (both feeds known) does not
+    /// end the run — the machine moves through it without stopping — and each block keeps
+    /// its own F ([`Run::block_feed_mm_min`]). Everything else ends runs as
+    /// [`RunBuilder::default`]'s walk does (SPEC §4b: the pass is the unit the patch sees).
+    pub fn passes() -> RunBuilder {
+        RunBuilder {
+            passes: true,
+            ..RunBuilder::default()
+        }
+    }
+
     fn finish_run(&mut self, why: RunBreak, emit: &mut impl FnMut(Run)) {
         if let Some(mut r) = self.cur.take()
             && r.len() >= 2
@@ -155,7 +170,26 @@ impl RunBuilder {
                         self.finish_run(RunBreak::Block, emit);
                         self.cur = Some(Self::start(i, st));
                     } else {
-                        if let Some(r) = &mut self.cur
+                        // A pass goes on through a change of F under G94: the blocks
+                        // so far keep theirs, and each block after states its own.
+                        let joins = self.passes
+                            && st.feed_mm_min.is_some()
+                            && !inverse_time
+                            && self.cur.as_ref().is_some_and(|r| {
+                                r.len() >= 2
+                                    && r.feed_mode == crate::FeedMode::PerMinute
+                                    && r.tcpm == st.tcpm
+                                    && r.transform == st.transform
+                                    && (r.feed_mm_min.is_some() || !r.block_feed_mm_min.is_empty())
+                            });
+                        if joins {
+                            if let Some(r) = &mut self.cur
+                                && r.feed_mm_min != st.feed_mm_min
+                                && let Some(g) = r.feed_mm_min.take()
+                            {
+                                r.block_feed_mm_min = vec![g; r.len() - 1];
+                            }
+                        } else if let Some(r) = &mut self.cur
                             && (r.feed_mm_min != st.feed_mm_min
                                 || r.tcpm != st.tcpm
                                 || r.transform != st.transform)
@@ -196,6 +230,10 @@ impl RunBuilder {
                             r.pos.push(st.pos);
                             if let Some(f) = st.inverse_time_per_min.filter(|_| inverse_time) {
                                 r.block_feed_mm_min.push(d * f);
+                            } else if !r.block_feed_mm_min.is_empty()
+                                && let Some(f) = st.feed_mm_min
+                            {
+                                r.block_feed_mm_min.push(f);
                             }
                         }
                     }

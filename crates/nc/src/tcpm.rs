@@ -113,6 +113,9 @@ pub struct ControllerCodes {
     /// The machine's kinematics are always TCP: X Y Z are always part-frame tool-tip
     /// positions. Default false.
     pub always: bool,
+    /// Letters of auxiliary axes (an extruder on `A` of a B-C printer): their words are
+    /// carried through like `E`, never read as an axis polepatch follows. Default none.
+    pub auxiliary: Vec<u8>,
 }
 
 /// What a code does to TCPM.
@@ -397,6 +400,7 @@ mod tests {
             on: vec![Code::parse("RTCPON").unwrap()],
             off: vec![Code::parse("RTCPOFF").unwrap()],
             always: false,
+            auxiliary: Vec::new(),
         };
         assert_eq!(lookalike(b"RTCP_OFF", &own).as_deref(), Some("RTCPOFF"));
         assert_eq!(lookalike(b"RTCP_OFF", &c), None);
@@ -426,6 +430,7 @@ mod tests {
             on: vec![Code::parse("M428").unwrap()],
             off: vec![Code::parse("M429").unwrap(), Code::parse("G43.4").unwrap()],
             always: false,
+            auxiliary: Vec::new(),
         };
         assert_eq!(own.m(Dialect::Fanuc, 4280), Some(Switch::On));
         assert_eq!(own.m(Dialect::Fanuc, 4290), Some(Switch::Off));

@@ -37,9 +37,10 @@ pub struct KeepCentre {
     pub decimals: usize,
     /// Millimetres per unit of the file's X Y Z words: 1 (mm) or 25.4 (inch).
     pub unit_mm: f64,
-    /// The path's s is the tip path's length (feed per minute): it is recomputed from the
-    /// written tips. False under inverse-time feed (G93), where s is the time-like
-    /// parameter every block keeps (its F, its time, is not changed).
+    /// The path's s follows the tip path's length (feed per minute, each segment scaled by
+    /// its block's feed: [`segment_scale`]): it is recomputed from the written tips. False
+    /// under inverse-time feed (G93), where s is the time-like parameter every block keeps
+    /// (its F, its time, is not changed).
     pub s_is_length: bool,
 }
 
@@ -65,18 +66,36 @@ impl KeepCentre {
     }
 }
 
-/// The cumulative length of the tips `xyz_mm`, from `s0`.
-pub fn tip_length(s0: f64, xyz_mm: &[[f64; 3]]) -> Vec<f64> {
+/// The path parameter over the tips `xyz_mm` (points `lo`… of `path`), from `s0`: their
+/// cumulative length, each segment scaled as `path` scales it ([`segment_scale`]).
+pub fn tip_length(path: &Path, lo: usize, s0: f64, xyz_mm: &[[f64; 3]]) -> Vec<f64> {
     let mut s = Vec::with_capacity(xyz_mm.len());
     let mut acc = s0;
     for (k, p) in xyz_mm.iter().enumerate() {
         if k > 0 {
             let q = xyz_mm[k - 1];
-            acc += (0..3).map(|i| (p[i] - q[i]).powi(2)).sum::<f64>().sqrt();
+            let d = (0..3).map(|i| (p[i] - q[i]).powi(2)).sum::<f64>().sqrt();
+            acc += d * segment_scale(path, lo + k);
         }
         s.push(acc);
     }
     s
+}
+
+/// How `path`'s parameter grows with its tool-tip length on the segment from point k − 1 to
+/// k: 1 under one feed per minute (s is the tip length); F_ref/F_k in a pass whose blocks
+/// have their own feeds, where s spaces the blocks by their time (a block of length L_k at
+/// F_k spans L_k·F_ref/F_k). When the tips move (a ball's centre kept) a segment keeps its
+/// feed, so its span scales with its new length by the same factor. 1 on a segment whose
+/// tips do not move.
+pub fn segment_scale(path: &Path, k: usize) -> f64 {
+    let (a, b) = (&path.axes[k - 1], &path.axes[k]);
+    let l = (0..3).map(|i| (b[i] - a[i]).powi(2)).sum::<f64>().sqrt();
+    if l > crate::tolerances::ZERO_SEGMENT_MM {
+        (path.s_mm[k] - path.s_mm[k - 1]) / l
+    } else {
+        1.0
+    }
 }
 
 /// The path as written when its rotary values become `p`, `c`: with `keep`, the tip of
@@ -116,7 +135,7 @@ pub fn written_path(
                 .map(|i| (out.axes[k][i] - out.axes[k - 1][i]).powi(2))
                 .sum::<f64>()
                 .sqrt();
-            out.s_mm[k] = out.s_mm[k - 1] + d;
+            out.s_mm[k] = out.s_mm[k - 1] + d * segment_scale(path, k);
             if d.is_nan() || d <= 0.0 {
                 return None;
             }

@@ -108,6 +108,8 @@ fn bound_room_deg(decimals: (usize, usize)) -> f64 {
 /// The driver's [`Sink`] for one zone: checks proposals and keeps the best.
 struct Selection<'a> {
     s: &'a [f64],
+    /// The path as read (its parameter's scale per segment: [`centre::segment_scale`]).
+    path: &'a Path,
     /// The path's axis values (the tips the program states).
     axes: &'a [[f64; 5]],
     target: &'a [[f64; 3]],
@@ -201,7 +203,7 @@ impl Selection<'_> {
                     std::array::from_fn(|j| q[j] + keep.radius_mm * (o0[j] - o1[j]))
                 })
                 .collect();
-            Some(tip_length(self.s[lo], &tips))
+            Some(tip_length(self.path, lo, self.s[lo], &tips))
         };
         let margin = core_margins(self.zone, self.opts.solver.core_margin_points);
         // `tips`: on the tips the values write (with a ball's centre kept), else on the
@@ -652,6 +654,7 @@ fn solve_zone(
     let core = zone_core(&zone, n, st.core_margin_points);
     let mut sel = Selection {
         s: f.s,
+        path,
         axes: &path.axes,
         target: &f.target,
         bound: &f.bound,

@@ -144,3 +144,7 @@ pub const REACH_SLACK: f64 = 1e-3;
 /// looser ones change which candidates pass verification. (The joint patch's own solver
 /// has its settings in [`crate::SolverSettings::ipm`].)
 pub const CLARABEL_MAX_ITER: u32 = 60;
+
+/// A path segment whose tool tips are closer than this, mm, has no feed scale of its own
+/// ([`crate::centre::segment_scale`]: 1).
+pub const ZERO_SEGMENT_MM: f64 = 1e-9;

@@ -107,6 +107,7 @@ pub fn analyze_program(
                 length_mm: rp.run.length_mm(),
                 // The run's F also when it is not analysed.
                 feed_mm_min: lp.run_feed_mm_min(r),
+                block_feeds_mm_min: block_feeds(&rp.run),
                 feed_mode: rp.run.feed_mode,
                 error: None,
                 figures: None,
@@ -136,4 +137,13 @@ pub fn analyze_program(
         not_analysed,
         runs,
     }
+}
+
+/// The lowest and highest of a run's block feeds, where its blocks have their own and they
+/// differ ([`RunReport::block_feeds_mm_min`]).
+fn block_feeds(run: &polepatch_nc::Run) -> Option<[f64; 2]> {
+    let f = &run.block_feed_mm_min;
+    let lo = f.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = f.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    (lo < hi).then_some([lo, hi])
 }

@@ -461,13 +461,16 @@ mod tests {
         assert!(!e.free, "{e:?}");
     }
 
-    /// A feed change splits the motion into two runs sharing a point: when the second
-    /// run's first move programs the rotary axes, the first run's end stays.
+    /// A change of feed mode (G94 to G93) splits the motion into two runs sharing a point:
+    /// when the second run's first move programs the rotary axes, the first run's end
+    /// stays. A change of F under G94 does not split it (issue 41: the pass is the unit).
     #[test]
     fn a_run_continued_by_the_next_keeps_its_end() {
-        let text = format!("{CUT}X3 A2 C40 F2000\nX4 A1 C50\nM30\n");
+        let text = format!("{CUT}G93 X3 A2 C40 F60\nX4 A1 C50 F60\nM30\n");
         assert_eq!(free(&text), [false, true]);
-        let text = format!("{CUT}X3 F2000\nX4\nM30\n");
+        let text = format!("{CUT}G93 X3 F60\nX4 F60\nM30\n");
         assert_eq!(free(&text), [true, true]);
+        let text = format!("{CUT}X3 A2 C40 F2000\nX4 A1 C50\nM30\n");
+        assert_eq!(free(&text), [true]);
     }
 }

@@ -448,7 +448,7 @@ fn run_options<'a>(
                 } else {
                     1.0
                 },
-                s_is_length: rp.run.feed_mode != polepatch_nc::FeedMode::InverseTime,
+                s_is_length: crate::program::parameter_is_length(&rp.run),
             });
         }
         ToolDemand::Cap { reach_mm } => {

@@ -121,6 +121,35 @@ pub fn endless_letters(machine: &Machine) -> [bool; 3] {
     endless
 }
 
+/// The letters of the machine's auxiliary axes ([`polepatch_kinematics::Controller::auxiliary_axes`]):
+/// one letter each, not X Y Z nor the machine's rotary letters (those it moves).
+fn auxiliary_letters(machine: &Machine) -> Result<Vec<u8>, Error> {
+    machine
+        .controller
+        .auxiliary_axes
+        .iter()
+        .map(|a| {
+            let l = a.trim().to_ascii_uppercase();
+            match l.as_bytes() {
+                [c] if c.is_ascii_alphabetic()
+                    && !b"XYZ".contains(c)
+                    && *c != machine.primary_letter() as u8
+                    && *c != machine.c_letter() as u8 =>
+                {
+                    Ok(*c)
+                }
+                _ => Err(Error::Options(format!(
+                    "machine {}: [controller] auxiliary_axes: '{a}' is not one letter other than \
+                     X Y Z, {} and {} (the axes the machine moves)",
+                    machine.name,
+                    machine.primary_letter(),
+                    machine.c_letter()
+                ))),
+            }
+        })
+        .collect()
+}
+
 /// How to read programs for `machine`: the dialect detected, the machine's TCPM codes;
 /// in inches when the program states no units and `inch` is true, else mm.
 pub fn read_options_with(
@@ -146,6 +175,7 @@ pub fn read_options_with(
             on: codes("tcpm_on", &machine.controller.tcpm_on)?,
             off: codes("tcpm_off", &machine.controller.tcpm_off)?,
             always: machine.controller.tcpm_always,
+            auxiliary: auxiliary_letters(machine)?,
         },
         flow: None,
         inch,
@@ -378,7 +408,7 @@ pub(crate) fn run_path(
         s_mm: if run.block_feed_mm_min.is_empty() {
             run.s_mm.clone()
         } else {
-            inverse_time_parameter(&run, feed)
+            block_feed_parameter(&run, feed)
         },
         axes: run.axes5(letters),
         feed_mm_min: feed,
@@ -390,8 +420,17 @@ pub(crate) fn run_path(
     }
 }
 
-/// The path parameter of an inverse-time (G93) run whose blocks have different feeds,
-/// at its reference feed `f_ref` ([`inverse_time_feed`]): block k of tool-tip length L_k
+/// Whether a run's path parameter follows its tool-tip length when the tips move (a ball's
+/// centre kept): under feed per minute, each block's span scaled by its own feed as
+/// [`block_feed_parameter`] scales it (the patcher's `segment_scale`); not under G93, where
+/// each block keeps its time whatever its length.
+pub(crate) fn parameter_is_length(run: &Run) -> bool {
+    run.feed_mode != polepatch_nc::FeedMode::InverseTime
+}
+
+/// The path parameter of a run whose blocks have different feeds — an inverse-time (G93)
+/// run, or a G94 pass whose F changes ([`polepatch_nc::RunBuilder::passes`]) — at its
+/// reference feed `f_ref` ([`reference_feed`]): block k of tool-tip length L_k
 /// and feed F_k (its time L_k/F_k) spans u_k − u_{k−1} = L_k·f_ref/F_k, so that moving
 /// along u at f_ref takes every block its programmed time.
 ///
@@ -400,7 +439,7 @@ pub(crate) fn run_path(
 /// for A and J (q_uu = q_ss·(F_k/f_ref)², q_uuu = q_sss·(F_k/f_ref)³). The analysis
 /// spline is the interpolant over u (the same points, knots spaced by block time); when
 /// every block has the same feed, u = s and the run is analysed exactly as in G94.
-fn inverse_time_parameter(run: &Run, f_ref: f64) -> Vec<f64> {
+fn block_feed_parameter(run: &Run, f_ref: f64) -> Vec<f64> {
     let feeds = &run.block_feed_mm_min;
     if feeds.iter().all(|&f| f == feeds[0]) {
         return run.s_mm.clone();
@@ -476,7 +515,7 @@ fn run_feed(
             .or(feed_fallback_mm_min)
             .ok_or(RunProblem::NoFeed)?
     } else {
-        inverse_time_feed(run)
+        reference_feed(run)
     };
     if feed < MIN_FEED_MM_MIN {
         // Under G93 the slowest block, named at its own line with its F as written.
@@ -498,10 +537,14 @@ fn run_feed(
     Ok(feed)
 }
 
-/// The reference feed of a G93 run: its length over its programmed time (Σ L_k / Σ
-/// L_k/F_k, mm/min), or the block feed when they are all equal; a block slower than
-/// [`MIN_FEED_MM_MIN`] makes the run too slow to analyse.
-fn inverse_time_feed(run: &Run) -> f64 {
+/// The reference feed of a run whose blocks have their own feeds (G93, or a G94 pass whose
+/// F changes): the feed that covers the greatest length of it (its cutting feed: a pass's
+/// plunge at F500 before 50 mm at F2000 is analysed at 2000, its cut exactly as a pass at
+/// one feed would be, the plunge's blocks spanning L·2000/500), the higher of equal ones;
+/// or the block feed when they are all equal; a block slower than [`MIN_FEED_MM_MIN`]
+/// makes the run too slow to analyse (its feed, the lowest). Any reference gives each
+/// block its own feed ([`block_feed_parameter`]); this one keeps most of the pass at u = s.
+pub(crate) fn reference_feed(run: &Run) -> f64 {
     let feeds = &run.block_feed_mm_min;
     if feeds.iter().all(|&f| f == feeds[0]) {
         return feeds[0];
@@ -509,10 +552,16 @@ fn inverse_time_feed(run: &Run) -> f64 {
     if feeds.iter().any(|&f| f < MIN_FEED_MM_MIN) {
         return feeds.iter().copied().fold(f64::INFINITY, f64::min);
     }
-    let time: f64 = feeds
-        .iter()
-        .enumerate()
-        .map(|(k, f)| (run.s_mm[k + 1] - run.s_mm[k]) / f)
-        .sum();
-    run.length_mm() / time
+    let mut by_feed: Vec<(f64, f64)> = Vec::new();
+    for (k, &f) in feeds.iter().enumerate() {
+        let l = run.s_mm[k + 1] - run.s_mm[k];
+        match by_feed.iter_mut().find(|(g, _)| *g == f) {
+            Some((_, len)) => *len += l,
+            None => by_feed.push((f, l)),
+        }
+    }
+    by_feed
+        .into_iter()
+        .max_by(|a, b| a.1.total_cmp(&b.1).then(a.0.total_cmp(&b.0)))
+        .map_or(feeds[0], |(f, _)| f)
 }

@@ -368,6 +368,10 @@ struct Reading<'a> {
     /// The machine's bounded rotary ranges, degrees, by letter (the tilting axis always;
     /// the pole axis unless it turns endlessly).
     ranges: Vec<(u8, (f64, f64))>,
+    /// Runs are passes: a change of F under G94 does not end one ([`RunBuilder::passes`]).
+    /// The simulator, which takes its motions apart at every feed change and joins them
+    /// itself, reads without.
+    passes: bool,
     /// The machine's distance from the pole.
     pole: crate::program::PoleDistance,
     /// How far from the pole a zone can lie (the cone, or the pole reach beyond it).
@@ -388,6 +392,15 @@ struct Reading<'a> {
     lazy_style: Option<usize>,
 }
 
+/// The run walk of a reading: passes or runs ([`Reading::passes`]).
+fn run_builder(rd: &Reading<'_>) -> RunBuilder {
+    if rd.passes {
+        RunBuilder::passes()
+    } else {
+        RunBuilder::default()
+    }
+}
+
 /// The machine's bounded rotary ranges by letter ([`Reading::ranges`]).
 fn ranges(machine: &Machine, letters: RotaryLetters) -> Vec<(u8, (f64, f64))> {
     std::iter::once((letters.tilt, machine.primary_range_deg))
@@ -403,6 +416,7 @@ impl<'a> Reading<'a> {
             name: &opts.name,
             letters,
             ranges: ranges(machine, letters),
+            passes: true,
             pole: crate::program::PoleDistance::of(machine),
             cone_deg: opts.patch.reach_deg(),
             fallback: opts.feed_fallback_mm_min,
@@ -421,6 +435,7 @@ impl<'a> Reading<'a> {
             name: &opts.name,
             letters,
             ranges: ranges(machine, letters),
+            passes: true,
             pole: crate::program::PoleDistance::of(machine),
             cone_deg: opts.analysis.reach_deg(),
             fallback: opts.feed_fallback_mm_min,
@@ -503,7 +518,7 @@ fn survey_once(
     // Where the style is counted from: the first block, or (lazy) none yet.
     let mut style_from = opts.lazy_style.is_none().then_some(0usize);
     let mut notes = crate::notes::Notes::new();
-    let mut builder = RunBuilder::default();
+    let mut builder = run_builder(opts);
     let mut prev = opts.read.initial();
     let mut i = 0usize;
     let mut no_run_why = None;
@@ -544,6 +559,9 @@ fn survey_once(
         // The first word of each rotary letter, and its first that is not 0 (a letter
         // that has turned has both).
         for w in s.words {
+            if opts.read.controller.auxiliary.contains(&w.letter) {
+                continue;
+            }
             let l = match w.letter {
                 b'A' => 0,
                 b'B' => 1,
@@ -1211,7 +1229,11 @@ pub(crate) fn each_run<T: Send>(
     work: impl Fn(&LoadedProgram) -> T + Sync,
     mut sink: impl FnMut(T) -> std::io::Result<()>,
 ) -> Result<char, Error> {
-    let rd = Reading::analysis(opts, machine)?;
+    // The simulator takes a motion apart at every feed change and joins the runs itself.
+    let rd = Reading {
+        passes: false,
+        ..Reading::analysis(opts, machine)?
+    };
     let (sv, l) = match begin(bytes, machine, &rd)? {
         Begun::Nothing { why, .. } => return Err(why),
         Begun::Stretches { sv, l, .. } => (sv, l),
@@ -1309,7 +1331,7 @@ fn each_stretch<T: Send>(
     let mut building: Option<InHand> = None;
     let mut done: VecDeque<InHand> = VecDeque::new();
     let mut failure: Option<Error> = None;
-    let mut builder = RunBuilder::default();
+    let mut builder = run_builder(rd);
     let mut run_no = 0usize;
     let mut prev = rd.read.initial();
     let mut i = 0usize;
@@ -1494,8 +1516,9 @@ mod tests {
         match plant {
             Some((marker, find, with)) => {
                 let text = String::from_utf8_lossy(&output).into_owned();
-                if text.contains(&marker) {
-                    text.replacen(&find, &with, 1).into_bytes()
+                // The last occurrence: the stretch's retract, after its pass.
+                if let (true, Some(at)) = (text.contains(&marker), text.rfind(&find)) {
+                    format!("{}{with}{}", &text[..at], &text[at + find.len()..]).into_bytes()
                 } else {
                     output
                 }

@@ -64,8 +64,13 @@ pub struct RunReport {
     pub points: usize,
     /// Path length, mm.
     pub length_mm: f64,
-    /// Feed used, mm/min (`null` if none).
+    /// Feed used, mm/min (`null` if none); where the blocks have their own (a pass whose
+    /// F changes, G93), the reference feed: the run's length over its programmed time.
     pub feed_mm_min: Option<f64>,
+    /// Where the blocks have their own feeds: the lowest and highest, mm/min (absent
+    /// otherwise). Equation 6's ratio is against each block's own.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub block_feeds_mm_min: Option<[f64; 2]>,
     /// Feed mode: `G94`, or `G93` (inverse time: the feed is each block's length over its
     /// time).
     #[serde(serialize_with = "feed_mode_by_name")]
