@@ -586,6 +586,7 @@ pub unsafe extern "C" fn pp_simulate_nc(
             feed_fallback_mm_min: o.feed_fallback_mm_min,
             name: o.name,
             work_offset_mm: o.work_offset_mm,
+            inch: o.inch,
             ..polepatch::SimulateOptions::default()
         };
         sim.sim.tcy_s = o.patch.tcy_s;

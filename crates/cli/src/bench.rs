@@ -44,7 +44,7 @@ use std::time::Instant;
 
 /// A strategy of the suite (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "kebab-case")]
+#[serde(rename_all = "snake_case")]
 pub enum BenchStrategy {
     /// polepatch, both rotary axes (the default of `polepatch patch`).
     Polepatch,
@@ -136,7 +136,7 @@ impl Default for BenchOptions {
 
 /// Which reference a zone gets ([`ZoneBound::kind`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "kebab-case")]
+#[serde(rename_all = "snake_case")]
 pub enum BoundKind {
     /// `best-found`: both axes, the best of several exact methods (an upper bound of the
     /// optimum).
@@ -539,6 +539,8 @@ pub fn bench_program(
         name: lp.name.clone(),
         feed_fallback_mm_min: opts.feed_fallback_mm_min,
         work_offset_mm: None,
+        // As the bench reads its programs (`load_nc`: a program without units in mm).
+        inch: false,
         sim: polepatch::sim::SimOptions {
             tcy_s: opts.patch.tcy_s,
             ..Default::default()

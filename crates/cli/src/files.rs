@@ -166,6 +166,7 @@ fn simulated(
         name: opts.name.clone(),
         feed_fallback_mm_min: opts.feed_fallback_mm_min,
         work_offset_mm: opts.work_offset_mm,
+        inch: opts.inch,
         sim: polepatch::sim::SimOptions {
             tcy_s: opts.patch.tcy_s,
             ..Default::default()

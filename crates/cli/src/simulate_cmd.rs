@@ -43,6 +43,9 @@ pub(crate) struct SimulateArgs {
     /// Work offset X,Y,Z (mm) for a machine with a kinematic chain (see `patch`).
     #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z", allow_hyphen_values = true)]
     work_offset: Option<[f64; 3]>,
+    /// Units of a program that states none (see `patch`). Default mm.
+    #[arg(long, value_enum)]
+    units: Option<crate::UnitsArg>,
     /// The planner: `jerk` (a jerk-limited controller, the default) or `linuxcnc` (a
     /// model of LinuxCNC 2.9's planner: V and A only, each line stopping within itself at
     /// half the acceleration; docs/linuxcnc.md, docs/validation.md).
@@ -175,6 +178,7 @@ pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
             name: name.clone(),
             feed_fallback_mm_min: args.feed,
             work_offset_mm: args.work_offset,
+            inch: args.units == Some(crate::UnitsArg::Inch),
             ..SimulateOptions::default()
         };
         opts.sim.tcy_s = args.tcy_ms.map(|ms| ms / 1000.0);

@@ -62,7 +62,7 @@ fn sing_peak_c_speed_is_about_200_rpm_with_a_zone_around_x25() {
         .collect();
     assert_eq!(zones.len(), 1, "{zones:?}");
     let z = &zones[0];
-    assert_eq!(z["kind"], "C-swing");
+    assert_eq!(z["kind"], "c_swing");
     assert!((z["min_abs_primary_deg"].as_f64().unwrap() - 1.0).abs() < 1e-9);
     // The zone spans the X=25 block (file line 41: `N360 X+25 Y+0 Z-8 A+1 C+180 *`).
     let lines = z["lines"].as_array().unwrap();

@@ -54,7 +54,7 @@ fn sing_has_its_zone_on_a_machine_whose_tool_points_up() {
         "tool_direction = [0.0, 0.0, -1.0]",
     );
     let upright = zones(&analyze_json("fixtures/c17/SING.I", "mikron-ucp710"));
-    assert_eq!(upright, [(32, 50, "C-swing".to_string())]);
+    assert_eq!(upright, [(32, 50, "c_swing".to_string())]);
     assert_eq!(zones(&analyze_json("fixtures/c17/SING.I", &up)), upright);
     let (code, _, err) = polepatch(&["analyze", "fixtures/c17/SING.I", "--machine", &up]);
     assert_eq!(code, 0);
@@ -122,7 +122,7 @@ fn the_bridge_mill_ini_analyses_and_patches_with_w_carried() {
     std::fs::write(&program, &text).unwrap();
     let doc = analyze_json(program.to_str().unwrap(), ini);
     assert_eq!(doc["primary"], "B");
-    assert_eq!(zones(&doc), [(29, 43, "C-swing".to_string())]);
+    assert_eq!(zones(&doc), [(29, 43, "c_swing".to_string())]);
     let out = dir.join("out.ngc");
     let report = dir.join("report.json");
     let (code, _, err) = polepatch(&[

@@ -226,7 +226,7 @@ fn no_tcpm_is_never_patched() {
     );
     let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
     assert_eq!(doc["words_changed"], 0);
-    assert_eq!(doc["untouched_runs"][0]["reason"], "no-tcpm");
+    assert_eq!(doc["untouched_runs"][0]["reason"], "no_tcpm");
     let mut strict = args.to_vec();
     strict.push("--strict");
     let (code, _, err) = polepatch(&strict);

@@ -237,3 +237,53 @@ fn an_inverse_time_f0_is_named_at_its_line() {
         "{err}"
     );
 }
+
+/// Issue 40: `--units` reaches the simulator. A program that states no units, read in
+/// inches by `simulate --units inch` (lengths ×25.4), and `patch --units inch --simulate`
+/// simulates the same inch reading it patched (it simulated a millimetre reading before).
+#[test]
+fn units_reach_the_simulation() {
+    let dir = temp_dir("simulate-units");
+    let text = std::fs::read_to_string(root().join("fixtures/shop/ac-flip-d0.5-fanuc-g94.nc"))
+        .unwrap()
+        .replace("G90 G21 G94", "G90 G94");
+    let prog = dir.join("no-units.nc");
+    std::fs::write(&prog, &text).unwrap();
+    let p = prog.to_str().unwrap();
+    let sim = |units: &[&str]| -> serde_json::Value {
+        let mut args = vec!["simulate", p, "-m", "mikron-ucp710", "--json"];
+        args.extend_from_slice(units);
+        let (code, out, err) = polepatch(&args);
+        assert_eq!(code, 0, "{err}");
+        serde_json::from_str::<serde_json::Value>(&out).unwrap()[0].clone()
+    };
+    let (mm, inch) = (sim(&[]), sim(&["--units", "inch"]));
+    let length = |r: &serde_json::Value| r["runs"][0]["length_mm"].as_f64().unwrap();
+    assert!((length(&inch) / length(&mm) - 25.4).abs() < 1e-9);
+    let total = |r: &serde_json::Value| r["total"]["time_s"].as_f64().unwrap();
+    assert!((total(&inch) - total(&mm)).abs() > 0.01 * total(&mm));
+    let report = dir.join("r.json");
+    let (code, _, err) = polepatch(&[
+        "patch",
+        p,
+        "-m",
+        "mikron-ucp710",
+        "--units",
+        "inch",
+        "--simulate",
+        "-o",
+        dir.join("out.nc").to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let before = r["simulated"]["before_s"].as_f64().unwrap();
+    assert!(
+        (before - total(&inch)).abs() <= 1e-9 * before,
+        "{before} vs {} (mm: {})",
+        total(&inch),
+        total(&mm)
+    );
+}

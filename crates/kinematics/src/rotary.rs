@@ -91,14 +91,17 @@ pub struct Rotaries {
 
 /// The layout of a machine, from what its two rotary axes turn.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
+#[serde(rename_all = "snake_case")]
 pub enum Layout {
     /// Both axes turn the table (trunnion, cradle, nutating table).
+    #[serde(alias = "table-table")]
     TableTable,
     /// The pole axis turns the table, the tilting axis the head (swivel head over a rotary
     /// table).
+    #[serde(alias = "head-table")]
     HeadTable,
     /// Both axes turn the head (fork head).
+    #[serde(alias = "head-head")]
     HeadHead,
 }
 

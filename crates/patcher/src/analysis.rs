@@ -80,6 +80,7 @@ impl AnalysisOptions {
 
 /// Kind of singular zone.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum ZoneKind {
     /// The primary axis changes sign near zero (domain-rule posts, G16): C jumps up to 180°.
     AFlip,
@@ -88,8 +89,8 @@ pub enum ZoneKind {
 }
 
 impl ZoneKind {
-    /// The name used in the reports of `polepatch`: `A-flip`, `C-swing`. (This type's own
-    /// serde form, in [`crate::ZoneReport`]'s JSON, is the variant's name.)
+    /// The name used in the text reports of `polepatch`: `A-flip`, `C-swing` (the JSON
+    /// reports write `a_flip`, `c_swing`, as every report enum, in snake_case).
     pub fn name(self) -> &'static str {
         match self {
             ZoneKind::AFlip => "A-flip",

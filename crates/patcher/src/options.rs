@@ -20,7 +20,7 @@ pub enum PatchAxes {
 /// the peers' rules ([`crate::peers`]); [`crate::strategy`] says which methods
 /// answer each.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
+#[serde(rename_all = "snake_case")]
 pub enum Strategy {
     /// polepatch: branch re-selection, joint patch, verification (or the C-only method).
     #[default]

@@ -53,7 +53,7 @@ pub enum Reference {
 
 /// The method that found a [`Reference::Best`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
+#[serde(rename_all = "snake_case")]
 pub enum ReferenceMethod {
     /// Branch re-selection alone (no orientation change).
     Reselect,

@@ -23,6 +23,7 @@ pub struct ZoneFigures {
 
 /// Outcome of one zone.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Outcome {
     /// C reaches feed (C ratio ≥ 1 on the written values).
     Reached,
@@ -162,6 +163,7 @@ impl std::fmt::Display for Reason {
 
 /// Which formulation produced the written values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Method {
     /// Branch re-selection alone: the points after the program's IK-branch switch moved to
     /// the other branch, `(P, C) → (−P, C ± 180°)` (no orientation change).
@@ -203,6 +205,7 @@ impl std::fmt::Display for Method {
 /// How a solve ended: clarabel's `SolverStatus`, plus polepatch's own outcomes of a solve
 /// that was not run. A numerical outcome, not an error (SPEC: bad input is kept apart).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum QpStatus {
     /// No solve was made.
     #[default]

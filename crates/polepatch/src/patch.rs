@@ -684,7 +684,7 @@ impl RunPatch<'_> {
                 UntouchedReason::CentrePath,
                 result.zones.len(),
                 why,
-                file_opts.cone_deg,
+                file_opts.reach_deg(),
             ));
             return None;
         }
@@ -1217,7 +1217,7 @@ fn untouched(
     reason: UntouchedReason,
     zones: usize,
     message: String,
-    cone_deg: f64,
+    reach_deg: f64,
 ) -> UntouchedRun {
     let pi = lp.primary_index();
     UntouchedRun {
@@ -1229,7 +1229,7 @@ fn untouched(
             .run
             .pos
             .iter()
-            .any(|p| lp.pole.near(p[pi], cone_deg)),
+            .any(|p| lp.pole.near(p[pi], reach_deg)),
         message,
     }
 }

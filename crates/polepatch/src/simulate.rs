@@ -35,6 +35,10 @@ pub struct SimulateOptions {
     pub name: String,
     /// Work offset for a machine with a kinematic chain (as [`crate::PatchOptions::work_offset_mm`]).
     pub work_offset_mm: Option<[f64; 3]>,
+    /// Read a program that states no length units in inches (as
+    /// [`crate::PatchOptions::inch`]: `patch --units inch --simulate` simulates what it
+    /// patched). Default false: mm.
+    pub inch: bool,
 }
 
 impl Default for SimulateOptions {
@@ -44,6 +48,7 @@ impl Default for SimulateOptions {
             feed_fallback_mm_min: None,
             name: "input".to_string(),
             work_offset_mm: None,
+            inch: false,
         }
     }
 }
@@ -283,6 +288,7 @@ pub fn simulate_nc_with(
         name: opts.name.clone(),
         feed_fallback_mm_min: opts.feed_fallback_mm_min,
         work_offset_mm: opts.work_offset_mm,
+        inch: opts.inch,
         ..crate::AnalyzeOptions::default()
     };
     let read = crate::stream::each_run(

@@ -63,7 +63,7 @@ def test_patch_joints_reaches_feed_and_reports_the_deviation_it_made() -> None:
     assert out.shape == joints.shape and out.dtype == np.float64
     assert np.array_equal(out[:, :3], joints[:, :3]), "x y z unchanged"
     assert np.array_equal(out[0], joints[0]) and np.array_equal(out[-1], joints[-1])
-    assert zones and all(z["outcome"] == "Reached" for z in zones), zones
+    assert zones and all(z["outcome"] == "reached" for z in zones), zones
     assert zones[0]["before"]["c_ratio"] < 1.0 <= zones[0]["after"]["c_ratio"]
     changed = np.any(out[:, 3:] != joints[:, 3:], axis=1)
     assert changed.any()

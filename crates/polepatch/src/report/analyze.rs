@@ -1,7 +1,7 @@
 //! The report of an analysis (the JSON of `polepatch analyze --json`): per run its
 //! Equation-6 figures and zones.
 
-use super::{by_name, feed_mode_by_name, limit_by_name, limits_by_name};
+use super::{feed_mode_by_name, limit_by_name, limits_by_name};
 use polepatch_kinematics::LimitKind;
 use polepatch_nc::FeedMode;
 use polepatch_patcher::ZoneKind;
@@ -13,8 +13,7 @@ use std::collections::BTreeMap;
 pub struct ZoneSummary {
     /// File lines of the first and last point of the zone.
     pub lines: [usize; 2],
-    /// `A-flip` or `C-swing`.
-    #[serde(serialize_with = "by_name")]
+    /// `a_flip` or `c_swing` (in text: `A-flip`, `C-swing`).
     pub kind: ZoneKind,
     /// File line of the singular point.
     pub singular_line: usize,

@@ -9,14 +9,13 @@
 //! (`z.outcome == Outcome::Reached`): a zone row's [`ZoneKind`], [`Outcome`],
 //! [`ZoneReason`], [`EndFreedom`], [`Method`], [`FeedMode`](polepatch_nc::FeedMode),
 //! [`ZoneTool`] and [`ToolPoint`](crate::tool::ToolPoint), a figure's [`LimitKind`], a
-//! simulated run's [`SimFrame`]. The JSON, the CSV and the printed summaries write each by
-//! its report name, its `Display` or `name()` (`reached`, `A-flip`, `g16-patch`,
-//! `tool_limited`; `G94` for a feed mode: [`feed_mode_name`]; `V`, `A`, `J`, `F` for a
-//! limit: [`limit_name`]); an optional one (a run not patched has no end pose or tool
-//! point) is written `-`. The patcher's enums keep their own serde form in the patcher's
-//! [`ZoneReport`](polepatch_patcher::ZoneReport) (`Reached`, `AFlip`: the zones
-//! [`crate::joints::patch_joints`] gives the bindings), so the report fields write theirs
-//! with `serialize_with`.
+//! simulated run's [`SimFrame`]. The JSON writes every such enum in one spelling,
+//! snake_case (`reached`, `c_swing`, `g16_patch`, `tool_limited`, `no_tcpm`, `solved`; issue
+//! 40), except the symbols a machinist reads as such: `G94` for a feed mode
+//! ([`feed_mode_name`]), `V`, `A`, `J`, `F` for a limit ([`limit_name`]), axis letters. The
+//! CSV and the printed summaries write the names people read (`A-flip`, `g16-patch`, their
+//! `Display` or `name()`); an optional one (a run not patched has no end pose or tool
+//! point) is written `-`.
 
 mod analyze;
 mod patch;

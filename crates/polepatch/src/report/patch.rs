@@ -53,8 +53,7 @@ pub struct ZoneRow {
     pub run: usize,
     /// File lines of the first and last point of the zone/patch.
     pub lines: [usize; 2],
-    /// `A-flip` or `C-swing`.
-    #[serde(serialize_with = "by_name")]
+    /// `a_flip` or `c_swing` (in text: `A-flip`, `C-swing`).
     pub kind: ZoneKind,
     /// Smallest |primary|, degrees.
     pub min_abs_primary_deg: f64,
@@ -94,8 +93,8 @@ pub struct ZoneRow {
     /// File line of the block after the run that decided its end pose (`None`: the end of
     /// the file, or a run without TCPM, whose end is always pinned).
     pub end_pose_line: Option<usize>,
-    /// `reselect`, `joint`, `peer`, `g16-patch`, `direct` or `none`.
-    #[serde(serialize_with = "by_name")]
+    /// `reselect`, `joint`, `peer`, `g16_patch`, `direct` or `none` (in text and CSV:
+    /// `g16-patch`).
     pub method: Method,
     /// Last solver status.
     pub qp_status: QpStatus,
@@ -369,7 +368,7 @@ impl ZoneRow {
 
 /// Why a run was left as it is although polepatch could have looked at it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "kebab-case")]
+#[serde(rename_all = "snake_case")]
 pub enum UntouchedReason {
     /// No TCPM active: X Y Z are machine coordinates, so rotary words cannot change alone.
     NoTcpm,
@@ -436,7 +435,9 @@ pub struct UntouchedRun {
     pub reason: UntouchedReason,
     /// Singular zones the run holds (reported in [`FileReport::zones`] as `unchanged`).
     pub zones: usize,
-    /// A point of the run is within the singular cone, or its primary value is not stated:
+    /// A point of the run is as near the pole as a zone can lie (the larger of the cone and
+    /// the pole reach, as every other "near the pole" of a run), or its primary value is
+    /// not stated:
     /// the run may hold a zone. With `zones` = 0 such a run was not analysed (no feed,
     /// invalid values), so whether it reaches feed is unknown ([`FileReport::runs_not_analysed`]).
     pub near_pole: bool,

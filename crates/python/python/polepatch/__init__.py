@@ -481,7 +481,7 @@ def patch_joints(
         zone — the patcher's zone report: ``first``/``last`` row, ``kind``,
         ``min_abs_primary_deg``, ``before``/``after`` figures (feed ratios, limiting axis
         and limit, ``time_s``), ``ideal_time_s``, ``max_deviation_deg``,
-        ``points_modified``, ``outcome`` (``Reached``, ``Improved``, ``Unchanged``),
+        ``points_modified``, ``outcome`` (``reached``, ``improved``, ``unchanged``),
         ``method``, ``qp`` (status, iterations, solves, ``solve_time_s``), decimals.
 
     Raises:
