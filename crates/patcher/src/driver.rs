@@ -1235,6 +1235,7 @@ impl<'a> Run<'a> {
             last,
             kind: d.zone.kind,
             min_abs_primary_deg: d.zone.min_abs_primary_deg,
+            core: [core.start, core.end],
             before,
             after,
             ideal_time_s: (path.s_mm[range.end] - path.s_mm[range.start])
@@ -1400,6 +1401,7 @@ pub fn report_unpatched(
                 last: zone.last,
                 kind: zone.kind,
                 min_abs_primary_deg: zone.min_abs_primary_deg,
+                core: [core.start, core.end],
                 before: f,
                 after: f,
                 ideal_time_s: (path.s_mm[core.end] - path.s_mm[core.start])

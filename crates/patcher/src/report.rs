@@ -317,6 +317,9 @@ pub struct ZoneReport {
     pub kind: ZoneKind,
     /// Smallest |primary| in the zone, degrees.
     pub min_abs_primary_deg: f64,
+    /// First and last point of the zone's core (the zone ± the core margin, cut at the
+    /// run's ends): where [`Outcome::Reached`] says the written values reach feed.
+    pub core: [usize; 2],
     /// Figures before patching, over the spans of the zone and of the patch, ± the core
     /// margin (from the analysis of the whole run).
     pub before: ZoneFigures,

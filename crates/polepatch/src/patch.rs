@@ -1241,6 +1241,7 @@ fn zone_row(lp: &LoadedProgram, run: usize, z: &ZoneReport) -> ZoneRow {
         file: lp.name.clone(),
         run: lp.run_number(run),
         lines: [lp.line_of(run, z.first), lp.line_of(run, z.last)],
+        core_lines: [lp.line_of(run, z.core[0]), lp.line_of(run, z.core[1])],
         kind: z.kind,
         min_abs_primary_deg: z.min_abs_primary_deg,
         before: FiguresRow::new(&z.before, pl),

@@ -1043,7 +1043,7 @@ fn verified_output(
             .flat_map(|p| p.report.zones.iter())
             .filter(|z| z.outcome == crate::Outcome::Reached)
             .map(|z| crate::verify::Claim {
-                lines: z.lines,
+                lines: z.core_lines,
                 both_axes: opts.patch.axes == polepatch_patcher::PatchAxes::Both,
             })
             .collect();

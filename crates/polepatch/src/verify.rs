@@ -90,7 +90,10 @@ const BATCH_BLOCKS: usize = 512;
 /// ([`verify_claims`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Claim {
-    /// File lines of the zone's first and last point.
+    /// File lines of the zone's core (`ZoneRow::core_lines`): where the report's `reached`
+    /// says the written values reach feed. Not the patch's whole range, which may keep a
+    /// slowness of the program's own that the patch only must not make worse (the
+    /// Equation-6 check of every run holds it to that).
     pub lines: [usize; 2],
     /// Both rotary axes reach feed there (`false`: C only, G16's method, `--only-c`).
     pub both_axes: bool,

@@ -412,3 +412,74 @@ fn a_lead_out_at_cutting_depth_keeps_a_ball_runs_end() {
     let check = verify_nc(planted.as_bytes(), &out, &ucp710(), &o, f).unwrap();
     assert!(check.passed(), "{:?}", check.violations);
 }
+
+/// `reached` is a claim about the zone's core (`core_lines`), not the patch's whole range:
+/// a slowness of the program's own inside the range but outside the core (NX's Haas UMC-750
+/// program, `nx_haas_umc750_g234.txt`: a 0.004 mm block turning C 2.8°, 0.888 of the feed
+/// in input and output) is the program's, held only to "no worse" by the Equation-6 check of
+/// the run. Planted in the input and the output alike, at the same line: the claim on the
+/// core holds, the same claim over the whole range is refused at that block.
+#[test]
+fn reached_is_claimed_over_the_zone_core() {
+    use polepatch::verify::{Claim, verify_claims};
+    let f = "ac-flip-d0.5-fanuc-g94.nc";
+    let input = std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../../fixtures/shop")
+            .join(f),
+    )
+    .unwrap();
+    let m = ucp710();
+    let o = opts(f, ToolOptions::default());
+    let (out, report) = patch_nc(input.as_bytes(), &m, &o).unwrap();
+    let z = &report.zones[0];
+    assert_eq!(z.outcome, Outcome::Reached);
+    let (lines, core) = (z.lines, z.core_lines);
+    assert!(
+        lines[0] < core[0] && core[1] < lines[1],
+        "{lines:?} {core:?}"
+    );
+    // The program's own kink: a block 0.004 mm long turning C by 2.8° and back, four lines
+    // after the range's first, in both programs (the output keeps the patch's values around
+    // it, so the block's neighbours are each program's own).
+    let at = lines[0] + 3;
+    let plant = |text: &str| {
+        let mut l: Vec<String> = text.lines().map(str::to_string).collect();
+        let (x, a, c) = {
+            let w: Vec<&str> = l[at - 1].split_whitespace().collect();
+            let v = |p: char| {
+                w.iter().find(|s| s.starts_with(p)).unwrap()[1..]
+                    .parse::<f64>()
+                    .unwrap()
+            };
+            (v('X'), v('A'), v('C'))
+        };
+        l[at - 1] = format!("X{:.3} A{a} C{:.3}", x - 0.004, c + 2.8);
+        l.insert(at, format!("X{x} A{a} C{c}"));
+        l.join("\n") + "\n"
+    };
+    let (pi, po) = (plant(&input), plant(&String::from_utf8(out).unwrap()));
+    let claim = |lines: [usize; 2]| Claim {
+        lines,
+        both_axes: true,
+    };
+    let on_core = verify_claims(pi.as_bytes(), po.as_bytes(), &m, &o, f, &[claim(core)]).unwrap();
+    assert!(on_core.passed(), "{:?}", on_core.violations);
+    let over_range = verify_claims(
+        pi.as_bytes(),
+        po.as_bytes(),
+        &m,
+        &o,
+        f,
+        &[claim([lines[0], lines[1] + 1])],
+    )
+    .unwrap();
+    assert!(
+        over_range
+            .violations
+            .iter()
+            .any(|v| v.check == Check::ReportedReached),
+        "{:?}",
+        over_range.violations
+    );
+}

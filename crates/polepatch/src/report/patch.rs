@@ -53,6 +53,10 @@ pub struct ZoneRow {
     pub run: usize,
     /// File lines of the first and last point of the zone/patch.
     pub lines: [usize; 2],
+    /// File lines of the first and last point of the zone's core (the zone ± a few points):
+    /// where `reached` says the written program reaches feed, and where `verify` holds it
+    /// to that (JSON only).
+    pub core_lines: [usize; 2],
     /// `a_flip` or `c_swing` (in text: `A-flip`, `C-swing`).
     pub kind: ZoneKind,
     /// Smallest |primary|, degrees.
