@@ -100,7 +100,7 @@ pub struct Claim {
 }
 
 /// What [`verify_nc`] found.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct VerifyReport {
     /// The original's name.
     pub original: String,
@@ -172,16 +172,7 @@ pub fn verify_claims(
         original: original_name.to_string(),
         patched: opts.name.clone(),
         machine: machine.name.clone(),
-        lines: 0,
-        lines_changed: 0,
-        moves_changed: 0,
-        max_reference_shift_mm: 0.0,
-        max_deviation_deg: 0.0,
-        runs_compared: 0,
-        positioning_moves_compared: 0,
-        time_before_s: 0.0,
-        time_after_s: 0.0,
-        violations: Vec::new(),
+        ..VerifyReport::default()
     };
     let (lines_o, lines_p) = (line_count(original), line_count(patched));
     if lines_o != lines_p {
@@ -499,21 +490,7 @@ impl<'a> Comparison<'a> {
             opts,
             letters,
             claims,
-            report: VerifyReport {
-                original: String::new(),
-                patched: String::new(),
-                machine: String::new(),
-                lines: 0,
-                lines_changed: 0,
-                moves_changed: 0,
-                max_reference_shift_mm: 0.0,
-                max_deviation_deg: 0.0,
-                runs_compared: 0,
-                positioning_moves_compared: 0,
-                time_before_s: 0.0,
-                time_after_s: 0.0,
-                violations: Vec::new(),
-            },
+            report: VerifyReport::default(),
             tracker: crate::tool::Tracker::default(),
             dialect: polepatch_nc::detect_dialect(original),
             i: 0,
