@@ -386,9 +386,15 @@ struct Pending {
 /// What the rounding of the written words adds to a [`Pending`] tolerance.
 #[derive(Clone, Copy)]
 enum Rounding {
-    /// A point: the X Y Z words' half units (in inch, times 25.4), and a ball's centre
+    /// A point: the half units of the X Y Z words whose value the patched block changed
+    /// (`rewritten`; an axis written as it was has no rounding to allow: a word restated
+    /// with its own value, or carried, is exact), in inch times 25.4, and a ball's centre
     /// (radius `radius_mm`, 0 for a point on the axis) turned by the rotary words'.
-    Linear { inch: bool, radius_mm: f64 },
+    Linear {
+        inch: bool,
+        radius_mm: f64,
+        rewritten: [bool; 3],
+    },
     /// An angle: the rotary words' half units, degrees.
     Rotary,
 }
@@ -772,11 +778,20 @@ impl<'a> Comparison<'a> {
         })
     }
 
-    /// How far rounding moves a reference point on one side, mm: the X Y Z words' half
-    /// units, and a ball's centre turned by the rotary words' half units.
-    fn rounding_mm(&self, dec: &[usize; 5], inch: bool, radius_mm: f64) -> f64 {
+    /// How far rounding moves a reference point on one side, mm: the half units of the
+    /// X Y Z words the patch rewrote (`rewritten`), and a ball's centre turned by the
+    /// rotary words' half units. (An integer-valued program's half unit is 0.5 mm: allowed
+    /// on every axis, a point could move 0.87 mm unseen.)
+    fn rounding_mm(
+        &self,
+        dec: &[usize; 5],
+        inch: bool,
+        radius_mm: f64,
+        rewritten: [bool; 3],
+    ) -> f64 {
         let unit = if inch { 25.4 } else { 1.0 };
         let xyz = (0..3)
+            .filter(|&k| rewritten[k])
             .map(|k| (half_unit(dec[k]) * unit).powi(2))
             .sum::<f64>()
             .sqrt();
@@ -892,6 +907,7 @@ impl<'a> Comparison<'a> {
                 rounding: Rounding::Linear {
                     inch: o.state.inch,
                     radius_mm: 0.0,
+                    rewritten: std::array::from_fn(|k| qo[k] != qp[k]),
                 },
                 message: format!(
                     "the positioning move's target X{:.4} Y{:.4} Z{:.4} became X{:.4} Y{:.4} \
@@ -928,6 +944,7 @@ impl<'a> Comparison<'a> {
             rounding: Rounding::Linear {
                 inch: o.state.inch,
                 radius_mm: radius,
+                rewritten: std::array::from_fn(|k| qo[k] != qp[k]),
             },
             message: format!(
                 "{what} moved {d:.4} mm: ({:.4}, {:.4}, {:.4}) became ({:.4}, {:.4}, {:.4}){}",
@@ -1143,9 +1160,11 @@ impl<'a> Comparison<'a> {
     fn finish(&mut self) {
         for p in std::mem::take(&mut self.pending) {
             let room = match p.rounding {
-                Rounding::Linear { inch, radius_mm } => {
-                    self.rounding_mm(&self.dec_p, inch, radius_mm)
-                }
+                Rounding::Linear {
+                    inch,
+                    radius_mm,
+                    rewritten,
+                } => self.rounding_mm(&self.dec_p, inch, radius_mm, rewritten),
                 Rounding::Rotary => half_unit(self.dec_p[3]) + half_unit(self.dec_p[4]),
             };
             let tol = p.base + room;
