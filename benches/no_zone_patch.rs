@@ -14,10 +14,7 @@ const SIZE: usize = 20 << 20;
 fn no_zone(c: &mut Criterion) {
     let machine = Machine::builtin("mikron-hsm600").expect("built-in machine");
     let primary = machine.primary_letter();
-    let opts = PatchOptions {
-        name: "bench".into(),
-        ..PatchOptions::default()
-    };
+    let opts = PatchOptions::named("bench");
     let mut g = c.benchmark_group("no_zone_patch");
     g.sample_size(10);
     for (name, style) in [("heidenhain", Style::Heidenhain), ("fanuc", Style::Fanuc)] {

@@ -418,8 +418,9 @@ unsafe fn options(opts: *const PpOptions) -> Result<polepatch::PatchOptions, Fai
     };
     p.allow_c_offset = o.allow_c_offset;
     p.tcy_s = (o.tcy_ms != 0.0).then_some(o.tcy_ms / 1000.0);
-    out.feed_fallback_mm_min = (o.feed_fallback_mm_min > 0.0).then_some(o.feed_fallback_mm_min);
-    out.work_offset_mm = o.has_work_offset.then_some(o.work_offset_mm);
+    out.read.feed_fallback_mm_min =
+        (o.feed_fallback_mm_min > 0.0).then_some(o.feed_fallback_mm_min);
+    out.read.work_offset_mm = o.has_work_offset.then_some(o.work_offset_mm);
     out.tool = tool_options(o)?;
     // The patcher's one rule set, its refusal naming the struct member.
     out.patch
@@ -427,7 +428,7 @@ unsafe fn options(opts: *const PpOptions) -> Result<polepatch::PatchOptions, Fai
         .map_err(|e| bad(e.message(&c_member(e.field))))?;
     if !o.name.is_null() {
         // SAFETY: non-NULL and NUL-terminated (header contract).
-        out.name = unsafe { c_str(o.name, "opts.name") }?.to_string();
+        out.read.name = unsafe { c_str(o.name, "opts.name") }?.to_string();
     }
     Ok(out)
 }
@@ -583,10 +584,7 @@ pub unsafe extern "C" fn pp_simulate_nc(
         // SAFETY: non-NULL, a live machine (header contract).
         let machine = unsafe { &(*m).0 };
         let mut sim = polepatch::SimulateOptions {
-            feed_fallback_mm_min: o.feed_fallback_mm_min,
-            name: o.name,
-            work_offset_mm: o.work_offset_mm,
-            inch: o.inch,
+            read: o.read,
             ..polepatch::SimulateOptions::default()
         };
         sim.sim.tcy_s = o.patch.tcy_s;

@@ -78,10 +78,7 @@ fn patch_nc_through_the_abi_is_the_library_on_every_fixture() {
             let status = unsafe {
                 pp_patch_nc(m, bytes.as_ptr(), bytes.len(), &opts, &mut out, &mut report)
             };
-            let lib_opts = polepatch::PatchOptions {
-                name: label.clone(),
-                ..polepatch::PatchOptions::default()
-            };
+            let lib_opts = polepatch::PatchOptions::named(label.clone());
             match polepatch::patch_nc(&bytes, &rust_machine, &lib_opts) {
                 Ok((want, want_report)) => {
                     assert_eq!(status, PpStatus::PpOk, "{label}: {}", last_error());
@@ -556,7 +553,10 @@ fn tool_options_through_the_abi_are_the_librarys() {
             unsafe { pp_patch_nc(m, bytes.as_ptr(), bytes.len(), &opts, &mut out, &mut report) };
         assert_eq!(status, PpStatus::PpOk, "{spec}: {}", last_error());
         let lib_opts = polepatch::PatchOptions {
-            name: name.into(),
+            read: polepatch::ReadOptions {
+                name: name.into(),
+                ..polepatch::ReadOptions::default()
+            },
             tool: ToolOptions {
                 tool: Some(Tool::parse(spec).unwrap()),
                 point: lib_point,

@@ -71,7 +71,10 @@ fn expected_with(
 ) -> (Vec<u8>, String) {
     let m = Machine::builtin(machine).unwrap();
     let opts = polepatch::PatchOptions {
-        name: name.into(),
+        read: polepatch::ReadOptions {
+            name: name.into(),
+            ..polepatch::ReadOptions::default()
+        },
         tool,
         ..polepatch::PatchOptions::default()
     };

@@ -535,12 +535,14 @@ pub fn bench_program(
         .sum();
     let zones = analysis_zones(lp, machine, &opts.patch);
     // The simulated time of the runs with a zone (as `time_s`), of a program's bytes.
+    // As the bench reads its programs (`load_nc`: a program without units in mm).
     let sim_opts = polepatch::SimulateOptions {
-        name: lp.name.clone(),
-        feed_fallback_mm_min: opts.feed_fallback_mm_min,
-        work_offset_mm: None,
-        // As the bench reads its programs (`load_nc`: a program without units in mm).
-        inch: false,
+        read: polepatch::ReadOptions {
+            name: lp.name.clone(),
+            feed_fallback_mm_min: opts.feed_fallback_mm_min,
+            work_offset_mm: None,
+            inch: false,
+        },
         sim: polepatch::sim::SimOptions {
             tcy_s: opts.patch.tcy_s,
             ..Default::default()
@@ -570,12 +572,14 @@ pub fn bench_program(
             &lp.program.bytes,
             machine,
             &polepatch::PatchOptions {
+                read: polepatch::ReadOptions {
+                    feed_fallback_mm_min: opts.feed_fallback_mm_min,
+                    name: lp.name.clone(),
+                    ..polepatch::ReadOptions::default()
+                },
                 patch: popts,
-                feed_fallback_mm_min: opts.feed_fallback_mm_min,
-                name: lp.name.clone(),
                 chord_tolerance_mm: lp.chord_tolerance_mm,
                 tool: lp.tool.clone(),
-                ..polepatch::PatchOptions::default()
             },
         )?;
         let patch_time_ms = t0.elapsed().as_secs_f64() * 1e3;

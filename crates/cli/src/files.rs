@@ -101,10 +101,8 @@ pub fn patch_job(
         path: target.path.display().to_string(),
         cause,
     };
-    let opts = polepatch::PatchOptions {
-        name,
-        ..opts.clone()
-    };
+    let mut opts = opts.clone();
+    opts.read.name = name;
     let like = (!outputs::is_std(input)).then_some(input);
     let mut sink = target.create(like).map_err(write_err)?;
     // With `simulate`, the output is kept as it is written.
@@ -163,10 +161,7 @@ fn simulated(
     opts: &polepatch::PatchOptions,
 ) {
     let sim_opts = polepatch::SimulateOptions {
-        name: opts.name.clone(),
-        feed_fallback_mm_min: opts.feed_fallback_mm_min,
-        work_offset_mm: opts.work_offset_mm,
-        inch: opts.inch,
+        read: opts.read.clone(),
         sim: polepatch::sim::SimOptions {
             tcy_s: opts.patch.tcy_s,
             ..Default::default()

@@ -9,7 +9,7 @@
 //! warnings on standard error; exit 1 on a program or machine polepatch refuses, 2 with
 //! `--strict` when a zone stays below feed or a run near the pole could not be analysed.
 
-use crate::{PatchArgs, machine, parse_xyz};
+use crate::{PatchArgs, machine};
 use anyhow::{Context, Result};
 use polepatch::patcher::PatchOptions;
 use polepatch_cli::files;
@@ -26,27 +26,21 @@ pub(crate) struct FilterArgs {
     /// Machine: a built-in name (mikron-ucp710, mikron-hsm600) or a TOML file.
     #[arg(long, short)]
     machine: String,
-    /// Feed in mm/min for runs with no F in force.
-    #[arg(long)]
-    feed: Option<f64>,
+    /// How the program is read: --feed, --units, --work-offset (as `patch`).
+    #[command(flatten)]
+    read: crate::ReadArgs,
     /// Singular cone, degrees (as `patch`). Default: a 5° cone and the pole reach.
     #[arg(long)]
     cone: Option<f64>,
     /// Pole reach, degrees (as `patch`). Default 10; with --cone, the cone.
     #[arg(long)]
     pole_reach: Option<f64>,
-    /// Units of a program that states none (as `patch`): mm unless said.
-    #[arg(long, value_enum)]
-    units: Option<crate::UnitsArg>,
     /// Largest orientation change allowed at any point, degrees (as `patch`).
     #[arg(long)]
     max_deviation: Option<f64>,
     /// Change C only, never the primary axis (G16's method).
     #[arg(long)]
     only_c: bool,
-    /// Work offset X,Y,Z (mm) for a machine with a kinematic chain (as `patch`).
-    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z", allow_hyphen_values = true)]
-    work_offset: Option<[f64; 3]>,
     /// Refuse the program (exit 2, nothing loaded) if a zone stays below feed or a run
     /// near the pole could not be analysed.
     #[arg(long)]
@@ -70,10 +64,9 @@ impl FilterArgs {
             report: self.report.clone(),
             csv: None,
             strict: self.strict,
-            feed: self.feed,
+            read: self.read.clone(),
             cone: self.cone,
             pole_reach: self.pole_reach,
-            units: self.units,
             max_deviation: self.max_deviation,
             margin: PatchOptions::default().margin,
             max_decimals: PatchOptions::default().max_decimals,
@@ -83,7 +76,6 @@ impl FilterArgs {
             c_offset: false,
             jobs: None,
             simulate: false,
-            work_offset: self.work_offset,
             chord_tolerance: polepatch::machine_frame::CHORD_TOLERANCE_MM,
             tool: self.tool.clone(),
         }
@@ -109,7 +101,8 @@ pub(crate) fn run(args: FilterArgs) -> Result<ExitCode> {
     };
     let name = files::shown(&args.file);
     let bytes = files::read(&args.file)?;
-    let opts = polepatch::PatchOptions { name, ..opts };
+    let mut opts = opts;
+    opts.read.name = name;
     // Progress in whole percent, each value once, as LinuxCNC reads it.
     let last = Mutex::new(None::<usize>);
     let progress = |done: usize, total: usize| {

@@ -50,7 +50,7 @@ struct Report {
 pub(crate) fn run(
     programs: &[PathBuf],
     machine_name: &str,
-    feed: Option<f64>,
+    read: &crate::ReadArgs,
     tcy_s: Option<f64>,
     json: bool,
 ) -> Result<ExitCode> {
@@ -66,7 +66,11 @@ pub(crate) fn run(
         let bytes = files::read(program)?;
         // The whole program is parsed here (this option is for checking a prediction, not
         // for files of gigabytes).
-        let lp = polepatch::load_nc(&bytes, &name, &machine, feed)?;
+        let opts = polepatch::AnalyzeOptions {
+            read: read.options(name.clone())?,
+            ..polepatch::AnalyzeOptions::default()
+        };
+        let lp = polepatch::load_nc_with(&bytes, &machine, &opts)?;
         let mut report = Report {
             file: name,
             machine: machine.name.clone(),

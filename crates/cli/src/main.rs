@@ -93,9 +93,9 @@ pub(crate) struct PatchArgs {
     /// be analysed (no feed, invalid values).
     #[arg(long)]
     pub(crate) strict: bool,
-    /// Feed in mm/min for runs with no F in force.
-    #[arg(long)]
-    pub(crate) feed: Option<f64>,
+    /// How the program is read: --feed, --units, --work-offset.
+    #[command(flatten)]
+    pub(crate) read: ReadArgs,
     /// A fixed singular cone, degrees: a stretch where C is below feed is a zone when its
     /// primary axis comes within it, and no other. Default: a 5° cone, and out to
     /// --pole-reach the stretches whose slowdown the pole dominates (docs/method.md).
@@ -141,11 +141,6 @@ pub(crate) struct PatchArgs {
     /// simulating both).
     #[arg(long)]
     pub(crate) simulate: bool,
-    /// Work offset X,Y,Z (mm, machine coordinates of the program's zero) for a machine
-    /// with a kinematic chain, where the program only names it (G54); default: the
-    /// program's datum shift (Heidenhain G54 X Y Z).
-    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z", allow_hyphen_values = true)]
-    pub(crate) work_offset: Option<[f64; 3]>,
     /// With a kinematic chain, for runs without TCPM: how far the tool tip may leave the
     /// programmed line between two points of a rewritten block, mm (the controller
     /// interpolates every axis linearly there); a run that would exceed it — and its
@@ -155,11 +150,42 @@ pub(crate) struct PatchArgs {
     /// The cutter and the point X Y Z state.
     #[command(flatten)]
     pub(crate) tool: ToolArgs,
+}
+
+/// How a program is read: one group of flags, declared once, which every subcommand that
+/// reads an NC program flattens into its arguments (`patch`, `analyze`, `simulate`,
+/// `verify`, `filter`); [`ReadArgs::options`] makes the library's [`polepatch::ReadOptions`]
+/// of them once.
+#[derive(clap::Args, Clone, Default)]
+#[command(allow_negative_numbers = true)]
+pub(crate) struct ReadArgs {
+    /// Feed in mm/min for runs with no F in force.
+    #[arg(long)]
+    pub(crate) feed: Option<f64>,
     /// Units of a program that states none (no G20/G21, G70/G71, BEGIN PGM … MM|INCH):
     /// nothing in the file tells inches from mm, so say it (default mm; the report says
     /// which was assumed).
     #[arg(long, value_enum)]
     pub(crate) units: Option<UnitsArg>,
+    /// Work offset X,Y,Z (mm, machine coordinates of the program's zero) for a machine
+    /// with a kinematic chain, where the program only names it (G54); default: the
+    /// program's datum shift (Heidenhain G54 X Y Z).
+    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub(crate) work_offset: Option<[f64; 3]>,
+}
+
+impl ReadArgs {
+    /// The library's reading options for an input called `name` (`--feed` checked: a bad
+    /// value is a usage error).
+    pub(crate) fn options(&self, name: String) -> Result<polepatch::ReadOptions> {
+        check_positive("--feed", self.feed)?;
+        Ok(polepatch::ReadOptions {
+            name,
+            feed_fallback_mm_min: self.feed,
+            work_offset_mm: self.work_offset,
+            inch: self.units == Some(UnitsArg::Inch),
+        })
+    }
 }
 
 /// The cutter and the point of it X Y Z state: one group of flags, declared once, which
@@ -232,9 +258,9 @@ struct AnalyzeArgs {
     /// Machine: a built-in name (mikron-ucp710, mikron-hsm600) or a TOML file.
     #[arg(long, short)]
     machine: String,
-    /// Feed in mm/min for runs with no F in force.
-    #[arg(long)]
-    feed: Option<f64>,
+    /// How the program is read: --feed, --units, --work-offset.
+    #[command(flatten)]
+    read: ReadArgs,
     /// A fixed singular cone, degrees (see `patch`). Default: a 5° cone and the pole reach.
     #[arg(long)]
     cone: Option<f64>,
@@ -244,16 +270,10 @@ struct AnalyzeArgs {
     /// Print one JSON document instead of the table.
     #[arg(long)]
     json: bool,
-    /// Work offset X,Y,Z (mm) for a machine with a kinematic chain (see `patch`).
-    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z", allow_hyphen_values = true)]
-    work_offset: Option<[f64; 3]>,
     /// Exit with status 2 when a run or lines could not be analysed (no feed, expressions,
     /// arcs or skippable blocks near the pole, …).
     #[arg(long)]
     strict: bool,
-    /// Units of a program that states none (see `patch`). Default mm.
-    #[arg(long, value_enum)]
-    units: Option<UnitsArg>,
 }
 
 /// `X,Y,Z` as three finite numbers.
@@ -419,20 +439,17 @@ pub(crate) fn check_positive(name: &str, v: Option<f64>) -> Result<()> {
 }
 
 fn analyze(args: AnalyzeArgs) -> Result<ExitCode> {
-    check_positive("--feed", args.feed)?;
+    let name = args.file.display().to_string();
+    let read = args.read.options(name.clone())?;
     let (cone_deg, pole_reach_deg) = cone_and_reach(args.cone, args.pole_reach)?;
     let machine = machine(&args.machine)?;
-    let name = args.file.display().to_string();
     let opts = polepatch::AnalyzeOptions {
+        read,
         analysis: AnalysisOptions {
             cone_deg,
             pole_reach_deg,
             ..AnalysisOptions::default()
         },
-        feed_fallback_mm_min: args.feed,
-        name: name.clone(),
-        work_offset_mm: args.work_offset,
-        inch: args.units == Some(UnitsArg::Inch),
     };
     let bytes = files::read(&args.file)?;
     let args_strict = args.strict;

@@ -16,7 +16,6 @@ use std::process::ExitCode;
 /// ([`PatchOptions::validate`]) and refused as a usage error naming the flag.
 fn options(args: &PatchArgs) -> Result<PatchOptions> {
     let (cone_deg, pole_reach_deg) = crate::cone_and_reach(args.cone, args.pole_reach)?;
-    check_positive("--feed", args.feed)?;
     let opts = PatchOptions {
         cone_deg,
         pole_reach_deg,
@@ -100,14 +99,14 @@ fn expand(inputs: &[PathBuf], skip: Option<&Path>) -> Result<Vec<(PathBuf, PathB
 /// The library's options for `args` (checked: a bad value is a usage error).
 pub(crate) fn file_options(args: &PatchArgs) -> Result<polepatch::PatchOptions> {
     check_positive("--chord-tolerance", Some(args.chord_tolerance))?;
+    let patch = options(args)?;
+    // The name is each file's (files::patch_job sets it).
+    let read = args.read.options(polepatch::ReadOptions::default().name)?;
     Ok(polepatch::PatchOptions {
-        patch: options(args)?,
-        feed_fallback_mm_min: args.feed,
-        work_offset_mm: args.work_offset,
+        read,
+        patch,
         chord_tolerance_mm: args.chord_tolerance,
         tool: args.tool.options()?,
-        inch: args.units == Some(crate::UnitsArg::Inch),
-        ..polepatch::PatchOptions::default()
     })
 }
 

@@ -121,8 +121,11 @@ pub(crate) fn run(args: PostArgs) -> Result<ExitCode> {
         },
         patch: !args.no_patch,
         patch_options: polepatch::PatchOptions {
-            name: name.clone(),
-            feed_fallback_mm_min: args.feed,
+            read: polepatch::ReadOptions {
+                name: name.clone(),
+                feed_fallback_mm_min: args.feed,
+                ..polepatch::ReadOptions::default()
+            },
             tool: args.tool.options()?,
             ..polepatch::PatchOptions::default()
         },

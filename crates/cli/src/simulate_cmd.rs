@@ -2,7 +2,7 @@
 //! to Equation 6's estimate and L/F; the trajectory as CSV; the feed and each axis' share
 //! of its limits along s as SVG (before and after, given two programs).
 
-use crate::{check_positive, machine, parse_xyz};
+use crate::{check_positive, machine};
 use anyhow::{Context, Result, bail};
 use plotters::prelude::*;
 use polepatch::kinematics::{Axis, Machine};
@@ -34,18 +34,12 @@ pub(crate) struct SimulateArgs {
     /// Draw the feed and each axis' share of its limits along s (SVG).
     #[arg(long)]
     plot: Option<PathBuf>,
-    /// Feed in mm/min for runs with no F in force.
-    #[arg(long)]
-    feed: Option<f64>,
+    /// How the program is read: --feed, --units, --work-offset.
+    #[command(flatten)]
+    read: crate::ReadArgs,
     /// Interpolation cycle time override, ms (default: the machine's).
     #[arg(long)]
     tcy_ms: Option<f64>,
-    /// Work offset X,Y,Z (mm) for a machine with a kinematic chain (see `patch`).
-    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z", allow_hyphen_values = true)]
-    work_offset: Option<[f64; 3]>,
-    /// Units of a program that states none (see `patch`). Default mm.
-    #[arg(long, value_enum)]
-    units: Option<crate::UnitsArg>,
     /// The planner: `jerk` (a jerk-limited controller, the default) or `linuxcnc` (a
     /// model of LinuxCNC 2.9's planner: V and A only, each line stopping within itself at
     /// half the acceleration; docs/linuxcnc.md, docs/validation.md).
@@ -122,7 +116,7 @@ impl Binned {
 }
 
 pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
-    check_positive("--feed", args.feed)?;
+    check_positive("--feed", args.read.feed)?;
     crate::check_tcy_ms(args.tcy_ms)?;
     if args.planner == crate::lcnc_planner::Planner::Linuxcnc {
         if args.trajectory.is_some() || args.plot.is_some() {
@@ -139,7 +133,7 @@ pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
         return crate::lcnc_planner::run(
             &args.programs,
             &args.machine,
-            args.feed,
+            &args.read,
             tcy_s,
             args.json,
         );
@@ -175,10 +169,7 @@ pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
         let name = program.display().to_string();
         let bytes = read(program)?;
         let mut opts = SimulateOptions {
-            name: name.clone(),
-            feed_fallback_mm_min: args.feed,
-            work_offset_mm: args.work_offset,
-            inch: args.units == Some(crate::UnitsArg::Inch),
+            read: args.read.options(name.clone())?,
             ..SimulateOptions::default()
         };
         opts.sim.tcy_s = args.tcy_ms.map(|ms| ms / 1000.0);

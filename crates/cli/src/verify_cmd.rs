@@ -1,7 +1,7 @@
 //! `polepatch verify ORIGINAL PATCHED`: the patched program held against its original
 //! ([`polepatch::verify`]), whoever wrote it.
 
-use crate::{PatchArgs, machine, parse_xyz};
+use crate::{PatchArgs, machine};
 use anyhow::Result;
 use polepatch_cli::files;
 use std::io::Write;
@@ -21,9 +21,9 @@ pub(crate) struct VerifyArgs {
     /// Print one JSON document instead of the lines.
     #[arg(long)]
     json: bool,
-    /// Feed in mm/min for runs with no F in force (as `patch`).
-    #[arg(long)]
-    feed: Option<f64>,
+    /// How the programs are read: --feed, --units, --work-offset (as `patch`).
+    #[command(flatten)]
+    read: crate::ReadArgs,
     /// Pole reach, degrees: the safety bound on the orientation change (as `patch`).
     #[arg(long)]
     pole_reach: Option<f64>,
@@ -33,12 +33,6 @@ pub(crate) struct VerifyArgs {
     /// Largest orientation change allowed at any point, degrees (as `patch`).
     #[arg(long)]
     max_deviation: Option<f64>,
-    /// Units of a program that states none (as `patch`): mm unless said.
-    #[arg(long, value_enum)]
-    units: Option<crate::UnitsArg>,
-    /// Work offset X,Y,Z (mm) for a machine with a kinematic chain (as `patch`).
-    #[arg(long, value_parser = parse_xyz, value_name = "X,Y,Z", allow_hyphen_values = true)]
-    work_offset: Option<[f64; 3]>,
     /// The cutter and the point X Y Z state (as `patch`): give them as `patch` was given.
     #[command(flatten)]
     tool: crate::ToolArgs,
@@ -55,7 +49,7 @@ impl VerifyArgs {
             report: None,
             csv: None,
             strict: false,
-            feed: self.feed,
+            read: self.read.clone(),
             cone: self.cone,
             pole_reach: self.pole_reach,
             max_deviation: self.max_deviation,
@@ -67,10 +61,8 @@ impl VerifyArgs {
             c_offset: false,
             jobs: None,
             simulate: false,
-            work_offset: self.work_offset,
             chord_tolerance: polepatch::machine_frame::CHORD_TOLERANCE_MM,
             tool: self.tool.clone(),
-            units: self.units,
         }
     }
 }
@@ -80,7 +72,7 @@ pub(crate) fn run(args: VerifyArgs) -> Result<ExitCode> {
     let machine = machine(&args.machine)?;
     let original = files::read(&args.original)?;
     let patched = files::read(&args.patched)?;
-    opts.name = args.patched.display().to_string();
+    opts.read.name = args.patched.display().to_string();
     let report = polepatch::verify::verify_nc(
         &original,
         &patched,

@@ -254,7 +254,10 @@ fn the_printed_report_is_the_librarys() {
         (feedless.display().to_string(), 0),
     ] {
         let opts = polepatch::AnalyzeOptions {
-            name: file.clone(),
+            read: polepatch::ReadOptions {
+                name: file.clone(),
+                ..polepatch::ReadOptions::default()
+            },
             ..polepatch::AnalyzeOptions::default()
         };
         let bytes = std::fs::read(root().join(&file)).unwrap();

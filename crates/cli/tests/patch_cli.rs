@@ -258,10 +258,7 @@ fn the_cli_writes_what_the_library_returns() {
                 "--report",
                 report.to_str().unwrap(),
             ]);
-            let opts = polepatch::PatchOptions {
-                name: file.into(),
-                ..polepatch::PatchOptions::default()
-            };
+            let opts = polepatch::PatchOptions::named(file);
             let m = polepatch::kinematics::Machine::builtin(machine).unwrap();
             let library =
                 polepatch::patch_nc(&std::fs::read(root().join(file)).unwrap(), &m, &opts);

@@ -353,7 +353,7 @@ mod tests {
     }
 
     use super::*;
-    use crate::load_nc;
+    use crate::stream::load_nc;
     use polepatch_kinematics::Machine;
 
     fn poses(text: &str) -> Vec<EndPose> {

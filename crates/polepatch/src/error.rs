@@ -122,9 +122,19 @@ pub enum Error {
     /// [`crate::patch_nc_to`]).
     #[error("cannot write the output: {0}")]
     Output(std::io::Error),
-    /// Bad options (a value out of range), named.
+    /// Bad options (a value out of range, or values that mean nothing together), with the
+    /// field named.
     #[error("{0}")]
-    Options(String),
+    Options(OptionError),
+    /// A machine polepatch cannot work with as described (a layout not supported yet, a
+    /// controller code or an auxiliary axis that cannot be read).
+    #[error("machine {machine}: {message}")]
+    Machine {
+        /// The machine's name.
+        machine: String,
+        /// What is wrong with it.
+        message: String,
+    },
     /// Memory for `what` could not be allocated.
     #[error("not enough memory for {what} of a program of {bytes} bytes")]
     OutOfMemory {
@@ -173,7 +183,63 @@ pub enum Error {
     Cancelled,
 }
 
+/// An option refused: which field (as the caller spells it: a struct member such as
+/// `cone_deg`, or a flag such as `--ignore`) and the whole message, which names it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct OptionError {
+    /// The field refused.
+    pub field: String,
+    /// The message, naming the field, the rule and the value.
+    pub message: String,
+}
+
+impl OptionError {
+    /// `field` refused; `rest` follows its name in the message (`{field} {rest}`).
+    pub fn new(field: &str, rest: impl std::fmt::Display) -> Self {
+        OptionError {
+            field: field.to_string(),
+            message: format!("{field} {rest}"),
+        }
+    }
+
+    /// `field` refused with a message of its own (which should name it).
+    pub fn with_message(field: &str, message: impl Into<String>) -> Self {
+        OptionError {
+            field: field.to_string(),
+            message: message.into(),
+        }
+    }
+
+    /// The patcher's refusal, its field by its Rust name.
+    pub fn of_patcher(e: &polepatch_patcher::OptionsError) -> Self {
+        OptionError {
+            field: e.field.name().to_string(),
+            message: e.to_string(),
+        }
+    }
+}
+
+impl std::fmt::Display for OptionError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl From<OptionError> for Error {
+    fn from(e: OptionError) -> Self {
+        Error::Options(e)
+    }
+}
+
 impl Error {
+    /// A machine refused: `machine` named, `message` what is wrong.
+    pub(crate) fn machine(machine: &str, message: impl Into<String>) -> Self {
+        Error::Machine {
+            machine: machine.to_string(),
+            message: message.into(),
+        }
+    }
+
     /// The program was read but holds nothing to analyse: no G1 motion, no rotary word in
     /// any G1 run, or every G1 move written with expressions. `patch` writes such a program
     /// unchanged and `analyze` reports no run, each with this error as a warning (a folder

@@ -171,7 +171,7 @@ pub struct JointsPatch {
 /// `p_decimals` are set to it). The first and the last point keep their values (what
 /// comes before and after the run is not known here).
 ///
-/// Errors: bad options ([`crate::check_patcher_options`]) and the refusals of
+/// Errors: bad options ([`crate::options::check_patcher_options`]) and the refusals of
 /// [`joints_path`].
 pub fn patch_joints(
     machine: &Machine,
@@ -179,7 +179,7 @@ pub fn patch_joints(
     feed_mm_min: f64,
     opts: &PatchOptions,
 ) -> Result<JointsPatch, Error> {
-    crate::check_patcher_options(opts)?;
+    crate::options::check_patcher_options(opts)?;
     let path = joints_path(xyzpc, feed_mm_min)?;
     let opts = PatchOptions {
         c_decimals: opts.max_decimals,
@@ -266,7 +266,7 @@ mod tests {
         };
         assert!(matches!(
             patch_joints(&m, &two, 1000.0, &bad),
-            Err(Error::Options(msg)) if msg.contains("margin")
+            Err(Error::Options(e)) if e.field == "margin"
         ));
     }
 

@@ -51,7 +51,7 @@ pub struct PostOptions {
     /// gives them.
     pub patch: bool,
     /// Options of the patch (name, feed fallback for points without a feed, …).
-    pub patch_options: crate::PatchOptions,
+    pub patch_options: crate::options::PatchOptions,
     /// Decimals of rotary words. Default 3.
     pub rotary_decimals: usize,
     /// Decimals of linear words in mm (inch output writes one more). Default 3.
@@ -71,7 +71,7 @@ impl Default for PostOptions {
             dialect: Dialect::Heidenhain,
             branch: BranchRule::Nearest,
             patch: true,
-            patch_options: crate::PatchOptions::default(),
+            patch_options: crate::options::PatchOptions::default(),
             rotary_decimals: 3,
             linear_decimals: 3,
             units: None,
@@ -117,7 +117,9 @@ pub fn read_cl_for_post(
     machine: &Machine,
     opts: &PostOptions,
 ) -> Result<ClProgram, Error> {
-    parse.check().map_err(Error::Options)?;
+    parse
+        .check()
+        .map_err(|m| Error::Options(crate::error::OptionError::with_message("parse", m)))?;
     let asked: Vec<String> = parse
         .ignore
         .iter()
@@ -148,10 +150,10 @@ pub fn read_cl_for_post(
                     .iter()
                     .find(|w| posted(w) && !skip.contains(w) && cl.records.contains_key(*w))
                 {
-                    return Err(Error::Options(format!(
+                    return Err(crate::error::OptionError::with_message("--ignore", format!(
                         "--ignore {w}: polepatch posts the {} {w} record(s) of {name}; only records it refuses in the file can be skipped",
                         cl.records[w]
-                    )));
+                    )).into());
                 }
                 for (w, why) in refusals {
                     if let Some(s) = cl.skipped.get_mut(&w) {
@@ -271,7 +273,7 @@ fn comp_refusal(name: &str, line: usize, column: usize, message: String) -> Erro
 
 impl Poster<'_> {
     fn name(&self) -> &str {
-        &self.opts.patch_options.name
+        &self.opts.patch_options.read.name
     }
 
     /// An error at CL point `p`'s record.
@@ -360,7 +362,7 @@ impl Poster<'_> {
     /// The feed of a feed move, or the error naming its line.
     fn feed(&self, p: &ClPoint) -> Result<f64, Error> {
         p.feed_mm_min
-            .or(self.opts.patch_options.feed_fallback_mm_min)
+            .or(self.opts.patch_options.read.feed_fallback_mm_min)
             .ok_or_else(|| {
                 self.at_point(
                     p,
@@ -755,10 +757,14 @@ pub fn post_items(
     opts: &PostOptions,
 ) -> Result<Vec<Item>, Error> {
     if !(opts.arc_tolerance_mm.is_finite() && (1e-6..=1.0).contains(&opts.arc_tolerance_mm)) {
-        return Err(Error::Options(format!(
-            "arc tolerance {} mm must be within 0.000001…1 mm",
-            opts.arc_tolerance_mm
-        )));
+        return Err(crate::error::OptionError::with_message(
+            "arc_tolerance_mm",
+            format!(
+                "arc tolerance {} mm must be within 0.000001…1 mm",
+                opts.arc_tolerance_mm
+            ),
+        )
+        .into());
     }
     let mut p = Poster {
         machine,
@@ -898,10 +904,11 @@ pub fn post_cl(
     opts: &PostOptions,
 ) -> Result<(Vec<u8>, Option<FileReport>), Error> {
     if opts.dialect == Dialect::MillPlus {
-        return Err(Error::Options(
-            "MillPlus programs are read, not written: post for heidenhain, sinumerik or fanuc"
-                .into(),
-        ));
+        return Err(crate::error::OptionError::with_message(
+            "dialect",
+            "MillPlus programs are read, not written: post for heidenhain, sinumerik or fanuc",
+        )
+        .into());
     }
     let inch = opts.units.unwrap_or(cl.units) == Units::Inch;
     if inch
@@ -914,12 +921,13 @@ pub fn post_cl(
         // At the CL file's units record when the inches are the file's, else the option's.
         return Err(match (opts.units, cl.units_at) {
             (None, Some(at)) => cl_error(
-                &opts.patch_options.name,
+                &opts.patch_options.read.name,
                 at.line,
                 at.column,
                 format!("the CL file is in inches (this record): {why}"),
             ),
-            _ => Error::Options(format!("--units inch: {why}")),
+            _ => crate::error::OptionError::with_message("units", format!("--units inch: {why}"))
+                .into(),
         });
     }
     let items = post_items(cl, machine, opts)?;
@@ -933,7 +941,7 @@ pub fn post_cl(
         .to_string();
     let mut comments = vec![format!(
         "posted by polepatch for {} from {}",
-        machine.name, opts.patch_options.name
+        machine.name, opts.patch_options.read.name
     )];
     for (w, n) in &cl.skipped {
         comments.push(format!(
@@ -946,12 +954,14 @@ pub fn post_cl(
     let Some(letters) =
         polepatch_nc::RotaryLetters::new(p as u8, c as u8).filter(|_| p.is_ascii() && c.is_ascii())
     else {
-        return Err(Error::Options(format!(
-            "machine {}: its rotary axes are called {p} and {c}; post writes rotary words A, B \
-             and C so far (issue 29), so it would write words for axes the machine does not \
-             have",
-            machine.name,
-        )));
+        return Err(Error::machine(
+            &machine.name,
+            format!(
+                "its rotary axes are called {p} and {c}; post writes rotary words A, B \
+                 and C so far (issue 29), so it would write words for axes the machine does not \
+                 have"
+            ),
+        ));
     };
     let bytes = emit(
         &items,
@@ -977,11 +987,11 @@ pub fn post_cl(
             patch_options.to_mut().tool.cl = tools;
         }
     }
-    match crate::patch_nc(&bytes, machine, &patch_options) {
+    match crate::entry::patch_nc(&bytes, machine, &patch_options) {
         Ok((out, mut report)) => {
             report
                 .warnings
-                .extend(skip_notes(cl, &opts.patch_options.name));
+                .extend(skip_notes(cl, &opts.patch_options.read.name));
             list_inserts(
                 cl,
                 &items,
@@ -995,7 +1005,7 @@ pub fn post_cl(
         Err(Error::Parse(e)) if insert_at(cl, &bytes, e.line).is_some() => {
             let (text, at) = insert_at(cl, &bytes, e.line).expect("matched");
             Err(cl_error(
-                &opts.patch_options.name,
+                &opts.patch_options.read.name,
                 at.line,
                 at.column,
                 format!(

@@ -101,11 +101,13 @@ pub fn check_layout(machine: &Machine) -> Result<RotaryLetters, Error> {
     let (p, c) = (machine.primary_letter(), machine.c_letter());
     match RotaryLetters::new(p as u8, c as u8) {
         Some(letters) if p.is_ascii() && c.is_ascii() => Ok(letters),
-        _ => Err(Error::Options(format!(
-            "machine {}: its rotary axes are called {p} and {c}; polepatch reads programs \
-             with rotary words A, B and C so far (issue 29)",
-            machine.name
-        ))),
+        _ => Err(Error::machine(
+            &machine.name,
+            format!(
+                "its rotary axes are called {p} and {c}; polepatch reads programs \
+                 with rotary words A, B and C so far (issue 29)"
+            ),
+        )),
     }
 }
 
@@ -138,13 +140,15 @@ fn auxiliary_letters(machine: &Machine) -> Result<Vec<u8>, Error> {
                 {
                     Ok(*c)
                 }
-                _ => Err(Error::Options(format!(
-                    "machine {}: [controller] auxiliary_axes: '{a}' is not one letter other than \
+                _ => Err(Error::machine(
+                    &machine.name,
+                    format!(
+                        "[controller] auxiliary_axes: '{a}' is not one letter other than \
                      X Y Z, {} and {} (the axes the machine moves)",
-                    machine.name,
-                    machine.primary_letter(),
-                    machine.c_letter()
-                ))),
+                        machine.primary_letter(),
+                        machine.c_letter()
+                    ),
+                )),
             }
         })
         .collect()
@@ -161,10 +165,7 @@ pub fn read_options_with(
         list.iter()
             .map(|c| {
                 polepatch_nc::Code::parse(c).map_err(|e| {
-                    Error::Options(format!(
-                        "machine {}: [controller] {field}: {e}",
-                        machine.name
-                    ))
+                    Error::machine(&machine.name, format!("[controller] {field}: {e}"))
                 })
             })
             .collect::<Result<Vec<_>, _>>()
@@ -252,7 +253,7 @@ pub struct LoadedProgram {
     /// Things the user should know (e.g. primary-letter substitution).
     pub warnings: Vec<String>,
     /// Chord tolerance for runs patched through the kinematic chain, mm (default
-    /// [`crate::machine_frame::CHORD_TOLERANCE_MM`]; see [`crate::PatchOptions`]).
+    /// [`crate::machine_frame::CHORD_TOLERANCE_MM`]; see [`crate::options::PatchOptions`]).
     pub chord_tolerance_mm: f64,
     /// What the rest of the file says about `program`, a stretch of it
     /// (the one reader's stretch; the whole file is one stretch).
@@ -260,7 +261,7 @@ pub struct LoadedProgram {
     /// What the reader carried through without analysing; empty for a
     /// stretch (the stream lists it once for the file).
     pub notes: crate::notes::Notes,
-    /// The caller's tool options ([`crate::PatchOptions::tool`]).
+    /// The caller's tool options ([`crate::options::PatchOptions::tool`]).
     pub tool: crate::tool::ToolOptions,
     /// The machine's distance from the pole.
     pub(crate) pole: PoleDistance,

@@ -39,9 +39,9 @@
 
 use crate::analyze::analyze_program;
 use crate::error::Error;
-use crate::load_nc;
 use crate::program::LoadedProgram;
 use crate::report::AnalyzeReport;
+use crate::stream::load_nc;
 use polepatch_kinematics::inverse::unwrap_near_deg;
 use polepatch_kinematics::{
     BranchRule, IkSolution, JigRotation, Machine, forward, inverse, inverse_path_from,
@@ -170,12 +170,12 @@ fn standard_only(machine: &Machine) -> Result<(), Error> {
     if machine.standard_form().is_some() {
         return Ok(());
     }
-    Err(Error::Options(format!(
-        "machine {}: reorient works on pairs with the pole axis along Z and the tilting axis \
+    Err(Error::machine(
+        &machine.name,
+        "reorient works on pairs with the pole axis along Z and the tilting axis \
          about X or Y so far (issue 29); this pair has an inclined axis or a tool not along Z \
          at zero",
-        machine.name
-    )))
+    ))
 }
 
 /// The edits that reorient `lp` by `tilt`, and the lines of moves with TCPM off.
@@ -464,11 +464,13 @@ pub fn program_figures(
 
 /// The analysis options of a cone, checked; and the pivot, checked.
 fn analysis_options(cone_deg: f64, pivot_mm: [f64; 3]) -> Result<AnalysisOptions, Error> {
-    crate::positive("cone_deg", "degrees", cone_deg)?;
+    crate::options::positive("cone_deg", "degrees", cone_deg)?;
     if pivot_mm.iter().any(|v| !v.is_finite()) {
-        return Err(Error::Options(format!(
-            "pivot_mm must be three finite numbers of mm, got {pivot_mm:?}"
-        )));
+        return Err(crate::error::OptionError::new(
+            "pivot_mm",
+            format_args!("must be three finite numbers of mm, got {pivot_mm:?}"),
+        )
+        .into());
     }
     Ok(AnalysisOptions {
         cone_deg,
@@ -514,16 +516,19 @@ pub fn check_tilt(tilt: &Tilt) -> Result<(), Error> {
         ("θz", tilt.theta_z_deg, MAX_THETA_Z_DEG),
     ] {
         if !(v.is_finite() && v.abs() <= max) {
-            return Err(Error::Options(format!(
-                "{name} = {v:?}° is outside the accepted range −{max}° to {max}°"
-            )));
+            return Err(crate::error::OptionError::new(
+                name,
+                format_args!("= {v:?}° is outside the accepted range −{max}° to {max}°"),
+            )
+            .into());
         }
     }
     if tilt.pivot_mm.iter().any(|v| !v.is_finite()) {
-        return Err(Error::Options(format!(
-            "the pivot {:?} mm must be finite",
-            tilt.pivot_mm
-        )));
+        return Err(crate::error::OptionError::with_message(
+            "pivot_mm",
+            format!("the pivot {:?} mm must be finite", tilt.pivot_mm),
+        )
+        .into());
     }
     Ok(())
 }

@@ -12,46 +12,17 @@
 //! of the G1 runs.
 
 use crate::error::Error;
+pub use crate::options::SimulateOptions;
 use crate::program::LoadedProgram;
 use crate::report::{SimFrame, SimRun, SimTotals, SimulateReport};
 use polepatch_kinematics::Machine;
 use polepatch_nc::RunBreak;
 use polepatch_patcher::Path;
-use polepatch_simulate::{Geometry, SimOptions, Step, simulate};
+use polepatch_simulate::{Geometry, Step, simulate};
 
 /// What a program without G1 motion reports ([`SimulateReport::nothing_to_simulate`]).
 pub const NO_G1_MOTION: &str = "the program has no G1 motion: rapid moves (G0), arcs and \
      blocks without tool-tip motion are not simulated";
-
-/// Options of [`simulate_nc`]. Plain struct; see each field for its default.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SimulateOptions {
-    /// Options of the simulator (Tcy, grid). Default: [`SimOptions`]'s.
-    pub sim: SimOptions,
-    /// Feed, mm/min, for runs with no F in force. Default `None` (such runs are listed
-    /// with the reason and not simulated).
-    pub feed_fallback_mm_min: Option<f64>,
-    /// Name of the input in messages and in the report. Default `"input"`.
-    pub name: String,
-    /// Work offset for a machine with a kinematic chain (as [`crate::PatchOptions::work_offset_mm`]).
-    pub work_offset_mm: Option<[f64; 3]>,
-    /// Read a program that states no length units in inches (as
-    /// [`crate::PatchOptions::inch`]: `patch --units inch --simulate` simulates what it
-    /// patched). Default false: mm.
-    pub inch: bool,
-}
-
-impl Default for SimulateOptions {
-    fn default() -> Self {
-        SimulateOptions {
-            sim: SimOptions::default(),
-            feed_fallback_mm_min: None,
-            name: "input".to_string(),
-            work_offset_mm: None,
-            inch: false,
-        }
-    }
-}
 
 /// One state of the simulated motion, for a trajectory or a plot.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -271,7 +242,7 @@ pub fn simulate_nc_with(
         opts,
         chain: Vec::new(),
         report: SimulateReport {
-            file: opts.name.clone(),
+            file: opts.read.name.clone(),
             machine: machine.name.clone(),
             tcy_s,
             primary: String::new(),
@@ -284,12 +255,9 @@ pub fn simulate_nc_with(
         t0_s: 0.0,
         s0_mm: 0.0,
     };
-    let reading = crate::AnalyzeOptions {
-        name: opts.name.clone(),
-        feed_fallback_mm_min: opts.feed_fallback_mm_min,
-        work_offset_mm: opts.work_offset_mm,
-        inch: opts.inch,
-        ..crate::AnalyzeOptions::default()
+    let reading = crate::options::AnalyzeOptions {
+        read: opts.read.clone(),
+        ..crate::options::AnalyzeOptions::default()
     };
     let read = crate::stream::each_run(
         bytes,

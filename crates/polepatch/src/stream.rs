@@ -410,18 +410,18 @@ fn ranges(machine: &Machine, letters: RotaryLetters) -> Vec<(u8, (f64, f64))> {
 
 impl<'a> Reading<'a> {
     /// How a patch with `opts` reads for `machine`.
-    fn patch(opts: &'a crate::PatchOptions, machine: &Machine) -> Result<Self, Error> {
+    fn patch(opts: &'a crate::options::PatchOptions, machine: &Machine) -> Result<Self, Error> {
         let letters = crate::program::check_layout(machine)?;
         Ok(Reading {
-            name: &opts.name,
+            name: &opts.read.name,
             letters,
             ranges: ranges(machine, letters),
             passes: true,
             pole: crate::program::PoleDistance::of(machine),
             cone_deg: opts.patch.reach_deg(),
-            fallback: opts.feed_fallback_mm_min,
-            work_offset_mm: opts.work_offset_mm,
-            read: crate::program::read_options_with(machine, opts.inch)?,
+            fallback: opts.read.feed_fallback_mm_min,
+            work_offset_mm: opts.read.work_offset_mm,
+            read: crate::program::read_options_with(machine, opts.read.inch)?,
             chord_tolerance_mm: opts.chord_tolerance_mm,
             tool: opts.tool.clone(),
             lazy_style: readings(letters).iter().position(|r| *r == letters),
@@ -429,18 +429,21 @@ impl<'a> Reading<'a> {
     }
 
     /// How an analysis (and [`load_nc`], [`each_run`]) with `opts` reads for `machine`.
-    fn analysis(opts: &'a crate::AnalyzeOptions, machine: &Machine) -> Result<Self, Error> {
+    fn analysis(
+        opts: &'a crate::options::AnalyzeOptions,
+        machine: &Machine,
+    ) -> Result<Self, Error> {
         let letters = crate::program::check_layout(machine)?;
         Ok(Reading {
-            name: &opts.name,
+            name: &opts.read.name,
             letters,
             ranges: ranges(machine, letters),
             passes: true,
             pole: crate::program::PoleDistance::of(machine),
             cone_deg: opts.analysis.reach_deg(),
-            fallback: opts.feed_fallback_mm_min,
-            work_offset_mm: opts.work_offset_mm,
-            read: crate::program::read_options_with(machine, opts.inch)?,
+            fallback: opts.read.feed_fallback_mm_min,
+            work_offset_mm: opts.read.work_offset_mm,
+            read: crate::program::read_options_with(machine, opts.read.inch)?,
             chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
             tool: crate::tool::ToolOptions::default(),
             lazy_style: None,
@@ -853,15 +856,15 @@ fn begin(bytes: &[u8], machine: &Machine, rd: &Reading<'_>) -> Result<Begun, Err
     }
 }
 
-/// [`crate::patch_nc_to`] with [`crate::Hooks`]: `progress` after each batch of stretches is
+/// [`crate::patch_nc_to`] with [`crate::hooks::Hooks`]: `progress` after each batch of stretches is
 /// written (and at the end), `cancelled` before each stretch is patched and before each
 /// batch is written ([`Error::Cancelled`]).
 pub fn patch_nc_hooked(
     bytes: &[u8],
     machine: &Machine,
-    opts: &crate::PatchOptions,
+    opts: &crate::options::PatchOptions,
     out: &mut dyn Write,
-    hooks: crate::Hooks<'_>,
+    hooks: crate::hooks::Hooks<'_>,
 ) -> Result<FileReport, Error> {
     opts.check()?;
     let rd = Reading::patch(opts, machine)?;
@@ -873,7 +876,7 @@ pub fn patch_nc_hooked(
         Begun::Stretches { sv, l } => (sv, l, None, false),
     };
     let letters = readings(rd.letters)[l];
-    let mut report = FileReport::unchanged(&opts.name, machine, Vec::new());
+    let mut report = FileReport::unchanged(&opts.read.name, machine, Vec::new());
     (report.not_analysed, report.warnings) = sv.head(&rd, letters, first);
     // A program with nothing to analyse has no run to patch either.
     let todo = if nothing {
@@ -915,7 +918,7 @@ pub fn patch_nc_hooked(
             if cancelled() {
                 return (
                     Vec::new(),
-                    FileReport::unchanged(&opts.name, machine, Vec::new()),
+                    FileReport::unchanged(&opts.read.name, machine, Vec::new()),
                 );
             }
             let (edits, part) = patch_program(&lp, machine, &opts.patch);
@@ -1011,7 +1014,7 @@ fn assemble(bytes: &[u8], parts: &[Part]) -> Vec<u8> {
 fn verified_output(
     bytes: &[u8],
     machine: &Machine,
-    opts: &crate::PatchOptions,
+    opts: &crate::options::PatchOptions,
     parts: &mut [Part],
     cancelled: &dyn Fn() -> bool,
 ) -> Result<(Vec<u8>, Vec<String>), Error> {
@@ -1048,7 +1051,7 @@ fn verified_output(
             })
             .collect();
         let check =
-            crate::verify::verify_claims(bytes, &output, machine, opts, &opts.name, &claims)?;
+            crate::verify::verify_claims(bytes, &output, machine, opts, &opts.read.name, &claims)?;
         if check.passed() {
             return Ok((output, Vec::new()));
         }
@@ -1057,7 +1060,7 @@ fn verified_output(
                 format!(
                     "{}: the {} peer's output fails its verification at line {} ({}: {}): \
                      peers are shown for comparison, not to be run",
-                    opts.name,
+                    opts.read.name,
                     opts.patch.strategy.name(),
                     v.line,
                     v.check.name(),
@@ -1094,7 +1097,7 @@ fn verified_output(
                 let why = format!(
                     "{}: lines {}–{} keep their values: the written program failed its \
                      verification at line {} ({}: {})",
-                    opts.name,
+                    opts.read.name,
                     lines[k][0],
                     lines[k][1],
                     v.line,
@@ -1107,7 +1110,7 @@ fn verified_output(
         }
         if !put {
             return Err(Error::Unverified {
-                path: opts.name.clone(),
+                path: opts.read.name.clone(),
                 violations: check.violations,
             });
         }
@@ -1134,7 +1137,7 @@ fn put_back(p: &mut Part, why: String) {
 pub fn analyze_nc_stretches(
     bytes: &[u8],
     machine: &Machine,
-    opts: &crate::AnalyzeOptions,
+    opts: &crate::options::AnalyzeOptions,
 ) -> Result<AnalyzeReport, Error> {
     let mut report = None;
     let mut runs = Vec::new();
@@ -1145,7 +1148,12 @@ pub fn analyze_nc_stretches(
         }
         Ok(())
     })?;
-    let mut report = report.ok_or_else(|| Error::Options("no report".to_string()))?;
+    // analyze_nc_each hands out the head before any run, or fails.
+    let Some(mut report) = report else {
+        return Err(Error::NoRuns {
+            path: opts.read.name.clone(),
+        });
+    };
     report.runs = runs;
     Ok(report)
 }
@@ -1165,18 +1173,18 @@ pub enum Piece<'a> {
 pub fn analyze_nc_each(
     bytes: &[u8],
     machine: &Machine,
-    opts: &crate::AnalyzeOptions,
+    opts: &crate::options::AnalyzeOptions,
     each: &mut dyn FnMut(Piece<'_>) -> std::io::Result<()>,
 ) -> Result<(), Error> {
     // A CL file handed to `analyze`: say so, not what the NC reader saw first.
     analyze_each(bytes, machine, opts, each)
-        .map_err(|e| crate::program::or_cl_file(e, bytes, &opts.name))
+        .map_err(|e| crate::program::or_cl_file(e, bytes, &opts.read.name))
 }
 
 fn analyze_each(
     bytes: &[u8],
     machine: &Machine,
-    opts: &crate::AnalyzeOptions,
+    opts: &crate::options::AnalyzeOptions,
     each: &mut dyn FnMut(Piece<'_>) -> std::io::Result<()>,
 ) -> Result<(), Error> {
     opts.check()?;
@@ -1191,7 +1199,7 @@ fn analyze_each(
     let letters = readings(rd.letters)[l];
     let (not_analysed, warnings) = sv.head(&rd, letters, first);
     each(Piece::Head(&AnalyzeReport {
-        file: opts.name.clone(),
+        file: opts.read.name.clone(),
         machine: machine.name.clone(),
         cone_deg: opts.analysis.cone_deg,
         pole_reach_deg: opts.analysis.pole_reach_deg,
@@ -1225,7 +1233,7 @@ fn analyze_each(
 pub(crate) fn each_run<T: Send>(
     bytes: &[u8],
     machine: &Machine,
-    opts: &crate::AnalyzeOptions,
+    opts: &crate::options::AnalyzeOptions,
     work: impl Fn(&LoadedProgram) -> T + Sync,
     mut sink: impl FnMut(T) -> std::io::Result<()>,
 ) -> Result<char, Error> {
@@ -1255,10 +1263,12 @@ pub fn load_nc(
     load_nc_with(
         bytes,
         machine,
-        &crate::AnalyzeOptions {
-            name: name.to_string(),
-            feed_fallback_mm_min,
-            ..crate::AnalyzeOptions::default()
+        &crate::options::AnalyzeOptions {
+            read: crate::options::ReadOptions {
+                feed_fallback_mm_min,
+                ..crate::options::ReadOptions::named(name)
+            },
+            ..crate::options::AnalyzeOptions::default()
         },
     )
 }
@@ -1268,10 +1278,11 @@ pub fn load_nc(
 pub fn load_nc_with(
     bytes: &[u8],
     machine: &Machine,
-    opts: &crate::AnalyzeOptions,
+    opts: &crate::options::AnalyzeOptions,
 ) -> Result<LoadedProgram, Error> {
     opts.check()?;
-    load_program(bytes, machine, opts).map_err(|e| crate::program::or_cl_file(e, bytes, &opts.name))
+    load_program(bytes, machine, opts)
+        .map_err(|e| crate::program::or_cl_file(e, bytes, &opts.read.name))
 }
 
 /// The whole program as one stretch ([`load_nc`]): the same two reads as
@@ -1280,9 +1291,9 @@ pub fn load_nc_with(
 pub(crate) fn load_program(
     bytes: &[u8],
     machine: &Machine,
-    opts: &crate::AnalyzeOptions,
+    opts: &crate::options::AnalyzeOptions,
 ) -> Result<LoadedProgram, Error> {
-    let name = opts.name.as_str();
+    let name = opts.read.name.as_str();
     let rd = Reading::analysis(opts, machine)?;
     let (sv, l) = match begin(bytes, machine, &rd)? {
         Begun::Nothing { why, .. } => return Err(why),
@@ -1550,10 +1561,7 @@ mod tests {
             .collect();
         let program = format!("{body}{second}");
         let machine = polepatch_kinematics::Machine::builtin("mikron-ucp710").unwrap();
-        let opts = crate::PatchOptions {
-            name: "planted.nc".into(),
-            ..crate::PatchOptions::default()
-        };
+        let opts = crate::options::PatchOptions::named("planted.nc");
         let (clean, clean_report) = crate::patch_nc(program.as_bytes(), &machine, &opts).unwrap();
         assert_eq!(clean_report.zones.len(), 2);
         assert!(

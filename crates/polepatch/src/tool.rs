@@ -487,7 +487,7 @@ fn settle(slot: &mut Option<(Option<Tool>, String)>, c: &(Option<Tool>, String),
     }
 }
 
-/// How the caller says the tool: [`crate::PatchOptions::tool`].
+/// How the caller says the tool: [`crate::options::PatchOptions::tool`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct ToolOptions {
     /// The tool for the whole program (`--tool ball:10`); `None`: per run, from the program
@@ -522,10 +522,14 @@ impl ToolOptions {
     /// Refuse a surface tolerance that is not a positive length.
     pub fn check(&self) -> Result<(), Error> {
         if !(self.surface_tolerance_mm.is_finite() && self.surface_tolerance_mm > 0.0) {
-            return Err(Error::Options(format!(
-                "surface_tolerance_mm must be a positive number of mm, got {}",
-                self.surface_tolerance_mm
-            )));
+            return Err(crate::error::OptionError::new(
+                "surface_tolerance_mm",
+                format_args!(
+                    "must be a positive number of mm, got {}",
+                    self.surface_tolerance_mm
+                ),
+            )
+            .into());
         }
         Ok(())
     }

@@ -139,7 +139,7 @@ impl VerifyReport {
 
 /// Hold `patched` against `original` for `machine` (module docs), reading both as a patch
 /// with `opts` reads (units, feed fallback, work offset, tool options, cone, pole reach and
-/// `max_deviation_deg`). `opts.name` names the patched program in messages; the original's
+/// `max_deviation_deg`). `opts.read.name` names the patched program in messages; the original's
 /// name is `original_name`.
 ///
 /// Bad input (either program unreadable) is an [`Error`]; what does not hold is in
@@ -148,7 +148,7 @@ pub fn verify_nc(
     original: &[u8],
     patched: &[u8],
     machine: &Machine,
-    opts: &crate::PatchOptions,
+    opts: &crate::options::PatchOptions,
     original_name: &str,
 ) -> Result<VerifyReport, Error> {
     verify_claims(original, patched, machine, opts, original_name, &[])
@@ -160,17 +160,17 @@ pub fn verify_claims(
     original: &[u8],
     patched: &[u8],
     machine: &Machine,
-    opts: &crate::PatchOptions,
+    opts: &crate::options::PatchOptions,
     original_name: &str,
     claims: &[Claim],
 ) -> Result<VerifyReport, Error> {
     opts.check()?;
     let letters = crate::program::check_layout(machine)?;
-    let mut read = crate::program::read_options_with(machine, opts.inch)?;
+    let mut read = crate::program::read_options_with(machine, opts.read.inch)?;
     read.dialect = polepatch_nc::detect_dialect(original);
     let mut report = VerifyReport {
         original: original_name.to_string(),
-        patched: opts.name.clone(),
+        patched: opts.read.name.clone(),
         machine: machine.name.clone(),
         ..VerifyReport::default()
     };
@@ -199,7 +199,7 @@ pub fn verify_claims(
     }
     loop {
         let mut cmp = Comparison::new(original, patched, machine, opts, letters, claims);
-        let settled = lockstep(original, patched, &read, &mut cmp, &opts.name)?;
+        let settled = lockstep(original, patched, &read, &mut cmp, &opts.read.name)?;
         match settled {
             Settled::Done(_) => {
                 cmp.finish();
@@ -404,7 +404,7 @@ struct Comparison<'a> {
     original: &'a [u8],
     patched: &'a [u8],
     machine: &'a Machine,
-    opts: &'a crate::PatchOptions,
+    opts: &'a crate::options::PatchOptions,
     letters: RotaryLetters,
     claims: &'a [Claim],
     report: VerifyReport,
@@ -482,11 +482,11 @@ impl<'a> Comparison<'a> {
         original: &'a [u8],
         patched: &'a [u8],
         machine: &'a Machine,
-        opts: &'a crate::PatchOptions,
+        opts: &'a crate::options::PatchOptions,
         letters: RotaryLetters,
         claims: &'a [Claim],
     ) -> Self {
-        let initial = crate::program::read_options_with(machine, opts.inch)
+        let initial = crate::program::read_options_with(machine, opts.read.inch)
             .map(|r| r.initial())
             .unwrap_or_default();
         Comparison {
@@ -750,7 +750,7 @@ impl<'a> Comparison<'a> {
             &self.datum_shifts,
             &self.frame_changes,
             i,
-            self.opts.work_offset_mm,
+            self.opts.read.work_offset_mm,
         )?;
         Some((chain, d))
     }
@@ -1048,7 +1048,7 @@ impl<'a> Comparison<'a> {
     fn compare_runs(&mut self, ro: &Run, rp: &Run) {
         let first_line = self.line_of(ro.blocks[0]);
         let lines: Vec<usize> = ro.blocks.iter().map(|&b| self.line_of(b)).collect();
-        let fallback = self.opts.feed_fallback_mm_min;
+        let fallback = self.opts.read.feed_fallback_mm_min;
         let path_o = crate::program::run_path(ro.clone(), self.letters, fallback, first_line).path;
         let path_p = crate::program::run_path(rp.clone(), self.letters, fallback, first_line).path;
         let (po, pp) = match (path_o, path_p) {

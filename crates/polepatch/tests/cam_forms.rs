@@ -34,10 +34,7 @@ fn hsm600() -> Machine {
 }
 
 fn opts(name: &str) -> PatchOptions {
-    PatchOptions {
-        name: name.to_string(),
-        ..PatchOptions::default()
-    }
+    PatchOptions::named(name)
 }
 
 /// The program with its rotary words taken out (with the blanks before them, so that a
@@ -162,10 +159,8 @@ fn units_stated_as_in_and_units_not_stated() {
         "{:?}",
         mm.warnings
     );
-    let inch_opts = PatchOptions {
-        inch: true,
-        ..opts("haas")
-    };
+    let mut inch_opts = opts("haas");
+    inch_opts.read.inch = true;
     let (_, inch) = patch_nc(&haas, &hsm600(), &inch_opts).unwrap();
     assert!(
         inch.warnings
@@ -340,10 +335,8 @@ fn conversational_blanks_after_the_letter() {
 #[test]
 fn patched_words_keep_the_style_of_the_file() {
     let bytes = cam("haas-umc-inch-no-g20.nc");
-    let o = PatchOptions {
-        inch: true,
-        ..opts("haas")
-    };
+    let mut o = opts("haas");
+    o.read.inch = true;
     let (out, report) = patch_nc(&bytes, &hsm600(), &o).unwrap();
     assert!(report.words_changed > 0);
     let before = parse(bytes, Dialect::Auto).unwrap();
@@ -379,7 +372,10 @@ fn creo_comments_and_blank_separated_columns_post() {
             let o = PostOptions {
                 dialect,
                 patch_options: PatchOptions {
-                    feed_fallback_mm_min: fallback,
+                    read: polepatch::ReadOptions {
+                        feed_fallback_mm_min: fallback,
+                        ..polepatch::ReadOptions::default()
+                    },
                     ..PatchOptions::default()
                 },
                 ..PostOptions::default()
@@ -404,10 +400,7 @@ fn insert_records_are_written_and_listed() {
     let prog = read_cl(&cl("camworks_insert_5axis.apt"), "camworks").unwrap();
     let o = PostOptions {
         dialect: Dialect::Fanuc,
-        patch_options: PatchOptions {
-            name: "camworks".into(),
-            ..PatchOptions::default()
-        },
+        patch_options: PatchOptions::named("camworks"),
         ..PostOptions::default()
     };
     let (bytes, report) = post_cl(&prog, &ucp710(), &o).unwrap();

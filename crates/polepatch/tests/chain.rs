@@ -2,6 +2,7 @@
 //! with the rotary values (the part-frame tool tip unchanged within 1 µm at every point),
 //! and TCPM programs are analysed and checked in the machine frame.
 
+use polepatch::ReadOptions;
 use polepatch::kinematics::{Chain, Machine};
 use polepatch::load_nc;
 use polepatch::machine_frame::TIP_TOLERANCE_MM;
@@ -183,7 +184,10 @@ fn without_tcpm_every_changed_block_stays_within_the_chord_tolerance() {
         let tcpm = std::fs::read(root().join("fixtures/generated").join(name)).unwrap();
         let input = machine_coordinates(&machine, &tcpm, datum);
         let opts = PatchOptions {
-            work_offset_mm: Some(datum),
+            read: ReadOptions {
+                work_offset_mm: Some(datum),
+                ..ReadOptions::default()
+            },
             ..PatchOptions::default()
         };
         let (out, report) = patch_nc(&input, &machine, &opts).unwrap();
@@ -250,7 +254,10 @@ fn without_tcpm_x_y_z_change_with_the_rotary_axes_and_the_tool_tip_stays() {
     let chain = machine.chain.unwrap();
     let (input, tips) = sing_without_tcpm(&machine);
     let opts = PatchOptions {
-        name: "SING_noM128.I".into(),
+        read: ReadOptions {
+            name: "SING_noM128.I".into(),
+            ..ReadOptions::default()
+        },
         chord_tolerance_mm: 1.0,
         ..PatchOptions::default()
     };
@@ -352,7 +359,10 @@ fn without_tcpm_and_without_a_work_offset_the_run_is_left() {
     // Given on the command line, the run is patched (with a chord tolerance that admits
     // SING's long blocks).
     let opts = PatchOptions {
-        work_offset_mm: Some(ON_AXIS_DATUM),
+        read: ReadOptions {
+            work_offset_mm: Some(ON_AXIS_DATUM),
+            ..ReadOptions::default()
+        },
         chord_tolerance_mm: 1.0,
         ..PatchOptions::default()
     };
@@ -437,7 +447,10 @@ fn the_work_offset_is_known_or_the_run_is_left() {
     let given = Some([10.0, 20.0, 30.0]);
     let datum = |text: &str, given: Option<[f64; 3]>| {
         let opts = polepatch::AnalyzeOptions {
-            work_offset_mm: given,
+            read: polepatch::ReadOptions {
+                work_offset_mm: given,
+                ..polepatch::ReadOptions::default()
+            },
             ..polepatch::AnalyzeOptions::default()
         };
         let lp = polepatch::load_nc_with(text.as_bytes(), &m, &opts).unwrap();
@@ -474,10 +487,8 @@ fn a_transformed_frame_leaves_the_run() {
         chord_tolerance_mm: 1.0,
         ..PatchOptions::default()
     };
-    let given = PatchOptions {
-        work_offset_mm: Some(ON_AXIS_DATUM),
-        ..opts.clone()
-    };
+    let mut given = opts.clone();
+    given.read.work_offset_mm = Some(ON_AXIS_DATUM);
     for code in [
         "N61 G73 G90 H+30 *\n",
         "N61 G72 F0.9995 *\n",
@@ -532,7 +543,10 @@ fn without_tcpm_a_ball_at_its_tip_keeps_its_centre_through_the_chain() {
     let chain = machine.chain.unwrap();
     let (input, _) = sing_without_tcpm(&machine);
     let opts = PatchOptions {
-        name: "SING_noM128_ball.I".into(),
+        read: ReadOptions {
+            name: "SING_noM128_ball.I".into(),
+            ..ReadOptions::default()
+        },
         chord_tolerance_mm: 1.0,
         tool: polepatch::tool::ToolOptions {
             tool: Some(polepatch::tool::Tool::parse("ball:10").unwrap()),

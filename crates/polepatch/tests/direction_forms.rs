@@ -26,10 +26,7 @@ fn ucp710() -> Machine {
 }
 
 fn opts(only_c: bool) -> PatchOptions {
-    let mut o = PatchOptions {
-        name: "direction-forms".into(),
-        ..PatchOptions::default()
-    };
+    let mut o = PatchOptions::named("direction-forms");
     if only_c {
         o.patch.axes = PatchAxes::OnlyC;
     }

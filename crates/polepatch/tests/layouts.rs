@@ -347,7 +347,10 @@ fn a_cam_trunnion_program_is_analysed_and_its_pole_pass_found() {
     let bytes = std::fs::read(root().join("fixtures/cam/haas-vf2tr-trunnion-ab.nc")).unwrap();
     let ab = machine("example-trunnion-ab.toml");
     let opts = polepatch::AnalyzeOptions {
-        inch: true,
+        read: polepatch::ReadOptions {
+            inch: true,
+            ..polepatch::ReadOptions::default()
+        },
         ..Default::default()
     };
     let a = polepatch::analyze_nc(&bytes, &ab, &opts).unwrap();

@@ -39,10 +39,7 @@ fn a_macro_constant_feed_is_analysed_at_its_feed() {
         "every variable here is a constant"
     );
     let m = Machine::builtin("mikron-ucp710").unwrap();
-    let o = PatchOptions {
-        name: "macro".into(),
-        ..PatchOptions::default()
-    };
+    let o = PatchOptions::named("macro");
     let (out, report) = patch_nc(&bytes, &m, &o).unwrap();
     assert!(report.not_analysed.is_empty(), "{:?}", report.not_analysed);
     assert_eq!(report.zones.len(), 2, "{:?}", report.zones);

@@ -18,10 +18,7 @@ fn shop(name: &str) -> String {
 }
 
 fn opts(name: &str) -> PatchOptions {
-    PatchOptions {
-        name: name.into(),
-        ..PatchOptions::default()
-    }
+    PatchOptions::named(name)
 }
 
 /// The simulated time of the whole program, s.

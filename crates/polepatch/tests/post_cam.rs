@@ -523,7 +523,10 @@ fn what_is_not_posted_is_refused_naming_the_record() {
                 &m,
                 &PostOptions {
                     patch_options: polepatch::PatchOptions {
-                        name: "t.apt".into(),
+                        read: polepatch::ReadOptions {
+                            name: "t.apt".into(),
+                            ..polepatch::ReadOptions::default()
+                        },
                         ..Default::default()
                     },
                     ..PostOptions::default()

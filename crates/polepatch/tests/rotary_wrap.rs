@@ -46,10 +46,7 @@ fn trunnion_with_platter_range() -> Machine {
 }
 
 fn opts() -> PatchOptions {
-    PatchOptions {
-        name: "wrap".to_string(),
-        ..PatchOptions::default()
-    }
+    PatchOptions::named("wrap")
 }
 
 /// The feed moves whose B word differs from the B before it by more than 180°, with the

@@ -329,15 +329,15 @@ fn a_cl_file_is_named_as_one() {
         ("SING.apt", 5),
     ] {
         let bytes = std::fs::read(root.join(file)).unwrap();
-        let opts = PatchOptions {
-            name: file.to_string(),
-            ..PatchOptions::default()
-        };
+        let opts = PatchOptions::named(file.to_string());
         let want = format!("{file}:{line}: this is a CL file");
         let e = patch_nc(&bytes, &m, &opts).unwrap_err().to_string();
         assert!(e.starts_with(&want), "{e}");
         let a = polepatch::AnalyzeOptions {
-            name: file.to_string(),
+            read: polepatch::ReadOptions {
+                name: file.to_string(),
+                ..polepatch::ReadOptions::default()
+            },
             ..polepatch::AnalyzeOptions::default()
         };
         let e = polepatch::analyze_nc(&bytes, &m, &a)

@@ -5,6 +5,7 @@
 //! `every_fixture_is_within_the_limits_by_finite_differences` (issue 43 item 1, open).
 
 mod common;
+use polepatch::ReadOptions;
 use polepatch::SimulateReport;
 use polepatch::kinematics::Machine;
 use polepatch::simulate::{SimState, SimulateOptions};
@@ -20,12 +21,14 @@ fn fixture(rel: &str) -> PathBuf {
 /// Simulate with every cycle, checking the trajectory as it comes.
 fn check(bytes: &[u8], m: &Machine, what: &str) -> SimulateReport {
     let opts = SimulateOptions {
+        read: ReadOptions {
+            name: what.to_string(),
+            ..ReadOptions::default()
+        },
         sim: polepatch::sim::SimOptions {
             every_cycle: true,
             ..Default::default()
         },
-        name: what.to_string(),
-        ..Default::default()
     };
     let mut states: Vec<SimState> = Vec::new();
     let mut on = |s: &SimState| states.push(*s);
@@ -152,12 +155,14 @@ fn the_default_and_the_every_cycle_simulation_are_one_answer() {
             let name = &m.name;
             let time = |every_cycle: bool| {
                 let opts = SimulateOptions {
+                    read: ReadOptions {
+                        name: f.to_string(),
+                        ..ReadOptions::default()
+                    },
                     sim: polepatch::sim::SimOptions {
                         every_cycle,
                         ..Default::default()
                     },
-                    name: f.to_string(),
-                    ..Default::default()
                 };
                 // (Every cycle is only computed for a caller that takes the states.)
                 let mut on = |_: &SimState| {};

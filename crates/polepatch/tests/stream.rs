@@ -5,6 +5,7 @@
 //! frame changes and feedless runs meet at stretch boundaries.
 
 mod common;
+use polepatch::ReadOptions;
 use polepatch::analyze_program;
 use polepatch::kinematics::Machine;
 use polepatch::patcher::AnalysisOptions;
@@ -22,10 +23,7 @@ fn whole(
         bytes,
         machine,
         &AnalyzeOptions {
-            name: opts.name.clone(),
-            feed_fallback_mm_min: opts.feed_fallback_mm_min,
-            work_offset_mm: opts.work_offset_mm,
-            inch: opts.inch,
+            read: opts.read.clone(),
             ..AnalyzeOptions::default()
         },
     )
@@ -35,14 +33,11 @@ fn whole(
 /// where they differ.
 fn same_analysis(bytes: &[u8], machine: &Machine, opts: &PatchOptions, what: &str) {
     let aopts = AnalyzeOptions {
+        read: opts.read.clone(),
         analysis: AnalysisOptions {
             cone_deg: opts.patch.cone_deg,
             ..AnalysisOptions::default()
         },
-        feed_fallback_mm_min: opts.feed_fallback_mm_min,
-        name: opts.name.clone(),
-        work_offset_mm: opts.work_offset_mm,
-        inch: opts.inch,
     };
     let full = whole(bytes, machine, opts).map(|lp| analyze_program(&lp, machine, &aopts.analysis));
     match (full, analyze_nc_stretches(bytes, machine, &aopts)) {
@@ -65,7 +60,7 @@ fn same(bytes: &[u8], machine: &Machine, opts: &PatchOptions, what: &str) -> Fil
         (Ok(rep), _) => rep,
         (Err(a), Err(b)) => {
             assert_eq!(a.to_string(), b.to_string(), "{what}");
-            FileReport::unchanged(&opts.name, machine, Vec::new())
+            FileReport::unchanged(&opts.read.name, machine, Vec::new())
         }
         (Err(a), Ok(_)) => panic!("{what}: {a}"),
     }
@@ -111,10 +106,7 @@ fn fixtures_give_the_whole_program_answer() {
         let bytes = fixture(f);
         for machine in machines() {
             for cone_deg in [0.05, 5.0] {
-                let mut opts = PatchOptions {
-                    name: f.clone(),
-                    ..PatchOptions::default()
-                };
+                let mut opts = PatchOptions::named(f.clone());
                 opts.patch.cone_deg = cone_deg;
                 let rep = same(
                     &bytes,
@@ -170,10 +162,7 @@ fn programs_built_across_stretch_boundaries() {
     );
     let bytes = text.into_bytes();
     for machine in common::machines_for("all.I", &bytes) {
-        let opts = PatchOptions {
-            name: "all.I".into(),
-            ..PatchOptions::default()
-        };
+        let opts = PatchOptions::named("all.I");
         let rep = same(&bytes, &machine, &opts, &machine.name);
         assert!(
             rep.zones.len() >= 3,
@@ -185,10 +174,8 @@ fn programs_built_across_stretch_boundaries() {
         assert_eq!(rep.untouched_runs.len(), 1, "the feedless run");
         assert_eq!(rep.untouched_runs[0].run, 1);
         // With a fallback feed the last run has one.
-        let opts = PatchOptions {
-            feed_fallback_mm_min: Some(1500.0),
-            ..opts
-        };
+        let mut opts = opts;
+        opts.read.feed_fallback_mm_min = Some(1500.0);
         same(
             &bytes,
             &machine,
@@ -222,8 +209,11 @@ fn chain_runs_get_their_work_offset_from_the_whole_file() {
         ),
     ] {
         let opts = PatchOptions {
-            name: what.into(),
-            work_offset_mm: offset,
+            read: ReadOptions {
+                name: what.into(),
+                work_offset_mm: offset,
+                ..ReadOptions::default()
+            },
             ..PatchOptions::default()
         };
         same(text.as_bytes(), &machine, &opts, what);

@@ -33,9 +33,8 @@ fn ball_at_tip() -> ToolOptions {
 
 fn opts(name: &str, tool: ToolOptions) -> PatchOptions {
     PatchOptions {
-        name: name.to_string(),
         tool,
-        ..PatchOptions::default()
+        ..PatchOptions::named(name)
     }
 }
 

@@ -12,7 +12,7 @@
 //! | `Error::Path` (joint arrays) | `InputError` | — |
 //! | `Error::Options` | `ValueError` | — |
 //! | `Error::Unverified` (the patched program fails its check against the input) | `VerificationError` | `path`, `line` (the first failing line) |
-//! | `MachineError` | `MachineError` | — |
+//! | `MachineError`, `Error::Machine` (a machine polepatch cannot work with: a layout not supported yet, a controller code it cannot read) | `MachineError` | — |
 //! | a panic | `InternalError` | — |
 //!
 //! `path` is the name the caller gave (`name=`); None when it gave none.
@@ -198,6 +198,7 @@ pub(crate) fn to_python(py: Python<'_>, failure: Failure) -> PyErr {
                 Error::Cancelled => pyo3::exceptions::PyKeyboardInterrupt::new_err(message),
                 Error::Path(_) => input_error(py, message, None, None, None),
                 Error::Options(_) => PyValueError::new_err(message),
+                Error::Machine { .. } => exception(py, "MachineError", message, |_| Ok(())),
                 Error::Output(_) => PyOSError::new_err(message),
                 Error::OutOfMemory { .. } => pyo3::exceptions::PyMemoryError::new_err(message),
                 Error::Unverified {

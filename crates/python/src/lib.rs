@@ -94,7 +94,7 @@ fn post_cl<'py>(
     let m = &machine.0;
     let out = detached(py, || {
         let post = || -> Result<Vec<u8>, polepatch::Error> {
-            let program = polepatch::post::read_cl(&cl, &opts.patch_options.name)?;
+            let program = polepatch::post::read_cl(&cl, &opts.patch_options.read.name)?;
             // The CL file's CUTTER/ and the tip, where the keywords did not say them.
             let mut opts = opts.clone();
             polepatch::post::tool_from_cl(&cl, &program, &mut opts);
@@ -120,7 +120,7 @@ fn reorient<'py>(
     name: Option<String>,
 ) -> PyResult<(Bound<'py, PyBytes>, String)> {
     let named = name.is_some();
-    let name = name.unwrap_or_else(|| polepatch::PatchOptions::default().name);
+    let name = name.unwrap_or_else(|| polepatch::ReadOptions::default().name);
     let pivot_mm = pivot_mm.map_or([0.0; 3], |(x, y, z)| [x, y, z]);
     let m = &machine.0;
     let tilt = match (theta_x, theta_z) {
@@ -192,7 +192,7 @@ fn feed_profile<'py>(
     let (runs, axes) = detached(py, || {
         let profile = || -> Result<(Vec<RunSamples>, Vec<String>), polepatch::Error> {
             opts.check()?;
-            let lp = polepatch::load_nc(&data, &opts.name, m, opts.feed_fallback_mm_min)?;
+            let lp = polepatch::load_nc(&data, &opts.read.name, m, opts.read.feed_fallback_mm_min)?;
             let analysis = polepatch::patcher::AnalysisOptions {
                 keep_samples: true,
                 ..opts.analysis.clone()

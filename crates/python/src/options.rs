@@ -137,16 +137,24 @@ impl FileKw {
     pub(crate) fn name(&self) -> String {
         self.name
             .clone()
-            .unwrap_or_else(|| polepatch::PatchOptions::default().name)
+            .unwrap_or_else(|| polepatch::ReadOptions::default().name)
+    }
+
+    /// How the library reads the input: these keywords (a program without units in mm).
+    pub(crate) fn read(&self) -> polepatch::ReadOptions {
+        polepatch::ReadOptions {
+            name: self.name(),
+            feed_fallback_mm_min: self.feed_fallback_mm_min,
+            work_offset_mm: self.work_offset_mm.map(|(x, y, z)| [x, y, z]),
+            inch: false,
+        }
     }
 
     /// The library's patch options with the patcher's `p`.
     pub(crate) fn patch(&self, p: &PatcherKw) -> PyResult<polepatch::PatchOptions> {
         Ok(polepatch::PatchOptions {
+            read: self.read(),
             patch: p.patcher()?,
-            feed_fallback_mm_min: self.feed_fallback_mm_min,
-            name: self.name(),
-            work_offset_mm: self.work_offset_mm.map(|(x, y, z)| [x, y, z]),
             ..polepatch::PatchOptions::default()
         })
     }
@@ -159,10 +167,7 @@ impl FileKw {
                 tcy_s: a.tcy_ms.map(|ms| ms / 1e3),
                 ..patcher::AnalysisOptions::default()
             },
-            feed_fallback_mm_min: self.feed_fallback_mm_min,
-            name: self.name(),
-            work_offset_mm: self.work_offset_mm.map(|(x, y, z)| [x, y, z]),
-            inch: false,
+            read: self.read(),
         }
     }
 }
@@ -319,8 +324,8 @@ pub(crate) fn defaults(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyDict
     d.set_item(
         "file",
         FileKw {
-            feed_fallback_mm_min: patch.feed_fallback_mm_min,
-            work_offset_mm: patch.work_offset_mm.map(|[x, y, z]| (x, y, z)),
+            feed_fallback_mm_min: patch.read.feed_fallback_mm_min,
+            work_offset_mm: patch.read.work_offset_mm.map(|[x, y, z]| (x, y, z)),
             name: None,
         },
     )?;

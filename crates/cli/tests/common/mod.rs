@@ -72,8 +72,11 @@ pub fn patch_lp(
         &lp.program.bytes,
         machine,
         &polepatch::PatchOptions {
+            read: polepatch::ReadOptions {
+                name: lp.name.clone(),
+                ..polepatch::ReadOptions::default()
+            },
             patch: opts.clone(),
-            name: lp.name.clone(),
             tool: lp.tool.clone(),
             ..polepatch::PatchOptions::default()
         },
@@ -600,7 +603,10 @@ pub fn machines_for(name: &str, bytes: &[u8]) -> Vec<Machine> {
         .into_iter()
         .filter(|m| {
             let opts = polepatch::AnalyzeOptions {
-                name: name.to_string(),
+                read: polepatch::ReadOptions {
+                    name: name.to_string(),
+                    ..polepatch::ReadOptions::default()
+                },
                 ..polepatch::AnalyzeOptions::default()
             };
             match polepatch::analyze_nc(bytes, m, &opts) {

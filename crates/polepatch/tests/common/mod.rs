@@ -19,7 +19,10 @@ pub fn machines_for(name: &str, bytes: &[u8]) -> Vec<Machine> {
         .into_iter()
         .filter(|m| {
             let opts = polepatch::AnalyzeOptions {
-                name: name.to_string(),
+                read: polepatch::ReadOptions {
+                    name: name.to_string(),
+                    ..polepatch::ReadOptions::default()
+                },
                 ..polepatch::AnalyzeOptions::default()
             };
             match polepatch::analyze_nc(bytes, m, &opts) {
