@@ -5,7 +5,10 @@
 //! [`crate::patch_nc`] for bytes or [`crate::stream`] for the stretches of a file.
 //!
 //! # The steps
-//! [`patch_program`] takes them in this order, one function each:
+//! [`patch_program`] takes them in this order, one function each. Each run's result is
+//! computed whole as a `RunOutcome` (`Patched { rows, edits }`, `Left { rows, untouched }`
+//! or `Quiet`) and folded into the report once, in run order, after the last step that can
+//! change it (direction forms): the report is never written and read back.
 //!
 //! 1. **The file's styles** (`file_styles`): the decimals the file writes C, the primary
 //!    axis and X Y Z with, and the patcher's options they set.
@@ -62,7 +65,6 @@ use polepatch_patcher::{
     report_unpatched,
 };
 use std::collections::HashMap;
-use std::ops::Range;
 
 /// How many times a run whose kept ball centre would leave its path between the points by
 /// more than the chord tolerance is solved again with its orientation change capped.
@@ -90,28 +92,108 @@ pub fn patch_program(
     // letter's substitution) is the stream's to report.
     let mut report = FileReport::unchanged(&lp.name, machine, Vec::new());
     let styles = file_styles(lp, opts);
-    let mut out = Written {
-        edits: Vec::new(),
-        written_c: styles.c.decimals,
-        written_p: styles.p.decimals,
-        run_edit_ranges: Vec::new(),
-    };
-    for r in 0..lp.runs.len() {
-        patch_run(lp, r, machine, &styles, &mut report, &mut out);
+    let mut outcomes: Vec<RunOutcome> = (0..lp.runs.len())
+        .map(|r| patch_run(lp, r, machine, &styles))
+        .collect();
+    // The decimals written for the rotary words: the file's, or more where a patched run
+    // needed them.
+    let mut written = [styles.c.decimals, styles.p.decimals];
+    for o in &outcomes {
+        if let RunOutcome::Patched { decimals, .. } = o {
+            written = [written[0].max(decimals[0]), written[1].max(decimals[1])];
+        }
+    }
+    // The edits of every patched run, each with its run (words restored by
+    // `restore_modal` belong to the run of their block).
+    let mut edits: Vec<Edit> = Vec::new();
+    let mut owner: Vec<Option<usize>> = Vec::new();
+    for (r, o) in outcomes.iter().enumerate() {
+        if let RunOutcome::Patched { edits: e, .. } = o {
+            edits.extend_from_slice(e);
+            owner.resize(edits.len(), Some(r));
+        }
     }
     let run_of = run_of_blocks(lp);
-    restore_modal(lp, &styles, &run_of, &mut out.edits);
-    let mut edits = direction_forms(
-        lp,
-        std::mem::take(&mut out.edits),
-        &out.run_edit_ranges,
-        &run_of,
-        &mut report,
-        &styles.opts,
+    restore_modal(lp, &styles, &run_of, &mut edits);
+    owner.extend(
+        edits[owner.len()..]
+            .iter()
+            .map(|e| run_of.get(&e.block).copied()),
     );
+    let forms = direction_forms(lp, edits, &owner);
+    for (run, reason, message) in forms.dropped {
+        outcomes[run] =
+            std::mem::take(&mut outcomes[run]).left(lp, run, reason, message, opts.reach_deg());
+    }
+    report.warnings.extend(forms.warning);
+    let mut edits = forms.edits;
     edits.sort_by_key(|e| (e.block, e.letter));
-    finish_report(lp, &styles, &out, edits.len(), &mut report);
+    // Each run's outcome, folded into the report once, in run order.
+    for o in outcomes {
+        match o {
+            RunOutcome::Quiet => {}
+            RunOutcome::Left { rows, untouched } => {
+                report.zones.extend(rows);
+                report.untouched_runs.extend(untouched);
+            }
+            RunOutcome::Patched { rows, .. } => report.zones.extend(rows),
+        }
+    }
+    finish_report(lp, &styles, written, edits.len(), &mut report);
     (edits, report)
+}
+
+/// What step 2 makes of one run: computed whole, then folded into the report once
+/// ([`patch_program`]).
+#[derive(Debug, Default)]
+enum RunOutcome {
+    /// Nothing to patch or report (no point within the pole reach).
+    #[default]
+    Quiet,
+    /// The run keeps its values: its zones' rows (nothing written) and, where there is
+    /// something to say, why.
+    Left {
+        /// The zones' rows, reported as they are.
+        rows: Vec<ZoneRow>,
+        /// The run among the untouched, with the reason.
+        untouched: Option<UntouchedRun>,
+    },
+    /// The run is patched.
+    Patched {
+        /// The zones' rows.
+        rows: Vec<ZoneRow>,
+        /// The words it changes (its blocks, and the blocks after it that restate its end).
+        edits: Vec<Edit>,
+        /// Decimal places written for its changed C and primary-axis words.
+        decimals: [usize; 2],
+    },
+}
+
+impl RunOutcome {
+    /// The run left as it is for `reason` (`message` for people): its rows, if any, are
+    /// not written.
+    fn left(
+        self,
+        lp: &LoadedProgram,
+        r: usize,
+        reason: UntouchedReason,
+        message: String,
+        reach_deg: f64,
+    ) -> RunOutcome {
+        let mut rows = match self {
+            RunOutcome::Quiet => Vec::new(),
+            RunOutcome::Left { rows, .. } | RunOutcome::Patched { rows, .. } => rows,
+        };
+        for row in &mut rows {
+            row.not_written();
+            row.reason = reason.zone_reason().unwrap_or(ZoneReason::NotPatched);
+        }
+        let untouched = untouched(lp, r, reason, rows.len(), message, reach_deg);
+        RunOutcome::Left {
+            rows,
+            untouched: Some(untouched),
+        }
+    }
 }
 
 /// The file's number styles and the patcher's options they set (step 1).
@@ -174,18 +256,6 @@ fn file_styles(lp: &LoadedProgram, opts: &PatchOptions) -> Styles {
     }
 }
 
-/// What the runs give the file (step 2).
-struct Written {
-    /// The edits, run after run.
-    edits: Vec<Edit>,
-    /// Decimal places written for changed C words (the file's at least).
-    written_c: usize,
-    /// Decimal places written for changed primary-axis words (the file's at least).
-    written_p: usize,
-    /// For each patched run: its index, its first zone row and its edits.
-    run_edit_ranges: Vec<(usize, usize, Range<usize>)>,
-}
-
 /// Whether a point of `path` is within the pole reach: a zone needs one (the patcher's
 /// `detect_zones`).
 fn near_pole(lp: &LoadedProgram, path: &Path, opts: &PatchOptions) -> bool {
@@ -195,48 +265,38 @@ fn near_pole(lp: &LoadedProgram, path: &Path, opts: &PatchOptions) -> bool {
         .any(|q| lp.pole.near(Some(q[pi]), opts.reach_deg()))
 }
 
-/// Step 2: run `r` patched, its rows in `report`, its edits in `out` (the sub-steps of
-/// the module docs).
-fn patch_run(
-    lp: &LoadedProgram,
-    r: usize,
-    machine: &Machine,
-    styles: &Styles,
-    report: &mut FileReport,
-    out: &mut Written,
-) {
+/// Step 2: what run `r` becomes (the sub-steps of the module docs).
+fn patch_run(lp: &LoadedProgram, r: usize, machine: &Machine, styles: &Styles) -> RunOutcome {
     let opts = &styles.opts;
     let rp = &lp.runs[r];
     let path = match &rp.path {
         Ok(p) => p,
         Err(problem) => {
-            report.untouched_runs.push(untouched(
+            return RunOutcome::Quiet.left(
                 lp,
                 r,
                 problem_reason(problem),
-                0,
                 problem.to_string(),
                 opts.reach_deg(),
-            ));
-            return;
+            );
         }
     };
     // A run with no point in the cone has nothing to patch or report, and its analysis is
     // skipped.
     if !near_pole(lp, path, opts) {
-        return;
+        return RunOutcome::Quiet;
     }
     let frame = RunFrame::of(lp, r, machine);
     if let Some(left) = why_left(rp, &frame, machine) {
-        report_left(lp, r, path, machine, opts, left, report);
-        return;
+        return report_left(lp, r, path, machine, opts, left);
     }
     let mut run = run_options(lp, r, path, machine, styles, &frame);
     let patched = run.pin_end_if_faster();
-    let Some((result, first_row)) = run.rows_within_centre_path(patched, opts, report) else {
-        return;
+    let (result, rows) = match run.rows_within_centre_path(patched) {
+        Ok(done) => done,
+        Err(left) => return left,
     };
-    let first_edit = out.edits.len();
+    let mut edits = Vec::new();
     if let Some((ch, d)) = frame.chain {
         match through_chain(
             lp,
@@ -251,28 +311,24 @@ fn patch_run(
             styles.xyz_decimals,
             lp.chord_tolerance_mm,
         ) {
-            Ok(mut xyz) => out.edits.append(&mut xyz),
+            Ok(mut xyz) => edits.append(&mut xyz),
             Err(why) => {
-                for row in &mut report.zones[first_row..] {
-                    row.not_written();
-                    row.reason = ZoneReason::NotPatched;
-                }
-                report.untouched_runs.push(untouched(
-                    lp,
-                    r,
-                    UntouchedReason::MachineFrame,
-                    result.zones.len(),
-                    why,
-                    opts.reach_deg(),
-                ));
-                return;
+                let rows = RunOutcome::Patched {
+                    rows,
+                    edits: Vec::new(),
+                    decimals: [0; 2],
+                };
+                return rows.left(lp, r, UntouchedReason::MachineFrame, why, opts.reach_deg());
             }
         }
     }
-    run.centre_edits(&result, &mut out.edits);
-    run.rotary_edits(&result, out);
-    out.run_edit_ranges
-        .push((r, first_row, first_edit..out.edits.len()));
+    run.centre_edits(&result, &mut edits);
+    let decimals = run.rotary_edits(&result, &mut edits);
+    RunOutcome::Patched {
+        rows,
+        edits,
+        decimals,
+    }
 }
 
 /// What decides how run `r`'s X Y Z relate to the machine.
@@ -374,37 +430,41 @@ fn report_left(
     machine: &Machine,
     opts: &PatchOptions,
     left: (UntouchedReason, &'static str),
-    report: &mut FileReport,
-) {
+) -> RunOutcome {
     let (reason, message) = left;
     match report_unpatched(path, machine, opts) {
+        Ok(zones) if zones.is_empty() => RunOutcome::Quiet,
         Ok(zones) => {
-            if !zones.is_empty() {
-                report.zones.extend(zones.iter().map(|z| {
+            let rows: Vec<ZoneRow> = zones
+                .iter()
+                .map(|z| {
                     let mut row = zone_row(lp, r, z);
                     if let Some(why) = reason.zone_reason() {
                         row.reason = why;
                     }
                     row
-                }));
-                report.untouched_runs.push(untouched(
-                    lp,
-                    r,
-                    reason,
-                    zones.len(),
-                    message.to_string(),
-                    opts.reach_deg(),
-                ));
+                })
+                .collect();
+            let untouched = untouched(
+                lp,
+                r,
+                reason,
+                zones.len(),
+                message.to_string(),
+                opts.reach_deg(),
+            );
+            RunOutcome::Left {
+                rows,
+                untouched: Some(untouched),
             }
         }
-        Err(e) => report.untouched_runs.push(untouched(
+        Err(e) => RunOutcome::Quiet.left(
             lp,
             r,
             UntouchedReason::Invalid,
-            0,
             e.to_string(),
             opts.reach_deg(),
-        )),
+        ),
     }
 }
 
@@ -561,41 +621,43 @@ impl RunPatch<'_> {
         patched
     }
 
-    /// Step 2.5: the report rows of `result`'s zones, appended to `report`; `centre_capped`:
-    /// the orientation change was capped for a kept ball centre's path.
-    fn zone_rows(&self, result: &PatchResult, centre_capped: bool, report: &mut FileReport) {
+    /// Step 2.5: the report rows of `result`'s zones; `centre_capped`: the orientation
+    /// change was capped for a kept ball centre's path.
+    fn zone_rows(&self, result: &PatchResult, centre_capped: bool) -> Vec<ZoneRow> {
         let (lp, r) = (self.lp, self.r);
         let rp = &lp.runs[r];
-        let first_row = report.zones.len();
-        report.zones.extend(result.zones.iter().map(|z| {
-            let mut row = zone_row(lp, r, z);
-            tool_fields(
-                &mut row,
-                &self.tool,
-                z,
-                self.work_path(),
-                result,
-                self.machine,
-                self.tool_capped,
-            );
-            if centre_capped && z.reason == polepatch_patcher::Reason::DeviationCap {
-                row.reason = ZoneReason::CentrePath;
-            }
-            row.end_pose = Some(if self.opts.keep_last_point {
-                EndFreedom::Pinned
-            } else {
-                EndFreedom::Free
-            });
-            row.end_pose_line = if rp.run.tcpm.is_on() {
-                self.end.decided_line
-            } else {
-                None
-            };
-            row
-        }));
+        let mut rows: Vec<ZoneRow> = result
+            .zones
+            .iter()
+            .map(|z| {
+                let mut row = zone_row(lp, r, z);
+                tool_fields(
+                    &mut row,
+                    &self.tool,
+                    z,
+                    self.work_path(),
+                    result,
+                    self.machine,
+                    self.tool_capped,
+                );
+                if centre_capped && z.reason == polepatch_patcher::Reason::DeviationCap {
+                    row.reason = ZoneReason::CentrePath;
+                }
+                row.end_pose = Some(if self.opts.keep_last_point {
+                    EndFreedom::Pinned
+                } else {
+                    EndFreedom::Free
+                });
+                row.end_pose_line = if rp.run.tcpm.is_on() {
+                    self.end.decided_line
+                } else {
+                    None
+                };
+                row
+            })
+            .collect();
         if rp.run.tcpm.is_on()
-            && let (Some((line, before, after)), Some(last)) =
-                (self.rapid(result), report.zones[first_row..].last_mut())
+            && let (Some((line, before, after)), Some(last)) = (self.rapid(result), rows.last_mut())
         {
             last.rapid_line = Some(line);
             last.rapid_time_before_s = Some(before);
@@ -605,21 +667,20 @@ impl RunPatch<'_> {
                 after
             });
         }
+        rows
     }
 
     /// Step 2.5: the rows of `patched`, solved again with the orientation change capped
     /// while a kept ball centre leaves its path between the points by more than the chord
     /// tolerance (where the original block stayed within it; the centre's excursion
     /// between two points grows with the change), up to CENTRE_PATH_RETRIES times. The
-    /// patch and the run's first row; `None` when the run keeps its values (reported
-    /// untouched).
+    /// patch and its rows; `Err` with the run's outcome when it keeps its values.
     fn rows_within_centre_path(
         &mut self,
         mut patched: Result<PatchResult, PathError>,
-        file_opts: &PatchOptions,
-        report: &mut FileReport,
-    ) -> Option<(PatchResult, usize)> {
+    ) -> Result<(PatchResult, Vec<ZoneRow>), RunOutcome> {
         let (lp, r) = (self.lp, self.r);
+        let reach_deg = self.opts.reach_deg();
         let chord_limit = lp.chord_tolerance_mm + machine_frame::TIP_TOLERANCE_MM;
         let mut centre_capped = false;
         let mut retries = 0;
@@ -627,26 +688,22 @@ impl RunPatch<'_> {
             let result = match patched {
                 Ok(res) => res,
                 Err(e) => {
-                    report.untouched_runs.push(untouched(
+                    return Err(RunOutcome::Quiet.left(
                         lp,
                         r,
                         UntouchedReason::Invalid,
-                        0,
                         e.to_string(),
-                        file_opts.reach_deg(),
+                        reach_deg,
                     ));
-                    return None;
                 }
             };
-            let first_row = report.zones.len();
-            self.zone_rows(&result, centre_capped, report);
-            let rows = &report.zones[first_row..];
+            let rows = self.zone_rows(&result, centre_capped);
             let worst_chord = rows
                 .iter()
                 .filter_map(|z| z.centre_chord_mm)
                 .fold(0.0, f64::max);
             if worst_chord <= chord_limit {
-                return Some((result, first_row));
+                return Ok((result, rows));
             }
             let worst_dev = rows.iter().map(|z| z.max_deviation_deg).fold(0.0, f64::max);
             if retries < CENTRE_PATH_RETRIES && worst_dev > 0.0 {
@@ -655,7 +712,6 @@ impl RunPatch<'_> {
                 self.opts.max_deviation_deg =
                     Some(self.opts.max_deviation_deg.map_or(cap, |c| c.min(cap)));
                 centre_capped = true;
-                report.zones.truncate(first_row);
                 patched = self.patch(&self.opts);
                 continue;
             }
@@ -674,19 +730,12 @@ impl RunPatch<'_> {
                 row.centre_chord_mm.unwrap_or(0.0),
                 lp.chord_tolerance_mm
             );
-            for row in &mut report.zones[first_row..] {
-                row.not_written();
-                row.reason = ZoneReason::CentrePath;
-            }
-            report.untouched_runs.push(untouched(
-                lp,
-                r,
-                UntouchedReason::CentrePath,
-                result.zones.len(),
-                why,
-                file_opts.reach_deg(),
-            ));
-            return None;
+            let rows = RunOutcome::Patched {
+                rows,
+                edits: Vec::new(),
+                decimals: [0; 2],
+            };
+            return Err(rows.left(lp, r, UntouchedReason::CentrePath, why, reach_deg));
         }
     }
 
@@ -715,10 +764,11 @@ impl RunPatch<'_> {
         }
     }
 
-    /// Step 2.7: the changed primary-axis and C words, and the decimals written for them.
-    /// The run ends on new values: the blocks after it that restated its last values
-    /// restate the new ones ([`crate::end_pose`]).
-    fn rotary_edits(&self, result: &PatchResult, out: &mut Written) {
+    /// Step 2.7: the changed primary-axis and C words, and the decimals written for them
+    /// (C, primary). The run ends on new values: the blocks after it that restated its
+    /// last values restate the new ones ([`crate::end_pose`]).
+    fn rotary_edits(&self, result: &PatchResult, edits: &mut Vec<Edit>) -> [usize; 2] {
+        let mut written = [0, 0];
         let rp = &self.lp.runs[self.r];
         let program = &self.lp.program;
         let letters = [
@@ -745,12 +795,9 @@ impl RunPatch<'_> {
                     debug_assert!(false, "patcher changed the start point of a run");
                     continue;
                 }
-                if letter == self.lp.pole_letter {
-                    out.written_c = out.written_c.max(decimals);
-                } else {
-                    out.written_p = out.written_p.max(decimals);
-                }
-                out.edits.push(Edit {
+                let w = usize::from(letter != self.lp.pole_letter);
+                written[w] = written[w].max(decimals);
+                edits.push(Edit {
                     block: rp.run.blocks[k],
                     letter,
                     value: values[k],
@@ -761,7 +808,7 @@ impl RunPatch<'_> {
             if !self.opts.keep_last_point && changed[n - 1] {
                 for &b in &self.end.restate {
                     if program.block_words(b).iter().any(|w| w.letter == letter) {
-                        out.edits.push(Edit {
+                        edits.push(Edit {
                             block: b,
                             letter,
                             value: values[n - 1],
@@ -771,6 +818,7 @@ impl RunPatch<'_> {
                 }
             }
         }
+        written
     }
 }
 
@@ -823,7 +871,7 @@ fn restore_modal(
 fn finish_report(
     lp: &LoadedProgram,
     styles: &Styles,
-    out: &Written,
+    written: [usize; 2],
     words: usize,
     report: &mut FileReport,
 ) {
@@ -835,96 +883,76 @@ fn finish_report(
     });
     if near {
         report.file_c_decimals = Some(styles.c.decimals);
-        report.written_c_decimals = Some(out.written_c);
+        report.written_c_decimals = Some(written[0]);
         report.file_primary_decimals = Some(styles.p.decimals);
-        report.written_primary_decimals = Some(out.written_p);
+        report.written_primary_decimals = Some(written[1]);
     }
+}
+
+/// What [`direction_forms`] leaves: the edits to write, the runs that keep their values
+/// (the run, the reason, the message), and a warning when a conflict could not be laid at
+/// a run's door.
+struct Forms {
+    edits: Vec<Edit>,
+    dropped: Vec<(usize, UntouchedReason, String)>,
+    warning: Option<String>,
 }
 
 /// Rotary words in a Sinumerik direction form (`C=DC(…)`, `C=ACP(…)`, `C=ACN(…)`): the
 /// edits of such words are written modulo 360 in the same form where it makes the patched
 /// move ([`polepatch_nc::write_direction_forms`]); a run whose edits ask a move the form
 /// cannot make keeps its values (its zones `direction_form`), and the check is made again
-/// without it (its edits changed where the next words start from).
-fn direction_forms(
-    lp: &LoadedProgram,
-    edits: Vec<Edit>,
-    run_edit_ranges: &[(usize, usize, std::ops::Range<usize>)],
-    run_of: &std::collections::HashMap<usize, usize>,
-    report: &mut FileReport,
-    opts: &PatchOptions,
-) -> Vec<Edit> {
+/// without it (its edits changed where the next words start from). `owner`: each edit's
+/// run.
+fn direction_forms(lp: &LoadedProgram, edits: Vec<Edit>, owner: &[Option<usize>]) -> Forms {
     let program = &lp.program;
-    // The run each edit belongs to (words restored by `restore_modal` are in its run).
-    let mut owner: Vec<Option<usize>> = vec![None; edits.len()];
-    for (r, _, range) in run_edit_ranges {
-        for o in &mut owner[range.clone()] {
-            *o = Some(*r);
-        }
-    }
-    for (o, e) in owner.iter_mut().zip(&edits) {
-        if o.is_none() {
-            *o = run_of.get(&e.block).copied();
-        }
-    }
-    let mut dropped: Vec<usize> = Vec::new();
+    let mut dropped: Vec<(usize, UntouchedReason, String)> = Vec::new();
+    let is_dropped =
+        |dropped: &[(usize, UntouchedReason, String)], r: usize| dropped.iter().any(|d| d.0 == r);
     loop {
         let mut kept: Vec<Edit> = edits
             .iter()
-            .zip(&owner)
-            .filter(|(_, o)| o.is_none_or(|r| !dropped.contains(&r)))
+            .zip(owner)
+            .filter(|(_, o)| o.is_none_or(|r| !is_dropped(&dropped, r)))
             .map(|(e, _)| *e)
             .collect();
         let conflicts = polepatch_nc::write_direction_forms(program, &mut kept);
         let Some(k) = conflicts.first() else {
-            return kept;
+            return Forms {
+                edits: kept,
+                dropped,
+                warning: None,
+            };
         };
         // The run of the edit that causes it.
         let run = edits
             .iter()
-            .zip(&owner)
-            .filter(|(e, o)| e.block == k.cause && o.is_some_and(|r| !dropped.contains(&r)))
+            .zip(owner)
+            .filter(|(e, o)| e.block == k.cause && o.is_some_and(|r| !is_dropped(&dropped, r)))
             .find_map(|(_, o)| *o);
         let Some(run) = run else {
             // Not attributable (should not happen): write nothing in a direction form.
-            report
-                .warnings
-                .push(format!("{}; no rotary word was changed", k.message));
-            return Vec::new();
+            return Forms {
+                edits: Vec::new(),
+                dropped,
+                warning: Some(format!("{}; no rotary word was changed", k.message)),
+            };
         };
-        dropped.push(run);
         let reason = if k.variable {
             UntouchedReason::MacroVariable
         } else {
             UntouchedReason::DirectionForm
         };
-        let Some((_, first_row, _)) = run_edit_ranges.iter().find(|(r, _, _)| *r == run) else {
-            continue;
+        let message = if k.variable {
+            format!("{}; the run keeps its values", k.message)
+        } else {
+            format!(
+                "{}: the form cannot make the patched move, and polepatch never writes a \
+                 word that makes a different one; the run keeps its values",
+                k.message
+            )
         };
-        let zones = report.zones[*first_row..]
-            .iter()
-            .take_while(|z| z.run == lp.run_number(run))
-            .count();
-        for row in &mut report.zones[*first_row..*first_row + zones] {
-            row.not_written();
-            row.reason = reason.zone_reason().unwrap_or(ZoneReason::NotPatched);
-        }
-        report.untouched_runs.push(untouched(
-            lp,
-            run,
-            reason,
-            zones,
-            if k.variable {
-                format!("{}; the run keeps its values", k.message)
-            } else {
-                format!(
-                    "{}: the form cannot make the patched move, and polepatch never writes a \
-                     word that makes a different one; the run keeps its values",
-                    k.message
-                )
-            },
-            opts.reach_deg(),
-        ));
+        dropped.push((run, reason, message));
     }
 }
 

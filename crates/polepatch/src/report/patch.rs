@@ -423,6 +423,7 @@ impl UntouchedReason {
             UntouchedReason::FrameTransformed => Some(ZoneReason::FrameTransformed),
             UntouchedReason::DirectionForm => Some(ZoneReason::DirectionForm),
             UntouchedReason::MacroVariable => Some(ZoneReason::MacroVariable),
+            UntouchedReason::CentrePath => Some(ZoneReason::CentrePath),
             _ => None,
         }
     }
