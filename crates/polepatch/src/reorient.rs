@@ -178,17 +178,13 @@ fn standard_only(machine: &Machine) -> Result<(), Error> {
     ))
 }
 
-/// The edits that reorient `lp` by `tilt`, and the lines of moves with TCPM off.
-pub fn reorient_edits(
-    lp: &LoadedProgram,
-    machine: &Machine,
-    tilt: &Tilt,
-) -> Result<(Vec<Edit>, Vec<usize>), Error> {
+/// Step 1 of [`reorient_edits`]: the moves under TCPM with their full positions (block,
+/// X Y Z P C), and the lines of moves with TCPM off; what cannot be reoriented refused at
+/// its line.
+#[allow(clippy::type_complexity)]
+fn moves_under_tcpm(lp: &LoadedProgram) -> Result<(Vec<(usize, [f64; 5])>, Vec<usize>), Error> {
     let program = &lp.program;
-    standard_only(machine)?;
     let (p_idx, c_idx) = (lp.primary_index(), lp.pole_index());
-    let rot = JigRotation::new(tilt.theta_x_deg, tilt.theta_z_deg);
-    // The moves under TCPM, with their full positions.
     let mut moves: Vec<(usize, [f64; 5])> = Vec::new();
     let mut untouched = Vec::new();
     for (b, block) in program.blocks.iter().enumerate() {
@@ -257,6 +253,19 @@ pub fn reorient_edits(
                 .into(),
         });
     }
+    Ok((moves, untouched))
+}
+
+/// The edits that reorient `lp` by `tilt`, and the lines of moves with TCPM off.
+pub fn reorient_edits(
+    lp: &LoadedProgram,
+    machine: &Machine,
+    tilt: &Tilt,
+) -> Result<(Vec<Edit>, Vec<usize>), Error> {
+    let program = &lp.program;
+    standard_only(machine)?;
+    let rot = JigRotation::new(tilt.theta_x_deg, tilt.theta_z_deg);
+    let (moves, untouched) = moves_under_tcpm(lp)?;
     let axes: Vec<[f64; 3]> = moves
         .iter()
         .map(|(_, q)| rot.apply(forward(machine, q[3], q[4])))

@@ -451,6 +451,32 @@ impl<'a> Reading<'a> {
     }
 }
 
+impl BeyondRange {
+    /// The first word of block `s` that moves a bounded rotary axis (`ranges`, by letter)
+    /// beyond its range, as the controller reaches it (the unwrapped position of a
+    /// direction form).
+    fn of(s: &Scanned<'_>, ranges: &[(u8, (f64, f64))]) -> Option<BeyondRange> {
+        for w in s.words {
+            let Some(&(letter, (lo, hi))) = ranges.iter().find(|r| r.0 == w.letter) else {
+                continue;
+            };
+            let idx = polepatch_nc::modal::axis_index(letter).unwrap_or(0);
+            if let Some(v) = s.state.pos[idx]
+                && !(lo - RANGE_SLACK_DEG..=hi + RANGE_SLACK_DEG).contains(&v)
+            {
+                return Some(BeyondRange {
+                    line: s.block.line,
+                    column: (w.start as usize).saturating_sub(s.block.span().start) + 1,
+                    letter,
+                    value_deg: v,
+                    range_deg: (lo, hi),
+                });
+            }
+        }
+        None
+    }
+}
+
 impl Survey {
     /// The file's number style from all its lines, where the survey counted it only from
     /// a point on ([`Reading::lazy_style`]): the lines before it are lexed again.
@@ -496,6 +522,56 @@ fn survey(bytes: &[u8], opts: &Reading<'_>) -> Result<Survey, Error> {
     }
 }
 
+/// The first word of each rotary letter A B C (not an auxiliary axis), and its first that
+/// is not 0 (a letter that has turned has both), as (line, column).
+fn first_rotary_words(
+    s: &Scanned<'_>,
+    auxiliary: &[u8],
+    first_word: &mut [Option<(usize, usize)>; 3],
+    first_turn: &mut [Option<(usize, usize)>; 3],
+) {
+    for w in s.words {
+        if auxiliary.contains(&w.letter) {
+            continue;
+        }
+        let l = match w.letter {
+            b'A' => 0,
+            b'B' => 1,
+            b'C' => 2,
+            _ => continue,
+        };
+        if first_turn[l].is_some() {
+            continue;
+        }
+        let column = (w.start as usize).saturating_sub(s.block.span().start) + 1;
+        let at = (s.block.line, column);
+        first_word[l].get_or_insert(at);
+        if w.value != 0.0 {
+            first_turn[l].get_or_insert(at);
+        }
+    }
+}
+
+/// A restating block that another run holds (from its first block on) cannot be rewritten
+/// for this one: the run's last point stays (decided there). Nothing after the others
+/// decides: the end of the file leaves them free.
+fn pin_ends_restated_by_other_runs(runs: &mut [RunRec]) {
+    let firsts: Vec<usize> = runs.iter().map(|r| r.first_block).collect();
+    for r in 0..runs.len() {
+        let next_first = firsts[r + 1..].iter().copied().min();
+        for e in &mut runs[r].end {
+            if let Some(nf) = next_first
+                && let Some(&(_, line)) = e.restate.iter().find(|&&(b, _)| b >= nf)
+            {
+                e.decided = Some((false, line));
+                e.restate.clear();
+            }
+        }
+    }
+}
+
+/// The first read of one reading (module docs, step 1): the runs, what decides their ends,
+/// the file's number style, notes, and the first words that tell why a program has no run.
 fn survey_once(
     bytes: &[u8],
     opts: &Reading<'_>,
@@ -534,24 +610,7 @@ fn survey_once(
         // A move to a rotary value beyond the machine's range (as the controller reaches
         // it: the unwrapped position of a direction form).
         if beyond_range.is_none() && s.block.is_move {
-            for w in s.words {
-                let Some(&(letter, (lo, hi))) = opts.ranges.iter().find(|r| r.0 == w.letter) else {
-                    continue;
-                };
-                let idx = polepatch_nc::modal::axis_index(letter).unwrap_or(0);
-                if let Some(v) = s.state.pos[idx]
-                    && !(lo - RANGE_SLACK_DEG..=hi + RANGE_SLACK_DEG).contains(&v)
-                {
-                    beyond_range = Some(BeyondRange {
-                        line: s.block.line,
-                        column: (w.start as usize).saturating_sub(s.block.span().start) + 1,
-                        letter,
-                        value_deg: v,
-                        range_deg: (lo, hi),
-                    });
-                    break;
-                }
-            }
+            beyond_range = BeyondRange::of(&s, &opts.ranges);
         }
         if s.state.incremental && !prev.incremental {
             incremental_set_line = Some(s.block.line);
@@ -559,28 +618,12 @@ fn survey_once(
         if no_run_why.is_none() {
             no_run_why = NoRunWhy::of(s.block, s.state, incremental_set_line);
         }
-        // The first word of each rotary letter, and its first that is not 0 (a letter
-        // that has turned has both).
-        for w in s.words {
-            if opts.read.controller.auxiliary.contains(&w.letter) {
-                continue;
-            }
-            let l = match w.letter {
-                b'A' => 0,
-                b'B' => 1,
-                b'C' => 2,
-                _ => continue,
-            };
-            if first_turn[l].is_some() {
-                continue;
-            }
-            let column = (w.start as usize).saturating_sub(s.block.span().start) + 1;
-            let at = (s.block.line, column);
-            first_word[l].get_or_insert(at);
-            if w.value != 0.0 {
-                first_turn[l].get_or_insert(at);
-            }
-        }
+        first_rotary_words(
+            &s,
+            &opts.read.controller.auxiliary,
+            &mut first_word,
+            &mut first_turn,
+        );
         // (Only while no rotary word has been read: the hint is for programs without.)
         if first_vector.is_none()
             && first_word.iter().all(Option::is_none)
@@ -628,21 +671,7 @@ fn survey_once(
     })
     .map_err(|e| Error::Parse(e.with_path(opts.name)))?;
     builder.finish(&mut |run| sv.take(run));
-    // A restating block that another run holds (from its first block on) cannot be
-    // rewritten for this one: the run's last point stays (decided there). Nothing after
-    // the others decides: the end of the file leaves them free.
-    let firsts: Vec<usize> = sv.runs.iter().map(|r| r.first_block).collect();
-    for r in 0..sv.runs.len() {
-        let next_first = firsts[r + 1..].iter().copied().min();
-        for e in &mut sv.runs[r].end {
-            if let Some(nf) = next_first
-                && let Some(&(_, line)) = e.restate.iter().find(|&&(b, _)| b >= nf)
-            {
-                e.decided = Some((false, line));
-                e.restate.clear();
-            }
-        }
-    }
+    pin_ends_restated_by_other_runs(&mut sv.runs);
     Ok((
         Survey {
             dialect: read.dialect,
