@@ -10,16 +10,10 @@
 //! rotary axis and C, degrees).
 
 use crate::error::Error;
+pub use crate::tolerances::SAME_TIP_MM;
+pub use crate::tolerances::ZERO_AXIS_NORM;
 use polepatch_kinematics::{BranchRule, Machine, inverse_path};
 use polepatch_patcher::{PatchOptions, Path, ZoneReport, patch_path};
-
-/// A tool axis shorter than this (in the units of i j k) is taken for zero and refused:
-/// it has no direction to normalise.
-pub const ZERO_AXIS_NORM: f64 = 1e-9;
-
-/// Two consecutive tool tips closer than this, mm, are the same point: a run cannot stand
-/// still (s must increase), so it is refused with a hint to split the run there.
-pub const SAME_TIP_MM: f64 = 1e-9;
 
 /// Joints for CL points: each `[x, y, z, i, j, k]` becomes `[x, y, z, p, c]`, x y z as
 /// given, p and c in degrees from the machine's inverse kinematics with `rule` (C

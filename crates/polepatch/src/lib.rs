@@ -47,7 +47,9 @@ mod notes;
 mod options;
 mod patch;
 mod program;
+mod settings;
 mod stream;
+mod tolerances;
 mod violation;
 
 pub use analyze::analyze_program;

@@ -39,16 +39,13 @@
 //! unknown — the run is left as it is, with a message asking for `--work-offset`, and no
 //! machine-frame check is made.
 
+pub use crate::settings::CHORD_SAMPLES;
+pub use crate::settings::CHORD_TOLERANCE_MM;
+pub use crate::tolerances::MIN_XYZ_DECIMALS;
+pub use crate::tolerances::PART_ZERO_LENGTH_MM;
+pub use crate::tolerances::TIP_TOLERANCE_MM;
 use polepatch_kinematics::{Chain, Machine};
 use polepatch_patcher::Path;
-
-/// The part-frame tool tip of a rewritten block without TCPM must be within this of the
-/// original, mm (issue 10: "to the file's precision", 1 µm).
-pub const TIP_TOLERANCE_MM: f64 = 1e-3;
-
-/// Fewest decimals written for X Y Z recomputed through the chain: rounding to 3 decimals
-/// moves a point by at most 0.0005·√3 ≈ 0.00087 mm < [`TIP_TOLERANCE_MM`].
-pub const MIN_XYZ_DECIMALS: usize = 3;
 
 /// The work offset of a run whose first block is `first` ([`crate::program::LoadedProgram::datum_mm`]), from the program's stated datum
 /// shifts and other frame changes (block indices in file order, as in
@@ -142,17 +139,6 @@ pub fn machine_frame_path(
     }
 }
 
-/// Default chord tolerance, mm: how far the part-frame tool tip of a block rewritten
-/// through the chain may leave the programmed line between its points (issue 19 §2).
-pub const CHORD_TOLERANCE_MM: f64 = 0.005;
-
-/// Samples per block for [`chord_error_mm`]. The tip's distance from the line is a smooth
-/// function of the interpolation parameter u that is 0 at both ends; for the rotary steps
-/// a rewritten block takes (tens of degrees at most) it is well within one sign change of
-/// its curvature over [0, 1], and sampling every 1/32 finds its maximum within about
-/// (1/64)²/2 of the maximum's curvature scale — under 0.02 % of it.
-pub const CHORD_SAMPLES: usize = 32;
-
 /// Largest distance of the part-frame tool tip from the programmed line `tips[0]`–`tips[1]`
 /// while a block without TCPM moves from program values `from` to `to` (`[X, Y, Z, P, C]`),
 /// every axis interpolated linearly as the controller does without TCPM: sampled at
@@ -190,12 +176,6 @@ pub fn round_to(v: f64, decimals: usize) -> f64 {
     let k = 10f64.powi(decimals as i32);
     (v * k).round() / k
 }
-
-/// A part-frame segment shorter than this is a rotary repositioning about the tool tip
-/// (mm): without TCPM the program's X Y Z move with it, so the run goes on; in the part
-/// frame the tool tip stands still, and the patcher treats the pieces either side as
-/// separate paths (as a TCPM program's zero-length block splits its runs).
-pub const PART_ZERO_LENGTH_MM: f64 = TIP_TOLERANCE_MM;
 
 /// [`polepatch_patcher::patch_path`] on a part-frame path that may stand still at places:
 /// each stretch between [`PART_ZERO_LENGTH_MM`] segments is patched on its own, its last

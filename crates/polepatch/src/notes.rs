@@ -24,6 +24,7 @@
 //! `--strict` counts the items (not the warnings) as a failure: the file was read, but
 //! not all of it was analysed.
 
+use crate::settings::NAMED_LINES;
 use polepatch_nc::modal::{A, B, C};
 use polepatch_nc::{Block, FeedMode, Flags, Lookalike, Modal, Motion, RotaryLetters, Word};
 use serde::Serialize;
@@ -94,9 +95,6 @@ pub struct Notes {
     /// The first block that states the units: its line and whether they are inches.
     stated: Option<(usize, bool)>,
 }
-
-/// At most this many lines are named for one kind of warning.
-const NAMED_LINES: usize = 5;
 
 impl Notes {
     /// An empty collector.

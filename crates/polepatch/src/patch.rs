@@ -57,6 +57,11 @@ use crate::report::{
     EndFreedom, FiguresRow, FileReport, UntouchedReason, UntouchedRun, ZoneReason, ZoneRow,
     ZoneTool,
 };
+use crate::settings::CENTRE_CHORD_SAMPLES;
+use crate::settings::CENTRE_PATH_RETRIES;
+use crate::tolerances::CENTRE_PATH_CAP_SAFETY;
+use crate::tolerances::MIN_INCH_XYZ_DECIMALS;
+use crate::tolerances::RAPID_TIME_TOL_S;
 use crate::tool::{RunTool, ToolDemand, ToolKind};
 use polepatch_kinematics::{Chain, Machine};
 use polepatch_nc::{Edit, FileStyle, NumberStyle, Tcpm};
@@ -65,18 +70,6 @@ use polepatch_patcher::{
     report_unpatched,
 };
 use std::collections::HashMap;
-
-/// How many times a run whose kept ball centre would leave its path between the points by
-/// more than the chord tolerance is solved again with its orientation change capped.
-const CENTRE_PATH_RETRIES: usize = 3;
-
-/// The cap of such a retry: the deviation that gave the excursion, scaled by the tolerance
-/// over the excursion and by this margin.
-const CENTRE_PATH_CAP_SAFETY: f64 = 0.9;
-
-/// Below this, a positioning move's time after a run is the same before and after a patch
-/// (what the end's choice ignores), s.
-const RAPID_TIME_TOL_S: f64 = 1e-3;
 
 /// Patch a loaded program: the edits to write and the report (the steps of the module
 /// docs).
@@ -1116,10 +1109,6 @@ fn run_tool(lp: &LoadedProgram, r: usize, machine: &Machine) -> RunTool {
     )
 }
 
-/// Fewest decimals for X Y Z of an inch program rewritten to keep a ball's centre
-/// (5: 0.25 µm per axis).
-const MIN_INCH_XYZ_DECIMALS: usize = 5;
-
 /// Distance from `p` to the segment `a`–`b`, mm.
 fn point_segment_mm(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
     let ab: [f64; 3] = std::array::from_fn(|i| b[i] - a[i]);
@@ -1135,9 +1124,6 @@ fn point_segment_mm(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
         .sum::<f64>()
         .sqrt()
 }
-
-/// Points sampled inside each block for the centre's path between two points.
-const CENTRE_CHORD_SAMPLES: usize = 8;
 
 /// The tool figures of a patched zone's row (module [`crate::tool`]): the tool and its
 /// point, the cutter's largest displacement at a written point, the centre's path between

@@ -23,6 +23,8 @@
 
 use crate::error::Error;
 use crate::report::FileReport;
+pub use crate::settings::ARC_TOLERANCE_MM;
+pub use crate::tolerances::SAME_AXIS_TOL;
 use polepatch_cl::{
     Arc, ClError, ClItem, ClPoint, ClProgram, CompSide, Coolant, CycleKind, MoveKind, ParseOptions,
     Plane, SpindleDir, Units,
@@ -32,13 +34,6 @@ use polepatch_nc::Dialect;
 use polepatch_nc::emit::{
     self, ArcPlane, Comp, EmitArc, EmitHole, EmitOptions, EmitPoint, HoleKind, Item, Spindle, emit,
 };
-
-/// Default chordal tolerance of arcs, mm.
-pub const ARC_TOLERANCE_MM: f64 = 0.001;
-
-/// Two tool axes closer than this (unit vectors, |a − b|) are the same axis: an arc
-/// between them keeps a fixed tool axis. CAM files write i j k with 6–9 decimals.
-pub const SAME_AXIS_TOL: f64 = 1e-6;
 
 /// Options of [`post_cl`]. Plain struct; see each field for its default.
 #[derive(Debug, Clone, PartialEq)]

@@ -1,6 +1,8 @@
 //! From NC bytes to the patcher's paths: parse, group into runs, pick the axes.
 
 use crate::error::Error;
+use crate::settings::CL_SNIFF_BYTES;
+pub use crate::tolerances::MIN_FEED_MM_MIN;
 use polepatch_kinematics::Machine;
 use polepatch_nc::{Dialect, FileStyle, Program, RotaryLetters, Run, modal};
 use polepatch_patcher::Path;
@@ -41,12 +43,6 @@ pub enum RunProblem {
         analysed: String,
     },
 }
-
-/// The lowest feed polepatch analyses, mm/min. Equation 6 itself has no lower limit, but a
-/// run at a feed below this (0.04 inch/min) is a typing error or a dwell written as a move,
-/// and its time estimate is meaningless; such a run is reported with its line and left as
-/// it is.
-pub const MIN_FEED_MM_MIN: f64 = 1.0;
 
 impl std::fmt::Display for RunProblem {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -357,9 +353,6 @@ pub(crate) fn or_cl_file(e: Error, bytes: &[u8], name: &str) -> Error {
         e => e,
     }
 }
-
-/// How far into a file [`cl_file_error`] looks for an APT `GOTO/` record, bytes.
-const CL_SNIFF_BYTES: usize = 64 * 1024;
 
 /// When `bytes` is a CL file (an APT `GOTO/` record starts a line within its first
 /// [`CL_SNIFF_BYTES`]), the error that says so, at that line: given instead of the NC

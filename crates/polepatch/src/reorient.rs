@@ -41,7 +41,15 @@ use crate::analyze::analyze_program;
 use crate::error::Error;
 use crate::program::LoadedProgram;
 use crate::report::AnalyzeReport;
+pub use crate::settings::MAX_THETA_X_DEG;
+pub use crate::settings::MAX_THETA_Z_DEG;
+pub use crate::settings::SEARCH_MAX_TILT_DEG;
+pub use crate::settings::SEARCH_REFINE_STEP_DEG;
+pub use crate::settings::SEARCH_STEP_DEG;
+pub use crate::settings::SEARCH_THETA_Z_STEP_DEG;
 use crate::stream::load_nc;
+pub use crate::tolerances::BRANCH_KEEP_DEG;
+pub use crate::tolerances::MIN_DECIMALS;
 use polepatch_kinematics::inverse::unwrap_near_deg;
 use polepatch_kinematics::{
     BranchRule, IkSolution, JigRotation, Machine, forward, inverse, inverse_path_from,
@@ -51,28 +59,6 @@ use polepatch_nc::{Edit, Motion, NumberStyle};
 use polepatch_patcher::AnalysisOptions;
 use serde::Serialize;
 use std::collections::BTreeMap;
-
-/// Below this |θx|, degrees, every reoriented move keeps the program's IK branch (its side
-/// of the pole); from it on, the branch is continued from move to move (`continue_branch`).
-/// A tilt of less than 1° moves no tool axis by more than 1°: the program is still where it
-/// was relative to the pole, flips and all; a larger tilt is meant to take the path away
-/// from the pole, where continuity is what keeps C from swinging.
-pub const BRANCH_KEEP_DEG: f64 = 1.0;
-/// Largest |θx| accepted, degrees: a jig tilts the part at most onto its side; beyond,
-/// the tool would reach the faces the program cuts from below.
-pub const MAX_THETA_X_DEG: f64 = 90.0;
-/// Largest |θz| accepted, degrees (one turn either way; a larger value is a typing error).
-pub const MAX_THETA_Z_DEG: f64 = 360.0;
-/// Fewest decimals written for reoriented values (the file's if more).
-pub const MIN_DECIMALS: usize = 3;
-/// Search: step of |θx| levels, degrees.
-pub const SEARCH_STEP_DEG: f64 = 1.0;
-/// Search: refinement step of |θx| below the first feasible level, degrees.
-pub const SEARCH_REFINE_STEP_DEG: f64 = 0.1;
-/// Search: largest tilt tried, degrees.
-pub const SEARCH_MAX_TILT_DEG: f64 = 45.0;
-/// Search: θz grid, degrees.
-pub const SEARCH_THETA_Z_STEP_DEG: f64 = 15.0;
 
 /// A jig tilt.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

@@ -54,6 +54,10 @@ use crate::patch::patch_program;
 use crate::program::{LoadedProgram, RunPath, Window, run_path};
 use crate::report::FileReport;
 use crate::report::{AnalyzeReport, RunReport};
+use crate::settings::BATCH_FRACTION;
+use crate::settings::BATCH_MAX_BYTES;
+use crate::settings::BATCH_MIN_BYTES;
+use crate::tolerances::RANGE_SLACK_DEG;
 use polepatch_kinematics::Machine;
 use polepatch_nc::{
     Dialect, FileStyle, ProgramBuilder, RotaryLetters, Run, RunBuilder, Scanned, StyleEvidence,
@@ -62,18 +66,6 @@ use polepatch_nc::{
 use std::collections::VecDeque;
 use std::io::Write;
 use std::ops::ControlFlow;
-
-/// A rotary value this far beyond the machine's range still counts as in it, degrees (the
-/// range's own round-off).
-const RANGE_SLACK_DEG: f64 = 1e-9;
-
-/// Stretches are patched in batches of about this part of the file's bytes (so that the
-/// batch's parsed programs, ~10× their bytes, stay a small part of the file's size) …
-const BATCH_FRACTION: usize = 256;
-/// … but at least this many bytes (small files: one batch) …
-const BATCH_MIN_BYTES: usize = 16 << 10;
-/// … and at most this many.
-const BATCH_MAX_BYTES: usize = 256 << 10;
 
 /// The two readings the survey follows at once, in the per-letter arrays (`l`): the
 /// machine's rotary letters, and the same with the third letter of A B C as the tilting

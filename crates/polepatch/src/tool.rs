@@ -76,17 +76,12 @@
 //! A CL file's `CUTTER/` is in the file's units likewise.
 
 use crate::error::Error;
+pub use crate::settings::SURFACE_TOLERANCE_MM;
+pub use crate::tolerances::CORNER_TOLERANCE_MM;
+use crate::tolerances::SAME_POINT_MM;
 use polepatch_cl::{ClItem, ClProgram, CutterShape};
 use polepatch_nc::{Block, Dialect, Flags, Modal, Word};
 use std::collections::HashMap;
-
-/// Two radii closer than this are equal when a corner radius is compared with half a
-/// diameter, mm (posts round both: Fusion writes D=0.1181 CR=0.0591 for a 3 mm probe).
-pub const CORNER_TOLERANCE_MM: f64 = 2e-3;
-
-/// The default surface tolerance for flat and bull-nose cutters, mm: how far their
-/// cutting surface may move at a CL point when the patch turns the tool about its tip.
-pub const SURFACE_TOLERANCE_MM: f64 = 0.005;
 
 /// A cutter's shape.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -592,9 +587,6 @@ pub enum ToolDemand {
     /// Nothing: X Y Z are the ball's centre, or the tool is unknown.
     Nothing,
 }
-
-/// Two points on the tool axis closer than this are the same point, mm.
-const SAME_POINT_MM: f64 = 1e-9;
 
 impl RunTool {
     /// For a ball: the height of its centre above the point X Y Z state, mm (R − h; R at

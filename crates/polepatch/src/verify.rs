@@ -54,6 +54,12 @@
 //! its own and handed over in batches), plus the runs in hand.
 
 use crate::error::Error;
+use crate::settings::BATCH_BLOCKS;
+use crate::tolerances::LINE_MATCH_MM;
+pub use crate::tolerances::RATIO_TOL_REL;
+pub use crate::tolerances::REACHED_TOL;
+pub use crate::tolerances::REFERENCE_TOL_MM;
+pub use crate::tolerances::TIME_TOL_REL;
 use crate::tool::{RunTool, ToolDemand, ToolKind, ToolPoint};
 pub use crate::violation::{Check, Violation};
 use polepatch_kinematics::{Machine, angle_between_deg, forward};
@@ -64,27 +70,6 @@ use polepatch_nc::{
 use polepatch_patcher::{AnalysisOptions, Path};
 use std::collections::VecDeque;
 use std::ops::ControlFlow;
-
-/// How far the tool's reference point may move, mm, beyond the rounding of the words
-/// written on both sides (SPEC §6: "a tip-programmed ball's centre within 1 µm (+
-/// rounding)").
-pub const REFERENCE_TOL_MM: f64 = 1e-3;
-
-/// A run reaches feed on an axis where its Equation-6 ratio is at least `1 − REACHED_TOL`
-/// (the analyses of the two sides are the same computation; this absorbs their round-off).
-pub const REACHED_TOL: f64 = 1e-6;
-
-/// Where the original is below feed, the written ratio may be this much lower (relative)
-/// and still count as no lower (issue 39: "1 % tolerance"): a ball's centre kept moves the
-/// tips, which moves X Y Z's own derivatives a little.
-pub const RATIO_TOL_REL: f64 = 0.01;
-
-/// A run's or the program's estimated time may be this much greater (relative) and still
-/// count as no greater (beyond the estimates' own error bounds).
-pub const TIME_TOL_REL: f64 = 1e-3;
-
-/// Batches of blocks handed from the patched program's reader to the comparison.
-const BATCH_BLOCKS: usize = 512;
 
 /// A zone the patch reports reached, to be held against the written program
 /// ([`verify_claims`]).
@@ -268,9 +253,6 @@ fn same_line(a: &str, b: &str) -> bool {
                     .is_none_or(|&(_, y)| (x - y).abs() <= LINE_MATCH_MM)
         })
 }
-
-/// How far X Y Z numbers of the same line may differ in [`same_line`], mm (or inch).
-const LINE_MATCH_MM: f64 = 0.1;
 
 /// The 1-based line of `original` where `patched`, which has a different number of lines,
 /// lost or gained one: the first line from which the programs pair better shifted by one.
