@@ -94,7 +94,7 @@ use crate::{
     qp::{QpBuilder, Row, combine, scaled},
     report::{QpStats, QpStatus},
     settings::SolverSettings,
-    tolerances::{REACH_SLACK, REACH_STEPS},
+    tolerances::{G16_SPACING_POINTS, REACH_SLACK, REACH_STEPS},
 };
 use polepatch_bspline::{BSpline, interpolate_not_a_knot, knots::clamped_cubic};
 
@@ -285,7 +285,11 @@ impl<'a> Split<'a> {
         let first_z = zone.first.min(sing);
         let last_z = zone.last.max(sing + 1).min(n - 1);
 
-        let h_cl = median_spacing(s_mm, first_z.saturating_sub(5), (last_z + 5).min(n - 1));
+        let h_cl = median_spacing(
+            s_mm,
+            first_z.saturating_sub(G16_SPACING_POINTS),
+            (last_z + G16_SPACING_POINTS).min(n - 1),
+        );
         if h_cl.is_nan() || h_cl <= 0.0 {
             return Err(PatchFailure::TooShort);
         }

@@ -21,6 +21,7 @@ use super::cones::{MAX_CONE, SocScaling, soc_div, soc_prod, soc_scaling, soc_ste
 use super::kkt::Kkt;
 use super::problem::Problem;
 use super::{IpmSettings, IpmSolution, IpmStatus, IpmWarm, inf_norm};
+use crate::tolerances::{IPM_COLD_DEPTH, IPM_SLACK_FLOOR};
 
 impl Problem {
     /// Solve (module docs of [`super`]): Mehrotra's predictor–corrector with
@@ -185,7 +186,7 @@ impl Iterate {
         // iterations on the held-out-like zones.)
         for v in [&mut s, &mut z] {
             let a = outside(v, ml, &sys.blocks);
-            if a >= -1e-8 || !a.is_finite() {
+            if a >= -IPM_COLD_DEPTH || !a.is_finite() {
                 let shift = if a.is_finite() { 1.0 + a } else { 1.0 };
                 v[..ml].iter_mut().for_each(|x| *x += shift);
                 for &(b0, _) in &sys.blocks {
@@ -196,7 +197,8 @@ impl Iterate {
         Iterate { x, s, z }
     }
 
-    /// Step `alpha` along `dir`, the linear slacks and multipliers kept above 1e-300.
+    /// Step `alpha` along `dir`, the linear slacks and multipliers kept at least
+    /// [`IPM_SLACK_FLOOR`].
     fn take_step(&mut self, sys: &Structure<'_>, alpha: f64, dir: &Direction) {
         let ml = sys.ml;
         let Iterate { x, s, z } = self;
@@ -208,8 +210,8 @@ impl Iterate {
             *zr += alpha * dzr;
         }
         for (sr, zr) in s[..ml].iter_mut().zip(z[..ml].iter_mut()) {
-            *sr = sr.max(1e-300);
-            *zr = zr.max(1e-300);
+            *sr = sr.max(IPM_SLACK_FLOOR);
+            *zr = zr.max(IPM_SLACK_FLOOR);
         }
     }
 
