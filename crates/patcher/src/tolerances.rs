@@ -8,8 +8,8 @@
 //! change per call. What is here is fixed: changing one changes what "equal", "not worse"
 //! or "enough points" mean, and every method together with it.
 //!
-//! The option defaults (the singular cone [`crate::CONE_DEG`], the pole reach
-//! [`crate::POLE_REACH_DEG`]) stay with the analysis they parametrise; the limits of the
+//! The option defaults that are not fields' literals (the singular cone [`crate::CONE_DEG`],
+//! the pole reach [`crate::POLE_REACH_DEG`]) are in [`crate::settings`]; the limits of the
 //! options (what [`crate::PatchOptions::validate`] accepts) stay with the options.
 
 // --- Equation 6 and "not worse" ------------------------------------------------------
