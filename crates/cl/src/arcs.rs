@@ -21,9 +21,8 @@
 //! circle, so [`Arc::segments`] takes δ = 2·acos(1 − tol/r) (and never more than 90°). The
 //! same holds on a helix: the axial part is linear in t on both the chord and the helix.
 
-/// An end point of an arc may be this far from the circle (mm): CAM files write 4–6
-/// decimals, inch files 0.0001 in = 0.00254 mm.
-pub const ON_CIRCLE_TOL_MM: f64 = 0.005;
+pub use crate::tolerances::ON_CIRCLE_TOL_MM;
+use crate::tolerances::{MAX_ARC_CHORDS, SLERP_OPPOSITE_RAD, SLERP_SAME_RAD};
 
 /// A circular or helical move.
 #[derive(Debug, Clone, PartialEq)]
@@ -106,10 +105,10 @@ fn rotate(v: [f64; 3], n: [f64; 3], angle: f64) -> [f64; 3] {
 pub fn slerp(a: [f64; 3], b: [f64; 3], t: f64) -> Option<[f64; 3]> {
     let c = cross(a, b);
     let angle = norm(c).atan2(dot(a, b));
-    if angle < 1e-12 {
+    if angle < SLERP_SAME_RAD {
         return Some(a);
     }
-    if std::f64::consts::PI - angle < 1e-9 {
+    if std::f64::consts::PI - angle < SLERP_OPPOSITE_RAD {
         return None;
     }
     let s = angle.sin();
@@ -205,8 +204,8 @@ impl Arc {
         };
         let n = (self.sweep_rad / step).ceil();
         // A tolerance far below the radius' precision would ask for billions of chords:
-        // bounded by a chord of 1e-9 rad (the caller checks the tolerance's range).
-        n.clamp(1.0, 1e7) as usize
+        // bounded (the caller checks the tolerance's range).
+        n.clamp(1.0, MAX_ARC_CHORDS) as usize
     }
 
     /// The chord end points from the first after the start to `end` (the caller's exact end
