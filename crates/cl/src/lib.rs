@@ -28,7 +28,7 @@ pub mod tolerances;
 mod values;
 pub mod write;
 
-pub use arcs::{Arc, Plane};
+pub use arcs::{Arc, ArcError, Plane};
 pub use cycles::{Cycle, CycleKind};
 pub use records::{
     ClItem, ClPoint, ClProgram, CompSide, Coolant, Cutter, CutterShape, MoveKind, Skipped,
