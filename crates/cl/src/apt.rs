@@ -28,6 +28,7 @@ use crate::records::{
     At, ClItem, ClPoint, ClProgram, CompSide, Coolant, Cutter, CutterShape, MoveKind, SpindleDir,
     Units,
 };
+use crate::tolerances::MAX_DWELL_S;
 use crate::values::{coordinate, number};
 use crate::{ClError, MAX_FEED_MM_MIN, MAX_SPINDLE_RPM, MM_PER_INCH, ParseOptions, err, unit_axis};
 
@@ -624,7 +625,7 @@ impl Reader<'_> {
                 ] {
                     coordinate(v, at, what, &format!("{v}"))?;
                 }
-                if c.feed_mm_min > MAX_FEED_MM_MIN || c.dwell_s > 1e5 {
+                if c.feed_mm_min > MAX_FEED_MM_MIN || c.dwell_s > MAX_DWELL_S {
                     return Err(e(
                         at,
                         format!(
@@ -693,7 +694,7 @@ impl Reader<'_> {
             .refusing("DELAY"));
         }
         let s = number(f[0].0, f[0].1, "DELAY seconds")?;
-        if !(0.0..=1e5).contains(&s) {
+        if !(0.0..=MAX_DWELL_S).contains(&s) {
             return Err(e(f[0].1, format!("DELAY {s} s must be within 0…100000 s")));
         }
         self.prog.items.push(ClItem::Dwell { seconds: s, at });

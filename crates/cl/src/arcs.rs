@@ -21,9 +21,8 @@
 //! circle, so [`Arc::segments`] takes δ = 2·acos(1 − tol/r) (and never more than 90°). The
 //! same holds on a helix: the axial part is linear in t on both the chord and the helix.
 
-/// An end point of an arc may be this far from the circle (mm): CAM files write 4–6
-/// decimals, inch files 0.0001 in = 0.00254 mm.
-pub const ON_CIRCLE_TOL_MM: f64 = 0.005;
+pub use crate::tolerances::ON_CIRCLE_TOL_MM;
+use crate::tolerances::{MAX_ARC_CHORDS, SLERP_OPPOSITE_RAD, SLERP_SAME_RAD};
 
 /// A circular or helical move.
 #[derive(Debug, Clone, PartialEq)]
@@ -106,10 +105,10 @@ fn rotate(v: [f64; 3], n: [f64; 3], angle: f64) -> [f64; 3] {
 pub fn slerp(a: [f64; 3], b: [f64; 3], t: f64) -> Option<[f64; 3]> {
     let c = cross(a, b);
     let angle = norm(c).atan2(dot(a, b));
-    if angle < 1e-12 {
+    if angle < SLERP_SAME_RAD {
         return Some(a);
     }
-    if std::f64::consts::PI - angle < 1e-9 {
+    if std::f64::consts::PI - angle < SLERP_OPPOSITE_RAD {
         return None;
     }
     let s = angle.sin();
@@ -117,6 +116,52 @@ pub fn slerp(a: [f64; 3], b: [f64; 3], t: f64) -> Option<[f64; 3]> {
     let v = add(scale(a, wa), scale(b, wb));
     let n = norm(v);
     Some(scale(v, 1.0 / n))
+}
+
+/// Why the values of an arc's record make no arc (the caller adds line and column).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ArcError {
+    /// The radius is not positive.
+    #[error("radius {radius_mm} must be positive")]
+    Radius {
+        /// The radius given, mm.
+        radius_mm: f64,
+    },
+    /// An end point is more than [`ON_CIRCLE_TOL_MM`] off the circle.
+    #[error(
+        "the {which} point ({:.4}, {:.4}, {:.4}) is {off_mm:.4} mm off the circle (centre ({:.4}, {:.4}, {:.4}), radius {radius_mm}); more than {tol} mm",
+        .point_mm[0], .point_mm[1], .point_mm[2], .center_mm[0], .center_mm[1], .center_mm[2],
+        tol = ON_CIRCLE_TOL_MM
+    )]
+    OffCircle {
+        /// `start` or `end`.
+        which: &'static str,
+        /// The end point, mm.
+        point_mm: [f64; 3],
+        /// Its distance from the circle, mm.
+        off_mm: f64,
+        /// The circle's centre, mm.
+        center_mm: [f64; 3],
+        /// The circle's radius, mm.
+        radius_mm: f64,
+    },
+    /// A stated sweep (`ANGLE`) is not positive.
+    #[error("ANGLE {deg}° must be positive (the direction is the axis's)")]
+    Angle {
+        /// The sweep stated, degrees.
+        deg: f64,
+    },
+    /// A stated sweep does not end at the end point.
+    #[error(
+        "ANGLE {deg}° does not end at the end point ({:.4}° from the start point about the axis)",
+        .end_rad.to_degrees()
+    )]
+    AngleEnd {
+        /// The sweep stated, degrees.
+        deg: f64,
+        /// The end point's angle from the start point about the axis, radians.
+        end_rad: f64,
+    },
 }
 
 impl Arc {
@@ -131,22 +176,25 @@ impl Arc {
         end: [f64; 3],
         sweep_deg: Option<f64>,
         start_axis: [f64; 3],
-    ) -> Result<Arc, String> {
+    ) -> Result<Arc, ArcError> {
         if radius_mm.is_nan() || radius_mm <= 0.0 {
-            return Err(format!("radius {radius_mm} must be positive"));
+            return Err(ArcError::Radius { radius_mm });
         }
         let a = sub(start, center);
         let b = sub(end, center);
         let (a_ax, b_ax) = (dot(a, normal), dot(b, normal));
         let a_pl = sub(a, scale(normal, a_ax));
         let b_pl = sub(b, scale(normal, b_ax));
-        for (what, v, p) in [("start", a_pl, start), ("end", b_pl, end)] {
+        for (which, v, p) in [("start", a_pl, start), ("end", b_pl, end)] {
             let off = (norm(v) - radius_mm).abs();
             if off > ON_CIRCLE_TOL_MM {
-                return Err(format!(
-                    "the {what} point ({:.4}, {:.4}, {:.4}) is {off:.4} mm off the circle (centre ({:.4}, {:.4}, {:.4}), radius {radius_mm}); more than {ON_CIRCLE_TOL_MM} mm",
-                    p[0], p[1], p[2], center[0], center[1], center[2]
-                ));
+                return Err(ArcError::OffCircle {
+                    which,
+                    point_mm: p,
+                    off_mm: off,
+                    center_mm: center,
+                    radius_mm,
+                });
             }
         }
         let mut theta = dot(normal, cross(a_pl, b_pl)).atan2(dot(a_pl, b_pl));
@@ -161,18 +209,16 @@ impl Arc {
         if let Some(deg) = sweep_deg {
             let stated = deg.to_radians();
             if stated.is_nan() || stated <= 0.0 {
-                return Err(format!(
-                    "ANGLE {deg}° must be positive (the direction is the axis's)"
-                ));
+                return Err(ArcError::Angle { deg });
             }
             // The stated angle must end where the end point is.
             let turns = ((stated - theta) / std::f64::consts::TAU).round();
             let off = (stated - theta - turns * std::f64::consts::TAU).abs() * radius_mm;
             if off > ON_CIRCLE_TOL_MM || turns < 0.0 {
-                return Err(format!(
-                    "ANGLE {deg}° does not end at the end point ({:.4}° from the start point about the axis)",
-                    theta.to_degrees()
-                ));
+                return Err(ArcError::AngleEnd {
+                    deg,
+                    end_rad: theta,
+                });
             }
             theta = stated;
         }
@@ -205,8 +251,8 @@ impl Arc {
         };
         let n = (self.sweep_rad / step).ceil();
         // A tolerance far below the radius' precision would ask for billions of chords:
-        // bounded by a chord of 1e-9 rad (the caller checks the tolerance's range).
-        n.clamp(1.0, 1e7) as usize
+        // bounded (the caller checks the tolerance's range).
+        n.clamp(1.0, MAX_ARC_CHORDS) as usize
     }
 
     /// The chord end points from the first after the start to `end` (the caller's exact end
@@ -350,12 +396,61 @@ mod tests {
             None,
             Z,
         )
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
         assert!(
             e.contains("end point") && e.contains("0.1000 mm off"),
             "{e}"
         );
         assert!(Arc::new([0.0; 3], Z, 0.0, [0.0; 3], [0.0; 3], None, Z).is_err());
+    }
+
+    /// Each refusal names its values, in the words the reader has always used (the
+    /// caller prefixes `CIRCLE: ` and the line and column).
+    #[test]
+    fn arc_errors_name_their_values() {
+        let s = [5.0, 0.0, 0.0];
+        let msg = |r: Result<Arc, ArcError>| r.unwrap_err().to_string();
+        assert_eq!(
+            msg(Arc::new([0.0; 3], Z, 0.0, s, s, None, Z)),
+            "radius 0 must be positive"
+        );
+        assert_eq!(
+            msg(Arc::new(
+                [0.0; 3],
+                Z,
+                10.0,
+                [10.0, 0.0, 0.0],
+                [0.0, 10.1, 0.0],
+                None,
+                Z
+            )),
+            "the end point (0.0000, 10.1000, 0.0000) is 0.1000 mm off the circle (centre (0.0000, 0.0000, 0.0000), radius 10); more than 0.005 mm"
+        );
+        assert_eq!(
+            msg(Arc::new(
+                [0.0; 3],
+                Z,
+                5.0,
+                s,
+                [0.0, 5.0, 0.0],
+                Some(-5.0),
+                Z
+            )),
+            "ANGLE -5° must be positive (the direction is the axis's)"
+        );
+        assert_eq!(
+            msg(Arc::new(
+                [0.0; 3],
+                Z,
+                5.0,
+                s,
+                [0.0, 5.0, 0.0],
+                Some(180.0),
+                Z
+            )),
+            "ANGLE 180° does not end at the end point (90.0000° from the start point about the axis)"
+        );
     }
 
     /// Every chord end is on the circle and every chord's midpoint within the tolerance,

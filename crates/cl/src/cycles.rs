@@ -98,13 +98,46 @@ pub(crate) struct CycleContext {
 
 /// Read the fields of a `CYCLE` record: `(text, where)` per comma-separated field.
 /// `number` reads a field as a finite number (with its error).
+///
+/// The steps: the mode ([`cycle_mode`]: a record without values, or a cycle's kind); each
+/// keyword and its value ([`CycleValues::read`]); the cycle from what was read
+/// ([`CycleValues::define`]).
 pub(crate) fn parse_cycle(
     fields: &[(&str, At)],
     at: At,
     ctx: &CycleContext,
     number: &dyn Fn(&str, At, &str) -> Result<f64, crate::ClError>,
 ) -> Result<CycleRecord, crate::ClError> {
-    let e = |at: At, m: String| crate::err(at.line, at.column, m);
+    let (mode, kind) = match cycle_mode(fields, at)? {
+        Mode::Record(record) => return Ok(record),
+        Mode::Define(mode, kind) => (mode, kind),
+    };
+    let mut values = CycleValues::default();
+    let mut k = 1;
+    while k < fields.len() {
+        values.read(fields, k, &mode, ctx, number)?;
+        // A value that follows its keyword: the next field must be a keyword again
+        // (a second value, e.g. STEP,p1,p2 or DWELL,s1,s2, is refused there).
+        k += 2;
+    }
+    values.define(kind, mode, at, ctx)
+}
+
+/// What a `CYCLE` record's first field says.
+enum Mode {
+    /// `OFF`, `ON` or `INIT`: the whole record.
+    Record(CycleRecord),
+    /// A cycle of this kind follows (the mode as written, upper case).
+    Define(String, CycleKind),
+}
+
+fn cycle_err(at: At, m: String) -> crate::ClError {
+    crate::err(at.line, at.column, m)
+}
+
+/// The mode of a `CYCLE` record (its first field).
+fn cycle_mode(fields: &[(&str, At)], at: At) -> Result<Mode, crate::ClError> {
+    let e = cycle_err;
     let Some(&(first, first_at)) = fields.first() else {
         return Err(e(at, "CYCLE without a mode".into()));
     };
@@ -116,9 +149,9 @@ pub(crate) fn parse_cycle(
                 format!("CYCLE/{mode} takes no values, got '{}'", fields[1].0.trim()),
             ));
         }
-        "OFF" => return Ok(CycleRecord::Off),
-        "ON" => return Ok(CycleRecord::On),
-        "INIT" => return Ok(CycleRecord::Init),
+        "OFF" => return Ok(Mode::Record(CycleRecord::Off)),
+        "ON" => return Ok(Mode::Record(CycleRecord::On)),
+        "INIT" => return Ok(Mode::Record(CycleRecord::Init)),
         "DRILL" => CycleKind::Drill,
         "DEEP" | "DEEP2" => CycleKind::Deep,
         "BRKCHP" => CycleKind::ChipBreak,
@@ -134,26 +167,45 @@ pub(crate) fn parse_cycle(
             ));
         }
     };
-    let mut depth = None;
-    let mut feed = None;
-    let mut clearance = None;
-    let mut retract = None;
-    let mut dwell = 0.0;
-    let mut peck = None;
-    let mut first_peck: Option<(f64, At)> = None;
-    let mut sub_peck = None;
-    let mut k = 1;
-    // The value after keyword `fields[k]`.
-    let value = |k: usize, what: &str| -> Result<f64, crate::ClError> {
-        match fields.get(k + 1) {
-            Some(&(t, a)) => number(t, a, what),
-            None => Err(e(
-                fields[k].1,
-                format!("CYCLE/{mode}: {what} without a value"),
-            )),
-        }
-    };
-    while k < fields.len() {
+    Ok(Mode::Define(mode, kind))
+}
+
+/// The values a cycle definition states, as read so far (lengths in mm, feed in mm/min).
+#[derive(Default)]
+struct CycleValues {
+    depth: Option<f64>,
+    feed: Option<f64>,
+    clearance: Option<f64>,
+    retract: Option<f64>,
+    dwell: f64,
+    peck: Option<f64>,
+    /// CAMWorks' `1STPECK` and where it is.
+    first_peck: Option<(f64, At)>,
+    /// CAMWorks' `SUBPECK`.
+    sub_peck: Option<f64>,
+}
+
+impl CycleValues {
+    /// Read the keyword `fields[k]` and its value `fields[k + 1]` of a `CYCLE/mode`.
+    fn read(
+        &mut self,
+        fields: &[(&str, At)],
+        k: usize,
+        mode: &str,
+        ctx: &CycleContext,
+        number: &dyn Fn(&str, At, &str) -> Result<f64, crate::ClError>,
+    ) -> Result<(), crate::ClError> {
+        let e = cycle_err;
+        // The value after keyword `fields[k]`.
+        let value = |k: usize, what: &str| -> Result<f64, crate::ClError> {
+            match fields.get(k + 1) {
+                Some(&(t, a)) => number(t, a, what),
+                None => Err(e(
+                    fields[k].1,
+                    format!("CYCLE/{mode}: {what} without a value"),
+                )),
+            }
+        };
         let (t, a) = fields[k];
         let key = t.trim().to_ascii_uppercase();
         let positive = |v: f64, what: &str, strict: bool| {
@@ -172,12 +224,12 @@ pub(crate) fn parse_cycle(
         match key.as_str() {
             "FEDTO" | "DEPTH" => {
                 let v = value(k, "FEDTO (depth)")?;
-                depth =
+                self.depth =
                     Some(positive(v, "FEDTO (the depth below the GOTO point)", true)? * ctx.scale);
             }
             "MMPM" | "IPM" => {
                 let v = positive(value(k, "feed")?, "feed", true)?;
-                feed = Some(if key == "IPM" { v * 25.4 } else { v });
+                self.feed = Some(if key == "IPM" { v * 25.4 } else { v });
             }
             "MMPR" | "IPR" => {
                 let v = positive(
@@ -193,29 +245,30 @@ pub(crate) fn parse_cycle(
                         ),
                     ));
                 };
-                feed = Some(v * rpm * if key == "IPR" { 25.4 } else { 1.0 });
+                self.feed = Some(v * rpm * if key == "IPR" { 25.4 } else { 1.0 });
             }
             "RAPTO" => {
-                clearance =
+                self.clearance =
                     Some(positive(value(k, "RAPTO")?, "RAPTO (clearance)", false)? * ctx.scale)
             }
             "RTRCTO" => {
-                retract =
+                self.retract =
                     Some(positive(value(k, "RTRCTO")?, "RTRCTO (retract)", false)? * ctx.scale)
             }
-            "DWELL" => dwell = positive(value(k, "DWELL")?, "DWELL (seconds)", false)?,
+            "DWELL" => self.dwell = positive(value(k, "DWELL")?, "DWELL (seconds)", false)?,
             "STEP" | "INCR" => {
-                peck = Some(positive(value(k, "STEP (peck)")?, "STEP (peck)", true)? * ctx.scale)
+                self.peck =
+                    Some(positive(value(k, "STEP (peck)")?, "STEP (peck)", true)? * ctx.scale)
             }
             // CAMWorks: the first peck and the following ones.
             "1STPECK" => {
-                first_peck = Some((
+                self.first_peck = Some((
                     positive(value(k, "1STPECK")?, "1STPECK", true)? * ctx.scale,
                     a,
                 ))
             }
             "SUBPECK" => {
-                sub_peck = Some(positive(value(k, "SUBPECK")?, "SUBPECK", true)? * ctx.scale)
+                self.sub_peck = Some(positive(value(k, "SUBPECK")?, "SUBPECK", true)? * ctx.scale)
             }
             "" => return Err(e(a, format!("CYCLE/{mode}: an empty field"))),
             _ if t.trim().parse::<f64>().is_ok() => {
@@ -236,59 +289,77 @@ pub(crate) fn parse_cycle(
                 ));
             }
         }
-        // A value that follows its keyword: the next field must be a keyword again
-        // (a second value, e.g. STEP,p1,p2 or DWELL,s1,s2, is refused there).
-        k += 2;
+        Ok(())
     }
-    match (first_peck, sub_peck) {
-        (Some((f, _)), Some(s)) if f == s => peck = peck.or(Some(f)),
-        (Some((f, _)), Some(s)) if ctx.uniform_peck => peck = peck.or(Some(f.min(s))),
-        (Some((f, fa)), Some(s)) => {
-            return Err(e(
-                fa,
+
+    /// The peck from CAMWorks' first and following pecks (when no `STEP` gave one): read
+    /// when they are equal, else the smaller with [`crate::ParseOptions::uniform_peck`],
+    /// else refused.
+    fn resolve_peck(&mut self, mode: &str, ctx: &CycleContext) -> Result<(), crate::ClError> {
+        match (self.first_peck, self.sub_peck) {
+            (Some((f, _)), Some(s)) if f == s => self.peck = self.peck.or(Some(f)),
+            (Some((f, _)), Some(s)) if ctx.uniform_peck => self.peck = self.peck.or(Some(f.min(s))),
+            (Some((f, fa)), Some(s)) => {
+                return Err(cycle_err(
+                    fa,
+                    format!(
+                        "CYCLE/{mode}: a first peck (1STPECK {f}) other than the following ones (SUBPECK {s}) is not posted (the dialects' peck cycles take one peck); give --uniform-peck to drill with the smaller one throughout"
+                    ),
+                ));
+            }
+            (Some((f, _)), None) | (None, Some(f)) => self.peck = self.peck.or(Some(f)),
+            (None, None) => {}
+        }
+        Ok(())
+    }
+
+    /// The cycle: depth, clearance and a feed (the record's, else the `FEDRAT` in force)
+    /// required, and a peck for peck drilling.
+    fn define(
+        mut self,
+        kind: CycleKind,
+        mode: String,
+        at: At,
+        ctx: &CycleContext,
+    ) -> Result<CycleRecord, crate::ClError> {
+        let e = cycle_err;
+        self.resolve_peck(&mode, ctx)?;
+        let depth_mm = self.depth.ok_or_else(|| {
+            e(
+                at,
+                format!("CYCLE/{mode} without FEDTO (the depth): the holes cannot be drilled"),
+            )
+        })?;
+        let clearance_mm = self.clearance.ok_or_else(|| {
+            e(
+                at,
                 format!(
-                    "CYCLE/{mode}: a first peck (1STPECK {f}) other than the following ones (SUBPECK {s}) is not posted (the dialects' peck cycles take one peck); give --uniform-peck to drill with the smaller one throughout"
+                    "CYCLE/{mode} without RAPTO (the clearance above the hole where the feed starts)"
                 ),
+            )
+        })?;
+        let feed_mm_min = self.feed.or(ctx.feed_mm_min).ok_or_else(|| {
+            e(
+                at,
+                format!("CYCLE/{mode} without a feed (no MMPM/IPM value and no FEDRAT before it)"),
+            )
+        })?;
+        if matches!(kind, CycleKind::Deep | CycleKind::ChipBreak) && self.peck.is_none() {
+            return Err(e(
+                at,
+                format!("CYCLE/{mode} (peck drilling) without STEP (the peck depth)"),
             ));
         }
-        (Some((f, _)), None) | (None, Some(f)) => peck = peck.or(Some(f)),
-        (None, None) => {}
+        Ok(CycleRecord::Define(Cycle {
+            kind,
+            mode,
+            depth_mm,
+            feed_mm_min,
+            clearance_mm,
+            retract_mm: self.retract,
+            dwell_s: self.dwell,
+            peck_mm: self.peck,
+            at,
+        }))
     }
-    let depth_mm = depth.ok_or_else(|| {
-        e(
-            at,
-            format!("CYCLE/{mode} without FEDTO (the depth): the holes cannot be drilled"),
-        )
-    })?;
-    let clearance_mm = clearance.ok_or_else(|| {
-        e(
-            at,
-            format!(
-                "CYCLE/{mode} without RAPTO (the clearance above the hole where the feed starts)"
-            ),
-        )
-    })?;
-    let feed_mm_min = feed.or(ctx.feed_mm_min).ok_or_else(|| {
-        e(
-            at,
-            format!("CYCLE/{mode} without a feed (no MMPM/IPM value and no FEDRAT before it)"),
-        )
-    })?;
-    if matches!(kind, CycleKind::Deep | CycleKind::ChipBreak) && peck.is_none() {
-        return Err(e(
-            at,
-            format!("CYCLE/{mode} (peck drilling) without STEP (the peck depth)"),
-        ));
-    }
-    Ok(CycleRecord::Define(Cycle {
-        kind,
-        mode,
-        depth_mm,
-        feed_mm_min,
-        clearance_mm,
-        retract_mm: retract,
-        dwell_s: dwell,
-        peck_mm: peck,
-        at,
-    }))
 }

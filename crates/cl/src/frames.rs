@@ -30,15 +30,8 @@ use crate::records::At;
 use crate::values::{coordinate, number};
 use crate::{ClError, err};
 
-/// Rotation matrices and MCS axes are accepted when orthonormal within this (CAM files
-/// write 6–7 decimals).
-pub const FRAME_TOLERANCE: f64 = 1e-4;
-
-/// Two `MSYS` records name the same MCS when their origins agree within this, mm.
-pub const MSYS_ORIGIN_TOLERANCE_MM: f64 = 1e-4;
-
-/// Two `MSYS` records name the same MCS when their axes agree within this.
-pub const MSYS_AXIS_TOLERANCE: f64 = 1e-6;
+use crate::tolerances::CSYS_IDENTITY_TOLERANCE;
+pub use crate::tolerances::{FRAME_TOLERANCE, MSYS_AXIS_TOLERANCE, MSYS_ORIGIN_TOLERANCE_MM};
 
 /// An NX machine coordinate system: origin (mm) and X and Y axes, in NX's absolute frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -145,9 +138,11 @@ impl Frames {
         for i in [3, 7, 11] {
             coordinate(v[i] * scale, f[i].1, "CSYS origin", f[i].0)?;
         }
-        let identity = (0..3)
-            .all(|i| (0..3).all(|j| (r[i][j] - if i == j { 1.0 } else { 0.0 }).abs() <= 1e-9))
-            && [3, 7, 11].iter().all(|&i| v[i] == 0.0);
+        let identity = (0..3).all(|i| {
+            (0..3).all(|j| {
+                (r[i][j] - if i == j { 1.0 } else { 0.0 }).abs() <= CSYS_IDENTITY_TOLERANCE
+            })
+        }) && [3, 7, 11].iter().all(|&i| v[i] == 0.0);
         let axis = [r[0][2], r[1][2], r[2][2]];
         if !identity && self.world.is_none() {
             return Err(e(

@@ -24,10 +24,11 @@ pub mod csv;
 pub mod cycles;
 pub mod frames;
 pub mod records;
+pub mod tolerances;
 mod values;
 pub mod write;
 
-pub use arcs::{Arc, Plane};
+pub use arcs::{Arc, ArcError, Plane};
 pub use cycles::{Cycle, CycleKind};
 pub use records::{
     ClItem, ClPoint, ClProgram, CompSide, Coolant, Cutter, CutterShape, MoveKind, Skipped,
@@ -35,20 +36,7 @@ pub use records::{
 };
 pub use write::{to_apt, to_csv};
 
-/// A tool axis may differ from unit length by this much (CAM files round to 4–7
-/// decimals); it is then normalised.
-pub const UNIT_TOLERANCE: f64 = 1e-3;
-
-/// The largest coordinate accepted, mm (100 m): beyond any machine's travel, and small
-/// enough that every value prints as a plain number in an NC word. The CL reader knows no
-/// machine; a machine's own travel, where it has one, is checked by the post.
-pub const MAX_COORDINATE_MM: f64 = 100_000.0;
-
-/// The largest feed accepted, mm/min (1000 m/min).
-pub const MAX_FEED_MM_MIN: f64 = 1_000_000.0;
-
-/// The largest spindle speed accepted, rpm.
-pub const MAX_SPINDLE_RPM: f64 = 1_000_000.0;
+pub use tolerances::{MAX_COORDINATE_MM, MAX_FEED_MM_MIN, MAX_SPINDLE_RPM, UNIT_TOLERANCE};
 
 /// mm per inch.
 pub const MM_PER_INCH: f64 = 25.4;

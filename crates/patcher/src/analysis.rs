@@ -30,14 +30,7 @@ use crate::spline::{AnalysisSpline, SpanCubic, SplineSystem};
 use crate::tolerances::{RATIO_TOL, TIME_MAX_DEPTH, TIME_REL_TOL};
 use polepatch_kinematics::{Axis, FeedBound, LimitKind, Machine, axis_feed_bound, feed_bound};
 
-/// Default singular cone, degrees: every stretch where C is below feed and the primary
-/// axis comes this close to the pole is a zone ([`detect_zones`]).
-pub const CONE_DEG: f64 = 5.0;
-
-/// Default pole reach, degrees: out to this distance from the pole, a stretch where C is
-/// below feed is a zone when the pole accounts for at least half its slowdown
-/// ([`pole_dominates`]).
-pub const POLE_REACH_DEG: f64 = 10.0;
+pub use crate::settings::{CONE_DEG, POLE_REACH_DEG};
 
 /// Options of [`analyze_path`].
 #[derive(Debug, Clone, PartialEq)]

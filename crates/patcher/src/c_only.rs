@@ -30,6 +30,7 @@ use crate::{
     protocol::{Proposal, Proposer, Sink, Tail, ZoneCtx},
     report::Method,
     settings::SolverSettings,
+    tolerances::ZERO_NET_C_DEG,
 };
 
 /// The C-only method (module docs).
@@ -113,7 +114,7 @@ impl COnly {
                 direct_range = Some(range);
                 let (first, last) = range;
                 let net = ctx.c[last] - ctx.c[first];
-                let sigma = (net.abs() > 1e-9).then(|| net.signum());
+                let sigma = (net.abs() > ZERO_NET_C_DEG).then(|| net.signum());
                 let tries: &[Option<f64>] = if sigma.is_some() {
                     &[sigma, None]
                 } else {

@@ -57,7 +57,10 @@ use crate::{
     options::PatchOptions,
     report::{QpStats, QpStatus},
     spline::{AnalysisSpline, span_offsets},
-    tolerances::{BOUND_BISECTIONS, BOUND_REL_TOL, HERMITE_WINDOW_POINTS, NOT_WORSE_SLACK},
+    tolerances::{
+        BOUND_BISECTIONS, BOUND_BRACKET_SLACK_DEG, BOUND_REL_TOL, HERMITE_WINDOW_POINTS,
+        NOT_WORSE_SLACK,
+    },
 };
 
 /// New C values for points `first..=last` (others fixed) minimising the largest orientation
@@ -278,7 +281,7 @@ fn deviation_bound_in(
     };
     debug_assert_eq!(w.len(), nd);
     let wmax = w.iter().fold(0.0f64, |m, v| m.max(*v));
-    let mut hi = 2.0 * wmax.min(1.0).asin().to_degrees() + 1e-9;
+    let mut hi = 2.0 * wmax.min(1.0).asin().to_degrees() + BOUND_BRACKET_SLACK_DEG;
     if !feasible(hi) {
         return Err(PatchFailure::Solver(stats));
     }

@@ -87,6 +87,18 @@ struct Checked {
     tips_spoiled: bool,
 }
 
+/// The points a candidate check looks at: the candidate's `first..=last`, the last point
+/// it changes (`changed_hi`: past `last` when its tail moves), and the window `lo..=hi`
+/// handed to the verification (its change and the zone, ± [`CHECK_MARGIN_POINTS`]).
+#[derive(Debug, Clone, Copy)]
+struct CheckWindow {
+    first: usize,
+    last: usize,
+    changed_hi: usize,
+    lo: usize,
+    hi: usize,
+}
+
 /// The safety bound on the orientation change of a point whose primary axis is programmed
 /// at `_p_deg`, degrees (docs/method.md, "The safety bound"): the pole reach `reach_deg`
 /// (the cone, or the pole reach beyond it: how far from the pole a zone lies), at every
@@ -158,7 +170,11 @@ impl Selection<'_> {
         materialize(self.p, self.c, prop, lo, hi, decimals)
     }
 
-    fn check(&self, prop: &Proposal) -> Option<(Checked, bool)> {
+    /// Where `prop` may be checked: `None` when it is malformed, changes points the zone
+    /// may not change, moves the last point that must stay, or is longer than the caller
+    /// allows; else the window of the check (`prop`'s change and the zone, ±
+    /// [`CHECK_MARGIN_POINTS`]).
+    fn window(&self, prop: &Proposal) -> Option<CheckWindow> {
         let n = self.s.len();
         let (first, last) = (prop.first, prop.last);
         if first < self.lower
@@ -188,108 +204,144 @@ impl Selection<'_> {
             .min(self.zone.first)
             .saturating_sub(CHECK_MARGIN_POINTS);
         let hi = (changed_hi.max(self.zone.last) + CHECK_MARGIN_POINTS).min(n - 1);
+        Some(CheckWindow {
+            first,
+            last,
+            changed_hi,
+            lo,
+            hi,
+        })
+    }
+
+    /// With a ball's centre kept (its `s` the tip path's length), the tip path's length
+    /// over the window with the values `(wp, wc)` (unrounded: the whole-run check picks
+    /// the decimals); `None` otherwise.
+    fn tip_s(&self, w: &CheckWindow, wp: &[f64], wc: &[f64]) -> Option<Vec<f64>> {
+        let (lo, hi) = (w.lo, w.hi);
+        let keep = self.opts.keep_centre.filter(|k| k.s_is_length)?;
+        let tips: Vec<[f64; 3]> = (lo..=hi)
+            .map(|i| {
+                let q = &self.axes[i];
+                let o0 = self.target[i];
+                let o1 = forward(self.machine, wp[i - lo], wc[i - lo]);
+                std::array::from_fn(|j| q[j] + keep.radius_mm * (o0[j] - o1[j]))
+            })
+            .collect();
+        Some(tip_length(self.path, lo, self.s[lo], &tips))
+    }
+
+    /// The verification of the window's values `(wp, wc)`. `tips`: on the tips the values
+    /// write (with a ball's centre kept — before and after each on its own), else on the
+    /// path length the methods solved on.
+    fn verify_on(&self, w: &CheckWindow, wp: &[f64], wc: &[f64], tips: bool) -> Verdict {
+        let (lo, hi) = (w.lo, w.hi);
         let (bp, bc) = (&self.p[lo..=hi], &self.c[lo..=hi]);
-        let axes = self.axes();
-        // With a ball's centre kept the tips move with the orientation, and the tip path's
-        // length with them: before and after each on its own (unrounded: the whole-run
-        // check picks the decimals).
-        let tip_s = |wp: &[f64], wc: &[f64]| -> Option<Vec<f64>> {
-            let keep = self.opts.keep_centre.filter(|k| k.s_is_length)?;
-            let tips: Vec<[f64; 3]> = (lo..=hi)
-                .map(|i| {
-                    let q = &self.axes[i];
-                    let o0 = self.target[i];
-                    let o1 = forward(self.machine, wp[i - lo], wc[i - lo]);
-                    std::array::from_fn(|j| q[j] + keep.radius_mm * (o0[j] - o1[j]))
-                })
-                .collect();
-            Some(tip_length(self.path, lo, self.s[lo], &tips))
-        };
         let margin = core_margins(self.zone, self.opts.solver.core_margin_points);
-        // `tips`: on the tips the values write (with a ball's centre kept), else on the
-        // path length the methods solved on.
-        let verify_on = |wp: &[f64], wc: &[f64], tips: bool| {
-            let ch: Vec<AxisChange> = axes
-                .iter()
-                .map(|&axis| AxisChange {
-                    axis,
-                    before: if axis == Axis::C { bc } else { bp },
-                    after: if axis == Axis::C { wc } else { wp },
-                })
-                .collect();
-            let (changed, core) = (
-                (first - lo, changed_hi - lo),
-                (self.zone.first.max(lo) - lo, self.zone.last.min(hi) - lo),
-            );
-            let moved = || Some((tip_s(bp, bc)?, tip_s(wp, wc)?)).filter(|_| tips);
-            match moved() {
-                Some((sb, sa)) => verify_change_on(
-                    &sb,
-                    &sa,
-                    &ch,
-                    changed,
-                    core,
-                    margin,
-                    self.machine,
-                    self.feed_mm_s,
-                ),
-                _ => verify_change_with_core(
-                    &self.s[lo..=hi],
-                    &ch,
-                    changed,
-                    core,
-                    margin,
-                    self.machine,
-                    self.feed_mm_s,
-                ),
-            }
-        };
-        let verify = |wp: &[f64], wc: &[f64]| verify_on(wp, wc, true);
-        // With a ball's centre kept, a change that fails on the tips it writes but passes on
-        // the path length it was solved on: the moved tips spoiled it.
+        let ch: Vec<AxisChange> = self
+            .axes()
+            .iter()
+            .map(|&axis| AxisChange {
+                axis,
+                before: if axis == Axis::C { bc } else { bp },
+                after: if axis == Axis::C { wc } else { wp },
+            })
+            .collect();
+        let (changed, core) = (
+            (w.first - lo, w.changed_hi - lo),
+            (self.zone.first.max(lo) - lo, self.zone.last.min(hi) - lo),
+        );
+        let moved = || Some((self.tip_s(w, bp, bc)?, self.tip_s(w, wp, wc)?)).filter(|_| tips);
+        match moved() {
+            Some((sb, sa)) => verify_change_on(
+                &sb,
+                &sa,
+                &ch,
+                changed,
+                core,
+                margin,
+                self.machine,
+                self.feed_mm_s,
+            ),
+            _ => verify_change_with_core(
+                &self.s[lo..=hi],
+                &ch,
+                changed,
+                core,
+                margin,
+                self.machine,
+                self.feed_mm_s,
+            ),
+        }
+    }
+
+    /// With a ball's centre kept: whether the values pass on the path length they were
+    /// solved on (so that, failing on the tips they write, the moved tips spoiled them).
+    fn spoiled(&self, w: &CheckWindow, wp: &[f64], wc: &[f64]) -> bool {
         let keeps_centre = self.opts.keep_centre.is_some_and(|k| k.s_is_length);
-        let spoiled = |wp: &[f64], wc: &[f64]| keeps_centre && verify_on(wp, wc, false).passes();
-        // The largest exact change, its largest ratio to the safety bound, and whether every
-        // point is within its bound (up to the rounding of `d`'s decimals).
-        let deviation = |wp: &[f64], wc: &[f64], d: (usize, usize)| {
-            let room = bound_room_deg(d);
-            let (mut dev, mut ratio, mut within) = (0.0f64, 0.0f64, true);
-            for i in first..=last {
-                let a = angle_between_deg(
-                    self.target[i],
-                    forward(self.machine, wp[i - lo], wc[i - lo]),
-                );
-                dev = dev.max(a);
-                if a > 0.0 {
-                    ratio = ratio.max(a / self.bound[i].max(f64::MIN_POSITIVE));
-                }
-                within &= a <= self.bound[i] + room;
+        keeps_centre && self.verify_on(w, wp, wc, false).passes()
+    }
+
+    /// The largest exact change of the window's values `(wp, wc)`, its largest ratio to
+    /// the safety bound, and whether every point is within its bound (up to the rounding
+    /// of `d`'s decimals).
+    fn deviation(
+        &self,
+        w: &CheckWindow,
+        wp: &[f64],
+        wc: &[f64],
+        d: (usize, usize),
+    ) -> (f64, f64, bool) {
+        let lo = w.lo;
+        let room = bound_room_deg(d);
+        let (mut dev, mut ratio, mut within) = (0.0f64, 0.0f64, true);
+        for i in w.first..=w.last {
+            let a = angle_between_deg(
+                self.target[i],
+                forward(self.machine, wp[i - lo], wc[i - lo]),
+            );
+            dev = dev.max(a);
+            if a > 0.0 {
+                ratio = ratio.max(a / self.bound[i].max(f64::MIN_POSITIVE));
             }
-            (dev, ratio, within)
-        };
+            within &= a <= self.bound[i] + room;
+        }
+        (dev, ratio, within)
+    }
+
+    /// `prop` rounded with `d` decimals (P, C), verified on the tips it writes, and its
+    /// deviations.
+    fn checked_with(&self, prop: &Proposal, w: &CheckWindow, d: (usize, usize)) -> Checked {
+        let (wp, wc) = self.materialize(prop, w.lo, w.hi, Some(d));
+        let verdict = self.verify_on(w, &wp, &wc, true);
+        let (deviation_deg, bound_ratio, within_bound) = self.deviation(w, &wp, &wc, d);
+        Checked {
+            prop: prop.clone(),
+            decimals: d,
+            verdict,
+            deviation_deg,
+            bound_ratio,
+            within_bound,
+            tips_spoiled: false,
+        }
+    }
+
+    /// Round, verify and measure `prop` ([`Checked`]; `None` when it cannot be checked:
+    /// [`Selection::window`]), and whether it passes. Without verification, with the
+    /// file's decimals; else with one more decimal at a time up to `max_decimals` while
+    /// only the rounding fails it.
+    fn check(&self, prop: &Proposal) -> Option<(Checked, bool)> {
+        let w = self.window(prop)?;
         let (pd0, cd0) = (self.opts.p_decimals, self.opts.c_decimals);
         if !self.verify {
-            let (wp, wc) = self.materialize(prop, lo, hi, Some((pd0, cd0)));
-            let (deviation_deg, bound_ratio, within_bound) = deviation(&wp, &wc, (pd0, cd0));
-            return Some((
-                Checked {
-                    prop: prop.clone(),
-                    decimals: (pd0, cd0),
-                    verdict: verify(&wp, &wc),
-                    deviation_deg,
-                    bound_ratio,
-                    within_bound,
-                    tips_spoiled: false,
-                },
-                false,
-            ));
+            return Some((self.checked_with(prop, &w, (pd0, cd0)), false));
         }
         // (Unrounded: where only the rounding fails on the solve's path length, more
         // decimals would mend it, as they do on the tips.)
+        let keeps_centre = self.opts.keep_centre.is_some_and(|k| k.s_is_length);
         let fails = |mut checked: Checked| {
             if keeps_centre {
-                let (up, uc) = self.materialize(prop, lo, hi, None);
-                checked.tips_spoiled = spoiled(&up, &uc);
+                let (up, uc) = self.materialize(prop, w.lo, w.hi, None);
+                checked.tips_spoiled = self.spoiled(&w, &up, &uc);
             }
             Some((checked, false))
         };
@@ -303,18 +355,8 @@ impl Selection<'_> {
             if last_checked.as_ref().is_some_and(|l| l.decimals == d) {
                 break;
             }
-            let (wp, wc) = self.materialize(prop, lo, hi, Some(d));
-            let verdict = verify(&wp, &wc);
-            let (deviation_deg, bound_ratio, within_bound) = deviation(&wp, &wc, d);
-            let checked = Checked {
-                prop: prop.clone(),
-                decimals: d,
-                verdict,
-                deviation_deg,
-                bound_ratio,
-                within_bound,
-                tips_spoiled: false,
-            };
+            let checked = self.checked_with(prop, &w, d);
+            let verdict = checked.verdict;
             if verdict.passes() {
                 return Some((checked, true));
             }
@@ -325,8 +367,8 @@ impl Selection<'_> {
                 // Not a rounding problem if the unrounded values fail too — unless they
                 // improve the zone and the rounding made a span worse (a capped solve's
                 // best improvement: its spans beyond their limits may not grow).
-                let (up, uc) = self.materialize(prop, lo, hi, None);
-                let unrounded = verify(&up, &uc);
+                let (up, uc) = self.materialize(prop, w.lo, w.hi, None);
+                let unrounded = self.verify_on(&w, &up, &uc, true);
                 if !unrounded.passes() {
                     if verdict.improves() || !unrounded.improves() {
                         return fails(checked);

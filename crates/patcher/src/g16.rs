@@ -94,7 +94,7 @@ use crate::{
     qp::{QpBuilder, Row, combine, scaled},
     report::{QpStats, QpStatus},
     settings::SolverSettings,
-    tolerances::{REACH_SLACK, REACH_STEPS},
+    tolerances::{G16_SPACING_POINTS, REACH_SLACK, REACH_STEPS},
 };
 use polepatch_bspline::{BSpline, interpolate_not_a_knot, knots::clamped_cubic};
 
@@ -135,7 +135,11 @@ struct PatchCurve {
     third: bool,
 }
 
-/// [`g16_patch`] with the patch curve.
+/// [`g16_patch`] with the patch curve. The steps: the split ([`Split::new`]); per attempt
+/// the fits on the window ([`Split::fit`]), the join search ([`Split::join`]), the patch
+/// ends widened by `extra` and the growth ([`Split::patch_ends`]), the patch QP when the
+/// change is within reach ([`solve_if_reachable`]); a join window enlarged when no join
+/// exists, the patch widened when no solution does.
 fn g16_patch_detail(
     s_mm: &[f64],
     p_deg: &[f64],
@@ -145,21 +149,9 @@ fn g16_patch_detail(
     lim: &CLimits,
     opts: &PatchOptions,
 ) -> Result<(Candidate, PatchCurve), PatchFailure> {
-    let n = s_mm.len();
-    let sing = zone.singular;
-    // At least two points on each side of the split, and consistent arrays.
-    if p_deg.len() != n || c_deg.len() != n || sing == 0 || sing + 2 >= n {
-        return Err(PatchFailure::TooShort);
-    }
-    let first_z = zone.first.min(sing);
-    let last_z = zone.last.max(sing + 1).min(n - 1);
-
-    let h_cl = median_spacing(s_mm, first_z.saturating_sub(5), (last_z + 5).min(n - 1));
-    if h_cl.is_nan() || h_cl <= 0.0 {
-        return Err(PatchFailure::TooShort);
-    }
     let settings = &opts.solver;
-    let h = h_cl * settings.g16_join_step_fraction;
+    let split = Split::new(s_mm, p_deg, c_deg, zone, settings)?;
+    let (n, sing) = (s_mm.len(), split.sing);
 
     // Offsets k·360 of C_a to consider (G16 stage 3, generalised).
     let offsets: &[f64] = if opts.allow_c_offset {
@@ -174,33 +166,183 @@ fn g16_patch_detail(
 
     for _ in 0..settings.g16_max_attempts {
         let ext = extra + grow;
-        let lo_fit = first_z.saturating_sub(fit_margin + ext);
-        let hi_fit = (last_z + fit_margin + ext).min(n - 1);
-        let fit = |range: std::ops::RangeInclusive<usize>, off: f64| {
-            let y: Vec<f64> = c_deg[range.clone()].iter().map(|c| c + off).collect();
-            interpolate_not_a_knot(&s_mm[range], &y).map_err(|_| PatchFailure::TooShort)
+        let lo_fit = split.first_z.saturating_sub(fit_margin + ext);
+        let hi_fit = (split.last_z + fit_margin + ext).min(n - 1);
+        let cb = split.fit(lo_fit..=sing, 0.0)?;
+        let Some(join) = split.join(&cb, (lo_fit, hi_fit), lim, offsets)? else {
+            if lo_fit == 0 && hi_fit == n - 1 {
+                return Err(PatchFailure::NoJoin);
+            }
+            fit_margin *= 2;
+            continue;
         };
-        let cb = fit(lo_fit..=sing, 0.0)?;
+        let (s_b, s_a, can_grow) = split.patch_ends(&join, ext, (lo_fit, hi_fit));
+        if let Some(max_len) = opts.max_patch_length_mm
+            && s_a - s_b > max_len
+        {
+            return Err(if stats.solves == 0 && ext == 0 {
+                PatchFailure::NoJoin
+            } else {
+                PatchFailure::Solver(stats)
+            });
+        }
+        let setup = PatchSetup {
+            s_mm,
+            p_deg,
+            cb: &cb,
+            ca: &join.ca,
+            s_b,
+            s_a,
+            core_b: join.core_b,
+            core_a: join.core_a,
+            sigma: join.sigma,
+            h_cl: split.h_cl,
+            lim,
+            max_dev: opts.max_deviation_deg,
+            settings,
+        };
+        let target = |i: usize| c_deg[i] + if i > sing { join.off } else { 0.0 };
+        let solved = solve_if_reachable(&setup, &target, opts, &mut stats)?;
+        if let Some(((first, last, c_new), spline, third)) = solved {
+            let curve = PatchCurve {
+                spline,
+                cb,
+                s_b,
+                s_a,
+                core_b: join.core_b,
+                core_a: join.core_a,
+                sigma: join.sigma,
+                third,
+                ca: join.ca,
+            };
+            let cand = Candidate {
+                first,
+                last,
+                c_deg: c_new,
+                c_offset_deg: join.off,
+                qp: stats,
+            };
+            return Ok((cand, curve));
+        }
+        if !can_grow {
+            if stats.solves == 0 {
+                // The patch is too short for the velocity bound.
+                stats.status = QpStatus::SkippedInfeasible;
+            }
+            return Err(PatchFailure::Solver(stats));
+        }
+        grow = (2 * grow).max(1);
+    }
+    Err(PatchFailure::Solver(stats))
+}
 
-        // Stage 6, for every offset k and direction σ: the core (monotone) joins from the
-        // split, then the patch ends at least one CL point outside the zone where C' and
-        // C'' are within the limits. Keep the consistent choices (σ·gap ≥ 0) and among them
-        // the shortest join |gap|.
+/// The path around one zone split at its singular point (stage 1): points `..=sing` are
+/// before, `sing + 1..` after; the zone widened to hold the split, and the join search's
+/// step.
+struct Split<'a> {
+    s_mm: &'a [f64],
+    c_deg: &'a [f64],
+    sing: usize,
+    /// First point of the zone, at most `sing`.
+    first_z: usize,
+    /// Last point of the zone, at least `sing + 1`.
+    last_z: usize,
+    /// Median CL spacing around the zone, mm.
+    h_cl: f64,
+    /// The join search's step, mm.
+    h: f64,
+}
+
+/// The choice of the join search (stage 6): the offset k·360 of C_a, the direction σ,
+/// C_a with the offset, and the joins, mm: the patch ends `join_b`, `join_a` and the core
+/// `core_b`, `core_a`.
+struct Join {
+    off: f64,
+    sigma: f64,
+    ca: BSpline,
+    join_b: f64,
+    core_b: f64,
+    core_a: f64,
+    join_a: f64,
+}
+
+impl<'a> Split<'a> {
+    /// The split of `zone`; [`PatchFailure::TooShort`] unless there are at least two
+    /// points on each side and the arrays agree.
+    fn new(
+        s_mm: &'a [f64],
+        p_deg: &[f64],
+        c_deg: &'a [f64],
+        zone: &Zone,
+        settings: &SolverSettings,
+    ) -> Result<Split<'a>, PatchFailure> {
+        let n = s_mm.len();
+        let sing = zone.singular;
+        // At least two points on each side of the split, and consistent arrays.
+        if p_deg.len() != n || c_deg.len() != n || sing == 0 || sing + 2 >= n {
+            return Err(PatchFailure::TooShort);
+        }
+        let first_z = zone.first.min(sing);
+        let last_z = zone.last.max(sing + 1).min(n - 1);
+
+        let h_cl = median_spacing(
+            s_mm,
+            first_z.saturating_sub(G16_SPACING_POINTS),
+            (last_z + G16_SPACING_POINTS).min(n - 1),
+        );
+        if h_cl.is_nan() || h_cl <= 0.0 {
+            return Err(PatchFailure::TooShort);
+        }
+        Ok(Split {
+            s_mm,
+            c_deg,
+            sing,
+            first_z,
+            last_z,
+            h_cl,
+            h: h_cl * settings.g16_join_step_fraction,
+        })
+    }
+
+    /// The not-a-knot cubic through the points `range` with C + `off` (stage 3).
+    fn fit(
+        &self,
+        range: std::ops::RangeInclusive<usize>,
+        off: f64,
+    ) -> Result<BSpline, PatchFailure> {
+        let y: Vec<f64> = self.c_deg[range.clone()].iter().map(|c| c + off).collect();
+        interpolate_not_a_knot(&self.s_mm[range], &y).map_err(|_| PatchFailure::TooShort)
+    }
+
+    /// Stage 6, for every offset k and direction σ: the core (monotone) joins from the
+    /// split, then the patch ends at least one CL point outside the zone where C' and C''
+    /// are within the limits. Keep the consistent choices (σ·gap ≥ 0) and among them the
+    /// shortest join |gap|; `None` when there is none on the fit window
+    /// `(lo_fit, hi_fit)`.
+    fn join(
+        &self,
+        cb: &BSpline,
+        (lo_fit, hi_fit): (usize, usize),
+        lim: &CLimits,
+        offsets: &[f64],
+    ) -> Result<Option<Join>, PatchFailure> {
+        let (s_mm, sing, h) = (self.s_mm, self.sing, self.h);
+        let n = s_mm.len();
         let within = |d: [f64; 4]| d[1].abs() <= lim.v && d[2].abs() <= lim.a;
-        let end_b = s_mm[first_z.saturating_sub(1)];
-        let end_a = s_mm[(last_z + 1).min(n - 1)];
+        let end_b = s_mm[self.first_z.saturating_sub(1)];
+        let end_a = s_mm[(self.last_z + 1).min(n - 1)];
         let (stop_b, stop_a) = (s_mm[lo_fit], s_mm[hi_fit]);
         let joins_b: Vec<Option<(f64, f64)>> = [1.0, -1.0]
             .iter()
             .map(|&sg| {
-                let core = join_search(&cb, s_mm[sing], stop_b, -h, |d| sg * d[1] >= 0.0)?;
-                let end = join_search(&cb, core.min(end_b), stop_b, -h, within)?;
+                let core = join_search(cb, s_mm[sing], stop_b, -h, |d| sg * d[1] >= 0.0)?;
+                let end = join_search(cb, core.min(end_b), stop_b, -h, within)?;
                 Some((core, end))
             })
             .collect();
-        let mut best: Option<(f64, f64, f64, BSpline, [f64; 4])> = None;
+        let mut best: Option<(f64, Join)> = None;
         for &off in offsets {
-            let ca = fit(sing + 1..=hi_fit, off)?;
+            let ca = self.fit(sing + 1..=hi_fit, off)?;
             for (si, sigma) in [1.0, -1.0].into_iter().enumerate() {
                 let Some((core_b, join_b)) = joins_b[si] else {
                     continue;
@@ -218,25 +360,39 @@ fn g16_patch_detail(
                     continue;
                 }
                 if best.as_ref().is_none_or(|b| gap.abs() < b.0) {
-                    let joins = [join_b, core_b, core_a, join_a];
-                    best = Some((gap.abs(), off, sigma, ca.clone(), joins));
+                    let join = Join {
+                        off,
+                        sigma,
+                        ca: ca.clone(),
+                        join_b,
+                        core_b,
+                        core_a,
+                        join_a,
+                    };
+                    best = Some((gap.abs(), join));
                 }
             }
         }
-        let Some((_, off, sigma, ca, [join_b, core_b, core_a, join_a])) = best else {
-            if lo_fit == 0 && hi_fit == n - 1 {
-                return Err(PatchFailure::NoJoin);
-            }
-            fit_margin *= 2;
-            continue;
-        };
-        let target = |i: usize| c_deg[i] + if i > sing { off } else { 0.0 };
+        Ok(best.map(|(_, join)| join))
+    }
 
-        // Widen by `ext` CL points each side, inside the fit window.
-        let ib = s_mm.partition_point(|&x| x <= join_b).saturating_sub(1);
-        let ia = s_mm.partition_point(|&x| x < join_a).min(n - 1);
+    /// The patch ends `(s_b, s_a)`: the joins widened by `ext` CL points each side,
+    /// inside the fit window `(lo_fit, hi_fit)`; and whether a further widening could
+    /// grow the patch.
+    fn patch_ends(
+        &self,
+        join: &Join,
+        ext: usize,
+        (lo_fit, hi_fit): (usize, usize),
+    ) -> (f64, f64, bool) {
+        let s_mm = self.s_mm;
+        let n = s_mm.len();
+        let ib = s_mm
+            .partition_point(|&x| x <= join.join_b)
+            .saturating_sub(1);
+        let ia = s_mm.partition_point(|&x| x < join.join_a).min(n - 1);
         let (s_b, s_a) = if ext == 0 {
-            (join_b, join_a)
+            (join.join_b, join.join_a)
         } else {
             (
                 s_mm[ib.saturating_sub(ext).max(lo_fit)],
@@ -244,90 +400,41 @@ fn g16_patch_detail(
             )
         };
         let can_grow = ib.saturating_sub(ext) > 0 || ia + ext < n - 1;
-        if let Some(max_len) = opts.max_patch_length_mm
-            && s_a - s_b > max_len
-        {
-            return Err(if stats.solves == 0 && ext == 0 {
-                PatchFailure::NoJoin
-            } else {
-                PatchFailure::Solver(stats)
-            });
-        }
-
-        // Necessary condition of |P'| ≤ v, |P''| ≤ a with the join slopes: skip hopeless
-        // widenings without a solve.
-        let gap = ca.eval(s_a) - cb.eval(s_b);
-        let (vb, va) = (cb.eval_derivs(s_b)[1], ca.eval_derivs(s_a)[1]);
-        let sg = if gap >= 0.0 { 1.0 } else { -1.0 };
-        let reach = reachable(s_a - s_b, sg * vb, sg * va, lim.v, lim.a);
-        let hopeless = gap.abs() > reach * (1.0 + REACH_SLACK);
-        let solved = if hopeless {
-            None
-        } else {
-            let setup = PatchSetup {
-                s_mm,
-                p_deg,
-                cb: &cb,
-                ca: &ca,
-                s_b,
-                s_a,
-                core_b,
-                core_a,
-                sigma,
-                h_cl,
-                lim,
-                max_dev: opts.max_deviation_deg,
-                settings,
-            };
-            let mut out = None;
-            let modes: &[bool] = if opts.third_derivative_continuity {
-                &[true, false]
-            } else {
-                &[false]
-            };
-            for &third in modes {
-                match solve_patch(&setup, &target, third, &mut stats) {
-                    Ok(Some((proj, spline))) => {
-                        out = Some((proj, spline, third));
-                        break;
-                    }
-                    Ok(None) => {}
-                    Err(e) => return Err(e),
-                }
-            }
-            out
-        };
-        if let Some(((first, last, c_new), spline, third)) = solved {
-            let curve = PatchCurve {
-                spline,
-                cb,
-                ca,
-                s_b,
-                s_a,
-                core_b,
-                core_a,
-                sigma,
-                third,
-            };
-            let cand = Candidate {
-                first,
-                last,
-                c_deg: c_new,
-                c_offset_deg: off,
-                qp: stats,
-            };
-            return Ok((cand, curve));
-        }
-        if !can_grow {
-            if stats.solves == 0 {
-                // The patch is too short for the velocity bound.
-                stats.status = QpStatus::SkippedInfeasible;
-            }
-            return Err(PatchFailure::Solver(stats));
-        }
-        grow = (2 * grow).max(1);
+        (s_b, s_a, can_grow)
     }
-    Err(PatchFailure::Solver(stats))
+}
+
+/// The patch QP on `setup` (with C³ joins first when asked, then C²), unless a necessary
+/// condition of |P'| ≤ v, |P''| ≤ a with the join slopes fails: hopeless widenings are
+/// skipped without a solve. The projected points, P and whether the C³ joins were kept;
+/// `None` when skipped or no mode produced a solution.
+fn solve_if_reachable(
+    setup: &PatchSetup<'_>,
+    target: &dyn Fn(usize) -> f64,
+    opts: &PatchOptions,
+    stats: &mut QpStats,
+) -> Result<Option<(Projected, BSpline, bool)>, PatchFailure> {
+    let (cb, ca, lim) = (setup.cb, setup.ca, setup.lim);
+    let (s_b, s_a) = (setup.s_b, setup.s_a);
+    let gap = ca.eval(s_a) - cb.eval(s_b);
+    let (vb, va) = (cb.eval_derivs(s_b)[1], ca.eval_derivs(s_a)[1]);
+    let sg = if gap >= 0.0 { 1.0 } else { -1.0 };
+    let reach = reachable(s_a - s_b, sg * vb, sg * va, lim.v, lim.a);
+    let hopeless = gap.abs() > reach * (1.0 + REACH_SLACK);
+    if hopeless {
+        return Ok(None);
+    }
+    let modes: &[bool] = if opts.third_derivative_continuity {
+        &[true, false]
+    } else {
+        &[false]
+    };
+    for &third in modes {
+        if let Some((proj, spline)) = solve_patch(setup, target, third, stats)? {
+            return Ok(Some((proj, spline, third)));
+        }
+    }
+    Ok(None)
 }
 
 /// Largest change of C over a patch of length `len` (mm) that starts with slope `v0` and

@@ -38,7 +38,7 @@
 //! built with offsets `0` and `hp.vars()` live side by side in one QP.
 
 use crate::spline::AnalysisSpline;
-use crate::tolerances::{CONSTRAINED_MARGIN_POINTS, HERMITE_WINDOW_POINTS};
+use crate::tolerances::{CONSTRAINED_MARGIN_POINTS, HERMITE_WINDOW_POINTS, SIGN_ROW_SCALE_FLOOR};
 use crate::{
     candidate::PatchFailure,
     qp::{QpBuilder, Row},
@@ -313,7 +313,7 @@ pub(crate) fn push_sign(qp: &mut QpBuilder, f: &Aff, sigma: f64) {
         .row
         .iter()
         .fold(f.c.abs(), |m, e| m.max(e.1.abs()))
-        .max(1e-300);
+        .max(SIGN_ROW_SCALE_FLOOR);
     let row: Row = f
         .row
         .iter()

@@ -97,7 +97,7 @@ use crate::{
     qp::Row,
     report::{QpStats, QpStatus},
     settings::SolverSettings,
-    tolerances::{JOINT_WINDOW_POINTS, ZERO_DEVIATION_DEG},
+    tolerances::{JOINT_WINDOW_POINTS, MIN_POINT_CAP_DEG, SCP_MERIT_FLOOR, ZERO_DEVIATION_DEG},
     window::{RowSet, Window},
 };
 use polepatch_kinematics::{Axis, Machine, angle_between_deg, forward, forward_jacobian};
@@ -228,11 +228,6 @@ impl JointProblem<'_> {
         self.cap_deg.is_some() || self.point_cap_deg.is_some()
     }
 }
-
-/// The smallest cap of a point in a capped solve, degrees (a point exactly on the pole
-/// whose bound is 0 still gets a cone that is not degenerate; the driver measures the
-/// written angle against the bound itself).
-const MIN_POINT_CAP_DEG: f64 = 1e-6;
 
 /// The problem's fixed part: the unknowns (each axis' free spline coefficients, interleaved
 /// along the path, then `t` and `e`), the limit rows and the machine's ranges.
@@ -578,7 +573,7 @@ pub fn solve_joint(pr: &JointProblem) -> Result<JointSolution, PatchFailure> {
                 rho = (st.trust_p_deg, st.trust_c_deg);
             }
             // Stop on a small gain once the limits are met (not while reaching them).
-            if !was_infeasible && gain < st.scp_rel_tol * merit.max(1e-12) {
+            if !was_infeasible && gain < st.scp_rel_tol * merit.max(SCP_MERIT_FLOOR) {
                 break;
             }
         } else {

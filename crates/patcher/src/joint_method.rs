@@ -29,6 +29,7 @@
 //!   excess over the limits within the cap: the best improvement the cap allows, or a
 //!   patch within it that reaches feed).
 
+use crate::candidate::PatchFailure;
 use crate::joint::{JointProblem, JointSolution, solve_joint};
 use crate::limits::GeomLimits;
 use crate::protocol::{Proposal, Proposer, Sink, Tail, ZoneCtx};
@@ -136,6 +137,11 @@ impl JointMethod {
     /// Solve and propose on the range `first..=last`; `true` when a solution within the
     /// limits was found (else the range is widened, unless `last_try`: then the best
     /// is proposed anyway, as an improvement).
+    ///
+    /// The steps: the starts ([`starts_on`]); the screening ([`RangeSolve::screen`]) and
+    /// the refinement of the best ([`RangeSolve::refine`]); the proposals of the solutions
+    /// ([`RangeSolve::offer_all`]); the capped solves when nothing passing met the caps
+    /// ([`RangeSolve::offer_capped`]).
     fn solve_range(
         ctx: &ZoneCtx<'_>,
         sink: &mut dyn Sink,
@@ -144,265 +150,12 @@ impl JointMethod {
         last: usize,
         last_try: bool,
     ) -> bool {
+        let starts = starts_on(ctx, first, last);
+        let rs = RangeSolve::new(ctx, memo, first, last);
         let st = ctx.settings;
-        let (p, c) = (ctx.p, ctx.c);
-        let mut starts: Vec<Start> = Vec::new();
-        // Through the pole: the other branch after the switch (or the least |P|).
-        let k = branch_switch(p, ctx.zone).unwrap_or_else(|| least_primary(p, ctx.zone));
-        if k + 1 >= first
-            && k < last
-            && let Some(shift) = tail_shift(ctx.machine, p, c, k, ctx.opts.keep_last_point)
-        {
-            let (op, oc) = other_branch(p, c, k, shift);
-            starts.push(Start {
-                p: op,
-                c: oc,
-                tail: Tail::Reselect { shift_deg: shift },
-                rule: false,
-            });
-        }
-        // The peers' rules across the cone stretch: C held (FREEZE) or linear (LINEARIZE),
-        // P on C's meridian — through the pole inside the range.
-        if let (Some(stretch), Ok(spline)) = (
-            cone_stretch(p, ctx.zone, ctx.opts.cone_deg),
-            crate::spline::AnalysisSpline::new(ctx.s, c),
-        ) && stretch[1] >= first
-            && stretch[2] <= last
-        {
-            for rule in [Rule::Freeze, Rule::Linearize] {
-                let (mut fp, mut fc) = (p.to_vec(), c.to_vec());
-                apply_rule(
-                    rule,
-                    ctx.machine,
-                    ctx.s,
-                    c,
-                    &spline,
-                    ctx.target,
-                    stretch,
-                    &mut fp,
-                    &mut fc,
-                );
-                // Through the pole: P on C's meridian comes out of the stretch on the other
-                // branch when the path passed the pole; then the points after it follow
-                // on that branch (when they may move).
-                let b = stretch[2];
-                if rule == Rule::Freeze
-                    && b < last
-                    && fp[b].abs() > POLE_DEG
-                    && fp[b].signum() != p[b + 1].signum()
-                    && let Some(shift) =
-                        tail_shift(ctx.machine, &fp, &fc, b, ctx.opts.keep_last_point)
-                {
-                    let (op, oc) = other_branch(&fp, &fc, b, shift);
-                    starts.push(Start {
-                        p: op,
-                        c: oc,
-                        tail: Tail::Reselect { shift_deg: shift },
-                        rule: true,
-                    });
-                }
-                starts.push(Start {
-                    p: fp,
-                    c: fc,
-                    tail: Tail::Keep,
-                    rule: true,
-                });
-            }
-        }
-        starts.push(Start {
-            p: p.to_vec(),
-            c: c.to_vec(),
-            tail: Tail::Keep,
-            rule: false,
-        });
-        for s0 in &mut starts {
-            smooth_pole_c(&s0.p, &mut s0.c, first, last);
-        }
-        let lim_p = GeomLimits::of(ctx.machine, Axis::Primary, ctx.feed_mm_min, ctx.margin);
-        let lim_c = GeomLimits::of(ctx.machine, Axis::C, ctx.feed_mm_min, ctx.margin);
-        let round_deg = 0.5 * 10f64.powi(-(ctx.opts.max_decimals as i32));
-        // Beyond a side where the zone was cut from a longer stretch below feed, the
-        // program's own slowness need only not get worse (crate::analysis::detect_zones).
-        let z = ctx.zone;
-        let pole_spans =
-            if z.cut_before { z.first } else { 0 }..if z.cut_after { z.last } else { ctx.s.len() };
-        // `before`: what "not worse" compares with (None: the start's own values); `capped`:
-        // the least excess over the core's limits within the caps, nothing else worse
-        // (`crate::joint`, capped).
-        let problem = |sp: &'_ [f64],
-                       sc: &'_ [f64],
-                       before: Option<(&'_ [f64], &'_ [f64])>,
-                       capped: Option<(usize, usize)>,
-                       warm: bool,
-                       solves: u32,
-                       ipm_start: Option<&'_ crate::ipm::IpmWarm>,
-                       settings: &'_ SolverSettings| {
-            let (first, last) = capped.unwrap_or((first, last));
-            let capped = capped.is_some();
-            let pr = JointProblem {
-                s_mm: ctx.s,
-                p_deg: sp,
-                c_deg: sc,
-                target: ctx.target,
-                first,
-                last,
-                lim_p,
-                lim_c,
-                feed_mm_min: ctx.feed_mm_min,
-                machine: ctx.machine,
-                core: ctx.core.clone(),
-                round_p_deg: round_deg,
-                round_c_deg: round_deg,
-                reference: before,
-                verified: (p, c),
-                pole_spans: pole_spans.clone(),
-                cap_deg: ctx.opts.max_deviation_deg.filter(|_| capped),
-                point_cap_deg: capped.then_some(ctx.bound_deg),
-                warm,
-                max_solves: solves,
-                ipm_start,
-                memo: Some(memo),
-                settings,
-            };
-            solve_joint(&pr)
-        };
-        // Each start's first solve, when several are screened, only ranks them: to the
-        // screening's tolerance (those that go on are solved again at the full one, from
-        // where it ended), and within the limits up to `screen_within_tol`.
-        let screen_st = SolverSettings {
-            ipm: crate::ipm::IpmSettings {
-                tol_feas: st.ipm.tol_feas.max(st.screen_ipm_tol),
-                tol_gap: st.ipm.tol_gap.max(st.screen_ipm_tol),
-                ..st.ipm
-            },
-            ..st.clone()
-        };
-        let within_tol = st.elastic_tol.max(st.screen_within_tol);
-        // More solves from a start's solution, with the same "before" as its first solves:
-        // the program's values for a rule's start, else the start's own values.
-        let go_on = |s0: &Start, sol: &JointSolution, solves: u32| {
-            let (mut wp, mut wc) = (s0.p.clone(), s0.c.clone());
-            wp[first..=last].copy_from_slice(&sol.p_deg);
-            wc[first..=last].copy_from_slice(&sol.c_deg);
-            let warm = sol.excess <= within_tol;
-            let before = if s0.rule {
-                (p, c)
-            } else {
-                (s0.p.as_slice(), s0.c.as_slice())
-            };
-            problem(
-                &wp,
-                &wc,
-                Some(before),
-                None,
-                warm,
-                solves,
-                sol.ipm_end.as_ref(),
-                st,
-            )
-        };
-        // Within the limits (an excess up to `tol`) first, by deviation, then the least
-        // excess.
-        let key_within = |s: &JointSolution, tol: f64| {
-            if s.excess <= tol {
-                (0u8, s.max_deviation_deg)
-            } else {
-                (1u8, s.excess)
-            }
-        };
-        let key = |s: &JointSolution| key_within(s, st.elastic_tol);
-        let rank = |v: &mut Vec<(usize, JointSolution)>, tol: f64| {
-            v.sort_by(|a, b| {
-                key_within(&a.1, tol)
-                    .partial_cmp(&key_within(&b.1, tol))
-                    .unwrap_or(std::cmp::Ordering::Equal)
-            })
-        };
-        // Add `more` (solves from `sol`) to `sol` when it is better; its solves count.
-        let keep_better = |sol: &mut JointSolution, more: JointSolution| {
-            let mut qp = sol.qp.clone();
-            crate::qp::add_stats(&mut qp, &more.qp);
-            if key(&more) < key(sol) {
-                *sol = JointSolution { qp, ..more };
-            } else {
-                sol.qp = qp;
-            }
-        };
-        // Screen: one solve from every start; the `screen_keep` best go on for the rest of
-        // `screen_solves`; then the best is refined up to `scp_max_solves`.
-        let screen = st.screen_solves.min(st.scp_max_solves).max(1);
-        let mut screened: Vec<(usize, JointSolution)> = Vec::new();
-        for (i, s0) in starts.iter().enumerate() {
-            let solves = if starts.len() == 1 {
-                st.scp_max_solves
-            } else {
-                1
-            };
-            match problem(
-                &s0.p,
-                &s0.c,
-                s0.rule.then_some((p, c)),
-                None,
-                false,
-                solves,
-                None,
-                if solves < st.scp_max_solves {
-                    &screen_st
-                } else {
-                    st
-                },
-            ) {
-                Ok(sol) => {
-                    let perfect =
-                        sol.excess <= st.elastic_tol && sol.max_deviation_deg <= ZERO_DEVIATION_DEG;
-                    screened.push((i, sol));
-                    if perfect {
-                        break; // within the limits, no orientation change: the best there is
-                    }
-                }
-                Err(crate::candidate::PatchFailure::Solver(q)) => sink.add_stats(&q),
-                Err(_) => {}
-            }
-        }
-        // Ranked after the screening's first solves within the limits up to `within_tol`: a
-        // loosely solved QP may leave a start that meets them just above `elastic_tol`.
-        rank(&mut screened, within_tol);
-        let perfect = screened.first().is_some_and(|(_, s)| {
-            s.excess <= st.elastic_tol && s.max_deviation_deg <= ZERO_DEVIATION_DEG
-        });
-        if starts.len() > 1 && !perfect {
-            if screen > 1 {
-                for (i, sol) in screened.iter_mut().take(st.screen_keep.max(1)) {
-                    if let Ok(more) = go_on(&starts[*i], sol, screen - 1) {
-                        keep_better(sol, more);
-                    }
-                }
-                rank(&mut screened, st.elastic_tol);
-            }
-            if let Some((i, sol)) = screened.first_mut()
-                && st.scp_max_solves > screen
-                && let Ok(more) = go_on(&starts[*i], sol, st.scp_max_solves - screen)
-            {
-                keep_better(sol, more);
-            }
-        }
-        // The best solution's values (whole path), its start's tail and what "not worse"
-        // compares with for it, for a capped solve.
-        let best = screened.first().map(|(i, sol)| {
-            let s0 = &starts[*i];
-            let (mut wp, mut wc) = (s0.p.clone(), s0.c.clone());
-            wp[first..=last].copy_from_slice(&sol.p_deg);
-            wc[first..=last].copy_from_slice(&sol.c_deg);
-            (
-                Start {
-                    p: wp,
-                    c: wc,
-                    tail: s0.tail,
-                    rule: s0.rule,
-                },
-                *i,
-            )
-        });
+        let mut screened = rs.screen(&starts, sink);
+        rs.refine(&starts, &mut screened);
+        let best = rs.best_start(&starts, &screened);
         let within = screened
             .first()
             .is_some_and(|(_, s)| s.excess <= st.elastic_tol);
@@ -412,6 +165,356 @@ impl JointMethod {
             }
             return false;
         }
+        rs.offer_all(&starts, screened, sink);
+        if sink.best_passing_deg().is_none() {
+            rs.offer_capped(&starts, best, sink);
+        }
+        true
+    }
+}
+
+/// The starts on the range `first..=last` (module docs, **Start**): the other branch
+/// after the switch (or the least |P|), the peers' rules across the cone stretch (with
+/// FREEZE's the other branch after the stretch when the path passed the pole), the
+/// program's values; C smoothed over the points on the pole ([`smooth_pole_c`]).
+fn starts_on(ctx: &ZoneCtx<'_>, first: usize, last: usize) -> Vec<Start> {
+    let (p, c) = (ctx.p, ctx.c);
+    let mut starts: Vec<Start> = Vec::new();
+    // Through the pole: the other branch after the switch (or the least |P|).
+    let k = branch_switch(p, ctx.zone).unwrap_or_else(|| least_primary(p, ctx.zone));
+    if k + 1 >= first
+        && k < last
+        && let Some(shift) = tail_shift(ctx.machine, p, c, k, ctx.opts.keep_last_point)
+    {
+        let (op, oc) = other_branch(p, c, k, shift);
+        starts.push(Start {
+            p: op,
+            c: oc,
+            tail: Tail::Reselect { shift_deg: shift },
+            rule: false,
+        });
+    }
+    // The peers' rules across the cone stretch: C held (FREEZE) or linear (LINEARIZE),
+    // P on C's meridian — through the pole inside the range.
+    if let (Some(stretch), Ok(spline)) = (
+        cone_stretch(p, ctx.zone, ctx.opts.cone_deg),
+        crate::spline::AnalysisSpline::new(ctx.s, c),
+    ) && stretch[1] >= first
+        && stretch[2] <= last
+    {
+        for rule in [Rule::Freeze, Rule::Linearize] {
+            let (mut fp, mut fc) = (p.to_vec(), c.to_vec());
+            apply_rule(
+                rule,
+                ctx.machine,
+                ctx.s,
+                c,
+                &spline,
+                ctx.target,
+                stretch,
+                &mut fp,
+                &mut fc,
+            );
+            // Through the pole: P on C's meridian comes out of the stretch on the other
+            // branch when the path passed the pole; then the points after it follow
+            // on that branch (when they may move).
+            let b = stretch[2];
+            if rule == Rule::Freeze
+                && b < last
+                && fp[b].abs() > POLE_DEG
+                && fp[b].signum() != p[b + 1].signum()
+                && let Some(shift) = tail_shift(ctx.machine, &fp, &fc, b, ctx.opts.keep_last_point)
+            {
+                let (op, oc) = other_branch(&fp, &fc, b, shift);
+                starts.push(Start {
+                    p: op,
+                    c: oc,
+                    tail: Tail::Reselect { shift_deg: shift },
+                    rule: true,
+                });
+            }
+            starts.push(Start {
+                p: fp,
+                c: fc,
+                tail: Tail::Keep,
+                rule: true,
+            });
+        }
+    }
+    starts.push(Start {
+        p: p.to_vec(),
+        c: c.to_vec(),
+        tail: Tail::Keep,
+        rule: false,
+    });
+    for s0 in &mut starts {
+        smooth_pole_c(&s0.p, &mut s0.c, first, last);
+    }
+    starts
+}
+
+/// A solution and the index of the start it came from.
+type Screened = Vec<(usize, JointSolution)>;
+
+/// Within the limits (an excess up to `tol`) first, by deviation, then the least excess.
+fn key_within(s: &JointSolution, tol: f64) -> (u8, f64) {
+    if s.excess <= tol {
+        (0u8, s.max_deviation_deg)
+    } else {
+        (1u8, s.excess)
+    }
+}
+
+/// Sort `v` by [`key_within`] with `tol`.
+fn rank(v: &mut Screened, tol: f64) {
+    v.sort_by(|a, b| {
+        key_within(&a.1, tol)
+            .partial_cmp(&key_within(&b.1, tol))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    })
+}
+
+/// Within the limits (up to `elastic_tol`) and no orientation change: the best there is.
+fn perfect(s: &JointSolution, st: &SolverSettings) -> bool {
+    s.excess <= st.elastic_tol && s.max_deviation_deg <= ZERO_DEVIATION_DEG
+}
+
+/// What every solve on one range shares: the zone, the range, the limits at this rung,
+/// the rounding, the spans judged by the pole passage and the screening's settings.
+struct RangeSolve<'r, 'a> {
+    ctx: &'r ZoneCtx<'a>,
+    memo: &'r crate::joint::WindowMemo,
+    first: usize,
+    last: usize,
+    lim_p: GeomLimits,
+    lim_c: GeomLimits,
+    /// Half a unit of the last written decimal, degrees.
+    round_deg: f64,
+    /// Beyond a side where the zone was cut from a longer stretch below feed, the
+    /// program's own slowness need only not get worse (crate::analysis::detect_zones).
+    pole_spans: std::ops::Range<usize>,
+    /// Each start's first solve, when several are screened, only ranks them: to the
+    /// screening's tolerance (those that go on are solved again at the full one, from
+    /// where it ended), and within the limits up to `within_tol`.
+    screen_st: SolverSettings,
+    within_tol: f64,
+}
+
+impl<'r, 'a> RangeSolve<'r, 'a> {
+    fn new(
+        ctx: &'r ZoneCtx<'a>,
+        memo: &'r crate::joint::WindowMemo,
+        first: usize,
+        last: usize,
+    ) -> Self {
+        let st = ctx.settings;
+        let z = ctx.zone;
+        RangeSolve {
+            ctx,
+            memo,
+            first,
+            last,
+            lim_p: GeomLimits::of(ctx.machine, Axis::Primary, ctx.feed_mm_min, ctx.margin),
+            lim_c: GeomLimits::of(ctx.machine, Axis::C, ctx.feed_mm_min, ctx.margin),
+            round_deg: 0.5 * 10f64.powi(-(ctx.opts.max_decimals as i32)),
+            pole_spans: if z.cut_before { z.first } else { 0 }..if z.cut_after {
+                z.last
+            } else {
+                ctx.s.len()
+            },
+            screen_st: SolverSettings {
+                ipm: crate::ipm::IpmSettings {
+                    tol_feas: st.ipm.tol_feas.max(st.screen_ipm_tol),
+                    tol_gap: st.ipm.tol_gap.max(st.screen_ipm_tol),
+                    ..st.ipm
+                },
+                ..st.clone()
+            },
+            within_tol: st.elastic_tol.max(st.screen_within_tol),
+        }
+    }
+
+    /// One joint solve from `(sp, sc)` on the range, or on `capped` with the caps: the
+    /// least excess over the core's limits within them, nothing else worse
+    /// (`crate::joint`, capped). `before`: what "not worse" compares with (None: the
+    /// start's own values).
+    #[allow(clippy::too_many_arguments)]
+    fn problem(
+        &self,
+        sp: &[f64],
+        sc: &[f64],
+        before: Option<(&[f64], &[f64])>,
+        capped: Option<(usize, usize)>,
+        warm: bool,
+        solves: u32,
+        ipm_start: Option<&crate::ipm::IpmWarm>,
+        settings: &SolverSettings,
+    ) -> Result<JointSolution, PatchFailure> {
+        let ctx = self.ctx;
+        let (first, last) = capped.unwrap_or((self.first, self.last));
+        let capped = capped.is_some();
+        let pr = JointProblem {
+            s_mm: ctx.s,
+            p_deg: sp,
+            c_deg: sc,
+            target: ctx.target,
+            first,
+            last,
+            lim_p: self.lim_p,
+            lim_c: self.lim_c,
+            feed_mm_min: ctx.feed_mm_min,
+            machine: ctx.machine,
+            core: ctx.core.clone(),
+            round_p_deg: self.round_deg,
+            round_c_deg: self.round_deg,
+            reference: before,
+            verified: (ctx.p, ctx.c),
+            pole_spans: self.pole_spans.clone(),
+            cap_deg: ctx.opts.max_deviation_deg.filter(|_| capped),
+            point_cap_deg: capped.then_some(ctx.bound_deg),
+            warm,
+            max_solves: solves,
+            ipm_start,
+            memo: Some(self.memo),
+            settings,
+        };
+        solve_joint(&pr)
+    }
+
+    /// The whole path's values of `s0` with `sol` on the range.
+    fn with_solution(&self, s0: &Start, sol: &JointSolution) -> (Vec<f64>, Vec<f64>) {
+        let (mut wp, mut wc) = (s0.p.clone(), s0.c.clone());
+        wp[self.first..=self.last].copy_from_slice(&sol.p_deg);
+        wc[self.first..=self.last].copy_from_slice(&sol.c_deg);
+        (wp, wc)
+    }
+
+    /// More solves from a start's solution, with the same "before" as its first solves:
+    /// the program's values for a rule's start, else the start's own values.
+    fn go_on(
+        &self,
+        s0: &Start,
+        sol: &JointSolution,
+        solves: u32,
+    ) -> Result<JointSolution, PatchFailure> {
+        let (wp, wc) = self.with_solution(s0, sol);
+        let warm = sol.excess <= self.within_tol;
+        let before = if s0.rule {
+            (self.ctx.p, self.ctx.c)
+        } else {
+            (s0.p.as_slice(), s0.c.as_slice())
+        };
+        self.problem(
+            &wp,
+            &wc,
+            Some(before),
+            None,
+            warm,
+            solves,
+            sol.ipm_end.as_ref(),
+            self.ctx.settings,
+        )
+    }
+
+    /// Add `more` (solves from `sol`) to `sol` when it is better; its solves count.
+    fn keep_better(&self, sol: &mut JointSolution, more: JointSolution) {
+        let tol = self.ctx.settings.elastic_tol;
+        let mut qp = sol.qp.clone();
+        crate::qp::add_stats(&mut qp, &more.qp);
+        if key_within(&more, tol) < key_within(sol, tol) {
+            *sol = JointSolution { qp, ..more };
+        } else {
+            sol.qp = qp;
+        }
+    }
+
+    /// One solve from every start (every solve when there is one start), until one is
+    /// [`perfect`]; ranked within the limits up to `within_tol`: a loosely solved QP may
+    /// leave a start that meets them just above `elastic_tol`.
+    fn screen(&self, starts: &[Start], sink: &mut dyn Sink) -> Screened {
+        let st = self.ctx.settings;
+        let (p, c) = (self.ctx.p, self.ctx.c);
+        let mut screened: Screened = Vec::new();
+        for (i, s0) in starts.iter().enumerate() {
+            let solves = if starts.len() == 1 {
+                st.scp_max_solves
+            } else {
+                1
+            };
+            match self.problem(
+                &s0.p,
+                &s0.c,
+                s0.rule.then_some((p, c)),
+                None,
+                false,
+                solves,
+                None,
+                if solves < st.scp_max_solves {
+                    &self.screen_st
+                } else {
+                    st
+                },
+            ) {
+                Ok(sol) => {
+                    let perfect = perfect(&sol, st);
+                    screened.push((i, sol));
+                    if perfect {
+                        break; // within the limits, no orientation change: the best there is
+                    }
+                }
+                Err(PatchFailure::Solver(q)) => sink.add_stats(&q),
+                Err(_) => {}
+            }
+        }
+        rank(&mut screened, self.within_tol);
+        screened
+    }
+
+    /// Unless one start was screened or the best is [`perfect`]: the `screen_keep` best go
+    /// on for the rest of `screen_solves`; then the best is refined up to
+    /// `scp_max_solves`.
+    fn refine(&self, starts: &[Start], screened: &mut Screened) {
+        let st = self.ctx.settings;
+        let screen = st.screen_solves.min(st.scp_max_solves).max(1);
+        let perfect = screened.first().is_some_and(|(_, s)| perfect(s, st));
+        if starts.len() > 1 && !perfect {
+            if screen > 1 {
+                for (i, sol) in screened.iter_mut().take(st.screen_keep.max(1)) {
+                    if let Ok(more) = self.go_on(&starts[*i], sol, screen - 1) {
+                        self.keep_better(sol, more);
+                    }
+                }
+                rank(screened, st.elastic_tol);
+            }
+            if let Some((i, sol)) = screened.first_mut()
+                && st.scp_max_solves > screen
+                && let Ok(more) = self.go_on(&starts[*i], sol, st.scp_max_solves - screen)
+            {
+                self.keep_better(sol, more);
+            }
+        }
+    }
+
+    /// The best solution's values (whole path), its start's tail and what "not worse"
+    /// compares with for it, for a capped solve; with its start's index.
+    fn best_start(&self, starts: &[Start], screened: &Screened) -> Option<(Start, usize)> {
+        screened.first().map(|(i, sol)| {
+            let s0 = &starts[*i];
+            let (wp, wc) = self.with_solution(s0, sol);
+            (
+                Start {
+                    p: wp,
+                    c: wc,
+                    tail: s0.tail,
+                    rule: s0.rule,
+                },
+                *i,
+            )
+        })
+    }
+
+    /// Offer the solutions best first, until one passes; the rest only count their solves.
+    fn offer_all(&self, starts: &[Start], screened: Screened, sink: &mut dyn Sink) {
         let mut offered_all = true;
         for (i, sol) in screened {
             if !offered_all {
@@ -420,8 +523,8 @@ impl JointMethod {
             }
             let passed = sink.offer(Proposal {
                 method: Method::Joint,
-                first,
-                last,
+                first: self.first,
+                last: self.last,
                 p: sol.p_deg,
                 c: sol.c_deg,
                 tail: starts[i].tail,
@@ -431,78 +534,82 @@ impl JointMethod {
                 offered_all = false; // the rest only count their solves
             }
         }
-        // When nothing passing met the caps — the user's `max_deviation_deg` and the safety
-        // bound near the pole (`crate::driver::pole_bound_deg`), or nothing passed at all:
-        // the least excess over the core's limits within them, every other span not worse
-        // (`crate::joint`, capped) — from the best solution (near the cap when it is just
-        // over it: a small step), and from each start that keeps every tool axis (the
-        // program's values, the other branch after the switch: within any cap; near the
-        // pole only the second passes through it). "Not worse" compares with what the
-        // verification compares with: the program's values, or for the other branch its
-        // own (the same sizes of every derivative past the switch). Beyond a side where the
-        // zone was cut from a longer stretch below feed the program is slow by its own
-        // doing, far from the pole: there the range keeps only `joint_range_min_points` to
-        // join it (and the best solution, which may reach further, is no start).
-        if sink.best_passing_deg().is_none() {
-            let z = ctx.zone;
-            let join = st.joint_range_min_points;
-            let range = (
-                if z.cut_before {
-                    first.max(z.first.saturating_sub(join))
-                } else {
-                    first
-                },
-                if z.cut_after {
-                    last.min(z.last + join)
-                } else {
-                    last
-                },
+    }
+
+    /// When nothing passing met the caps — the user's `max_deviation_deg` and the safety
+    /// bound near the pole (`crate::driver::pole_bound_deg`), or nothing passed at all:
+    /// the least excess over the core's limits within them, every other span not worse
+    /// (`crate::joint`, capped) — from the best solution (near the cap when it is just
+    /// over it: a small step), and from each start that keeps every tool axis (the
+    /// program's values, the other branch after the switch: within any cap; near the
+    /// pole only the second passes through it). "Not worse" compares with what the
+    /// verification compares with: the program's values, or for the other branch its
+    /// own (the same sizes of every derivative past the switch). Beyond a side where the
+    /// zone was cut from a longer stretch below feed the program is slow by its own
+    /// doing, far from the pole: there the range keeps only `joint_range_min_points` to
+    /// join it (and the best solution, which may reach further, is no start).
+    fn offer_capped(&self, starts: &[Start], best: Option<(Start, usize)>, sink: &mut dyn Sink) {
+        let ctx = self.ctx;
+        let st = ctx.settings;
+        let (first, last) = (self.first, self.last);
+        let (p, c) = (ctx.p, ctx.c);
+        let z = ctx.zone;
+        let join = st.joint_range_min_points;
+        let range = (
+            if z.cut_before {
+                first.max(z.first.saturating_sub(join))
+            } else {
+                first
+            },
+            if z.cut_after {
+                last.min(z.last + join)
+            } else {
+                last
+            },
+        );
+        let own = |s0: &Start| -> (Vec<f64>, Vec<f64>) {
+            if s0.rule {
+                (p.to_vec(), c.to_vec())
+            } else {
+                (s0.p.clone(), s0.c.clone())
+            }
+        };
+        let capped = best
+            .iter()
+            .filter(|_| range == (first, last))
+            .map(|(b, i)| (b, own(&starts[*i]), true))
+            .chain(
+                starts
+                    .iter()
+                    .filter(|s0| !s0.rule)
+                    .map(|s0| (s0, own(s0), false)),
             );
-            let own = |s0: &Start| -> (Vec<f64>, Vec<f64>) {
-                if s0.rule {
-                    (p.to_vec(), c.to_vec())
-                } else {
-                    (s0.p.clone(), s0.c.clone())
+        for (s0, (bp, bc), warm) in capped {
+            let r = self.problem(
+                &s0.p,
+                &s0.c,
+                Some((&bp, &bc)),
+                Some(range),
+                warm,
+                st.scp_max_solves,
+                None,
+                st,
+            );
+            match r {
+                Ok(sol) => {
+                    sink.offer(Proposal {
+                        method: Method::Joint,
+                        first: range.0,
+                        last: range.1,
+                        p: sol.p_deg,
+                        c: sol.c_deg,
+                        tail: s0.tail,
+                        qp: sol.qp,
+                    });
                 }
-            };
-            let capped = best
-                .iter()
-                .filter(|_| range == (first, last))
-                .map(|(b, i)| (b, own(&starts[*i]), true))
-                .chain(
-                    starts
-                        .iter()
-                        .filter(|s0| !s0.rule)
-                        .map(|s0| (s0, own(s0), false)),
-                );
-            for (s0, (bp, bc), warm) in capped {
-                let r = problem(
-                    &s0.p,
-                    &s0.c,
-                    Some((&bp, &bc)),
-                    Some(range),
-                    warm,
-                    st.scp_max_solves,
-                    None,
-                    st,
-                );
-                match r {
-                    Ok(sol) => {
-                        sink.offer(Proposal {
-                            method: Method::Joint,
-                            first: range.0,
-                            last: range.1,
-                            p: sol.p_deg,
-                            c: sol.c_deg,
-                            tail: s0.tail,
-                            qp: sol.qp,
-                        });
-                    }
-                    Err(crate::candidate::PatchFailure::Solver(q)) => sink.add_stats(&q),
-                    Err(_) => {}
-                }
+                Err(PatchFailure::Solver(q)) => sink.add_stats(&q),
+                Err(_) => {}
             }
         }
-        true
     }
 }

@@ -89,6 +89,10 @@ impl std::fmt::Display for ReferenceMethod {
 /// The reference of `zone` on a path given by `s_mm`, `p_deg`, `c_deg` (the program's
 /// values), with points `first..=last` movable (module docs). `max_decimals` is unused by
 /// the relaxation (it allows any values) and kept for the callers.
+///
+/// The steps: the relaxation ([`reachable`]: unreachable is a proof); re-selection alone
+/// ([`RefPath::reselect`]); the starts ([`RefPath::starts`]); the joint solve from each
+/// ([`RefPath::best`]).
 #[allow(clippy::too_many_arguments)]
 pub fn zone_reference(
     s_mm: &[f64],
@@ -127,35 +131,86 @@ pub fn zone_reference(
         .zip(c_deg)
         .map(|(p, c)| forward(machine, *p, *c))
         .collect();
-    let passes = |p: &[f64], c: &[f64], changed: (usize, usize)| {
+    let rp = RefPath {
+        s_mm,
+        p_deg,
+        c_deg,
+        zone,
+        first,
+        last,
+        machine,
+        feed_mm_min,
+        target,
+        st,
+        core,
+    };
+    if rp.reselect() {
+        return Ok(Reference::Best {
+            deviation_deg: 0.0,
+            method: ReferenceMethod::Reselect,
+        });
+    }
+    Ok(match rp.best(&rp.starts()) {
+        Some((deviation_deg, method)) => Reference::Best {
+            deviation_deg,
+            method,
+        },
+        None => Reference::Failed,
+    })
+}
+
+/// One zone's reference problem (the arguments of [`zone_reference`]), the program's tool
+/// axes, the reference's settings and the zone's core.
+struct RefPath<'a> {
+    s_mm: &'a [f64],
+    p_deg: &'a [f64],
+    c_deg: &'a [f64],
+    zone: &'a Zone,
+    first: usize,
+    last: usize,
+    machine: &'a Machine,
+    feed_mm_min: f64,
+    target: Vec<[f64; 3]>,
+    st: SolverSettings,
+    core: std::ops::Range<usize>,
+}
+
+/// A start of the joint solve: the method it stands for and the whole path's values.
+type RefStart = (ReferenceMethod, Vec<f64>, Vec<f64>);
+
+impl RefPath<'_> {
+    /// Whether `(p, c)`, changed on `changed`, passes the verification against the
+    /// program's values.
+    fn passes(&self, p: &[f64], c: &[f64], changed: (usize, usize)) -> bool {
         let ch = [
             AxisChange {
                 axis: Axis::Primary,
-                before: p_deg,
+                before: self.p_deg,
                 after: p,
             },
             AxisChange {
                 axis: Axis::C,
-                before: c_deg,
+                before: self.c_deg,
                 after: c,
             },
         ];
         verify_change_with_core(
-            s_mm,
+            self.s_mm,
             &ch,
             changed,
-            (zone.first, zone.last),
-            core_margins(zone, st.core_margin_points),
-            machine,
-            feed_mm_min / 60.0,
+            (self.zone.first, self.zone.last),
+            core_margins(self.zone, self.st.core_margin_points),
+            self.machine,
+            self.feed_mm_min / 60.0,
         )
         .passes()
-    };
-    // The singular point and the other branch after it.
-    let k = (zone.first..=zone.last)
-        .min_by(|&a, &b| p_deg[a].abs().total_cmp(&p_deg[b].abs()))
-        .unwrap_or(zone.singular);
-    let flipped = |after: usize| -> (Vec<f64>, Vec<f64>) {
+    }
+
+    /// The program's values with the points after `after` on the other branch,
+    /// continuous with the last point off the pole (on it C does not orient the tool).
+    fn flipped(&self, after: usize) -> (Vec<f64>, Vec<f64>) {
+        let (p_deg, c_deg) = (self.p_deg, self.c_deg);
+        let n = self.s_mm.len();
         let (mut p, mut c) = (p_deg.to_vec(), c_deg.to_vec());
         if after + 1 < n {
             // Continuous with the last point off the pole (on it C does not orient the tool).
@@ -170,95 +225,132 @@ pub fn zone_reference(
             }
         }
         (p, c)
-    };
-    let (lo, hi) = machine.primary_range_deg;
-    let in_range = |p: &[f64]| p.iter().all(|v| (lo..=hi).contains(v));
-    // The points after the range keep their values unless the last point may move: then
-    // they may go to the other branch as a block.
-    let tail_free = last == n - 1;
-    // Re-selection alone: the flip point of a domain-rule program, if any.
-    if let Some(f) = (zone.first..zone.last).filter(|_| tail_free).find(|&i| {
-        p_deg[i] != 0.0 && p_deg[i + 1] != 0.0 && p_deg[i].signum() != p_deg[i + 1].signum()
-    }) {
-        let (p, c) = flipped(f);
-        if in_range(&p) && passes(&p, &c, (f + 1, f + 1)) {
-            return Ok(Reference::Best {
-                deviation_deg: 0.0,
-                method: ReferenceMethod::Reselect,
-            });
+    }
+
+    /// Every primary value within the machine's range.
+    fn in_range(&self, p: &[f64]) -> bool {
+        let (lo, hi) = self.machine.primary_range_deg;
+        p.iter().all(|v| (lo..=hi).contains(v))
+    }
+
+    /// The points after the range keep their values unless the last point may move: then
+    /// they may go to the other branch as a block.
+    fn tail_free(&self) -> bool {
+        self.last == self.s_mm.len() - 1
+    }
+
+    /// Re-selection alone: the flip point of a domain-rule program, if any, and the other
+    /// branch after it reaches feed.
+    fn reselect(&self) -> bool {
+        let (zone, p_deg) = (self.zone, self.p_deg);
+        if let Some(f) = (zone.first..zone.last)
+            .filter(|_| self.tail_free())
+            .find(|&i| {
+                p_deg[i] != 0.0 && p_deg[i + 1] != 0.0 && p_deg[i].signum() != p_deg[i + 1].signum()
+            })
+        {
+            let (p, c) = self.flipped(f);
+            return self.in_range(&p) && self.passes(&p, &c, (f + 1, f + 1));
         }
+        false
     }
-    let mut starts: Vec<(ReferenceMethod, Vec<f64>, Vec<f64>)> =
-        vec![(ReferenceMethod::AsIs, p_deg.to_vec(), c_deg.to_vec())];
-    let (op, oc) = flipped(k);
-    if tail_free && in_range(&op) {
-        starts.push((ReferenceMethod::OtherBranch, op, oc));
-    }
-    // FREEZE and LINEARIZE across the cone stretch (the peers' rules, crate::starts).
-    let cone = CONE_DEG.max(zone.min_abs_primary_deg);
-    if let (Some(stretch), Ok(spline)) = (
-        cone_stretch(p_deg, zone, cone),
-        AnalysisSpline::new(s_mm, c_deg),
-    ) {
-        for (name, rule) in [
-            (ReferenceMethod::Freeze, Rule::Freeze),
-            (ReferenceMethod::Linearize, Rule::Linearize),
-        ] {
-            let (mut rp, mut rc) = (p_deg.to_vec(), c_deg.to_vec());
-            apply_rule(
-                rule, machine, s_mm, c_deg, &spline, &target, stretch, &mut rp, &mut rc,
-            );
-            starts.push((name, rp, rc));
+
+    /// The starts (module docs): as-is; the other branch after the singular point (the
+    /// least |P| of the zone); FREEZE and LINEARIZE across the cone stretch (the peers'
+    /// rules, crate::starts).
+    fn starts(&self) -> Vec<RefStart> {
+        let (zone, p_deg, c_deg) = (self.zone, self.p_deg, self.c_deg);
+        // The singular point and the other branch after it.
+        let k = (zone.first..=zone.last)
+            .min_by(|&a, &b| p_deg[a].abs().total_cmp(&p_deg[b].abs()))
+            .unwrap_or(zone.singular);
+        let mut starts: Vec<RefStart> =
+            vec![(ReferenceMethod::AsIs, p_deg.to_vec(), c_deg.to_vec())];
+        let (op, oc) = self.flipped(k);
+        if self.tail_free() && self.in_range(&op) {
+            starts.push((ReferenceMethod::OtherBranch, op, oc));
         }
-    }
-    let mut best: Option<(f64, ReferenceMethod)> = None;
-    for (name, sp, sc) in &starts {
-        let pr = JointProblem {
-            s_mm,
-            p_deg: sp,
-            c_deg: sc,
-            target: &target,
-            first,
-            last,
-            lim_p: GeomLimits::of(machine, Axis::Primary, feed_mm_min, st.reference_margin),
-            lim_c: GeomLimits::of(machine, Axis::C, feed_mm_min, st.reference_margin),
-            feed_mm_min,
-            machine,
-            core: core.clone(),
-            round_p_deg: 0.0,
-            round_c_deg: 0.0,
-            reference: Some((p_deg, c_deg)),
-            verified: (p_deg, c_deg),
-            pole_spans: if zone.cut_before { zone.first } else { 0 }..if zone.cut_after {
-                zone.last
-            } else {
-                n
-            },
-            cap_deg: None,
-            point_cap_deg: None,
-            warm: false,
-            max_solves: st.scp_max_solves,
-            ipm_start: None,
-            memo: None,
-            settings: &st,
-        };
-        let Ok(sol) = solve_joint(&pr) else { continue };
-        let (mut p, mut c) = (sp.clone(), sc.clone());
-        p[first..=last].copy_from_slice(&sol.p_deg);
-        c[first..=last].copy_from_slice(&sol.c_deg);
-        // Starts other than "as-is" change points outside the range only as a block that
-        // keeps the tool axes; the deviation counts the range.
-        if passes(&p, &c, (first, last)) && best.is_none_or(|(d, _)| sol.max_deviation_deg < d) {
-            best = Some((sol.max_deviation_deg, *name));
+        // FREEZE and LINEARIZE across the cone stretch (the peers' rules, crate::starts).
+        let cone = CONE_DEG.max(zone.min_abs_primary_deg);
+        if let (Some(stretch), Ok(spline)) = (
+            cone_stretch(p_deg, zone, cone),
+            AnalysisSpline::new(self.s_mm, c_deg),
+        ) {
+            for (name, rule) in [
+                (ReferenceMethod::Freeze, Rule::Freeze),
+                (ReferenceMethod::Linearize, Rule::Linearize),
+            ] {
+                let (mut rp, mut rc) = (p_deg.to_vec(), c_deg.to_vec());
+                apply_rule(
+                    rule,
+                    self.machine,
+                    self.s_mm,
+                    c_deg,
+                    &spline,
+                    &self.target,
+                    stretch,
+                    &mut rp,
+                    &mut rc,
+                );
+                starts.push((name, rp, rc));
+            }
         }
+        starts
     }
-    Ok(match best {
-        Some((deviation_deg, method)) => Reference::Best {
-            deviation_deg,
-            method,
-        },
-        None => Reference::Failed,
-    })
+
+    /// The joint solve from every start; the smallest largest deviation of a solution
+    /// that passes, and its start's method.
+    fn best(&self, starts: &[RefStart]) -> Option<(f64, ReferenceMethod)> {
+        let (s_mm, p_deg, c_deg, zone) = (self.s_mm, self.p_deg, self.c_deg, self.zone);
+        let (first, last, machine, feed_mm_min) =
+            (self.first, self.last, self.machine, self.feed_mm_min);
+        let st = &self.st;
+        let n = s_mm.len();
+        let mut best: Option<(f64, ReferenceMethod)> = None;
+        for (name, sp, sc) in starts {
+            let pr = JointProblem {
+                s_mm,
+                p_deg: sp,
+                c_deg: sc,
+                target: &self.target,
+                first,
+                last,
+                lim_p: GeomLimits::of(machine, Axis::Primary, feed_mm_min, st.reference_margin),
+                lim_c: GeomLimits::of(machine, Axis::C, feed_mm_min, st.reference_margin),
+                feed_mm_min,
+                machine,
+                core: self.core.clone(),
+                round_p_deg: 0.0,
+                round_c_deg: 0.0,
+                reference: Some((p_deg, c_deg)),
+                verified: (p_deg, c_deg),
+                pole_spans: if zone.cut_before { zone.first } else { 0 }..if zone.cut_after {
+                    zone.last
+                } else {
+                    n
+                },
+                cap_deg: None,
+                point_cap_deg: None,
+                warm: false,
+                max_solves: st.scp_max_solves,
+                ipm_start: None,
+                memo: None,
+                settings: st,
+            };
+            let Ok(sol) = solve_joint(&pr) else { continue };
+            let (mut p, mut c) = (sp.clone(), sc.clone());
+            p[first..=last].copy_from_slice(&sol.p_deg);
+            c[first..=last].copy_from_slice(&sol.c_deg);
+            // Starts other than "as-is" change points outside the range only as a block that
+            // keeps the tool axes; the deviation counts the range.
+            if self.passes(&p, &c, (first, last))
+                && best.is_none_or(|(d, _)| sol.max_deviation_deg < d)
+            {
+                best = Some((sol.max_deviation_deg, *name));
+            }
+        }
+        best
+    }
 }
 
 #[cfg(test)]

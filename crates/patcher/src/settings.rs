@@ -11,6 +11,22 @@
 
 use crate::ipm::IpmSettings;
 
+// --- The options' defaults ---------------------------------------------------------------
+
+/// Default singular cone, degrees: every stretch where C is below feed and the primary
+/// axis comes this close to the pole is a zone ([`crate::analysis::detect_zones`]). 5°:
+/// the rule before the pole reach (issue 30, docs/history.md); near the pole a large change
+/// of C is a small change of tool axis (≈ sin|P|·ΔC).
+pub const CONE_DEG: f64 = 5.0;
+
+/// Default pole reach, degrees: out to this distance from the pole, a stretch where C is
+/// below feed is a zone when the pole accounts for at least half its slowdown
+/// ([`crate::analysis::pole_dominates`]). 10°, measured (docs/history.md, issue 30): it
+/// finds a real Haas UMC program's corners at B 6.2°–7.4° as one zone each, where a 15°
+/// reach also joins the last span of C17's `%SING` to its zone and makes G16's method
+/// worse there.
+pub const POLE_REACH_DEG: f64 = 10.0;
+
 /// Numerical settings of the patcher (module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SolverSettings {

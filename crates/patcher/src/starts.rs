@@ -29,7 +29,11 @@
 //! ([`primary_on_meridian`]). FREEZE and LINEARIZE are starts of the joint patch and of
 //! the bench reference; the bench scores all three as peers ([`crate::peers`]).
 
-use crate::{analysis::Zone, spline::AnalysisSpline, tolerances::POLE_DEG};
+use crate::{
+    analysis::Zone,
+    spline::AnalysisSpline,
+    tolerances::{HALF_TURN_SLACK_DEG, POLE_DEG},
+};
 use polepatch_kinematics::{Machine, forward_jacobian, wrap_deg};
 
 /// A cone rule (module docs).
@@ -96,7 +100,7 @@ pub fn tail_shift(
     let r = (0..=k).rev().find(|&i| p[i].abs() > POLE_DEG).unwrap_or(k);
     let d = wrap_deg(c[k + 1] + 180.0 - c[r]) - (c[k + 1] + 180.0 - c[r]);
     let shift = 180.0 + d;
-    let shift = if shift > 180.0 + 1e-9 {
+    let shift = if shift > 180.0 + HALF_TURN_SLACK_DEG {
         shift - 360.0
     } else {
         shift

@@ -8,8 +8,8 @@
 //! change per call. What is here is fixed: changing one changes what "equal", "not worse"
 //! or "enough points" mean, and every method together with it.
 //!
-//! The option defaults (the singular cone [`crate::CONE_DEG`], the pole reach
-//! [`crate::POLE_REACH_DEG`]) stay with the analysis they parametrise; the limits of the
+//! The option defaults that are not fields' literals (the singular cone [`crate::CONE_DEG`],
+//! the pole reach [`crate::POLE_REACH_DEG`]) are in [`crate::settings`]; the limits of the
 //! options (what [`crate::PatchOptions::validate`] accepts) stay with the options.
 
 // --- Equation 6 and "not worse" ------------------------------------------------------
@@ -148,3 +148,63 @@ pub const CLARABEL_MAX_ITER: u32 = 60;
 /// A path segment whose tool tips are closer than this, mm, has no feed scale of its own
 /// ([`crate::centre::segment_scale`]: 1).
 pub const ZERO_SEGMENT_MM: f64 = 1e-9;
+
+/// The SCP of the joint patch ([`crate::joint::solve_joint`]) stops when an accepted step
+/// gains less than [`crate::SolverSettings::scp_rel_tol`] times the merit, the merit
+/// taken at least this (dimensionless): at a merit of 0 it still stops on a gain of
+/// round-off instead of going on to its last solve.
+pub const SCP_MERIT_FLOOR: f64 = 1e-12;
+
+/// The smallest cap of a point in a capped joint solve, degrees (a point exactly on the
+/// pole whose bound is 0 still gets a cone that is not degenerate; the driver measures
+/// the written angle against the bound itself).
+pub const MIN_POINT_CAP_DEG: f64 = 1e-6;
+
+/// A pivot of the joint window's dense elimination ([`crate::window`]) at or below this
+/// fraction of the matrix's largest entry vanishes (dimensionless): some thousands of
+/// times double precision's round-off, where the eliminated end slopes would carry no
+/// digits.
+pub const PIVOT_REL_TOL: f64 = 1e-12;
+
+/// A sign row `σ·f ≥ 0` of a Hermite QP ([`crate::hermite`]) is divided by its largest
+/// coefficient, at least this (in the row's units): a row of zeros is left as it is
+/// instead of divided by zero.
+pub const SIGN_ROW_SCALE_FLOOR: f64 = 1e-300;
+
+// --- Zero tests -----------------------------------------------------------------------
+
+/// A net change of C over a C-only range at or below this, degrees, has no direction
+/// ([`crate::c_only`]: the direct QP is then tried without a monotone direction): a
+/// change of round-off size has no sign to hold to.
+pub const ZERO_NET_C_DEG: f64 = 1e-9;
+
+/// The shift that puts the points after a branch switch on the other branch is taken in
+/// (−180°, 180°] up to this slack, degrees ([`crate::starts::tail_shift`]): a shift of
+/// 180° that the wrapping left a round-off above it is +180°, not −180°.
+pub const HALF_TURN_SLACK_DEG: f64 = 1e-9;
+
+/// Slack on the upper end of the C-only deviation bound's bracket, degrees
+/// ([`crate::direct::deviation_bound_sampled`]): 2·asin(max w) allows every change, and
+/// the slack keeps the round-off of the `asin` from making that end infeasible.
+pub const BOUND_BRACKET_SLACK_DEG: f64 = 1e-9;
+
+/// Points either side of a zone over which G16's method takes the median CL spacing
+/// ([`crate::g16`]: its join step and shortest span are fractions of it): a few, so the
+/// spacing is the zone's own, not the path's elsewhere.
+pub const G16_SPACING_POINTS: usize = 5;
+
+// --- The interior-point method (crate::ipm) --------------------------------------------
+
+/// Iterative refinement of a KKT solve stops when the residual is below this fraction of
+/// `1 + ‖rhs‖∞` (dimensionless): a few hundred times double precision's round-off, below
+/// which a step only moves round-off.
+pub const IPM_REFINE_REL_TOL: f64 = 1e-13;
+
+/// A cold start's slacks and multipliers are shifted into their cones unless they lie at
+/// least this deep inside already (on the equilibrated problem): a point on a cone's
+/// boundary leaves the first step no room.
+pub const IPM_COLD_DEPTH: f64 = 1e-8;
+
+/// After each step the linear slacks and multipliers are at least this: one that rounded
+/// to 0 would make the scaling `z/s` infinite or zero.
+pub const IPM_SLACK_FLOOR: f64 = 1e-300;

@@ -35,7 +35,8 @@ use crate::candidate::PatchFailure;
 use crate::qp::Row;
 use crate::spline::{AnalysisSpline, SplineSystem};
 use crate::tolerances::{
-    EDGE_SPANS, MIN_ROW_BOUND, NOT_WORSE_SAMPLES_PER_SPAN, NOT_WORSE_SLACK, WIDEN_POINTS,
+    EDGE_SPANS, MIN_ROW_BOUND, NOT_WORSE_SAMPLES_PER_SPAN, NOT_WORSE_SLACK, PIVOT_REL_TOL,
+    WIDEN_POINTS,
 };
 
 pub use crate::tolerances::JOINT_WINDOW_POINTS;
@@ -579,7 +580,7 @@ fn solve_dense(a: &mut [f64], m: usize, no: usize) -> Option<Vec<f64>> {
     for col in 0..m {
         let piv =
             (col..m).max_by(|&p, &q| a[p * wd + col].abs().total_cmp(&a[q * wd + col].abs()))?;
-        if a[piv * wd + col].abs() <= 1e-12 * scale {
+        if a[piv * wd + col].abs() <= PIVOT_REL_TOL * scale {
             return None;
         }
         if piv != col {

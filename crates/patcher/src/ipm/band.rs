@@ -11,6 +11,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::inf_norm;
+use crate::tolerances::IPM_REFINE_REL_TOL;
 
 /// The half-bandwidths the band's loops are compiled for; a wider band uses the same
 /// loops with the width read at run time.
@@ -387,7 +388,7 @@ fn band_solve_dyn(band: &[f64], dinv: &[f64], nb: usize, w: usize, x: &mut [f64]
 }
 
 /// Iterative refinement of `sol` (solved with the regularised factors `kkt`) against the
-/// unregularised matrix `unreg`, until the residual is below 1e-13 of the right-hand side
+/// unregularised matrix `unreg`, until the residual is below [`IPM_REFINE_REL_TOL`] of the right-hand side
 /// or `max_steps` steps, whichever first (a step that does not lower it ends it).
 pub(super) fn refine(
     kkt: &BorderedBand,
@@ -397,7 +398,7 @@ pub(super) fn refine(
     tmp: &mut [f64],
     max_steps: u32,
 ) {
-    let target = 1e-13 * (1.0 + inf_norm(rhs));
+    let target = IPM_REFINE_REL_TOL * (1.0 + inf_norm(rhs));
     let mut last = f64::INFINITY;
     for _ in 0..max_steps {
         unreg.mul(sol, tmp);

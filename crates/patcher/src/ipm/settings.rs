@@ -28,7 +28,8 @@ pub struct IpmSettings {
     /// Default 1e-4.
     pub warm_mu: f64,
     /// Most iterative refinement steps per solve (it stops earlier when the residual is
-    /// below 1e-13 of the right-hand side). Default 4.
+    /// below [`crate::tolerances::IPM_REFINE_REL_TOL`] (1e-13) of the right-hand side).
+    /// Default 4.
     pub refinement_steps: u32,
     /// Divide the objective (and `H`) by its largest coefficient before solving, as the
     /// rows are divided by theirs. The stopping rule's gap (`μ ≤ tol_gap·(1 + |objective|)`)

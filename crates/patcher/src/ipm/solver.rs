@@ -1,5 +1,17 @@
-//! The interior-point loop (module docs of [`super`]): equilibration, the start, the
-//! residuals, the scalings, the predictor and corrector steps.
+//! The interior-point loop (module docs of [`super`]), written as Clarabel's solver loop
+//! is: one driver ([`Problem::solve_warm`]) over named steps on the loop's state —
+//!
+//! 1. the start: [`Iterate::cold`] (CVXOPT's) or [`Iterate::warm`] (a previous solve's,
+//!    centred);
+//! 2. the residuals `r_d`, `r_g`, `μ` and the objective ([`Residuals::update`]) and the
+//!    termination checks ([`Residuals::converged`]);
+//! 3. the scalings at the iterate ([`Scalings::update`]) and the KKT factor
+//!    ([`Newton::factor`]);
+//! 4. the predictor: `r_c = λ∘λ` ([`affine_rc`]) and its Newton step
+//!    ([`Newton::direction`]), then `σ` ([`centring`]);
+//! 5. the corrector: `r_c = λ∘λ + (W⁻ᵀ·ds_a)∘(W·dz_a) − σ·μ·e` ([`corrector_rc`]) and its
+//!    Newton step;
+//! 6. the step length ([`step_length`]) and the step ([`Iterate::take_step`]).
 
 // Index loops mirror the method's formulas (rows, cones).
 #![allow(clippy::needless_range_loop)]
@@ -9,6 +21,7 @@ use super::cones::{MAX_CONE, SocScaling, soc_div, soc_prod, soc_scaling, soc_ste
 use super::kkt::Kkt;
 use super::problem::Problem;
 use super::{IpmSettings, IpmSolution, IpmStatus, IpmWarm, inf_norm};
+use crate::tolerances::{IPM_COLD_DEPTH, IPM_SLACK_FLOOR};
 
 impl Problem {
     /// Solve (module docs of [`super`]): Mehrotra's predictor–corrector with
@@ -25,20 +38,254 @@ impl Problem {
         self.equilibrated(st.scale_objective).solve_scaled(st, warm)
     }
 
+    /// The loop (module docs): the steps in their order.
     fn solve_scaled(&self, st: &IpmSettings, warm: Option<&IpmWarm>) -> IpmSolution {
-        let sys = Kkt::new(self);
-        let (nb, k) = (self.nb, self.k);
-        let n = nb + k;
-        let (ml, mi) = (sys.ml, sys.mi);
-        let hv = &sys.h;
-        let degree = (ml + sys.cones.len()).max(1) as f64;
-        let w = self.half_bandwidth();
-        let hmat = sys.h_matrix(w);
-        let mut unreg = BorderedBand::new(nb, w, k);
-        let mut kkt = BorderedBand::new(nb, w, k);
-        let blocks: Vec<(usize, usize)> = sys.cones.iter().map(|c| (c.b0, c.q)).collect();
-        let mut d = vec![1.0; ml];
-        let mut d_sqrt = vec![1.0; ml];
+        let sys = Structure::new(self);
+        let mut newton = Newton::new(&sys);
+        let mut sc = Scalings::new(&sys);
+        let warm = warm.filter(|w| w.x.len() == sys.n && w.z.len() == sys.kkt.mi);
+        let mut it = match warm {
+            Some(w) => Iterate::warm(&sys, w, st),
+            None => Iterate::cold(&sys, &self.c, &sc, &mut newton, st),
+        };
+        let scale_h = 1.0 + inf_norm(&sys.kkt.h);
+        let scale_c = 1.0 + inf_norm(&self.c);
+        let mut res = Residuals::new(&sys);
+        let (mut affine, mut step) = (Direction::new(&sys), Direction::new(&sys));
+        let mut rc = vec![0.0; sys.kkt.mi];
+        for k in 0..st.max_iter {
+            let (mu, obj) = res.update(&sys, &self.c, &it);
+            if !(obj.is_finite() && mu.is_finite()) {
+                return it.end(IpmStatus::NumericalError, k);
+            }
+            if res.converged(st, (scale_h, scale_c), mu, obj) {
+                return it.end(IpmStatus::Solved, k);
+            }
+            sc.update(&sys, &it);
+            if !newton.factor(&sys, &sc, st) {
+                return it.end(IpmStatus::NumericalError, k);
+            }
+            affine_rc(&sys, &sc, &mut rc);
+            newton.direction(&sys, &sc, &res, &rc, &mut affine, st);
+            let sigma = centring(&sys, &it, &affine, mu);
+            let smu = sigma * mu;
+            corrector_rc(&sys, &sc, &affine, smu, &mut rc);
+            newton.direction(&sys, &sc, &res, &rc, &mut step, st);
+            let alpha = step_length(&sys, &it, &step, st);
+            if !(alpha.is_finite() && step.dx.iter().all(|v| v.is_finite())) {
+                return it.end(IpmStatus::NumericalError, k);
+            }
+            it.take_step(&sys, alpha, &step);
+        }
+        it.end(IpmStatus::MaxIterations, st.max_iter)
+    }
+}
+
+/// What the loop knows of the problem, fixed over its iterations: the KKT system's
+/// structure, `H` as a bordered band, the cones' blocks `(first slack, rows)` and the
+/// degree `ν` (one per linear row and per cone).
+struct Structure<'a> {
+    kkt: Kkt<'a>,
+    hmat: BorderedBand,
+    blocks: Vec<(usize, usize)>,
+    /// Unknowns (band and border).
+    n: usize,
+    /// Linear slacks (the rest are the cones').
+    ml: usize,
+    /// Half-bandwidth of the KKT matrix.
+    w: usize,
+    degree: f64,
+}
+
+impl<'a> Structure<'a> {
+    fn new(p: &'a Problem) -> Structure<'a> {
+        let kkt = Kkt::new(p);
+        let degree = (kkt.ml + kkt.cones.len()).max(1) as f64;
+        let w = p.half_bandwidth();
+        let hmat = kkt.h_matrix(w);
+        let blocks = kkt.cones.iter().map(|c| (c.b0, c.q)).collect();
+        Structure {
+            n: p.nb + p.k,
+            ml: kkt.ml,
+            kkt,
+            hmat,
+            blocks,
+            w,
+            degree,
+        }
+    }
+}
+
+/// The iterate: the primal point `x`, the slacks `s` and the multipliers `z`.
+struct Iterate {
+    x: Vec<f64>,
+    s: Vec<f64>,
+    z: Vec<f64>,
+}
+
+impl Iterate {
+    /// Warm: x as given, ŝ = h − G·x and the previous multipliers, centred by Mehrotra's
+    /// heuristic ([`centre`]) at least √warm_mu inside every cone: the products start near
+    /// `warm_mu`, where the previous solve was some iterations before its end, not at its
+    /// last complementarity (from which the changed problem's residuals could not be
+    /// reduced in full steps).
+    fn warm(sys: &Structure<'_>, w: &IpmWarm, st: &IpmSettings) -> Iterate {
+        let mi = sys.kkt.mi;
+        let (mut x, mut s, mut z) = (vec![0.0; sys.n], vec![0.0; mi], vec![0.0; mi]);
+        x.copy_from_slice(&w.x);
+        sys.kkt.g_mul(&x, &mut s);
+        for (sr, hr) in s.iter_mut().zip(&sys.kkt.h) {
+            *sr = hr - *sr;
+        }
+        z.copy_from_slice(&w.z);
+        centre(&mut s, &mut z, sys.ml, &sys.blocks, st.warm_mu.sqrt());
+        Iterate { x, s, z }
+    }
+
+    /// Cold (CVXOPT's start): x̂ minimising ½xᵀHx + cᵀx + ½‖G·x − h‖² (the KKT matrix at
+    /// the identity scalings `sc`), then ŝ = h − G·x̂ and ẑ = −ŝ, each moved into the
+    /// cones' interiors.
+    fn cold(
+        sys: &Structure<'_>,
+        c: &[f64],
+        sc: &Scalings,
+        newton: &mut Newton,
+        st: &IpmSettings,
+    ) -> Iterate {
+        let (ml, mi, hv) = (sys.ml, sys.kkt.mi, &sys.kkt.h);
+        let (mut x, mut s, mut z) = (vec![0.0; sys.n], vec![0.0; mi], vec![0.0; mi]);
+        if newton.factor(sys, sc, st) {
+            let Newton {
+                unreg,
+                kkt,
+                rhs,
+                sol,
+                tmp,
+                ..
+            } = newton;
+            for (r, c) in rhs.iter_mut().zip(c) {
+                *r = -c;
+            }
+            sys.kkt.gt_mul_add(hv, rhs);
+            sol.copy_from_slice(rhs);
+            kkt.solve(sol);
+            refine(kkt, unreg, rhs, sol, tmp, st.refinement_steps);
+            if sol.iter().all(|v| v.is_finite()) {
+                x.copy_from_slice(sol);
+            }
+        }
+        sys.kkt.g_mul(&x, &mut s);
+        for (sr, hr) in s.iter_mut().zip(hv) {
+            *sr = hr - *sr;
+        }
+        for (zr, sr) in z.iter_mut().zip(&s) {
+            *zr = -sr;
+        }
+        // Shift into the interior: by 1 + the distance outside (the largest violation).
+        // (Mehrotra's heuristic, as a warm start is centred, took 11 % more
+        // iterations on the held-out-like zones.)
+        for v in [&mut s, &mut z] {
+            let a = outside(v, ml, &sys.blocks);
+            if a >= -IPM_COLD_DEPTH || !a.is_finite() {
+                let shift = if a.is_finite() { 1.0 + a } else { 1.0 };
+                v[..ml].iter_mut().for_each(|x| *x += shift);
+                for &(b0, _) in &sys.blocks {
+                    v[b0] += shift;
+                }
+            }
+        }
+        Iterate { x, s, z }
+    }
+
+    /// Step `alpha` along `dir`, the linear slacks and multipliers kept at least
+    /// [`IPM_SLACK_FLOOR`].
+    fn take_step(&mut self, sys: &Structure<'_>, alpha: f64, dir: &Direction) {
+        let ml = sys.ml;
+        let Iterate { x, s, z } = self;
+        for (xj, dj) in x.iter_mut().zip(&dir.dx) {
+            *xj += alpha * dj;
+        }
+        for ((sr, dsr), (zr, dzr)) in s.iter_mut().zip(&dir.ds).zip(z.iter_mut().zip(&dir.dz)) {
+            *sr += alpha * dsr;
+            *zr += alpha * dzr;
+        }
+        for (sr, zr) in s[..ml].iter_mut().zip(z[..ml].iter_mut()) {
+            *sr = sr.max(IPM_SLACK_FLOOR);
+            *zr = zr.max(IPM_SLACK_FLOOR);
+        }
+    }
+
+    /// The solution as it stands, with how and after how many iterations the loop ended.
+    fn end(self, status: IpmStatus, iterations: u32) -> IpmSolution {
+        IpmSolution {
+            x: self.x,
+            z: self.z,
+            status,
+            iterations,
+        }
+    }
+}
+
+/// The residuals at the iterate: `r_d = H·x + c + Gᵀ·z`, `r_g = G·x + s − h`, and `H·x`.
+struct Residuals {
+    rd: Vec<f64>,
+    rg: Vec<f64>,
+    hx: Vec<f64>,
+}
+
+impl Residuals {
+    fn new(sys: &Structure<'_>) -> Residuals {
+        Residuals {
+            rd: vec![0.0; sys.n],
+            rg: vec![0.0; sys.kkt.mi],
+            hx: vec![0.0; sys.n],
+        }
+    }
+
+    /// The residuals at `it`; returns `μ = sᵀz/ν` and the objective `½xᵀHx + cᵀx`.
+    fn update(&mut self, sys: &Structure<'_>, c: &[f64], it: &Iterate) -> (f64, f64) {
+        let Residuals { rd, rg, hx } = self;
+        sys.hmat.mul(&it.x, hx);
+        for ((r, c), h) in rd.iter_mut().zip(c).zip(hx.iter()) {
+            *r = c + h;
+        }
+        sys.kkt.gt_mul_add(&it.z, rd);
+        sys.kkt.g_mul(&it.x, rg);
+        for ((r, sr), hr) in rg.iter_mut().zip(&it.s).zip(&sys.kkt.h) {
+            *r += sr - hr;
+        }
+        let mu = dot(&it.s, &it.z) / sys.degree;
+        let obj = 0.5 * dot(hx, &it.x) + dot(c, &it.x);
+        (mu, obj)
+    }
+
+    /// Converged: `‖r_g‖∞ ≤ tol_feas·(1 + ‖h‖∞)`, `‖r_d‖∞ ≤ tol_feas·(1 + ‖c‖∞)` and
+    /// `μ ≤ tol_gap·(1 + |objective|)` (`scale`: the two `1 + ‖·‖∞`).
+    fn converged(
+        &self,
+        st: &IpmSettings,
+        (scale_h, scale_c): (f64, f64),
+        mu: f64,
+        obj: f64,
+    ) -> bool {
+        inf_norm(&self.rg) <= st.tol_feas * scale_h
+            && inf_norm(&self.rd) <= st.tol_feas * scale_c
+            && mu <= st.tol_gap * (1.0 + obj.abs())
+    }
+}
+
+/// The scalings at the iterate: on the linear slacks `V = z/s` (`d`) and `W⁻¹ = √(z/s)`
+/// (`d_sqrt`), on the cones their Nesterov–Todd `W`; and `λ = W·z`.
+struct Scalings {
+    d: Vec<f64>,
+    d_sqrt: Vec<f64>,
+    scal: Vec<SocScaling>,
+    lam: Vec<f64>,
+}
+
+impl Scalings {
+    /// The identity scalings (the cold start's KKT matrix).
+    fn new(sys: &Structure<'_>) -> Scalings {
         let ident = SocScaling {
             eta: 1.0,
             wbar: {
@@ -47,280 +294,255 @@ impl Problem {
                 e
             },
         };
-        let mut scal: Vec<SocScaling> = vec![ident; blocks.len()];
-        let mut yscratch: Vec<f64> = Vec::new();
-        let (mut rhs, mut sol, mut tmp) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        let warm = warm.filter(|w| w.x.len() == n && w.z.len() == mi);
-        let (mut x, mut s, mut z) = (vec![0.0; n], vec![0.0; mi], vec![0.0; mi]);
-        if let Some(w) = warm {
-            // Warm: x as given, ŝ = h − G·x and the previous multipliers, centred by
-            // Mehrotra's heuristic ([`centre`]) at least √warm_mu inside every cone: the
-            // products start near `warm_mu`, where the previous solve was some iterations
-            // before its end, not at its last complementarity (from which the changed
-            // problem's residuals could not be reduced in full steps).
-            x.copy_from_slice(&w.x);
-            sys.g_mul(&x, &mut s);
-            for (sr, hr) in s.iter_mut().zip(hv) {
-                *sr = hr - *sr;
-            }
-            z.copy_from_slice(&w.z);
-            centre(&mut s, &mut z, ml, &blocks, st.warm_mu.sqrt());
-        } else {
-            // Start (CVXOPT's): x̂ minimising ½xᵀHx + cᵀx + ½‖G·x − h‖², then ŝ = h − G·x̂ and
-            // ẑ = −ŝ, each moved into the cones' interiors.
-            if assemble_factor(
-                &sys,
-                &hmat,
-                (&d, &scal),
-                &mut yscratch,
-                st,
-                &mut unreg,
-                &mut kkt,
-            ) {
-                for (r, c) in rhs.iter_mut().zip(&self.c) {
-                    *r = -c;
-                }
-                sys.gt_mul_add(hv, &mut rhs);
-                sol.copy_from_slice(&rhs);
-                kkt.solve(&mut sol);
-                refine(&kkt, &unreg, &rhs, &mut sol, &mut tmp, st.refinement_steps);
-                if sol.iter().all(|v| v.is_finite()) {
-                    x.copy_from_slice(&sol);
-                }
-            }
-            sys.g_mul(&x, &mut s);
-            for (sr, hr) in s.iter_mut().zip(hv) {
-                *sr = hr - *sr;
-            }
-            for (zr, sr) in z.iter_mut().zip(&s) {
-                *zr = -sr;
-            }
-            // Shift into the interior: by 1 + the distance outside (the largest violation).
-            // (Mehrotra's heuristic, as a warm start is centred, took 11 % more
-            // iterations on the held-out-like zones.)
-            for v in [&mut s, &mut z] {
-                let a = outside(v, ml, &blocks);
-                if a >= -1e-8 || !a.is_finite() {
-                    let shift = if a.is_finite() { 1.0 + a } else { 1.0 };
-                    v[..ml].iter_mut().for_each(|x| *x += shift);
-                    for &(b0, _) in &blocks {
-                        v[b0] += shift;
-                    }
-                }
-            }
-        }
-        let scale_h = 1.0 + inf_norm(hv);
-        let scale_c = 1.0 + inf_norm(&self.c);
-        let (mut rd, mut rg, mut hx) = (vec![0.0; n], vec![0.0; mi], vec![0.0; n]);
-        let mut lam = vec![0.0; mi];
-        let (mut w_r, mut dz, mut ds, mut gdx) =
-            (vec![0.0; mi], vec![0.0; mi], vec![0.0; mi], vec![0.0; mi]);
-        let (mut dz_a, mut ds_a, mut rc) = (vec![0.0; mi], vec![0.0; mi], vec![0.0; mi]);
-        let mut dx = vec![0.0; n];
-        for it in 0..st.max_iter {
-            // Residuals.
-            hmat.mul(&x, &mut hx);
-            for ((r, c), h) in rd.iter_mut().zip(&self.c).zip(&hx) {
-                *r = c + h;
-            }
-            sys.gt_mul_add(&z, &mut rd);
-            sys.g_mul(&x, &mut rg);
-            for ((r, sr), hr) in rg.iter_mut().zip(&s).zip(hv) {
-                *r += sr - hr;
-            }
-            let mu = dot(&s, &z) / degree;
-            let obj = 0.5 * dot(&hx, &x) + dot(&self.c, &x);
-            if !(obj.is_finite() && mu.is_finite()) {
-                return IpmSolution {
-                    x,
-                    z: z.clone(),
-                    status: IpmStatus::NumericalError,
-                    iterations: it,
-                };
-            }
-            if inf_norm(&rg) <= st.tol_feas * scale_h
-                && inf_norm(&rd) <= st.tol_feas * scale_c
-                && mu <= st.tol_gap * (1.0 + obj.abs())
-            {
-                return IpmSolution {
-                    x,
-                    z: z.clone(),
-                    status: IpmStatus::Solved,
-                    iterations: it,
-                };
-            }
-            // Scalings: linear slacks `V = z/s`, `W⁻¹ = sqrt(z/s)`; cones their `W`.
-            for ((((l, dr), dq), sr), zr) in lam[..ml]
-                .iter_mut()
-                .zip(d.iter_mut())
-                .zip(d_sqrt.iter_mut())
-                .zip(&s[..ml])
-                .zip(&z[..ml])
-            {
-                *l = (sr * zr).sqrt();
-                *dr = zr / sr;
-                *dq = dr.sqrt();
-            }
-            for (bi, &(b0, q)) in blocks.iter().enumerate() {
-                scal[bi] = soc_scaling(&s[b0..b0 + q], &z[b0..b0 + q], &mut lam[b0..b0 + q]);
-            }
-            if !assemble_factor(
-                &sys,
-                &hmat,
-                (&d, &scal),
-                &mut yscratch,
-                st,
-                &mut unreg,
-                &mut kkt,
-            ) {
-                return IpmSolution {
-                    x,
-                    z: z.clone(),
-                    status: IpmStatus::NumericalError,
-                    iterations: it,
-                };
-            }
-            // One Newton solve for the complementarity residual `rc` (module docs, with
-            // u = λ \ (−r_c), w = V·r_g + W⁻¹·u): the steps dx, dz, ds.
-            let mut newton = |rc: &[f64], dz: &mut [f64], ds: &mut [f64], dx: &mut [f64]| {
-                // Linear slacks: u = −r_c/λ, w = V·r_g + W⁻¹·u with V = z/s, W⁻¹ = √(z/s).
-                for (((((wr, rcr), l), dr), dq), g) in w_r[..ml]
-                    .iter_mut()
-                    .zip(&rc[..ml])
-                    .zip(&lam[..ml])
-                    .zip(&d)
-                    .zip(&d_sqrt)
-                    .zip(&rg[..ml])
-                {
-                    *wr = dr * g + dq * (-rcr / l);
-                }
-                for (bi, &(b0, q)) in blocks.iter().enumerate() {
-                    let (mut neg, mut u) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
-                    for (dd, v) in neg.iter_mut().zip(&rc[b0..b0 + q]) {
-                        *dd = -v;
-                    }
-                    soc_div(&lam[b0..b0 + q], &neg[..q], &mut u[..q]);
-                    // W⁻¹·(W⁻¹·r_g + u).
-                    let mut t = [0.0; MAX_CONE];
-                    scal[bi].apply_inv(&rg[b0..b0 + q], &mut t[..q]);
-                    for a in 0..q {
-                        t[a] += u[a];
-                    }
-                    scal[bi].apply_inv(&t[..q], &mut w_r[b0..b0 + q]);
-                }
-                rhs.copy_from_slice(&rd);
-                sys.gt_mul_add(&w_r, &mut rhs);
-                for v in rhs.iter_mut() {
-                    *v = -*v;
-                }
-                sol.copy_from_slice(&rhs);
-                kkt.solve(&mut sol);
-                refine(&kkt, &unreg, &rhs, &mut sol, &mut tmp, st.refinement_steps);
-                dx.copy_from_slice(&sol);
-                sys.g_mul(dx, &mut gdx);
-                for ((dsr, g), gd) in ds.iter_mut().zip(&rg).zip(&gdx) {
-                    *dsr = -g - gd;
-                }
-                for (((dzr, dr), gd), wr) in dz[..ml].iter_mut().zip(&d).zip(&gdx[..ml]).zip(&w_r) {
-                    *dzr = dr * gd + wr;
-                }
-                for (bi, &(b0, q)) in blocks.iter().enumerate() {
-                    let (mut t, mut t2) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
-                    scal[bi].apply_inv(&gdx[b0..b0 + q], &mut t[..q]);
-                    scal[bi].apply_inv(&t[..q], &mut t2[..q]);
-                    for a in 0..q {
-                        dz[b0 + a] = t2[a] + w_r[b0 + a];
-                    }
-                }
-            };
-            let max_step = |v: &[f64], dv: &[f64]| -> f64 {
-                let mut a = f64::INFINITY;
-                for (vr, dr) in v[..ml].iter().zip(&dv[..ml]) {
-                    if *dr < 0.0 {
-                        a = a.min(-vr / dr);
-                    }
-                }
-                for &(b0, q) in &blocks {
-                    a = soc_step(&v[b0..b0 + q], &dv[b0..b0 + q], a);
-                }
-                a
-            };
-            // Predictor: r_c = λ∘λ.
-            for (r, l) in rc[..ml].iter_mut().zip(&lam[..ml]) {
-                *r = l * l;
-            }
-            for &(b0, q) in &blocks {
-                let mut l = [0.0; MAX_CONE];
-                l[..q].copy_from_slice(&lam[b0..b0 + q]);
-                soc_prod(&l[..q], &l[..q], &mut rc[b0..b0 + q]);
-            }
-            newton(&rc, &mut dz_a, &mut ds_a, &mut dx);
-            let a_aff = max_step(&s, &ds_a).min(max_step(&z, &dz_a)).min(1.0);
-            let mu_aff = s
-                .iter()
-                .zip(&ds_a)
-                .zip(z.iter().zip(&dz_a))
-                .map(|((sr, dsr), (zr, dzr))| (sr + a_aff * dsr) * (zr + a_aff * dzr))
-                .sum::<f64>()
-                / degree;
-            let sigma = if mu > 0.0 {
-                (mu_aff / mu).powi(3).min(1.0)
-            } else {
-                0.0
-            };
-            // Corrector: r_c = λ∘λ + (W⁻ᵀ·ds_a)∘(W·dz_a) − σ·μ·e.
-            let smu = sigma * mu;
-            for (((r, l), dsr), dzr) in rc[..ml]
-                .iter_mut()
-                .zip(&lam[..ml])
-                .zip(&ds_a[..ml])
-                .zip(&dz_a[..ml])
-            {
-                *r = l * l + dsr * dzr - smu;
-            }
-            for (bi, &(b0, q)) in blocks.iter().enumerate() {
-                let (mut sd, mut zd) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
-                scal[bi].apply_inv(&ds_a[b0..b0 + q], &mut sd[..q]);
-                scal[bi].apply(&dz_a[b0..b0 + q], &mut zd[..q]);
-                let mut l = [0.0; MAX_CONE];
-                l[..q].copy_from_slice(&lam[b0..b0 + q]);
-                let (mut ll, mut sz) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
-                soc_prod(&l[..q], &l[..q], &mut ll[..q]);
-                soc_prod(&sd[..q], &zd[..q], &mut sz[..q]);
-                for a in 0..q {
-                    rc[b0 + a] = ll[a] + sz[a];
-                }
-                rc[b0] -= smu;
-            }
-            newton(&rc, &mut dz, &mut ds, &mut dx);
-            let alpha = (st.step_fraction * max_step(&s, &ds).min(max_step(&z, &dz))).min(1.0);
-            if !(alpha.is_finite() && dx.iter().all(|v| v.is_finite())) {
-                return IpmSolution {
-                    x,
-                    z: z.clone(),
-                    status: IpmStatus::NumericalError,
-                    iterations: it,
-                };
-            }
-            for (xj, dj) in x.iter_mut().zip(&dx) {
-                *xj += alpha * dj;
-            }
-            for ((sr, dsr), (zr, dzr)) in s.iter_mut().zip(&ds).zip(z.iter_mut().zip(&dz)) {
-                *sr += alpha * dsr;
-                *zr += alpha * dzr;
-            }
-            for (sr, zr) in s[..ml].iter_mut().zip(z[..ml].iter_mut()) {
-                *sr = sr.max(1e-300);
-                *zr = zr.max(1e-300);
-            }
-        }
-        IpmSolution {
-            x,
-            z: z.clone(),
-            status: IpmStatus::MaxIterations,
-            iterations: st.max_iter,
+        Scalings {
+            d: vec![1.0; sys.ml],
+            d_sqrt: vec![1.0; sys.ml],
+            scal: vec![ident; sys.blocks.len()],
+            lam: vec![0.0; sys.kkt.mi],
         }
     }
+
+    /// The scalings at `it`.
+    fn update(&mut self, sys: &Structure<'_>, it: &Iterate) {
+        let ml = sys.ml;
+        let (s, z) = (&it.s, &it.z);
+        for ((((l, dr), dq), sr), zr) in self.lam[..ml]
+            .iter_mut()
+            .zip(self.d.iter_mut())
+            .zip(self.d_sqrt.iter_mut())
+            .zip(&s[..ml])
+            .zip(&z[..ml])
+        {
+            *l = (sr * zr).sqrt();
+            *dr = zr / sr;
+            *dq = dr.sqrt();
+        }
+        for (bi, &(b0, q)) in sys.blocks.iter().enumerate() {
+            self.scal[bi] = soc_scaling(&s[b0..b0 + q], &z[b0..b0 + q], &mut self.lam[b0..b0 + q]);
+        }
+    }
+}
+
+/// A search direction `(dx, ds, dz)`.
+struct Direction {
+    dx: Vec<f64>,
+    ds: Vec<f64>,
+    dz: Vec<f64>,
+}
+
+impl Direction {
+    fn new(sys: &Structure<'_>) -> Direction {
+        Direction {
+            dx: vec![0.0; sys.n],
+            ds: vec![0.0; sys.kkt.mi],
+            dz: vec![0.0; sys.kkt.mi],
+        }
+    }
+}
+
+/// The KKT matrix `H + Gᵀ·V·G` (factored, and unregularised for the refinement) and the
+/// buffers of its Newton solves.
+struct Newton {
+    unreg: BorderedBand,
+    kkt: BorderedBand,
+    /// The assembly's scratch.
+    y: Vec<f64>,
+    rhs: Vec<f64>,
+    sol: Vec<f64>,
+    tmp: Vec<f64>,
+    /// `w = V·r_g + W⁻¹·u`.
+    w_r: Vec<f64>,
+    /// `G·dx`.
+    gdx: Vec<f64>,
+}
+
+impl Newton {
+    fn new(sys: &Structure<'_>) -> Newton {
+        let (nb, k, n, mi) = (sys.kkt.nb, sys.kkt.k, sys.n, sys.kkt.mi);
+        Newton {
+            unreg: BorderedBand::new(nb, sys.w, k),
+            kkt: BorderedBand::new(nb, sys.w, k),
+            y: Vec::new(),
+            rhs: vec![0.0; n],
+            sol: vec![0.0; n],
+            tmp: vec![0.0; n],
+            w_r: vec![0.0; mi],
+            gdx: vec![0.0; mi],
+        }
+    }
+
+    /// Assemble and factor the KKT matrix at the scalings `sc` ([`assemble_factor`]);
+    /// `false` when it cannot be factored.
+    fn factor(&mut self, sys: &Structure<'_>, sc: &Scalings, st: &IpmSettings) -> bool {
+        assemble_factor(
+            &sys.kkt,
+            &sys.hmat,
+            (&sc.d, &sc.scal),
+            &mut self.y,
+            st,
+            &mut self.unreg,
+            &mut self.kkt,
+        )
+    }
+
+    /// One Newton solve for the complementarity residual `rc` (module docs of [`super`],
+    /// with u = λ \ (−r_c), w = V·r_g + W⁻¹·u): the step `dir`.
+    fn direction(
+        &mut self,
+        sys: &Structure<'_>,
+        sc: &Scalings,
+        res: &Residuals,
+        rc: &[f64],
+        dir: &mut Direction,
+        st: &IpmSettings,
+    ) {
+        let ml = sys.ml;
+        let (lam, d, d_sqrt, scal) = (&sc.lam, &sc.d, &sc.d_sqrt, &sc.scal);
+        let (rd, rg) = (&res.rd, &res.rg);
+        let Newton {
+            unreg,
+            kkt,
+            rhs,
+            sol,
+            tmp,
+            w_r,
+            gdx,
+            ..
+        } = self;
+        let Direction { dx, ds, dz } = dir;
+        // Linear slacks: u = −r_c/λ, w = V·r_g + W⁻¹·u with V = z/s, W⁻¹ = √(z/s).
+        for (((((wr, rcr), l), dr), dq), g) in w_r[..ml]
+            .iter_mut()
+            .zip(&rc[..ml])
+            .zip(&lam[..ml])
+            .zip(d)
+            .zip(d_sqrt)
+            .zip(&rg[..ml])
+        {
+            *wr = dr * g + dq * (-rcr / l);
+        }
+        for (bi, &(b0, q)) in sys.blocks.iter().enumerate() {
+            let (mut neg, mut u) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
+            for (dd, v) in neg.iter_mut().zip(&rc[b0..b0 + q]) {
+                *dd = -v;
+            }
+            soc_div(&lam[b0..b0 + q], &neg[..q], &mut u[..q]);
+            // W⁻¹·(W⁻¹·r_g + u).
+            let mut t = [0.0; MAX_CONE];
+            scal[bi].apply_inv(&rg[b0..b0 + q], &mut t[..q]);
+            for a in 0..q {
+                t[a] += u[a];
+            }
+            scal[bi].apply_inv(&t[..q], &mut w_r[b0..b0 + q]);
+        }
+        rhs.copy_from_slice(rd);
+        sys.kkt.gt_mul_add(w_r, rhs);
+        for v in rhs.iter_mut() {
+            *v = -*v;
+        }
+        sol.copy_from_slice(rhs);
+        kkt.solve(sol);
+        refine(kkt, unreg, rhs, sol, tmp, st.refinement_steps);
+        dx.copy_from_slice(sol);
+        sys.kkt.g_mul(dx, gdx);
+        for ((dsr, g), gd) in ds.iter_mut().zip(rg).zip(gdx.iter()) {
+            *dsr = -g - gd;
+        }
+        for (((dzr, dr), gd), wr) in dz[..ml].iter_mut().zip(d).zip(&gdx[..ml]).zip(w_r.iter()) {
+            *dzr = dr * gd + wr;
+        }
+        for (bi, &(b0, q)) in sys.blocks.iter().enumerate() {
+            let (mut t, mut t2) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
+            scal[bi].apply_inv(&gdx[b0..b0 + q], &mut t[..q]);
+            scal[bi].apply_inv(&t[..q], &mut t2[..q]);
+            for a in 0..q {
+                dz[b0 + a] = t2[a] + w_r[b0 + a];
+            }
+        }
+    }
+}
+
+/// The predictor's complementarity residual: `r_c = λ∘λ`.
+fn affine_rc(sys: &Structure<'_>, sc: &Scalings, rc: &mut [f64]) {
+    let (ml, lam) = (sys.ml, &sc.lam);
+    for (r, l) in rc[..ml].iter_mut().zip(&lam[..ml]) {
+        *r = l * l;
+    }
+    for &(b0, q) in &sys.blocks {
+        let mut l = [0.0; MAX_CONE];
+        l[..q].copy_from_slice(&lam[b0..b0 + q]);
+        soc_prod(&l[..q], &l[..q], &mut rc[b0..b0 + q]);
+    }
+}
+
+/// Mehrotra's centring parameter `σ = (μ_aff/μ)³` (at most 1; 0 when `μ` is not
+/// positive), `μ_aff` the complementarity after the affine step `aff`'s largest length.
+fn centring(sys: &Structure<'_>, it: &Iterate, aff: &Direction, mu: f64) -> f64 {
+    let (s, z) = (&it.s, &it.z);
+    let (ds_a, dz_a) = (&aff.ds, &aff.dz);
+    let a_aff = max_step(sys, s, ds_a).min(max_step(sys, z, dz_a)).min(1.0);
+    let mu_aff = s
+        .iter()
+        .zip(ds_a)
+        .zip(z.iter().zip(dz_a))
+        .map(|((sr, dsr), (zr, dzr))| (sr + a_aff * dsr) * (zr + a_aff * dzr))
+        .sum::<f64>()
+        / sys.degree;
+    if mu > 0.0 {
+        (mu_aff / mu).powi(3).min(1.0)
+    } else {
+        0.0
+    }
+}
+
+/// The corrector's complementarity residual:
+/// `r_c = λ∘λ + (W⁻ᵀ·ds_a)∘(W·dz_a) − σ·μ·e` (`smu` = σ·μ, `aff` the affine step).
+fn corrector_rc(sys: &Structure<'_>, sc: &Scalings, aff: &Direction, smu: f64, rc: &mut [f64]) {
+    let (ml, lam) = (sys.ml, &sc.lam);
+    let (ds_a, dz_a) = (&aff.ds, &aff.dz);
+    for (((r, l), dsr), dzr) in rc[..ml]
+        .iter_mut()
+        .zip(&lam[..ml])
+        .zip(&ds_a[..ml])
+        .zip(&dz_a[..ml])
+    {
+        *r = l * l + dsr * dzr - smu;
+    }
+    for (bi, &(b0, q)) in sys.blocks.iter().enumerate() {
+        let (mut sd, mut zd) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
+        sc.scal[bi].apply_inv(&ds_a[b0..b0 + q], &mut sd[..q]);
+        sc.scal[bi].apply(&dz_a[b0..b0 + q], &mut zd[..q]);
+        let mut l = [0.0; MAX_CONE];
+        l[..q].copy_from_slice(&lam[b0..b0 + q]);
+        let (mut ll, mut sz) = ([0.0; MAX_CONE], [0.0; MAX_CONE]);
+        soc_prod(&l[..q], &l[..q], &mut ll[..q]);
+        soc_prod(&sd[..q], &zd[..q], &mut sz[..q]);
+        for a in 0..q {
+            rc[b0 + a] = ll[a] + sz[a];
+        }
+        rc[b0] -= smu;
+    }
+}
+
+/// The step length along `dir`: [`IpmSettings::step_fraction`] of the largest that keeps
+/// `s` and `z` in their cones, at most 1.
+fn step_length(sys: &Structure<'_>, it: &Iterate, dir: &Direction, st: &IpmSettings) -> f64 {
+    (st.step_fraction * max_step(sys, &it.s, &dir.ds).min(max_step(sys, &it.z, &dir.dz))).min(1.0)
+}
+
+/// The largest step `a` with `v + a·dv` in the cones (∞ when every direction stays).
+fn max_step(sys: &Structure<'_>, v: &[f64], dv: &[f64]) -> f64 {
+    let ml = sys.ml;
+    let mut a = f64::INFINITY;
+    for (vr, dr) in v[..ml].iter().zip(&dv[..ml]) {
+        if *dr < 0.0 {
+            a = a.min(-vr / dr);
+        }
+    }
+    for &(b0, q) in &sys.blocks {
+        a = soc_step(&v[b0..b0 + q], &dv[b0..b0 + q], a);
+    }
+    a
 }
 
 /// Assemble `H + Gᵀ·V·G` and factor it: unregularised first when
