@@ -237,11 +237,11 @@ impl Sink for Forward<'_> {
         // the cycles would have had, exactly.
         if self.every_cycle && !cycle && j == 0.0 && from.a == 0.0 && to.a == 0.0 && from.v == to.v
         {
-            let n = ((to.t - from.t) / self.dt + 1e-9).floor() as u64;
+            let n = ((to.t - from.t) / self.dt + tolerances::CYCLE_COUNT_SLACK).floor() as u64;
             let mut prev = *from;
             for k in 1..=n {
                 let t = from.t + k as f64 * self.dt;
-                if t >= to.t - 1e-12 * to.t.abs().max(1.0) {
+                if t >= to.t - tolerances::TIME_MATCH_REL * to.t.abs().max(1.0) {
                     break;
                 }
                 let x = from.x + k as f64 * self.dt * from.v;
@@ -252,7 +252,7 @@ impl Sink for Forward<'_> {
                 self.one(&prev, &next, 0.0, true);
                 prev = next;
             }
-            let whole = ((to.t - prev.t) / self.dt - 1.0).abs() < 1e-9;
+            let whole = ((to.t - prev.t) / self.dt - 1.0).abs() < tolerances::CYCLE_MATCH_REL;
             self.one(&prev, to, 0.0, whole);
             return;
         }
