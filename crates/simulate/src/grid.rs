@@ -7,7 +7,7 @@ use polepatch_patcher::{Path, PathError};
 
 use crate::caps::Local;
 use crate::error::SimError;
-use crate::tolerances::LIMIT_USE;
+use crate::tolerances::{GRID_BATCH_POINTS, LIMIT_USE};
 
 /// A motion's path: the parts (runs that follow one another without a stop) joined at
 /// their shared points, one analysis spline per axis over all their points.
@@ -186,9 +186,6 @@ pub struct Grid {
     pub limit: Vec<f64>,
 }
 
-/// Grid points evaluated per batch.
-const CHUNK: usize = 4096;
-
 impl Grid {
     /// Cut each span into `⌈h/(F·Tcy)⌉` cells (at most `max_cells`), and bound the feed on
     /// each cell by Equation 6 (limits × [`LIMIT_USE`]) with the largest |q_s|, |q_ss|, |q_sss| of each axis over the
@@ -218,12 +215,12 @@ impl Grid {
         }
         s.push(geo.knots[n - 1]);
         let mut cell = Vec::with_capacity(s.len() - 1);
-        let mut derivs: Vec<[[f64; 4]; 5]> = Vec::with_capacity(CHUNK + 1);
-        let mut buf = vec![[0.0; 4]; CHUNK + 1];
+        let mut derivs: Vec<[[f64; 4]; 5]> = Vec::with_capacity(GRID_BATCH_POINTS + 1);
+        let mut buf = vec![[0.0; 4]; GRID_BATCH_POINTS + 1];
         let mut span = 0usize;
         let mut start = 0usize;
         while start + 1 < s.len() {
-            let end = (start + CHUNK).min(s.len() - 1);
+            let end = (start + GRID_BATCH_POINTS).min(s.len() - 1);
             let ts = &s[start..=end];
             derivs.clear();
             derivs.resize(ts.len(), [[0.0; 4]; 5]);

@@ -46,8 +46,10 @@
 //! asked for, the backward pass always (its profile is a ceiling: the same one for the
 //! report and the trajectory, and nothing recorded per cycle of a long cruise) — so the
 //! work is bounded by the points and the speed changes, not by the run time, and the
-//! memory by the points whatever the mode. Memory is the
-//! spline and the grid (a few words per grid point): bounded by the motion's points.
+//! memory by the points whatever the mode. The simulator's memory is the spline, the
+//! passes' ceilings, the backward profile and the grid of one motion: it grows with the
+//! motion's points, not its duration (with the reading and the analysis around it, about
+//! 0.9 KB a point: docs/simulation.md, "Speed and memory").
 //!
 //! On a straight line this is the time-optimal jerk-limited rest-to-rest profile (the
 //! 7-segment S-curve) to a cycle; on a curved path it is a jerk-limited motion under the
@@ -237,11 +239,11 @@ impl Sink for Forward<'_> {
         // the cycles would have had, exactly.
         if self.every_cycle && !cycle && j == 0.0 && from.a == 0.0 && to.a == 0.0 && from.v == to.v
         {
-            let n = ((to.t - from.t) / self.dt + 1e-9).floor() as u64;
+            let n = ((to.t - from.t) / self.dt + tolerances::CYCLE_COUNT_SLACK).floor() as u64;
             let mut prev = *from;
             for k in 1..=n {
                 let t = from.t + k as f64 * self.dt;
-                if t >= to.t - 1e-12 * to.t.abs().max(1.0) {
+                if t >= to.t - tolerances::TIME_MATCH_REL * to.t.abs().max(1.0) {
                     break;
                 }
                 let x = from.x + k as f64 * self.dt * from.v;
@@ -252,7 +254,7 @@ impl Sink for Forward<'_> {
                 self.one(&prev, &next, 0.0, true);
                 prev = next;
             }
-            let whole = ((to.t - prev.t) / self.dt - 1.0).abs() < 1e-9;
+            let whole = ((to.t - prev.t) / self.dt - 1.0).abs() < tolerances::CYCLE_MATCH_REL;
             self.one(&prev, to, 0.0, whole);
             return;
         }

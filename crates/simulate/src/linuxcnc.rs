@@ -45,6 +45,12 @@
 //! cycle (`tpRunCycle`: regular cycles, split cycles at a segment's end) at the servo
 //! period and counts the cycles until the last segment has stopped.
 
+use crate::tolerances::{
+    LCNC_MAX_CYCLES_PER_SEGMENT as MAX_CYCLES_PER_SEGMENT,
+    LCNC_MIN_DISPLACEMENT as MIN_DISPLACEMENT, LCNC_POS_EPSILON as POS_EPSILON,
+    LCNC_TIME_EPSILON as TIME_EPSILON, LCNC_VEL_EPSILON as VEL_EPSILON,
+};
+
 /// Limits and settings of a LinuxCNC machine, in the planner's units.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinuxCncMachine {
@@ -85,18 +91,6 @@ pub struct LinuxCncRun {
     /// Largest speed of each axis in the world frame, X Y Z mm/s, primary and C °/s.
     pub peak_axis_velocity: [f64; 5],
 }
-
-/// Displacements below this are no motion (emccanon's `applyMinDisplacement`, in mm or °).
-const MIN_DISPLACEMENT: f64 = 1e-7;
-/// tp_types.h `TP_VEL_EPSILON`.
-const VEL_EPSILON: f64 = 1e-8;
-/// tp_types.h `TP_POS_EPSILON`.
-const POS_EPSILON: f64 = 1e-12;
-/// tp_types.h `TP_TIME_EPSILON`.
-const TIME_EPSILON: f64 = 1e-12;
-/// Bound on the cycles of one run, per segment: a segment that does not finish within
-/// this many cycles means the model is stuck (never seen; a guard, not a limit).
-const MAX_CYCLES_PER_SEGMENT: usize = 10_000_000;
 
 /// One segment (`TC_STRUCT` of a line) with the state the planner keeps.
 #[derive(Debug, Clone)]

@@ -54,13 +54,20 @@
 //! cycle — at the speed there, or from rest in the rest-to-rest time at the jerk cap —
 //! not jumped within it.
 
+use std::collections::VecDeque;
+
 use polepatch_kinematics::Machine;
 
 use crate::caps::{Caps, Local};
 use crate::grid::{Cursor, Geometry, count_at_most};
 use crate::tolerances::{
-    CEILING_REL, CRAWL_CRUISE_REL, CRAWL_JERK_SHARE, CRUISE_ABS_MM_S, CRUISE_REL, END_MM,
-    JERK_BISECTIONS, SETTLE_REL,
+    A_CAP_SLACK_MM_S2, A_CAP_SLACK_REL, BRAKE_A_SHARE, BRAKE_PIECE_CYCLES, BRAKE_PIECES_MAX,
+    BRAKE_PIECES_TO_GO, BRAKE_SPEED_FLOOR_MM_S, CBRT_GUESS_BIAS, CBRT_HALLEY_STEPS, CEILING_REL,
+    CEILING_REL_P, CRAWL_CRUISE_REL, CRAWL_JERK_SHARE, CRAWL_UNDER_LIMIT_REL, CRUISE_ABS_MM_S,
+    CRUISE_REL, CYCLE_MATCH_REL, DIP_NEAR_CYCLES, DIP_NEAR_MM, DIP_TIGHTEN, DIP_TRIES, DIPS_MAX,
+    END_MM, JERK_BISECTIONS, OVER_PROFILE_REL, RAMP_JERK_FLOOR_MM_S3, RAMP_STEPS, RAMP_STEPS_MAX,
+    REWIND_BUDGET_PER_STEP_INV, REWIND_BUDGET_STEPS, REWIND_STEPS, SETTLE_REL, STALL_STEPS,
+    TIME_BISECTIONS,
 };
 
 /// A ceiling along a pass: values at increasing pass positions, and between them W^(3/2)
@@ -194,10 +201,6 @@ impl<'a> Ceiling<'a> {
     }
 }
 
-/// `(1 + CEILING_REL)^(3/2)` to rounding (the next term, 3/8·CEILING_REL², is far below
-/// it).
-const CEILING_REL_P: f64 = 1.0 + 1.5 * CEILING_REL;
-
 /// Whether a speed `v` is above the ceiling W = P^(2/3) by more than [`CEILING_REL`]:
 /// `v > W·(1 + CEILING_REL)` ⟺ `v^(3/2) > P·(1 + CEILING_REL)^(3/2)` (both sides
 /// non-negative, x ↦ x^(3/2) increasing).
@@ -233,8 +236,8 @@ fn cbrt(p: f64) -> f64 {
     if p <= 0.0 || !p.is_finite() {
         return p.max(0.0);
     }
-    let mut y = f64::from_bits(p.to_bits() / 3 + 0x2A9F_7893_782D_A1CE);
-    for _ in 0..3 {
+    let mut y = f64::from_bits(p.to_bits() / 3 + CBRT_GUESS_BIAS);
+    for _ in 0..CBRT_HALLEY_STEPS {
         let y3 = y * y * y;
         y *= (y3 + 2.0 * p) / (2.0 * y3 + p);
     }
@@ -252,6 +255,17 @@ pub(crate) struct State {
     pub v: f64,
     /// Acceleration along the pass, mm/s².
     pub a: f64,
+}
+
+impl State {
+    /// (x, v, a) after `dt` (s) under jerk `j` (mm/s³).
+    #[inline]
+    fn after(&self, dt: f64, j: f64) -> (f64, f64, f64) {
+        let x1 = self.x + self.v * dt + 0.5 * self.a * dt * dt + j * dt * dt * dt / 6.0;
+        let v1 = self.v + self.a * dt + 0.5 * j * dt * dt;
+        let a1 = self.a + j * dt;
+        (x1, v1, a1)
+    }
 }
 
 /// What a pass hands out.
@@ -314,39 +328,6 @@ struct Pending {
     clipped: bool,
 }
 
-/// Pieces of the look-ahead ramp (module docs).
-const RAMP_STEPS: usize = 8;
-
-/// Steps without progress after which a pass gives up (the limits allow no motion).
-const STALL_STEPS: u32 = 1_000_000;
-
-/// Steps a pass keeps before handing them out: how far back a rewind can go.
-const REWIND_STEPS: usize = 16_384;
-/// How far a forward pass may be above the backward profile (under the velocity limit)
-/// and go on braking, relative.
-const OVER_PROFILE_REL: f64 = 2e-3;
-/// Steps a pass may undo by rewinds: one per this many steps taken, plus
-/// [`REWIND_BUDGET_STEPS`]; past it, clips (the work stays within a small multiple of
-/// the motion's cycles where the profile is clipped at almost every cycle).
-const REWIND_BUDGET_PER_STEP_INV: u64 = 4;
-/// See [`REWIND_BUDGET_PER_STEP_INV`].
-const REWIND_BUDGET_STEPS: u64 = 100_000;
-/// Tries per dip: each lowers its speed by the factor [`DIP_TIGHTEN`].
-const DIP_TRIES: u32 = 40;
-/// Factor on a dip's speed when the motion is above the ceiling there again.
-const DIP_TIGHTEN: f64 = 0.97;
-/// Dips kept at once, at most (beyond: clips).
-const DIPS_MAX: usize = 4096;
-/// Cycles per piece of the braking of [`Pass::clears_dips`].
-const BRAKE_PIECE_CYCLES: f64 = 4.0;
-/// The braking of [`Pass::clears_dips`] in pieces of this fraction of the time to the next
-/// dip at the speed where each starts.
-const BRAKE_PIECES_TO_GO: f64 = 8.0;
-/// Pieces of that braking, at most.
-const BRAKE_PIECES_MAX: usize = 100_000;
-/// Share of the |a| at which the jerk cap runs out that the braking holds.
-const BRAKE_A_SHARE: f64 = 0.8;
-
 impl Pass<'_> {
     fn s_of(&self, x: f64, len: f64) -> f64 {
         if self.forward { x } else { len - x }
@@ -379,7 +360,7 @@ impl Pass<'_> {
             return false;
         }
         let (ac, jc) = self.caps(caps, v1.max(0.0), a1.abs());
-        if a1.abs() > ac.max(0.0) * (1.0 + 1e-12) + 1e-12 || jc < 0.0 {
+        if a1.abs() > ac.max(0.0) * (1.0 + A_CAP_SLACK_REL) + A_CAP_SLACK_MM_S2 || jc < 0.0 {
             return false;
         }
         // The comparisons with W and a_W in P = W^(3/2) (no cube root: see
@@ -394,10 +375,10 @@ impl Pass<'_> {
         // The ramp of a down at the jerk cap, in RAMP_STEPS pieces, until it meets the
         // ceiling's acceleration: under the ceiling all the way.
         let aw = cbrt(p) * dp / 1.5;
-        let jb = jc.max(1e-300);
+        let jb = jc.max(RAMP_JERK_FLOOR_MM_S3);
         let dtau = (a1 - aw) / jb / RAMP_STEPS as f64;
         let (mut x, mut v, mut a, mut c) = (x1, v1, a1, i);
-        for _ in 0..4 * RAMP_STEPS {
+        for _ in 0..RAMP_STEPS_MAX {
             x += v * dtau + 0.5 * a * dtau * dtau - jb * dtau * dtau * dtau / 6.0;
             v += a * dtau - 0.5 * jb * dtau * dtau;
             a -= jb * dtau;
@@ -439,7 +420,7 @@ impl Pass<'_> {
                 .filter(|d| d.x > x)
                 .fold(x_last, |m, d| m.min(d.x));
             let h = (BRAKE_PIECE_CYCLES * self.dt)
-                .max((x_next - x) / (v.max(1e-12) * BRAKE_PIECES_TO_GO));
+                .max((x_next - x) / (v.max(BRAKE_SPEED_FLOOR_MM_S) * BRAKE_PIECES_TO_GO));
             let (d, _) = self
                 .geo
                 .derivs_feed_near(self.s_of(x.min(len), len), &mut cur);
@@ -500,419 +481,654 @@ impl Pass<'_> {
         false
     }
 
-    /// Run the pass from rest at x = 0 to x = L; `sink` gets every step.
+    /// Run the pass from rest at x = 0 to x = L; `sink` gets every step. One
+    /// [`Stepper::cycle`] after another until the end; `Err(s)` where the pass made no
+    /// progress for [`STALL_STEPS`] steps (s, mm, on the path).
     pub fn run(&self, sink: &mut dyn Sink) -> Result<PassStats, f64> {
-        let len = self.geo.length();
-        let mut st = State {
-            t: 0.0,
-            x: 0.0,
-            v: 0.0,
-            a: 0.0,
-        };
-        let mut stats = PassStats::default();
-        let mut hint = 0usize;
-        let mut idle = 0u32;
-        let mut cursor = Cursor::default();
-        // The ceiling at the end of the last cycle: where this one starts.
-        let mut at_end: Option<(f64, (f64, f64, usize))> = None;
-        let mut buf: std::collections::VecDeque<Pending> = std::collections::VecDeque::new();
-        let mut dips: Vec<Dip> = Vec::new();
-        // Steps undone by rewinds: past a budget, clips again.
-        let mut undone: u64 = 0;
-        let emit =
-            |buf: &mut std::collections::VecDeque<Pending>, sink: &mut dyn Sink, keep: usize| {
-                while buf.len() > keep {
-                    let p = buf.pop_front().expect("non-empty");
-                    sink.step(&p.from, &p.to, p.j, p.cycle);
-                }
-            };
-        // A step taken: kept for a rewind (handed out when it is REWIND_STEPS old), or
-        // handed out at once.
-        let rewind = self.rewind;
-        let keep =
-            |buf: &mut std::collections::VecDeque<Pending>, sink: &mut dyn Sink, p: Pending| {
-                if rewind {
-                    buf.push_back(p);
-                    emit(buf, sink, REWIND_STEPS);
-                } else {
-                    sink.step(&p.from, &p.to, p.j, p.cycle);
-                }
-            };
-        while st.x < len - END_MM {
-            let (hint0, cursor0) = (hint, cursor);
-            if !dips.is_empty() {
-                // A dip no rewind can reach any more is done with.
-                let oldest = buf.front().map_or(st.x, |p| p.from.x);
-                let n = dips.partition_point(|d| d.x < oldest);
-                dips.drain(..n);
-            }
-            // Dips (sorted by x) ahead of this state: the only ones a check looks at.
-            let ahead_from = dips.partition_point(|d| d.x <= st.x);
-            let ahead = &dips[ahead_from..];
-            let (d, feed) = self.geo.derivs_feed_near(self.s_of(st.x, len), &mut cursor);
-            let loc = Local::from_derivs(&d);
-            let vmax = loc.v_cap(self.machine).min(feed);
-            let caps = Caps::new(&loc, self.machine);
-            let (w, aw, i) = match at_end {
-                Some((x, c)) if x == st.x => c,
-                _ => self.ceiling.at(st.x, hint),
-            };
-            hint = i;
-            let (ac, jc) = self.caps(&caps, st.v, st.a.abs());
-            let dt = self.dt;
-            // A cruise on a flat stretch of the ceiling: jump to the next grid point
-            // when the state there is safe (then it is everywhere before it).
-            // Within CRUISE_REL of the ceiling, or of one cycle at the jerk cap where the
-            // ceiling is below that (the crawl regime, where a cycle's jerk is coarser
-            // than the speed).
-            let one_cycle = jc.max(0.0) * self.dt * self.dt;
-            let near = (CRUISE_REL * w)
-                .max(CRAWL_CRUISE_REL * w.min(one_cycle))
-                .max(CRUISE_ABS_MM_S);
-            let mut cruise = None;
-            if !self.every_cycle && st.a.abs() * self.dt <= near && st.v > 0.0 && st.v >= w - near {
-                let nx = (i + 1).min(self.ceiling.x.len() - 1);
-                let xn = self.ceiling.x[nx].min(len);
+        let mut stepper = Stepper::new(self, sink);
+        while stepper.st.x < stepper.len - END_MM {
+            stepper.cycle()?;
+        }
+        Ok(stepper.finish())
+    }
+}
 
-                if xn > st.x
-                    && self.ceiling.v[i] == self.ceiling.v[nx]
-                    && self
-                        .ceiling
-                        .m
-                        .as_ref()
-                        .is_none_or(|m| m[i] == 0.0 && m[nx] == 0.0)
-                    && self.safe(&caps, vmax, xn, st.v, 0.0, i, len, ahead)
-                {
-                    // The forward pass jumps whole cycles (to within one cycle of the
-                    // grid point; the rest is an ordinary cycle), so that its states stay
-                    // on the cycle grid and a trajectory is the same states with each
-                    // jump cut into its cycles: one answer with or without a trajectory
-                    // (issue 43). The end of the path keeps its last, partial cycle.
-                    let to = if xn >= len - END_MM {
-                        State {
-                            t: st.t + (len - st.x) / st.v,
-                            x: len,
-                            v: st.v,
-                            a: 0.0,
-                        }
-                    } else if self.forward {
-                        // Cycle by cycle as an ordinary cycle at j = 0 computes them
-                        // (x + v·dt, t + dt: the same bits), up to the grid point; a
-                        // state that still accelerates a little settles first (below).
-                        let mut to = st;
-                        if st.a == 0.0 {
-                            let step = st.v * dt;
-                            while to.x + step < xn {
-                                to.x += step;
-                                to.t += dt;
-                            }
-                        }
-                        to
-                    } else {
-                        State {
-                            t: st.t + (xn - st.x) / st.v,
-                            x: xn,
-                            v: st.v,
-                            a: 0.0,
-                        }
-                    };
-                    cruise = (to.x > st.x).then_some(to);
-                }
-            }
-            if let Some(to) = cruise {
-                let p = Pending {
-                    from: st,
-                    to,
-                    j: 0.0,
-                    cycle: false,
-                    hint: hint0,
-                    cursor: cursor0,
-                    clipped: false,
-                };
-                keep(&mut buf, sink, p);
-                st = to;
-                stats.steps += 1;
-                continue;
-            }
-            let jm = jc.max(0.0);
-            let ac = ac.max(0.0);
-            let mut lo = (-jm).max((-ac - st.a) / dt);
-            let mut hi = jm.min((ac - st.a) / dt);
-            if lo > hi || (jc < 0.0 && st.a != 0.0) {
-                // |a| above the cap at this speed: bring it back as fast as allowed; and
-                // where |a| leaves no jerk at all (j_cap < 0: no jerk keeps the axes
-                // within J), at the jerk cap of a = 0 — a |a| held there would brake the
-                // motion to a standstill.
-                let jr = if jc < 0.0 {
-                    (self.caps(&caps, st.v, 0.0).1).max(0.0)
-                } else {
-                    jm
-                };
-                let j = -st.a.signum() * jr;
-                lo = j;
-                hi = j;
-            }
-            let next = |j: f64| {
-                let x1 = st.x + st.v * dt + 0.5 * st.a * dt * dt + j * dt * dt * dt / 6.0;
-                let v1 = st.v + st.a * dt + 0.5 * j * dt * dt;
-                let a1 = st.a + j * dt;
-                (x1, v1, a1)
-            };
-            let ok = |j: f64| {
-                let (x1, v1, a1) = next(j);
-                self.safe(&caps, vmax, x1, v1, a1, hint, len, ahead)
-            };
-            // On a flat ceiling, just under it: settle (a → 0) rather than take the
-            // largest safe jerk, which would overshoot and chatter about the ceiling.
-            let (w0, aw0) = (w, aw);
-            let jz = (-st.a / dt).clamp(lo, hi);
-            let settle = aw0 == 0.0 && w0 - st.v <= SETTLE_REL * w0;
-            let j = if ok(hi) {
-                hi
-            } else if settle && ok(jz) {
-                jz
-            } else if !ok(lo) {
-                if self.rewind && st.v > w0 {
-                    // Above the profile already (a state let stand, below): towards its
-                    // acceleration, not the hardest braking, which would leave it with
-                    // more deceleration than it can bring back to 0 before it stops.
-                    ((aw0 - st.a) / dt).clamp(lo, hi)
-                } else {
-                    lo
-                }
-            } else {
-                bisect(lo, hi, ok)
-            };
-            // A motion that decelerates must be able to bring a to 0 before it stops
-            // (v ≥ a²/(2·j_cap)): the smallest jerk that keeps this, when the one above
-            // does not (then the ceiling may be left: a rewind or a clip follows).
-            let lands = |j: f64| {
-                let (_, v1, a1) = next(j);
-                a1 >= 0.0 || {
-                    let jf = self.caps(&caps, v1.max(0.0), a1.abs()).1;
-                    jf > 0.0 && v1 >= a1 * a1 / (2.0 * jf)
-                }
-            };
-            let j = if !self.rewind || lands(j) || !lands(hi) || st.v <= 0.0 {
-                j
-            } else {
-                bisect(hi, j, lands)
-            };
-            let (mut x1, mut v1, mut a1) = next(j);
-            let mut t1 = st.t + dt;
-            if v1 < 0.0 {
-                // Stopped within the cycle (only near a standstill): rest where v = 0.
-                let (mut lo_t, mut hi_t) = (0.0, dt);
-                for _ in 0..60 {
-                    let tm = 0.5 * (lo_t + hi_t);
-                    if st.v + st.a * tm + 0.5 * j * tm * tm > 0.0 {
-                        lo_t = tm;
-                    } else {
-                        hi_t = tm;
-                    }
-                }
-                let tm = lo_t;
-                x1 = (st.x + st.v * tm + 0.5 * st.a * tm * tm + j * tm * tm * tm / 6.0).max(st.x);
-                v1 = 0.0;
-                a1 = 0.0;
-            }
-            let mut clipped = false;
-            let crawl = x1 <= st.x;
-            if crawl {
-                // No progress: at rest where the ceiling is below what one cycle at the
-                // jerk cap makes (W < j_cap·Tcy²), or where the ceiling (the backward
-                // profile) has come to a near standstill with a deceleration that would
-                // take the motion back: go on at a crawl under the velocity limit, whose
-                // step is a part of the jerk cap (counted as a clip). Before 2026-11-28 a
-                // forward state on such a profile with v > 0 was put back on it every cycle
-                // and never moved ("the limits allow no motion", issue 43).
-                let xc = x1.max(st.x);
-                let w0 = match &self.limit {
-                    Some(l) => l.at(xc, 0).0,
-                    _ => self.ceiling.at(xc, hint).0,
-                };
-                v1 = (w0.min(vmax) * (1.0 - 1e-9))
-                    .min(CRAWL_JERK_SHARE * jm * dt * dt)
-                    .max(0.0);
-                a1 = 0.0;
-                x1 = x1.max(st.x) + v1 * dt;
-                if v1 > 0.0 {
-                    stats.clips += 1;
-                    clipped = true;
-                }
-            }
-            // Never backwards (a cycle in which the speed dips below 0 and back).
-            x1 = x1.max(st.x);
-            if x1 > len {
-                // The last, partial cycle: the time at which x reaches L.
-                let (mut t_lo, mut t_hi) = (0.0, dt);
-                for _ in 0..60 {
-                    let tm = 0.5 * (t_lo + t_hi);
-                    let xm = st.x + st.v * tm + 0.5 * st.a * tm * tm + j * tm * tm * tm / 6.0;
-                    if xm < len {
-                        t_lo = tm;
-                    } else {
-                        t_hi = tm;
-                    }
-                }
-                let tm = t_hi;
-                x1 = len;
-                v1 = (st.v + st.a * tm + 0.5 * j * tm * tm).max(0.0);
-                a1 = st.a + j * tm;
-                t1 = st.t + tm;
-            }
-            if x1 >= len - END_MM && x1 < len {
-                // Within END_MM of the end: this state is the end (one state, not a
-                // second one at the same time), reached after the cycle — the last
-                // nanometres at the speed there, or from rest in the rest-to-rest time
-                // at the jerk cap, 4·(d/(2·j))^(1/3) — so that no cycle of the
-                // trajectory jumps them.
-                let d = len - x1;
-                t1 += if v1 > 0.0 {
-                    (d / v1).min(dt)
-                } else if jm > 0.0 {
-                    4.0 * (d / (2.0 * jm)).cbrt()
-                } else {
-                    dt
-                };
-                x1 = len;
-            }
-            let end = self.ceiling.at(x1, hint);
-            at_end = Some((x1, end));
-            let (w1, aw1, _) = end;
-            let w1 = w1.min(vmax);
-            // Just above a profile that is not itself the limit (the forward pass under
-            // the backward profile), and under the velocity limit: go on, braking at the
-            // caps from the next cycle (no state is safe above the ceiling) — a motion
-            // within the limits, where a clip or a rewind would jump it.
-            let over_ok = self.rewind
-                && v1 <= w1 * (1.0 + OVER_PROFILE_REL)
-                && self
-                    .limit
-                    .as_ref()
-                    .is_some_and(|l| v1 <= l.at(x1, 0).0.min(vmax) * (1.0 + CEILING_REL));
-            if over_ok {
-                // (nothing: the state stands)
-            } else if v1 > w1 * (1.0 + CEILING_REL)
-                && self.rewind
-                && x1 < len
-                && undone < stats.steps / REWIND_BUDGET_PER_STEP_INV + REWIND_BUDGET_STEPS
-            {
-                // Above the ceiling: go back to where braking still passes here at or
-                // under it, instead of a clip.
-                let near = 2.0 * st.v.max(v1) * dt + 1e-9;
-                let lo_k = dips.partition_point(|d| d.x < x1 - near);
-                let k = match (lo_k < dips.len() && dips[lo_k].x <= x1 + near).then_some(lo_k) {
-                    Some(k) => {
-                        dips[k].v *= DIP_TIGHTEN;
-                        dips[k].tries += 1;
-                        Some(k).filter(|&k| dips[k].tries <= DIP_TRIES)
-                    }
-                    None if dips.len() < DIPS_MAX => {
-                        let at = dips.partition_point(|d| d.x < x1);
-                        dips.insert(
-                            at,
-                            Dip {
-                                x: x1,
-                                v: w1,
-                                tries: 0,
-                            },
-                        );
-                        Some(at)
-                    }
-                    None => None,
-                };
-                if k.is_some() {
-                    let mut m = 1usize;
-                    let mut back = None;
-                    while m <= buf.len() {
-                        let p = &buf[buf.len() - m];
-                        if self.clears_dips(p.from.x, p.from.v, p.from.a, &dips, len) {
-                            back = Some(m);
-                            break;
-                        }
-                        m *= 2;
-                    }
-                    if back.is_none() && !buf.is_empty() {
-                        let p = &buf[0];
-                        if self.clears_dips(p.from.x, p.from.v, p.from.a, &dips, len) {
-                            back = Some(buf.len());
-                        }
-                    }
-                    if let Some(m) = back {
-                        let keep = buf.len() - m;
-                        let first = &buf[keep];
-                        st = first.from;
-                        hint = first.hint;
-                        cursor = first.cursor;
-                        at_end = None;
-                        idle = 0;
-                        for p in buf.drain(keep..) {
-                            stats.steps -= 1;
-                            if p.clipped {
-                                stats.clips -= 1;
-                            }
-                        }
-                        undone += m as u64;
-                        continue;
-                    }
-                    if let Some(k) = k {
-                        // No state kept can brake to it: the dip is of no use.
-                        dips.remove(k);
-                    }
-                }
-            }
-            if !(over_ok || (crawl && v1 > 0.0)) && v1 > w1 * (1.0 + CEILING_REL) {
-                clipped = true;
-                // On the ceiling with its acceleration, within the caps there at that
-                // speed: |a| also where some jerk is left (`Caps::a_for_jerk`) — above it
-                // no jerk could bring |a| back, and the pass would hold it, braking, far
-                // under the ceiling.
-                v1 = w1;
-                let (d1, _) = self.geo.derivs_feed_near(self.s_of(x1, len), &mut cursor);
-                let caps1 = Caps::new(&Local::from_derivs(&d1), self.machine);
-                let lim = (caps1.a_cap(v1) * self.use_caps[0])
-                    .min(caps1.a_for_jerk(v1))
-                    .max(0.0);
-                a1 = aw1.clamp(-lim, lim);
-                stats.clips += 1;
-            }
-            if x1 <= st.x {
-                idle += 1;
-                if idle > STALL_STEPS {
-                    return Err(self.s_of(st.x, len));
-                }
-            } else {
-                idle = 0;
-            }
-            let to = State {
-                t: t1,
-                x: x1,
-                v: v1,
-                a: a1,
-            };
-            let p = Pending {
-                from: st,
+/// The state one cycle on, as the steps of [`Stepper::cycle`] make it.
+#[derive(Debug, Clone, Copy)]
+struct Next {
+    /// Time, s.
+    t: f64,
+    /// Distance along the pass, mm.
+    x: f64,
+    /// Speed, mm/s.
+    v: f64,
+    /// Acceleration along the pass, mm/s².
+    a: f64,
+    /// Put on a ceiling (a clip, or a crawl that moves): counted in [`PassStats::clips`].
+    clipped: bool,
+}
+
+/// What one cycle of a pass did ([`Stepper::cycle`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Cycle {
+    /// Jumped a cruise on a flat stretch of the ceiling to its next grid point.
+    Cruised,
+    /// One cycle (or the last, partial one): under the ceiling, on it (a clip), or at a
+    /// crawl.
+    Stepped,
+    /// Went back to a kept state from which braking passes a dip ahead; the steps after
+    /// it undone.
+    Rewound,
+}
+
+/// Where a cycle starts: the limits at the state, and the ceiling there.
+struct Here {
+    /// The caps of the path at the state.
+    caps: Caps,
+    /// The feed and the axes' velocity limit at the state, mm/s.
+    vmax: f64,
+    /// The ceiling W at the state, mm/s.
+    w: f64,
+    /// The ceiling's acceleration a_W there, mm/s².
+    aw: f64,
+    /// The ceiling's cell of the state.
+    cell: usize,
+    /// The acceleration cap at the state's speed (this pass's share), mm/s²; negative
+    /// where no acceleration is within the limits.
+    ac: f64,
+    /// The jerk cap at the state's speed and |acceleration| (this pass's share), mm/s³;
+    /// negative where no jerk is within the limits.
+    jc: f64,
+    /// The first of the dips ahead of the state (index in [`Stepper::dips`]).
+    ahead_from: usize,
+}
+
+/// A pass under way: its state, the steps taken and not handed out yet (what a rewind
+/// can go back over), the dips and the counts. [`Stepper::cycle`] takes one cycle.
+struct Stepper<'p, 's> {
+    pass: &'p Pass<'p>,
+    sink: &'s mut dyn Sink,
+    /// Length of the pass, mm.
+    len: f64,
+    /// The state the next cycle starts from.
+    st: State,
+    stats: PassStats,
+    /// The ceiling's cell of the state (where its searches start).
+    hint: usize,
+    /// Steps without progress in a row.
+    idle: u32,
+    /// Where the path was last evaluated.
+    cursor: Cursor,
+    /// The ceiling at the end of the last cycle (x, (W, a_W, cell)): where this one
+    /// starts.
+    at_end: Option<(f64, (f64, f64, usize))>,
+    /// Steps taken and not handed out: kept [`REWIND_STEPS`] deep when the pass rewinds.
+    buf: VecDeque<Pending>,
+    /// Where the pass found itself above its ceiling, sorted by x.
+    dips: Vec<Dip>,
+    /// Steps undone by rewinds: past a budget, clips again.
+    undone: u64,
+}
+
+impl<'p, 's> Stepper<'p, 's> {
+    /// At rest at x = 0.
+    fn new(pass: &'p Pass<'p>, sink: &'s mut dyn Sink) -> Stepper<'p, 's> {
+        Stepper {
+            pass,
+            sink,
+            len: pass.geo.length(),
+            st: State {
+                t: 0.0,
+                x: 0.0,
+                v: 0.0,
+                a: 0.0,
+            },
+            stats: PassStats::default(),
+            hint: 0,
+            idle: 0,
+            cursor: Cursor::default(),
+            at_end: None,
+            buf: VecDeque::new(),
+            dips: Vec::new(),
+            undone: 0,
+        }
+    }
+
+    /// One cycle, in its steps: the limits here; a cruise when one may be jumped; else
+    /// the jerk, the state a cycle on (a stop within it, a crawl, the end of the path),
+    /// that state against the ceiling (it stands, a rewind, or a clip), and the step
+    /// kept. `Err(s)`: no progress for [`STALL_STEPS`] steps.
+    fn cycle(&mut self) -> Result<Cycle, f64> {
+        let (hint0, cursor0) = (self.hint, self.cursor);
+        self.forget_passed_dips();
+        let here = self.here();
+        if let Some(to) = self.cruise(&here) {
+            self.take(Pending {
+                from: self.st,
                 to,
-                j,
-                cycle: (t1 - st.t - self.dt).abs() <= 1e-9 * self.dt,
+                j: 0.0,
+                cycle: false,
                 hint: hint0,
                 cursor: cursor0,
-                clipped,
+                clipped: false,
+            });
+            return Ok(Cycle::Cruised);
+        }
+        let j = self.jerk(&here);
+        let mut next = self.reach(j);
+        let crawl = self.crawl_if_stuck(&here, &mut next);
+        self.end_of_path(&here, j, &mut next);
+        let end = self.pass.ceiling.at(next.x, self.hint);
+        self.at_end = Some((next.x, end));
+        let (w1, aw1, _) = end;
+        let w1 = w1.min(here.vmax);
+        let over_ok = self.stands_over_profile(&here, &next, w1);
+        if !over_ok && self.rewind(&next, w1) {
+            return Ok(Cycle::Rewound);
+        }
+        if !(over_ok || (crawl && next.v > 0.0)) && next.v > w1 * (1.0 + CEILING_REL) {
+            self.clip(&mut next, w1, aw1);
+        }
+        self.count_idle(next.x)?;
+        let dt = self.pass.dt;
+        let p = Pending {
+            from: self.st,
+            to: State {
+                t: next.t,
+                x: next.x,
+                v: next.v,
+                a: next.a,
+            },
+            j,
+            cycle: (next.t - self.st.t - dt).abs() <= CYCLE_MATCH_REL * dt,
+            hint: hint0,
+            cursor: cursor0,
+            clipped: next.clipped,
+        };
+        self.take(p);
+        Ok(Cycle::Stepped)
+    }
+
+    /// Dips no rewind can reach any more (behind the oldest kept step) are done with.
+    fn forget_passed_dips(&mut self) {
+        if !self.dips.is_empty() {
+            let oldest = self.buf.front().map_or(self.st.x, |p| p.from.x);
+            let n = self.dips.partition_point(|d| d.x < oldest);
+            self.dips.drain(..n);
+        }
+    }
+
+    /// The limits at the state and the ceiling there (the end of the last cycle's, when
+    /// it ended here).
+    fn here(&mut self) -> Here {
+        let pass = self.pass;
+        let st = self.st;
+        // Dips (sorted by x) ahead of this state: the only ones a check looks at.
+        let ahead_from = self.dips.partition_point(|d| d.x <= st.x);
+        let (d, feed) = pass
+            .geo
+            .derivs_feed_near(pass.s_of(st.x, self.len), &mut self.cursor);
+        let loc = Local::from_derivs(&d);
+        let vmax = loc.v_cap(pass.machine).min(feed);
+        let caps = Caps::new(&loc, pass.machine);
+        let (w, aw, cell) = match self.at_end {
+            Some((x, c)) if x == st.x => c,
+            _ => pass.ceiling.at(st.x, self.hint),
+        };
+        self.hint = cell;
+        let (ac, jc) = pass.caps(&caps, st.v, st.a.abs());
+        Here {
+            caps,
+            vmax,
+            w,
+            aw,
+            cell,
+            ac,
+            jc,
+            ahead_from,
+        }
+    }
+
+    /// The dips ahead of the state where the cycle started.
+    fn ahead(&self, here: &Here) -> &[Dip] {
+        &self.dips[here.ahead_from..]
+    }
+
+    /// A cruise on a flat stretch of the ceiling: the state at the next grid point, when
+    /// it is safe there (then it is everywhere before it). Within [`CRUISE_REL`] of the
+    /// ceiling, or of one cycle at the jerk cap where the ceiling is below that (the crawl
+    /// regime, where a cycle's jerk is coarser than the speed).
+    fn cruise(&self, here: &Here) -> Option<State> {
+        let pass = self.pass;
+        let (st, len, i, w) = (self.st, self.len, here.cell, here.w);
+        let one_cycle = here.jc.max(0.0) * pass.dt * pass.dt;
+        let near = (CRUISE_REL * w)
+            .max(CRAWL_CRUISE_REL * w.min(one_cycle))
+            .max(CRUISE_ABS_MM_S);
+        let cruising =
+            !pass.every_cycle && st.a.abs() * pass.dt <= near && st.v > 0.0 && st.v >= w - near;
+        if !cruising {
+            return None;
+        }
+        let nx = (i + 1).min(pass.ceiling.x.len() - 1);
+        let xn = pass.ceiling.x[nx].min(len);
+        let flat = xn > st.x
+            && pass.ceiling.v[i] == pass.ceiling.v[nx]
+            && pass
+                .ceiling
+                .m
+                .as_ref()
+                .is_none_or(|m| m[i] == 0.0 && m[nx] == 0.0)
+            && pass.safe(
+                &here.caps,
+                here.vmax,
+                xn,
+                st.v,
+                0.0,
+                i,
+                len,
+                self.ahead(here),
+            );
+        if !flat {
+            return None;
+        }
+        // The forward pass jumps whole cycles (to within one cycle of the grid point; the
+        // rest is an ordinary cycle), so that its states stay on the cycle grid and a
+        // trajectory is the same states with each jump cut into its cycles: one answer
+        // with or without a trajectory (issue 43). The end of the path keeps its last,
+        // partial cycle.
+        let to = if xn >= len - END_MM {
+            State {
+                t: st.t + (len - st.x) / st.v,
+                x: len,
+                v: st.v,
+                a: 0.0,
+            }
+        } else if pass.forward {
+            // Cycle by cycle as an ordinary cycle at j = 0 computes them (x + v·dt,
+            // t + dt: the same bits), up to the grid point; a state that still
+            // accelerates a little settles first (an ordinary cycle).
+            let mut to = st;
+            if st.a == 0.0 {
+                let step = st.v * pass.dt;
+                while to.x + step < xn {
+                    to.x += step;
+                    to.t += pass.dt;
+                }
+            }
+            to
+        } else {
+            State {
+                t: st.t + (xn - st.x) / st.v,
+                x: xn,
+                v: st.v,
+                a: 0.0,
+            }
+        };
+        (to.x > st.x).then_some(to)
+    }
+
+    /// The range of jerks of this cycle within the caps: [lo, hi], mm/s³; where |a| is
+    /// above its cap at this speed, the one jerk that brings it back as fast as allowed —
+    /// and where |a| leaves no jerk at all (j_cap < 0: no jerk keeps the axes within J),
+    /// at the jerk cap of a = 0 (a |a| held there would brake the motion to a standstill).
+    fn jerk_range(&self, here: &Here) -> (f64, f64) {
+        let (st, dt) = (self.st, self.pass.dt);
+        let jm = here.jc.max(0.0);
+        let ac = here.ac.max(0.0);
+        let lo = (-jm).max((-ac - st.a) / dt);
+        let hi = jm.min((ac - st.a) / dt);
+        if lo > hi || (here.jc < 0.0 && st.a != 0.0) {
+            let jr = if here.jc < 0.0 {
+                (self.pass.caps(&here.caps, st.v, 0.0).1).max(0.0)
+            } else {
+                jm
             };
-            keep(&mut buf, sink, p);
-            st = to;
-            stats.steps += 1;
+            let j = -st.a.signum() * jr;
+            return (j, j);
         }
-        emit(&mut buf, sink, 0);
-        if st.x < len {
-            // A path shorter than END_MM: its end is reached at once.
-            let to = State { x: len, ..st };
-            sink.step(&st, &to, 0.0, false);
-            st = to;
+        (lo, hi)
+    }
+
+    /// The jerk of this cycle: the largest safe one (bisection); on a flat ceiling just
+    /// under it the one that settles (a → 0: the largest would overshoot and chatter about
+    /// the ceiling); where none is safe, the hardest braking (or, above the profile
+    /// already when rewinding, towards its acceleration). Then, when rewinding, a motion
+    /// that decelerates keeps v ≥ a²/(2·j_cap) ([`Stepper::landing_jerk`]).
+    fn jerk(&self, here: &Here) -> f64 {
+        let pass = self.pass;
+        let (st, dt) = (self.st, pass.dt);
+        let (lo, hi) = self.jerk_range(here);
+        let ahead = self.ahead(here);
+        let ok = |j: f64| {
+            let (x1, v1, a1) = st.after(dt, j);
+            pass.safe(
+                &here.caps, here.vmax, x1, v1, a1, self.hint, self.len, ahead,
+            )
+        };
+        let (w0, aw0) = (here.w, here.aw);
+        let jz = (-st.a / dt).clamp(lo, hi);
+        let settle = aw0 == 0.0 && w0 - st.v <= SETTLE_REL * w0;
+        let j = if ok(hi) {
+            hi
+        } else if settle && ok(jz) {
+            jz
+        } else if !ok(lo) {
+            if pass.rewind && st.v > w0 {
+                // Above the profile already (a state let stand): towards its
+                // acceleration, not the hardest braking, which would leave it with more
+                // deceleration than it can bring back to 0 before it stops.
+                ((aw0 - st.a) / dt).clamp(lo, hi)
+            } else {
+                lo
+            }
+        } else {
+            bisect(lo, hi, ok)
+        };
+        self.landing_jerk(here, j, hi)
+    }
+
+    /// A motion that decelerates must be able to bring a to 0 before it stops
+    /// (v ≥ a²/(2·j_cap)): the smallest jerk from `j` towards `hi` that keeps this, when
+    /// `j` does not (then the ceiling may be left: a rewind or a clip follows). Only when
+    /// the pass rewinds; else `j`.
+    fn landing_jerk(&self, here: &Here, j: f64, hi: f64) -> f64 {
+        let pass = self.pass;
+        let (st, dt) = (self.st, pass.dt);
+        let lands = |j: f64| {
+            let (_, v1, a1) = st.after(dt, j);
+            a1 >= 0.0 || {
+                let jf = pass.caps(&here.caps, v1.max(0.0), a1.abs()).1;
+                jf > 0.0 && v1 >= a1 * a1 / (2.0 * jf)
+            }
+        };
+        if !pass.rewind || lands(j) || !lands(hi) || st.v <= 0.0 {
+            j
+        } else {
+            bisect(hi, j, lands)
         }
-        stats.time_s = st.t;
-        Ok(stats)
+    }
+
+    /// The state one cycle on under jerk `j`; stopped within the cycle (only near a
+    /// standstill): at rest where v = 0.
+    fn reach(&self, j: f64) -> Next {
+        let (st, dt) = (self.st, self.pass.dt);
+        let (mut x1, mut v1, mut a1) = st.after(dt, j);
+        if v1 < 0.0 {
+            let (mut lo_t, mut hi_t) = (0.0, dt);
+            for _ in 0..TIME_BISECTIONS {
+                let tm = 0.5 * (lo_t + hi_t);
+                if st.v + st.a * tm + 0.5 * j * tm * tm > 0.0 {
+                    lo_t = tm;
+                } else {
+                    hi_t = tm;
+                }
+            }
+            let tm = lo_t;
+            x1 = (st.x + st.v * tm + 0.5 * st.a * tm * tm + j * tm * tm * tm / 6.0).max(st.x);
+            v1 = 0.0;
+            a1 = 0.0;
+        }
+        Next {
+            t: st.t + dt,
+            x: x1,
+            v: v1,
+            a: a1,
+            clipped: false,
+        }
+    }
+
+    /// No progress: at rest where the ceiling is below what one cycle at the jerk cap
+    /// makes (W < j_cap·Tcy²), or where the ceiling (the backward profile) has come to a
+    /// near standstill with a deceleration that would take the motion back: go on at a
+    /// crawl under the velocity limit, whose step is a part of the jerk cap (counted as a
+    /// clip). Before 2026-11-28 a forward state on such a profile with v > 0 was put back
+    /// on it every cycle and never moved ("the limits allow no motion", issue 43). Then,
+    /// crawl or not, never backwards (a cycle in which the speed dips below 0 and back).
+    /// Whether it crawled.
+    fn crawl_if_stuck(&mut self, here: &Here, next: &mut Next) -> bool {
+        let (pass, st, dt) = (self.pass, self.st, self.pass.dt);
+        let crawl = next.x <= st.x;
+        if crawl {
+            let xc = next.x.max(st.x);
+            let w0 = match &pass.limit {
+                Some(l) => l.at(xc, 0).0,
+                _ => pass.ceiling.at(xc, self.hint).0,
+            };
+            let jm = here.jc.max(0.0);
+            next.v = (w0.min(here.vmax) * (1.0 - CRAWL_UNDER_LIMIT_REL))
+                .min(CRAWL_JERK_SHARE * jm * dt * dt)
+                .max(0.0);
+            next.a = 0.0;
+            next.x = next.x.max(st.x) + next.v * dt;
+            if next.v > 0.0 {
+                self.stats.clips += 1;
+                next.clipped = true;
+            }
+        }
+        next.x = next.x.max(st.x);
+        crawl
+    }
+
+    /// Past the end: the last, partial cycle, to the time at which x reaches L. Within
+    /// [`END_MM`] of the end: this state is the end (one state, not a second one at the
+    /// same time), reached after the cycle — the last nanometres at the speed there, or
+    /// from rest in the rest-to-rest time at the jerk cap, 4·(d/(2·j))^(1/3) — so that
+    /// no cycle of the trajectory jumps them.
+    fn end_of_path(&self, here: &Here, j: f64, next: &mut Next) {
+        let (st, dt, len) = (self.st, self.pass.dt, self.len);
+        if next.x > len {
+            let (mut t_lo, mut t_hi) = (0.0, dt);
+            for _ in 0..TIME_BISECTIONS {
+                let tm = 0.5 * (t_lo + t_hi);
+                let xm = st.x + st.v * tm + 0.5 * st.a * tm * tm + j * tm * tm * tm / 6.0;
+                if xm < len {
+                    t_lo = tm;
+                } else {
+                    t_hi = tm;
+                }
+            }
+            let tm = t_hi;
+            next.x = len;
+            next.v = (st.v + st.a * tm + 0.5 * j * tm * tm).max(0.0);
+            next.a = st.a + j * tm;
+            next.t = st.t + tm;
+        }
+        if next.x >= len - END_MM && next.x < len {
+            let d = len - next.x;
+            let jm = here.jc.max(0.0);
+            next.t += if next.v > 0.0 {
+                (d / next.v).min(dt)
+            } else if jm > 0.0 {
+                4.0 * (d / (2.0 * jm)).cbrt()
+            } else {
+                dt
+            };
+            next.x = len;
+        }
+    }
+
+    /// Just above a profile that is not itself the limit (the forward pass under the
+    /// backward profile, rewinding), by at most [`OVER_PROFILE_REL`], and under the
+    /// velocity limit: the state stands, braking at the caps from the next cycle (no state
+    /// is safe above the ceiling) — a motion within the limits, where a clip or a rewind
+    /// would jump it. `w1`: the ceiling there (at most the feed and the axes' V), mm/s.
+    fn stands_over_profile(&self, here: &Here, next: &Next, w1: f64) -> bool {
+        let pass = self.pass;
+        pass.rewind
+            && next.v <= w1 * (1.0 + OVER_PROFILE_REL)
+            && pass
+                .limit
+                .as_ref()
+                .is_some_and(|l| next.v <= l.at(next.x, 0).0.min(here.vmax) * (1.0 + CEILING_REL))
+    }
+
+    /// Above the ceiling `w1` (mm/s) when rewinding, within the budget of undone steps:
+    /// note the dip here and go back to the latest kept state from which braking passes
+    /// it at or under its speed. Whether it went back.
+    fn rewind(&mut self, next: &Next, w1: f64) -> bool {
+        let pass = self.pass;
+        let budget = self.stats.steps / REWIND_BUDGET_PER_STEP_INV + REWIND_BUDGET_STEPS;
+        let above = next.v > w1 * (1.0 + CEILING_REL)
+            && pass.rewind
+            && next.x < self.len
+            && self.undone < budget;
+        if !above {
+            return false;
+        }
+        let Some(k) = self.note_dip(next, w1) else {
+            return false;
+        };
+        match self.braking_start() {
+            Some(m) => {
+                self.undo(m);
+                true
+            }
+            None => {
+                // No state kept can brake to it: the dip is of no use.
+                self.dips.remove(k);
+                false
+            }
+        }
+    }
+
+    /// The dip at `next` (a dip already there, within two cycles' travel: its speed
+    /// lowered by [`DIP_TIGHTEN`], until [`DIP_TRIES`]; else a new one at `w1`, up to
+    /// [`DIPS_MAX`]): its index, or `None` when it is given up.
+    fn note_dip(&mut self, next: &Next, w1: f64) -> Option<usize> {
+        let (x1, v1) = (next.x, next.v);
+        let near = DIP_NEAR_CYCLES * self.st.v.max(v1) * self.pass.dt + DIP_NEAR_MM;
+        let dips = &mut self.dips;
+        let lo_k = dips.partition_point(|d| d.x < x1 - near);
+        match (lo_k < dips.len() && dips[lo_k].x <= x1 + near).then_some(lo_k) {
+            Some(k) => {
+                dips[k].v *= DIP_TIGHTEN;
+                dips[k].tries += 1;
+                Some(k).filter(|&k| dips[k].tries <= DIP_TRIES)
+            }
+            None if dips.len() < DIPS_MAX => {
+                let at = dips.partition_point(|d| d.x < x1);
+                dips.insert(
+                    at,
+                    Dip {
+                        x: x1,
+                        v: w1,
+                        tries: 0,
+                    },
+                );
+                Some(at)
+            }
+            None => None,
+        }
+    }
+
+    /// How many kept steps back (1, 2, 4, …, then all) the latest state is from which the
+    /// hardest braking passes every dip ahead ([`Pass::clears_dips`]); `None` if none.
+    fn braking_start(&self) -> Option<usize> {
+        let (pass, buf) = (self.pass, &self.buf);
+        let clears =
+            |p: &Pending| pass.clears_dips(p.from.x, p.from.v, p.from.a, &self.dips, self.len);
+        let mut m = 1usize;
+        while m <= buf.len() {
+            if clears(&buf[buf.len() - m]) {
+                return Some(m);
+            }
+            m *= 2;
+        }
+        if !buf.is_empty() && clears(&buf[0]) {
+            return Some(buf.len());
+        }
+        None
+    }
+
+    /// Undo the last `m` kept steps: go on from where the first of them started.
+    fn undo(&mut self, m: usize) {
+        let keep = self.buf.len() - m;
+        let first = &self.buf[keep];
+        self.st = first.from;
+        self.hint = first.hint;
+        self.cursor = first.cursor;
+        self.at_end = None;
+        self.idle = 0;
+        for p in self.buf.drain(keep..) {
+            self.stats.steps -= 1;
+            if p.clipped {
+                self.stats.clips -= 1;
+            }
+        }
+        self.undone += m as u64;
+    }
+
+    /// Put the state on the ceiling `w1` (mm/s) with its acceleration `aw1` (mm/s²),
+    /// within the caps there at that speed: |a| also where some jerk is left
+    /// ([`Caps::a_for_jerk`]) — above it no jerk could bring |a| back, and the pass would
+    /// hold it, braking, far under the ceiling. Counted.
+    fn clip(&mut self, next: &mut Next, w1: f64, aw1: f64) {
+        let pass = self.pass;
+        next.clipped = true;
+        next.v = w1;
+        let (d1, _) = pass
+            .geo
+            .derivs_feed_near(pass.s_of(next.x, self.len), &mut self.cursor);
+        let caps1 = Caps::new(&Local::from_derivs(&d1), pass.machine);
+        let lim = (caps1.a_cap(next.v) * pass.use_caps[0])
+            .min(caps1.a_for_jerk(next.v))
+            .max(0.0);
+        next.a = aw1.clamp(-lim, lim);
+        self.stats.clips += 1;
+    }
+
+    /// Count a step that makes no progress; `Err(s)` past [`STALL_STEPS`] in a row.
+    fn count_idle(&mut self, x1: f64) -> Result<(), f64> {
+        if x1 <= self.st.x {
+            self.idle += 1;
+            if self.idle > STALL_STEPS {
+                return Err(self.pass.s_of(self.st.x, self.len));
+            }
+        } else {
+            self.idle = 0;
+        }
+        Ok(())
+    }
+
+    /// A step taken: kept for a rewind (handed out when it is [`REWIND_STEPS`] old), or
+    /// handed out at once; the state moves on.
+    fn take(&mut self, p: Pending) {
+        let to = p.to;
+        if self.pass.rewind {
+            self.buf.push_back(p);
+            self.hand_out(REWIND_STEPS);
+        } else {
+            self.sink.step(&p.from, &p.to, p.j, p.cycle);
+        }
+        self.st = to;
+        self.stats.steps += 1;
+    }
+
+    /// Hand out the oldest kept steps until `keep` are left.
+    fn hand_out(&mut self, keep: usize) {
+        while self.buf.len() > keep {
+            let Some(p) = self.buf.pop_front() else {
+                break;
+            };
+            self.sink.step(&p.from, &p.to, p.j, p.cycle);
+        }
+    }
+
+    /// The end: every kept step handed out; a path shorter than [`END_MM`] reached at
+    /// once.
+    fn finish(mut self) -> PassStats {
+        self.hand_out(0);
+        if self.st.x < self.len {
+            let to = State {
+                x: self.len,
+                ..self.st
+            };
+            self.sink.step(&self.st, &to, 0.0, false);
+            self.st = to;
+        }
+        self.stats.time_s = self.st.t;
+        self.stats
     }
 }
 

@@ -53,3 +53,112 @@ pub const SETTLE_REL: f64 = 1e-6;
 /// state within this fraction of the ceiling cruises (see [`CRUISE_REL`]): the cycle is
 /// too coarse there to come closer without chattering.
 pub const CRAWL_CRUISE_REL: f64 = 1e-3;
+
+/// `(1 + CEILING_REL)^(3/2)` to rounding (the next term, 3/8·CEILING_REL², is far below
+/// it): [`CEILING_REL`] on P = W^(3/2), in which the passes compare speeds with their
+/// ceiling without a cube root.
+pub const CEILING_REL_P: f64 = 1.0 + 1.5 * CEILING_REL;
+
+/// An acceleration counts as within its cap a_cap up to this fraction of the cap …
+/// (rounding of the cap's terms: a state put exactly on the cap stays safe).
+pub const A_CAP_SLACK_REL: f64 = 1e-12;
+/// … plus this, mm/s² (rounding where the cap is near 0).
+pub const A_CAP_SLACK_MM_S2: f64 = 1e-12;
+
+/// Pieces of the look-ahead ramp of a safe state (pass.rs module docs: a down to the
+/// ceiling's a_W at the jerk cap, checked under the ceiling at the end of each piece).
+pub const RAMP_STEPS: usize = 8;
+/// Pieces of that ramp checked at most (the ceiling's a_W moves as the ramp goes, so the
+/// ramp may take longer than the first estimate; four estimates' worth).
+pub const RAMP_STEPS_MAX: usize = 4 * RAMP_STEPS;
+/// The ramp's jerk at least this, mm/s³: where the jerk cap is 0 the ramp is long (and
+/// fails the ceiling), not a division by 0.
+pub const RAMP_JERK_FLOOR_MM_S3: f64 = 1e-300;
+
+/// Halvings of a time within one cycle (when the speed reaches 0 within it, when x
+/// reaches the end of the path): 2⁻⁶⁰ of Tcy, below the rounding of t.
+pub const TIME_BISECTIONS: usize = 60;
+
+/// A step is one interpolation cycle when its time is Tcy to within this fraction of Tcy
+/// (the rounding of t summed over cycles); the trajectory's `cycle` flag.
+pub const CYCLE_MATCH_REL: f64 = 1e-9;
+
+/// A jumped cruise is cut into its whole cycles with this slack, in cycles (the rounding
+/// of its time over Tcy: a cruise of exactly n cycles is n, not n − 1).
+pub const CYCLE_COUNT_SLACK: f64 = 1e-9;
+
+/// A cycle of a cut cruise whose time is within this fraction of the cruise's end time
+/// (relative to that time, at least 1 s) is the end itself, not a cycle before it.
+pub const TIME_MATCH_REL: f64 = 1e-12;
+
+/// A crawl (a pass that makes no progress, pass.rs) moves this fraction under the
+/// velocity limit: strictly under it, so that the crawl is never a clip against it.
+pub const CRAWL_UNDER_LIMIT_REL: f64 = 1e-9;
+
+/// Steps without progress in a row after which a pass gives up: the limits allow no
+/// motion there (`SimError::Stalled`). About 17 minutes of cycles at 1 ms.
+pub const STALL_STEPS: u32 = 1_000_000;
+
+/// Steps a rewinding pass keeps before handing them out: how far back a rewind can go
+/// (16 s of cycles at 1 ms; at most this many steps held).
+pub const REWIND_STEPS: usize = 16_384;
+/// How far a rewinding forward pass may be above the backward profile (under the
+/// velocity limit) and go on braking, relative to the profile.
+pub const OVER_PROFILE_REL: f64 = 2e-3;
+/// Steps a pass may undo by rewinds: one per this many steps taken, plus
+/// [`REWIND_BUDGET_STEPS`]; past it, clips (the work stays within a small multiple of
+/// the motion's cycles where the profile is clipped at almost every cycle).
+pub const REWIND_BUDGET_PER_STEP_INV: u64 = 4;
+/// See [`REWIND_BUDGET_PER_STEP_INV`], steps.
+pub const REWIND_BUDGET_STEPS: u64 = 100_000;
+/// Tries per dip: each lowers its speed by the factor [`DIP_TIGHTEN`].
+pub const DIP_TRIES: u32 = 40;
+/// Factor on a dip's speed when the motion is above the ceiling there again (the
+/// braking is computed coarser than the motion).
+pub const DIP_TIGHTEN: f64 = 0.97;
+/// Dips kept at once, at most (beyond: clips).
+pub const DIPS_MAX: usize = 4096;
+/// A state above its ceiling within this many cycles' travel of a dip (at the larger of
+/// the speeds at the two ends of the cycle) is at that dip …
+pub const DIP_NEAR_CYCLES: f64 = 2.0;
+/// … plus this, mm (rounding at a standstill).
+pub const DIP_NEAR_MM: f64 = 1e-9;
+/// The braking a rewind checks against the dips is in pieces of at least this many
+/// cycles …
+pub const BRAKE_PIECE_CYCLES: f64 = 4.0;
+/// … and of at least this fraction of the time to the next dip at the speed where each
+/// starts (the inverse: 8 pieces to the next dip).
+pub const BRAKE_PIECES_TO_GO: f64 = 8.0;
+/// Pieces of that braking, at most (beyond: the state cannot brake in time).
+pub const BRAKE_PIECES_MAX: usize = 100_000;
+/// Share of the |a| at which the jerk cap runs out (`Caps::a_for_jerk`) that the
+/// braking holds (room for the jerk to bring it back).
+pub const BRAKE_A_SHARE: f64 = 0.8;
+/// The time to the next dip is taken at a speed of at least this, mm/s (a braking that
+/// starts at rest).
+pub const BRAKE_SPEED_FLOOR_MM_S: f64 = 1e-12;
+
+/// The first guess of the passes' cube root: the bits of p divided by 3 plus this
+/// (two thirds of the exponent bias, 1023·2⁵²·2/3, lowered to balance the guess's error
+/// over a binade: within about 3 % everywhere).
+pub const CBRT_GUESS_BIAS: u64 = 0x2A9F_7893_782D_A1CE;
+/// Halley steps from that guess (cubic convergence: 3 % → 10⁻⁵ → 10⁻¹⁵ → rounding).
+pub const CBRT_HALLEY_STEPS: usize = 3;
+
+/// Grid points whose path derivatives are evaluated in one batch (`Grid::new`): the
+/// batch's derivatives, 160 bytes a point, are held at once (640 kB).
+pub const GRID_BATCH_POINTS: usize = 4096;
+
+/// LinuxCNC's planner model (linuxcnc.rs): displacements below this are no motion,
+/// mm or ° (emccanon's `applyMinDisplacement`).
+pub const LCNC_MIN_DISPLACEMENT: f64 = 1e-7;
+/// LinuxCNC's `TP_VEL_EPSILON` (tp_types.h), mm/s.
+pub const LCNC_VEL_EPSILON: f64 = 1e-8;
+/// LinuxCNC's `TP_POS_EPSILON` (tp_types.h), mm.
+pub const LCNC_POS_EPSILON: f64 = 1e-12;
+/// LinuxCNC's `TP_TIME_EPSILON` (tp_types.h), s.
+pub const LCNC_TIME_EPSILON: f64 = 1e-12;
+/// Bound on the cycles of one run of the LinuxCNC model, per segment: a segment that
+/// does not finish within this many cycles means the model is stuck (never seen; a
+/// guard, not a limit).
+pub const LCNC_MAX_CYCLES_PER_SEGMENT: usize = 10_000_000;
