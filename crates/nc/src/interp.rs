@@ -11,6 +11,7 @@ use crate::lexer::{Lexer, Token};
 use crate::modal::{A, AXES, B, C, FeedMode, Modal, Motion, Tcpm, X, Y, Z};
 use crate::statements::is_sinumerik_frame;
 use crate::tcpm::{ControllerCodes, ReadOptions, Switch, code10};
+use crate::tolerances::{HALF_TURN_DEG, ZERO_LENGTH_MM};
 use crate::word::{RotaryForm, Word};
 use std::ops::Range;
 
@@ -49,7 +50,7 @@ fn wrap_axis(
     let tip = |p: &[Option<f64>; 6]| Some([p[X]?, p[Y]?, p[Z]?]);
     let (t0, t1) = (tip(before)?, tip(after)?);
     let d2: f64 = t0.iter().zip(t1).map(|(a, b)| (b - a) * (b - a)).sum();
-    if d2.sqrt() <= crate::run::ZERO_LENGTH_MM {
+    if d2.sqrt() <= ZERO_LENGTH_MM {
         return None;
     }
     (A..=C).find(|&k| {
@@ -60,10 +61,6 @@ fn wrap_axis(
             && matches!((before[k], after[k]), (Some(p), Some(q)) if (q - p).abs() > HALF_TURN_DEG)
     })
 }
-
-/// Half a turn, degrees, and the round-off a written value may carry: a plain rotary move
-/// larger than this is a wrap on an axis that may take the shorter way.
-pub(crate) const HALF_TURN_DEG: f64 = 180.0 + 1e-9;
 
 /// `#100`, `-#100`, `+#100`: a macro variable's number (below 1000) and whether it is
 /// negated.

@@ -9,6 +9,7 @@
 
 use crate::modal::{AXES, X, Z};
 use crate::program::Program;
+use crate::tolerances::DIRECTION_FORM_REACH_TOL_DEG;
 use crate::word::{RotaryForm, Word};
 use crate::writer::Edit;
 pub use crate::writer::inserted_form;
@@ -263,15 +264,17 @@ fn unedited_direction_word(
     match (now, after) {
         (Some(p), Some(a)) => {
             let reached = w.form.delta(p, w.value).map(|d| p + d);
-            let conflict = reached.is_none_or(|r| (r - a).abs() > 1e-6).then(|| {
-                format!(
-                    "line {line}: {l}={form}({}) after the patched moves starts from \
-                     {p:.3}, not {}, and reaches {} instead of {a:.3}",
-                    w.value,
-                    before.map_or("an unknown position".into(), |v| format!("{v:.3}")),
-                    reached.map_or("no settled position".into(), |r| format!("{r:.3}")),
-                )
-            });
+            let conflict = reached
+                .is_none_or(|r| (r - a).abs() > DIRECTION_FORM_REACH_TOL_DEG)
+                .then(|| {
+                    format!(
+                        "line {line}: {l}={form}({}) after the patched moves starts from \
+                         {p:.3}, not {}, and reaches {} instead of {a:.3}",
+                        w.value,
+                        before.map_or("an unknown position".into(), |v| format!("{v:.3}")),
+                        reached.map_or("no settled position".into(), |r| format!("{r:.3}")),
+                    )
+                });
             (Some(a), conflict)
         }
         _ => (after, None),

@@ -4,6 +4,7 @@
 //! [`crate::conversational`]).
 
 use crate::flow::{Key, Nest, Stmt};
+use crate::tolerances::CODE_MATCH_TOL;
 
 /// Sinumerik frame instructions (a shift, rotation, scaling or mirror of the programmable
 /// frame).
@@ -323,14 +324,14 @@ impl<'a> Line<'a> {
     fn m(&self, code: f64) -> bool {
         self.body
             .iter()
-            .any(|x| matches!(x, Tok::Word(b'M', v) if (*v - code).abs() < 1e-9))
+            .any(|x| matches!(x, Tok::Word(b'M', v) if (*v - code).abs() < CODE_MATCH_TOL))
     }
 
     /// Whether the line holds the G code `code`.
     fn g(&self, code: f64) -> bool {
         self.body
             .iter()
-            .any(|x| matches!(x, Tok::Word(b'G', v) if (*v - code).abs() < 1e-9))
+            .any(|x| matches!(x, Tok::Word(b'G', v) if (*v - code).abs() < CODE_MATCH_TOL))
     }
 
     /// A jump's target: a number (block), `N100`, or a label name, after the keyword at `i`
