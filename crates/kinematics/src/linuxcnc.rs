@@ -80,6 +80,7 @@ use crate::machine_file::{
     DEG_PER_REV, DEG_S_PER_RPM, MM_PER_M, MM_S_PER_M_MIN, check_pair, positive, range,
 };
 use crate::rotary::{Carrier, Rotaries, RotaryAxis, add};
+use crate::tolerances::LINUXCNC_NO_LIMIT;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -397,7 +398,7 @@ impl IniReading<'_> {
             }
         };
         let c_range_deg = match (pole_ini.wrapped, pole_ini.range.map(to_deg)) {
-            (false, Some((lo, hi))) if lo > -1e98 && hi < 1e98 => Some(
+            (false, Some((lo, hi))) if lo > -LINUXCNC_NO_LIMIT && hi < LINUXCNC_NO_LIMIT => Some(
                 range(
                     &format!("[AXIS_{pole_letter}] MIN_LIMIT/MAX_LIMIT"),
                     &[lo, hi],
