@@ -14,6 +14,7 @@
 //!   programmed feed F wins a tie with any axis.
 
 use crate::machine::{Axis, AxisLimits, Machine};
+use crate::tolerances::CBRT_SKIP_MARGIN;
 use serde::Serialize;
 
 /// Which term of Equation 6 binds.
@@ -66,7 +67,7 @@ pub fn axis_feed_bound(limits: &AxisLimits, d: [f64; 3]) -> AxisBound {
     // cbrt(t) < f implies t < f³ (the margin covers the rounding of f³), so the result
     // is the same as always taking it.
     let tj = term(limits.j, d[2]);
-    if tj < feed_mm_s * feed_mm_s * feed_mm_s * (1.0 + 1e-9) {
+    if tj < feed_mm_s * feed_mm_s * feed_mm_s * (1.0 + CBRT_SKIP_MARGIN) {
         let j = tj.cbrt();
         if j < feed_mm_s {
             feed_mm_s = j;

@@ -27,6 +27,7 @@
 
 use crate::hal::{Hal, Value};
 use crate::ini::Ini;
+use std::ops::Range;
 
 /// One word of a Tcl command: its text as written (without the braces or quotes that
 /// delimit it), how it is delimited, and its 1-based line and column.
@@ -56,176 +57,207 @@ type Command = Result<Vec<Word>, (usize, usize, String)>;
 /// The commands of a Tcl script, in order (module docs: comments, continuation lines,
 /// braces, quotes and brackets as Tcl groups them).
 fn commands(text: &str) -> Vec<Command> {
-    let b = text.as_bytes();
+    let mut sc = Scanner {
+        text,
+        b: text.as_bytes(),
+        i: 0,
+        line: 1,
+        line_start: 0,
+    };
     let mut out = Vec::new();
-    let mut i = 0;
-    let (mut line, mut line_start) = (1usize, 0usize);
-    // Advance over byte `k` (a newline starts a line).
-    macro_rules! step {
-        ($k:expr) => {{
-            if b[$k] == b'\n' {
-                line += 1;
-                line_start = $k + 1;
-            }
-        }};
-    }
-    while i < b.len() {
-        // Between commands: blanks, newlines, `;`.
-        if matches!(b[i], b' ' | b'\t' | b'\r' | b'\n' | b';') {
-            step!(i);
-            i += 1;
+    while sc.i < sc.b.len() {
+        if sc.skip_separator() {
             continue;
         }
-        if b[i] == b'\\' && b.get(i + 1) == Some(&b'\n') {
-            step!(i + 1);
-            i += 2;
+        if sc.b[sc.i] == b'#' {
+            sc.skip_comment();
             continue;
         }
-        // A comment runs to the end of its line (a `\` before the newline continues it).
-        if b[i] == b'#' {
-            while i < b.len() && b[i] != b'\n' {
-                if b[i] == b'\\' && b.get(i + 1) == Some(&b'\n') {
-                    step!(i + 1);
-                    i += 1;
-                }
-                i += 1;
-            }
-            continue;
-        }
-        // A command: words up to a newline or `;` outside any grouping.
-        let mut words = Vec::new();
-        let mut broken = None;
-        loop {
-            while i < b.len() && matches!(b[i], b' ' | b'\t' | b'\r') {
-                i += 1;
-            }
-            if i + 1 < b.len() && b[i] == b'\\' && b[i + 1] == b'\n' {
-                step!(i + 1);
-                i += 2;
-                continue;
-            }
-            if i >= b.len() || b[i] == b'\n' || b[i] == b';' {
+        match sc.command() {
+            Err(e) => {
+                out.push(Err(e));
                 break;
             }
-            let (wl, wc) = (line, i - line_start + 1);
-            let start = i;
-            let (kind, body) = match b[i] {
-                b'{' => {
-                    let mut depth = 0usize;
-                    let mut end = None;
-                    while i < b.len() {
-                        step!(i);
-                        match b[i] {
-                            b'\\' => {
-                                if i + 1 < b.len() {
-                                    step!(i + 1);
-                                }
-                                i += 1;
-                            }
-                            b'{' => depth += 1,
-                            b'}' => {
-                                depth -= 1;
-                                if depth == 0 {
-                                    end = Some(i);
-                                    i += 1;
-                                    break;
-                                }
-                            }
-                            _ => {}
-                        }
-                        i += 1;
-                    }
-                    match end {
-                        Some(e) => (Kind::Braced, start + 1..e),
-                        None => {
-                            broken = Some((wl, wc, "an open brace '{' never closed".into()));
-                            break;
-                        }
-                    }
-                }
-                b'"' => {
-                    i += 1;
-                    let mut brackets = 0usize;
-                    let mut end = None;
-                    while i < b.len() {
-                        step!(i);
-                        match b[i] {
-                            b'\\' => {
-                                if i + 1 < b.len() {
-                                    step!(i + 1);
-                                }
-                                i += 1;
-                            }
-                            b'[' => brackets += 1,
-                            b']' => brackets = brackets.saturating_sub(1),
-                            b'"' if brackets == 0 => {
-                                end = Some(i);
-                                i += 1;
-                                break;
-                            }
-                            _ => {}
-                        }
-                        i += 1;
-                    }
-                    match end {
-                        Some(e) => (Kind::Quoted, start + 1..e),
-                        None => {
-                            broken = Some((wl, wc, "an open quote '\"' never closed".into()));
-                            break;
-                        }
-                    }
-                }
-                _ => {
-                    // Brackets (and braces inside them) group across blanks.
-                    let (mut brackets, mut braces) = (0usize, 0usize);
-                    while i < b.len() {
-                        let c = b[i];
-                        if brackets == 0
-                            && braces == 0
-                            && matches!(c, b' ' | b'\t' | b'\r' | b'\n' | b';')
-                        {
-                            break;
-                        }
-                        step!(i);
-                        match c {
-                            b'\\' => {
-                                if i + 1 < b.len() {
-                                    step!(i + 1);
-                                }
-                                i += 1;
-                            }
-                            b'[' if braces == 0 => brackets += 1,
-                            b']' if braces == 0 => brackets = brackets.saturating_sub(1),
-                            b'{' if brackets > 0 => braces += 1,
-                            b'}' if brackets > 0 => braces = braces.saturating_sub(1),
-                            _ => {}
-                        }
-                        i += 1;
-                    }
-                    if brackets > 0 {
-                        broken = Some((wl, wc, "an open bracket '[' never closed".into()));
-                        break;
-                    }
-                    (Kind::Bare, start..i)
-                }
+            Ok(words) if words.is_empty() => {}
+            Ok(words) => out.push(Ok(words)),
+        }
+    }
+    out
+}
+
+/// A place in a Tcl script as [`commands`] splits it: the byte `i`, its 1-based line and
+/// where that line starts.
+struct Scanner<'t> {
+    text: &'t str,
+    b: &'t [u8],
+    i: usize,
+    line: usize,
+    line_start: usize,
+}
+
+impl Scanner<'_> {
+    /// Advance over byte `k` (a newline starts a line).
+    fn step(&mut self, k: usize) {
+        if self.b[k] == b'\n' {
+            self.line += 1;
+            self.line_start = k + 1;
+        }
+    }
+
+    /// Between commands: a blank, a newline, `;` or a continued line, passed over (`false`
+    /// if there is none at `i`).
+    fn skip_separator(&mut self) -> bool {
+        let (b, i) = (self.b, self.i);
+        if matches!(b[i], b' ' | b'\t' | b'\r' | b'\n' | b';') {
+            self.step(i);
+            self.i += 1;
+            return true;
+        }
+        if b[i] == b'\\' && b.get(i + 1) == Some(&b'\n') {
+            self.step(i + 1);
+            self.i += 2;
+            return true;
+        }
+        false
+    }
+
+    /// A comment runs to the end of its line (a `\` before the newline continues it).
+    fn skip_comment(&mut self) {
+        let b = self.b;
+        while self.i < b.len() && b[self.i] != b'\n' {
+            if b[self.i] == b'\\' && b.get(self.i + 1) == Some(&b'\n') {
+                self.step(self.i + 1);
+                self.i += 1;
+            }
+            self.i += 1;
+        }
+    }
+
+    /// A command: words up to a newline or `;` outside any grouping.
+    fn command(&mut self) -> Command {
+        let b = self.b;
+        let mut words = Vec::new();
+        loop {
+            while self.i < b.len() && matches!(b[self.i], b' ' | b'\t' | b'\r') {
+                self.i += 1;
+            }
+            if self.i + 1 < b.len() && b[self.i] == b'\\' && b[self.i + 1] == b'\n' {
+                self.step(self.i + 1);
+                self.i += 2;
+                continue;
+            }
+            if self.i >= b.len() || b[self.i] == b'\n' || b[self.i] == b';' {
+                break;
+            }
+            let (wl, wc) = (self.line, self.i - self.line_start + 1);
+            let word = match b[self.i] {
+                b'{' => self.braced(),
+                b'"' => self.quoted(),
+                _ => self.bare(),
             };
+            let (kind, body) = word.map_err(|what| (wl, wc, what.to_string()))?;
             words.push(Word {
-                text: text[body].to_string(),
+                text: self.text[body].to_string(),
                 kind,
                 line: wl,
                 column: wc,
             });
         }
-        match broken {
-            Some(e) => {
-                out.push(Err(e));
+        Ok(words)
+    }
+
+    /// A word in braces from `i` (at its `{`), nested braces counted: its text inside them.
+    fn braced(&mut self) -> Result<(Kind, Range<usize>), &'static str> {
+        let b = self.b;
+        let start = self.i;
+        let mut depth = 0usize;
+        while self.i < b.len() {
+            self.step(self.i);
+            match b[self.i] {
+                b'\\' => {
+                    if self.i + 1 < b.len() {
+                        self.step(self.i + 1);
+                    }
+                    self.i += 1;
+                }
+                b'{' => depth += 1,
+                b'}' => {
+                    depth -= 1;
+                    if depth == 0 {
+                        let end = self.i;
+                        self.i += 1;
+                        return Ok((Kind::Braced, start + 1..end));
+                    }
+                }
+                _ => {}
+            }
+            self.i += 1;
+        }
+        Err("an open brace '{' never closed")
+    }
+
+    /// A word in quotes from `i` (at its `"`), brackets inside counted: its text inside
+    /// them.
+    fn quoted(&mut self) -> Result<(Kind, Range<usize>), &'static str> {
+        let b = self.b;
+        let start = self.i;
+        self.i += 1;
+        let mut brackets = 0usize;
+        while self.i < b.len() {
+            self.step(self.i);
+            match b[self.i] {
+                b'\\' => {
+                    if self.i + 1 < b.len() {
+                        self.step(self.i + 1);
+                    }
+                    self.i += 1;
+                }
+                b'[' => brackets += 1,
+                b']' => brackets = brackets.saturating_sub(1),
+                b'"' if brackets == 0 => {
+                    let end = self.i;
+                    self.i += 1;
+                    return Ok((Kind::Quoted, start + 1..end));
+                }
+                _ => {}
+            }
+            self.i += 1;
+        }
+        Err("an open quote '\"' never closed")
+    }
+
+    /// A plain word from `i`: up to a blank, a newline or `;` outside brackets (and braces
+    /// inside them), which group across blanks.
+    fn bare(&mut self) -> Result<(Kind, Range<usize>), &'static str> {
+        let b = self.b;
+        let start = self.i;
+        let (mut brackets, mut braces) = (0usize, 0usize);
+        while self.i < b.len() {
+            let c = b[self.i];
+            if brackets == 0 && braces == 0 && matches!(c, b' ' | b'\t' | b'\r' | b'\n' | b';') {
                 break;
             }
-            None if words.is_empty() => {}
-            None => out.push(Ok(words)),
+            self.step(self.i);
+            match c {
+                b'\\' => {
+                    if self.i + 1 < b.len() {
+                        self.step(self.i + 1);
+                    }
+                    self.i += 1;
+                }
+                b'[' if braces == 0 => brackets += 1,
+                b']' if braces == 0 => brackets = brackets.saturating_sub(1),
+                b'{' if brackets > 0 => braces += 1,
+                b'}' if brackets > 0 => braces = braces.saturating_sub(1),
+                _ => {}
+            }
+            self.i += 1;
         }
+        if brackets > 0 {
+            return Err("an open bracket '[' never closed");
+        }
+        Ok((Kind::Bare, start..self.i))
     }
-    out
 }
 
 /// Tcl's special characters: a word holding one is not plain text.

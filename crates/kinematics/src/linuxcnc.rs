@@ -80,6 +80,7 @@ use crate::machine_file::{
     DEG_PER_REV, DEG_S_PER_RPM, MM_PER_M, MM_S_PER_M_MIN, check_pair, positive, range,
 };
 use crate::rotary::{Carrier, Rotaries, RotaryAxis, add};
+use crate::tolerances::LINUXCNC_NO_LIMIT;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -222,81 +223,207 @@ pub fn machine_from_ini_text(
     dir: Option<&Path>,
 ) -> Result<Machine, MachineError> {
     let ini = Ini::parse(text, origin)?;
-    let err = |m: String| invalid(origin, m);
-    let mut warnings = Vec::new();
+    let mut r = IniReading {
+        ini: &ini,
+        origin,
+        dir,
+        warnings: Vec::new(),
+    };
     if let Some(line) = ini.includes.first() {
-        warnings.push(format!(
+        r.warnings.push(format!(
             "{origin}: line {line}: #INCLUDE is expanded by LinuxCNC's start script, not read \
              here: keys in the included file are missing"
         ));
     }
-
-    // [KINS] KINEMATICS = module params...
-    let kins = ini.entry("KINS", "KINEMATICS").ok_or_else(|| {
-        err("no [KINS] KINEMATICS: which kinematics module runs the machine?".into())
-    })?;
-    let mut words = kins.value.split_whitespace();
-    let module_name = words.next().unwrap_or("");
-    let params: HashMap<String, String> = words
-        .filter_map(|w| w.split_once('='))
-        .map(|(k, v)| (k.to_ascii_lowercase(), v.to_string()))
-        .collect();
-    let module = Module::from_name(module_name).ok_or_else(|| {
-        err(format!(
-            "line {}: [KINS] KINEMATICS = {module_name}: polepatch reads the 5-axis modules \
-             xyzac-trt-kins, xyzbc-trt-kins, xyzab_tdr_kins and 5axiskins; describe this machine in a \
-             TOML file (its two rotary axes as [[rotary]], see the README)",
-            kins.line
-        ))
-    })?;
+    let (module, params) = r.kinematics_module()?;
     let identity_first = params
         .get("sparm")
         .is_some_and(|s| s.contains("identityfirst"));
+    let units = r.units()?;
+    let tcy_ms =
+        crate::machine::check_tcy_ms("[EMCMOT] SERVO_PERIOD (as ms)", units.servo_period_s * 1e3)
+            .map_err(|m| r.err(m))?;
+    let axes = r.axes(module, &params, units)?;
+    let hal = r.hal()?;
+    let (con, chain) = r.chain(module, &hal, units.mm)?;
+    let controller = r.tcpm_codes(module.tcp_type(identity_first))?;
+    r.machine(module, con, tcy_ms, axes, chain, controller)
+}
 
-    // Units.
-    let lin = ini.get("TRAJ", "LINEAR_UNITS").unwrap_or("mm");
-    let mm = linear_mm(lin)
-        .ok_or_else(|| err(format!("[TRAJ] LINEAR_UNITS = {lin}: not mm or inch")))?;
-    let ang = ini.get("TRAJ", "ANGULAR_UNITS").unwrap_or("deg");
-    let deg = angular_deg(ang).ok_or_else(|| {
-        err(format!(
-            "[TRAJ] ANGULAR_UNITS = {ang}: not deg, rad or grad"
-        ))
-    })?;
+/// A LinuxCNC INI being read into a [`Machine`] (module docs): the file, where it is, and
+/// the warnings so far.
+struct IniReading<'a> {
+    ini: &'a Ini,
+    /// Names the INI in messages.
+    origin: &'a str,
+    /// The folder relative paths start from (`None`: no file is read).
+    dir: Option<&'a Path>,
+    warnings: Vec<String>,
+}
 
-    // Servo period.
-    let servo_s = match ini.get("EMCMOT", "SERVO_PERIOD") {
-        Some(v) => {
-            let ns = number(v)
-                .ok_or_else(|| err(format!("[EMCMOT] SERVO_PERIOD = {v}: not a number")))?;
-            ns * 1e-9
-        }
-        None => DEFAULT_SERVO_PERIOD_S,
-    };
-    let tcy_ms = crate::machine::check_tcy_ms("[EMCMOT] SERVO_PERIOD (as ms)", servo_s * 1e3)
-        .map_err(err)?;
+/// The INI's units: mm per linear unit, degrees per angular unit, and the servo period
+/// (seconds), in which an axis without a jerk reaches its acceleration.
+#[derive(Debug, Clone, Copy)]
+struct Units {
+    mm: f64,
+    deg: f64,
+    servo_period_s: f64,
+}
 
-    // Joints per letter.
-    let coordinates: String = params
-        .get("coordinates")
-        .map(String::as_str)
-        .or(ini.get("TRAJ", "COORDINATES"))
-        .unwrap_or(module.default_coordinates())
-        .chars()
-        .filter(|c| !c.is_whitespace())
-        .map(|c| c.to_ascii_uppercase())
-        .collect();
-    let joints_of = |letter: char| -> Vec<usize> {
-        coordinates
+/// The axes read from the INI: the limits of X Y Z, the tilting axis and the pole axis (in
+/// internal units), and the travels of the two rotary axes (degrees).
+struct Axes {
+    limits: [AxisLimits; 5],
+    primary_range_deg: (f64, f64),
+    c_range_deg: Option<(f64, f64)>,
+}
+
+impl IniReading<'_> {
+    fn err(&self, message: String) -> MachineError {
+        invalid(self.origin, message)
+    }
+
+    /// `[KINS] KINEMATICS = module params…`: the module and its parameters (keys lower
+    /// case).
+    fn kinematics_module(&self) -> Result<(Module, HashMap<String, String>), MachineError> {
+        let kins = self.ini.entry("KINS", "KINEMATICS").ok_or_else(|| {
+            self.err("no [KINS] KINEMATICS: which kinematics module runs the machine?".into())
+        })?;
+        let mut words = kins.value.split_whitespace();
+        let module_name = words.next().unwrap_or("");
+        let params: HashMap<String, String> = words
+            .filter_map(|w| w.split_once('='))
+            .map(|(k, v)| (k.to_ascii_lowercase(), v.to_string()))
+            .collect();
+        let module = Module::from_name(module_name).ok_or_else(|| {
+            self.err(format!(
+                "line {}: [KINS] KINEMATICS = {module_name}: polepatch reads the 5-axis modules \
+                 xyzac-trt-kins, xyzbc-trt-kins, xyzab_tdr_kins and 5axiskins; describe this machine in a \
+                 TOML file (its two rotary axes as [[rotary]], see the README)",
+                kins.line
+            ))
+        })?;
+        Ok((module, params))
+    }
+
+    /// `[TRAJ] LINEAR_UNITS`, `ANGULAR_UNITS` and `[EMCMOT] SERVO_PERIOD`.
+    fn units(&self) -> Result<Units, MachineError> {
+        let ini = self.ini;
+        let lin = ini.get("TRAJ", "LINEAR_UNITS").unwrap_or("mm");
+        let mm = linear_mm(lin)
+            .ok_or_else(|| self.err(format!("[TRAJ] LINEAR_UNITS = {lin}: not mm or inch")))?;
+        let ang = ini.get("TRAJ", "ANGULAR_UNITS").unwrap_or("deg");
+        let deg = angular_deg(ang).ok_or_else(|| {
+            self.err(format!(
+                "[TRAJ] ANGULAR_UNITS = {ang}: not deg, rad or grad"
+            ))
+        })?;
+        let servo_period_s = match ini.get("EMCMOT", "SERVO_PERIOD") {
+            Some(v) => {
+                let ns = number(v).ok_or_else(|| {
+                    self.err(format!("[EMCMOT] SERVO_PERIOD = {v}: not a number"))
+                })?;
+                ns * 1e-9
+            }
+            None => DEFAULT_SERVO_PERIOD_S,
+        };
+        Ok(Units {
+            mm,
+            deg,
+            servo_period_s,
+        })
+    }
+
+    /// The letters of the joints, in their order: the module's `coordinates=`, else
+    /// `[TRAJ] COORDINATES`, else the module's default.
+    fn coordinates(&self, module: Module, params: &HashMap<String, String>) -> String {
+        params
+            .get("coordinates")
+            .map(String::as_str)
+            .or(self.ini.get("TRAJ", "COORDINATES"))
+            .unwrap_or(module.default_coordinates())
             .chars()
-            .enumerate()
-            .filter(|&(_, c)| c == letter)
-            .map(|(n, _)| n)
+            .filter(|c| !c.is_whitespace())
+            .map(|c| c.to_ascii_uppercase())
             .collect()
-    };
-    let read_axis = |letter: char| -> Result<AxisIni, MachineError> {
+    }
+
+    /// The limits and travels of the module's axes (module docs), converted to internal
+    /// units (mm/s…, °/s…) and checked in the TOML's units; axes without a jerk are warned
+    /// about.
+    fn axes(
+        &mut self,
+        module: Module,
+        params: &HashMap<String, String>,
+        units: Units,
+    ) -> Result<Axes, MachineError> {
+        let coordinates = self.coordinates(module, params);
+        let mut no_jerk = Vec::new();
+        let mut limits_of = |letter: char, rotary: bool| {
+            self.limits_of(&coordinates, letter, rotary, units, &mut no_jerk)
+        };
+        let (lx, _) = limits_of('X', false)?;
+        let (ly, _) = limits_of('Y', false)?;
+        let (lz, _) = limits_of('Z', false)?;
+        let ((pole_letter, _), (tilt_letter, _)) = module.axes();
+        let (lp, tilt_ini) = limits_of(tilt_letter, true)?;
+        let (lc, pole_ini) = limits_of(pole_letter, true)?;
+        if !no_jerk.is_empty() {
+            self.warnings.push(format!(
+                "{}: no MAX_JERK for {}: jerk taken as MAX_ACCELERATION / SERVO_PERIOD ({} \
+                 ms), the acceleration reached in one servo cycle as LinuxCNC's trapezoidal \
+                 planner does",
+                self.origin,
+                no_jerk
+                    .iter()
+                    .map(char::to_string)
+                    .collect::<Vec<_>>()
+                    .join(" "),
+                num(units.servo_period_s * 1e3)
+            ));
+        }
+        let deg = units.deg;
+        let to_deg = |(lo, hi): (f64, f64)| (lo * deg, hi * deg);
+        let primary_range_deg = match tilt_ini.range.map(to_deg) {
+            Some((lo, hi)) => range(
+                &format!("[AXIS_{tilt_letter}] MIN_LIMIT/MAX_LIMIT"),
+                &[lo, hi],
+            )
+            .map_err(|m| self.err(m))?,
+            None => {
+                return Err(self.err(format!(
+                    "axis {tilt_letter} tilts the tool and needs a travel: MIN_LIMIT and MAX_LIMIT in \
+                     [AXIS_{tilt_letter}]"
+                )));
+            }
+        };
+        let c_range_deg = match (pole_ini.wrapped, pole_ini.range.map(to_deg)) {
+            (false, Some((lo, hi))) if lo > -LINUXCNC_NO_LIMIT && hi < LINUXCNC_NO_LIMIT => Some(
+                range(
+                    &format!("[AXIS_{pole_letter}] MIN_LIMIT/MAX_LIMIT"),
+                    &[lo, hi],
+                )
+                .map_err(|m| self.err(m))?,
+            ),
+            _ => None,
+        };
+        Ok(Axes {
+            limits: [lx, ly, lz, lp, lc],
+            primary_range_deg,
+            c_range_deg,
+        })
+    }
+
+    /// The values of axis `letter` over `[AXIS_L]` and its joints (`coordinates`), in the
+    /// INI's units.
+    fn read_axis(&self, coordinates: &str, letter: char) -> Result<AxisIni, MachineError> {
+        let ini = self.ini;
         let mut sections = vec![format!("AXIS_{letter}")];
-        sections.extend(joints_of(letter).into_iter().map(|n| format!("JOINT_{n}")));
+        sections.extend(
+            joints_of(coordinates, letter)
+                .into_iter()
+                .map(|n| format!("JOINT_{n}")),
+        );
         // The values of `key` over the axis and its joints, combined by `pick` (the smaller
         // limit, the larger MIN_LIMIT).
         let combined =
@@ -305,7 +432,7 @@ pub fn machine_from_ini_text(
                 for s in &sections {
                     if let Some(e) = ini.entry(s, key) {
                         let v = number(&e.value).ok_or_else(|| {
-                            err(format!(
+                            self.err(format!(
                                 "line {}: [{s}] {key} = {}: not a number",
                                 e.line, e.value
                             ))
@@ -329,160 +456,142 @@ pub fn machine_from_ini_text(
                 .get(&format!("AXIS_{letter}"), "WRAPPED_ROTARY")
                 .is_some_and(|v| v.trim() == "1"),
         })
-    };
-
-    // Limits, converted to internal units (mm/s…, °/s…) and checked in the TOML's units.
-    let mut no_jerk = Vec::new();
-    let mut limits_of =
-        |letter: char, rotary: bool| -> Result<(AxisLimits, AxisIni), MachineError> {
-            let ax = read_axis(letter)?;
-            let where_ = if joints_of(letter).is_empty() {
-                format!("[AXIS_{letter}]")
-            } else {
-                format!(
-                    "[AXIS_{letter}] or [JOINT_{}]",
-                    joints_of(letter)
-                        .iter()
-                        .map(usize::to_string)
-                        .collect::<Vec<_>>()
-                        .join("]/[JOINT_")
-                )
-            };
-            let need = |v: Option<f64>, key: &str| {
-                v.ok_or_else(|| err(format!("no {key} for axis {letter} in {where_}")))
-            };
-            let unit = if rotary { deg } else { mm };
-            let v = need(ax.v, "MAX_VELOCITY")? * unit;
-            let a = need(ax.a, "MAX_ACCELERATION")? * unit;
-            let j = match ax.j {
-                Some(j) => j * unit,
-                None => {
-                    no_jerk.push(letter);
-                    default_jerk(a, servo_s)
-                }
-            };
-            let field = |key: &str| format!("{where_} {key}");
-            // The TOML file's units: m/min, m/s², m/s³ or rpm, rev/s², rev/s³.
-            let (kv, ka) = if rotary {
-                (DEG_S_PER_RPM, DEG_PER_REV)
-            } else {
-                (MM_S_PER_M_MIN, MM_PER_M)
-            };
-            positive(&field("MAX_VELOCITY (converted)"), v / kv).map_err(err)?;
-            positive(&field("MAX_ACCELERATION (converted)"), a / ka).map_err(err)?;
-            positive(&field("jerk (converted)"), j / ka).map_err(err)?;
-            Ok((AxisLimits { v, a, j }, ax))
-        };
-    let (lx, _) = limits_of('X', false)?;
-    let (ly, _) = limits_of('Y', false)?;
-    let (lz, _) = limits_of('Z', false)?;
-    let ((pole_letter, pole_dir), (tilt_letter, tilt_dir)) = module.axes();
-    let (lp, tilt_ini) = limits_of(tilt_letter, true)?;
-    let (lc, pole_ini) = limits_of(pole_letter, true)?;
-    if !no_jerk.is_empty() {
-        warnings.push(format!(
-            "{origin}: no MAX_JERK for {}: jerk taken as MAX_ACCELERATION / SERVO_PERIOD ({} \
-             ms), the acceleration reached in one servo cycle as LinuxCNC's trapezoidal \
-             planner does",
-            no_jerk
-                .iter()
-                .map(char::to_string)
-                .collect::<Vec<_>>()
-                .join(" "),
-            num(servo_s * 1e3)
-        ));
     }
-    let to_deg = |(lo, hi): (f64, f64)| (lo * deg, hi * deg);
-    let primary_range_deg = match tilt_ini.range.map(to_deg) {
-        Some((lo, hi)) => range(
-            &format!("[AXIS_{tilt_letter}] MIN_LIMIT/MAX_LIMIT"),
-            &[lo, hi],
-        )
-        .map_err(err)?,
-        None => {
-            return Err(err(format!(
-                "axis {tilt_letter} tilts the tool and needs a travel: MIN_LIMIT and MAX_LIMIT in \
-                 [AXIS_{tilt_letter}]"
-            )));
-        }
-    };
-    let c_range_deg = match (pole_ini.wrapped, pole_ini.range.map(to_deg)) {
-        (false, Some((lo, hi))) if lo > -1e98 && hi < 1e98 => Some(
-            range(
-                &format!("[AXIS_{pole_letter}] MIN_LIMIT/MAX_LIMIT"),
-                &[lo, hi],
+
+    /// The limits of axis `letter` (converted to internal units and checked in the TOML's
+    /// units) and what the INI gives for it; a letter without a jerk is added to `no_jerk`.
+    fn limits_of(
+        &self,
+        coordinates: &str,
+        letter: char,
+        rotary: bool,
+        units: Units,
+        no_jerk: &mut Vec<char>,
+    ) -> Result<(AxisLimits, AxisIni), MachineError> {
+        let ax = self.read_axis(coordinates, letter)?;
+        let joints = joints_of(coordinates, letter);
+        let where_ = if joints.is_empty() {
+            format!("[AXIS_{letter}]")
+        } else {
+            format!(
+                "[AXIS_{letter}] or [JOINT_{}]",
+                joints
+                    .iter()
+                    .map(usize::to_string)
+                    .collect::<Vec<_>>()
+                    .join("]/[JOINT_")
             )
-            .map_err(err)?,
-        ),
-        _ => None,
-    };
-
-    // HAL: the pivot parameters and conventional-directions.
-    let read_dir = |rel: &str| -> Option<PathBuf> { dir.map(|d| d.join(rel)) };
-    let mut hal = Hal::default();
-    for key in ["HALFILE", "HALCMD", "POSTGUI_HALFILE"] {
-        for e in ini.entries_of("HAL", key) {
-            if key == "HALCMD" {
-                hal.halcmd_line(&e.value, &ini);
-            } else {
-                hal_file(&ini, origin, dir, e, &mut hal)?;
+        };
+        let need = |v: Option<f64>, key: &str| {
+            v.ok_or_else(|| self.err(format!("no {key} for axis {letter} in {where_}")))
+        };
+        let unit = if rotary { units.deg } else { units.mm };
+        let v = need(ax.v, "MAX_VELOCITY")? * unit;
+        let a = need(ax.a, "MAX_ACCELERATION")? * unit;
+        let j = match ax.j {
+            Some(j) => j * unit,
+            None => {
+                no_jerk.push(letter);
+                default_jerk(a, units.servo_period_s)
             }
-        }
+        };
+        let field = |key: &str| format!("{where_} {key}");
+        // The TOML file's units: m/min, m/s², m/s³ or rpm, rev/s², rev/s³.
+        let (kv, ka) = if rotary {
+            (DEG_S_PER_RPM, DEG_PER_REV)
+        } else {
+            (MM_S_PER_M_MIN, MM_PER_M)
+        };
+        let err = |m| self.err(m);
+        positive(&field("MAX_VELOCITY (converted)"), v / kv).map_err(err)?;
+        positive(&field("MAX_ACCELERATION (converted)"), a / ka).map_err(err)?;
+        positive(&field("jerk (converted)"), j / ka).map_err(err)?;
+        Ok((AxisLimits { v, a, j }, ax))
     }
 
-    let prefix = module.hal_prefix();
-    let pin = |name: &str| hal.value(&format!("{prefix}.{name}"));
-    let con = match module {
-        Module::XyzabTdr | Module::FiveAxis => 1.0,
-        _ => match pin("conventional-directions") {
-            Ok(Some(v)) if v != 0.0 => 1.0,
-            Ok(_) => -1.0,
-            Err(why) => {
-                return Err(err(format!(
-                    "{why}: the senses of the rotary axes depend on it (set it with setp)"
-                )));
+    /// The HAL the INI runs: `[HAL] HALFILE`, `HALCMD` and `POSTGUI_HALFILE`, in that order.
+    fn hal(&self) -> Result<Hal, MachineError> {
+        let mut hal = Hal::default();
+        for key in ["HALFILE", "HALCMD", "POSTGUI_HALFILE"] {
+            for e in self.ini.entries_of("HAL", key) {
+                if key == "HALCMD" {
+                    hal.halcmd_line(&e.value, self.ini);
+                } else {
+                    hal_file(self.ini, self.origin, self.dir, e, &mut hal)?;
+                }
             }
-        },
-    };
-    let mut pivot = HashMap::new();
-    let mut unknown = Vec::new();
-    for &(name, default) in module.parameter_pins() {
-        match pin(name) {
-            Ok(v) => {
-                pivot.insert(name, v.unwrap_or(default) * mm);
-            }
-            Err(why) => unknown.push(why),
         }
+        Ok(hal)
     }
-    let chain = if !unknown.is_empty() {
-        warnings.push(format!(
-            "{origin}: no kinematic chain (programs without TCP are then not patched): {}",
-            unknown.join("; ")
-        ));
-        None
-    } else if module == Module::FiveAxis {
-        // Both head axes through the pivot, `pivot-length` above the tip of a tool of
-        // length 0 at B = 0 (the tool-offset part of the pin taken as 0, as for the trt
-        // modules' tool-offset pin).
-        let pivot = [0.0, 0.0, pivot["pivot-length"]];
-        Some(Chain {
-            c_axis_point_mm: pivot,
-            primary_axis_point_mm: pivot,
-        })
-    } else {
+
+    /// From the module's HAL pins: the sense `con` of its rotary axes
+    /// (`conventional-directions`) and the chain its pivot parameters give (`mm`: mm per
+    /// linear unit), or none, with a warning, where a pin cannot be known or the module's
+    /// offsets are not a pair of fixed axes.
+    fn chain(
+        &mut self,
+        module: Module,
+        hal: &Hal,
+        mm: f64,
+    ) -> Result<(f64, Option<Chain>), MachineError> {
+        let origin = self.origin;
+        let prefix = module.hal_prefix();
+        let pin = |name: &str| hal.value(&format!("{prefix}.{name}"));
+        let con = match module {
+            Module::XyzabTdr | Module::FiveAxis => 1.0,
+            _ => match pin("conventional-directions") {
+                Ok(Some(v)) if v != 0.0 => 1.0,
+                Ok(_) => -1.0,
+                Err(why) => {
+                    return Err(self.err(format!(
+                        "{why}: the senses of the rotary axes depend on it (set it with setp)"
+                    )));
+                }
+            },
+        };
+        let mut pivot = HashMap::new();
+        let mut unknown = Vec::new();
+        for &(name, default) in module.parameter_pins() {
+            match pin(name) {
+                Ok(v) => {
+                    pivot.insert(name, v.unwrap_or(default) * mm);
+                }
+                Err(why) => unknown.push(why),
+            }
+        }
+        if !unknown.is_empty() {
+            self.warnings.push(format!(
+                "{origin}: no kinematic chain (programs without TCP are then not patched): {}",
+                unknown.join("; ")
+            ));
+            return Ok((con, None));
+        }
+        if module == Module::FiveAxis {
+            // Both head axes through the pivot, `pivot-length` above the tip of a tool of
+            // length 0 at B = 0 (the tool-offset part of the pin taken as 0, as for the trt
+            // modules' tool-offset pin).
+            let pivot = [0.0, 0.0, pivot["pivot-length"]];
+            return Ok((
+                con,
+                Some(Chain {
+                    c_axis_point_mm: pivot,
+                    primary_axis_point_mm: pivot,
+                }),
+            ));
+        }
         let r = [
             pivot["x-rot-point"],
             pivot["y-rot-point"],
             pivot["z-rot-point"],
         ];
         let (dx, dy, dz) = (pivot["x-offset"], pivot["y-offset"], pivot["z-offset"]);
-        match module {
+        let chain = match module {
             Module::XyzacTrt => Some(Chain {
                 c_axis_point_mm: r,
                 primary_axis_point_mm: add(r, [0.0, dy, dz]),
             }),
             Module::XyzbcTrt if con < 0.0 && (dx != 0.0 || dz != 0.0) => {
-                warnings.push(format!(
+                self.warnings.push(format!(
                     "{origin}: no kinematic chain: xyzbc-trt-kins with x-offset/z-offset and \
                      conventional-directions 0 turns its offsets with −B while it turns the table \
                      with +B (trtfuncs.c, dpx/dpz), which no pair of fixed axes does"
@@ -498,108 +607,140 @@ pub fn machine_from_ini_text(
                 primary_axis_point_mm: r,
             }),
             Module::FiveAxis => unreachable!("read above"),
-        }
-    };
-
-    // The TCPM codes.
-    let tcp_type = module.tcp_type(identity_first);
-    let mut controller = Controller::default();
-    let sub_dirs: Vec<PathBuf> = ini
-        .get("RS274NGC", "SUBROUTINE_PATH")
-        .map(|p| p.split(':').filter_map(|d| read_dir(d.trim())).collect())
-        .unwrap_or_default();
-    for remap in ini.all("RS274NGC", "REMAP") {
-        let mut words = remap.split_whitespace();
-        let code = words.next().unwrap_or("").to_ascii_uppercase();
-        let Some(ngc) = words.find_map(|w| w.strip_prefix("ngc=")) else {
-            continue;
         };
-        match kinstype_of(ngc, &sub_dirs) {
-            Ok(Some(k)) if k == tcp_type => controller.tcpm_on.push(code),
-            Ok(Some(_)) => controller.tcpm_off.push(code),
-            Ok(None) => {}
-            Err(why) => {
-                warnings.push(format!(
-                    "{origin}: REMAP {code}: {why}; taken as ending TCP (a run after it is not \
-                     patched as TCP)"
-                ));
-                controller.tcpm_off.push(code);
+        Ok((con, chain))
+    }
+
+    /// The TCPM codes: each `[RS274NGC] REMAP` whose subroutine sets `#<kinstype>`
+    /// (`tcp_type`: the module's TCP type), and whether the kinematics are always TCP.
+    fn tcpm_codes(&mut self, tcp_type: i64) -> Result<Controller, MachineError> {
+        let origin = self.origin;
+        let dir = self.dir;
+        let read_dir = |rel: &str| -> Option<PathBuf> { dir.map(|d| d.join(rel)) };
+        let mut controller = Controller::default();
+        let sub_dirs: Vec<PathBuf> = self
+            .ini
+            .get("RS274NGC", "SUBROUTINE_PATH")
+            .map(|p| p.split(':').filter_map(|d| read_dir(d.trim())).collect())
+            .unwrap_or_default();
+        for remap in self.ini.all("RS274NGC", "REMAP") {
+            let mut words = remap.split_whitespace();
+            let code = words.next().unwrap_or("").to_ascii_uppercase();
+            let Some(ngc) = words.find_map(|w| w.strip_prefix("ngc=")) else {
+                continue;
+            };
+            match kinstype_of(ngc, &sub_dirs) {
+                Ok(Some(k)) if k == tcp_type => controller.tcpm_on.push(code),
+                Ok(Some(_)) => controller.tcpm_off.push(code),
+                Ok(None) => {}
+                Err(why) => {
+                    self.warnings.push(format!(
+                        "{origin}: REMAP {code}: {why}; taken as ending TCP (a run after it is not \
+                         patched as TCP)"
+                    ));
+                    controller.tcpm_off.push(code);
+                }
             }
         }
+        let switched = !controller.tcpm_on.is_empty() || !controller.tcpm_off.is_empty();
+        let starts_tcp = tcp_type == 0;
+        if starts_tcp && !switched {
+            controller.tcpm_always = true;
+        } else if starts_tcp {
+            self.warnings.push(format!(
+                "{origin}: the kinematics start as TCP (switchkins type 0) and {} switch them: \
+                 polepatch takes TCP as off until a program's first switching code",
+                [controller.tcpm_on.clone(), controller.tcpm_off.clone()]
+                    .concat()
+                    .join(", ")
+            ));
+        } else if controller.tcpm_on.is_empty() {
+            self.warnings.push(format!(
+                "{origin}: the kinematics start as identity and no REMAP switches them to TCP \
+                 (type {tcp_type}): every run is read as without TCP"
+            ));
+        }
+        crate::machine_file::checked_controller(controller).map_err(|m| self.err(m))
     }
-    let switched = !controller.tcpm_on.is_empty() || !controller.tcpm_off.is_empty();
-    let starts_tcp = tcp_type == 0;
-    if starts_tcp && !switched {
-        controller.tcpm_always = true;
-    } else if starts_tcp {
-        warnings.push(format!(
-            "{origin}: the kinematics start as TCP (switchkins type 0) and {} switch them: \
-             polepatch takes TCP as off until a program's first switching code",
-            [controller.tcpm_on.clone(), controller.tcpm_off.clone()]
-                .concat()
-                .join(", ")
-        ));
-    } else if controller.tcpm_on.is_empty() {
-        warnings.push(format!(
-            "{origin}: the kinematics start as identity and no REMAP switches them to TCP \
-             (type {tcp_type}): every run is read as without TCP"
-        ));
-    }
-    let controller = crate::machine_file::checked_controller(controller).map_err(err)?;
 
-    let rotary = Rotaries {
-        primary: RotaryAxis {
-            letter: tilt_letter,
-            carrier: module.carrier(),
-            direction: tilt_dir,
-        },
-        c: RotaryAxis {
-            letter: pole_letter,
-            carrier: module.carrier(),
-            direction: pole_dir,
-        },
-        tool_direction: [0.0, 0.0, 1.0],
-    };
-    // The senses (module docs): the trt modules' `con` on both axes; 5axiskins' B turns
-    // the tool against the conventional direction (its note 10), its C with it.
-    let (primary_sense, c_sense) = match module {
-        Module::FiveAxis => (-1.0, 1.0),
-        _ => (con, con),
-    };
-    if module == Module::FiveAxis {
-        warnings.push(format!(
-            "{origin}: 5axiskins moves the tool along its axis by W (5axiskins.c: the tool's \
-             tip is at X Y Z + W·o, o the tool axis from the tip towards the spindle; W < 0 \
-             drills): polepatch carries W words through, and where a block at W ≠ 0 has its B \
-             or C changed the tip moves by |W| times the change of orientation (radians)"
-        ));
+    /// The machine: the module's rotary axes and senses (`con`), checked as a pair, and its
+    /// name (`[EMC] MACHINE`, else the file's).
+    fn machine(
+        mut self,
+        module: Module,
+        con: f64,
+        tcy_ms: f64,
+        axes: Axes,
+        chain: Option<Chain>,
+        controller: Controller,
+    ) -> Result<Machine, MachineError> {
+        let origin = self.origin;
+        let ((pole_letter, pole_dir), (tilt_letter, tilt_dir)) = module.axes();
+        let rotary = Rotaries {
+            primary: RotaryAxis {
+                letter: tilt_letter,
+                carrier: module.carrier(),
+                direction: tilt_dir,
+            },
+            c: RotaryAxis {
+                letter: pole_letter,
+                carrier: module.carrier(),
+                direction: pole_dir,
+            },
+            tool_direction: [0.0, 0.0, 1.0],
+        };
+        // The senses (module docs): the trt modules' `con` on both axes; 5axiskins' B turns
+        // the tool against the conventional direction (its note 10), its C with it.
+        let (primary_sense, c_sense) = match module {
+            Module::FiveAxis => (-1.0, 1.0),
+            _ => (con, con),
+        };
+        if module == Module::FiveAxis {
+            self.warnings.push(format!(
+                "{origin}: 5axiskins moves the tool along its axis by W (5axiskins.c: the tool's \
+                 tip is at X Y Z + W·o, o the tool axis from the tip towards the spindle; W < 0 \
+                 drills): polepatch carries W words through, and where a block at W ≠ 0 has its B \
+                 or C changed the tip moves by |W| times the change of orientation (radians)"
+            ));
+        }
+        check_pair(
+            &rotary,
+            [&pole_letter.to_string(), &tilt_letter.to_string()],
+        )
+        .map_err(|m| self.err(m))?;
+        let name = self
+            .ini
+            .get("EMC", "MACHINE")
+            .map(str::to_string)
+            .unwrap_or_else(|| {
+                Path::new(origin)
+                    .file_stem()
+                    .map_or(origin.to_string(), |s| s.to_string_lossy().into_owned())
+            });
+        Ok(Machine {
+            name,
+            rotary,
+            primary_sense,
+            c_sense,
+            primary_range_deg: axes.primary_range_deg,
+            c_range_deg: axes.c_range_deg,
+            tcy_s: tcy_ms / 1000.0,
+            limits: axes.limits,
+            chain,
+            controller,
+            warnings: self.warnings,
+        })
     }
-    check_pair(
-        &rotary,
-        [&pole_letter.to_string(), &tilt_letter.to_string()],
-    )
-    .map_err(err)?;
-    let name = ini
-        .get("EMC", "MACHINE")
-        .map(str::to_string)
-        .unwrap_or_else(|| {
-            Path::new(origin)
-                .file_stem()
-                .map_or(origin.to_string(), |s| s.to_string_lossy().into_owned())
-        });
-    Ok(Machine {
-        name,
-        rotary,
-        primary_sense,
-        c_sense,
-        primary_range_deg,
-        c_range_deg,
-        tcy_s: tcy_ms / 1000.0,
-        limits: [lx, ly, lz, lp, lc],
-        chain,
-        controller,
-        warnings,
-    })
+}
+
+/// The joints of axis `letter`: its places in `coordinates`.
+fn joints_of(coordinates: &str, letter: char) -> Vec<usize> {
+    coordinates
+        .chars()
+        .enumerate()
+        .filter(|&(_, c)| c == letter)
+        .map(|(n, _)| n)
+        .collect()
 }
 
 /// The files of LinuxCNC's own HAL library (`lib/hallib`), which `linuxcnc` finds there

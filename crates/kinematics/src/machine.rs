@@ -1,8 +1,9 @@
 //! Machine model: the two rotary axes as a chain, senses, ranges, kinematic limits,
-//! interpolation cycle time, and the bounds a machine's values must keep (loading a
-//! machine — built-in, TOML file, LinuxCNC INI — is in `load.rs`).
+//! interpolation cycle time, and the bounds a machine's values must keep (named in
+//! [`crate::tolerances`]; loading a machine — built-in, TOML file, LinuxCNC INI — is in `load.rs`).
 
 use crate::rotary::{Layout, Rotaries};
+pub use crate::tolerances::{LIMIT_MAX, LIMIT_MIN, MAX_MACHINE_FILE_BYTES, TCY_MS_RANGE};
 use serde::{Deserialize, Serialize};
 
 /// The five axes of a 5-axis machine, in the fixed order used by every per-axis array in
@@ -212,22 +213,6 @@ impl Machine {
         }
     }
 }
-
-/// Largest machine file read, bytes (1 MiB; a machine description is under 2 KB). A longer
-/// file, or a device that never ends (`/dev/zero`), is refused rather than read whole.
-pub const MAX_MACHINE_FILE_BYTES: u64 = 1 << 20;
-
-/// Smallest kinematic limit accepted, in the file's units (m/min, m/s², m/s³, rpm, rev/s²,
-/// rev/s³). The slowest axis of a real machine is orders of magnitude above it; a value
-/// below is a unit mistake, and would make every time estimate astronomically long.
-pub const LIMIT_MIN: f64 = 1e-3;
-/// Largest kinematic limit accepted, in the file's units (the fastest real axes are below
-/// 10⁴ in every one of them).
-pub const LIMIT_MAX: f64 = 1e6;
-/// Range of the interpolation cycle time `tcy_ms` accepted, milliseconds: controllers
-/// interpolate every 0.1 ms (the fastest) to a few ms; 100 ms is a generous bound, and the
-/// analysis samples every F·Tcy, so a Tcy far below 0.1 ms only multiplies the work.
-pub const TCY_MS_RANGE: (f64, f64) = (0.1, 100.0);
 
 /// The whole file at `path`, as text, reading at most [`MAX_MACHINE_FILE_BYTES`] + 1
 /// bytes: more is an error, as is text that is not UTF-8.

@@ -17,7 +17,7 @@ use crate::machine::{
     check_tcy_ms, num,
 };
 use crate::rotary::{Carrier, Rotaries, RotaryAxis, angle_rad, norm, scale};
-use crate::tolerances::{MIN_AXIS_SIN, MIN_DIRECTION_NORM};
+use crate::tolerances::{MIN_AXIS_SIN, MIN_DIRECTION_NORM, UNIT_NORM_TOL};
 use serde::Deserialize;
 
 /// mm/s per m/min.
@@ -203,7 +203,7 @@ fn direction(field: &str, d: &[f64]) -> Result<[f64; 3], String> {
     // [0, 0, 1] and [0, 0, 2] both give exactly [0, 0, 1].
     let u = scale(1.0 / n, v);
     // Held by the bound above; kept so that no NaN direction can ever leave here.
-    if (norm(u) - 1.0).abs().is_nan() || (norm(u) - 1.0).abs() >= 1e-12 {
+    if (norm(u) - 1.0).abs().is_nan() || (norm(u) - 1.0).abs() >= UNIT_NORM_TOL {
         return Err(format!("{field} = {v:?} cannot be normalised"));
     }
     Ok(u)

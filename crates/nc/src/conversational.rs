@@ -78,6 +78,38 @@ struct Words<'a> {
     line_start: usize,
 }
 
+/// A word that is a plain number, `letter` at `start` and its value at `value`.
+fn plain_word(letter: u8, start: usize, value: &Range<usize>, v: f64) -> Word {
+    Word {
+        letter,
+        start: start as u32,
+        value_start: value.start as u32,
+        end: value.end as u32,
+        value: v,
+        form: RotaryForm::Plain,
+        tail: 0,
+    }
+}
+
+/// What a letter written without a number right after it (`Z 25.000`, `F MAX`, `F`) stands
+/// for.
+enum Lone {
+    /// The number in the next token is its value.
+    Value(Range<usize>),
+    /// `F MAX`: the next token is read too.
+    Rapid,
+    /// An empty `F` field: no word.
+    Empty,
+}
+
+/// Where the words of a line go as they are read.
+struct Sink<'s> {
+    s: &'s mut Scan,
+    words: &'s mut Vec<Word>,
+    /// X Y Z A B C and F named so far in the block.
+    seen: [bool; 7],
+}
+
 impl Words<'_> {
     fn err(&self, at: usize, message: String) -> ParseError {
         ParseError::at(self.line, at - self.line_start + 1, message)
@@ -92,7 +124,11 @@ impl Words<'_> {
         words: &mut Vec<Word>,
     ) -> Result<(), ParseError> {
         let b = self.bytes;
-        let mut seen = [false; 7];
+        let mut out = Sink {
+            s,
+            words,
+            seen: [false; 7],
+        };
         let mut k = 0;
         while k < toks.len() {
             let t = &toks[k];
@@ -107,32 +143,19 @@ impl Words<'_> {
             let lone = value.is_empty()
                 && matches!(name.as_slice(), [l] | [b'I', l] if axis_index(*l).is_some() || *l == b'F');
             if lone {
-                match toks.get(k) {
-                    Some(next) if parse_number(&b[next.clone()]).is_some() => {
-                        value = next.clone();
+                match self.lone_letter(&name, t, toks.get(k))? {
+                    Lone::Value(next) => {
+                        value = next;
                         k += 1;
                     }
-                    // `F MAX` (older TNC listings, NX's posts for them): `FMAX`.
-                    Some(next) if name == b"F" && b[next.clone()].eq_ignore_ascii_case(b"MAX") => {
-                        s.rapid_once = true;
+                    Lone::Rapid => {
+                        out.s.rapid_once = true;
                         k += 1;
                         continue;
                     }
-                    // An empty `F` field (`L R F M30`, older TNC listings): no feed given.
-                    _ if name == b"F" => continue,
-                    _ => {
-                        return Err(self.err(
-                            t.start,
-                            format!(
-                                "{} word has no number (a blank after the letter is read only when \
-                                 a number follows it)",
-                                String::from_utf8_lossy(&name)
-                            ),
-                        ));
-                    }
+                    Lone::Empty => continue,
                 }
             }
-            let value_text = &b[value.clone()];
             // An axis word, possibly incremental (`IX+5`).
             let (incremental, axis) = match name.as_slice() {
                 [l] => (false, axis_index(*l)),
@@ -140,141 +163,175 @@ impl Words<'_> {
                 _ => (false, None),
             };
             if let Some(i) = axis {
-                let letter = AXES[i];
                 let at = t.start + usize::from(incremental);
-                if std::mem::replace(&mut seen[i], true) {
-                    return Err(self.err(
-                        at,
-                        format!(
-                            "{} appears twice in this block; the control rejects such a block",
-                            letter as char
-                        ),
-                    ));
-                }
-                if value_text.is_empty() {
-                    return Err(self.err(at, format!("{} word has no number", letter as char)));
-                }
-                match parse_number(value_text) {
-                    Some(v) if v.is_finite() => {
-                        s.axes[i] = Some(v);
-                        if incremental {
-                            s.axes_incremental |= 1 << i;
-                        }
-                        words.push(Word {
-                            letter,
-                            start: at as u32,
-                            value_start: value.start as u32,
-                            end: value.end as u32,
-                            value: v,
-                            form: RotaryForm::Plain,
-                            tail: 0,
-                        });
-                    }
-                    _ if value_text.iter().any(|c| c.eq_ignore_ascii_case(&b'Q')) => {
-                        s.axes_expr |= 1 << i;
-                    }
-                    _ => {
-                        return Err(self.err(
-                            at,
-                            format!(
-                                "{} value '{}' is not a number",
-                                letter as char,
-                                String::from_utf8_lossy(value_text)
-                            ),
-                        ));
-                    }
-                }
+                self.axis_word(i, incremental, at, value, &mut out)?;
                 continue;
             }
+            let value_text = &b[value.clone()];
             match name.as_slice() {
-                b"F" => {
-                    if std::mem::replace(&mut seen[6], true) {
-                        return Err(self.err(t.start, "F appears twice in this block".into()));
-                    }
-                    match parse_number(value_text) {
-                        Some(v) if v.is_finite() => {
-                            s.feed = Some(v);
-                            words.push(Word {
-                                letter: b'F',
-                                start: t.start as u32,
-                                value_start: value.start as u32,
-                                end: value.end as u32,
-                                value: v,
-                                form: RotaryForm::Plain,
-                                tail: 0,
-                            });
-                        }
-                        _ if value_text.iter().any(|c| c.eq_ignore_ascii_case(&b'Q')) => {
-                            s.feed_expr = true;
-                        }
-                        _ => {
-                            return Err(self.err(
-                                t.start,
-                                format!(
-                                    "F value '{}' is not a number",
-                                    String::from_utf8_lossy(value_text)
-                                ),
-                            ));
-                        }
-                    }
-                }
-                b"FMAX" => s.rapid_once = true,
-                b"FAUTO" | b"FU" | b"FZ" => s.feed_unknown = true,
+                b"F" => self.feed_word(t.start, value, &mut out)?,
+                b"FMAX" => out.s.rapid_once = true,
+                b"FAUTO" | b"FU" | b"FZ" => out.s.feed_unknown = true,
                 // `M` alone: no miscellaneous function (older TNC listings write the empty
                 // dialog field).
                 b"M" if value_text.is_empty() => {}
-                b"M" => {
-                    let v = parse_number(value_text)
-                        .filter(|v| v.is_finite())
-                        .ok_or_else(|| {
-                            self.err(
-                                t.start,
-                                format!(
-                                    "M value '{}' is not a number",
-                                    String::from_utf8_lossy(value_text)
-                                ),
-                            )
-                        })?;
-                    words.push(Word {
-                        letter: b'M',
-                        start: t.start as u32,
-                        value_start: value.start as u32,
-                        end: value.end as u32,
-                        value: v,
-                        form: RotaryForm::Plain,
-                        tail: 0,
-                    });
-                    match code10(v) {
-                        // Machine coordinates for this block; retract along the tool axis;
-                        // cycle call: positions unknown after.
-                        Some(910 | 920 | 1400 | 990 | 890) => {
-                            s.unknown_after = true;
-                            s.breaks = true;
-                        }
-                        c => m_code(Dialect::Conversational, controller, c, s),
-                    }
-                }
+                b"M" => self.m_word(controller, t.start, value, &mut out)?,
                 // Radius compensation: R0 none, RL/RR/R+/R- on (ends runs).
                 b"R" if value_text == b"0" => {}
-                b"RL" | b"RR" | b"R" => s.breaks = true,
+                b"RL" | b"RR" | b"R" => out.s.breaks = true,
                 // Arc direction, arc radius, polar coordinates, approach lengths…: read by
                 // the arc and polar moves, which end runs anyway.
-                _ => s.breaks = true,
+                _ => out.s.breaks = true,
             }
+        }
+        Ok(())
+    }
+
+    /// What the letter `name` of the token `t`, written without a number, stands for, given
+    /// the token after it.
+    fn lone_letter(
+        &self,
+        name: &[u8],
+        t: &Range<usize>,
+        next: Option<&Range<usize>>,
+    ) -> Result<Lone, ParseError> {
+        let b = self.bytes;
+        match next {
+            Some(next) if parse_number(&b[next.clone()]).is_some() => Ok(Lone::Value(next.clone())),
+            // `F MAX` (older TNC listings, NX's posts for them): `FMAX`.
+            Some(next) if name == b"F" && b[next.clone()].eq_ignore_ascii_case(b"MAX") => {
+                Ok(Lone::Rapid)
+            }
+            // An empty `F` field (`L R F M30`, older TNC listings): no feed given.
+            _ if name == b"F" => Ok(Lone::Empty),
+            _ => Err(self.err(
+                t.start,
+                format!(
+                    "{} word has no number (a blank after the letter is read only when \
+                     a number follows it)",
+                    String::from_utf8_lossy(name)
+                ),
+            )),
+        }
+    }
+
+    /// The word of axis `i` (incremental: `IX+5`), its letter at `at` and its value at
+    /// `value`.
+    fn axis_word(
+        &self,
+        i: usize,
+        incremental: bool,
+        at: usize,
+        value: Range<usize>,
+        out: &mut Sink<'_>,
+    ) -> Result<(), ParseError> {
+        let letter = AXES[i];
+        let value_text = &self.bytes[value.clone()];
+        if std::mem::replace(&mut out.seen[i], true) {
+            return Err(self.err(
+                at,
+                format!(
+                    "{} appears twice in this block; the control rejects such a block",
+                    letter as char
+                ),
+            ));
+        }
+        if value_text.is_empty() {
+            return Err(self.err(at, format!("{} word has no number", letter as char)));
+        }
+        match parse_number(value_text) {
+            Some(v) if v.is_finite() => {
+                out.s.axes[i] = Some(v);
+                if incremental {
+                    out.s.axes_incremental |= 1 << i;
+                }
+                out.words.push(plain_word(letter, at, &value, v));
+            }
+            _ if value_text.iter().any(|c| c.eq_ignore_ascii_case(&b'Q')) => {
+                out.s.axes_expr |= 1 << i;
+            }
+            _ => {
+                return Err(self.err(
+                    at,
+                    format!(
+                        "{} value '{}' is not a number",
+                        letter as char,
+                        String::from_utf8_lossy(value_text)
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The F word at `start`, its value at `value`.
+    fn feed_word(
+        &self,
+        start: usize,
+        value: Range<usize>,
+        out: &mut Sink<'_>,
+    ) -> Result<(), ParseError> {
+        let value_text = &self.bytes[value.clone()];
+        if std::mem::replace(&mut out.seen[6], true) {
+            return Err(self.err(start, "F appears twice in this block".into()));
+        }
+        match parse_number(value_text) {
+            Some(v) if v.is_finite() => {
+                out.s.feed = Some(v);
+                out.words.push(plain_word(b'F', start, &value, v));
+            }
+            _ if value_text.iter().any(|c| c.eq_ignore_ascii_case(&b'Q')) => {
+                out.s.feed_expr = true;
+            }
+            _ => {
+                return Err(self.err(
+                    start,
+                    format!(
+                        "F value '{}' is not a number",
+                        String::from_utf8_lossy(value_text)
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The M word at `start`, its value at `value` (not empty).
+    fn m_word(
+        &self,
+        controller: &ControllerCodes,
+        start: usize,
+        value: Range<usize>,
+        out: &mut Sink<'_>,
+    ) -> Result<(), ParseError> {
+        let value_text = &self.bytes[value.clone()];
+        let v = parse_number(value_text)
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| {
+                self.err(
+                    start,
+                    format!(
+                        "M value '{}' is not a number",
+                        String::from_utf8_lossy(value_text)
+                    ),
+                )
+            })?;
+        out.words.push(plain_word(b'M', start, &value, v));
+        match code10(v) {
+            // Machine coordinates for this block; retract along the tool axis;
+            // cycle call: positions unknown after.
+            Some(910 | 920 | 1400 | 990 | 890) => {
+                out.s.unknown_after = true;
+                out.s.breaks = true;
+            }
+            c => m_code(Dialect::Conversational, controller, c, out.s),
         }
         Ok(())
     }
 }
 
-/// What a conversational line says (module docs), its words appended to `words`.
-pub(crate) fn lex(
-    controller: &ControllerCodes,
-    bytes: &[u8],
-    span: Range<usize>,
-    line: usize,
-    words: &mut Vec<Word>,
-) -> Result<Scan, ParseError> {
-    let mut s = Scan::default();
+/// A control byte outside a comment: the line is refused.
+fn check_control_bytes(bytes: &[u8], span: &Range<usize>, line: usize) -> Result<(), ParseError> {
     for (k, &c) in bytes[span.clone()].iter().enumerate() {
         if (c < 0x20 && !is_blank(c)) || c == 0x7f {
             // Inside a comment the bytes are the user's.
@@ -291,6 +348,19 @@ pub(crate) fn lex(
             }
         }
     }
+    Ok(())
+}
+
+/// What a conversational line says (module docs), its words appended to `words`.
+pub(crate) fn lex(
+    controller: &ControllerCodes,
+    bytes: &[u8],
+    span: Range<usize>,
+    line: usize,
+    words: &mut Vec<Word>,
+) -> Result<Scan, ParseError> {
+    let mut scan = Scan::default();
+    check_control_bytes(bytes, &span, line)?;
     let mut toks = tokens(bytes, span.clone());
     // Block number.
     if toks
@@ -300,234 +370,56 @@ pub(crate) fn lex(
         toks.remove(0);
     }
     let Some(first) = toks.first().cloned() else {
-        return Ok(s);
+        return Ok(scan);
     };
     let key = upper(bytes, &first);
     let rest = &toks[1..];
-    let w = Words {
+    let l = Line {
         bytes,
-        line,
-        line_start: span.start,
+        rest,
+        second: rest.first().map(|t| upper(bytes, t)).unwrap_or_default(),
+        words: Words {
+            bytes,
+            line,
+            line_start: span.start,
+        },
     };
-    let second = rest.first().map(|t| upper(bytes, t)).unwrap_or_default();
+    let s = &mut scan;
     match key.as_slice() {
         k if k.first() == Some(&b'*') => {}
-        b"BEGIN" => {
-            // `INCH` (NX's Heidenhain posts write `IN`) or `MM`; anything else states no
-            // units.
-            if let Some(unit) = rest.last() {
-                let u = upper(bytes, unit);
-                if u == b"INCH" || u == b"IN" {
-                    s.inch = Some(true);
-                } else if u == b"MM" {
-                    s.inch = Some(false);
-                }
-            }
-            s.breaks = true;
-        }
+        b"BEGIN" => l.begin(s),
         b"END" => {
             s.flags.set(Flags::PROGRAM_END);
-            m_code(Dialect::Conversational, controller, Some(300), &mut s);
+            m_code(Dialect::Conversational, controller, Some(300), s);
         }
-        b"L" => {
-            s.motion = Some(Motion::Linear);
-            w.read(controller, rest, &mut s, words)?;
-        }
-        b"LN" => {
-            s.motion = Some(Motion::Linear);
-            s.flags.set(Flags::NOT_MODELLED);
-            s.breaks = true;
-            let axes: Vec<_> = rest
-                .iter()
-                .filter(|t| {
-                    let txt = upper(bytes, t);
-                    txt.len() >= 2
-                        && matches!(txt[0], b'X' | b'Y' | b'Z')
-                        && !txt[1].is_ascii_alphabetic()
-                })
-                .cloned()
-                .collect();
-            w.read(controller, &axes, &mut s, words)?;
-            // The tool axis follows the normal vectors: rotary positions unknown.
-            for i in [A, B, C] {
-                s.axes_expr |= 1 << i;
-            }
-        }
-        b"C" | b"CR" | b"CT" => {
-            s.motion = Some(Motion::ArcCw);
-            w.read(controller, rest, &mut s, words)?;
-            s.breaks = true;
-        }
-        b"LP" | b"CP" | b"APPR" | b"DEP" => {
-            s.motion = Some(if key == b"LP" {
-                Motion::Linear
-            } else {
-                Motion::ArcCw
-            });
-            s.flags.set(Flags::ARC);
-            s.xy_unknown_after = true;
-            if key != b"LP" {
-                s.unknown_after = true;
-            }
-            s.breaks = true;
-        }
-        b"CC" | b"BLK" => {
-            // A circle centre or the blank: axis words that are not a move.
-            s.no_move = true;
-        }
-        b"RND" | b"CHF" => s.breaks = true,
-        b"TOOL" => {
-            // `TOOL CALL 5 Z S12000`, `TOOL CALL "BALL6" Z`: a tool change. A call that
-            // names no tool (`TOOL CALL Z S10000`, `TOOL CALL S10000`: a new spindle speed
-            // or axis for the tool in use) changes nothing that moves: it ends no run.
-            if second == b"CALL" {
-                let third = rest.get(1).map(|t| upper(bytes, t)).unwrap_or_default();
-                let names_tool = third
-                    .first()
-                    .is_some_and(|c| c.is_ascii_digit() || matches!(c, b'"' | b'\'' | b'Q'));
-                if names_tool {
-                    s.flags.set(Flags::TOOL_CHANGE);
-                    s.breaks = true;
-                }
-            } else {
-                s.breaks = true;
-            }
-        }
-        b"CYCL" => {
-            if second == b"DEF" {
-                let number = rest.get(1).map(|t| upper(bytes, t)).unwrap_or_default();
-                let mut parts = number.split(|&c| c == b'.');
-                let major = parts.next().unwrap_or_default();
-                let minor = parts.next().unwrap_or_default();
-                if matches!(major, b"7" | b"247" | b"8" | b"10" | b"11" | b"19" | b"26") {
-                    s.datum_shift = true;
-                    s.unknown_after = true;
-                    if minor == b"1" {
-                        cycle_transform(major, &upper_tokens(bytes, &rest[2..]), &mut s);
-                    }
-                } else {
-                    s.no_move = true;
-                }
-            } else {
-                s.unknown_after = true;
-            }
-            s.breaks = true;
-        }
+        b"L" | b"LN" | b"C" | b"CR" | b"CT" | b"LP" | b"CP" | b"APPR" | b"DEP" | b"CC" | b"BLK"
+        | b"RND" | b"CHF" => l.path(&key, controller, s, words)?,
+        b"TOOL" => l.tool(s),
+        b"CYCL" => l.cycle(s),
         b"TCH" => {
             s.unknown_after = true;
             s.breaks = true;
         }
-        b"LBL" => {
-            let name = rest
-                .first()
-                .map(|t| label_name(bytes, t))
-                .unwrap_or_default();
-            s.flow = Some(if name == "0" {
-                Stmt::Return {
-                    falls_through: true,
-                }
-            } else {
-                Stmt::Label(Key::Label(name))
-            });
-        }
-        b"CALL" => {
-            s.flow = Some(if second == b"LBL" {
-                let name = rest
-                    .get(1)
-                    .map(|t| label_name(bytes, t))
-                    .unwrap_or_default();
-                if name.starts_with('Q') {
-                    Stmt::Opaque
-                } else {
-                    let rep = rest.iter().position(|t| upper(bytes, t) == b"REP");
-                    let times = rep
-                        .and_then(|k| rest.get(k + 1))
-                        .map(|t| upper(bytes, t))
-                        .and_then(|t| crate::lexer::parse_number(&t));
-                    Stmt::Call {
-                        key: Key::Label(name),
-                        repeats: rep.is_some() && times != Some(0.0),
-                    }
-                }
-            } else {
-                // CALL PGM, CALL SELECTED PGM: a program outside the file.
-                Stmt::External
-            });
-        }
+        b"LBL" => s.flow = Some(l.label()),
+        b"CALL" => s.flow = Some(l.call()),
         b"SEL" => {
-            if second == b"PGM" {
+            if l.second == b"PGM" {
                 s.flow = Some(Stmt::External);
             } else {
                 s.breaks = true;
             }
         }
-        b"FN" => {
-            let n = rest
-                .first()
-                .map(|t| {
-                    bytes[t.clone()]
-                        .iter()
-                        .take_while(|c| c.is_ascii_digit())
-                        .fold(0u32, |a, &d| {
-                            a.saturating_mul(10).saturating_add(u32::from(d - b'0'))
-                        })
-                })
-                .unwrap_or(0);
-            if (9..=12).contains(&n) {
-                // `FN 9: IF +Q1 EQU +0 GOTO LBL 5`: a conditional jump.
-                let goto = rest.iter().position(|t| upper(bytes, t) == b"GOTO");
-                let name = goto
-                    .and_then(|k| rest.get(k + 2))
-                    .map(|t| label_name(bytes, t));
-                s.flow = Some(match name {
-                    Some(name) if !name.starts_with('Q') && !name.is_empty() => Stmt::Jump {
-                        key: Key::Label(name),
-                        cond: true,
-                    },
-                    _ => Stmt::Opaque,
-                });
-            }
-            s.breaks = true;
-        }
+        b"FN" => l.parameter_function(s),
         k if k.first() == Some(&b'Q') => s.breaks = true,
-        b"FUNCTION" => function(&bytes[first.start..span.end], &mut s),
-        b"PLANE" => {
-            s.datum_shift = true;
-            s.unknown_after = true;
-            s.breaks = true;
-            // A tilted working plane rotates the frame; `PLANE RESET` ends it.
-            if second == b"RESET" {
-                s.transform_off |= transform::ROTATION;
-            } else {
-                s.transform_on |= transform::ROTATION;
-            }
-        }
-        b"TRANS" => {
-            // TNC7 frames: `TRANS DATUM …`, `TRANS MIRROR …`, `TRANS ROTATION …`,
-            // `TRANS SCALE …`; `… RESET` ends them.
-            s.datum_shift = true;
-            s.unknown_after = true;
-            s.breaks = true;
-            let reset = rest.iter().any(|t| upper(bytes, t) == b"RESET");
-            let bit = match second.as_slice() {
-                b"MIRROR" => transform::MIRROR,
-                b"ROTATION" => transform::ROTATION,
-                b"SCALE" | b"SCALING" => transform::SCALING,
-                b"DATUM" => 0,
-                _ => transform::ALL,
-            };
-            if reset {
-                s.transform_off |= bit;
-            } else {
-                s.transform_on |= bit;
-            }
-        }
+        b"FUNCTION" => function(&bytes[first.start..span.end], s),
+        b"PLANE" => l.plane(s),
+        b"TRANS" => l.trans(s),
         b"STOP" => {
             s.breaks = true;
-            w.read(controller, rest, &mut s, words)?;
+            l.words.read(controller, rest, s, words)?;
         }
         k if k.first() == Some(&b'M') && k.len() > 1 && k[1].is_ascii_digit() => {
-            w.read(controller, &toks, &mut s, words)?;
+            l.words.read(controller, &toks, s, words)?;
         }
         _ => {
             s.flags.set(Flags::NOT_MODELLED);
@@ -535,8 +427,254 @@ pub(crate) fn lex(
             s.breaks = true;
         }
     }
-    after_lex(bytes, &span, &mut s);
-    Ok(s)
+    after_lex(bytes, &span, s);
+    Ok(scan)
+}
+
+/// A conversational line after its keyword: what each keyword's reading needs.
+struct Line<'a> {
+    bytes: &'a [u8],
+    /// The tokens after the keyword.
+    rest: &'a [Range<usize>],
+    /// The first of them, upper case (empty if there is none).
+    second: Vec<u8>,
+    /// Their reader as words.
+    words: Words<'a>,
+}
+
+impl Line<'_> {
+    /// `BEGIN PGM NAME MM`: the program's units.
+    fn begin(&self, s: &mut Scan) {
+        // `INCH` (NX's Heidenhain posts write `IN`) or `MM`; anything else states no
+        // units.
+        if let Some(unit) = self.rest.last() {
+            let u = upper(self.bytes, unit);
+            if u == b"INCH" || u == b"IN" {
+                s.inch = Some(true);
+            } else if u == b"MM" {
+                s.inch = Some(false);
+            }
+        }
+        s.breaks = true;
+    }
+
+    /// The path keywords: lines, arcs, polar moves, approach and departure, circle centre
+    /// and blank, corners (`key`, upper case).
+    fn path(
+        &self,
+        key: &[u8],
+        controller: &ControllerCodes,
+        s: &mut Scan,
+        words: &mut Vec<Word>,
+    ) -> Result<(), ParseError> {
+        let (bytes, rest) = (self.bytes, self.rest);
+        match key {
+            b"L" => {
+                s.motion = Some(Motion::Linear);
+                self.words.read(controller, rest, s, words)?;
+            }
+            b"LN" => {
+                s.motion = Some(Motion::Linear);
+                s.flags.set(Flags::NOT_MODELLED);
+                s.breaks = true;
+                let axes: Vec<_> = rest
+                    .iter()
+                    .filter(|t| {
+                        let txt = upper(bytes, t);
+                        txt.len() >= 2
+                            && matches!(txt[0], b'X' | b'Y' | b'Z')
+                            && !txt[1].is_ascii_alphabetic()
+                    })
+                    .cloned()
+                    .collect();
+                self.words.read(controller, &axes, s, words)?;
+                // The tool axis follows the normal vectors: rotary positions unknown.
+                for i in [A, B, C] {
+                    s.axes_expr |= 1 << i;
+                }
+            }
+            b"C" | b"CR" | b"CT" => {
+                s.motion = Some(Motion::ArcCw);
+                self.words.read(controller, rest, s, words)?;
+                s.breaks = true;
+            }
+            b"LP" | b"CP" | b"APPR" | b"DEP" => {
+                s.motion = Some(if key == b"LP" {
+                    Motion::Linear
+                } else {
+                    Motion::ArcCw
+                });
+                s.flags.set(Flags::ARC);
+                s.xy_unknown_after = true;
+                if key != b"LP" {
+                    s.unknown_after = true;
+                }
+                s.breaks = true;
+            }
+            b"CC" | b"BLK" => {
+                // A circle centre or the blank: axis words that are not a move.
+                s.no_move = true;
+            }
+            // `RND`, `CHF`.
+            _ => s.breaks = true,
+        }
+        Ok(())
+    }
+
+    /// `TOOL CALL …`, `TOOL DEF …`.
+    fn tool(&self, s: &mut Scan) {
+        // `TOOL CALL 5 Z S12000`, `TOOL CALL "BALL6" Z`: a tool change. A call that
+        // names no tool (`TOOL CALL Z S10000`, `TOOL CALL S10000`: a new spindle speed
+        // or axis for the tool in use) changes nothing that moves: it ends no run.
+        if self.second == b"CALL" {
+            let third = self
+                .rest
+                .get(1)
+                .map(|t| upper(self.bytes, t))
+                .unwrap_or_default();
+            let names_tool = third
+                .first()
+                .is_some_and(|c| c.is_ascii_digit() || matches!(c, b'"' | b'\'' | b'Q'));
+            if names_tool {
+                s.flags.set(Flags::TOOL_CHANGE);
+                s.breaks = true;
+            }
+        } else {
+            s.breaks = true;
+        }
+    }
+
+    /// `CYCL DEF n…`, `CYCL CALL`.
+    fn cycle(&self, s: &mut Scan) {
+        let (bytes, rest) = (self.bytes, self.rest);
+        if self.second == b"DEF" {
+            let number = rest.get(1).map(|t| upper(bytes, t)).unwrap_or_default();
+            let mut parts = number.split(|&c| c == b'.');
+            let major = parts.next().unwrap_or_default();
+            let minor = parts.next().unwrap_or_default();
+            if matches!(major, b"7" | b"247" | b"8" | b"10" | b"11" | b"19" | b"26") {
+                s.datum_shift = true;
+                s.unknown_after = true;
+                if minor == b"1" {
+                    cycle_transform(major, &upper_tokens(bytes, &rest[2..]), s);
+                }
+            } else {
+                s.no_move = true;
+            }
+        } else {
+            s.unknown_after = true;
+        }
+        s.breaks = true;
+    }
+
+    /// `LBL n`, `LBL "NAME"`: a label; `LBL 0`: a return.
+    fn label(&self) -> Stmt {
+        let name = self
+            .rest
+            .first()
+            .map(|t| label_name(self.bytes, t))
+            .unwrap_or_default();
+        if name == "0" {
+            Stmt::Return {
+                falls_through: true,
+            }
+        } else {
+            Stmt::Label(Key::Label(name))
+        }
+    }
+
+    /// `CALL LBL n [REP m]`, `CALL PGM`, `CALL SELECTED PGM`.
+    fn call(&self) -> Stmt {
+        let (bytes, rest) = (self.bytes, self.rest);
+        if self.second == b"LBL" {
+            let name = rest
+                .get(1)
+                .map(|t| label_name(bytes, t))
+                .unwrap_or_default();
+            if name.starts_with('Q') {
+                Stmt::Opaque
+            } else {
+                let rep = rest.iter().position(|t| upper(bytes, t) == b"REP");
+                let times = rep
+                    .and_then(|k| rest.get(k + 1))
+                    .map(|t| upper(bytes, t))
+                    .and_then(|t| crate::lexer::parse_number(&t));
+                Stmt::Call {
+                    key: Key::Label(name),
+                    repeats: rep.is_some() && times != Some(0.0),
+                }
+            }
+        } else {
+            // CALL PGM, CALL SELECTED PGM: a program outside the file.
+            Stmt::External
+        }
+    }
+
+    /// `FN n: …`: parameter arithmetic, and the conditional jumps `FN 9`…`FN 12`.
+    fn parameter_function(&self, s: &mut Scan) {
+        let (bytes, rest) = (self.bytes, self.rest);
+        let n = rest
+            .first()
+            .map(|t| {
+                bytes[t.clone()]
+                    .iter()
+                    .take_while(|c| c.is_ascii_digit())
+                    .fold(0u32, |a, &d| {
+                        a.saturating_mul(10).saturating_add(u32::from(d - b'0'))
+                    })
+            })
+            .unwrap_or(0);
+        if (9..=12).contains(&n) {
+            // `FN 9: IF +Q1 EQU +0 GOTO LBL 5`: a conditional jump.
+            let goto = rest.iter().position(|t| upper(bytes, t) == b"GOTO");
+            let name = goto
+                .and_then(|k| rest.get(k + 2))
+                .map(|t| label_name(bytes, t));
+            s.flow = Some(match name {
+                Some(name) if !name.starts_with('Q') && !name.is_empty() => Stmt::Jump {
+                    key: Key::Label(name),
+                    cond: true,
+                },
+                _ => Stmt::Opaque,
+            });
+        }
+        s.breaks = true;
+    }
+
+    /// `PLANE …`, `PLANE RESET`.
+    fn plane(&self, s: &mut Scan) {
+        s.datum_shift = true;
+        s.unknown_after = true;
+        s.breaks = true;
+        // A tilted working plane rotates the frame; `PLANE RESET` ends it.
+        if self.second == b"RESET" {
+            s.transform_off |= transform::ROTATION;
+        } else {
+            s.transform_on |= transform::ROTATION;
+        }
+    }
+
+    /// `TRANS DATUM/MIRROR/ROTATION/SCALE …` and their `RESET`.
+    fn trans(&self, s: &mut Scan) {
+        // TNC7 frames: `TRANS DATUM …`, `TRANS MIRROR …`, `TRANS ROTATION …`,
+        // `TRANS SCALE …`; `… RESET` ends them.
+        s.datum_shift = true;
+        s.unknown_after = true;
+        s.breaks = true;
+        let reset = self.rest.iter().any(|t| upper(self.bytes, t) == b"RESET");
+        let bit = match self.second.as_slice() {
+            b"MIRROR" => transform::MIRROR,
+            b"ROTATION" => transform::ROTATION,
+            b"SCALE" | b"SCALING" => transform::SCALING,
+            b"DATUM" => 0,
+            _ => transform::ALL,
+        };
+        if reset {
+            s.transform_off |= bit;
+        } else {
+            s.transform_on |= bit;
+        }
+    }
 }
 
 /// A label's name as `LBL` and `CALL LBL` write it: a number, or a quoted name (upper case).

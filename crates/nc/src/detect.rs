@@ -2,6 +2,7 @@
 
 use crate::dialect::Dialect;
 use crate::lines::LineEnds;
+use crate::tolerances::DETECT_HEAD_BYTES;
 
 /// Guess the dialect from the first 64 KiB: a `BEGIN PGM` line → Heidenhain
 /// conversational, and so do lines that only conversational has (`L X+10 R0 F…`,
@@ -9,7 +10,7 @@ use crate::lines::LineEnds;
 /// `TRAORI`/`TRAFOOF` → Sinumerik; `( )` comments or `G43.4` → Fanuc; `M128` or
 /// `FUNCTION TCPM` → Heidenhain ISO; `;` comments → Sinumerik; else Fanuc.
 pub fn detect(bytes: &[u8]) -> Dialect {
-    let head = &bytes[..bytes.len().min(64 * 1024)];
+    let head = &bytes[..bytes.len().min(DETECT_HEAD_BYTES)];
     let contains = |needle: &[u8]| {
         head.windows(needle.len())
             .any(|w| w.eq_ignore_ascii_case(needle))

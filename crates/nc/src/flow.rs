@@ -334,144 +334,123 @@ impl Recorder {
 
     /// Solve the recorded flow from the state `initial` (module docs).
     pub(crate) fn solve(&self, initial: Tcpm) -> FlowPlan {
-        if self.opaque {
-            return FlowPlan {
-                entries: Vec::new(),
-                all_unknown: true,
-            };
-        }
-        let nodes = &self.nodes;
-        let n = nodes.len();
-        let mut labels: HashMap<&Key, Vec<usize>> = HashMap::new();
-        for (i, node) in nodes.iter().enumerate() {
-            match &node.kind {
-                Kind::Label(k) | Kind::SubBody(k) | Kind::Group(k) => {
-                    labels.entry(k).or_default().push(i)
-                }
-                _ => {}
-            }
-        }
-        // A jump to a label the file does not hold: control may go anywhere.
-        let unresolved = nodes.iter().any(|node| match &node.kind {
-            Kind::Jump { key, .. } => !labels.contains_key(key),
-            _ => false,
-        });
-        if unresolved {
-            return FlowPlan {
-                entries: Vec::new(),
-                all_unknown: true,
-            };
-        }
-        // Calls per called key, and the owner (called label) of every return.
-        let mut calls: HashMap<&Key, Vec<usize>> = HashMap::new();
-        for (i, node) in nodes.iter().enumerate() {
-            if let Kind::Call { key, .. } = &node.kind
-                && labels.contains_key(key)
-            {
-                calls.entry(key).or_default().push(i);
-            }
-        }
-        let mut owner: Vec<Option<&Key>> = vec![None; n];
-        let mut current: Option<&Key> = None;
-        for (i, node) in nodes.iter().enumerate() {
-            match &node.kind {
-                Kind::Label(k) | Kind::SubBody(k) if calls.contains_key(k) => current = Some(k),
-                Kind::Return { .. } => owner[i] = current,
-                Kind::SubEnd(k) => owner[i] = Some(k),
-                _ => {}
-            }
-        }
-        let mut state: Vec<Option<Tcpm>> = vec![None; n];
-        let mut work: Vec<usize> = Vec::new();
-        let send = |state: &mut Vec<Option<Tcpm>>, work: &mut Vec<usize>, to: usize, t: Tcpm| {
-            if to >= n {
-                return;
-            }
-            let joined = state[to].map_or(t, |s| s.join(t));
-            if state[to] != Some(joined) {
-                state[to] = Some(joined);
-                work.push(to);
-            }
+        let unknown_everywhere = FlowPlan {
+            entries: Vec::new(),
+            all_unknown: true,
         };
-        send(&mut state, &mut work, 0, initial);
-        while let Some(i) = work.pop() {
-            let Some(s) = state[i] else { continue };
-            let next = i + 1;
-            match &nodes[i].kind {
-                Kind::Start
-                | Kind::Label(_)
-                | Kind::SubBody(_)
-                | Kind::AfterCall
-                | Kind::AfterSub(_) => send(&mut state, &mut work, next, s),
-                Kind::Switch { to, skippable } => {
-                    send(&mut state, &mut work, next, s.switched(*to, *skippable))
+        if self.opaque {
+            return unknown_everywhere;
+        }
+        let Some(edges) = Edges::new(&self.nodes) else {
+            // A jump to a label the file does not hold: control may go anywhere.
+            return unknown_everywhere;
+        };
+        let state = self.propagate(&edges, initial);
+        self.plan(&state)
+    }
+
+    /// The state before every node: the data-flow problem of the module docs solved by a
+    /// worklist from `initial` at the first node (`None`: no way in).
+    fn propagate(&self, edges: &Edges<'_>, initial: Tcpm) -> Vec<Option<Tcpm>> {
+        let mut w = Worklist {
+            state: vec![None; self.nodes.len()],
+            work: Vec::new(),
+        };
+        w.send(0, initial);
+        while let Some(i) = w.work.pop() {
+            let Some(s) = w.state[i] else { continue };
+            self.send_on(i, s, edges, &mut w);
+        }
+        w.state
+    }
+
+    /// Send the state `s` before node `i` along the node's edges (module docs).
+    fn send_on(&self, i: usize, s: Tcpm, edges: &Edges<'_>, w: &mut Worklist) {
+        let nodes = &self.nodes;
+        let labels = &edges.labels;
+        let next = i + 1;
+        match &nodes[i].kind {
+            Kind::Start
+            | Kind::Label(_)
+            | Kind::SubBody(_)
+            | Kind::AfterCall
+            | Kind::AfterSub(_) => w.send(next, s),
+            Kind::Switch { to, skippable } => w.send(next, s.switched(*to, *skippable)),
+            Kind::End => {}
+            Kind::Group(k) => {
+                w.send(next, s);
+                for &j in &labels[k] {
+                    w.send(j, s);
                 }
-                Kind::End => {}
-                Kind::Group(k) => {
-                    send(&mut state, &mut work, next, s);
-                    for &j in &labels[k] {
-                        send(&mut state, &mut work, j, s);
+            }
+            Kind::SubSkip(k) => {
+                // In file order the definition is skipped (one without its end: what
+                // follows it is not reached in order).
+                let after = Kind::AfterSub(k.clone());
+                if let Some(p) = nodes[next..].iter().position(|nd| nd.kind == after) {
+                    w.send(next + p, s);
+                }
+            }
+            Kind::SubEnd(_) | Kind::Return { .. } => self.send_return(i, s, edges, w),
+            Kind::Call { key, .. } => match labels.get(key) {
+                Some(entries) => {
+                    for &j in entries {
+                        w.send(j, s);
                     }
                 }
-                Kind::SubSkip(k) => {
-                    // In file order the definition is skipped (one without its end: what
-                    // follows it is not reached in order).
-                    let after = Kind::AfterSub(k.clone());
-                    if let Some(p) = nodes[next..].iter().position(|nd| nd.kind == after) {
-                        send(&mut state, &mut work, next + p, s);
-                    }
+                // Nothing of that name in the file: code outside it.
+                None => w.send(next, Tcpm::Unknown),
+            },
+            Kind::External => w.send(next, Tcpm::Unknown),
+            Kind::ToolChange => w.send(next, s.after_tool_change()),
+            Kind::Jump { key, cond } => {
+                for &j in &labels[key] {
+                    w.send(j, s);
                 }
-                Kind::SubEnd(_) | Kind::Return { .. } => {
-                    let falls = matches!(
-                        nodes[i].kind,
-                        Kind::Return {
-                            falls_through: true
-                        }
-                    );
-                    match owner[i] {
-                        Some(k) => {
-                            for &c in calls.get(k).map_or(&[][..], Vec::as_slice) {
-                                send(&mut state, &mut work, c + 1, s);
-                                if matches!(nodes[c].kind, Kind::Call { repeats: true, .. }) {
-                                    for &j in &labels[k] {
-                                        send(&mut state, &mut work, j, s);
-                                    }
-                                }
-                            }
-                            if falls {
-                                send(&mut state, &mut work, next, s);
-                            }
-                        }
-                        // A return where no call is active: Heidenhain's label 0 goes on;
-                        // Fanuc's M99 in the main program starts it again.
-                        None if falls => send(&mut state, &mut work, next, s),
-                        None => send(&mut state, &mut work, 0, s),
-                    }
-                }
-                Kind::Call { key, .. } => match labels.get(key) {
-                    Some(entries) => {
-                        for &j in entries {
-                            send(&mut state, &mut work, j, s);
-                        }
-                    }
-                    // Nothing of that name in the file: code outside it.
-                    None => send(&mut state, &mut work, next, Tcpm::Unknown),
-                },
-                Kind::External => send(&mut state, &mut work, next, Tcpm::Unknown),
-                Kind::ToolChange => send(&mut state, &mut work, next, s.after_tool_change()),
-                Kind::Jump { key, cond } => {
-                    for &j in &labels[key] {
-                        send(&mut state, &mut work, j, s);
-                    }
-                    if *cond {
-                        send(&mut state, &mut work, next, s);
-                    }
+                if *cond {
+                    w.send(next, s);
                 }
             }
         }
-        // The plan: every node's state before its line (⊥, no way in: unknown), and after a
-        // node that does not fall through, the state of the lines up to the next node.
-        let mut entries = Vec::with_capacity(2 * n);
+    }
+
+    /// Send the state `s` before the return (or `endsub`) node `i` back to the block after
+    /// every call of its subprogram (and to its start again for a repeated call).
+    fn send_return(&self, i: usize, s: Tcpm, edges: &Edges<'_>, w: &mut Worklist) {
+        let nodes = &self.nodes;
+        let next = i + 1;
+        let falls = matches!(
+            nodes[i].kind,
+            Kind::Return {
+                falls_through: true
+            }
+        );
+        match edges.owner[i] {
+            Some(k) => {
+                for &c in edges.calls.get(k).map_or(&[][..], Vec::as_slice) {
+                    w.send(c + 1, s);
+                    if matches!(nodes[c].kind, Kind::Call { repeats: true, .. }) {
+                        for &j in &edges.labels[k] {
+                            w.send(j, s);
+                        }
+                    }
+                }
+                if falls {
+                    w.send(next, s);
+                }
+            }
+            // A return where no call is active: Heidenhain's label 0 goes on;
+            // Fanuc's M99 in the main program starts it again.
+            None if falls => w.send(next, s),
+            None => w.send(0, s),
+        }
+    }
+
+    /// The plan: every node's state before its line (⊥, no way in: unknown), and after a
+    /// node that does not fall through, the state of the lines up to the next node.
+    fn plan(&self, state: &[Option<Tcpm>]) -> FlowPlan {
+        let nodes = &self.nodes;
+        let mut entries = Vec::with_capacity(2 * nodes.len());
         for (i, node) in nodes.iter().enumerate() {
             let join = matches!(
                 node.kind,
@@ -504,6 +483,84 @@ impl Recorder {
         FlowPlan {
             entries,
             all_unknown: false,
+        }
+    }
+}
+
+/// Where the recorded nodes lead besides the next one (module docs): the nodes of each
+/// label, the calls of each called label, and the called label each return belongs to.
+struct Edges<'a> {
+    /// The label, subroutine-body and group nodes of each key.
+    labels: HashMap<&'a Key, Vec<usize>>,
+    /// The call nodes of each key the file holds.
+    calls: HashMap<&'a Key, Vec<usize>>,
+    /// The owner (called label) of every return and `endsub` node.
+    owner: Vec<Option<&'a Key>>,
+}
+
+impl<'a> Edges<'a> {
+    /// The edges of `nodes`; `None` when a jump names a label the file does not hold.
+    fn new(nodes: &'a [Node]) -> Option<Self> {
+        let mut labels: HashMap<&Key, Vec<usize>> = HashMap::new();
+        for (i, node) in nodes.iter().enumerate() {
+            match &node.kind {
+                Kind::Label(k) | Kind::SubBody(k) | Kind::Group(k) => {
+                    labels.entry(k).or_default().push(i)
+                }
+                _ => {}
+            }
+        }
+        let unresolved = nodes.iter().any(|node| match &node.kind {
+            Kind::Jump { key, .. } => !labels.contains_key(key),
+            _ => false,
+        });
+        if unresolved {
+            return None;
+        }
+        // Calls per called key, and the owner (called label) of every return.
+        let mut calls: HashMap<&Key, Vec<usize>> = HashMap::new();
+        for (i, node) in nodes.iter().enumerate() {
+            if let Kind::Call { key, .. } = &node.kind
+                && labels.contains_key(key)
+            {
+                calls.entry(key).or_default().push(i);
+            }
+        }
+        let mut owner: Vec<Option<&Key>> = vec![None; nodes.len()];
+        let mut current: Option<&Key> = None;
+        for (i, node) in nodes.iter().enumerate() {
+            match &node.kind {
+                Kind::Label(k) | Kind::SubBody(k) if calls.contains_key(k) => current = Some(k),
+                Kind::Return { .. } => owner[i] = current,
+                Kind::SubEnd(k) => owner[i] = Some(k),
+                _ => {}
+            }
+        }
+        Some(Edges {
+            labels,
+            calls,
+            owner,
+        })
+    }
+}
+
+/// The states of the nodes as the solution grows, and the nodes whose state changed.
+struct Worklist {
+    state: Vec<Option<Tcpm>>,
+    work: Vec<usize>,
+}
+
+impl Worklist {
+    /// Join `t` into the state of node `to` (past the last node: nothing); a change puts
+    /// `to` on the list.
+    fn send(&mut self, to: usize, t: Tcpm) {
+        if to >= self.state.len() {
+            return;
+        }
+        let joined = self.state[to].map_or(t, |s| s.join(t));
+        if self.state[to] != Some(joined) {
+            self.state[to] = Some(joined);
+            self.work.push(to);
         }
     }
 }

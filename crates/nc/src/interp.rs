@@ -11,6 +11,7 @@ use crate::lexer::{Lexer, Token};
 use crate::modal::{A, AXES, B, C, FeedMode, Modal, Motion, Tcpm, X, Y, Z};
 use crate::statements::is_sinumerik_frame;
 use crate::tcpm::{ControllerCodes, ReadOptions, Switch, code10};
+use crate::tolerances::{HALF_TURN_DEG, ZERO_LENGTH_MM};
 use crate::word::{RotaryForm, Word};
 use std::ops::Range;
 
@@ -49,7 +50,7 @@ fn wrap_axis(
     let tip = |p: &[Option<f64>; 6]| Some([p[X]?, p[Y]?, p[Z]?]);
     let (t0, t1) = (tip(before)?, tip(after)?);
     let d2: f64 = t0.iter().zip(t1).map(|(a, b)| (b - a) * (b - a)).sum();
-    if d2.sqrt() <= crate::run::ZERO_LENGTH_MM {
+    if d2.sqrt() <= ZERO_LENGTH_MM {
         return None;
     }
     (A..=C).find(|&k| {
@@ -60,10 +61,6 @@ fn wrap_axis(
             && matches!((before[k], after[k]), (Some(p), Some(q)) if (q - p).abs() > HALF_TURN_DEG)
     })
 }
-
-/// Half a turn, degrees, and the round-off a written value may carry: a plain rotary move
-/// larger than this is a wrap on an axis that may take the shorter way.
-pub(crate) const HALF_TURN_DEG: f64 = 180.0 + 1e-9;
 
 /// `#100`, `-#100`, `+#100`: a macro variable's number (below 1000) and whether it is
 /// negated.
@@ -228,6 +225,86 @@ fn looks_like_axis_words(text: &[u8]) -> bool {
         AXES.contains(&w[0].to_ascii_uppercase())
             && (w[1].is_ascii_digit() || matches!(w[1], b'+' | b'-' | b'.'))
     })
+}
+
+/// One ISO line as its tokens are read: where it is, and what a token leaves for the
+/// tokens after it.
+struct IsoLine {
+    span: Range<usize>,
+    line: usize,
+    /// X Y Z A B C F seen in this block, with the column of the first.
+    seen: [Option<usize>; 7],
+    // Values the frame codes read after the words: Heidenhain ISO G73's H, LinuxCNC
+    // G10's R; the Sinumerik frame instruction and CYCLE800's argument list.
+    h_word: Option<f64>,
+    r_word: Option<f64>,
+    sinumerik_frame: Option<Range<usize>>,
+    cycle800_level: Option<bool>,
+    rpl: bool,
+}
+
+impl IsoLine {
+    fn new(span: Range<usize>, line: usize) -> Self {
+        IsoLine {
+            span,
+            line,
+            seen: [None; 7],
+            h_word: None,
+            r_word: None,
+            sinumerik_frame: None,
+            cycle800_level: None,
+            rpl: false,
+        }
+    }
+
+    /// A word of `letter` at `at`: an error if it is an axis or F the block named before.
+    fn once(&mut self, letter: u8, at: usize) -> Result<(), ParseError> {
+        let col = |at: usize| at - self.span.start + 1;
+        if let Some(k) = axis_or_feed(letter) {
+            if let Some(first) = self.seen[k] {
+                return Err(ParseError::at(
+                    self.line,
+                    col(at),
+                    format!(
+                        "{} appears twice in this block (first at col {first}); controllers \
+                         reject such a block and polepatch will not guess which is meant",
+                        letter as char
+                    ),
+                ));
+            }
+            self.seen[k] = Some(col(at));
+        }
+        Ok(())
+    }
+}
+
+/// An assignment to `letter` (`X=…`, `F#100`, `o<name>`), `value` the text after the letter.
+fn assignment(letter: u8, value: &[u8], s: &mut Scan) {
+    if let Some(i) = AXES.iter().position(|&l| l == letter) {
+        s.axes_expr |= bit(i);
+        s.vars[i] = macro_variable(value);
+    } else if letter == b'F' {
+        s.feed_expr = true;
+        s.vars[6] = macro_variable(value);
+    } else if letter == b'O' {
+        // `o<name> call`, `o<name> sub`: LinuxCNC program flow.
+        s.unknown_after = true;
+        s.breaks = true;
+        s.maybe_flow = true;
+    } else if !matches!(letter, b'R' | b'S') {
+        s.breaks = true;
+    }
+}
+
+/// The units a `%` line states (`%NAME G71`).
+fn percent_units(text: &[u8], s: &mut Scan) {
+    for w in text.split(|b| b.is_ascii_whitespace()) {
+        if w.eq_ignore_ascii_case(b"G70") {
+            s.inch = Some(true);
+        } else if w.eq_ignore_ascii_case(b"G71") {
+            s.inch = Some(false);
+        }
+    }
 }
 
 impl Interpreter {
@@ -430,33 +507,7 @@ impl Interpreter {
             *s = crate::conversational::lex(&self.controller, bytes, span, line, words)?;
             return Ok(());
         }
-        // X Y Z A B C F seen in this block, with the column of the first.
-        let mut seen: [Option<usize>; 7] = [None; 7];
-        let col = |at: usize| at - span.start + 1;
-        let mut once = |letter: u8, at: usize| -> Result<(), ParseError> {
-            if let Some(k) = axis_or_feed(letter) {
-                if let Some(first) = seen[k] {
-                    return Err(ParseError::at(
-                        line,
-                        col(at),
-                        format!(
-                            "{} appears twice in this block (first at col {first}); controllers \
-                             reject such a block and polepatch will not guess which is meant",
-                            letter as char
-                        ),
-                    ));
-                }
-                seen[k] = Some(col(at));
-            }
-            Ok(())
-        };
-        // Values the frame codes read after the words: Heidenhain ISO G73's H, LinuxCNC
-        // G10's R; the Sinumerik frame instruction and CYCLE800's argument list.
-        let mut h_word: Option<f64> = None;
-        let mut r_word: Option<f64> = None;
-        let mut sinumerik_frame: Option<Range<usize>> = None;
-        let mut cycle800_level: Option<bool> = None;
-        let mut rpl = false;
+        let mut l = IsoLine::new(span.clone(), line);
         let mut lexer = Lexer::new(bytes, span.clone());
         loop {
             // Most tokens are plain words: read without the general path.
@@ -477,57 +528,7 @@ impl Interpreter {
                     value,
                     form,
                 } => {
-                    if matches!(letter, b'A' | b'B' | b'C') {
-                        s.axes_form[usize::from(letter - b'A')] = form;
-                    }
-                    once(letter, wspan.start)?;
-                    // An auxiliary axis of the machine (an extruder on `A`): carried like `E`.
-                    let read_as = if self.controller.auxiliary.contains(&letter) {
-                        b'E'
-                    } else {
-                        letter
-                    };
-                    match read_as {
-                        b'X' => s.axes[X] = Some(value),
-                        b'Y' => s.axes[Y] = Some(value),
-                        b'Z' => s.axes[Z] = Some(value),
-                        b'A' => s.axes[A] = Some(value),
-                        b'B' => s.axes[B] = Some(value),
-                        b'C' => s.axes[C] = Some(value),
-                        b'F' => s.feed = Some(value),
-                        b'G' => self.g(code10(value), s),
-                        b'M' => m_code(self.dialect, &self.controller, code10(value), s),
-                        // Heidenhain ISO `T5 G17` calls the tool; elsewhere a T word
-                        // alone selects the next tool (the change is `M6`): a preselect
-                        // moves nothing and ends no run.
-                        b'T' if self.dialect == Dialect::Heidenhain => {
-                            s.flags.set(Flags::TOOL_CHANGE);
-                            s.breaks = true;
-                        }
-                        b'T' => {}
-                        b'N' => {
-                            s.number = (value >= 0.0 && value.fract() == 0.0 && value < 1e15)
-                                .then_some(value as u64);
-                        }
-                        b'R' => r_word = Some(value),
-                        // Spindle, arc centre, program number; extruder and auxiliary axes
-                        // are carried through (listed by the caller).
-                        b'S' | b'I' | b'J' | b'K' | b'E' | b'U' | b'V' | b'W' => {}
-                        // A program number or LinuxCNC o-word, a label or subprogram call.
-                        b'O' | b'L' => {
-                            s.maybe_flow = true;
-                            if letter == b'L' {
-                                s.breaks = true;
-                            }
-                        }
-                        // D/H offsets, P Q L parameters.
-                        _ => {
-                            if letter == b'H' {
-                                h_word = Some(value);
-                            }
-                            s.breaks = true
-                        }
-                    }
+                    self.word(&mut l, letter, wspan.start, value, form, s)?;
                     // Offsets fit: files are at most 4 GiB.
                     words.push(Word {
                         letter,
@@ -546,47 +547,18 @@ impl Interpreter {
                         function(&bytes[ispan.start..span.end], s);
                         break;
                     }
-                    let n = &bytes[name.clone()];
-                    if self.dialect == Dialect::Sinumerik {
-                        if n.eq_ignore_ascii_case(b"CYCLE800") {
-                            cycle800_level = Some(!cycle800_rotates(&bytes[name.end..ispan.end]));
-                        } else if n.eq_ignore_ascii_case(b"RPL") {
-                            rpl = true;
-                        } else if is_sinumerik_frame(n) {
-                            sinumerik_frame = Some(name.clone());
-                        }
-                    }
-                    self.ident(n, name, s)
+                    self.ident_token(&mut l, bytes, name, ispan, s);
                 }
                 Token::Assign {
                     letter,
                     span: aspan,
                 } => {
-                    once(letter, aspan.start)?;
-                    if let Some(i) = AXES.iter().position(|&l| l == letter) {
-                        s.axes_expr |= bit(i);
-                        s.vars[i] = macro_variable(&bytes[aspan.start + 1..aspan.end]);
-                    } else if letter == b'F' {
-                        s.feed_expr = true;
-                        s.vars[6] = macro_variable(&bytes[aspan.start + 1..aspan.end]);
-                    } else if letter == b'O' {
-                        // `o<name> call`, `o<name> sub`: LinuxCNC program flow.
-                        s.unknown_after = true;
-                        s.breaks = true;
-                        s.maybe_flow = true;
-                    } else if !matches!(letter, b'R' | b'S') {
-                        s.breaks = true;
-                    }
+                    l.once(letter, aspan.start)?;
+                    assignment(letter, &bytes[aspan.start + 1..aspan.end], s);
                 }
                 Token::Indexed { letter, .. } => crate::millplus::indexed(self.dialect, letter, s),
                 Token::Percent { span } => {
-                    for w in bytes[span].split(|b| b.is_ascii_whitespace()) {
-                        if w.eq_ignore_ascii_case(b"G70") {
-                            s.inch = Some(true);
-                        } else if w.eq_ignore_ascii_case(b"G71") {
-                            s.inch = Some(false);
-                        }
-                    }
+                    percent_units(&bytes[span], s);
                     // `%NAME` in a Heidenhain ISO block calls another program.
                     s.maybe_flow |= self.dialect == Dialect::Heidenhain;
                 }
@@ -620,11 +592,11 @@ impl Interpreter {
         }
         self.frames_after_words(
             s,
-            h_word,
-            r_word,
-            sinumerik_frame.map(|r| &bytes[r]),
-            rpl,
-            cycle800_level,
+            l.h_word,
+            l.r_word,
+            l.sinumerik_frame.map(|r| &bytes[r]),
+            l.rpl,
+            l.cycle800_level,
         );
         if s.maybe_flow {
             s.flow = crate::statements::read_iso(self.dialect, bytes, span.clone());
@@ -633,6 +605,92 @@ impl Interpreter {
         Ok(())
     }
 
+    /// A word with a plain number (`letter` at `at`, its `value` and rotary `form`).
+    fn word(
+        &self,
+        l: &mut IsoLine,
+        letter: u8,
+        at: usize,
+        value: f64,
+        form: RotaryForm,
+        s: &mut Scan,
+    ) -> Result<(), ParseError> {
+        if matches!(letter, b'A' | b'B' | b'C') {
+            s.axes_form[usize::from(letter - b'A')] = form;
+        }
+        l.once(letter, at)?;
+        // An auxiliary axis of the machine (an extruder on `A`): carried like `E`.
+        let read_as = if self.controller.auxiliary.contains(&letter) {
+            b'E'
+        } else {
+            letter
+        };
+        match read_as {
+            b'X' => s.axes[X] = Some(value),
+            b'Y' => s.axes[Y] = Some(value),
+            b'Z' => s.axes[Z] = Some(value),
+            b'A' => s.axes[A] = Some(value),
+            b'B' => s.axes[B] = Some(value),
+            b'C' => s.axes[C] = Some(value),
+            b'F' => s.feed = Some(value),
+            b'G' => self.g(code10(value), s),
+            b'M' => m_code(self.dialect, &self.controller, code10(value), s),
+            // Heidenhain ISO `T5 G17` calls the tool; elsewhere a T word
+            // alone selects the next tool (the change is `M6`): a preselect
+            // moves nothing and ends no run.
+            b'T' if self.dialect == Dialect::Heidenhain => {
+                s.flags.set(Flags::TOOL_CHANGE);
+                s.breaks = true;
+            }
+            b'T' => {}
+            b'N' => {
+                s.number =
+                    (value >= 0.0 && value.fract() == 0.0 && value < 1e15).then_some(value as u64);
+            }
+            b'R' => l.r_word = Some(value),
+            // Spindle, arc centre, program number; extruder and auxiliary axes
+            // are carried through (listed by the caller).
+            b'S' | b'I' | b'J' | b'K' | b'E' | b'U' | b'V' | b'W' => {}
+            // A program number or LinuxCNC o-word, a label or subprogram call.
+            b'O' | b'L' => {
+                s.maybe_flow = true;
+                if letter == b'L' {
+                    s.breaks = true;
+                }
+            }
+            // D/H offsets, P Q L parameters.
+            _ => {
+                if letter == b'H' {
+                    l.h_word = Some(value);
+                }
+                s.breaks = true
+            }
+        }
+        Ok(())
+    }
+
+    /// An identifier token (`name`, the token at `ispan`) other than Heidenhain's
+    /// `FUNCTION`: Sinumerik's frame instructions are noted for after the words.
+    fn ident_token(
+        &self,
+        l: &mut IsoLine,
+        bytes: &[u8],
+        name: Range<usize>,
+        ispan: Range<usize>,
+        s: &mut Scan,
+    ) {
+        let n = &bytes[name.clone()];
+        if self.dialect == Dialect::Sinumerik {
+            if n.eq_ignore_ascii_case(b"CYCLE800") {
+                l.cycle800_level = Some(!cycle800_rotates(&bytes[name.end..ispan.end]));
+            } else if n.eq_ignore_ascii_case(b"RPL") {
+                l.rpl = true;
+            } else if is_sinumerik_frame(n) {
+                l.sinumerik_frame = Some(name.clone());
+            }
+        }
+        self.ident(n, name, s)
+    }
     /// The frame transformations of a block, once its words are read.
     fn frames_after_words(
         &self,
@@ -762,8 +820,64 @@ impl Interpreter {
         self.constants(s);
         // G92 shifts the axes it names: a datum shift of ours only where it names one.
         s.datum_shift |= s.g92 && (s.axes.iter().any(Option::is_some) || s.axes_expr != 0);
+        self.follow_flow(s, line);
+        // A Heidenhain control (ISO or conversational) turns a plain rotary word the way it
+        // is written unless M126 is active; the machine's endless axes count elsewhere.
+        let endless_axes = if matches!(self.dialect, Dialect::Heidenhain | Dialect::Conversational)
+        {
+            [false; 3]
+        } else {
+            self.endless
+        };
+        let pos_before = self.modal.pos;
+        let mut out = Outcome {
+            breaks: s.breaks,
+            flags: s.flags,
+            is_move: false,
+        };
+        self.apply_modes(s, &mut out);
+        self.apply_tcpm(s, &mut out);
+        self.apply_feed_mode(s, &mut out);
+        let scale = if self.modal.inch { 25.4 } else { 1.0 };
+        self.lookalike = s.lookalike.take();
+        if s.stated_datum {
+            let v = |i: usize| s.axes[i].unwrap_or(0.0) * scale;
+            self.stated_datum = Some([v(X), v(Y), v(Z)]);
+        } else if s.datum_shift || s.work_offset {
+            self.frame_changed = true;
+        }
+        self.apply_feed(s, scale);
+        apply_positions(&mut self.modal, s, scale, &mut out);
+        let m = &self.modal;
+        if s.axes_incremental != 0 {
+            out.flags.set(Flags::INCREMENTAL_WORDS);
+            out.breaks = true;
+        }
+        if out.is_move && !out.breaks && m.motion == Motion::Linear && !m.incremental {
+            let endless = |k: usize| endless_axes[k - A] || m.shortest_path;
+            if wrap_axis(s, &pos_before, &m.pos, endless).is_some() {
+                out.flags.set(Flags::ROTARY_WRAP);
+                out.breaks = true;
+            }
+        }
+        // Offsets fit: files are at most 4 GiB.
+        Block {
+            line,
+            start: span.start as u32,
+            end: span.end as u32,
+            words_start: words.start as u32,
+            words_end: words.end as u32,
+            state: 0,
+            is_move: out.is_move,
+            breaks_run: out.breaks,
+            flags: out.flags,
+        }
+    }
+
+    /// Program flow before the block: the state the flow plan settles at its line
+    /// ([`crate::flow`]), and the block's flow events for the recorder of a first read.
+    fn follow_flow(&mut self, s: &Scan, line: usize) {
         let always = self.controller.always;
-        // Before the block: what program flow settles ([`crate::flow`]).
         if let Some(plan) = &self.plan {
             let (tcpm, join) = self.cursor.at(plan, line);
             if let Some(t) = tcpm {
@@ -788,22 +902,16 @@ impl Interpreter {
                 number: s.number,
             });
         }
-        // A Heidenhain control (ISO or conversational) turns a plain rotary word the way it
-        // is written unless M126 is active; the machine's endless axes count elsewhere.
-        let endless_axes = if matches!(self.dialect, Dialect::Heidenhain | Dialect::Conversational)
-        {
-            [false; 3]
-        } else {
-            self.endless
-        };
+    }
+
+    /// The modes the block sets: shortest path, motion, canned cycle, incremental, units,
+    /// frame transformations.
+    fn apply_modes(&mut self, s: &Scan, out: &mut Outcome) {
         let m = &mut self.modal;
-        let pos_before = m.pos;
-        let mut breaks = s.breaks;
-        let mut flags = s.flags;
         if let Some(sp) = s.shortest_path {
             m.shortest_path = sp;
         }
-        if flags.has(Flags::PROGRAM_END) {
+        if out.flags.has(Flags::PROGRAM_END) {
             // "At the end of program, M126 is automatically canceled" (Heidenhain).
             m.shortest_path = false;
         }
@@ -825,17 +933,23 @@ impl Interpreter {
         }
         if let Some(inch) = s.inch {
             m.inch = inch;
-            flags.set(Flags::UNITS);
+            out.flags.set(Flags::UNITS);
         }
         m.transform = (m.transform & !s.transform_off) | s.transform_on;
+    }
+
+    /// TCPM after the block: its switch, and code it runs that may switch it.
+    fn apply_tcpm(&mut self, s: &Scan, out: &mut Outcome) {
+        let always = self.controller.always;
+        let m = &mut self.modal;
         if let Some(sw) = s.tcpm {
             if !always {
-                m.tcpm = m.tcpm.switched(sw.state(), flags.has(Flags::SKIPPABLE));
+                m.tcpm = m.tcpm.switched(sw.state(), out.flags.has(Flags::SKIPPABLE));
             }
             if sw == Switch::On {
                 m.tcpm_centre = s.tcpm_centre;
             }
-            breaks = true;
+            out.breaks = true;
         }
         if !always {
             match &s.flow {
@@ -850,22 +964,24 @@ impl Interpreter {
                 m.tcpm = Tcpm::Unknown;
             }
         }
+    }
+
+    /// The feed mode (per minute, inverse time, per revolution): a change forgets the feed.
+    fn apply_feed_mode(&mut self, s: &Scan, out: &mut Outcome) {
+        let m = &mut self.modal;
         if let Some(fm) = s.feed_mode
             && fm != m.feed_mode
         {
             m.feed_mode = fm;
             m.feed_mm_min = None;
-            breaks = true;
+            out.breaks = true;
         }
         m.inverse_time_per_min = None;
-        let scale = if m.inch { 25.4 } else { 1.0 };
-        self.lookalike = s.lookalike.take();
-        if s.stated_datum {
-            let v = |i: usize| s.axes[i].unwrap_or(0.0) * scale;
-            self.stated_datum = Some([v(X), v(Y), v(Z)]);
-        } else if s.datum_shift || s.work_offset {
-            self.frame_changed = true;
-        }
+    }
+
+    /// The feed the block states, in mm/min (`scale`: mm per program unit).
+    fn apply_feed(&mut self, s: &Scan, scale: f64) {
+        let m = &mut self.modal;
         if s.feed_expr || s.feed_unknown {
             m.feed_mm_min = None;
         } else if let Some(f) = s.feed {
@@ -883,100 +999,92 @@ impl Interpreter {
                 FeedMode::PerRevolution => m.feed_mm_min = None,
             }
         }
-        let has_axes = s.axes.iter().any(Option::is_some) || s.axes_expr != 0;
-        let mut is_move = false;
-        if s.datum_shift || s.reference || s.unknown_after {
-            // Linear positions unknown afterwards; so are rotary axes named in the block.
-            for (i, p) in m.pos.iter_mut().enumerate() {
-                if i < A || s.axes[i].is_some() || s.axes_expr & bit(i) != 0 || s.unknown_after {
-                    *p = None;
-                }
+    }
+}
+
+/// What [`Interpreter::apply`] finds out about a block as it goes.
+struct Outcome {
+    /// The block ends a run.
+    breaks: bool,
+    flags: Flags,
+    /// The block moves the tool.
+    is_move: bool,
+}
+
+/// The positions after the block (`scale`: mm per program unit of a linear value), and
+/// whether it moves.
+fn apply_positions(m: &mut Modal, s: &Scan, scale: f64, out: &mut Outcome) {
+    let has_axes = s.axes.iter().any(Option::is_some) || s.axes_expr != 0;
+    if s.datum_shift || s.reference || s.unknown_after {
+        // Linear positions unknown afterwards; so are rotary axes named in the block.
+        for (i, p) in m.pos.iter_mut().enumerate() {
+            if i < A || s.axes[i].is_some() || s.axes_expr & bit(i) != 0 || s.unknown_after {
+                *p = None;
             }
-            is_move = s.reference && has_axes;
-            breaks = true;
-        } else if s.no_move {
-            breaks = true;
+        }
+        out.is_move = s.reference && has_axes;
+        out.breaks = true;
+        return;
+    }
+    if s.no_move {
+        out.breaks = true;
+        return;
+    }
+    if s.work_offset {
+        m.pos[X] = None;
+        m.pos[Y] = None;
+        m.pos[Z] = None;
+        out.breaks = true;
+    }
+    for (i, v) in s.axes.iter().enumerate() {
+        let form = if i >= A {
+            s.axes_form[i - A]
         } else {
-            if s.work_offset {
-                m.pos[X] = None;
-                m.pos[Y] = None;
-                m.pos[Z] = None;
-                breaks = true;
+            RotaryForm::Plain
+        };
+        if let Some(v) = *v
+            && form.is_directional()
+        {
+            // A position modulo 360 and a direction (absolute in G91 too): the
+            // controller's unwrapped position follows from where the axis is; from
+            // an unknown position, the value itself (the same pose). DC to a half
+            // turn names no direction: unknown.
+            m.pos[i] = match m.pos[i] {
+                Some(p) => form.delta(p, v).map(|d| p + d),
+                None => Some(v.rem_euclid(360.0)),
+            };
+            if m.pos[i].is_none() {
+                out.breaks = true;
             }
-            for (i, v) in s.axes.iter().enumerate() {
-                let form = if i >= A {
-                    s.axes_form[i - A]
-                } else {
-                    RotaryForm::Plain
-                };
-                if let Some(v) = *v
-                    && form.is_directional()
-                {
-                    // A position modulo 360 and a direction (absolute in G91 too): the
-                    // controller's unwrapped position follows from where the axis is; from
-                    // an unknown position, the value itself (the same pose). DC to a half
-                    // turn names no direction: unknown.
-                    m.pos[i] = match m.pos[i] {
-                        Some(p) => form.delta(p, v).map(|d| p + d),
-                        None => Some(v.rem_euclid(360.0)),
-                    };
-                    if m.pos[i].is_none() {
-                        breaks = true;
-                    }
-                } else if let Some(v) = *v {
-                    let v = if i < A { v * scale } else { v };
-                    m.pos[i] = if m.incremental || s.axes_incremental & bit(i) != 0 {
-                        m.pos[i].map(|p| p + v)
-                    } else {
-                        Some(v)
-                    };
-                }
-                if s.axes_expr & bit(i) != 0 {
-                    m.pos[i] = None;
-                }
-            }
-            if s.xy_unknown_after {
-                m.pos[X] = None;
-                m.pos[Y] = None;
-            }
-            if m.canned_cycle && has_axes {
-                // A hole: the tool goes down and back to a plane the reader does not
-                // follow.
-                m.pos[Z] = None;
-                is_move = true;
-                breaks = true;
-            } else if has_axes || s.xy_unknown_after {
-                is_move = m.motion != Motion::None;
-                if m.motion != Motion::Linear {
-                    breaks = true;
-                }
-                if matches!(m.motion, Motion::ArcCw | Motion::ArcCcw) {
-                    flags.set(Flags::ARC);
-                }
-            }
+        } else if let Some(v) = *v {
+            let v = if i < A { v * scale } else { v };
+            m.pos[i] = if m.incremental || s.axes_incremental & bit(i) != 0 {
+                m.pos[i].map(|p| p + v)
+            } else {
+                Some(v)
+            };
         }
-        if s.axes_incremental != 0 {
-            flags.set(Flags::INCREMENTAL_WORDS);
-            breaks = true;
+        if s.axes_expr & bit(i) != 0 {
+            m.pos[i] = None;
         }
-        if is_move && !breaks && m.motion == Motion::Linear && !m.incremental {
-            let endless = |k: usize| endless_axes[k - A] || m.shortest_path;
-            if wrap_axis(s, &pos_before, &m.pos, endless).is_some() {
-                flags.set(Flags::ROTARY_WRAP);
-                breaks = true;
-            }
+    }
+    if s.xy_unknown_after {
+        m.pos[X] = None;
+        m.pos[Y] = None;
+    }
+    if m.canned_cycle && has_axes {
+        // A hole: the tool goes down and back to a plane the reader does not
+        // follow.
+        m.pos[Z] = None;
+        out.is_move = true;
+        out.breaks = true;
+    } else if has_axes || s.xy_unknown_after {
+        out.is_move = m.motion != Motion::None;
+        if m.motion != Motion::Linear {
+            out.breaks = true;
         }
-        // Offsets fit: files are at most 4 GiB.
-        Block {
-            line,
-            start: span.start as u32,
-            end: span.end as u32,
-            words_start: words.start as u32,
-            words_end: words.end as u32,
-            state: 0,
-            is_move,
-            breaks_run: breaks,
-            flags,
+        if matches!(m.motion, Motion::ArcCw | Motion::ArcCcw) {
+            out.flags.set(Flags::ARC);
         }
     }
 }

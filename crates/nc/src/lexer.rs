@@ -221,6 +221,15 @@ pub fn parse_number(text: &[u8]) -> Option<f64> {
     Some(if neg { -magnitude } else { magnitude })
 }
 
+/// Where the parts of a word are: its `letter` at `p`, whether `=` follows the letter, and
+/// where its value starts (`ns`).
+struct WordAt {
+    p: usize,
+    letter: u8,
+    eq: bool,
+    ns: usize,
+}
+
 /// Tokens of one line.
 pub struct Lexer<'a> {
     bytes: &'a [u8],
@@ -432,24 +441,7 @@ impl<'a> Lexer<'a> {
         let l = letter as char;
         let q = p + 1;
         let eq = q < self.end && b[q] == b'=';
-        let mut ns = if eq { q + 1 } else { q };
-        // `X  6.302`, `Y -11.56`: blanks before a number belong to the word.
-        let mut k = ns;
-        while k < self.end && is_blank(b[k]) {
-            k += 1;
-        }
-        if k > ns
-            && k < self.end
-            && (b[k].is_ascii_digit()
-                || b[k] == b'.'
-                || (matches!(b[k], b'+' | b'-')
-                    && b[k + 1..self.end]
-                        .iter()
-                        .find(|&&c| !is_blank(c))
-                        .is_some_and(|c| c.is_ascii_digit() || *c == b'.')))
-        {
-            ns = k;
-        }
+        let ns = self.value_start(if eq { q + 1 } else { q });
         if eq
             && matches!(letter, b'A' | b'B' | b'C')
             && let Some(t) = self.direction_form(p, letter, ns)
@@ -460,44 +452,10 @@ impl<'a> Lexer<'a> {
         if e < self.end && is_control(b[e]) {
             return self.err(e, control_message(b[e]));
         }
-        if is_axis(letter) && e > ds && e + 1 < self.end && matches!(b[e], b'e' | b'E') {
-            let k = if matches!(b[e + 1], b'+' | b'-') {
-                e + 2
-            } else {
-                e + 1
-            };
-            if k < self.end && b[k].is_ascii_digit() {
-                let mut x = k;
-                while x < self.end && b[x].is_ascii_digit() {
-                    x += 1;
-                }
-                return self.err(
-                    p,
-                    format!(
-                        "{l} value '{}' is in exponent notation (or an E word follows without a blank); \
-                         NC programs use plain decimals and polepatch will not guess which is meant",
-                        self.text(ns..x)
-                    ),
-                );
-            }
-        }
         if is_axis(letter)
-            && e > ds
-            && e + 1 < self.end
-            && b[e] == b','
-            && b[e + 1].is_ascii_digit()
+            && let Some(message) = self.misread_number(letter, ns, ds, e)
         {
-            let mut x = e + 1;
-            while x < self.end && b[x].is_ascii_digit() {
-                x += 1;
-            }
-            return self.err(
-                p,
-                format!(
-                    "{l} value '{}' is not a number (a decimal comma? NC programs use a point)",
-                    self.text(ns..x)
-                ),
-            );
+            return self.err(p, message);
         }
         let followed_by_expr = e < self.end
             && matches!(
@@ -508,55 +466,7 @@ impl<'a> Lexer<'a> {
             || (eq && followed_by_expr)
             || (!eq && e < self.end && matches!(b[e], b'#' | b'['))
         {
-            // Not a plain number.
-            let x = self.skip_expr(ns);
-            if is_axis(letter) {
-                let text = &b[ns..x];
-                return if text.is_empty() {
-                    self.err(p, format!("{l} word has no number"))
-                } else if matches!(text, b"+" | b"-") {
-                    self.err(
-                        p,
-                        format!("{l} value '{}' is not a number", self.text(ns..x)),
-                    )
-                } else if is_non_finite_name(text) {
-                    self.err(
-                        p,
-                        format!("{l} value '{}' is not a finite number", self.text(ns..x)),
-                    )
-                } else if is_expression_start(text) {
-                    // An expression or a variable: the reader marks the block.
-                    self.pos = x;
-                    Some(Ok(Token::Assign { letter, span: p..x }))
-                } else {
-                    self.err(
-                        p,
-                        format!("{l} value '{}' is not a number", self.text(ns..x)),
-                    )
-                };
-            }
-            if NUMBER_LETTERS.contains(&letter) && !eq && e == ds {
-                let next = b.get(e).copied().filter(|_| e < self.end);
-                if !matches!(next, Some(b'#' | b'[')) {
-                    return if e > ns {
-                        self.err(
-                            p,
-                            format!("{l} value '{}' is not a number", self.text(ns..e)),
-                        )
-                    } else {
-                        self.err(p, format!("{l} word has no number"))
-                    };
-                }
-            }
-            self.pos = x.max(q);
-            return Some(Ok(if x > q {
-                Token::Assign {
-                    letter,
-                    span: p..self.pos,
-                }
-            } else {
-                Token::Other { span: p..q }
-            }));
+            return self.not_plain(WordAt { p, letter, eq, ns }, ds, e);
         }
         let value = match fast.or_else(|| {
             let text = &b[ns..e];
@@ -601,6 +511,124 @@ impl<'a> Lexer<'a> {
             value_span: ns..e,
             value,
             form: RotaryForm::Plain,
+        }))
+    }
+
+    /// Where a word's value starts, `ns` just past its letter (and `=`): `X  6.302`,
+    /// `Y -11.56`: blanks before a number belong to the word.
+    fn value_start(&self, ns: usize) -> usize {
+        let b = self.bytes;
+        let mut k = ns;
+        while k < self.end && is_blank(b[k]) {
+            k += 1;
+        }
+        if k > ns
+            && k < self.end
+            && (b[k].is_ascii_digit()
+                || b[k] == b'.'
+                || (matches!(b[k], b'+' | b'-')
+                    && b[k + 1..self.end]
+                        .iter()
+                        .find(|&&c| !is_blank(c))
+                        .is_some_and(|c| c.is_ascii_digit() || *c == b'.')))
+        {
+            k
+        } else {
+            ns
+        }
+    }
+
+    /// Why the number of an axis word (`letter`, its value from `ns`, the digits `ds..e`)
+    /// is refused when a number in another notation runs on after it: exponent notation
+    /// (`X1.5E3`) or a decimal comma (`X1,5`).
+    fn misread_number(&self, letter: u8, ns: usize, ds: usize, e: usize) -> Option<String> {
+        let b = self.bytes;
+        let l = letter as char;
+        if e > ds && e + 1 < self.end && matches!(b[e], b'e' | b'E') {
+            let k = if matches!(b[e + 1], b'+' | b'-') {
+                e + 2
+            } else {
+                e + 1
+            };
+            if k < self.end && b[k].is_ascii_digit() {
+                let mut x = k;
+                while x < self.end && b[x].is_ascii_digit() {
+                    x += 1;
+                }
+                return Some(format!(
+                    "{l} value '{}' is in exponent notation (or an E word follows without a blank); \
+                     NC programs use plain decimals and polepatch will not guess which is meant",
+                    self.text(ns..x)
+                ));
+            }
+        }
+        if e > ds && e + 1 < self.end && b[e] == b',' && b[e + 1].is_ascii_digit() {
+            let mut x = e + 1;
+            while x < self.end && b[x].is_ascii_digit() {
+                x += 1;
+            }
+            return Some(format!(
+                "{l} value '{}' is not a number (a decimal comma? NC programs use a point)",
+                self.text(ns..x)
+            ));
+        }
+        None
+    }
+
+    /// A word whose value is not a plain number (`at`; the number scanned from its value
+    /// start is `ds..e`): an expression or variable, or an error naming the value.
+    fn not_plain(&mut self, at: WordAt, ds: usize, e: usize) -> Option<Result<Token, LexError>> {
+        let b = self.bytes;
+        let WordAt { p, letter, eq, ns } = at;
+        let l = letter as char;
+        let q = p + 1;
+        let x = self.skip_expr(ns);
+        if is_axis(letter) {
+            let text = &b[ns..x];
+            return if text.is_empty() {
+                self.err(p, format!("{l} word has no number"))
+            } else if matches!(text, b"+" | b"-") {
+                self.err(
+                    p,
+                    format!("{l} value '{}' is not a number", self.text(ns..x)),
+                )
+            } else if is_non_finite_name(text) {
+                self.err(
+                    p,
+                    format!("{l} value '{}' is not a finite number", self.text(ns..x)),
+                )
+            } else if is_expression_start(text) {
+                // An expression or a variable: the reader marks the block.
+                self.pos = x;
+                Some(Ok(Token::Assign { letter, span: p..x }))
+            } else {
+                self.err(
+                    p,
+                    format!("{l} value '{}' is not a number", self.text(ns..x)),
+                )
+            };
+        }
+        if NUMBER_LETTERS.contains(&letter) && !eq && e == ds {
+            let next = b.get(e).copied().filter(|_| e < self.end);
+            if !matches!(next, Some(b'#' | b'[')) {
+                return if e > ns {
+                    self.err(
+                        p,
+                        format!("{l} value '{}' is not a number", self.text(ns..e)),
+                    )
+                } else {
+                    self.err(p, format!("{l} word has no number"))
+                };
+            }
+        }
+        self.pos = x.max(q);
+        Some(Ok(if x > q {
+            Token::Assign {
+                letter,
+                span: p..self.pos,
+            }
+        } else {
+            Token::Other { span: p..q }
         }))
     }
 

@@ -13,9 +13,10 @@
 //!
 //! Each module imports only modules listed before it:
 //!
-//! - the basic types: `dialect.rs` ([`Dialect`]), `word.rs` ([`Word`], [`RotaryForm`]),
-//!   `block.rs` ([`Block`], [`Flags`]), [`modal`] (the state after a block: [`Modal`],
-//!   positions, TCPM), [`lines`] (line ends), [`error`];
+//! - the basic types: [`tolerances`] (named tolerances and tuning numbers), `dialect.rs`
+//!   ([`Dialect`]), `word.rs` ([`Word`], [`RotaryForm`]), `block.rs` ([`Block`], [`Flags`]),
+//!   [`modal`] (the state after a block: [`Modal`], positions, TCPM), [`lines`] (line ends),
+//!   [`error`];
 //! - [`lexer`] (the tokens of a line), [`flow`] (program flow and how it settles TCPM),
 //!   [`tcpm`] (which codes switch TCPM; [`ReadOptions`]);
 //! - reading a line: `lexed.rs` (what a line says, and what every dialect reads alike),
@@ -49,6 +50,7 @@ pub mod run;
 mod statements;
 pub mod style;
 pub mod tcpm;
+pub mod tolerances;
 mod word;
 pub mod writer;
 

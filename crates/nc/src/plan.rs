@@ -9,6 +9,8 @@
 
 use crate::modal::{AXES, X, Z};
 use crate::program::Program;
+use crate::tolerances::DIRECTION_FORM_REACH_TOL_DEG;
+use crate::word::{RotaryForm, Word};
 use crate::writer::Edit;
 pub use crate::writer::inserted_form;
 
@@ -100,10 +102,23 @@ pub struct FormConflict {
 /// direction word in the file are left as they are.
 pub fn write_direction_forms(program: &Program, edits: &mut [Edit]) -> Vec<FormConflict> {
     use crate::modal::A;
-    use std::collections::HashMap;
+    let mut conflicts = variable_conflicts(program, edits);
+    for (k, &letter) in AXES.iter().enumerate().skip(A) {
+        if program
+            .words
+            .iter()
+            .any(|w| w.letter == letter && w.form.is_directional())
+        {
+            direction_forms_of(program, edits, k, letter, &mut conflicts);
+        }
+    }
+    conflicts
+}
+
+/// The edits of words whose value is a variable or an expression (`C#105`, read as the
+/// variable's constant value): never rewritten, nor given a second word of its letter.
+fn variable_conflicts(program: &Program, edits: &[Edit]) -> Vec<FormConflict> {
     let mut conflicts = Vec::new();
-    // A word whose value is a variable or an expression (`C#105`, read as the variable's
-    // constant value): never rewritten, nor given a second word of its letter.
     for e in edits.iter() {
         let block = &program.blocks[e.block];
         let held = crate::lexer::Lexer::new(&program.bytes, block.span())
@@ -128,139 +143,185 @@ pub fn write_direction_forms(program: &Program, edits: &mut [Edit]) -> Vec<FormC
             });
         }
     }
-    for (k, &letter) in AXES.iter().enumerate().skip(A) {
-        if !program
-            .words
-            .iter()
-            .any(|w| w.letter == letter && w.form.is_directional())
-        {
-            continue;
+    conflicts
+}
+
+/// [`write_direction_forms`] for the rotary `letter` (axis index `k`), which the file
+/// writes in a direction form somewhere: from its first edit on, each block's word is
+/// written or checked from the patched position before it.
+fn direction_forms_of(
+    program: &Program,
+    edits: &mut [Edit],
+    k: usize,
+    letter: u8,
+    conflicts: &mut Vec<FormConflict>,
+) {
+    use std::collections::HashMap;
+    let by_block: HashMap<usize, usize> = edits
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| e.letter == letter)
+        .map(|(i, e)| (e.block, i))
+        .collect();
+    let Some(&first) = by_block.keys().min() else {
+        return;
+    };
+    let last = by_block.keys().copied().max().unwrap_or(first);
+    let l = letter as char;
+    // The patched position before block `b`, and the block of the last edit.
+    let mut now = program.state_before(first).pos[k];
+    let mut cause = first;
+    for b in first..program.blocks.len() {
+        let before = program.state_before(b).pos[k];
+        if b > last && now == before {
+            break;
         }
-        let by_block: HashMap<usize, usize> = edits
-            .iter()
-            .enumerate()
-            .filter(|(_, e)| e.letter == letter)
-            .map(|(i, e)| (e.block, i))
-            .collect();
-        let Some(&first) = by_block.keys().min() else {
-            continue;
+        let after = program.state(b).pos[k];
+        let word = program.word(b, letter);
+        let line = program.blocks[b].line;
+        let edit = by_block.get(&b).copied();
+        if edit.is_some() {
+            cause = b;
+        }
+        let (next, conflict) = match (word, edit) {
+            (Some(w), Some(i)) if w.form.is_directional() => {
+                edited_direction_word(w, &mut edits[i], now, line, l)
+            }
+            (Some(w), None) if w.form.is_directional() => {
+                unedited_direction_word(w, now, before, after, line, l)
+            }
+            (None, Some(i)) => {
+                // Inserted in the form of the letter's word before it.
+                let form = inserted_form(program, b, letter);
+                inserted_word(form, &mut edits[i], now, line, l)
+            }
+            (Some(_), Some(i)) => (Some(edits[i].value), None),
+            (Some(_), None) => (after, None),
+            (None, None) => (if after.is_none() { None } else { now }, None),
         };
-        let last = by_block.keys().copied().max().unwrap_or(first);
-        let l = letter as char;
-        // The patched position before block `b`, and the block of the last edit.
-        let mut now = program.state_before(first).pos[k];
-        let mut cause = first;
-        for b in first..program.blocks.len() {
-            let before = program.state_before(b).pos[k];
-            if b > last && now == before {
-                break;
-            }
-            let after = program.state(b).pos[k];
-            let word = program.word(b, letter);
-            let line = program.blocks[b].line;
-            let edit = by_block.get(&b).copied();
-            if edit.is_some() {
-                cause = b;
-            }
-            let mut conflict = |message: String| {
-                conflicts.push(FormConflict {
-                    block: b,
-                    letter,
-                    cause,
-                    message,
-                    variable: false,
-                });
-            };
-            match (word, edit) {
-                (Some(w), Some(i)) if w.form.is_directional() => {
-                    let to = edits[i].value;
-                    let form = w.form.name();
-                    let from = now.unwrap_or(to);
-                    match w.form.write(from, to, edits[i].decimals) {
-                        Ok(t) => {
-                            edits[i].value = t;
-                            now = Some(from + w.form.delta(from, t).unwrap_or(to - from));
-                        }
-                        Err(d) => {
-                            conflict(format!(
-                                "line {line}: the patched {l} moves {:+.3}° (from {from:.3} to \
-                                 {to:.3}); {l}={form}(…) {}",
-                                to - from,
-                                match d {
-                                    Some(d) => format!("would move {d:+.3}° instead"),
-                                    None => "names no direction for a half turn".into(),
-                                }
-                            ));
-                            now = Some(to);
-                        }
-                    }
-                }
-                (Some(w), None) if w.form.is_directional() => {
-                    // Unedited: from where the patch left the axis, the word moves as it
-                    // did only if it reaches the same unwrapped position.
-                    let form = w.form.name();
-                    now = match (now, after) {
-                        (Some(p), Some(a)) => {
-                            let reached = w.form.delta(p, w.value).map(|d| p + d);
-                            if reached.is_none_or(|r| (r - a).abs() > 1e-6) {
-                                conflict(format!(
-                                    "line {line}: {l}={form}({}) after the patched moves starts from \
-                                     {p:.3}, not {}, and reaches {} instead of {a:.3}",
-                                    w.value,
-                                    before.map_or("an unknown position".into(), |v| format!(
-                                        "{v:.3}"
-                                    )),
-                                    reached.map_or("no settled position".into(), |r| format!(
-                                        "{r:.3}"
-                                    )),
-                                ));
-                            }
-                            Some(a)
-                        }
-                        _ => after,
-                    };
-                }
-                (None, Some(i)) => {
-                    // Inserted in the form of the letter's word before it.
-                    let form = inserted_form(program, b, letter);
-                    let to = edits[i].value;
-                    let from = now.unwrap_or(to);
-                    if form.is_directional() {
-                        match form.write(from, to, edits[i].decimals) {
-                            Ok(t) => edits[i].value = t,
-                            Err(d) => conflict(format!(
-                                "line {line}: the patched {l} moves {:+.3}° (from {from:.3} to \
-                                 {to:.3}); an inserted {l}={}(…) {}",
-                                to - from,
-                                form.name(),
-                                match d {
-                                    Some(d) => format!("would move {d:+.3}° instead"),
-                                    None => "names no direction for a half turn".into(),
-                                }
-                            )),
-                        }
-                    } else if !(0.0..360.0).contains(&to) {
-                        // A plain word after direction words, outside [0, 360): how the
-                        // controller reads it on a modulo axis is not settled here.
-                        conflict(format!(
-                            "line {line}: the patch would insert a plain {l} word ({to:.3}, \
-                             outside [0, 360)) into a file that writes {l} in a direction form \
-                             (DC/ACP/ACN)"
-                        ));
-                    }
-                    now = Some(to);
-                }
-                (Some(_), Some(i)) => now = Some(edits[i].value),
-                (Some(_), None) => now = after,
-                (None, None) => {
-                    if after.is_none() {
-                        now = None;
-                    }
-                }
-            }
+        now = next;
+        if let Some(message) = conflict {
+            conflicts.push(FormConflict {
+                block: b,
+                letter,
+                cause,
+                message,
+                variable: false,
+            });
         }
     }
-    conflicts
+}
+
+/// An edited direction word `w` (edit `e`, the patched position before it `now`; `line`,
+/// `l`: its line and letter): the number to write, the patched position after it, and a
+/// conflict if the form cannot make the move.
+fn edited_direction_word(
+    w: &Word,
+    e: &mut Edit,
+    now: Option<f64>,
+    line: usize,
+    l: char,
+) -> (Option<f64>, Option<String>) {
+    let to = e.value;
+    let form = w.form.name();
+    let from = now.unwrap_or(to);
+    match w.form.write(from, to, e.decimals) {
+        Ok(t) => {
+            e.value = t;
+            (
+                Some(from + w.form.delta(from, t).unwrap_or(to - from)),
+                None,
+            )
+        }
+        Err(d) => (
+            Some(to),
+            Some(format!(
+                "line {line}: the patched {l} moves {:+.3}° (from {from:.3} to \
+                 {to:.3}); {l}={form}(…) {}",
+                to - from,
+                match d {
+                    Some(d) => format!("would move {d:+.3}° instead"),
+                    None => "names no direction for a half turn".into(),
+                }
+            )),
+        ),
+    }
+}
+
+/// An unedited direction word `w` after an edit: from where the patch left the axis
+/// (`now`), the word moves as it did only if it reaches the same unwrapped position as
+/// before (`after`; `before`: the position before it in the original). The patched
+/// position after it, and a conflict if it does not.
+fn unedited_direction_word(
+    w: &Word,
+    now: Option<f64>,
+    before: Option<f64>,
+    after: Option<f64>,
+    line: usize,
+    l: char,
+) -> (Option<f64>, Option<String>) {
+    let form = w.form.name();
+    match (now, after) {
+        (Some(p), Some(a)) => {
+            let reached = w.form.delta(p, w.value).map(|d| p + d);
+            let conflict = reached
+                .is_none_or(|r| (r - a).abs() > DIRECTION_FORM_REACH_TOL_DEG)
+                .then(|| {
+                    format!(
+                        "line {line}: {l}={form}({}) after the patched moves starts from \
+                         {p:.3}, not {}, and reaches {} instead of {a:.3}",
+                        w.value,
+                        before.map_or("an unknown position".into(), |v| format!("{v:.3}")),
+                        reached.map_or("no settled position".into(), |r| format!("{r:.3}")),
+                    )
+                });
+            (Some(a), conflict)
+        }
+        _ => (after, None),
+    }
+}
+
+/// A word to be inserted for edit `e` in `form` (the form of the letter's word before it),
+/// the patched position before it `now`: the number to write in a direction form, the
+/// patched position after it, and a conflict if the word cannot make the move.
+fn inserted_word(
+    form: RotaryForm,
+    e: &mut Edit,
+    now: Option<f64>,
+    line: usize,
+    l: char,
+) -> (Option<f64>, Option<String>) {
+    let to = e.value;
+    let from = now.unwrap_or(to);
+    let conflict = if form.is_directional() {
+        match form.write(from, to, e.decimals) {
+            Ok(t) => {
+                e.value = t;
+                None
+            }
+            Err(d) => Some(format!(
+                "line {line}: the patched {l} moves {:+.3}° (from {from:.3} to \
+                 {to:.3}); an inserted {l}={}(…) {}",
+                to - from,
+                form.name(),
+                match d {
+                    Some(d) => format!("would move {d:+.3}° instead"),
+                    None => "names no direction for a half turn".into(),
+                }
+            )),
+        }
+    } else if !(0.0..360.0).contains(&to) {
+        // A plain word after direction words, outside [0, 360): how the
+        // controller reads it on a modulo axis is not settled here.
+        Some(format!(
+            "line {line}: the patch would insert a plain {l} word ({to:.3}, \
+             outside [0, 360)) into a file that writes {l} in a direction form \
+             (DC/ACP/ACN)"
+        ))
+    } else {
+        None
+    };
+    (Some(to), conflict)
 }
 
 #[cfg(test)]

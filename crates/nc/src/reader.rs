@@ -13,6 +13,7 @@ use crate::lines::LineEnds;
 use crate::modal::Modal;
 use crate::style::StyleEvidence;
 use crate::tcpm::ReadOptions;
+use crate::tolerances::{MAX_SCAN_THREADS, SCAN_WINDOW_BYTES};
 use crate::word::Word;
 use std::ops::Range;
 
@@ -113,7 +114,7 @@ pub fn scan_blocks_with(
     opts: &ReadOptions,
     visit: impl FnMut(Scanned<'_>) -> std::ops::ControlFlow<()>,
 ) -> Result<Settled, ParseError> {
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get().min(MAX_SCAN_THREADS));
     scan_with(bytes, opts, threads, visit)
 }
 
@@ -282,11 +283,6 @@ fn read(
     }
     Ok(true)
 }
-
-/// Size of the windows [`scan`] lexes on several threads at a time, bytes: large enough
-/// that starting threads costs nothing, small enough that a window's words stay a small
-/// part of any program worth doing this for.
-const SCAN_WINDOW_BYTES: usize = 256 << 10;
 
 /// One part of a window, lexed: per line (its span, what it says, its words' range in
 /// `words`), up to the first error, which is kept with its line counted within the part.

@@ -4,6 +4,7 @@ use crate::modal::{A, B, C, Modal, RotaryLetters, X, Y, Z};
 
 use crate::block::Block;
 use crate::program::Program;
+pub use crate::tolerances::ZERO_LENGTH_MM;
 
 /// Why a run ended (for reports).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -66,11 +67,6 @@ impl Run {
         self.s_mm.last().copied().unwrap_or(0.0)
     }
 }
-
-/// A G1 block whose tool tip moves less than this (mm) has zero tool-tip length: it ends
-/// the current run and is not part of any run. Exact repeats give 0; the tolerance only
-/// absorbs rounding from inch conversion and incremental sums.
-pub const ZERO_LENGTH_MM: f64 = 1e-9;
 
 /// The runs of a program (each with at least 2 points), in file order.
 ///

@@ -4,6 +4,7 @@
 //! [`crate::conversational`]).
 
 use crate::flow::{Key, Nest, Stmt};
+use crate::tolerances::CODE_MATCH_TOL;
 
 /// Sinumerik frame instructions (a shift, rotation, scaling or mirror of the programmable
 /// frame).
@@ -273,31 +274,70 @@ pub(crate) fn read_iso(
 ) -> Option<Stmt> {
     use crate::Dialect;
     let t = toks(bytes, span);
-    // Skip a block number.
-    let body: &[Tok] = match t.first() {
-        Some(Tok::Word(b'N', _)) => &t[1..],
-        _ => &t,
-    };
-    let word = |l: u8| {
-        body.iter().find_map(|x| match x {
-            Tok::Word(c, v) if *c == l => Some(*v),
+    let line = Line::new(&t);
+    match dialect {
+        Dialect::Heidenhain => heidenhain(&line),
+        Dialect::Sinumerik => sinumerik(&line),
+        _ => linuxcnc_o_word(&line).or_else(|| fanuc(&line)),
+    }
+}
+
+/// The tokens of a line, and the questions every dialect's reading asks of them.
+struct Line<'a> {
+    /// Every token.
+    all: &'a [Tok],
+    /// The tokens after the block number, if there is one.
+    body: &'a [Tok],
+}
+
+impl<'a> Line<'a> {
+    fn new(all: &'a [Tok]) -> Self {
+        // Skip a block number.
+        let body: &[Tok] = match all.first() {
+            Some(Tok::Word(b'N', _)) => &all[1..],
+            _ => all,
+        };
+        Line { all, body }
+    }
+
+    /// Whether the line starts with a block number.
+    fn numbered(&self) -> bool {
+        matches!(self.all.first(), Some(Tok::Word(b'N', _)))
+    }
+
+    /// The value of the first word of `letter`.
+    fn word(&self, letter: u8) -> Option<f64> {
+        self.body.iter().find_map(|x| match x {
+            Tok::Word(c, v) if *c == letter => Some(*v),
             _ => None,
         })
-    };
-    let ident_at = |name: &str| {
-        body.iter()
+    }
+
+    /// Where the identifier `name` stands (also with a number right after it: `DO1`).
+    fn ident_at(&self, name: &str) -> Option<usize> {
+        self.body
+            .iter()
             .position(|x| matches!(x, Tok::Ident(s) if s == name || (s.starts_with(name) && s[name.len()..].bytes().all(|b| b.is_ascii_digit()))))
-    };
-    let m = |code: f64| {
-        body.iter()
-            .any(|x| matches!(x, Tok::Word(b'M', v) if (*v - code).abs() < 1e-9))
-    };
-    let g = |code: f64| {
-        body.iter()
-            .any(|x| matches!(x, Tok::Word(b'G', v) if (*v - code).abs() < 1e-9))
-    };
-    // A jump's target: a number (block), `N100`, or a label name.
-    let target_after = |i: usize, name_len: usize| -> Option<Key> {
+    }
+
+    /// Whether the line holds the M code `code`.
+    fn m(&self, code: f64) -> bool {
+        self.body
+            .iter()
+            .any(|x| matches!(x, Tok::Word(b'M', v) if (*v - code).abs() < CODE_MATCH_TOL))
+    }
+
+    /// Whether the line holds the G code `code`.
+    fn g(&self, code: f64) -> bool {
+        self.body
+            .iter()
+            .any(|x| matches!(x, Tok::Word(b'G', v) if (*v - code).abs() < CODE_MATCH_TOL))
+    }
+
+    /// A jump's target: a number (block), `N100`, or a label name, after the keyword at `i`
+    /// whose name is `name_len` long.
+    fn target_after(&self, i: usize, name_len: usize) -> Option<Key> {
+        let body = self.body;
         if let Some(Tok::Ident(s)) = body.get(i)
             && s.len() > name_len
         {
@@ -309,251 +349,281 @@ pub(crate) fn read_iso(
             Some(Tok::Ident(s)) => Some(Key::Label(s.clone())),
             _ => None,
         }
-    };
-    match dialect {
-        Dialect::Heidenhain => {
-            // `G98 L1` label, `G98 L0` return; `L1,0` call (`L1,3`: three more times).
-            // (`G99 T1 L+0 R+2` defines a tool: its L is a length.)
-            if let Some(l) = word(b'L')
-                && !g(99.0)
-            {
-                let n = whole(l)?;
-                if g(98.0) {
-                    return Some(if n == 0 {
-                        Stmt::Return {
-                            falls_through: true,
-                        }
-                    } else {
-                        Stmt::Label(Key::Label(n.to_string()))
-                    });
+    }
+}
+
+/// Heidenhain ISO: `G98 L` labels and returns, `L1,0` calls, `%NAME` calls of other
+/// programs.
+fn heidenhain(line: &Line<'_>) -> Option<Stmt> {
+    let body = line.body;
+    // `G98 L1` label, `G98 L0` return; `L1,0` call (`L1,3`: three more times).
+    // (`G99 T1 L+0 R+2` defines a tool: its L is a length.)
+    if let Some(l) = line.word(b'L')
+        && !line.g(99.0)
+    {
+        let n = whole(l)?;
+        if line.g(98.0) {
+            return Some(if n == 0 {
+                Stmt::Return {
+                    falls_through: true,
                 }
-                let rep = body.iter().find_map(|x| match x {
-                    Tok::Other(o) if o.first() == Some(&b',') => whole_text(&o[1..]),
-                    _ => None,
-                })?;
-                return Some(Stmt::Call {
-                    key: Key::Label(n.to_string()),
-                    repeats: rep > 0,
-                });
-            }
-            // `N50 %NAME *` inside a numbered block: another program is called (the header
-            // and end lines name the unit, `%NAME G71`; `% TEXT` with a blank is not a call).
-            let numbered = matches!(t.first(), Some(Tok::Word(b'N', _)));
-            let called = numbered
-                && body.iter().any(|x| match x {
-                    Tok::Other(o) if o.first() == Some(&b'%') => {
-                        let up = o.to_ascii_uppercase();
-                        o.get(1)
-                            .is_some_and(|c| c.is_ascii_alphanumeric() || *c == b'_')
-                            && !up.windows(3).any(|w| w == b"G70" || w == b"G71")
-                    }
-                    _ => false,
-                });
-            called.then_some(Stmt::External)
-        }
-        Dialect::Sinumerik => {
-            // `NAME:` label (a name followed by a colon at the start of the block).
-            if let (Some(Tok::Ident(name)), Some(Tok::Other(o))) = (body.first(), body.get(1))
-                && o.first() == Some(&b':')
-            {
-                return Some(Stmt::Label(Key::Label(name.clone())));
-            }
-            for name in ["GOTOF", "GOTOB", "GOTOC", "GOTO"] {
-                if let Some(i) = body
-                    .iter()
-                    .position(|x| matches!(x, Tok::Ident(s) if s == name))
-                {
-                    let cond = ident_at("IF").is_some() || name == "GOTOC";
-                    return Some(match target_after(i, name.len()) {
-                        Some(key) => Stmt::Jump { key, cond },
-                        None => Stmt::Opaque,
-                    });
-                }
-            }
-            let first_ident = body.iter().find_map(|x| match x {
-                Tok::Ident(s) => Some(s.as_str()),
-                _ => None,
+            } else {
+                Stmt::Label(Key::Label(n.to_string()))
             });
-            match first_ident {
-                Some("IF" | "WHILE" | "FOR" | "LOOP") => {
-                    return Some(Stmt::Nested {
-                        role: Nest::Open,
-                        tag: 0,
-                    });
-                }
-                Some("REPEAT") => {
-                    // `REPEAT` alone opens a loop; with labels it repeats a section.
-                    let args = body.iter().skip(1).any(|x| matches!(x, Tok::Ident(_)));
-                    return Some(if args {
-                        Stmt::Opaque
-                    } else {
-                        Stmt::Nested {
-                            role: Nest::Open,
-                            tag: 0,
-                        }
-                    });
-                }
-                Some("REPEATB" | "CASE") => return Some(Stmt::Opaque),
-                Some("ELSE") => {
-                    return Some(Stmt::Nested {
-                        role: Nest::Middle,
-                        tag: 0,
-                    });
-                }
-                Some("ENDIF" | "ENDWHILE" | "ENDFOR" | "ENDLOOP" | "UNTIL") => {
-                    return Some(Stmt::Nested {
-                        role: Nest::Close,
-                        tag: 0,
-                    });
-                }
-                Some("RET") => {
-                    return Some(Stmt::Return {
-                        falls_through: false,
-                    });
-                }
-                _ => {}
-            }
-            if m(17.0) {
-                return Some(Stmt::Return {
-                    falls_through: false,
-                });
-            }
-            if let Some(i) = ident_at("MCALL") {
-                // A modal call of a standard cycle keeps TCPM; of anything else, every
-                // later move calls it.
-                return match body.get(i + 1) {
-                    Some(Tok::Ident(s)) if !s.starts_with("CYCLE") => Some(Stmt::Opaque),
-                    _ => None,
-                };
-            }
-            if word(b'L').is_some()
-                || body
-                    .iter()
-                    .any(|x| matches!(x, Tok::Ident(s) if matches!(s.as_str(), "CALL" | "PCALL" | "EXTCALL")))
-            {
-                return Some(Stmt::External);
-            }
-            // The first identifier of the block, not an instruction and not assigned to:
-            // a subprogram's name.
-            let first = body.iter().position(|x| matches!(x, Tok::Ident(_)))?;
-            let Tok::Ident(name) = &body[first] else {
-                return None;
-            };
-            let assigned =
-                matches!(body.get(first + 1), Some(Tok::Other(o)) if o.first() == Some(&b'='));
-            let call = !assigned
-                && !SINUMERIK_INSTRUCTIONS.contains(&name.as_str())
-                && !name.starts_with("CYCLE")
-                && !name.starts_with("TRA")
-                && !is_sinumerik_frame(name.as_bytes());
-            call.then_some(Stmt::External)
         }
-        _ => {
-            // LinuxCNC o-words.
-            if let Some(Tok::Other(o)) = body.first()
-                && o.eq_ignore_ascii_case(b"o")
-                && let (Some(Tok::Other(name)), Some(Tok::Ident(kw))) = (body.get(1), body.get(2))
-            {
-                return Some(o_word(
-                    &format!("O{}", String::from_utf8_lossy(name).to_ascii_uppercase()),
-                    kw,
-                ));
+        let rep = body.iter().find_map(|x| match x {
+            Tok::Other(o) if o.first() == Some(&b',') => whole_text(&o[1..]),
+            _ => None,
+        })?;
+        return Some(Stmt::Call {
+            key: Key::Label(n.to_string()),
+            repeats: rep > 0,
+        });
+    }
+    // `N50 %NAME *` inside a numbered block: another program is called (the header
+    // and end lines name the unit, `%NAME G71`; `% TEXT` with a blank is not a call).
+    let called = line.numbered()
+        && body.iter().any(|x| match x {
+            Tok::Other(o) if o.first() == Some(&b'%') => {
+                let up = o.to_ascii_uppercase();
+                o.get(1)
+                    .is_some_and(|c| c.is_ascii_alphanumeric() || *c == b'_')
+                    && !up.windows(3).any(|w| w == b"G70" || w == b"G71")
             }
-            if let (Some(Tok::Word(b'O', v)), Some(Tok::Ident(kw))) = (body.first(), body.get(1)) {
-                return Some(o_word(&format!("O{v}"), kw));
-            }
-            // A Fanuc program number starts a (sub)program.
-            if let (Some(Tok::Word(b'O', v)), None) = (t.first(), t.get(1)) {
-                return whole(*v).map(|n| Stmt::Label(Key::Program(n)));
-            }
-            if let Some(i) = ident_at("GOTO") {
-                let cond = ident_at("IF").is_some_and(|k| k < i);
-                return Some(match target_after(i, 4) {
-                    Some(Key::Block(n)) => Stmt::Jump {
-                        key: Key::Block(n),
-                        cond,
-                    },
-                    _ => Stmt::Opaque,
-                });
-            }
-            // Fanuc loops: `WHILE [...] DO 1` … `END 1` (also `DO1`, `END1`).
-            let loop_tag = |i: usize, name: &str| -> u32 {
-                let n = match (&body[i], body.get(i + 1)) {
-                    (Tok::Ident(s), _) if s.len() > name.len() => {
-                        whole_text(&s.as_bytes()[name.len()..])
-                    }
-                    (_, Some(Tok::Other(o))) => whole_text(o),
-                    _ => None,
-                };
-                n.and_then(|n| u32::try_from(n).ok()).unwrap_or(0)
-            };
-            if let Some(i) = ident_at("DO") {
-                return Some(Stmt::Nested {
-                    role: Nest::Open,
-                    tag: loop_tag(i, "DO"),
-                });
-            }
-            if let Some(i) = ident_at("END") {
-                return Some(Stmt::Nested {
-                    role: Nest::Close,
-                    tag: loop_tag(i, "END"),
-                });
-            }
-            let p = word(b'P').and_then(whole);
-            let repeat = word(b'L').and_then(whole).is_some_and(|l| l > 1);
-            if m(98.0) {
-                return Some(match p {
-                    // `M98 P32000`: three times program 2000 (the old form, count first).
-                    Some(p) if p > 9999 => Stmt::Call {
-                        key: Key::Program(p % 10000),
-                        repeats: p / 10000 > 1 || repeat,
-                    },
-                    Some(p) => Stmt::Call {
-                        key: Key::Program(p),
-                        repeats: repeat,
-                    },
-                    None => Stmt::External,
-                });
-            }
-            if m(97.0) {
-                return Some(match p {
-                    Some(p) => Stmt::Call {
-                        key: Key::Block(p),
-                        repeats: repeat,
-                    },
-                    None => Stmt::Opaque,
-                });
-            }
-            if m(99.0) {
-                return Some(if p.is_some() {
-                    Stmt::Opaque
-                } else {
-                    Stmt::Return {
-                        falls_through: false,
-                    }
-                });
-            }
-            if g(65.0) {
-                return Some(match p {
-                    Some(p) => Stmt::Call {
-                        key: Key::Program(p),
-                        repeats: repeat,
-                    },
-                    None => Stmt::External,
-                });
-            }
-            if g(66.0) || g(66.1) {
-                return Some(Stmt::Opaque);
-            }
-            if m(198.0) {
-                return Some(Stmt::External);
-            }
-            if m(6.0) {
-                return Some(Stmt::ToolChange);
-            }
-            None
+            _ => false,
+        });
+    called.then_some(Stmt::External)
+}
+
+/// Sinumerik: labels, jumps, structured statements, returns, and calls (by keyword or by a
+/// subprogram's name).
+fn sinumerik(line: &Line<'_>) -> Option<Stmt> {
+    let body = line.body;
+    // `NAME:` label (a name followed by a colon at the start of the block).
+    if let (Some(Tok::Ident(name)), Some(Tok::Other(o))) = (body.first(), body.get(1))
+        && o.first() == Some(&b':')
+    {
+        return Some(Stmt::Label(Key::Label(name.clone())));
+    }
+    for name in ["GOTOF", "GOTOB", "GOTOC", "GOTO"] {
+        if let Some(i) = body
+            .iter()
+            .position(|x| matches!(x, Tok::Ident(s) if s == name))
+        {
+            let cond = line.ident_at("IF").is_some() || name == "GOTOC";
+            return Some(match line.target_after(i, name.len()) {
+                Some(key) => Stmt::Jump { key, cond },
+                None => Stmt::Opaque,
+            });
         }
     }
+    if let Some(stmt) = sinumerik_keyword(body) {
+        return Some(stmt);
+    }
+    if line.m(17.0) {
+        return Some(Stmt::Return {
+            falls_through: false,
+        });
+    }
+    if let Some(i) = line.ident_at("MCALL") {
+        // A modal call of a standard cycle keeps TCPM; of anything else, every
+        // later move calls it.
+        return match body.get(i + 1) {
+            Some(Tok::Ident(s)) if !s.starts_with("CYCLE") => Some(Stmt::Opaque),
+            _ => None,
+        };
+    }
+    if line.word(b'L').is_some()
+        || body.iter().any(
+            |x| matches!(x, Tok::Ident(s) if matches!(s.as_str(), "CALL" | "PCALL" | "EXTCALL")),
+        )
+    {
+        return Some(Stmt::External);
+    }
+    sinumerik_named_call(body)
+}
+
+/// The Sinumerik structured statement or return the block's first identifier is, if it is
+/// one.
+fn sinumerik_keyword(body: &[Tok]) -> Option<Stmt> {
+    let first_ident = body.iter().find_map(|x| match x {
+        Tok::Ident(s) => Some(s.as_str()),
+        _ => None,
+    });
+    match first_ident {
+        Some("IF" | "WHILE" | "FOR" | "LOOP") => Some(Stmt::Nested {
+            role: Nest::Open,
+            tag: 0,
+        }),
+        Some("REPEAT") => {
+            // `REPEAT` alone opens a loop; with labels it repeats a section.
+            let args = body.iter().skip(1).any(|x| matches!(x, Tok::Ident(_)));
+            Some(if args {
+                Stmt::Opaque
+            } else {
+                Stmt::Nested {
+                    role: Nest::Open,
+                    tag: 0,
+                }
+            })
+        }
+        Some("REPEATB" | "CASE") => Some(Stmt::Opaque),
+        Some("ELSE") => Some(Stmt::Nested {
+            role: Nest::Middle,
+            tag: 0,
+        }),
+        Some("ENDIF" | "ENDWHILE" | "ENDFOR" | "ENDLOOP" | "UNTIL") => Some(Stmt::Nested {
+            role: Nest::Close,
+            tag: 0,
+        }),
+        Some("RET") => Some(Stmt::Return {
+            falls_through: false,
+        }),
+        _ => None,
+    }
+}
+
+/// A Sinumerik subprogram called by its name: the first identifier of the block, not an
+/// instruction and not assigned to.
+fn sinumerik_named_call(body: &[Tok]) -> Option<Stmt> {
+    let first = body.iter().position(|x| matches!(x, Tok::Ident(_)))?;
+    let Tok::Ident(name) = &body[first] else {
+        return None;
+    };
+    let assigned = matches!(body.get(first + 1), Some(Tok::Other(o)) if o.first() == Some(&b'='));
+    let call = !assigned
+        && !SINUMERIK_INSTRUCTIONS.contains(&name.as_str())
+        && !name.starts_with("CYCLE")
+        && !name.starts_with("TRA")
+        && !is_sinumerik_frame(name.as_bytes());
+    call.then_some(Stmt::External)
+}
+
+/// LinuxCNC o-words (`o<name> call`, `o100 sub`), if the line is one.
+fn linuxcnc_o_word(line: &Line<'_>) -> Option<Stmt> {
+    let body = line.body;
+    if let Some(Tok::Other(o)) = body.first()
+        && o.eq_ignore_ascii_case(b"o")
+        && let (Some(Tok::Other(name)), Some(Tok::Ident(kw))) = (body.get(1), body.get(2))
+    {
+        return Some(o_word(
+            &format!("O{}", String::from_utf8_lossy(name).to_ascii_uppercase()),
+            kw,
+        ));
+    }
+    if let (Some(Tok::Word(b'O', v)), Some(Tok::Ident(kw))) = (body.first(), body.get(1)) {
+        return Some(o_word(&format!("O{v}"), kw));
+    }
+    None
+}
+
+/// Fanuc and Haas (and what LinuxCNC shares with them): program numbers, `GOTO`, loops,
+/// calls and returns, the tool change.
+fn fanuc(line: &Line<'_>) -> Option<Stmt> {
+    // A Fanuc program number starts a (sub)program.
+    if let (Some(Tok::Word(b'O', v)), None) = (line.all.first(), line.all.get(1)) {
+        return whole(*v).map(|n| Stmt::Label(Key::Program(n)));
+    }
+    if let Some(i) = line.ident_at("GOTO") {
+        let cond = line.ident_at("IF").is_some_and(|k| k < i);
+        return Some(match line.target_after(i, 4) {
+            Some(Key::Block(n)) => Stmt::Jump {
+                key: Key::Block(n),
+                cond,
+            },
+            _ => Stmt::Opaque,
+        });
+    }
+    if let Some(stmt) = fanuc_loop(line) {
+        return Some(stmt);
+    }
+    if let Some(stmt) = fanuc_call(line) {
+        return Some(stmt);
+    }
+    if line.m(6.0) {
+        return Some(Stmt::ToolChange);
+    }
+    None
+}
+
+/// Fanuc loops: `WHILE [...] DO 1` … `END 1` (also `DO1`, `END1`).
+fn fanuc_loop(line: &Line<'_>) -> Option<Stmt> {
+    let body = line.body;
+    let loop_tag = |i: usize, name: &str| -> u32 {
+        let n = match (&body[i], body.get(i + 1)) {
+            (Tok::Ident(s), _) if s.len() > name.len() => whole_text(&s.as_bytes()[name.len()..]),
+            (_, Some(Tok::Other(o))) => whole_text(o),
+            _ => None,
+        };
+        n.and_then(|n| u32::try_from(n).ok()).unwrap_or(0)
+    };
+    if let Some(i) = line.ident_at("DO") {
+        return Some(Stmt::Nested {
+            role: Nest::Open,
+            tag: loop_tag(i, "DO"),
+        });
+    }
+    if let Some(i) = line.ident_at("END") {
+        return Some(Stmt::Nested {
+            role: Nest::Close,
+            tag: loop_tag(i, "END"),
+        });
+    }
+    None
+}
+
+/// Fanuc calls and returns: `M98`, `M97`, `M99`, `G65`, `G66`, `M198`.
+fn fanuc_call(line: &Line<'_>) -> Option<Stmt> {
+    let p = line.word(b'P').and_then(whole);
+    let repeat = line.word(b'L').and_then(whole).is_some_and(|l| l > 1);
+    if line.m(98.0) {
+        return Some(match p {
+            // `M98 P32000`: three times program 2000 (the old form, count first).
+            Some(p) if p > 9999 => Stmt::Call {
+                key: Key::Program(p % 10000),
+                repeats: p / 10000 > 1 || repeat,
+            },
+            Some(p) => Stmt::Call {
+                key: Key::Program(p),
+                repeats: repeat,
+            },
+            None => Stmt::External,
+        });
+    }
+    if line.m(97.0) {
+        return Some(match p {
+            Some(p) => Stmt::Call {
+                key: Key::Block(p),
+                repeats: repeat,
+            },
+            None => Stmt::Opaque,
+        });
+    }
+    if line.m(99.0) {
+        return Some(if p.is_some() {
+            Stmt::Opaque
+        } else {
+            Stmt::Return {
+                falls_through: false,
+            }
+        });
+    }
+    if line.g(65.0) {
+        return Some(match p {
+            Some(p) => Stmt::Call {
+                key: Key::Program(p),
+                repeats: repeat,
+            },
+            None => Stmt::External,
+        });
+    }
+    if line.g(66.0) || line.g(66.1) {
+        return Some(Stmt::Opaque);
+    }
+    if line.m(198.0) {
+        return Some(Stmt::External);
+    }
+    None
 }
 
 /// A LinuxCNC o-word statement `oNAME keyword`.

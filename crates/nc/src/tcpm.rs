@@ -30,6 +30,7 @@
 
 use crate::dialect::Dialect;
 use crate::modal::{Modal, Tcpm};
+use crate::tolerances::CODE10_ROUND_TOL;
 
 /// A code that can switch TCPM: a G or M code (number × 10: `G43.4` → 434) or an
 /// identifier (`TRAORI`, upper case).
@@ -100,7 +101,7 @@ impl std::fmt::Display for Code {
 pub(crate) fn code10(v: f64) -> Option<i64> {
     let t = v * 10.0;
     let r = t.round();
-    ((t - r).abs() < 1e-6 && (0.0..1e9).contains(&r)).then_some(r as i64)
+    ((t - r).abs() < CODE10_ROUND_TOL && (0.0..1e9).contains(&r)).then_some(r as i64)
 }
 
 /// A machine's own TCPM codes, added to its dialect's built-in ones (module docs).

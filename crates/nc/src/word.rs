@@ -1,6 +1,7 @@
 //! Address words (`C+148.494`, `X=10`, `C=DC(12.5)`) with their byte spans, and the forms a
 //! rotary word states its position in.
 
+use crate::tolerances::FORM_EPS_DEG;
 use std::ops::Range;
 
 /// How a rotary word states where the axis goes: as a plain number (`C12.5`, `C=12.5`:
@@ -21,10 +22,6 @@ pub enum RotaryForm {
     /// `ACN(…)`: in the negative direction to the value modulo 360.
     Acn,
 }
-
-/// Below this (degrees) two modulo positions are the same (no turn for ACP/ACN, an
-/// ambiguous half turn for DC).
-const FORM_EPS_DEG: f64 = 1e-9;
 
 impl RotaryForm {
     /// The form's name as written (`DC`, `ACP`, `ACN`; empty for a plain number).
