@@ -149,7 +149,7 @@ fn a_line_takes_the_s_curve_time() {
 /// claim in docs/simulation.md ("within every axis' V, A and J") was never checked at
 /// the moves' ends. Issue 43 item 1; run with `-- --ignored --nocapture` for the figures.
 #[test]
-#[ignore = "issue 43 item 1: the moves' ends exceed J, up to 25.5x (docs/journal/2026-11-28-simulate.md)"]
+#[ignore = "issue 43 item 1: the moves' ends exceed J, up to 25.5x (docs/journal/simulation.md)"]
 fn every_line_is_within_the_limits_by_finite_differences() {
     let mut worst_all = 0.0f64;
     for name in ["mikron-ucp710", "mikron-hsm600"] {
