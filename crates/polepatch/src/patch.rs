@@ -127,7 +127,7 @@ pub fn patch_program(
             RunOutcome::Quiet => {}
             RunOutcome::Left { rows, untouched } => {
                 report.zones.extend(rows);
-                report.untouched_runs.extend(untouched);
+                report.untouched_runs.push(untouched);
             }
             RunOutcome::Patched { rows, .. } => report.zones.extend(rows),
         }
@@ -143,13 +143,12 @@ enum RunOutcome {
     /// Nothing to patch or report (no point within the pole reach).
     #[default]
     Quiet,
-    /// The run keeps its values: its zones' rows (nothing written) and, where there is
-    /// something to say, why.
+    /// The run keeps its values: its zones' rows (nothing written) and why.
     Left {
         /// The zones' rows, reported as they are.
         rows: Vec<ZoneRow>,
         /// The run among the untouched, with the reason.
-        untouched: Option<UntouchedRun>,
+        untouched: UntouchedRun,
     },
     /// The run is patched.
     Patched {
@@ -182,10 +181,7 @@ impl RunOutcome {
             row.reason = reason.zone_reason().unwrap_or(ZoneReason::NotPatched);
         }
         let untouched = untouched(lp, r, reason, rows.len(), message, reach_deg);
-        RunOutcome::Left {
-            rows,
-            untouched: Some(untouched),
-        }
+        RunOutcome::Left { rows, untouched }
     }
 }
 
@@ -446,10 +442,7 @@ fn report_left(
                 message.to_string(),
                 opts.reach_deg(),
             );
-            RunOutcome::Left {
-                rows,
-                untouched: Some(untouched),
-            }
+            RunOutcome::Left { rows, untouched }
         }
         Err(e) => RunOutcome::Quiet.left(
             lp,
