@@ -32,7 +32,7 @@ pub(crate) struct Interpreter {
     /// ([`crate::tcpm::lookalike`]).
     pub(crate) lookalike: Option<Range<usize>>,
     /// Fanuc macro variables whose value is a constant here ([`Interpreter::constants`]).
-    consts: std::collections::HashMap<u32, f64>,
+    pub(crate) consts: std::collections::HashMap<u32, f64>,
     /// The rotary axes A B C that turn without end ([`ReadOptions::endless`]).
     endless: [bool; 3],
 }
@@ -332,6 +332,33 @@ impl Interpreter {
             consts: std::collections::HashMap::new(),
             endless: opts.endless,
         }
+    }
+
+    /// An interpreter that lexes as this one does (lexing reads only the dialect and the
+    /// controller's codes), for a thread that lexes ahead while this one applies blocks to
+    /// the modal state ([`crate::reader`]).
+    pub(crate) fn lexing_twin(&self) -> Interpreter {
+        Interpreter {
+            dialect: self.dialect,
+            controller: self.controller.clone(),
+            modal: self.modal,
+            plan: None,
+            cursor: crate::flow::Cursor::default(),
+            recorder: None,
+            stated_datum: None,
+            frame_changed: false,
+            lookalike: None,
+            consts: std::collections::HashMap::new(),
+            endless: self.endless,
+        }
+    }
+
+    /// Take up a read where another left it ([`crate::Resume`]): its modal state and
+    /// macro constants; flow is not recorded again.
+    pub(crate) fn resume(&mut self, modal: Modal, consts: &std::collections::HashMap<u32, f64>) {
+        self.modal = modal;
+        self.consts = consts.clone();
+        self.recorder = None;
     }
 
     /// Record block labels numbered `targets` too (a second pass).

@@ -65,7 +65,8 @@ pub use modal::{FeedMode, Modal, Motion, RotaryLetters, Tcpm};
 pub use plan::{FormConflict, restore_modal, write_direction_forms};
 pub use program::Program;
 pub use reader::{
-    Lookalike, Scanned, Settled, scan, scan_blocks, scan_blocks_with, style_evidence_to,
+    Lookalike, Resume, Scanned, Settled, scan, scan_blocks, scan_blocks_with, scan_resumed,
+    style_evidence_to,
 };
 pub use run::{Run, RunBreak, RunBuilder, primary_in_use, primary_of, runs};
 pub use style::{FileStyle, NumberStyle, StyleEvidence};

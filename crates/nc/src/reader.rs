@@ -1,7 +1,10 @@
 //! The one reader: [`scan_blocks_with`] reads a program block by block — lexing lines on
-//! several threads, applying them to the modal state in file order — and gives each block,
-//! its words and the state after it to a visitor; [`scan`] and [`scan_blocks`] are its
-//! simpler forms, [`crate::parse`] collects it into a [`Program`].
+//! several threads, ahead of the thread that applies them to the modal state in file order
+//! — and gives each block, its words and the state after it to a visitor; [`scan`] and
+//! [`scan_blocks`] are its simpler forms, [`crate::parse`] collects it into a [`Program`].
+//! A visitor may keep the place after a block ([`Scanned::resume_after`]) and read again
+//! from there later ([`scan_resumed`]): a reader that reads a file once and then only the
+//! stretches it needs.
 
 use crate::block::Block;
 use crate::detect::detect;
@@ -13,7 +16,7 @@ use crate::lines::LineEnds;
 use crate::modal::Modal;
 use crate::style::StyleEvidence;
 use crate::tcpm::ReadOptions;
-use crate::tolerances::{MAX_SCAN_THREADS, SCAN_WINDOW_BYTES};
+use crate::tolerances::{MAX_SCAN_THREADS, SCAN_FIRST_WINDOW_BYTES, SCAN_WINDOW_BYTES};
 use crate::word::Word;
 use std::ops::Range;
 
@@ -81,6 +84,91 @@ pub struct Scanned<'a> {
     /// A word of the block that looks like a TCPM code without being one
     /// ([`crate::tcpm::lookalike`]), for a warning.
     pub lookalike: Option<&'a Lookalike>,
+    /// The macro variables the reader holds constant after the block.
+    consts: &'a std::collections::HashMap<u32, f64>,
+}
+
+impl Scanned<'_> {
+    /// Where a read can resume after this block ([`scan_resumed`]): the next line, the
+    /// modal state after this block, and what else the reader holds between blocks.
+    pub fn resume_after(&self) -> Resume {
+        Resume {
+            after: Some(self.block.span().end),
+            ends: Some(self.line_ends),
+            line: self.block.line,
+            modal: *self.state,
+            consts: self.consts.clone(),
+        }
+    }
+}
+
+/// A place to resume reading a file at: the start of a line, with the reader's state before
+/// it ([`Scanned::resume_after`], [`Resume::file_start`]). A read resumed there gives the
+/// same blocks, states and errors as the read of the whole file gives from there on, when
+/// both use the same settled options (the dialect found, the flow plan: [`Settled`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Resume {
+    /// The end of the block before (its line ending not included); `None` at the start of
+    /// the file. The line to read next starts after that line ending (found when the read
+    /// resumes: a survey keeps many such places and resumes at few).
+    after: Option<usize>,
+    /// The file's line ending (`None` at the start: not looked at yet).
+    ends: Option<LineEnds>,
+    /// The number of the line before it (0 at the start of the file).
+    line: usize,
+    /// The modal state before it.
+    modal: Modal,
+    /// Fanuc macro variables held constant (none in most files: no allocation).
+    consts: std::collections::HashMap<u32, f64>,
+}
+
+impl Resume {
+    /// The start of the file, as `opts` reads it.
+    pub fn file_start(opts: &ReadOptions) -> Resume {
+        Resume {
+            after: None,
+            ends: None,
+            line: 0,
+            modal: opts.initial(),
+            consts: std::collections::HashMap::new(),
+        }
+    }
+
+    /// About where reading resumes: the end of the block before it (0 at the start of the
+    /// file), bytes.
+    pub fn near_byte(&self) -> usize {
+        self.after.unwrap_or(0)
+    }
+
+    /// The modal state before the line there.
+    pub fn state(&self) -> &Modal {
+        &self.modal
+    }
+}
+
+/// Read `bytes` from `from` on, as [`scan_blocks_with`] reads them there, until `visit`
+/// stops or the file ends. `opts` must be the options the read that made `from` settled
+/// on (the dialect found, the flow plan: [`Settled`]); a read that resumes does not
+/// settle flow again.
+pub fn scan_resumed(
+    bytes: &[u8],
+    opts: &ReadOptions,
+    from: &Resume,
+    visit: impl FnMut(Scanned<'_>) -> std::ops::ControlFlow<()>,
+) -> Result<(), ParseError> {
+    if u32::try_from(bytes.len()).is_err() {
+        return Err(too_big(bytes.len()));
+    }
+    let dialect = match opts.dialect {
+        Dialect::Auto => detect(bytes),
+        d => d,
+    };
+    let mut interp = Interpreter::new(opts, dialect);
+    interp.resume(from.modal, &from.consts);
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get().min(MAX_SCAN_THREADS));
+    let ends = from.ends.unwrap_or_else(|| LineEnds::of(bytes));
+    let start = from.after.map_or(0, |end| ends.cut_after(bytes, end));
+    read(bytes, ends, (start, from.line), threads, &mut interp, visit).map(|_| ())
 }
 
 /// An identifier the reader does not know that looks like a TCPM code: a post's typo
@@ -133,14 +221,15 @@ pub(crate) fn scan_with(
         d => d,
     };
     let mut interp = Interpreter::new(opts, dialect);
-    let completed = read(bytes, threads, &mut interp, visit)?;
+    let ends = LineEnds::of(bytes);
+    let completed = read(bytes, ends, (0, 0), threads, &mut interp, visit)?;
     let Some(mut flow) = interp.recorder.take() else {
         return Ok(Settled::Done(dialect));
     };
     if !completed {
         // The visit stopped early: whether the rest of the file has flow is still to see.
         let mut whole = Interpreter::new(opts, dialect);
-        read(bytes, threads, &mut whole, |_| {
+        read(bytes, ends, (0, 0), threads, &mut whole, |_| {
             std::ops::ControlFlow::Continue(())
         })?;
         flow = whole.recorder.take().unwrap_or_default();
@@ -152,7 +241,7 @@ pub(crate) fn scan_with(
         // Jumps name block numbers: find those blocks.
         let mut again = Interpreter::new(opts, dialect);
         again.record_block_labels(flow.block_targets.clone());
-        read(bytes, threads, &mut again, |_| {
+        read(bytes, ends, (0, 0), threads, &mut again, |_| {
             std::ops::ControlFlow::Continue(())
         })?;
         flow = again.recorder.take().unwrap_or_default();
@@ -193,14 +282,16 @@ pub fn style_evidence_to(
     Ok(ev)
 }
 
-/// One read of the file with `interp`: whether `visit` took every block.
+/// One read of the file (line endings `ends`) with `interp`, from the line that starts at
+/// byte `from.0` (whose number is `from.1 + 1`): whether `visit` took every block.
 fn read(
     bytes: &[u8],
+    ends: LineEnds,
+    from: (usize, usize),
     threads: usize,
     interp: &mut Interpreter,
     mut visit: impl FnMut(Scanned<'_>) -> std::ops::ControlFlow<()>,
 ) -> Result<bool, ParseError> {
-    let ends = LineEnds::of(bytes);
     let mut give = |interp: &mut Interpreter, block: &Block, words: &[Word]| {
         let lookalike = interp.lookalike.take().and_then(|at| {
             let word = &bytes[at.clone()];
@@ -218,70 +309,120 @@ fn read(
             frame_changed: std::mem::take(&mut interp.frame_changed),
             lookalike: lookalike.as_ref(),
             line_ends: ends,
+            consts: &interp.consts,
         })
     };
-    if threads <= 1 || bytes.len() < SCAN_WINDOW_BYTES {
+    let (start, lines_before) = from;
+    if threads <= 1 || bytes.len() - start.min(bytes.len()) < SCAN_WINDOW_BYTES {
         let mut words = Vec::with_capacity(32);
-        for (span, line) in ends.lines_from(bytes, 0) {
+        for (span, line) in ends.lines_from(bytes, start) {
             words.clear();
-            let block = interp.block(bytes, span, line, &mut words)?;
+            let block = interp.block(bytes, span, lines_before + line, &mut words)?;
             if give(interp, &block, &words).is_break() {
                 return Ok(false);
             }
         }
         return Ok(true);
     }
-    // Windows of about SCAN_WINDOW_BYTES, each cut at line ends into one part per thread;
-    // the parts are lexed side by side (lexing needs only the dialect), then applied to
-    // the modal state in file order. Memory: one window's words and line summaries.
-    let mut line_offset = 0usize;
-    let mut from = 0usize;
-    let mut parts: Vec<LexedPart> = (0..threads).map(|_| LexedPart::default()).collect();
-    while from < bytes.len() {
-        let to = ends.cut_after(bytes, from + SCAN_WINDOW_BYTES);
-        let mut cuts = vec![from];
-        for k in 1..threads {
-            let c = ends
-                .cut_after(bytes, from + (to - from) * k / threads)
-                .min(to);
-            cuts.push(c.max(*cuts.last().unwrap_or(&from)));
-        }
-        cuts.push(to);
-        let interp_ref = &*interp;
-        std::thread::scope(|sc| {
-            let (first, rest) = parts.split_at_mut(1);
-            let handles: Vec<_> = cuts
-                .windows(2)
-                .skip(1)
-                .zip(rest.iter_mut())
-                .map(|(w, part)| {
-                    let (a, b) = (w[0], w[1]);
-                    sc.spawn(move || part.lex(interp_ref, ends, bytes, a..b))
-                })
-                .collect();
-            first[0].lex(interp_ref, ends, bytes, cuts[0]..cuts[1]);
-            for h in handles {
-                h.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
+    // Windows of about SCAN_WINDOW_BYTES, each cut at line ends into one part per thread.
+    // A lexing thread lexes the parts of the next windows side by side (lexing needs only
+    // the dialect and the controller's codes: `lexing_twin`) while this thread applies the
+    // window before to the modal state, in file order, and gives its blocks to `visit`:
+    // the two overlap, so a visitor that does much per block costs little more than the
+    // lexing. The lexing thread hands a window over when this thread takes it, and only
+    // then lexes the next: a read that stops lexes at most one window past where it stops.
+    // Memory: two windows' words and line summaries (one applied, one being lexed). Nothing read depends on the overlap: the same blocks,
+    // states and errors, in the same order, as one thread gives.
+    let twin = interp.lexing_twin();
+    std::thread::scope(|sc| {
+        let (full_tx, full_rx) = std::sync::mpsc::sync_channel::<Window>(0);
+        let (empty_tx, empty_rx) = std::sync::mpsc::channel::<Vec<LexedPart>>();
+        let twin = &twin;
+        sc.spawn(move || {
+            let mut from = start;
+            // Windows grow from the first: a read that stops early (a stretch read again
+            // from a place in the file) lexes little past where it stops.
+            let mut size = SCAN_FIRST_WINDOW_BYTES;
+            while from < bytes.len() {
+                let mut parts = empty_rx
+                    .try_recv()
+                    .unwrap_or_else(|_| (0..threads).map(|_| LexedPart::default()).collect());
+                let to = lex_window(twin, ends, bytes, from, size, &mut parts);
+                size = (size * 2).min(SCAN_WINDOW_BYTES);
+                // The reader stopped (its visitor, or an error): nothing more to lex.
+                if full_tx.send(Window { parts }).is_err() {
+                    return;
+                }
+                from = to;
             }
         });
-        for part in &mut parts {
-            for (k, (span, scan, words)) in part.lines.iter_mut().enumerate() {
-                let line = line_offset + k + 1;
-                let ws = &part.words[words.clone()];
-                let block = interp.apply(scan, line, span.clone(), 0..ws.len());
-                if give(interp, &block, ws).is_break() {
-                    return Ok(false);
+        let mut line_offset = lines_before;
+        for mut window in full_rx {
+            for part in &mut window.parts {
+                for (k, (span, scan, words)) in part.lines.iter_mut().enumerate() {
+                    let line = line_offset + k + 1;
+                    let ws = &part.words[words.clone()];
+                    let block = interp.apply(scan, line, span.clone(), 0..ws.len());
+                    if give(interp, &block, ws).is_break() {
+                        return Ok(false);
+                    }
+                }
+                line_offset += part.line_count;
+                if let Some(mut e) = part.error.take() {
+                    e.line += line_offset - part.line_count;
+                    return Err(e);
                 }
             }
-            line_offset += part.line_count;
-            if let Some(mut e) = part.error.take() {
-                e.line += line_offset - part.line_count;
-                return Err(e);
-            }
+            // The lexing thread may be done already: then the parts are not needed.
+            let _ = empty_tx.send(window.parts);
         }
-        from = to;
+        Ok(true)
+    })
+}
+
+/// A window of the file lexed in parts, in file order ([`read`]).
+struct Window {
+    parts: Vec<LexedPart>,
+}
+
+/// Lex the window of `bytes` from `from` (a line start) to about `size` bytes further, cut
+/// at line ends into `parts.len()` parts lexed on as many threads; returns where the window
+/// ends (a line start, or the end of the file).
+fn lex_window(
+    interp: &Interpreter,
+    ends: LineEnds,
+    bytes: &[u8],
+    from: usize,
+    size: usize,
+    parts: &mut [LexedPart],
+) -> usize {
+    let threads = parts.len();
+    let to = ends.cut_after(bytes, from + size);
+    let mut cuts = vec![from];
+    for k in 1..threads {
+        let c = ends
+            .cut_after(bytes, from + (to - from) * k / threads)
+            .min(to);
+        cuts.push(c.max(*cuts.last().unwrap_or(&from)));
     }
-    Ok(true)
+    cuts.push(to);
+    std::thread::scope(|sc| {
+        let (first, rest) = parts.split_at_mut(1);
+        let handles: Vec<_> = cuts
+            .windows(2)
+            .skip(1)
+            .zip(rest.iter_mut())
+            .map(|(w, part)| {
+                let (a, b) = (w[0], w[1]);
+                sc.spawn(move || part.lex(interp, ends, bytes, a..b))
+            })
+            .collect();
+        first[0].lex(interp, ends, bytes, cuts[0]..cuts[1]);
+        for h in handles {
+            h.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
+        }
+    });
+    to
 }
 
 /// One part of a window, lexed: per line (its span, what it says, its words' range in
@@ -587,6 +728,106 @@ pub(crate) mod tests {
             let got = scanned(&bytes, threads).unwrap();
             assert_eq!(got.len(), expected.len(), "{threads} threads");
             assert!(got == expected, "{threads} threads");
+        }
+    }
+
+    /// Every block of `bytes` as a full read gives it, and the place after each.
+    fn visited_with_places(bytes: &[u8], opts: &ReadOptions) -> (Visited, Vec<Resume>) {
+        let (mut v, mut places) = (Vec::new(), Vec::new());
+        let settled = scan_blocks_with(bytes, opts, |s| {
+            let b = s.block;
+            v.push((
+                b.line,
+                b.span(),
+                s.words.to_vec(),
+                *s.state,
+                b.is_move,
+                b.breaks_run,
+                s.stated_datum,
+                s.frame_changed,
+            ));
+            places.push(s.resume_after());
+            std::ops::ControlFlow::Continue(())
+        })
+        .unwrap();
+        assert!(matches!(settled, Settled::Done(_)));
+        (v, places)
+    }
+
+    /// A read resumed after block `k` gives the blocks the full read gives from `k + 1` on.
+    fn resumes_as_the_full_read(bytes: &[u8], opts: &ReadOptions, every: usize) {
+        let (full, places) = visited_with_places(bytes, opts);
+        assert!(full.len() > 2);
+        for k in (0..full.len()).step_by(every) {
+            let mut got = Vec::new();
+            scan_resumed(bytes, opts, &places[k], |s| {
+                let b = s.block;
+                got.push((
+                    b.line,
+                    b.span(),
+                    s.words.to_vec(),
+                    *s.state,
+                    b.is_move,
+                    b.breaks_run,
+                    s.stated_datum,
+                    s.frame_changed,
+                ));
+                // A stretch: up to 40 blocks (the threaded read stops early too).
+                if got.len() == 40 {
+                    std::ops::ControlFlow::Break(())
+                } else {
+                    std::ops::ControlFlow::Continue(())
+                }
+            })
+            .unwrap();
+            let want = &full[k + 1..(k + 41).min(full.len())];
+            assert!(got == want, "resumed after block {k}");
+        }
+        // And from the start of the file, to its end.
+        let mut all = 0usize;
+        scan_resumed(bytes, opts, &Resume::file_start(opts), |_| {
+            all += 1;
+            std::ops::ControlFlow::Continue(())
+        })
+        .unwrap();
+        assert_eq!(all, full.len());
+    }
+
+    #[test]
+    fn a_read_resumed_at_a_place_reads_what_the_full_read_reads_from_there() {
+        // Threaded (a file of several windows), with datum shifts, G92 and comments.
+        let big = big(1);
+        let opts = ReadOptions::dialect(Dialect::Heidenhain);
+        resumes_as_the_full_read(&big, &opts, 997);
+        // Fanuc macro constants held across the place, CR LF line ends, a byte-order mark.
+        let fanuc = b"\xEF\xBB\xBF%\r\nO1000\r\n#100=1200.\r\nG90 G43.4 H1\r\nG1 X0 Y0 Z5 A10 C0 F#100\r\n\
+                      X1 Y1 A11 C5\r\n#101=5.\r\nX2 Y#101 A12 C10 F#100\r\nX3 Y3 A13 C15\r\nM30\r\n%\r\n";
+        let opts = ReadOptions::dialect(Dialect::Fanuc);
+        resumes_as_the_full_read(fanuc, &opts, 1);
+    }
+
+    #[test]
+    fn a_visitor_that_stops_early_stops_the_threaded_read_where_one_thread_stops() {
+        // Stopping in the third window: the lexing thread is ahead, and must end too.
+        let bytes = big(3);
+        let stop_at = 3 * (SCAN_WINDOW_BYTES / 40);
+        for threads in [1, 2, 3] {
+            let mut lines = Vec::new();
+            let settled = scan_with(&bytes, &ReadOptions::default(), threads, |s| {
+                lines.push(s.block.line);
+                if lines.len() == stop_at {
+                    std::ops::ControlFlow::Break(())
+                } else {
+                    std::ops::ControlFlow::Continue(())
+                }
+            })
+            .unwrap();
+            assert!(matches!(settled, Settled::Done(_)), "{threads} threads");
+            assert_eq!(
+                lines,
+                (1..=stop_at).collect::<Vec<_>>(),
+                "{threads} threads"
+            );
         }
     }
 

@@ -120,6 +120,22 @@ impl RunBuilder {
         }
     }
 
+    /// The walk taken up at block `first` (`st`: the state after it) for the run that
+    /// starts there, as the walk of the whole file (`passes` or not) found it: the blocks
+    /// after `first` give the same run, which starts at `first` whether the whole walk had
+    /// opened it there or only noted `first` as the last place the tool was. For a reader
+    /// that reads again only the stretch of a run ([`crate::scan_resumed`]). A run that
+    /// ends at the stretch's end is given by [`RunBuilder::finish`], with
+    /// [`RunBreak::End`]: the caller knows what ended it in the file.
+    pub fn resumed_at(passes: bool, first: usize, st: &Modal) -> RunBuilder {
+        RunBuilder {
+            cur: None,
+            prev: *st,
+            last_pos: Some(first),
+            passes,
+        }
+    }
+
     fn finish_run(&mut self, why: RunBreak, emit: &mut impl FnMut(Run)) {
         if let Some(mut r) = self.cur.take()
             && r.len() >= 2

@@ -46,6 +46,11 @@ pub(crate) const DETECT_HEAD_BYTES: usize = 64 * 1024;
 /// stay a small part of any program worth doing this for.
 pub(crate) const SCAN_WINDOW_BYTES: usize = 256 << 10;
 
+/// Size of the first window a threaded read lexes, bytes (4 KiB); each next one is twice
+/// the last, up to [`SCAN_WINDOW_BYTES`]: a read that stops early (a stretch of a file read
+/// again from a place in it) lexes at most a few times what it reads.
+pub(crate) const SCAN_FIRST_WINDOW_BYTES: usize = 4 << 10;
+
 /// Most threads the reader lexes on (at most the machine's available parallelism): the
 /// value the threaded reader was introduced with (issue 10 §2). The count changes only the
 /// time a read takes, never what it reads (tested on 1, 2 and 3 threads).

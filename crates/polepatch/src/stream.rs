@@ -3,9 +3,10 @@
 //!
 //! A parsed program costs about ten times its bytes (words, blocks, modal states, run
 //! positions). Only runs that come within the cone can hold a zone, and a patch changes
-//! words of its own run only; so [`patch_nc_to`] reads the program twice as a stream
-//! ([`polepatch_nc::scan_blocks`]) and parses in full only the stretches that hold such
-//! runs:
+//! words of its own run only; so [`patch_nc_to`] reads the program once as a stream
+//! ([`polepatch_nc::scan_blocks`]) and then reads again, from the places the first read
+//! kept ([`polepatch_nc::Resume`]), only the stretches that hold such runs, which it parses
+//! in full:
 //!
 //! 1. **Survey.** The runs ([`polepatch_nc::RunBuilder`], the same walk as the whole-program
 //!    path), each with its first and last block, whether a point is within the cone for
@@ -15,7 +16,9 @@
 //!    [`crate::machine_frame::datum_at`]); and for every run its end pose
 //!    ([`crate::end_pose::After::verdict`], decided by the first block after the run that
 //!    decides, with the blocks before it that restate the run's last values — for both
-//!    tilting letters since the one in use is known only at the end).
+//!    tilting letters since the one in use is known only at the end); the tool the program
+//!    uses ([`crate::tool::Tracker`]); and for every run a stretch may hold, the place
+//!    before its first block where a read resumes ([`RunRec::kept`]).
 //! 2. **Stretches.** A run near the pole (or without a feed, which the report lists) is
 //!    a stretch from its first block (point 0) to its last — or to the last block after
 //!    it that restates its last values, when its end is free (that block is rewritten
@@ -24,9 +27,12 @@
 //!    both stretches, and written with the first (the whole-program path builds every
 //!    run's path from the original values too, and never changes a run's first point, so
 //!    the second stretch has it unchanged — checked when writing).
-//! 3. **Patch.** The second read builds each stretch as a program of its own
-//!    ([`polepatch_nc::ProgramBuilder`]: the file's lines, states and bytes), with the
-//!    runs exactly as the first read found them, and hands it to
+//! 3. **Patch.** The second read resumes at each stretch's place
+//!    ([`polepatch_nc::scan_resumed`]: the bytes between stretches are not lexed again),
+//!    builds the stretch as a program of its own ([`polepatch_nc::ProgramBuilder`]: the
+//!    file's lines, states and bytes), with the runs exactly as the first read found them
+//!    (the run walk taken up at the run's first block, [`RunBuilder::resumed_at`]; checked),
+//!    and hands it to
 //!    [`crate::patch::patch_program`] with what the rest of the file says
 //!    ([`crate::program::Window`]: run numbers, number style, end poses, work offsets).
 //!    Bytes between stretches are copied; each stretch is written as
@@ -37,8 +43,8 @@
 //! fixture, both machines, and programs built to cross stretch boundaries. Programs the
 //! whole-program path rejects (no runs, no rotary words) are handed to it for its error.
 //!
-//! Stretches are patched on all cores in batches of about 1/256 of the file (16 KiB to
-//! 256 KiB of it), then written in file order.
+//! Stretches are read again and patched on all cores in batches of about 1/256 of the file
+//! (16 KiB to 256 KiB of it), then written in file order.
 //!
 //! [`analyze_nc_each`] reads the same way with every run a stretch, and hands each run's
 //! report out as it is made (a program of many runs has a report larger than itself).
@@ -60,10 +66,9 @@ use crate::settings::BATCH_MIN_BYTES;
 use crate::tolerances::RANGE_SLACK_DEG;
 use polepatch_kinematics::Machine;
 use polepatch_nc::{
-    Dialect, FileStyle, ProgramBuilder, RotaryLetters, Run, RunBuilder, Scanned, StyleEvidence,
-    scan_blocks_with,
+    Dialect, FileStyle, ProgramBuilder, Resume, RotaryLetters, Run, RunBreak, RunBuilder, Scanned,
+    StyleEvidence, scan_blocks_with, scan_resumed,
 };
-use std::collections::VecDeque;
 use std::io::Write;
 use std::ops::ControlFlow;
 
@@ -100,6 +105,22 @@ struct RunRec {
     /// The first move after the run's last block: where its X Y Z are restored when the
     /// run's last point gets new ones ([`crate::patch`], step 3).
     next_move: Option<usize>,
+    /// What ended the run in the file.
+    ended_by: RunBreak,
+    /// For a run a stretch may hold ([`Reading::keep_all`], else a run near the pole or
+    /// without a feed for either tilting letter): where the second read resumes (before
+    /// the run's first block), and the tool the program uses for the run.
+    kept: Option<Box<Kept>>,
+}
+
+/// What the survey keeps of a run a stretch may hold ([`RunRec::kept`]).
+#[derive(Debug, Clone)]
+struct Kept {
+    /// Where the second read resumes: before the run's first block (`None`: from the start
+    /// of the file — every run opens where the survey took a place for it, so this is a
+    /// fallback that costs time, never a different reading).
+    start: Option<Resume>,
+    tool: crate::tool::FoundTool,
 }
 
 /// The end pose of a run as the survey finds it ([`crate::end_pose`]).
@@ -282,6 +303,13 @@ struct Surveying {
     /// The end pose of the open run so far, from the blocks after its last block, per
     /// letter.
     first_after: [EndRec; 2],
+    /// [`Reading::keep_all`].
+    keep_all: bool,
+    /// The tool in use ([`crate::tool`]): a run's is the program's as it stands at the
+    /// run's last block (a tool change ends runs).
+    tracker: crate::tool::Tracker,
+    /// The open run's first block, and where a read resumes before it.
+    open_start: Option<(usize, Resume)>,
 }
 
 impl Surveying {
@@ -298,6 +326,19 @@ impl Surveying {
         }
         let first_block = run.blocks[0];
         let r = self.runs.len();
+        let feedless = self
+            .readings
+            .map(|letters| crate::program::run_check(&run, letters, self.fallback, 0).is_err());
+        let start = self
+            .open_start
+            .take_if(|(f, _)| *f == first_block)
+            .map(|(_, at)| at);
+        let kept = (self.keep_all || near.iter().chain(&feedless).any(|&b| b)).then(|| {
+            Box::new(Kept {
+                start,
+                tool: self.tracker.found(),
+            })
+        });
         for (l, rec) in self.first_after.iter().enumerate() {
             if rec.decided.is_none() {
                 self.pending[l].push(r);
@@ -307,9 +348,7 @@ impl Surveying {
             first_block,
             last_block: *run.blocks.last().unwrap_or(&first_block),
             near,
-            feedless: self
-                .readings
-                .map(|letters| crate::program::run_check(&run, letters, self.fallback, 0).is_err()),
+            feedless,
             end: self.first_after.clone(),
             datum_mm: crate::machine_frame::datum_at(
                 &self.datum_shifts,
@@ -318,6 +357,8 @@ impl Surveying {
                 self.work_offset_mm,
             ),
             next_move: None,
+            ended_by: run.ended_by,
+            kept,
         });
         self.awaiting_move.push(r);
         if let Some(own) = self.lazy_style
@@ -382,6 +423,9 @@ struct Reading<'a> {
     /// with none is copied; its style is never used), and [`Survey::complete_style`] the
     /// lines before. `None`: from the start.
     lazy_style: Option<usize>,
+    /// Every run may be a stretch (an analysis): the survey keeps where the second read
+    /// resumes for each ([`RunRec::kept`]); else only for the runs a patch may patch.
+    keep_all: bool,
 }
 
 /// The run walk of a reading: passes or runs ([`Reading::passes`]).
@@ -417,6 +461,7 @@ impl<'a> Reading<'a> {
             chord_tolerance_mm: opts.chord_tolerance_mm,
             tool: opts.tool.clone(),
             lazy_style: readings(letters).iter().position(|r| *r == letters),
+            keep_all: false,
         })
     }
 
@@ -439,6 +484,7 @@ impl<'a> Reading<'a> {
             chord_tolerance_mm: crate::machine_frame::CHORD_TOLERANCE_MM,
             tool: crate::tool::ToolOptions::default(),
             lazy_style: None,
+            keep_all: true,
         })
     }
 }
@@ -584,7 +630,20 @@ fn survey_once(
         pending: [Vec::new(), Vec::new()],
         awaiting_move: Vec::new(),
         first_after: [EndRec::default(), EndRec::default()],
+        keep_all: opts.keep_all,
+        tracker: crate::tool::Tracker::default(),
+        open_start: None,
     };
+    // The dialect the tool descriptions are read in (the reader's, detected as it does).
+    let dialect = match read.dialect {
+        Dialect::Auto => polepatch_nc::detect_dialect(bytes),
+        d => d,
+    };
+    // Where a read resumes before the block in hand (after the one before it), and before
+    // the last block that moved or changed a position: where the run walk opens a run
+    // (`RunBuilder`: at the block in hand, or at that last place).
+    let mut before = Resume::file_start(read);
+    let mut before_last_pos: Option<(usize, Resume)> = None;
     let mut style = StyleEvidence::default();
     // Where the style is counted from: the first block, or (lazy) none yet.
     let mut style_from = opts.lazy_style.is_none().then_some(0usize);
@@ -639,6 +698,24 @@ fn survey_once(
             sv.frame_changes.push(i);
         }
         builder.push(i, s.block, s.state, &mut |run| sv.take(run));
+        if let Some(f) = builder.open_run_first_block()
+            && sv.open_start.as_ref().is_none_or(|(g, _)| *g != f)
+        {
+            sv.open_start = if f == i {
+                Some((f, before.clone()))
+            } else {
+                before_last_pos.clone().filter(|(b, _)| *b == f)
+            };
+        }
+        // After the runs this block ends: a tool change is the next run's.
+        sv.tracker
+            .block(dialect, s.block, &bytes[s.block.span()], s.words, s.state);
+        let after = s.resume_after();
+        if s.block.is_move || s.state.pos != prev.pos {
+            before_last_pos = Some((i, std::mem::replace(&mut before, after)));
+        } else {
+            before = after;
+        }
         if s.block.is_move {
             for r in sv.awaiting_move.drain(..) {
                 sv.runs[r].next_move = Some(i);
@@ -1346,10 +1423,11 @@ pub(crate) fn load_program(
     Ok(lp)
 }
 
-/// The second read (module docs, step 3): each stretch of `todo` built as a program with
-/// its runs and what the rest of the file says, handed to `work` — in batches on all
-/// cores — and the results to `sink` in file order, with the bytes of the file the
-/// stretch covers.
+/// The second read (module docs, step 3): each stretch of `todo` read again from where the
+/// survey left a place before it ([`Kept::start`]), built as a program with its runs and
+/// what the rest of the file says, handed to `work` — in batches on all cores — and the
+/// results to `sink` in file order, with the bytes of the file the stretch covers. Only the
+/// stretches are lexed again, not the bytes between them.
 fn each_stretch<T: Send>(
     bytes: &[u8],
     sv: &Survey,
@@ -1359,118 +1437,132 @@ fn each_stretch<T: Send>(
     work: impl Fn(LoadedProgram) -> T + Sync,
     mut sink: impl FnMut(T, std::ops::Range<usize>) -> std::io::Result<()>,
 ) -> Result<(), Error> {
-    let mut next = 0usize; // next stretch to start
-    let mut building: Option<InHand> = None;
-    let mut done: VecDeque<InHand> = VecDeque::new();
-    let mut failure: Option<Error> = None;
-    let mut builder = run_builder(rd);
-    let mut run_no = 0usize;
-    let mut prev = rd.read.initial();
-    let mut i = 0usize;
-    let mut ready: Vec<InHand> = Vec::new();
-    let mut ready_bytes = 0usize;
+    use rayon::prelude::*;
     let batch_bytes = (bytes.len() / BATCH_FRACTION).clamp(BATCH_MIN_BYTES, BATCH_MAX_BYTES);
-    let mut flush = |ready: &mut Vec<InHand>| {
-        use rayon::prelude::*;
-        let parts: Vec<_> = std::mem::take(ready)
-            .into_par_iter()
-            .map(|hand| {
+    // About where each stretch starts in the file: its batch is cut by these.
+    let near_byte: Vec<usize> = todo
+        .iter()
+        .map(|st| {
+            sv.runs[st.runs.clone()]
+                .first()
+                .and_then(|r| r.kept.as_ref()?.start.as_ref())
+                .map_or(0, Resume::near_byte)
+        })
+        .collect();
+    let mut k = 0usize;
+    while k < todo.len() {
+        let (mut e, mut size) = (k, 0usize);
+        while e < todo.len() && (e == k || size < batch_bytes) {
+            let next = near_byte.get(e + 1).copied().unwrap_or(bytes.len());
+            size += next.saturating_sub(near_byte[e]);
+            e += 1;
+        }
+        let parts: Vec<Result<(T, std::ops::Range<usize>), Error>> = todo[k..e]
+            .par_iter()
+            .map(|st| {
+                let hand = read_stretch(bytes, sv, st, rd)?;
                 let replaced = hand.program.base()..hand.end_byte.unwrap_or(bytes.len());
-                (work(loaded(bytes, hand, sv, l, rd)), replaced)
+                Ok((work(loaded(bytes, hand, sv, l, rd)), replaced))
             })
             .collect();
-        for (part, replaced) in parts {
-            sink(part, replaced)?;
+        for part in parts {
+            let (t, replaced) = part?;
+            sink(t, replaced).map_err(Error::Output)?;
         }
-        Ok::<(), std::io::Error>(())
-    };
-    // The tool in use ([`crate::tool`]): a run's is the program's as it stands at the
-    // run's last block (a tool change ends runs).
-    let mut tracker = crate::tool::Tracker::default();
-    let give_run = |run: Run,
-                    run_no: &mut usize,
-                    building: &mut Option<InHand>,
-                    done: &mut VecDeque<InHand>,
-                    tracker: &crate::tool::Tracker| {
-        let r = *run_no;
-        *run_no += 1;
-        let hand = done
-            .iter_mut()
-            .chain(building.iter_mut())
-            .find(|h| h.stretch.runs.contains(&r));
-        if let Some(h) = hand {
-            h.runs.push((run, tracker.found()));
-        }
-    };
-    // The survey's options: the dialect found and the program flow settled, so this read
-    // ends `Done`.
-    let _ = scan_blocks_with(bytes, &sv.read, |s: Scanned<'_>| {
-        if let Some(h) = &mut building {
-            h.program.push(&s);
-            if h.stretch.last_block == i {
-                h.end_byte = Some(if h.stretch.whole {
-                    bytes.len()
-                } else {
-                    line_end_after(bytes, s.block.span().end)
-                });
-                done.extend(building.take());
-            }
-        }
-        // The next stretch may start at the block this one ended at (two runs sharing a
-        // point): that block is then in both.
-        if building.is_none()
-            && let Some(st) = todo.get(next)
-            && st.first_block == i
-        {
+        k = e;
+    }
+    Ok(())
+}
+
+/// Read stretch `st` again: from the place the survey kept before its first run (or, for
+/// the whole file and where none was kept, from the start, walking the runs before it),
+/// its blocks into a program and its runs as the survey found them, each with the tool the
+/// survey found for it.
+fn read_stretch(
+    bytes: &[u8],
+    sv: &Survey,
+    st: &Stretch,
+    rd: &Reading<'_>,
+) -> Result<InHand, Error> {
+    let recs = &sv.runs[st.runs.clone()];
+    let resumed = (!st.whole)
+        .then(|| recs.first()?.kept.as_ref()?.start.clone())
+        .flatten();
+    let from = resumed
+        .clone()
+        .unwrap_or_else(|| Resume::file_start(&sv.read));
+    let mut i = if resumed.is_some() { st.first_block } else { 0 };
+    // The walk: taken up at the run's first block when resumed there, else from the start.
+    let mut builder = resumed.is_none().then(|| run_builder(rd));
+    let mut program: Option<ProgramBuilder> = None;
+    let mut runs: Vec<Run> = Vec::with_capacity(recs.len());
+    let wanted = |run: &Run| recs.iter().any(|r| r.first_block == run.blocks[0]);
+    let mut end_byte = bytes.len();
+    let mut prev = *from.state();
+    scan_resumed(bytes, &sv.read, &from, |s: Scanned<'_>| {
+        if i >= st.first_block {
             let base = if st.whole { 0 } else { s.block.span().start };
-            let mut program = ProgramBuilder::new(base, &prev);
-            program.push(&s);
-            building = Some(InHand {
-                stretch: st.clone(),
-                program,
-                end_byte: None,
-                runs: Vec::new(),
-            });
-            next += 1;
+            program
+                .get_or_insert_with(|| ProgramBuilder::new(base, &prev))
+                .push(&s);
         }
-        builder.push(i, s.block, s.state, &mut |run| {
-            give_run(run, &mut run_no, &mut building, &mut done, &tracker)
-        });
-        // After the runs this block ends: a tool change is the next run's.
-        tracker.block(
-            sv.dialect,
-            s.block,
-            &bytes[s.block.span()],
-            s.words,
-            s.state,
-        );
-        while done
-            .front()
-            .is_some_and(|h| h.runs.len() == h.stretch.runs.len())
-        {
-            if let Some(h) = done.pop_front() {
-                ready_bytes += h.end_byte.unwrap_or(bytes.len()) - h.program.base();
-                ready.push(h);
-            }
+        match &mut builder {
+            Some(b) => b.push(i, s.block, s.state, &mut |run| {
+                if wanted(&run) {
+                    runs.push(run);
+                }
+            }),
+            None => builder = Some(RunBuilder::resumed_at(rd.passes, i, s.state)),
         }
-        if ready_bytes >= batch_bytes {
-            ready_bytes = 0;
-            if let Err(e) = flush(&mut ready) {
-                failure = Some(Error::Output(e));
-                return ControlFlow::Break(());
+        if i == st.last_block {
+            if !st.whole {
+                end_byte = line_end_after(bytes, s.block.span().end);
             }
+            return ControlFlow::Break(());
         }
         prev = *s.state;
         i += 1;
         ControlFlow::Continue(())
     })
     .map_err(|e| Error::Parse(e.with_path(rd.name)))?;
-    if let Some(e) = failure {
-        return Err(e);
+    if let Some(b) = &mut builder {
+        b.finish(&mut |run| {
+            if wanted(&run) {
+                runs.push(run);
+            }
+        });
     }
-    builder.finish(&mut |run| give_run(run, &mut run_no, &mut building, &mut done, &tracker));
-    ready.extend(done);
-    flush(&mut ready).map_err(Error::Output)
+    // The runs as the survey found them: the same blocks (a stretch's end is its run's end
+    // or later), what ended each in the file, the tool the survey tracked.
+    assert!(
+        runs.len() == recs.len()
+            && runs.iter().zip(recs).all(|(run, rec)| {
+                run.blocks.first() == Some(&rec.first_block)
+                    && run.blocks.last() == Some(&rec.last_block)
+            }),
+        "the second read found other runs than the survey in the stretch at block {}",
+        st.first_block
+    );
+    let runs = runs
+        .into_iter()
+        .zip(recs)
+        .map(|(mut run, rec)| {
+            run.ended_by = rec.ended_by;
+            let tool = rec
+                .kept
+                .as_ref()
+                .map(|k| k.tool.clone())
+                .unwrap_or_default();
+            (run, tool)
+        })
+        .collect();
+    let program = program.unwrap_or_else(|| ProgramBuilder::new(0, &prev));
+    Ok(InHand {
+        stretch: st.clone(),
+        program,
+        end_byte: Some(end_byte),
+        runs,
+    })
 }
 
 /// A stretch as a loaded program: its blocks, its runs (block indices re-based) with their

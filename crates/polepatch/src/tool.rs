@@ -1507,7 +1507,13 @@ fn fusion_id(c: &str) -> Option<ToolId> {
 /// ([`comment_text`]'s forms) or M6. Most blocks do not, and [`Tracker::block`] skips them
 /// without looking further.
 fn may_name_tool(text: &[u8], words: &[Word]) -> bool {
-    if text.iter().any(|&b| matches!(b, b'T' | b't' | b'(' | b';')) {
+    // Every block of a program passes here: the bytes are looked at in chunks, each
+    // without an early exit (which the compiler turns into a few vector compares).
+    let marked = |c: &[u8]| {
+        c.iter()
+            .fold(false, |f, &b| f | matches!(b, b'T' | b't' | b'(' | b';'))
+    };
+    if text.chunks(32).any(marked) {
         return true;
     }
     let t = text.trim_ascii_start();
