@@ -15,8 +15,7 @@ use crate::error::SplineError;
 use crate::interp::{check_finite, check_lengths};
 use crate::spline::{BSpline, check_knots};
 
-/// Relative size below which a diagonal entry of R counts as zero (rank deficiency).
-pub const RANK_TOLERANCE: f64 = 1e-12;
+pub use crate::tolerances::RANK_TOLERANCE;
 
 /// The cubic spline on `knots` (clamped, as from [`crate::knots::clamped_cubic`]) minimising
 /// `Σ w[i]·(f(s[i]) − y[i])²`; `w = None` means all ones.

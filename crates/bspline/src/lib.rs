@@ -39,6 +39,7 @@ pub mod knots;
 pub mod pp;
 pub mod sample;
 pub mod spline;
+pub mod tolerances;
 
 pub use basis::BasisRow;
 pub use error::SplineError;

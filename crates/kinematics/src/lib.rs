@@ -39,6 +39,7 @@ pub mod machine;
 mod machine_file;
 pub mod reorient;
 pub mod rotary;
+pub mod settings;
 pub mod tolerances;
 
 #[cfg(test)]

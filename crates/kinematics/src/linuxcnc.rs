@@ -92,8 +92,7 @@ pub fn default_jerk(max_acceleration: f64, servo_period_s: f64) -> f64 {
     max_acceleration / servo_period_s
 }
 
-/// LinuxCNC's default servo period when `[EMCMOT] SERVO_PERIOD` is absent, seconds.
-pub const DEFAULT_SERVO_PERIOD_S: f64 = 1e-3;
+pub use crate::settings::DEFAULT_SERVO_PERIOD_S;
 
 fn invalid(origin: &str, message: String) -> MachineError {
     MachineError::Invalid {

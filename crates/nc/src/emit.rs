@@ -637,9 +637,7 @@ impl Writer<'_> {
     }
 }
 
-/// Heidenhain cycle 203's retraction for chip breaking (Q256), mm: the CL does not state
-/// one; 0.2 mm is the value in Heidenhain's cycle 203 examples.
-pub const HEIDENHAIN_CHIP_BREAK_MM: f64 = 0.2;
+pub use crate::settings::HEIDENHAIN_CHIP_BREAK_MM;
 
 /// The program's bytes.
 pub fn emit(items: &[Item], o: &EmitOptions) -> Vec<u8> {

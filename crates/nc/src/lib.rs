@@ -47,6 +47,7 @@ pub mod plan;
 pub mod program;
 mod reader;
 pub mod run;
+pub mod settings;
 mod statements;
 pub mod style;
 pub mod tcpm;

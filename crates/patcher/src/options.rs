@@ -228,9 +228,7 @@ impl AnalysisOptions {
     }
 }
 
-/// Most decimal places a rotary value may be written with (`max_decimals`): beyond 9 the
-/// written digits are below any control's resolution and only lengthen the file.
-pub const MAX_WRITTEN_DECIMALS: usize = 9;
+pub use crate::settings::MAX_WRITTEN_DECIMALS;
 
 /// The margin is below this (`margin` ∈ `[0, MAX_MARGIN)`): the solvers aim at
 /// (1 − margin) of the rotary axes' limits, and at half of them or less a patch gives

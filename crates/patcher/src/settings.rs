@@ -259,3 +259,7 @@ impl SolverSettings {
         }
     }
 }
+
+/// Most decimal places a rotary value may be written with (`max_decimals`): beyond 9 the
+/// written digits are below any control's resolution and only lengthen the file.
+pub const MAX_WRITTEN_DECIMALS: usize = 9;
