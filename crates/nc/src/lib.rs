@@ -49,6 +49,7 @@ mod reader;
 pub mod run;
 pub mod settings;
 mod statements;
+pub mod stretch;
 pub mod style;
 pub mod tcpm;
 pub mod tolerances;

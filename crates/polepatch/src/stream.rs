@@ -67,7 +67,7 @@ use crate::tolerances::RANGE_SLACK_DEG;
 use polepatch_kinematics::Machine;
 use polepatch_nc::{
     Dialect, FileStyle, ProgramBuilder, Resume, RotaryLetters, Run, RunBreak, RunBuilder, Scanned,
-    StyleEvidence, scan_blocks_with, scan_resumed,
+    StyleEvidence, scan_blocks_with,
 };
 use std::io::Write;
 use std::ops::ControlFlow;
@@ -815,14 +815,6 @@ struct InHand {
     runs: Vec<(Run, crate::tool::FoundTool)>,
 }
 
-/// The byte just past the line ending after `at` (the end of `bytes` if none).
-fn line_end_after(bytes: &[u8], at: usize) -> usize {
-    bytes[at..]
-        .iter()
-        .position(|&b| b == b'\n')
-        .map_or(bytes.len(), |k| at + k + 1)
-}
-
 /// After the first read: the survey and the reading (`l`, of [`readings`]) for the
 /// stretches, or a program that holds nothing to analyse.
 enum Begun {
@@ -1474,8 +1466,8 @@ fn each_stretch<T: Send>(
     Ok(())
 }
 
-/// Read stretch `st` again: from the place the survey kept before its first run (or, for
-/// the whole file and where none was kept, from the start, walking the runs before it),
+/// Read stretch `st` again ([`polepatch_nc::stretch`]): from the place the survey kept
+/// before its first run (or, for the whole file and where none was kept, from the start),
 /// its blocks into a program and its runs as the survey found them, each with the tool the
 /// survey found for it.
 fn read_stretch(
@@ -1484,66 +1476,35 @@ fn read_stretch(
     st: &Stretch,
     rd: &Reading<'_>,
 ) -> Result<InHand, Error> {
+    use polepatch_nc::stretch::{ReadFrom, StretchSpec, read_stretch};
     let recs = &sv.runs[st.runs.clone()];
     let resumed = (!st.whole)
         .then(|| recs.first()?.kept.as_ref()?.start.clone())
         .flatten();
-    let from = resumed
-        .clone()
-        .unwrap_or_else(|| Resume::file_start(&sv.read));
-    let mut i = if resumed.is_some() { st.first_block } else { 0 };
-    // The walk: taken up at the run's first block when resumed there, else from the start.
-    let mut builder = resumed.is_none().then(|| run_builder(rd));
-    let mut program: Option<ProgramBuilder> = None;
-    let mut runs: Vec<Run> = Vec::with_capacity(recs.len());
-    let wanted = |run: &Run| recs.iter().any(|r| r.first_block == run.blocks[0]);
-    let mut end_byte = bytes.len();
-    let mut prev = *from.state();
-    scan_resumed(bytes, &sv.read, &from, |s: Scanned<'_>| {
-        if i >= st.first_block {
-            let base = if st.whole { 0 } else { s.block.span().start };
-            program
-                .get_or_insert_with(|| ProgramBuilder::new(base, &prev))
-                .push(&s);
-        }
-        match &mut builder {
-            Some(b) => b.push(i, s.block, s.state, &mut |run| {
-                if wanted(&run) {
-                    runs.push(run);
-                }
-            }),
-            None => builder = Some(RunBuilder::resumed_at(rd.passes, i, s.state)),
-        }
-        if i == st.last_block {
-            if !st.whole {
-                end_byte = line_end_after(bytes, s.block.span().end);
-            }
-            return ControlFlow::Break(());
-        }
-        prev = *s.state;
-        i += 1;
-        ControlFlow::Continue(())
+    let spec = StretchSpec {
+        from: resumed.map_or(ReadFrom::FileStart, |at| ReadFrom::RunStart(Box::new(at))),
+        first_block: st.first_block,
+        last_block: st.last_block,
+        whole: st.whole,
+        passes: rd.passes,
+    };
+    let read = read_stretch(bytes, &sv.read, &spec, |first| {
+        recs.iter().any(|r| r.first_block == first)
     })
     .map_err(|e| Error::Parse(e.with_path(rd.name)))?;
-    if let Some(b) = &mut builder {
-        b.finish(&mut |run| {
-            if wanted(&run) {
-                runs.push(run);
-            }
-        });
-    }
     // The runs as the survey found them: the same blocks (a stretch's end is its run's end
     // or later), what ended each in the file, the tool the survey tracked.
     assert!(
-        runs.len() == recs.len()
-            && runs.iter().zip(recs).all(|(run, rec)| {
+        read.runs.len() == recs.len()
+            && read.runs.iter().zip(recs).all(|(run, rec)| {
                 run.blocks.first() == Some(&rec.first_block)
                     && run.blocks.last() == Some(&rec.last_block)
             }),
         "the second read found other runs than the survey in the stretch at block {}",
         st.first_block
     );
-    let runs = runs
+    let runs = read
+        .runs
         .into_iter()
         .zip(recs)
         .map(|(mut run, rec)| {
@@ -1556,11 +1517,10 @@ fn read_stretch(
             (run, tool)
         })
         .collect();
-    let program = program.unwrap_or_else(|| ProgramBuilder::new(0, &prev));
     Ok(InHand {
         stretch: st.clone(),
-        program,
-        end_byte: Some(end_byte),
+        program: read.program,
+        end_byte: Some(read.end_byte),
         runs,
     })
 }
