@@ -40,6 +40,7 @@ mod machine_file;
 pub mod reorient;
 pub mod rotary;
 pub mod tolerances;
+pub mod vec3;
 
 #[cfg(test)]
 mod testutil;
