@@ -252,7 +252,7 @@ fn near_pole(lp: &LoadedProgram, path: &Path, opts: &PatchOptions) -> bool {
     let pi = polepatch_kinematics::Axis::Primary.index();
     path.axes
         .iter()
-        .any(|q| lp.pole.near(Some(q[pi]), opts.reach_deg()))
+        .any(|q| lp.pole.near(q[pi], opts.reach_deg()))
 }
 
 /// Step 2: what run `r` becomes (the sub-steps of the module docs).
@@ -1235,7 +1235,8 @@ fn untouched(
             .run
             .pos
             .iter()
-            .any(|p| lp.pole.near(p[pi], reach_deg)),
+            // A value never programmed reads as 0, as `Run::axes5` reads it.
+            .any(|p| lp.pole.near(p[pi].unwrap_or(0.0), reach_deg)),
         message,
     }
 }
