@@ -31,6 +31,7 @@ use crate::records::{
 use crate::tolerances::MAX_DWELL_S;
 use crate::values::{coordinate, number};
 use crate::{ClError, MAX_FEED_MM_MIN, MAX_SPINDLE_RPM, MM_PER_INCH, ParseOptions, err, unit_axis};
+use polepatch_kinematics::vec3;
 
 /// Records that do not change what the machine does: read, counted, not posted.
 pub const PASSIVE: &[&str] = &[
@@ -466,9 +467,9 @@ impl Reader<'_> {
             };
             // Without a stated radius: the start point's distance from the axis.
             let r = r.unwrap_or_else(|| {
-                let a = crate::arcs::sub(start, c);
-                let ax = crate::arcs::dot(a, n);
-                crate::arcs::norm(crate::arcs::sub(a, crate::arcs::scale(n, ax)))
+                let a = vec3::sub(start, c);
+                let ax = vec3::dot(a, n);
+                vec3::norm(vec3::sub(a, vec3::scale(n, ax)))
             });
             MoveKind::Arc(
                 Arc::new(c, n, r, start, p, angle, self.last_axis)

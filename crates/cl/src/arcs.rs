@@ -23,6 +23,7 @@
 
 pub use crate::tolerances::ON_CIRCLE_TOL_MM;
 use crate::tolerances::{MAX_ARC_CHORDS, SLERP_OPPOSITE_RAD, SLERP_SAME_RAD};
+use polepatch_kinematics::vec3::{add, cross, dot, norm, scale, sub};
 
 /// A circular or helical move.
 #[derive(Debug, Clone, PartialEq)]
@@ -63,29 +64,6 @@ impl Plane {
             Plane::Yz => 0,
         }
     }
-}
-
-pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-pub(crate) fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-pub(crate) fn scale(a: [f64; 3], k: f64) -> [f64; 3] {
-    [a[0] * k, a[1] * k, a[2] * k]
-}
-pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-pub(crate) fn norm(a: [f64; 3]) -> f64 {
-    a[0].hypot(a[1]).hypot(a[2])
 }
 
 /// `v` rotated by `angle` radians counter-clockwise about the unit axis `n` (Rodrigues).

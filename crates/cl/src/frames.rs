@@ -29,6 +29,7 @@
 use crate::records::At;
 use crate::values::{coordinate, number};
 use crate::{ClError, err};
+use polepatch_kinematics::vec3;
 
 use crate::tolerances::CSYS_IDENTITY_TOLERANCE;
 pub use crate::tolerances::{FRAME_TOLERANCE, MSYS_AXIS_TOLERANCE, MSYS_ORIGIN_TOLERANCE_MM};
@@ -89,7 +90,7 @@ fn orthonormal(rows: &[[f64; 3]]) -> bool {
     rows.iter().enumerate().all(|(i, a)| {
         rows.iter().enumerate().all(|(j, b)| {
             let want = if i == j { 1.0 } else { 0.0 };
-            (crate::arcs::dot(*a, *b) - want).abs() <= FRAME_TOLERANCE
+            (vec3::dot(*a, *b) - want).abs() <= FRAME_TOLERANCE
         })
     })
 }
@@ -128,7 +129,7 @@ impl Frames {
     ) -> Result<[f64; 3], ClError> {
         let v: [f64; 12] = numbers("CSYS (a 3×4 matrix [R|t] by rows)", f, at)?;
         let r = [[v[0], v[1], v[2]], [v[4], v[5], v[6]], [v[8], v[9], v[10]]];
-        let det = crate::arcs::dot(r[0], crate::arcs::cross(r[1], r[2]));
+        let det = vec3::dot(r[0], vec3::cross(r[1], r[2]));
         if !orthonormal(&r) || det <= 0.0 {
             return Err(e(
                 at,
@@ -153,7 +154,7 @@ impl Frames {
                 ),
             ));
         }
-        let n = crate::arcs::norm(axis);
+        let n = vec3::norm(axis);
         Ok([axis[0] / n, axis[1] / n, axis[2] / n])
     }
 

@@ -7,6 +7,7 @@ use polepatch::load_nc;
 use polepatch::reorient::{ReorientReport, Tilt, pole_after, reorient_nc, search, tool_axes};
 use polepatch_cli::files::read;
 use polepatch_cli::outputs::{Input, Output, plan};
+use polepatch_kinematics::vec3::{cross, norm_direct};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -286,15 +287,7 @@ fn sphere_svg(
     Ok(buf)
 }
 
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
 fn normalize(a: [f64; 3]) -> [f64; 3] {
-    let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    let n = norm_direct(a);
     [a[0] / n, a[1] / n, a[2] / n]
 }

@@ -36,7 +36,8 @@
 
 use crate::chain::Chain;
 use crate::machine::Machine;
-use crate::rotary::{Carrier, RotaryAxis, add, rotate_deg, scale, sub};
+use crate::rotary::{Carrier, RotaryAxis, rotate_deg};
+use crate::vec3::{add, scale, sub};
 
 /// A table axis turning `v` (a vector, no position): `R(u, −s·θ)·v`.
 fn table_turn(axis: &RotaryAxis, sense: f64, angle_deg: f64, v: [f64; 3]) -> [f64; 3] {
@@ -75,7 +76,7 @@ impl Chain {
         tool_length_mm: f64,
     ) -> [f64; 3] {
         let r = &machine.rotary;
-        let reach = scale(tool_length_mm, r.tool_direction);
+        let reach = scale(r.tool_direction, tool_length_mm);
         // Relative to the tip at zero: h(y) = Q + R(u, s·θ)·(y − Q), applied to y = 0.
         let turn = |axis: &RotaryAxis, point: [f64; 3], sense: f64, angle: f64, y: [f64; 3]| {
             let q = add(point, reach);
@@ -342,6 +343,7 @@ mod tests {
     /// general code must give the same bits for every table-table A-C and B-C machine.
     mod before {
         use crate::machine::{Machine, PrimaryAxis};
+        use crate::vec3::{add, sub};
 
         fn rot_p(primary: PrimaryAxis, angle_deg: f64, v: [f64; 3]) -> [f64; 3] {
             let (s, c) = angle_deg.to_radians().sin_cos();
@@ -353,12 +355,6 @@ mod tests {
         fn rot_z(angle_deg: f64, v: [f64; 3]) -> [f64; 3] {
             let (s, c) = angle_deg.to_radians().sin_cos();
             [c * v[0] - s * v[1], s * v[0] + c * v[1], v[2]]
-        }
-        fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-            [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-        }
-        fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-            [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
         }
         fn kind(m: &Machine) -> PrimaryAxis {
             m.standard_form().unwrap().primary
@@ -487,7 +483,7 @@ mod tests {
                 // zero; the gauge point is tool_mm up the tool; head axes (points relative
                 // to the gauge point) turn the tool, the one next to the tool first.
                 let tip0 = add(x, DATUM);
-                let gauge = add(tip0, scale(tool_mm, r.tool_direction));
+                let gauge = add(tip0, scale(r.tool_direction, tool_mm));
                 let mut tool_tip = tip0;
                 if r.primary.carrier == Carrier::Head {
                     let q = add(gauge, chain.primary_axis_point_mm);

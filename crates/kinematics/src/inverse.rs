@@ -335,6 +335,95 @@ pub fn inverse_path_from(
     out
 }
 
+/// How far the tool is from a machine's pole, degrees, from its tilting axis' value: the
+/// one rule of "near the pole" — the survey of a program, the patch's skip of a run with no
+/// point near it, the patcher's fast path and its zones all ask it.
+///
+/// On the standard form (the built-ins, and every pair with the pole axis along Z and the
+/// tilting axis about X or Y) the distance is `|P|` (not wrapped) and the signed distance P
+/// itself, exactly; on other pairs the angle between the tool and the pole
+/// ([`Machine::pole_tilt_deg`]), signed by the side of [`Machine::pole_p_deg`] the primary
+/// axis is on; a pair that cannot reach the pole is 180° from it everywhere. Built once per
+/// machine ([`PoleDistance::of`]: the pole is found then, not at every point).
+#[derive(Debug, Clone)]
+pub struct PoleDistance {
+    rule: PoleRule,
+}
+
+#[derive(Debug, Clone)]
+enum PoleRule {
+    /// `|P|`.
+    Standard,
+    /// A pair that cannot reach the pole: 180°.
+    NoPole,
+    /// Through the pair's kinematics.
+    General {
+        rotary: crate::rotary::Rotaries,
+        primary_sense: f64,
+        pole_p_deg: f64,
+        opposite: bool,
+    },
+}
+
+impl PoleDistance {
+    /// The rule of `machine`.
+    pub fn of(machine: &Machine) -> PoleDistance {
+        let rule = if machine.standard_form().is_some() {
+            PoleRule::Standard
+        } else {
+            match machine.pole() {
+                None => PoleRule::NoPole,
+                Some(pole) => PoleRule::General {
+                    rotary: machine.rotary,
+                    primary_sense: machine.primary_sense,
+                    pole_p_deg: pole.p_deg,
+                    opposite: pole.opposite,
+                },
+            }
+        };
+        PoleDistance { rule }
+    }
+
+    /// The distance from the pole of a tool whose tilting axis is at `primary_deg`,
+    /// degrees (≥ 0).
+    pub fn deg(&self, primary_deg: f64) -> f64 {
+        match &self.rule {
+            PoleRule::Standard => primary_deg.abs(),
+            PoleRule::NoPole => 180.0,
+            PoleRule::General {
+                rotary,
+                primary_sense,
+                opposite,
+                ..
+            } => pole_tilt_general(rotary, *primary_sense, primary_deg, *opposite),
+        }
+    }
+
+    /// The signed distance: [`PoleDistance::deg`], negative where the primary axis is below
+    /// the pole's value, so that a sign change is a pass through the pole onto the other
+    /// branch (P itself on the standard form; 180° everywhere without a pole).
+    pub fn signed_deg(&self, primary_deg: f64) -> f64 {
+        match &self.rule {
+            PoleRule::Standard => primary_deg,
+            PoleRule::NoPole => 180.0,
+            PoleRule::General { pole_p_deg, .. } => {
+                let tilt = self.deg(primary_deg);
+                if primary_deg < *pole_p_deg {
+                    -tilt
+                } else {
+                    tilt
+                }
+            }
+        }
+    }
+
+    /// Whether a tool whose tilting axis is at `primary_deg` lies within `reach_deg` of the
+    /// pole (where a zone can be).
+    pub fn near(&self, primary_deg: f64, reach_deg: f64) -> bool {
+        self.deg(primary_deg) <= reach_deg
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -838,6 +927,39 @@ mod tests {
                         // A few ulps of a unit vector: degrees ↔ radians round twice.
                         prop_assert!(dist(forward(m, s.p_deg, s.c_deg), o) < 4e-15);
                     },
+                }
+            }
+        }
+    }
+
+    /// The one rule agrees with the machine's own: |P| on the standard form, the tilt
+    /// elsewhere, signed by the side of the pole; 180° on a pair without a pole.
+    #[test]
+    fn the_pole_distance_is_the_machines_tilt_signed_by_its_side() {
+        let ucp = Machine::builtin("mikron-ucp710").unwrap();
+        let d = PoleDistance::of(&ucp);
+        assert_eq!((d.deg(-3.5), d.signed_deg(-3.5)), (3.5, -3.5));
+        assert_eq!(d.deg(270.0), 270.0, "not wrapped");
+        assert!(d.near(-2.0, 2.0) && !d.near(2.5, 2.0));
+        let no_pole = crate::testutil::pair_machine(
+            [0.0, 0.0, 1.0],
+            [1.0, 0.0, 0.0],
+            crate::testutil::unit([1.0, 0.0, 1.0]),
+            1.0,
+            1.0,
+        );
+        assert!(no_pole.standard_form().is_none() && no_pole.pole_p_deg().is_none());
+        for m in [tdr(), nutating(), no_pole] {
+            let d = PoleDistance::of(&m);
+            for p in [-40.0, -5.0, 0.0, 0.3, 7.0, 60.0, 89.0, 91.0] {
+                match m.pole_p_deg() {
+                    Some(pole) => {
+                        let tilt = m.pole_tilt_deg(p);
+                        assert_eq!(d.deg(p).to_bits(), tilt.to_bits());
+                        let signed = if p < pole { -tilt } else { tilt };
+                        assert_eq!(d.signed_deg(p).to_bits(), signed.to_bits());
+                    }
+                    None => assert_eq!((d.deg(p), d.signed_deg(p)), (180.0, 180.0)),
                 }
             }
         }

@@ -41,6 +41,7 @@ pub mod reorient;
 pub mod rotary;
 pub mod settings;
 pub mod tolerances;
+pub mod vec3;
 
 #[cfg(test)]
 mod testutil;
@@ -50,7 +51,7 @@ pub use chain::Chain;
 pub use feed::{AxisBound, FeedBound, LimitKind, axis_feed_bound, axis_feed_ratio, feed_bound};
 pub use forward::{StandardForm, angle_between_deg, forward, forward_jacobian};
 pub use inverse::{
-    BranchRule, domain_rule_index, inverse, inverse_path, inverse_path_from, solve_ik,
+    BranchRule, PoleDistance, domain_rule_index, inverse, inverse_path, inverse_path_from, solve_ik,
 };
 pub use machine::{Axis, AxisLimits, Controller, Machine, MachineError, PrimaryAxis};
 pub use reorient::JigRotation;

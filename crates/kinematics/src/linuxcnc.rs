@@ -79,8 +79,9 @@ use crate::machine::{AxisLimits, Controller, Machine, MachineError, num, read_bo
 use crate::machine_file::{
     DEG_PER_REV, DEG_S_PER_RPM, MM_PER_M, MM_S_PER_M_MIN, check_pair, positive, range,
 };
-use crate::rotary::{Carrier, Rotaries, RotaryAxis, add};
+use crate::rotary::{Carrier, Rotaries, RotaryAxis};
 use crate::tolerances::LINUXCNC_NO_LIMIT;
+use crate::vec3::add;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 

@@ -16,8 +16,9 @@ use crate::machine::{
     AxisLimits, Controller, LIMIT_MAX, LIMIT_MIN, Machine, PrimaryAxis, ROTARY_LETTERS,
     check_tcy_ms, num,
 };
-use crate::rotary::{Carrier, Rotaries, RotaryAxis, angle_rad, norm, scale};
+use crate::rotary::{Carrier, Rotaries, RotaryAxis, angle_rad};
 use crate::tolerances::{MIN_AXIS_SIN, MIN_DIRECTION_NORM, UNIT_NORM_TOL};
+use crate::vec3::{norm, scale};
 use serde::Deserialize;
 
 /// mm/s per m/min.
@@ -201,7 +202,7 @@ fn direction(field: &str, d: &[f64]) -> Result<[f64; 3], String> {
         ));
     }
     // [0, 0, 1] and [0, 0, 2] both give exactly [0, 0, 1].
-    let u = scale(1.0 / n, v);
+    let u = scale(v, 1.0 / n);
     // Held by the bound above; kept so that no NaN direction can ever leave here.
     if (norm(u) - 1.0).abs().is_nan() || (norm(u) - 1.0).abs() >= UNIT_NORM_TOL {
         return Err(format!("{field} = {v:?} cannot be normalised"));

@@ -51,6 +51,7 @@
 //! axis). For the built-in form the two solutions are `(P, C)` and `(−P, C + 180°)`.
 
 use crate::tolerances::{POLE_SIN_TOL, REACH_TOL_RAD};
+use crate::vec3::{cross, dot, norm, scale, sub};
 use serde::{Deserialize, Serialize};
 
 /// What a rotary axis turns.
@@ -138,36 +139,6 @@ impl Rotaries {
             _ => Layout::HeadTable,
         }
     }
-}
-
-// ---- small vector algebra (machine frame, unitless or mm) ----
-
-pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-pub(crate) fn norm(a: [f64; 3]) -> f64 {
-    a[0].hypot(a[1]).hypot(a[2])
-}
-
-pub(crate) fn scale(k: f64, a: [f64; 3]) -> [f64; 3] {
-    [k * a[0], k * a[1], k * a[2]]
-}
-
-pub(crate) fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 /// The angle between two vectors, radians in [0, π], accurate near 0 and π.
@@ -277,9 +248,9 @@ impl PairGeometry {
         let b = rot.primary.direction;
         let t0 = rot.tool_direction;
         let bt = dot(b, t0);
-        let perp = sub(t0, scale(bt, b));
+        let perp = sub(t0, scale(b, bt));
         let rt = norm(perp);
-        let e1 = scale(1.0 / rt, perp);
+        let e1 = scale(perp, 1.0 / rt);
         let e2 = cross(b, e1);
         PairGeometry {
             a,
@@ -334,8 +305,8 @@ impl PairGeometry {
     /// `v·o − (a·v)(a·o)` would be lost to rounding).
     fn alpha(&self, v: [f64; 3], o: [f64; 3]) -> f64 {
         let a = self.a;
-        let v_perp = sub(v, scale(dot(a, v), a));
-        let o_perp = sub(o, scale(dot(a, o), a));
+        let v_perp = sub(v, scale(a, dot(a, v)));
+        let o_perp = sub(o, scale(a, dot(a, o)));
         dot(a, cross(v_perp, o_perp)).atan2(dot(v_perp, o_perp))
     }
 }
@@ -367,7 +338,7 @@ pub(crate) fn jacobian_general(
     let o = rotate_deg(a, sc * c_deg, v);
     let dv = cross(rot.primary.direction, v);
     let dp = rotate_deg(a, sc * c_deg, dv);
-    [o, scale(sp * k, dp), scale(sc * k, cross(a, o))]
+    [o, scale(dp, sp * k), scale(cross(a, o), sc * k)]
 }
 
 /// The inverse kinematics of any pair in closed form (module docs).
@@ -376,8 +347,8 @@ pub(crate) fn inverse_general(rot: &Rotaries, sp: f64, sc: f64, o_wp: [f64; 3]) 
     if !(m > 0.0 && o_wp.iter().all(|x| x.is_finite())) {
         return Ik::Invalid;
     }
-    let o = scale(1.0 / m, o_wp);
-    let o = scale(1.0 / norm(o), o);
+    let o = scale(o_wp, 1.0 / m);
+    let o = scale(o, 1.0 / norm(o));
     let g = PairGeometry::new(rot);
     let sin_gamma = norm(cross(g.a, o));
     let gamma = sin_gamma.atan2(dot(g.a, o));
@@ -454,7 +425,7 @@ pub(crate) fn pole_general(rot: &Rotaries, sp: f64, range_deg: (f64, f64)) -> Op
 pub(crate) fn pole_tilt_general(rot: &Rotaries, sp: f64, p_deg: f64, opposite: bool) -> f64 {
     let v = rotate_deg(rot.primary.direction, sp * p_deg, rot.tool_direction);
     let pole = if opposite {
-        scale(-1.0, rot.c.direction)
+        scale(rot.c.direction, -1.0)
     } else {
         rot.c.direction
     };
@@ -499,7 +470,7 @@ mod tests {
             assert!(dist(rotate_deg(u, 90.0, from), to) < 1e-15, "{u:?}");
             for angle in [-170.0, -33.3, 0.0, 12.5, 90.0, 180.0] {
                 for sign in [1.0, -1.0] {
-                    let u = scale(sign, u);
+                    let u = scale(u, sign);
                     let want = rodrigues(u, angle, v);
                     assert!(dist(rotate_deg(u, angle, v), want) < 1e-15, "{u:?} {angle}");
                 }
@@ -718,8 +689,8 @@ mod tests {
             let (p, c) = (rng.uniform(-180.0, 180.0), rng.uniform(-360.0, 360.0));
             let [o, dp, dc] = forward_jacobian(&m, p, c);
             assert!(dist(o, forward(&m, p, c)) < 1e-15);
-            let np = scale(0.5 / h, sub(forward(&m, p + h, c), forward(&m, p - h, c)));
-            let nc = scale(0.5 / h, sub(forward(&m, p, c + h), forward(&m, p, c - h)));
+            let np = scale(sub(forward(&m, p + h, c), forward(&m, p - h, c)), 0.5 / h);
+            let nc = scale(sub(forward(&m, p, c + h), forward(&m, p, c - h)), 0.5 / h);
             assert!(dist(np, dp) < 1e-9, "{np:?} {dp:?}");
             assert!(dist(nc, dc) < 1e-9, "{nc:?} {dc:?}");
             // |∂o/∂C| per radian is the sine of the tilt from the pole.
@@ -776,7 +747,7 @@ mod tests {
                 opposite: false
             }
         );
-        match solve_ik(&m, scale(-1.0, a)) {
+        match solve_ik(&m, scale(a, -1.0)) {
             Ik::Pole { p_deg, opposite } => assert!(opposite && p_deg.abs() == 180.0),
             other => panic!("{other:?}"),
         }

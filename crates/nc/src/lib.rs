@@ -27,7 +27,7 @@
 //!   [`ProgramBuilder`]);
 //! - using a program: [`run`] (runs of G1 motion), [`style`] (the file's number style),
 //!   [`writer`] ([`write()`]), [`plan`] (the words a rewrite must add), [`emit`] (new
-//!   programs).
+//!   programs), [`tooldesc`] (what the text says of the tool: descriptions, calls, `DL`).
 
 mod block;
 mod builder;
@@ -53,6 +53,7 @@ pub mod stretch;
 pub mod style;
 pub mod tcpm;
 pub mod tolerances;
+pub mod tooldesc;
 mod word;
 pub mod writer;
 

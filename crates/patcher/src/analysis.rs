@@ -28,7 +28,9 @@
 use crate::path::{Path, PathError};
 use crate::spline::{AnalysisSpline, SpanCubic, SplineSystem};
 use crate::tolerances::{RATIO_TOL, TIME_MAX_DEPTH, TIME_REL_TOL};
-use polepatch_kinematics::{Axis, FeedBound, LimitKind, Machine, axis_feed_bound, feed_bound};
+use polepatch_kinematics::{
+    Axis, FeedBound, LimitKind, Machine, PoleDistance, axis_feed_bound, feed_bound,
+};
 
 pub use crate::settings::{CONE_DEG, POLE_REACH_DEG};
 
@@ -283,25 +285,17 @@ fn run_analysis(
     Ok(analysis)
 }
 
-/// Each point's signed distance from the pole, degrees: its magnitude the angle between the
-/// tool and the pole axis ([`Machine::pole_tilt_deg`]), its sign the side of the pole the
-/// primary axis is on (the sign of P − [`Machine::pole_p_deg`]), so that a sign change is a
-/// pass through the pole onto the other branch. On the standard form (the built-ins, and
-/// every pair with the pole axis along Z and the tilting axis about X or Y) it is P itself,
-/// exactly; a pair that cannot reach the pole is 180° from it everywhere.
+/// Each point's signed distance from the pole, degrees ([`PoleDistance::signed_deg`]): its
+/// magnitude the angle between the tool and the pole axis, its sign the side of the pole
+/// the primary axis is on, so that a sign change is a pass through the pole onto the other
+/// branch. On the standard form it is P itself, exactly; a pair that cannot reach the pole
+/// is 180° from it everywhere.
 pub fn pole_side_deg(path: &Path, machine: &Machine) -> Vec<f64> {
-    let p = path.axes.iter().map(|q| q[Axis::Primary.index()]);
-    if machine.standard_form().is_some() {
-        return p.collect();
-    }
-    let Some(pole_p) = machine.pole_p_deg() else {
-        return p.map(|_| 180.0).collect();
-    };
-    p.map(|p| {
-        let tilt = machine.pole_tilt_deg(p);
-        if p < pole_p { -tilt } else { tilt }
-    })
-    .collect()
+    let pole = PoleDistance::of(machine);
+    path.axes
+        .iter()
+        .map(|q| pole.signed_deg(q[Axis::Primary.index()]))
+        .collect()
 }
 
 /// A stretch of consecutive spans whose C-limited ratio is below 1.

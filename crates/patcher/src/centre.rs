@@ -25,6 +25,7 @@
 //! rotary axes on it ([`crate::driver`]).
 
 use crate::path::Path;
+use polepatch_kinematics::vec3::{along, sub};
 use polepatch_kinematics::{Axis, Machine, forward};
 
 /// Keep a ball's centre: the ball's radius and how X Y Z are written
@@ -62,7 +63,8 @@ impl KeepCentre {
     ) -> [f64; 3] {
         let o0 = forward(machine, p0_deg, c0_deg);
         let o1 = forward(machine, p_deg, c_deg);
-        std::array::from_fn(|i| tip_mm[i] + self.radius_mm * (o0[i] - o1[i]))
+        // tip + R·(o − o′): the centre tip + R·o less R·o′.
+        along(tip_mm, sub(o0, o1), self.radius_mm)
     }
 }
 

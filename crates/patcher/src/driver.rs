@@ -64,7 +64,7 @@ use crate::{
     tolerances::{CAP_SLACK_DEG, CENTRE_TIME_REL, CHECK_MARGIN_POINTS, RATIO_TOL},
     verify::{AxisChange, Verdict, not_worse_floor, verify_change_on, verify_change_with_core},
 };
-use polepatch_kinematics::{Axis, Machine, angle_between_deg, forward};
+use polepatch_kinematics::{Axis, Machine, PoleDistance, angle_between_deg, forward};
 
 pub use crate::zones::{core_margins, figures_over, merge_zones, zone_core};
 
@@ -884,14 +884,9 @@ fn patch_on(
 /// Whether some point of `path` is near enough the pole to lie in a zone
 /// ([`PatchOptions::reach_deg`]).
 fn near_pole(path: &Path, machine: &Machine, opts: &PatchOptions) -> bool {
-    let reach = opts.reach_deg();
-    if machine.standard_form().is_some() {
-        let pi = Axis::Primary.index();
-        return path.axes.iter().any(|q| q[pi].abs() <= reach);
-    }
-    crate::analysis::pole_side_deg(path, machine)
-        .iter()
-        .any(|d| d.abs() <= reach)
+    let (pole, reach) = (PoleDistance::of(machine), opts.reach_deg());
+    let pi = Axis::Primary.index();
+    path.axes.iter().any(|q| pole.near(q[pi], reach))
 }
 
 /// The rotary axes that must reach feed and may not get worse.

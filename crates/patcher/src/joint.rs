@@ -100,6 +100,7 @@ use crate::{
     tolerances::{JOINT_WINDOW_POINTS, MIN_POINT_CAP_DEG, SCP_MERIT_FLOOR, ZERO_DEVIATION_DEG},
     window::{RowSet, Window},
 };
+use polepatch_kinematics::vec3::dot;
 use polepatch_kinematics::{Axis, Machine, angle_between_deg, forward, forward_jacobian};
 use std::time::Instant;
 
@@ -215,10 +216,6 @@ fn tangent_basis(o: [f64; 3]) -> [[f64; 3]; 2] {
         o[0] * e1[1] - o[1] * e1[0],
     ];
     [e1, e2]
-}
-
-fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 impl JointProblem<'_> {
@@ -463,8 +460,8 @@ impl<'a> Model<'a> {
             let r0: [f64; 3] =
                 std::array::from_fn(|m| o[m] - pr.target[i][m] - a[m] * dp - b[m] * dc);
             let [e1, e2] = tangent_basis(pr.target[i]);
-            let (u0, ua, ub) = (dot3(e1, r0), dot3(e1, a), dot3(e1, b));
-            let (v0, va, vb) = (dot3(e2, r0), dot3(e2, a), dot3(e2, b));
+            let (u0, ua, ub) = (dot(e1, r0), dot(e1, a), dot(e1, b));
+            let (v0, va, vb) = (dot(e2, r0), dot(e2, a), dot(e2, b));
             // u = u0 + ua·δP + ub·δC (an affine form of the unknowns), v likewise.
             let u = Aff::sum(&[(ua, fp), (ub, fc), (u0, &Aff::constant(1.0))]);
             let v = Aff::sum(&[(va, fp), (vb, fc), (v0, &Aff::constant(1.0))]);
@@ -659,7 +656,7 @@ mod tests {
             let (o, o2) = (forward(&m, p, c), forward(&m, p2, c2));
             let [e1, e2] = tangent_basis(o);
             let r = [o2[0] - o[0], o2[1] - o[1], o2[2] - o[2]];
-            let tang = (dot3(e1, r).powi(2) + dot3(e2, r).powi(2)).sqrt();
+            let tang = (dot(e1, r).powi(2) + dot(e2, r).powi(2)).sqrt();
             let theta = angle_between_deg(o, o2).to_radians();
             assert!(
                 (tang - theta.sin()).abs() < 1e-12,
@@ -669,9 +666,7 @@ mod tests {
             assert!(tang <= chord(theta.to_degrees()) + 1e-15);
             // The basis is orthonormal and orthogonal to o.
             assert!(
-                dot3(e1, o).abs() < 1e-15
-                    && dot3(e2, o).abs() < 1e-15
-                    && dot3(e1, e2).abs() < 1e-15
+                dot(e1, o).abs() < 1e-15 && dot(e2, o).abs() < 1e-15 && dot(e1, e2).abs() < 1e-15
             );
         }
     }

@@ -63,6 +63,7 @@ use crate::tolerances::CENTRE_PATH_CAP_SAFETY;
 use crate::tolerances::MIN_INCH_XYZ_DECIMALS;
 use crate::tolerances::RAPID_TIME_TOL_S;
 use crate::tool::{RunTool, ToolDemand, ToolKind};
+use polepatch_kinematics::vec3::along;
 use polepatch_kinematics::{Chain, Machine};
 use polepatch_nc::{Edit, FileStyle, NumberStyle, Tcpm};
 use polepatch_patcher::{
@@ -251,7 +252,7 @@ fn near_pole(lp: &LoadedProgram, path: &Path, opts: &PatchOptions) -> bool {
     let pi = polepatch_kinematics::Axis::Primary.index();
     path.axes
         .iter()
-        .any(|q| lp.pole.near(Some(q[pi]), opts.reach_deg()))
+        .any(|q| lp.pole.near(q[pi], opts.reach_deg()))
 }
 
 /// Step 2: what run `r` becomes (the sub-steps of the module docs).
@@ -1169,9 +1170,7 @@ fn tool_fields(
             // The centre's height above the point X Y Z state; X Y Z rewritten to keep it.
             let reach = rt.centre_offset_mm().unwrap_or(0.0);
             let keeps = matches!(rt.demand(), ToolDemand::KeepCentre { .. });
-            let centre = |tip: [f64; 3], o: [f64; 3]| -> [f64; 3] {
-                std::array::from_fn(|i| tip[i] + reach * o[i])
-            };
+            let centre = |tip: [f64; 3], o: [f64; 3]| along(tip, o, reach);
             let mut at_points: f64 = 0.0;
             let mut between: f64 = 0.0;
             let m = CENTRE_CHORD_SAMPLES;
@@ -1236,7 +1235,8 @@ fn untouched(
             .run
             .pos
             .iter()
-            .any(|p| lp.pole.near(p[pi], reach_deg)),
+            // A value never programmed reads as 0, as `Run::axes5` reads it.
+            .any(|p| lp.pole.near(p[pi].unwrap_or(0.0), reach_deg)),
         message,
     }
 }

@@ -3,7 +3,7 @@
 use crate::error::Error;
 use crate::settings::CL_SNIFF_BYTES;
 pub use crate::tolerances::MIN_FEED_MM_MIN;
-use polepatch_kinematics::Machine;
+use polepatch_kinematics::{Machine, PoleDistance};
 use polepatch_nc::{Dialect, FileStyle, Program, RotaryLetters, Run, modal};
 use polepatch_patcher::Path;
 
@@ -180,46 +180,6 @@ pub fn read_options_with(
     })
 }
 
-/// How far a point is from the pole of a machine, degrees, from its tilting axis' value:
-/// `|P|` on the standard form, else the angle between the tool and the pole axis
-/// ([`Machine::pole_tilt_deg`]; 180° everywhere on a pair that cannot reach the pole) —
-/// the magnitude of `patcher::analysis::pole_side_deg`.
-#[derive(Debug, Clone)]
-pub(crate) enum PoleDistance {
-    /// The standard form: `|P|`.
-    Standard,
-    /// Another pair: through its kinematics.
-    General(Box<Machine>),
-}
-
-impl PoleDistance {
-    /// The rule of `machine`.
-    pub(crate) fn of(machine: &Machine) -> PoleDistance {
-        if machine.standard_form().is_some() {
-            PoleDistance::Standard
-        } else {
-            PoleDistance::General(Box::new(machine.clone()))
-        }
-    }
-    /// The distance from the pole of a point whose tilting axis is at `primary_deg`.
-    pub(crate) fn deg(&self, primary_deg: f64) -> f64 {
-        match self {
-            PoleDistance::Standard => primary_deg.abs(),
-            PoleDistance::General(m) => match m.pole_p_deg() {
-                Some(_) => m.pole_tilt_deg(primary_deg),
-                None => 180.0,
-            },
-        }
-    }
-    /// Whether a point whose tilting axis is at `primary_deg` lies within `reach_deg` of the
-    /// pole, where a zone can be (`patcher::detect_zones`): a value never programmed reads
-    /// as 0, as [`Run::axes5`] reads it. The one rule the survey, the patch and the report
-    /// use.
-    pub(crate) fn near(&self, primary_deg: Option<f64>, reach_deg: f64) -> bool {
-        self.deg(primary_deg.unwrap_or(0.0)) <= reach_deg
-    }
-}
-
 /// One run of the program with its path for the patcher.
 #[derive(Debug, Clone)]
 pub struct RunPath {
@@ -259,7 +219,7 @@ pub struct LoadedProgram {
     pub notes: crate::notes::Notes,
     /// The caller's tool options ([`crate::options::PatchOptions::tool`]).
     pub tool: crate::tool::ToolOptions,
-    /// The machine's distance from the pole.
+    /// The machine's distance from the pole (the one rule of "near the pole").
     pub(crate) pole: PoleDistance,
 }
 

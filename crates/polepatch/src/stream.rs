@@ -283,7 +283,7 @@ struct Surveying {
     /// The two readings followed ([`readings`]).
     readings: [RotaryLetters; 2],
     /// The machine's distance from the pole.
-    pole: crate::program::PoleDistance,
+    pole: polepatch_kinematics::PoleDistance,
     /// [`Reading::lazy_style`].
     lazy_style: Option<usize>,
     /// Some run given out may be patched (for the tilting letter it may have): the style
@@ -321,7 +321,9 @@ impl Surveying {
                 *u |= v.is_some();
             }
             for (l, letters) in self.readings.iter().enumerate() {
-                near[l] |= self.pole.near(p[letters.tilt_index()], self.cone_deg);
+                // A value never programmed reads as 0, as `Run::axes5` reads it.
+                let primary_deg = p[letters.tilt_index()].unwrap_or(0.0);
+                near[l] |= self.pole.near(primary_deg, self.cone_deg);
             }
         }
         let first_block = run.blocks[0];
@@ -406,7 +408,7 @@ struct Reading<'a> {
     /// itself, reads without.
     passes: bool,
     /// The machine's distance from the pole.
-    pole: crate::program::PoleDistance,
+    pole: polepatch_kinematics::PoleDistance,
     /// How far from the pole a zone can lie (the cone, or the pole reach beyond it).
     cone_deg: f64,
     fallback: Option<f64>,
@@ -453,7 +455,7 @@ impl<'a> Reading<'a> {
             letters,
             ranges: ranges(machine, letters),
             passes: true,
-            pole: crate::program::PoleDistance::of(machine),
+            pole: polepatch_kinematics::PoleDistance::of(machine),
             cone_deg: opts.patch.reach_deg(),
             fallback: opts.read.feed_fallback_mm_min,
             work_offset_mm: opts.read.work_offset_mm,
@@ -476,7 +478,7 @@ impl<'a> Reading<'a> {
             letters,
             ranges: ranges(machine, letters),
             passes: true,
-            pole: crate::program::PoleDistance::of(machine),
+            pole: polepatch_kinematics::PoleDistance::of(machine),
             cone_deg: opts.analysis.reach_deg(),
             fallback: opts.read.feed_fallback_mm_min,
             work_offset_mm: opts.read.work_offset_mm,

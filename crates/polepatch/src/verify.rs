@@ -62,6 +62,7 @@ pub use crate::tolerances::REFERENCE_TOL_MM;
 pub use crate::tolerances::TIME_TOL_REL;
 use crate::tool::{RunTool, ToolDemand, ToolKind, ToolPoint};
 pub use crate::violation::{Check, Violation};
+use polepatch_kinematics::vec3::{along, norm_direct, sub};
 use polepatch_kinematics::{Machine, angle_between_deg, forward};
 use polepatch_nc::{
     Block, Dialect, Flags, Modal, Motion, ReadOptions, RotaryLetters, Run, RunBuilder, Scanned,
@@ -451,14 +452,6 @@ fn half_unit(decimals: usize) -> f64 {
     0.5 * 10f64.powi(-(decimals.min(15) as i32))
 }
 
-fn norm(v: [f64; 3]) -> f64 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
 impl<'a> Comparison<'a> {
     fn new(
         original: &'a [u8],
@@ -749,12 +742,7 @@ impl<'a> Comparison<'a> {
         };
         Some(match tool.demand() {
             ToolDemand::KeepCentre { offset_mm } => {
-                let o = forward(self.machine, q[3], q[4]);
-                [
-                    tip[0] + offset_mm * o[0],
-                    tip[1] + offset_mm * o[1],
-                    tip[2] + offset_mm * o[2],
-                ]
+                along(tip, forward(self.machine, q[3], q[4]), offset_mm)
             }
             _ => tip,
         })
@@ -880,7 +868,7 @@ impl<'a> Comparison<'a> {
                         .into(),
                 );
             }
-            let d = norm(sub([qo[0], qo[1], qo[2]], [qp[0], qp[1], qp[2]]));
+            let d = norm_direct(sub([qo[0], qo[1], qo[2]], [qp[0], qp[1], qp[2]]));
             self.pending.push(Pending {
                 line,
                 check: Check::PositioningTarget,
@@ -911,7 +899,7 @@ impl<'a> Comparison<'a> {
             ToolDemand::KeepCentre { offset_mm } => offset_mm,
             _ => 0.0,
         };
-        let d = norm(sub(ro, rp));
+        let d = norm_direct(sub(ro, rp));
         self.report.max_reference_shift_mm = self.report.max_reference_shift_mm.max(d);
         let what = match bt.tool.tool {
             Some(t) if radius > 0.0 => format!("the {}'s centre (tip + R·o)", t.describe()),
