@@ -37,6 +37,10 @@ impl Flags {
     /// −352.356°). Which one the machine does is not in the program: the block ends runs,
     /// belongs to none and is never changed.
     pub const ROTARY_WRAP: Flags = Flags(512);
+    /// The block may say something of the tool (a `T`, a comment, `M6`, a `*` line): the
+    /// tool reader ([`crate::tooldesc`]) looks at its text; other blocks only end a group of
+    /// descriptions.
+    pub const MAY_NAME_TOOL: Flags = Flags(1024);
 
     /// Whether every bit of `other` is set.
     pub fn has(self, other: Flags) -> bool {

@@ -526,8 +526,15 @@ impl Interpreter {
         words: &mut Vec<Word>,
         s: &mut Scan,
     ) -> Result<(), ParseError> {
+        let first = words.len();
         self.lex_line(bytes, span.clone(), line, words, s)
-            .map_err(|e| crate::lines::explain_lone_cr(bytes, &span, e))
+            .map_err(|e| crate::lines::explain_lone_cr(bytes, &span, e))?;
+        // Whether the block may say something of the tool ([`crate::tooldesc`]): looked at
+        // here, where lines are lexed side by side, not where blocks are taken in order.
+        if crate::tooldesc::may_name_tool(&bytes[span], &words[first..]) {
+            s.flags.set(Flags::MAY_NAME_TOOL);
+        }
+        Ok(())
     }
 
     fn lex_line(

@@ -405,7 +405,7 @@ impl Tracker {
             self.revision += 1;
         }
         let code = !comment_only(text);
-        if !may_name_tool(text, words) {
+        if !block.flags.has(Flags::MAY_NAME_TOOL) {
             // What a block without a T, a comment or M6 does (below): it ends a table and
             // the group.
             self.nx_table = false;
@@ -810,7 +810,7 @@ fn fusion_id(c: &str) -> Option<ToolId> {
 /// words, `TOOL DEF`/`TOOL CALL`, `T="…"`, the tables' headers), a comment
 /// ([`comment_text`]'s forms) or M6. Most blocks do not, and [`Tracker::block`] skips them
 /// without looking further.
-fn may_name_tool(text: &[u8], words: &[Word]) -> bool {
+pub(crate) fn may_name_tool(text: &[u8], words: &[Word]) -> bool {
     // Every block of a program passes here: the bytes are looked at in chunks, each
     // without an early exit (which the compiler turns into a few vector compares).
     let marked = |c: &[u8]| {
