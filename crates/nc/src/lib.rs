@@ -5,6 +5,8 @@
 //! block. [`runs`] groups G1 motion into runs with the cumulative tool-tip path length s.
 //! [`write()`] renders the program with chosen words changed or inserted in the file's own
 //! number style; every other byte is copied unchanged, so `write(&parse(b)?, &[]) == b`.
+//! [`apply_edits`] is the one application of a rewrite's edits: the words that keep what
+//! the edits do not change, the direction forms, and the write in the file's style.
 //!
 //! Units: linear values and s in mm (inch programs, G20/G70, are converted on read),
 //! feed in mm/min, rotary values in degrees as written.
@@ -26,9 +28,11 @@
 //!   one reader, [`scan_blocks_with`], and its simpler forms), `builder.rs` ([`parse`],
 //!   [`ProgramBuilder`]);
 //! - using a program: [`run`] (runs of G1 motion), [`style`] (the file's number style),
-//!   [`writer`] ([`write()`]), [`plan`] (the words a rewrite must add), [`emit`] (new
-//!   programs).
+//!   [`writer`] ([`write()`]), [`plan`] (the words a rewrite must add, and its direction
+//!   forms), [`apply`] ([`apply_edits`]: edits in, bytes or the groups that conflict out),
+//!   [`emit`] (new programs).
 
+pub mod apply;
 mod block;
 mod builder;
 pub mod conversational;
@@ -54,6 +58,7 @@ pub mod tolerances;
 mod word;
 pub mod writer;
 
+pub use apply::{Applied, EditGroup, EditPlan, GroupConflict, apply_edits};
 pub use block::{Block, Flags};
 pub use builder::{ProgramBuilder, parse, parse_with};
 pub use detect::detect as detect_dialect;
@@ -62,7 +67,7 @@ pub use error::ParseError;
 pub use flow::FlowPlan;
 pub use lines::LineEnds;
 pub use modal::{FeedMode, Modal, Motion, RotaryLetters, Tcpm};
-pub use plan::{FormConflict, restore_modal, write_direction_forms};
+pub use plan::FormConflict;
 pub use program::Program;
 pub use reader::{
     Lookalike, Scanned, Settled, scan, scan_blocks, scan_blocks_with, style_evidence_to,
@@ -71,4 +76,4 @@ pub use run::{Run, RunBreak, RunBuilder, primary_in_use, primary_of, runs};
 pub use style::{FileStyle, NumberStyle, StyleEvidence};
 pub use tcpm::{Code, ControllerCodes, ReadOptions};
 pub use word::{RotaryForm, Word};
-pub use writer::{Edit, write, write_styled};
+pub use writer::{Edit, write};
