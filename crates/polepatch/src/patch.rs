@@ -100,7 +100,7 @@ pub fn patch_program<'p>(
             written = [written[0].max(decimals[0]), written[1].max(decimals[1])];
         }
     }
-    // Steps 3 and 4 and the write: one application of every patched run's edits.
+    // Step 3: one application of every patched run's edits (the write included).
     let plan = edit_plan(lp, &styles, &mut outcomes);
     let applied = polepatch_nc::apply_edits(&lp.program, &plan, &styles.file);
     for dropped in applied.dropped {
@@ -801,7 +801,7 @@ impl RunPatch<'_> {
     }
 }
 
-/// Steps 3 and 4 as data for [`polepatch_nc::apply_edits`]: one group per run (its blocks
+/// Step 3 as data for [`polepatch_nc::apply_edits`]: one group per run (its blocks
 /// after its start point; a patched run's edits, taken from its outcome), and the file's
 /// decimals for a restored word. Inside a run, a point that relied on a modal value keeps
 /// it; after a run only the blocks that restate its last values are written: its end
