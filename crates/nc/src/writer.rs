@@ -1,6 +1,6 @@
 //! Rewriting: changed or inserted words, every other byte copied.
 //!
-//! [`write`] writes edits as they are in the program's own style (a whole program);
+//! [`write()`] writes edits as they are in the program's own style (a whole program);
 //! `write_styled`, in a given file's style, is the last step of [`crate::apply_edits`].
 
 use crate::modal::AXES;
