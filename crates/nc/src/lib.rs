@@ -5,6 +5,8 @@
 //! block. [`runs`] groups G1 motion into runs with the cumulative tool-tip path length s.
 //! [`write()`] renders the program with chosen words changed or inserted in the file's own
 //! number style; every other byte is copied unchanged, so `write(&parse(b)?, &[]) == b`.
+//! [`apply_edits`] is the one application of a rewrite's edits: the words that keep what
+//! the edits do not change, the direction forms, and the write in the file's style.
 //!
 //! Units: linear values and s in mm (inch programs, G20/G70, are converted on read),
 //! feed in mm/min, rotary values in degrees as written.
@@ -26,9 +28,12 @@
 //!   one reader, [`scan_blocks_with`], and its simpler forms), `builder.rs` ([`parse`],
 //!   [`ProgramBuilder`]);
 //! - using a program: [`run`] (runs of G1 motion), [`style`] (the file's number style),
-//!   [`writer`] ([`write()`]), [`plan`] (the words a rewrite must add), [`emit`] (new
-//!   programs), [`tooldesc`] (what the text says of the tool: descriptions, calls, `DL`).
+//!   [`writer`] ([`write()`]), [`plan`] (the words a rewrite must add, and its direction
+//!   forms), [`apply`] ([`apply_edits`]: edits in, bytes or the groups that conflict out),
+//!   [`emit`] (new programs), [`tooldesc`] (what the text says of the tool: descriptions,
+//!   calls, `DL`), [`stretch`] (a stretch read again from a place a first read kept).
 
+pub mod apply;
 mod block;
 mod builder;
 pub mod conversational;
@@ -57,6 +62,7 @@ pub mod tooldesc;
 mod word;
 pub mod writer;
 
+pub use apply::{Applied, EditGroup, EditPlan, GroupConflict, apply_edits};
 pub use block::{Block, Flags};
 pub use builder::{ProgramBuilder, parse, parse_with};
 pub use detect::detect as detect_dialect;
@@ -65,7 +71,7 @@ pub use error::ParseError;
 pub use flow::FlowPlan;
 pub use lines::LineEnds;
 pub use modal::{FeedMode, Modal, Motion, RotaryLetters, Tcpm};
-pub use plan::{FormConflict, restore_modal, write_direction_forms};
+pub use plan::FormConflict;
 pub use program::Program;
 pub use reader::{
     Lookalike, Resume, Scanned, Settled, scan, scan_blocks, scan_blocks_with, scan_resumed,
@@ -75,4 +81,4 @@ pub use run::{Run, RunBreak, RunBuilder, primary_in_use, primary_of, runs};
 pub use style::{FileStyle, NumberStyle, StyleEvidence};
 pub use tcpm::{Code, ControllerCodes, ReadOptions};
 pub use word::{RotaryForm, Word};
-pub use writer::{Edit, write, write_styled};
+pub use writer::{Edit, write};

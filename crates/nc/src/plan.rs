@@ -1,18 +1,22 @@
-//! Edit planning: the words a rewrite must add so that nothing but the intended values
-//! change.
+//! Edit planning: the words a rewrite must add, and the numbers it must write, so that
+//! nothing but the intended values change. Steps 2 and 3 of [`crate::apply_edits`], which
+//! is their one caller.
 //!
 //! A block that relies on a modal axis value (it has no word for that letter) inherits
 //! whatever the blocks before it left. When an edit changes the value of a letter in a
 //! block, the next move after it that has no word for that letter would inherit the new
-//! value and move differently: [`restore_modal`] gives that move its original value
-//! explicitly, written in the file's style.
+//! value and move differently: `restore_modal` gives that move its original value
+//! explicitly, written in the file's style. A word in a Sinumerik direction form
+//! (`C=DC(…)`) says which way to turn as well as where to: `write_direction_forms` gives
+//! the edits of such words the numbers that make the patched moves, and names a
+//! [`FormConflict`] where none does.
 
 use crate::modal::{AXES, X, Z};
 use crate::program::Program;
 use crate::tolerances::DIRECTION_FORM_REACH_TOL_DEG;
 use crate::word::{RotaryForm, Word};
 use crate::writer::Edit;
-pub use crate::writer::inserted_form;
+use crate::writer::inserted_form;
 
 /// For every edit, find the next block after it that moves or carries the edited letter;
 /// when that block has no word for the letter and is not edited for it itself, add an edit
@@ -25,7 +29,7 @@ pub use crate::writer::inserted_form;
 /// says whether a restoring word of `letter` may go into `block` for an edit of
 /// `edited_block` (a caller may forbid words outside the stretch it rewrote). Edits are appended; the order of
 /// `edits` is otherwise kept.
-pub fn restore_modal(
+pub(crate) fn restore_modal(
     program: &Program,
     edits: &mut Vec<Edit>,
     decimals_of: &dyn Fn(u8) -> usize,
@@ -100,7 +104,7 @@ pub struct FormConflict {
 /// there is not the same kind of move), a [`FormConflict`] names it: the caller must drop
 /// the edits that cause it (and call again on the original values). Letters without a
 /// direction word in the file are left as they are.
-pub fn write_direction_forms(program: &Program, edits: &mut [Edit]) -> Vec<FormConflict> {
+pub(crate) fn write_direction_forms(program: &Program, edits: &mut [Edit]) -> Vec<FormConflict> {
     use crate::modal::A;
     let mut conflicts = variable_conflicts(program, edits);
     for (k, &letter) in AXES.iter().enumerate().skip(A) {
@@ -322,168 +326,4 @@ fn inserted_word(
         None
     };
     (Some(to), conflict)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::{Dialect, parse, write};
-
-    fn c(block: usize, value: f64) -> Edit {
-        Edit {
-            block,
-            letter: b'C',
-            value,
-            decimals: 3,
-        }
-    }
-
-    /// The move after an edited block relied on modal C: it gets its old C written out,
-    /// and a block that carries its own C is left alone.
-    #[test]
-    fn next_move_keeps_its_position() {
-        let src = "G1 X0 Y0 Z0 A1 C10.5 F100\nX1 C20.25\nX2\nX3 C40.125\n";
-        let p = parse(src.as_bytes().to_vec(), Dialect::Auto).unwrap();
-        let mut edits = vec![c(1, 25.0)];
-        restore_modal(&p, &mut edits, &|_| 3, &|_, _, _| true);
-        assert_eq!(edits.len(), 2);
-        let out = String::from_utf8(write(&p, &edits)).unwrap();
-        assert_eq!(
-            out,
-            "G1 X0 Y0 Z0 A1 C10.5 F100\nX1 C25\nX2 C20.25\nX3 C40.125\n"
-        );
-        // Consecutive edits: only the block after the last one is restored.
-        let mut edits = vec![c(1, 25.0), c(2, 30.0)];
-        restore_modal(&p, &mut edits, &|_| 3, &|_, _, _| true);
-        assert_eq!(edits.len(), 2, "block 3 has its own C");
-        // A caller that forbids words outside its stretch gets none.
-        let mut edits = vec![c(1, 25.0)];
-        restore_modal(&p, &mut edits, &|_| 3, &|_, b, _| b <= 1);
-        assert_eq!(edits.len(), 1);
-    }
-
-    /// Comments and non-moves between the edit and the next move are skipped; the primary
-    /// letter is restored like C; an inch program gets its linear value back in inches.
-    #[test]
-    fn skips_non_moves_and_handles_every_axis_letter() {
-        let src = "G20 G1 X0 Y0 Z0 A1 C10 F10\n(NOTE)\nX1 A2 C20\nM8\nY2\n";
-        let p = parse(src.as_bytes().to_vec(), Dialect::Auto).unwrap();
-        let mut edits = vec![
-            Edit {
-                block: 2,
-                letter: b'A',
-                value: -2.0,
-                decimals: 3,
-            },
-            Edit {
-                block: 2,
-                letter: b'X',
-                value: 1.5,
-                decimals: 3,
-            },
-        ];
-        restore_modal(&p, &mut edits, &|_| 1, &|_, _, _| true);
-        let out = String::from_utf8(write(&p, &edits)).unwrap();
-        assert_eq!(
-            out,
-            "G20 G1 X0 Y0 Z0 A1 C10 F10\n(NOTE)\nX1.500 A-2.000 C20\nM8\nX1.0 Y2 A2.0\n"
-        );
-    }
-
-    fn dc_program() -> crate::Program {
-        let src = "N10 TRAORI\nN20 G1 X0 Y0 Z0 A1 C=DC(350.) F1000\nN30 X1 A0.5 C=DC(10.)\n\
-                   N40 X2 A0.5 C=DC(30.)\nN50 X3 A1 C=DC(40.)\n";
-        parse(src.as_bytes().to_vec(), Dialect::Sinumerik).unwrap()
-    }
-
-    /// Issue 30 item 10: an edited `C=DC(…)` is written modulo 360 in the same form where
-    /// the shorter way is the patched move; an unedited one after it is checked from its
-    /// new starting point.
-    #[test]
-    fn direction_forms_are_written_modulo_360_where_they_make_the_move() {
-        let p = dc_program();
-        assert_eq!(p.state(2).pos[crate::modal::C], Some(370.0));
-        let mut edits = vec![c(2, 375.5), c(3, 385.25)];
-        assert_eq!(write_direction_forms(&p, &mut edits), vec![]);
-        assert_eq!((edits[0].value, edits[1].value), (15.5, 25.25));
-        let out = String::from_utf8(write(&p, &edits)).unwrap();
-        assert!(
-            out.contains("C=DC(15.5)") && out.contains("C=DC(25.25)"),
-            "{out}"
-        );
-        // A patched move the shorter way cannot make (a turn of +190°).
-        let mut edits = vec![c(2, 540.0)];
-        let conflicts = write_direction_forms(&p, &mut edits);
-        assert_eq!(conflicts.len(), 1, "{conflicts:?}");
-        assert_eq!((conflicts[0].block, conflicts[0].cause), (2, 2));
-        assert!(
-            conflicts[0]
-                .message
-                .contains("would move -170.000° instead")
-        );
-        // From 540 the unedited DC(30.) after it still reaches 390 (−150°).
-        // A word inserted after direction words takes their form.
-        let src = "G1 X0 A1 C=DC(350.) F1000\nX1\nX2 C=DC(10.)\n";
-        let p = parse(src.as_bytes().to_vec(), Dialect::Sinumerik).unwrap();
-        let mut edits = vec![c(1, 365.0)];
-        assert_eq!(write_direction_forms(&p, &mut edits), vec![]);
-        let out = String::from_utf8(write(&p, &edits)).unwrap();
-        assert_eq!(
-            out,
-            "G1 X0 A1 C=DC(350.) F1000\nX1 C=DC(5.000)\nX2 C=DC(10.)\n"
-        );
-    }
-
-    #[test]
-    fn acp_and_acn_keep_their_direction() {
-        let src = "G1 X0 A1 C=ACP(350.) F1000\nX1 C=ACP(10.)\nX2 C=ACN(0.)\nX3 C=ACN(355.)\n";
-        let p = parse(src.as_bytes().to_vec(), Dialect::Sinumerik).unwrap();
-        let cs: Vec<_> = (0..4).map(|b| p.state(b).pos[crate::modal::C]).collect();
-        assert_eq!(cs, [Some(350.0), Some(370.0), Some(360.0), Some(355.0)]);
-        // ACP to 362 is +12 from 350: written 2.
-        let mut edits = vec![c(1, 362.0)];
-        assert_eq!(write_direction_forms(&p, &mut edits), vec![]);
-        assert_eq!(edits[0].value, 2.0);
-        // ACP cannot move back.
-        let mut edits = vec![c(1, 345.0)];
-        let k = write_direction_forms(&p, &mut edits);
-        assert!(k[0].message.contains("ACP"), "{k:?}");
-        // ACN to 357 from 360 is −3: written 357; the ACN(355.) after it still goes −2.
-        let mut edits = vec![c(2, 357.0)];
-        assert_eq!(write_direction_forms(&p, &mut edits), vec![]);
-        assert_eq!(edits[0].value, 357.0);
-        // ACN cannot move forward.
-        let mut edits = vec![c(3, 362.0)];
-        assert!(!write_direction_forms(&p, &mut edits).is_empty());
-    }
-}
-
-#[cfg(test)]
-mod variable_tests {
-    use super::*;
-    use crate::{Dialect, parse};
-
-    /// Issue 30 item 11: `C#105` is read as the constant but never rewritten.
-    #[test]
-    fn a_variable_word_is_never_rewritten() {
-        let src = "#105=10.\nG1 X0 A1 C#105 F1000\nX1 C20.\n";
-        let p = parse(src.as_bytes().to_vec(), Dialect::Fanuc).unwrap();
-        assert_eq!(p.state(1).pos[crate::modal::C], Some(10.0));
-        let mut edits = vec![Edit {
-            block: 1,
-            letter: b'C',
-            value: 12.0,
-            decimals: 3,
-        }];
-        let k = write_direction_forms(&p, &mut edits);
-        assert_eq!(k.len(), 1);
-        assert!(k[0].variable && k[0].message.contains("`C#105`"), "{k:?}");
-        let mut edits = vec![Edit {
-            block: 2,
-            letter: b'C',
-            value: 22.0,
-            decimals: 3,
-        }];
-        assert!(write_direction_forms(&p, &mut edits).is_empty());
-    }
 }

@@ -313,7 +313,7 @@ impl NumberStyle {
 }
 
 /// How a whole file writes its axis words (X Y Z A B C, each as [`NumberStyle::of`]) and
-/// separates words: what [`crate::write_styled`] needs to write edits into any stretch
+/// separates words: what [`crate::apply_edits`] needs to write edits into any stretch
 /// of the file the file's way.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FileStyle {

@@ -1,4 +1,7 @@
 //! Rewriting: changed or inserted words, every other byte copied.
+//!
+//! [`write()`] writes edits as they are in the program's own style (a whole program);
+//! `write_styled`, in a given file's style, is the last step of [`crate::apply_edits`].
 
 use crate::modal::AXES;
 use crate::program::Program;
@@ -46,7 +49,7 @@ pub fn write(program: &Program, edits: &[Edit]) -> Vec<u8> {
 ///
 /// # Panics
 /// If an edit names a block that does not exist.
-pub fn write_styled(program: &Program, edits: &[Edit], file: &FileStyle) -> Vec<u8> {
+pub(crate) fn write_styled(program: &Program, edits: &[Edit], file: &FileStyle) -> Vec<u8> {
     let bytes = &program.bytes;
     if edits.is_empty() {
         return bytes.clone();

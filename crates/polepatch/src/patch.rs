@@ -8,7 +8,8 @@
 //! [`patch_program`] takes them in this order, one function each. Each run's result is
 //! computed whole as a `RunOutcome` (`Patched { rows, edits }`, `Left { rows, untouched }`
 //! or `Quiet`) and folded into the report once, in run order, after the last step that can
-//! change it (direction forms): the report is never written and read back.
+//! change it (the application of the edits, which drops the runs whose direction forms
+//! conflict): the report is never written and read back.
 //!
 //! 1. **The file's styles** (`file_styles`): the decimals the file writes C, the primary
 //!    axis and X Y Z with, and the patcher's options they set.
@@ -34,12 +35,14 @@
 //!    7. **the edits** (`RunPatch::centre_edits`, `RunPatch::rotary_edits`): the tips of a
 //!       kept ball centre, then the primary-axis and C words, each with the blocks after
 //!       the run that restate its last values ([`crate::end_pose`]).
-//! 3. **Modal words** (`restore_modal`): inside a run, a point that relied on a modal
-//!    value keeps it.
-//! 4. **Direction forms** (`direction_forms`): the edits of Sinumerik `DC`/`ACP`/`ACN`
-//!    words are written in their form, or their run keeps its values.
-//! 5. **The report's totals** (`finish_report`): the words changed, the file's decimals
-//!    and those written.
+//! 3. **Modal words, direction forms and the write**, in one application of the edits
+//!    ([`polepatch_nc::apply_edits`], its plan made by `edit_plan`: one group per run, the
+//!    file's decimals): inside a run, a point that relied on a modal value keeps it; the
+//!    edits of Sinumerik `DC`/`ACP`/`ACN` words are written in their form, or their run is
+//!    dropped and keeps its values (`direction_form_left` says why); the stretch's bytes
+//!    are written in the file's style.
+//! 4. **The report's totals** (`finish_report`): the words changed (the edits written),
+//!    the file's decimals and those written.
 //!
 //! # What is never patched
 //! A run whose X Y Z are machine coordinates (no TCPM: M128, TRAORI, G43.4 not active) is
@@ -65,23 +68,24 @@ use crate::tolerances::RAPID_TIME_TOL_S;
 use crate::tool::{RunTool, ToolDemand, ToolKind};
 use polepatch_kinematics::vec3::along;
 use polepatch_kinematics::{Chain, Machine};
-use polepatch_nc::{Edit, FileStyle, NumberStyle, Tcpm};
+use polepatch_nc::modal::AXES;
+use polepatch_nc::{Edit, EditGroup, EditPlan, FileStyle, GroupConflict, NumberStyle, Tcpm};
 use polepatch_patcher::{
     KeepCentre, Method, PatchOptions, PatchResult, Path, PathError, ZoneReport, patch_path,
     report_unpatched,
 };
-use std::collections::HashMap;
+use std::borrow::Cow;
 
-/// Patch a loaded program: the edits to write and the report (the steps of the module
-/// docs).
+/// Patch a loaded program: its bytes as patched (borrowed when nothing changes) and the
+/// report (the steps of the module docs).
 ///
 /// `opts.c_decimals` and `opts.p_decimals` are taken from the file (its number style);
 /// `opts.max_decimals` is raised to the file's decimals when lower.
-pub fn patch_program(
-    lp: &LoadedProgram,
+pub fn patch_program<'p>(
+    lp: &'p LoadedProgram,
     machine: &Machine,
     opts: &PatchOptions,
-) -> (Vec<Edit>, FileReport) {
+) -> (Cow<'p, [u8]>, FileReport) {
     // A stretch of a file: what the file says as a whole (its notes, the primary
     // letter's substitution) is the stream's to report.
     let mut report = FileReport::unchanged(&lp.name, machine, Vec::new());
@@ -97,31 +101,19 @@ pub fn patch_program(
             written = [written[0].max(decimals[0]), written[1].max(decimals[1])];
         }
     }
-    // The edits of every patched run, each with its run (words restored by
-    // `restore_modal` belong to the run of their block).
-    let mut edits: Vec<Edit> = Vec::new();
-    let mut owner: Vec<Option<usize>> = Vec::new();
-    for (r, o) in outcomes.iter().enumerate() {
-        if let RunOutcome::Patched { edits: e, .. } = o {
-            edits.extend_from_slice(e);
-            owner.resize(edits.len(), Some(r));
-        }
-    }
-    let run_of = run_of_blocks(lp);
-    restore_modal(lp, &styles, &run_of, &mut edits);
-    owner.extend(
-        edits[owner.len()..]
-            .iter()
-            .map(|e| run_of.get(&e.block).copied()),
-    );
-    let forms = direction_forms(lp, edits, &owner);
-    for (run, reason, message) in forms.dropped {
+    // Step 3: one application of every patched run's edits (the write included).
+    let plan = edit_plan(lp, &styles, &mut outcomes);
+    let applied = polepatch_nc::apply_edits(&lp.program, &plan, &styles.file);
+    for dropped in applied.dropped {
+        let (run, reason, message) = direction_form_left(dropped);
         outcomes[run] =
             std::mem::take(&mut outcomes[run]).left(lp, run, reason, message, opts.reach_deg());
     }
-    report.warnings.extend(forms.warning);
-    let mut edits = forms.edits;
-    edits.sort_by_key(|e| (e.block, e.letter));
+    if let Some(k) = applied.unattributed {
+        report
+            .warnings
+            .push(format!("{}; no rotary word was changed", k.message));
+    }
     // Each run's outcome, folded into the report once, in run order.
     for o in outcomes {
         match o {
@@ -133,8 +125,8 @@ pub fn patch_program(
             RunOutcome::Patched { rows, .. } => report.zones.extend(rows),
         }
     }
-    finish_report(lp, &styles, written, edits.len(), &mut report);
-    (edits, report)
+    finish_report(lp, &styles, written, applied.edits_written, &mut report);
+    (applied.bytes, report)
 }
 
 /// What step 2 makes of one run: computed whole, then folded into the report once
@@ -155,7 +147,8 @@ enum RunOutcome {
     Patched {
         /// The zones' rows.
         rows: Vec<ZoneRow>,
-        /// The words it changes (its blocks, and the blocks after it that restate its end).
+        /// The words it changes (its blocks, and the blocks after it that restate its end);
+        /// taken into the plan of step 3 ([`edit_plan`]).
         edits: Vec<Edit>,
         /// Decimal places written for its changed C and primary-axis words.
         decimals: [usize; 2],
@@ -809,50 +802,41 @@ impl RunPatch<'_> {
     }
 }
 
-/// The run of each block inside a run (its start excluded).
-fn run_of_blocks(lp: &LoadedProgram) -> HashMap<usize, usize> {
-    lp.runs
+/// Step 3 as data for [`polepatch_nc::apply_edits`]: one group per run (its blocks
+/// after its start point; a patched run's edits, taken from its outcome), and the file's
+/// decimals for a restored word. Inside a run, a point that relied on a modal value keeps
+/// it; after a run only the blocks that restate its last values are written: its end
+/// point only moves when what follows does not depend on the pose ([`crate::end_pose`]).
+/// Where the run's last point got new X Y Z (a ball's centre kept), the first move after
+/// the run that relies on them gets the original values back: a positioning move keeps
+/// its target (its rotary words carry the run's new pose, by design, and are never
+/// restored).
+fn edit_plan(lp: &LoadedProgram, styles: &Styles, outcomes: &mut [RunOutcome]) -> EditPlan {
+    let groups = lp
+        .runs
         .iter()
-        .enumerate()
-        .flat_map(|(r, rp)| rp.run.blocks.iter().skip(1).map(move |&b| (b, r)))
-        .collect()
-}
-
-/// Step 3: inside a run, a point that relied on a modal value keeps it; after a run only
-/// the blocks that restate its last values are written: its end point only moves when
-/// what follows does not depend on the pose ([`crate::end_pose`]). Where the run's last
-/// point got new X Y Z (a ball's centre kept), the first move after the run that relies on
-/// them gets the original values back: a positioning move keeps its target (its rotary
-/// words carry the run's new pose, by design, and are never restored).
-fn restore_modal(
-    lp: &LoadedProgram,
-    styles: &Styles,
-    run_of: &HashMap<usize, usize>,
-    edits: &mut Vec<Edit>,
-) {
-    let file_decimals = |l: u8| match l {
+        .zip(outcomes.iter_mut())
+        .map(|(rp, o)| EditGroup {
+            blocks: rp.run.blocks.iter().skip(1).copied().collect(),
+            edits: match o {
+                RunOutcome::Patched { edits, .. } => std::mem::take(edits),
+                _ => Vec::new(),
+            },
+            restore_xyz_after: true,
+        })
+        .collect();
+    let restore_decimals = AXES.map(|l| match l {
         b'X' | b'Y' | b'Z' => styles.of(lp, l).decimals,
         l if l == lp.pole_letter => styles.c.decimals,
         _ => styles.p.decimals,
-    };
-    let allow = |edited: usize, b: usize, letter: u8| {
-        let Some(&r) = run_of.get(&edited) else {
-            return false;
-        };
-        if run_of.get(&b) == Some(&r) {
-            return true;
-        }
-        // The first move after the run, outside every run: X Y Z only.
-        let last = *lp.runs[r].run.blocks.last().unwrap_or(&edited);
-        matches!(letter, b'X' | b'Y' | b'Z')
-            && edited == last
-            && !run_of.contains_key(&b)
-            && (last + 1..b).all(|k| !lp.program.blocks[k].is_move)
-    };
-    polepatch_nc::restore_modal(&lp.program, edits, &file_decimals, &allow);
+    });
+    EditPlan {
+        groups,
+        restore_decimals,
+    }
 }
 
-/// Step 5: the words changed (`words`), and the file's decimals and those written, where a
+/// Step 4: the words changed (`words`), and the file's decimals and those written, where a
 /// run of the stretch comes near the pole (one with only runs that cannot be analysed
 /// says nothing of them).
 fn finish_report(
@@ -876,70 +860,29 @@ fn finish_report(
     }
 }
 
-/// What [`direction_forms`] leaves: the edits to write, the runs that keep their values
-/// (the run, the reason, the message), and a warning when a conflict could not be laid at
-/// a run's door.
-struct Forms {
-    edits: Vec<Edit>,
-    dropped: Vec<(usize, UntouchedReason, String)>,
-    warning: Option<String>,
-}
-
-/// Rotary words in a Sinumerik direction form (`C=DC(…)`, `C=ACP(…)`, `C=ACN(…)`): the
-/// edits of such words are written modulo 360 in the same form where it makes the patched
-/// move ([`polepatch_nc::write_direction_forms`]); a run whose edits ask a move the form
-/// cannot make keeps its values (its zones `direction_form`), and the check is made again
-/// without it (its edits changed where the next words start from). `owner`: each edit's
-/// run.
-fn direction_forms(lp: &LoadedProgram, edits: Vec<Edit>, owner: &[Option<usize>]) -> Forms {
-    let program = &lp.program;
-    let mut dropped: Vec<(usize, UntouchedReason, String)> = Vec::new();
-    let is_dropped =
-        |dropped: &[(usize, UntouchedReason, String)], r: usize| dropped.iter().any(|d| d.0 == r);
-    loop {
-        let mut kept: Vec<Edit> = edits
-            .iter()
-            .zip(owner)
-            .filter(|(_, o)| o.is_none_or(|r| !is_dropped(&dropped, r)))
-            .map(|(e, _)| *e)
-            .collect();
-        let conflicts = polepatch_nc::write_direction_forms(program, &mut kept);
-        let Some(k) = conflicts.first() else {
-            return Forms {
-                edits: kept,
-                dropped,
-                warning: None,
-            };
-        };
-        // The run of the edit that causes it.
-        let run = edits
-            .iter()
-            .zip(owner)
-            .filter(|(e, o)| e.block == k.cause && o.is_some_and(|r| !is_dropped(&dropped, r)))
-            .find_map(|(_, o)| *o);
-        let Some(run) = run else {
-            // Not attributable (should not happen): write nothing in a direction form.
-            return Forms {
-                edits: Vec::new(),
-                dropped,
-                warning: Some(format!("{}; no rotary word was changed", k.message)),
-            };
-        };
-        let reason = if k.variable {
-            UntouchedReason::MacroVariable
-        } else {
-            UntouchedReason::DirectionForm
-        };
-        let message = if k.variable {
-            format!("{}; the run keeps its values", k.message)
-        } else {
+/// Step 3, for a run whose edits [`polepatch_nc::apply_edits`] dropped: Sinumerik
+/// direction-form words (`C=DC(…)`, `C=ACP(…)`, `C=ACN(…)`) are written modulo 360 in the
+/// same form where it makes the patched move; a run whose edits ask a move the form cannot
+/// make keeps its values (its zones `direction_form`), as does one whose edit would rewrite
+/// a variable (`macro_variable`). The run, the reason and the message.
+fn direction_form_left(dropped: GroupConflict) -> (usize, UntouchedReason, String) {
+    let k = dropped.conflict;
+    if k.variable {
+        (
+            dropped.group,
+            UntouchedReason::MacroVariable,
+            format!("{}; the run keeps its values", k.message),
+        )
+    } else {
+        (
+            dropped.group,
+            UntouchedReason::DirectionForm,
             format!(
                 "{}: the form cannot make the patched move, and polepatch never writes a \
                  word that makes a different one; the run keeps its values",
                 k.message
-            )
-        };
-        dropped.push((run, reason, message));
+            ),
+        )
     }
 }
 

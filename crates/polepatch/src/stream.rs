@@ -36,7 +36,8 @@
 //!    [`crate::patch::patch_program`] with what the rest of the file says
 //!    ([`crate::program::Window`]: run numbers, number style, end poses, work offsets).
 //!    Bytes between stretches are copied; each stretch is written as
-//!    [`polepatch_nc::write_styled`] renders it.
+//!    [`crate::patch::patch_program`] returns it (the one application of its edits,
+//!    [`polepatch_nc::apply_edits`], in the file's style).
 //!
 //! The output and the report are those of the whole-program path
 //! (see [`load_nc`]) — tested on every
@@ -69,6 +70,7 @@ use polepatch_nc::{
     Dialect, FileStyle, ProgramBuilder, Resume, RotaryLetters, Run, RunBreak, RunBuilder, Scanned,
     StyleEvidence, scan_blocks_with,
 };
+use std::borrow::Cow;
 use std::io::Write;
 use std::ops::ControlFlow;
 
@@ -1013,11 +1015,10 @@ pub fn patch_nc_hooked(
                     FileReport::unchanged(&opts.read.name, machine, Vec::new()),
                 );
             }
-            let (edits, part) = patch_program(&lp, machine, &opts.patch);
-            let output = if edits.is_empty() {
-                lp.program.bytes
-            } else {
-                polepatch_nc::write_styled(&lp.program, &edits, &sv.style)
+            let (output, part) = patch_program(&lp, machine, &opts.patch);
+            let output = match output {
+                Cow::Owned(bytes) => bytes,
+                Cow::Borrowed(_) => lp.program.bytes,
             };
             #[cfg(test)]
             let output = tests::planted(output);
