@@ -324,16 +324,18 @@ fn read(
         }
         return Ok(true);
     }
-    // Windows of about SCAN_WINDOW_BYTES, each cut at line ends into one part per thread.
-    // A lexing thread lexes the parts of the next windows side by side (lexing needs only
-    // the dialect and the controller's codes: `lexing_twin`) while this thread applies the
-    // window before to the modal state, in file order, and gives its blocks to `visit`:
-    // the two overlap, so a visitor that does much per block costs little more than the
-    // lexing. The lexing thread hands a window over when this thread takes it, and only
-    // then lexes the next: a read that stops lexes at most one window past where it stops.
-    // Memory: two windows' words and line summaries (one applied, one being lexed). Nothing read depends on the overlap: the same blocks,
-    // states and errors, in the same order, as one thread gives.
+    // Windows of up to SCAN_WINDOW_BYTES, each cut at line ends into one part per lexing
+    // thread (every thread but this one, at least one). They lex the next window's parts
+    // side by side (lexing needs only the dialect and the controller's codes:
+    // `lexing_twin`) while this thread applies the window before to the modal state, in
+    // file order, and gives its blocks to `visit`. A window is handed over when this thread
+    // takes it, and only then is the next lexed: a read that stops lexes at most one window
+    // past where it stops. Memory: two windows' words and line summaries (one applied, one
+    // being lexed). Nothing read depends on the overlap: the same blocks, states and
+    // errors, in the same order, as one thread gives.
     let twin = interp.lexing_twin();
+    // This thread applies; the others lex.
+    let lexers = (threads - 1).max(1);
     std::thread::scope(|sc| {
         let (full_tx, full_rx) = std::sync::mpsc::sync_channel::<Window>(0);
         let (empty_tx, empty_rx) = std::sync::mpsc::channel::<Vec<LexedPart>>();
@@ -346,7 +348,7 @@ fn read(
             while from < bytes.len() {
                 let mut parts = empty_rx
                     .try_recv()
-                    .unwrap_or_else(|_| (0..threads).map(|_| LexedPart::default()).collect());
+                    .unwrap_or_else(|_| (0..lexers).map(|_| LexedPart::default()).collect());
                 let to = lex_window(twin, ends, bytes, from, size, &mut parts);
                 size = (size * 2).min(SCAN_WINDOW_BYTES);
                 // The reader stopped (its visitor, or an error): nothing more to lex.
