@@ -612,6 +612,48 @@ fn pin_ends_restated_by_other_runs(runs: &mut [RunRec]) {
     }
 }
 
+/// Where a read resumes, as the survey goes ([`RunRec::kept`]): before the block in hand
+/// (after the one before it), and before the last block that moved or changed a position —
+/// the two blocks where the run walk opens a run (`RunBuilder`: at the block in hand, or at
+/// that last place).
+struct Places {
+    before: Resume,
+    before_last_pos: Option<(usize, Resume)>,
+}
+
+impl Places {
+    fn new(read: &polepatch_nc::ReadOptions) -> Places {
+        Places {
+            before: Resume::file_start(read),
+            before_last_pos: None,
+        }
+    }
+
+    /// The walk has taken block `i`; its open run starts at block `first`: the survey
+    /// keeps the place before it, when that run is new.
+    fn open(&self, sv: &mut Surveying, first: Option<usize>, i: usize) {
+        if let Some(f) = first
+            && sv.open_start.as_ref().is_none_or(|(g, _)| *g != f)
+        {
+            sv.open_start = if f == i {
+                Some((f, self.before.clone()))
+            } else {
+                self.before_last_pos.clone().filter(|(b, _)| *b == f)
+            };
+        }
+    }
+
+    /// Block `i` (`s`; the state before it `prev`) is read: the places move on.
+    fn after(&mut self, s: &Scanned<'_>, prev: &polepatch_nc::Modal, i: usize) {
+        let after = s.resume_after();
+        if s.block.is_move || s.state.pos != prev.pos {
+            self.before_last_pos = Some((i, std::mem::replace(&mut self.before, after)));
+        } else {
+            self.before = after;
+        }
+    }
+}
+
 /// The first read of one reading (module docs, step 1): the runs, what decides their ends,
 /// the file's number style, notes, and the first words that tell why a program has no run.
 fn survey_once(
@@ -643,11 +685,7 @@ fn survey_once(
         Dialect::Auto => polepatch_nc::detect_dialect(bytes),
         d => d,
     };
-    // Where a read resumes before the block in hand (after the one before it), and before
-    // the last block that moved or changed a position: where the run walk opens a run
-    // (`RunBuilder`: at the block in hand, or at that last place).
-    let mut before = Resume::file_start(read);
-    let mut before_last_pos: Option<(usize, Resume)> = None;
+    let mut places = Places::new(read);
     let mut style = StyleEvidence::default();
     // Where the style is counted from: the first block, or (lazy) none yet.
     let mut style_from = opts.lazy_style.is_none().then_some(0usize);
@@ -702,24 +740,11 @@ fn survey_once(
             sv.frame_changes.push(i);
         }
         builder.push(i, s.block, s.state, &mut |run| sv.take(run));
-        if let Some(f) = builder.open_run_first_block()
-            && sv.open_start.as_ref().is_none_or(|(g, _)| *g != f)
-        {
-            sv.open_start = if f == i {
-                Some((f, before.clone()))
-            } else {
-                before_last_pos.clone().filter(|(b, _)| *b == f)
-            };
-        }
+        places.open(&mut sv, builder.open_run_first_block(), i);
         // After the runs this block ends: a tool change is the next run's.
         sv.tracker
             .block(dialect, s.block, &bytes[s.block.span()], s.words, s.state);
-        let after = s.resume_after();
-        if s.block.is_move || s.state.pos != prev.pos {
-            before_last_pos = Some((i, std::mem::replace(&mut before, after)));
-        } else {
-            before = after;
-        }
+        places.after(&s, &prev, i);
         if s.block.is_move {
             for r in sv.awaiting_move.drain(..) {
                 sv.runs[r].next_move = Some(i);
