@@ -120,6 +120,15 @@ impl RunBuilder {
         }
     }
 
+    /// The walk of a kind: passes ([`RunBuilder::passes`]) or runs ([`RunBuilder::default`]).
+    pub fn of_kind(passes: bool) -> RunBuilder {
+        if passes {
+            RunBuilder::passes()
+        } else {
+            RunBuilder::default()
+        }
+    }
+
     /// The walk taken up at block `first` (`st`: the state after it) for the run that
     /// starts there, as the walk of the whole file (`passes` or not) found it: the blocks
     /// after `first` give the same run, which starts at `first` whether the whole walk had

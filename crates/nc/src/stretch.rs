@@ -73,7 +73,7 @@ pub fn read_stretch(
     // The walk: taken up at the run's first block when read from there, else from the start.
     let mut builder = match spec.from {
         ReadFrom::RunStart(_) => None,
-        ReadFrom::FileStart => Some(walk(spec.passes)),
+        ReadFrom::FileStart => Some(RunBuilder::of_kind(spec.passes)),
     };
     let mut program: Option<ProgramBuilder> = None;
     let mut runs = Vec::new();
@@ -118,15 +118,6 @@ pub fn read_stretch(
     })
 }
 
-/// The run walk of a kind.
-fn walk(passes: bool) -> RunBuilder {
-    if passes {
-        RunBuilder::passes()
-    } else {
-        RunBuilder::default()
-    }
-}
-
 /// The byte just past the line ending after `at` (the end of `bytes` if none).
 fn line_end_after(bytes: &[u8], at: usize) -> usize {
     bytes[at..]
@@ -146,7 +137,7 @@ mod tests {
     fn walked(text: &str, passes: bool) -> (Vec<Run>, Vec<Resume>) {
         let opts = ReadOptions::dialect(Dialect::Fanuc);
         let (mut runs, mut places) = (Vec::new(), Vec::new());
-        let mut b = walk(passes);
+        let mut b = RunBuilder::of_kind(passes);
         let mut i = 0usize;
         let _ = scan_blocks_with(text.as_bytes(), &opts, |s| {
             b.push(i, s.block, s.state, &mut |r| runs.push(r));

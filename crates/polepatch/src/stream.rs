@@ -434,11 +434,7 @@ struct Reading<'a> {
 
 /// The run walk of a reading: passes or runs ([`Reading::passes`]).
 fn run_builder(rd: &Reading<'_>) -> RunBuilder {
-    if rd.passes {
-        RunBuilder::passes()
-    } else {
-        RunBuilder::default()
-    }
+    RunBuilder::of_kind(rd.passes)
 }
 
 /// The machine's bounded rotary ranges by letter ([`Reading::ranges`]).
