@@ -446,6 +446,21 @@ fn print_summary(
                 rapids.len()
             )?;
         }
+        // The plan (crate::plan): runs that start on the other branch (the positioning
+        // move before them rewritten to go there).
+        let carried: std::collections::BTreeSet<usize> = rep
+            .zones
+            .iter()
+            .filter(|z| z.start_branch == Some(polepatch::Branch::Other))
+            .map(|z| z.run)
+            .collect();
+        if !carried.is_empty() {
+            writeln!(
+                out,
+                "  runs started on the other branch (the move before each rewritten): {}",
+                carried.len()
+            )?;
+        }
         for (letter, written, file) in [
             ("C", rep.written_c_decimals, rep.file_c_decimals),
             (

@@ -305,10 +305,11 @@ fn capped_deviation_keeps_the_best_improvement() {
 /// Issue 21: `max_deviation_deg` holds on the exact angle of the written words, and a cap
 /// the default meets changes nothing: on every fixture and both machines, capped at the
 /// default's largest deviation in the file, every zone still reaches feed within the cap
-/// and the output is the default's, byte for byte.
+/// and the output is the default's, byte for byte — or (issue 41's plan, below) one that
+/// turns the tool less.
 #[test]
 fn a_cap_the_default_meets_changes_nothing() {
-    let mut capped = 0;
+    let (mut capped, mut changed) = (0, 0);
     for f in &fixtures() {
         let bytes = std::fs::read(f).unwrap();
         let name = name_of(f);
@@ -352,15 +353,28 @@ fn a_cap_the_default_meets_changes_nothing() {
                     m.name
                 );
             }
+            // The plan chooses among a run's patches (end pinned, end free, start free:
+            // crate::plan) the one that turns the tool least; the patcher's search is not
+            // monotone in the cap (capped, it may find a patch below the cap that the
+            // uncapped search passed by), so the capped plan may pick another patch — never
+            // one that turns the tool more.
+            let worst_c = report_c
+                .zones
+                .iter()
+                .map(|z| z.max_deviation_deg)
+                .fold(0.0, f64::max);
             assert!(
-                out == out_c,
-                "{name} on {}: the cap changed the output",
+                out == out_c || worst_c < worst,
+                "{name} on {}: the cap changed the output ({worst:.4}° → {worst_c:.4}°)",
                 m.name
             );
+            changed += usize::from(out != out_c);
             capped += 1;
         }
     }
     assert!(capped > 50, "{capped}");
+    // Most programs: the same output, byte for byte.
+    assert!(changed * 10 <= capped, "{changed} of {capped} changed");
 }
 
 /// Issue 21: C17's `%SING` reached feed at 1.000° by default but was left unchanged with
@@ -501,9 +515,8 @@ fn rapids_after_runs_are_accounted_for() {
                 "{} run {run}: zones and rapid {before:.3} s → {after:.3} s",
                 m.name
             );
-            if last.end_pose == Some(polepatch::EndFreedom::Pinned) {
-                assert_eq!(ra, rb, "{last:?}");
-            }
+            // The plan keeps every positioning move as fast (crate::plan).
+            assert!(ra <= rb + 1e-3, "{} run {run}: {rb} s → {ra} s", m.name);
         }
         // Every pass but the last is followed by the next pass's positioning move.
         assert!(
@@ -511,5 +524,108 @@ fn rapids_after_runs_are_accounted_for() {
             "{}: {with_rapid} runs with a rapid",
             m.name
         );
+    }
+}
+
+/// Issue 41: a zigzag of near-pole passes posted on the continuous branch (A ≥ 0, C
+/// swinging half a turn where a pass goes by the pole), the passes alternating direction.
+/// A pass's zone is cheapest re-selected onto the other branch, which its end then keeps;
+/// the next pass can start on that branch (the positioning move between them rewritten to
+/// the same tool axis). The plan over the passes carries the branch: every zone reaches
+/// feed, each within 1.25× (+0.01°) of the reference that lets each run end on either
+/// branch, every positioning move no slower than the input's, and the written program
+/// verifies (`verify_nc`: the move's clearance included).
+#[test]
+fn zigzag_passes_carry_the_branch_and_keep_the_positioning_moves() {
+    use polepatch::patcher::patch_path;
+    let base = Pass {
+        domain_rule: false,
+        ..Pass::default()
+    };
+    for m in machines() {
+        let base = Pass {
+            b_axis: m.primary_letter() == 'B',
+            ..base.clone()
+        };
+        let text = polepatch_fixturegen::zigzag_program(&base, 8, &[0.0, 0.4, 0.9, 0.05], "ZIGZAG");
+        let lp = load_bytes(text.as_bytes(), "zigzag", &m);
+        let opts = PatchOptions::default();
+        let (out, report) = patch_lp(&lp, &m, &opts);
+        // The reference: each run alone, its end free.
+        let free = PatchOptions {
+            keep_last_point: false,
+            ..opts.clone()
+        };
+        let mut carried = 0;
+        let mut worst_ref = 0.0f64;
+        for run in report
+            .zones
+            .iter()
+            .map(|z| z.run)
+            .collect::<std::collections::BTreeSet<_>>()
+        {
+            let zones: Vec<_> = report.zones.iter().filter(|z| z.run == run).collect();
+            let path = lp.runs[run - 1].path.as_ref().expect("a path");
+            let reference = patch_path(path, &m, &free).expect("the reference patch");
+            let ref_dev = reference
+                .zones
+                .iter()
+                .map(|z| z.max_deviation_deg)
+                .fold(0.0, f64::max);
+            worst_ref = worst_ref.max(ref_dev);
+            for z in &zones {
+                assert_eq!(
+                    z.outcome,
+                    polepatch::patcher::Outcome::Reached,
+                    "{} {z:?}",
+                    m.name
+                );
+                assert!(
+                    z.max_deviation_deg <= 1.25 * ref_dev + 0.01,
+                    "{} run {run}: {:.3}° against the reference's {ref_dev:.3}°",
+                    m.name,
+                    z.max_deviation_deg
+                );
+            }
+            let last = zones.last().expect("a zone");
+            if let (Some(rb), Some(ra)) = (last.rapid_time_before_s, last.rapid_time_after_s) {
+                assert!(ra <= rb + 1e-3, "{} run {run}: {rb} s → {ra} s", m.name);
+            }
+            carried += usize::from(zones[0].start_branch == Some(polepatch::Branch::Other));
+        }
+        assert!(
+            carried >= 2,
+            "{}: {carried} passes start on the other branch",
+            m.name
+        );
+        let v = polepatch::verify::verify_nc(
+            text.as_bytes(),
+            &out,
+            &m,
+            &polepatch::PatchOptions::default(),
+            "zigzag",
+        )
+        .expect("verify reads both");
+        assert!(v.passed(), "{}: {:?}", m.name, v.violations);
+        assert!(v.time_after_s <= v.time_before_s, "{}: {v:?}", m.name);
+        // `--max-deviation` at 1.1× the reference's largest: every zone still at feed.
+        let capped = PatchOptions {
+            max_deviation_deg: Some(1.1 * worst_ref),
+            ..PatchOptions::default()
+        };
+        let (_, report_c) = patch_lp(&lp, &m, &capped);
+        for z in &report_c.zones {
+            assert_eq!(
+                z.outcome,
+                polepatch::patcher::Outcome::Reached,
+                "{} {z:?}",
+                m.name
+            );
+            assert!(
+                z.max_deviation_deg <= 1.1 * worst_ref + 1e-9,
+                "{} {z:?}",
+                m.name
+            );
+        }
     }
 }

@@ -46,6 +46,7 @@ mod hooks;
 mod notes;
 mod options;
 mod patch;
+mod plan;
 mod program;
 mod settings;
 mod stream;
@@ -65,8 +66,8 @@ pub use options::{
 pub use patcher::MAX_WRITTEN_DECIMALS;
 pub use program::{LoadedProgram, MIN_FEED_MM_MIN, RunPath, RunProblem, Window};
 pub use report::{
-    AnalyzeReport, EndFreedom, FileReport, Outcome, SimulateReport, UntouchedReason, UntouchedRun,
-    ZoneReason, ZoneRow, ZoneTool,
+    AnalyzeReport, Branch, EndFreedom, FileReport, Outcome, SimulateReport, UntouchedReason,
+    UntouchedRun, ZoneReason, ZoneRow, ZoneTool,
 };
 pub use simulate::{simulate_nc, simulate_nc_with};
 pub use stream::{Piece, analyze_nc_each, load_nc, load_nc_with};

@@ -13,7 +13,7 @@
 //!
 //! 1. **The file's styles** (`file_styles`): the decimals the file writes C, the primary
 //!    axis and X Y Z with, and the patcher's options they set.
-//! 2. **Each run**, in file order (`patch_run`):
+//! 2. **Each run**, in file order (`prepare_run`, then `finish_run`):
 //!    1. a run without a path (no feed, a feed too low, an unknown or other rotary value)
 //!       is reported untouched; a run with no point within the pole reach
 //!       (`near_pole`) has nothing to patch or report, and its analysis is skipped;
@@ -24,9 +24,15 @@
 //!       values unless the blocks after the run free it) and its tool (a ball programmed
 //!       at its tip keeps its centre, a flat or bull-nose cutter caps the orientation
 //!       change: [`crate::tool`]);
-//!    4. **the patch** (`RunPatch::patch`, on the part-frame path for a run without TCPM)
-//!       and **the end's choice** (`RunPatch::pin_end_if_faster`): a free end is pinned
-//!       where the positioning move after the run then makes the whole faster;
+//!    4. **the choices** (`RunPatch::choices`): the run patched with its end pinned, its
+//!       end free, its start free where the positioning move before it goes to its first
+//!       point (`linked_starts`), and on the other branch (`other_branch`) — on the
+//!       part-frame path for a run without TCPM (pinned or free end only); then **the
+//!       plan** (`plan_runs`, [`crate::plan`]) takes one choice per run over every run at
+//!       once — every zone at feed where a choice reaches it, no positioning move slower,
+//!       the largest change of orientation the smallest — with the whole turns a linked
+//!       run's C is written with, and each run is finished with its choice (`finish_run`,
+//!       steps 5 to 7);
 //!    5. **the report rows** (`RunPatch::zone_rows`), solved again with the orientation
 //!       change capped while a kept ball centre would leave its path between the points
 //!       (`RunPatch::rows_within_centre_path`; a run that cannot keep it keeps its values);
@@ -57,14 +63,13 @@ use crate::machine_frame;
 use crate::program::{LoadedProgram, RunPath, RunProblem};
 use crate::report::axis_letter;
 use crate::report::{
-    EndFreedom, FiguresRow, FileReport, UntouchedReason, UntouchedRun, ZoneReason, ZoneRow,
+    Branch, EndFreedom, FiguresRow, FileReport, UntouchedReason, UntouchedRun, ZoneReason, ZoneRow,
     ZoneTool,
 };
 use crate::settings::CENTRE_CHORD_SAMPLES;
 use crate::settings::CENTRE_PATH_RETRIES;
 use crate::tolerances::CENTRE_PATH_CAP_SAFETY;
 use crate::tolerances::MIN_INCH_XYZ_DECIMALS;
-use crate::tolerances::RAPID_TIME_TOL_S;
 use crate::tool::{RunTool, ToolDemand, ToolKind};
 use polepatch_kinematics::vec3::along;
 use polepatch_kinematics::{Chain, Machine};
@@ -90,8 +95,17 @@ pub fn patch_program<'p>(
     // letter's substitution) is the stream's to report.
     let mut report = FileReport::unchanged(&lp.name, machine, Vec::new());
     let styles = file_styles(lp, opts);
-    let mut outcomes: Vec<RunOutcome> = (0..lp.runs.len())
-        .map(|r| patch_run(lp, r, machine, &styles))
+    // Step 2: each run's choices, the plan over them, each run finished with its choice.
+    let linked = linked_starts(lp, &styles.opts);
+    let prepared: Vec<Prepared> = (0..lp.runs.len())
+        .map(|r| prepare_run(lp, r, machine, &styles, linked[r]))
+        .collect();
+    let chosen = plan_runs(lp, machine, &prepared, &linked);
+    let mut outcomes: Vec<RunOutcome> = prepared
+        .into_iter()
+        .zip(chosen)
+        .enumerate()
+        .map(|(r, (p, c))| finish_run(lp, r, machine, &styles, p, c))
         .collect();
     // The decimals written for the rotary words: the file's, or more where a patched run
     // needed them.
@@ -248,33 +262,309 @@ fn near_pole(lp: &LoadedProgram, path: &Path, opts: &PatchOptions) -> bool {
         .any(|q| lp.pole.near(q[pi], opts.reach_deg()))
 }
 
-/// Step 2: what run `r` becomes (the sub-steps of the module docs).
-fn patch_run(lp: &LoadedProgram, r: usize, machine: &Machine, styles: &Styles) -> RunOutcome {
+/// Step 2, before the plan: run `r` done already (nothing to patch, or left as it is), or
+/// open with its choices (`start_linked`: its start may be chosen, [`linked_starts`]).
+enum Prepared<'a> {
+    Done(RunOutcome),
+    Open {
+        run: Box<RunPatch<'a>>,
+        frame: RunFrame<'a>,
+        choices: Vec<RunChoice>,
+    },
+}
+
+/// One way to patch a run (step 2.4): its end kept or free, its start kept or free, and
+/// the patch.
+struct RunChoice {
+    keep_last_point: bool,
+    start_free: bool,
+    flipped: bool,
+    result: Result<PatchResult, PathError>,
+}
+
+/// Step 2.1 to 2.4: what run `r` is before the plan (the sub-steps of the module docs).
+fn prepare_run<'a>(
+    lp: &'a LoadedProgram,
+    r: usize,
+    machine: &'a Machine,
+    styles: &Styles,
+    start_linked: bool,
+) -> Prepared<'a> {
     let opts = &styles.opts;
     let rp = &lp.runs[r];
     let path = match &rp.path {
         Ok(p) => p,
         Err(problem) => {
-            return RunOutcome::Quiet.left(
+            return Prepared::Done(RunOutcome::Quiet.left(
                 lp,
                 r,
                 problem_reason(problem),
                 problem.to_string(),
                 opts.reach_deg(),
-            );
+            ));
         }
     };
     // A run with no point in the cone has nothing to patch or report, and its analysis is
     // skipped.
     if !near_pole(lp, path, opts) {
-        return RunOutcome::Quiet;
+        return Prepared::Done(RunOutcome::Quiet);
     }
     let frame = RunFrame::of(lp, r, machine);
     if let Some(left) = why_left(rp, &frame, machine) {
-        return report_left(lp, r, path, machine, opts, left);
+        return Prepared::Done(report_left(lp, r, path, machine, opts, left));
     }
-    let mut run = run_options(lp, r, path, machine, styles, &frame);
-    let patched = run.pin_end_if_faster();
+    let run = run_options(lp, r, path, machine, styles, &frame);
+    let choices = run.choices(start_linked);
+    Prepared::Open {
+        run: Box::new(run),
+        frame,
+        choices,
+    }
+}
+
+/// Which runs' starts may be chosen: run `r`'s first point is where the positioning move
+/// that frees run `r − 1`'s end goes ([`crate::end_pose`]: above the clearance, under
+/// TCPM), that move programs both rotary axes (its words are rewritten), both runs come
+/// within the pole reach and run under TCPM. Then `r` may start on the other branch, the
+/// move going there instead ([`crate::plan`]).
+fn linked_starts(lp: &LoadedProgram, opts: &PatchOptions) -> Vec<bool> {
+    let near = |r: usize| {
+        let rp = &lp.runs[r];
+        rp.run.tcpm.is_on() && rp.path.as_ref().is_ok_and(|p| near_pole(lp, p, opts))
+    };
+    let letters = [lp.primary_letter, lp.pole_letter];
+    (0..lp.runs.len())
+        .map(|r| {
+            let Some(prev) = r.checked_sub(1) else {
+                return false;
+            };
+            let Some(next) = lp.end_pose(prev).next else {
+                return false;
+            };
+            let first = lp.runs[r].run.blocks[0];
+            let words = lp.program.block_words(first);
+            next.line == lp.line_of(r, 0)
+                && lp.program.state(first).tcpm.is_on()
+                && letters.iter().all(|&l| {
+                    words
+                        .iter()
+                        .any(|w| w.letter == l && !w.form.is_directional())
+                })
+                && near(prev)
+                && near(r)
+        })
+        .collect()
+}
+
+/// The plan (step 2, [`crate::plan`]): the index of each run's choice (0 for a run done
+/// already), and where the move after it goes when that is the next run's first point (as
+/// the next run's choice writes it). Where no plan keeps every positioning move as fast (a
+/// run whose every choice that keeps its ends failed), each run takes its first choice.
+fn plan_runs(
+    lp: &LoadedProgram,
+    machine: &Machine,
+    prepared: &[Prepared],
+    linked: &[bool],
+) -> Vec<(usize, f64, Option<[f64; 2]>)> {
+    use crate::plan::{After, Choice, Pass};
+    let pi = polepatch_kinematics::Axis::Primary.index();
+    let ci = polepatch_kinematics::Axis::C.index();
+    let mut passes: Vec<Pass> = Vec::with_capacity(prepared.len());
+    // Per run, the index among its choices of each choice offered to the plan.
+    let mut offered: Vec<Vec<usize>> = Vec::with_capacity(prepared.len());
+    for (r, p) in prepared.iter().enumerate() {
+        let path = lp.runs[r].path.as_ref().ok();
+        let ends = path.map(|p| {
+            let (a, b) = (p.axes[0], p.axes[p.axes.len() - 1]);
+            ([a[pi], a[ci]], [b[pi], b[ci]])
+        });
+        let mut choices = Vec::new();
+        let mut index = Vec::new();
+        let mut input_s = 0.0;
+        if let (
+            Prepared::Open {
+                choices: all, run, ..
+            },
+            Some(path),
+            Some((s0, e0)),
+        ) = (p, path, ends)
+        {
+            let input_time = run_time(run, path);
+            input_s = input_time.map_or(0.0, |t| t.0);
+            for (i, ch) in all.iter().enumerate() {
+                let Ok(res) = &ch.result else { continue };
+                if turns_half_way(path, res) || !within_ranges(machine, res) {
+                    continue;
+                }
+                let n = res.p_deg.len();
+                let zones_time: f64 = res.zones.iter().map(|z| z.after.time_s).sum();
+                let written = Path {
+                    axes: (0..n)
+                        .map(|k| {
+                            let x = res.xyz_mm[k];
+                            [x[0], x[1], x[2], res.p_deg[k], res.c_deg[k]]
+                        })
+                        .collect(),
+                    ..path.clone()
+                };
+                let written_time = run_time(run, &written);
+                // A patch that makes the run slower as a whole (beyond the estimates'
+                // tolerance, as `verify` holds it) is not a choice.
+                if let (Some((t0, e0)), Some((t1, e1))) = (input_time, written_time)
+                    && t1 > t0 + t0 * crate::verify::TIME_TOL_REL + e0 + e1
+                {
+                    continue;
+                }
+                let start = [res.p_deg[0], res.c_deg[0]];
+                let end = [res.p_deg[n - 1], res.c_deg[n - 1]];
+                let below = || {
+                    res.zones
+                        .iter()
+                        .filter(|z| z.outcome != polepatch_patcher::Outcome::Reached)
+                };
+                choices.push(Choice {
+                    start,
+                    end,
+                    unreached: below().count(),
+                    shortfall: below()
+                        .map(|z| 1.0 - z.after.overall_ratio.clamp(0.0, 1.0))
+                        .sum(),
+                    deviation_deg: res
+                        .zones
+                        .iter()
+                        .map(|z| z.max_deviation_deg)
+                        .fold(0.0, f64::max),
+                    time_s: written_time.map_or(zones_time, |t| t.0),
+                    changed_ends: usize::from(start != s0) + usize::from(end != e0),
+                    shiftable: linked[r],
+                    c_span_deg: [
+                        res.c_deg.iter().copied().fold(f64::INFINITY, f64::min),
+                        res.c_deg.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                    ],
+                });
+                index.push(i);
+            }
+        }
+        if choices.is_empty() {
+            // A run done already, or one whose every patch failed (step 2.5 leaves it as it
+            // is): it keeps its values.
+            let (s0, e0) = ends.unwrap_or(([f64::NAN; 2], [f64::NAN; 2]));
+            choices.push(Choice {
+                start: s0,
+                end: e0,
+                unreached: 0,
+                shortfall: 0.0,
+                deviation_deg: 0.0,
+                time_s: 0.0,
+                changed_ends: 0,
+                shiftable: false,
+                c_span_deg: [s0[1].min(e0[1]), s0[1].max(e0[1])],
+            });
+            index.push(0);
+        }
+        let after = match (lp.runs[r].run.tcpm.is_on(), lp.end_pose(r).next, ends) {
+            (true, Some(next), Some((_, e0))) => Some(After {
+                next,
+                input_s: next.time_s(machine, e0[0], e0[1]),
+                into_next: linked.get(r + 1).copied().unwrap_or(false),
+            }),
+            _ => None,
+        };
+        passes.push(Pass {
+            choices,
+            input_s,
+            after,
+        });
+        offered.push(index);
+    }
+    let plan = crate::plan::plan(&passes, machine).unwrap_or_else(|| vec![(0, 0.0); passes.len()]);
+    // The next run's first point where the move after a run goes there.
+    (0..prepared.len())
+        .map(|r| {
+            let target = passes[r].after.filter(|a| a.into_next).map(|_| {
+                let (c, shift) = plan[r + 1];
+                let start = passes[r + 1].choices[c].start;
+                [start[0], start[1] + shift]
+            });
+            let (c, shift) = plan[r];
+            (offered[r][c], shift, target)
+        })
+        .collect()
+}
+
+/// Equation 6's time of `path` as run `run` writes it, and its error bound, s — for a run
+/// under TCPM (X Y Z part coordinates: the path is what the machine follows); `None`
+/// without TCPM (the written X Y Z come through the chain later) or where it cannot be
+/// analysed.
+fn run_time(run: &RunPatch, path: &Path) -> Option<(f64, f64)> {
+    if run.part_path.is_some() {
+        return None;
+    }
+    let o = &run.opts;
+    let aopts = polepatch_patcher::AnalysisOptions {
+        cone_deg: o.cone_deg,
+        pole_reach_deg: o.pole_reach_deg,
+        tcy_s: o.tcy_s,
+        keep_samples: false,
+    };
+    polepatch_patcher::analyze_path(path, run.machine, &aopts)
+        .ok()
+        .map(|a| (a.time_s, a.time_error_s))
+}
+
+/// Whether `res` writes a block that turns C by half a revolution or more where the
+/// program's block did not: a controller that takes the shorter way on an endless C turns
+/// it the other way, and the reader does not analyse across such a move. Such a patch is
+/// not a choice the plan may take.
+fn turns_half_way(path: &Path, res: &PatchResult) -> bool {
+    let ci = polepatch_kinematics::Axis::C.index();
+    (1..res.c_deg.len()).any(|k| {
+        (res.c_deg[k] - res.c_deg[k - 1]).abs() >= 180.0
+            && (path.axes[k][ci] - path.axes[k - 1][ci]).abs() < 180.0
+    })
+}
+
+/// Whether every value `res` writes is within the machine's ranges (a patch on the other
+/// branch may leave the primary axis' range, or C's where it has one).
+fn within_ranges(machine: &Machine, res: &PatchResult) -> bool {
+    let (lo, hi) = machine.primary_range_deg;
+    res.p_deg.iter().all(|p| (lo..=hi).contains(p))
+        && machine
+            .c_range_deg
+            .is_none_or(|(lo, hi)| res.c_deg.iter().all(|c| (lo..=hi).contains(c)))
+}
+
+/// Step 2.5 to 2.7: run `r` with its choice `c` (the plan's).
+fn finish_run(
+    lp: &LoadedProgram,
+    r: usize,
+    machine: &Machine,
+    styles: &Styles,
+    prepared: Prepared,
+    (c, shift_deg, next_target): (usize, f64, Option<[f64; 2]>),
+) -> RunOutcome {
+    let opts = &styles.opts;
+    let (mut run, frame, mut choices) = match prepared {
+        Prepared::Done(outcome) => return outcome,
+        Prepared::Open {
+            run,
+            frame,
+            choices,
+        } => (*run, frame, choices),
+    };
+    let c = c.min(choices.len() - 1);
+    let choice = choices.swap_remove(c);
+    run.opts.keep_last_point = choice.keep_last_point;
+    run.start_free = choice.start_free;
+    run.flipped = choice.flipped;
+    run.shift_deg = shift_deg;
+    run.next_target = next_target;
+    let path = run.path;
+    let patched = if shift_deg != 0.0 {
+        choice.result.map(|r| run.written(r))
+    } else {
+        choice.result
+    };
     let (result, rows) = match run.rows_within_centre_path(patched) {
         Ok(done) => done,
         Err(left) => return left,
@@ -311,6 +601,25 @@ fn patch_run(lp: &LoadedProgram, r: usize, machine: &Machine, styles: &Styles) -
         rows,
         edits,
         decimals,
+    }
+}
+
+/// `path` on the other IK branch: every point `(−P, C ± 180°)` — the same tool axes — C
+/// turned the way that brings its first value nearer zero (one way for every point, so C's
+/// travel is the program's).
+fn other_branch(path: &Path) -> Path {
+    let half = if path.axes.first().is_some_and(|q| q[4] > 0.0) {
+        -180.0
+    } else {
+        180.0
+    };
+    Path {
+        axes: path
+            .axes
+            .iter()
+            .map(|q| [q[0], q[1], q[2], -q[3], q[4] + half])
+            .collect(),
+        ..path.clone()
     }
 }
 
@@ -515,6 +824,10 @@ fn run_options<'a>(
         tool,
         tool_capped,
         opts,
+        start_free: false,
+        flipped: false,
+        shift_deg: 0.0,
+        next_target: None,
     }
 }
 
@@ -536,6 +849,19 @@ struct RunPatch<'a> {
     tool_capped: bool,
     /// The run's options.
     opts: PatchOptions,
+    /// The run's first point may change (its start linked, [`linked_starts`]; the plan's
+    /// choice): the patch is [`polepatch_patcher::patch_path_free_start`]'s, its end kept.
+    start_free: bool,
+    /// The patcher works on the run's path on the other branch (every point `(−P, C ±
+    /// 180°)`, the same tool axes): its end stays there, its start is free or kept there
+    /// (the plan's choice).
+    flipped: bool,
+    /// Whole turns added to every C value the run writes (the plan's, for a linked start:
+    /// the move before it turns C the short way), degrees.
+    shift_deg: f64,
+    /// Where the positioning move after the run goes when the plan put the next run's
+    /// first point on another branch (primary, C, degrees).
+    next_target: Option<[f64; 2]>,
 }
 
 impl RunPatch<'_> {
@@ -546,17 +872,53 @@ impl RunPatch<'_> {
 
     /// Step 2.4: the patch of the run with options `o`.
     fn patch(&self, o: &PatchOptions) -> Result<PatchResult, PathError> {
-        if self.part_path.is_some() {
+        if self.flipped {
+            let flipped = other_branch(self.path);
+            let res = if self.start_free {
+                polepatch_patcher::patch_path_free_start(&flipped, self.machine, o)
+            } else {
+                patch_path(&flipped, self.machine, o)
+            };
+            return res.map(|r| self.written(r));
+        }
+        if self.shift_deg != 0.0 {
+            let res = if self.start_free {
+                polepatch_patcher::patch_path_free_start(self.path, self.machine, o)
+            } else {
+                patch_path(self.path, self.machine, o)
+            };
+            return res.map(|r| self.written(r));
+        }
+        if self.start_free {
+            polepatch_patcher::patch_path_free_start(self.work_path(), self.machine, o)
+        } else if self.part_path.is_some() {
             machine_frame::patch_part_frame(self.work_path(), self.machine, o)
         } else {
             patch_path(self.work_path(), self.machine, o)
         }
     }
 
+    /// `res` with the plan's whole turns added to C, and what is written marked: what
+    /// differs from the file's values.
+    fn written(&self, mut res: PatchResult) -> PatchResult {
+        for (k, q) in self.path.axes.iter().enumerate() {
+            res.c_deg[k] += self.shift_deg;
+            res.p_changed[k] = res.p_deg[k] != q[3];
+            res.c_changed[k] = res.c_deg[k] != q[4];
+        }
+        res
+    }
+
     /// The positioning move after a free end: its line and its time from the original end
     /// and from the end of `res`, s.
     fn rapid(&self, res: &PatchResult) -> Option<(usize, f64, f64)> {
-        let next = self.end.next.as_ref()?;
+        let next = *self.end.next.as_ref()?;
+        // Where the move goes in the written program: the next run's first point as the
+        // plan writes it.
+        let mut written = next;
+        if let Some([p, c]) = self.next_target {
+            (written.p_deg, written.c_deg) = (p, c);
+        }
         let path = self.path;
         let n = path.axes.len();
         let (p0, c0) = (path.axes[n - 1][3], path.axes[n - 1][4]);
@@ -564,41 +926,113 @@ impl RunPatch<'_> {
         Some((
             next.line,
             next.time_s(self.machine, p0, c0),
-            next.time_s(self.machine, p1, c1),
+            written.time_s(self.machine, p1, c1),
         ))
     }
 
-    /// The time of `res`'s zones and of the positioning move after them, s.
-    fn run_time(&self, res: &PatchResult) -> f64 {
-        res.zones.iter().map(|z| z.after.time_s).sum::<f64>()
-            + self.rapid(res).map_or(0.0, |(_, _, after)| after)
-    }
-
-    /// Step 2.4: the patch, and the end's choice. The positioning move after a free end
-    /// starts from the patched end: where that costs more time than the patch saves in
-    /// the run (a re-selected end whose next rapid turns C by 180° more), the end is pinned
-    /// instead when that is faster overall (issue 31: every move the patch changes is
-    /// accounted for).
-    fn pin_end_if_faster(&mut self) -> Result<PatchResult, PathError> {
-        let mut patched = self.patch(&self.opts);
-        if let Ok(res) = &patched
-            && !self.opts.keep_last_point
-            && self
-                .rapid(res)
-                .is_some_and(|(_, before, after)| after > before + RAPID_TIME_TOL_S)
-        {
-            let pinned_opts = PatchOptions {
-                keep_last_point: true,
-                ..self.opts.clone()
-            };
-            if let Ok(pinned) = self.patch(&pinned_opts)
-                && self.run_time(&pinned) + RAPID_TIME_TOL_S < self.run_time(res)
-            {
-                patched = Ok(pinned);
-                self.opts = pinned_opts;
+    /// Step 2.4: the run's choices for the plan ([`crate::plan`]): its end free where the
+    /// blocks after it allow (and the run's options do not pin it), its end kept (unless
+    /// the free end kept it anyway), and its start free where it is linked to the run
+    /// before ([`linked_starts`]; then its end is kept).
+    fn choices(&self, start_linked: bool) -> Vec<RunChoice> {
+        let mut out = Vec::new();
+        let pinned = PatchOptions {
+            keep_last_point: true,
+            ..self.opts.clone()
+        };
+        if !self.opts.keep_last_point {
+            let free = self.patch(&self.opts);
+            let n = self.path.axes.len();
+            let kept_end = free
+                .as_ref()
+                .is_ok_and(|r| !r.p_changed[n - 1] && !r.c_changed[n - 1]);
+            out.push(RunChoice {
+                keep_last_point: false,
+                start_free: false,
+                flipped: false,
+                result: free,
+            });
+            if kept_end {
+                return self.with_free_start(out, start_linked, &pinned, true);
             }
         }
-        patched
+        out.push(RunChoice {
+            keep_last_point: true,
+            start_free: false,
+            flipped: false,
+            result: self.patch(&pinned),
+        });
+        self.with_free_start(out, start_linked, &pinned, false)
+    }
+
+    /// `out` and, for a linked start, the choice with the start free and the end kept;
+    /// where the end is free and its patch kept it (`free_end_kept`), the choices that end
+    /// on the other branch: the run on the
+    /// other branch with its start free (the patcher may re-select the program's branch
+    /// at the start), and — for a linked start — kept there whole.
+    fn with_free_start(
+        &self,
+        mut out: Vec<RunChoice>,
+        start_linked: bool,
+        pinned: &PatchOptions,
+        free_end_kept: bool,
+    ) -> Vec<RunChoice> {
+        if self.part_path.is_some() {
+            return out;
+        }
+        let mut add = |start_free: bool, flipped: bool| {
+            let run = RunPatch {
+                start_free,
+                flipped,
+                opts: pinned.clone(),
+                ..self.clone_shallow()
+            };
+            out.push(RunChoice {
+                keep_last_point: true,
+                start_free,
+                flipped,
+                result: run.patch(pinned),
+            });
+        };
+        if start_linked {
+            add(true, false);
+        }
+        // The other branch at the end, where the free end did not take it.
+        if !self.opts.keep_last_point && free_end_kept {
+            add(true, true);
+            if start_linked {
+                add(false, true);
+            }
+        }
+        // A flipped run whose start the patcher put back on the program's branch is a
+        // choice for any run; one that starts on the other branch only for a linked start.
+        out.retain(|c| {
+            !c.flipped
+                || start_linked
+                || c.result
+                    .as_ref()
+                    .is_ok_and(|r| !r.p_changed[0] && !r.c_changed[0])
+        });
+        out
+    }
+
+    /// The same run with the same options (for another choice).
+    fn clone_shallow(&self) -> RunPatch<'_> {
+        RunPatch {
+            lp: self.lp,
+            r: self.r,
+            machine: self.machine,
+            path: self.path,
+            part_path: None,
+            end: self.end.clone(),
+            tool: self.tool.clone(),
+            tool_capped: self.tool_capped,
+            opts: self.opts.clone(),
+            start_free: self.start_free,
+            flipped: self.flipped,
+            shift_deg: self.shift_deg,
+            next_target: self.next_target,
+        }
     }
 
     /// Step 2.5: the report rows of `result`'s zones; `centre_capped`: the orientation
@@ -628,6 +1062,18 @@ impl RunPatch<'_> {
                 } else {
                     EndFreedom::Free
                 });
+                // The other branch: C half a turn away (the primary axis' sign then
+                // changes); a patched end near its own values is on the program's.
+                let branch = |k: usize| {
+                    let dc = (result.c_deg[k] - self.path.axes[k][4]).rem_euclid(360.0);
+                    Some(if (dc - 180.0).abs() < 90.0 {
+                        Branch::Other
+                    } else {
+                        Branch::Program
+                    })
+                };
+                row.start_branch = branch(0);
+                row.end_branch = branch(self.path.axes.len() - 1);
                 row.end_pose_line = if rp.run.tcpm.is_on() {
                     self.end.decided_line
                 } else {
@@ -641,11 +1087,7 @@ impl RunPatch<'_> {
         {
             last.rapid_line = Some(line);
             last.rapid_time_before_s = Some(before);
-            last.rapid_time_after_s = Some(if self.opts.keep_last_point {
-                before
-            } else {
-                after
-            });
+            last.rapid_time_after_s = Some(after);
         }
         rows
     }
@@ -770,8 +1212,10 @@ impl RunPatch<'_> {
                 if !changed[k] {
                     continue;
                 }
-                if k == 0 {
-                    // Point 0 belongs to the block before the run; the patcher never moves it.
+                if k == 0 && !self.start_free && !self.flipped {
+                    // Point 0 belongs to the block before the run; the patcher moves it only
+                    // where the run's start is free (that block is the positioning move that
+                    // goes there: linked_starts).
                     debug_assert!(false, "patcher changed the start point of a run");
                     continue;
                 }
@@ -1228,5 +1672,7 @@ fn zone_row(lp: &LoadedProgram, run: usize, z: &ZoneReport) -> ZoneRow {
         rapid_line: None,
         rapid_time_before_s: None,
         rapid_time_after_s: None,
+        start_branch: None,
+        end_branch: None,
     }
 }

@@ -25,8 +25,10 @@
 //!    with it; such a block never belongs to another run). Two runs may share a block (a
 //!    feed change splits a path into two runs with a common point): the block is then in
 //!    both stretches, and written with the first (the whole-program path builds every
-//!    run's path from the original values too, and never changes a run's first point, so
-//!    the second stretch has it unchanged — checked when writing).
+//!    run's path from the original values too, and never changes a first point that is
+//!    another run's last, so the second stretch has it unchanged — checked when writing).
+//!    Runs planned together ([`crate::plan`]: the positioning move that frees one's end
+//!    goes to the next one's first point, which the plan may move) are one stretch.
 //! 3. **Patch.** The second read resumes at each stretch's place
 //!    ([`polepatch_nc::scan_resumed`]: the bytes between stretches are not lexed again),
 //!    builds the stretch as a program of its own ([`polepatch_nc::ProgramBuilder`]: the
@@ -135,6 +137,8 @@ struct EndRec {
     scan: Scan,
     /// The positioning move that freed the end, if it was one.
     next: Option<crate::end_pose::NextMove>,
+    /// That move's file block index.
+    next_block: Option<usize>,
 }
 
 impl EndRec {
@@ -147,6 +151,7 @@ impl EndRec {
             Step::Free => {
                 self.decided = Some((true, line));
                 self.next = after.next_move(letters, line);
+                self.next_block = self.next.map(|_| i);
             }
             Step::Pinned => {
                 self.decided = Some((false, line));
@@ -808,7 +813,8 @@ struct Stretch {
 /// (a ball's centre kept moves its tips; [`crate::patch`], step 3), unless that move
 /// belongs to the next run.
 fn stretches(runs: &[RunRec], l: usize, wanted: impl Fn(&RunRec) -> bool) -> Vec<Stretch> {
-    runs.iter()
+    let one: Vec<Stretch> = runs
+        .iter()
         .enumerate()
         .filter(|(_, rec)| wanted(rec))
         .map(|(r, rec)| {
@@ -827,7 +833,22 @@ fn stretches(runs: &[RunRec], l: usize, wanted: impl Fn(&RunRec) -> bool) -> Vec
                 whole: false,
             }
         })
-        .collect()
+        .collect();
+    // Runs whose end's positioning move goes to the next run's first point are planned
+    // together (crate::plan): one stretch.
+    let mut out: Vec<Stretch> = Vec::with_capacity(one.len());
+    for st in one {
+        if let Some(last) = out.last_mut()
+            && last.runs.end == st.runs.start
+            && runs[last.runs.end - 1].end[l].next_block == Some(runs[st.runs.start].first_block)
+        {
+            last.last_block = last.last_block.max(st.last_block);
+            last.runs.end = st.runs.end;
+            continue;
+        }
+        out.push(st);
+    }
+    out
 }
 
 /// A stretch being read in the second pass.
@@ -1645,7 +1666,9 @@ mod tests {
         let pass =
             std::fs::read_to_string(root.join("fixtures/verify/fanuc-g434-retract-restated.nc"))
                 .unwrap();
-        // The pass twice: the second's retract at Z60 (not planted).
+        // The pass twice: the second's retract at Z60 (not planted), after a tool change —
+        // else the positioning move of the second would go where the first's end is freed
+        // to, and the two would be planned together (crate::plan) and put back together.
         let body = pass
             .trim_end_matches("%\n")
             .trim_end_matches("M30\n")
@@ -1656,7 +1679,7 @@ mod tests {
             .skip_while(|l| !l.starts_with("G0 X0 Y0 Z50."))
             .map(|l| format!("{}\n", l.replace("Z50.", "Z60.")))
             .collect();
-        let program = format!("{body}{second}");
+        let program = format!("{body}T1 M6\nG43.4 H1\n{second}");
         let machine = polepatch_kinematics::Machine::builtin("mikron-ucp710").unwrap();
         let opts = crate::options::PatchOptions::named("planted.nc");
         let (clean, clean_report) = crate::patch_nc(program.as_bytes(), &machine, &opts).unwrap();

@@ -413,6 +413,10 @@ struct Comparison<'a> {
     /// differs only by where the run before left the axes is then the same move, from a
     /// pose the patch chose.
     since_tool_change: bool,
+    /// The highest part-frame Z a retract of the original (a move under TCPM that raises
+    /// only Z) reached since it last cut (a feed move in X or Y), mm: the clearance of
+    /// check 3.
+    clearance_mm: Option<f64>,
     /// The work offset: the program's stated datum shifts and other frame changes.
     datum_shifts: Vec<(usize, [f64; 3])>,
     frame_changes: Vec<usize>,
@@ -480,6 +484,7 @@ impl<'a> Comparison<'a> {
             dec_p: [0; 5],
             pending: Vec::new(),
             since_tool_change: false,
+            clearance_mm: None,
             datum_shifts: Vec::new(),
             frame_changes: Vec::new(),
             runs_o: RunBuilder::passes(),
@@ -534,6 +539,9 @@ impl<'a> Comparison<'a> {
         }
         if o.block.is_move && (self.prev_o.pos != self.prev_p.pos || o.state.pos != p.state.pos) {
             self.positioning(line, o.block, o.state, &p.state);
+        }
+        if o.block.is_move {
+            self.clearance(o.state);
         }
         // The runs of both programs, paired as they end.
         self.lines.push_back((i, line));
@@ -935,7 +943,7 @@ impl<'a> Comparison<'a> {
 
     /// Check 6: a move outside the runs (a positioning move, a rotary-only G1) whose start
     /// or target differ, timed on both sides.
-    fn positioning(&mut self, _line: usize, b: &Block, o: &Modal, p: &Modal) {
+    fn positioning(&mut self, line: usize, b: &Block, o: &Modal, p: &Modal) {
         let rapid = o.motion == Motion::Rapid;
         let tip_still = matches!(
             (self.values(&self.prev_o), self.values(o)),
@@ -955,6 +963,63 @@ impl<'a> Comparison<'a> {
         self.report.positioning_moves_compared += 1;
         self.report.time_before_s += crate::end_pose::positioning_time_s(self.machine, a0, a1);
         self.report.time_after_s += crate::end_pose::positioning_time_s(self.machine, b0, b1);
+        // 3: a positioning move that turns the rotary axes from or to other values than
+        // the original's turns the table under the tool on another way: under TCPM the tool
+        // tip stays on the programmed line, so that is safe only above the clearance the
+        // program retracted to (crate::end_pose's proof), with the tip there at both ends.
+        // A tool change or the program's own rotary-only repositioning took the tool away
+        // (check 2's exemption).
+        let turns = |x: [f64; 5], y: [f64; 5]| x[3] != y[3] || x[4] != y[4];
+        let other_way = (turns(a0, a1) || turns(b0, b1)) && (turns(a0, b0) || turns(a1, b1));
+        if rapid && other_way && !self.since_tool_change {
+            let low = a0[2].min(a1[2]);
+            let fine = o.tcpm.is_on()
+                && p.tcpm.is_on()
+                && self
+                    .clearance_mm
+                    .is_some_and(|c| low >= c - REFERENCE_TOL_MM);
+            if !fine {
+                self.violation(
+                    line,
+                    Check::PositioningTarget,
+                    format!(
+                        "the positioning move turns the rotary axes another way than the                          original's (from P{:.4} C{:.4} to P{:.4} C{:.4}; the original: from                          P{:.4} C{:.4} to P{:.4} C{:.4}) {}",
+                        b0[3],
+                        b0[4],
+                        b1[3],
+                        b1[4],
+                        a0[3],
+                        a0[4],
+                        a1[3],
+                        a1[4],
+                        match self.clearance_mm {
+                            _ if !(o.tcpm.is_on() && p.tcpm.is_on()) => {
+                                "without TCPM: the part turns under the tool".to_string()
+                            }
+                            Some(c) => format!(
+                                "with the tool tip at Z{low:.4}, below the clearance Z{c:.4}                                  the program retracted to"
+                            ),
+                            None => "before the program retracted the tool".to_string(),
+                        }
+                    ),
+                );
+            }
+        }
+    }
+
+    /// The clearance after a move of the original in state `o` (check 3): a move under
+    /// TCPM that raises only Z sets it; a feed move in X or Y (cutting) clears it.
+    fn clearance(&mut self, o: &Modal) {
+        let (Some(a), Some(b)) = (self.values(&self.prev_o), self.values(o)) else {
+            self.clearance_mm = None;
+            return;
+        };
+        let z_only = a[0] == b[0] && a[1] == b[1] && a[3] == b[3] && a[4] == b[4];
+        if o.tcpm.is_on() && z_only && b[2] > a[2] {
+            self.clearance_mm = Some(self.clearance_mm.map_or(b[2], |c| c.max(b[2])));
+        } else if o.motion != Motion::Rapid && (a[0] != b[0] || a[1] != b[1]) {
+            self.clearance_mm = None;
+        }
     }
 
     /// Pair the runs both programs have ended so far.

@@ -23,7 +23,7 @@ mod simulate;
 
 pub use analyze::{AnalyzeReport, MachineFrameFigures, RunFigures, RunReport, ZoneSummary};
 pub use patch::{
-    EndFreedom, FiguresRow, FileReport, UntouchedReason, UntouchedRun, ZoneReason, ZoneRow,
+    Branch, EndFreedom, FiguresRow, FileReport, UntouchedReason, UntouchedRun, ZoneReason, ZoneRow,
     ZoneTool, feed_mode_name,
 };
 pub use polepatch_kinematics::LimitKind;

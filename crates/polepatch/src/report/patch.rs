@@ -97,6 +97,14 @@ pub struct ZoneRow {
     /// File line of the block after the run that decided its end pose (`None`: the end of
     /// the file, or a run without TCPM, whose end is always pinned).
     pub end_pose_line: Option<usize>,
+    /// The IK branch the run starts on as written: `program` (the input's) or `other`
+    /// (the plan put it on the other branch, the positioning move before it rewritten to
+    /// go there: [`crate::plan`]); `None`, written `-`, for a run that was not patched.
+    #[serde(serialize_with = "by_name_or_dash")]
+    pub start_branch: Option<Branch>,
+    /// The branch the run ends on as written (the same names).
+    #[serde(serialize_with = "by_name_or_dash")]
+    pub end_branch: Option<Branch>,
     /// `reselect`, `joint`, `peer`, `g16_patch`, `direct` or `none` (in text and CSV:
     /// `g16-patch`).
     pub method: Method,
@@ -255,12 +263,14 @@ impl ZoneRow {
         self.max_cutter_shift_mm = self.max_cutter_shift_mm.map(|_| 0.0);
         self.centre_chord_mm = None;
         self.rapid_time_after_s = self.rapid_time_before_s;
+        self.start_branch = self.start_branch.map(|_| Branch::Program);
+        self.end_branch = self.end_branch.map(|_| Branch::Program);
     }
 }
 
 impl ZoneRow {
     /// CSV column names of [`ZoneRow::csv_fields`] (the row's fields after `file`).
-    pub const CSV_COLUMNS: [&'static str; 44] = [
+    pub const CSV_COLUMNS: [&'static str; 46] = [
         "run",
         "first_line",
         "last_line",
@@ -287,6 +297,8 @@ impl ZoneRow {
         "reason",
         "end_pose",
         "end_pose_line",
+        "start_branch",
+        "end_branch",
         "method",
         "qp_status",
         "qp_iterations",
@@ -343,6 +355,8 @@ impl ZoneRow {
             self.reason.to_string(),
             self.end_pose.map_or("-", EndFreedom::name).to_string(),
             self.end_pose_line.map_or(String::new(), |l| l.to_string()),
+            self.start_branch.map_or("-", Branch::name).to_string(),
+            self.end_branch.map_or("-", Branch::name).to_string(),
             self.method.to_string(),
             self.qp_status.to_string(),
             self.qp_iterations.to_string(),
@@ -367,6 +381,32 @@ impl ZoneRow {
             self.rapid_time_after_s
                 .map_or(String::new(), |v| format!("{v:.6}")),
         ]
+    }
+}
+
+/// Which IK branch a run's end is on, as written (the plan's choice, [`crate::plan`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Branch {
+    /// The input's values.
+    Program,
+    /// The other branch: `(−P, C ± 180°)`, the same tool axis.
+    Other,
+}
+
+impl Branch {
+    /// `program` or `other`: its serde form.
+    pub fn name(self) -> &'static str {
+        match self {
+            Branch::Program => "program",
+            Branch::Other => "other",
+        }
+    }
+}
+
+impl std::fmt::Display for Branch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
     }
 }
 
