@@ -344,15 +344,115 @@ pub fn simulate(
     if !(tcy_s.is_finite() && tcy_s > 0.0) {
         return Err(SimError::BadCycleTime(tcy_s));
     }
+    // The passes first, all they held (spline, grid, ceilings, profile) freed on return;
+    // then Equation 6 on each part, whose own spline and solver are then the only
+    // whole-motion arrays alive: the peak is one of the two, not their sum.
+    let motion = passes(parts, machine, opts, tcy_s, sink)?;
+    let aopts = AnalysisOptions {
+        tcy_s: Some(tcy_s),
+        ..AnalysisOptions::default()
+    };
+    let mut out_parts = Vec::with_capacity(parts.len());
+    for (k, p) in parts.iter().enumerate() {
+        let a = analyze_path(p, machine, &aopts)
+            .map_err(|source| SimError::Path { part: k, source })?;
+        out_parts.push(PartSim {
+            time_s: motion.part_times[k],
+            eq6_time_s: a.time_s,
+            ideal_time_s: a.ideal_time_s,
+            length_mm: a.length_mm,
+            feed_mm_min: p.feed_mm_min,
+            min_feed: motion.min[k],
+        });
+    }
+    Ok(Simulation {
+        parts: out_parts,
+        time_s: motion.stats.time_s,
+        clips: motion.stats.clips,
+        steps: motion.stats.steps,
+    })
+}
+
+/// What the forward pass found: each part's time and lowest feed, and the pass's counts.
+struct Motion {
+    part_times: Vec<f64>,
+    min: Vec<Option<MinFeed>>,
+    stats: pass::PassStats,
+}
+
+/// The backward profile B(s): speed and acceleration at increasing s.
+struct Profile {
+    x: Vec<f64>,
+    v: Vec<f64>,
+    a: Vec<f64>,
+}
+
+/// The spline of the motion, the grid of W, the backward pass and the forward pass that
+/// hands the states to `sink`; everything but the results dropped on return.
+fn passes(
+    parts: &[Path],
+    machine: &Machine,
+    opts: &SimOptions,
+    tcy_s: f64,
+    sink: &mut dyn FnMut(&Step, &Geometry),
+) -> Result<Motion, SimError> {
     let geo = Geometry::new(parts)?;
     let grid = Grid::new(&geo, machine, tcy_s, opts.max_cells_per_span);
-    let len = geo.length();
+    let b = backward(&geo, &grid, machine, tcy_s)?;
 
-    // Backward pass under W.
+    // Forward pass under B: the trajectory.
+    let fwd = Pass {
+        geo: &geo,
+        machine,
+        ceiling: Ceiling::new(&b.x, &b.v, Some(&b.a)),
+        limit: Some(Ceiling::new(&grid.s, &grid.limit, None)),
+        forward: true,
+        dt: tcy_s,
+        use_caps: [1.0, 1.0],
+        // The same steps whether or not every cycle is handed out (the sink cuts the
+        // jumped cruises into cycles): one answer.
+        every_cycle: false,
+        rewind: opts.rewind,
+    };
+    let mut out = Forward {
+        geo: &geo,
+        user: sink,
+        part: 0,
+        part_start_t: 0.0,
+        part_times: Vec::with_capacity(parts.len()),
+        next_knot: 1,
+        min: vec![None; parts.len()],
+        started: false,
+        every_cycle: opts.every_cycle,
+        dt: tcy_s,
+    };
+    let stats = fwd
+        .run(&mut out)
+        .map_err(|s| SimError::Stalled { s_mm: s })?;
+    let mut part_times = out.part_times;
+    while part_times.len() < parts.len() {
+        part_times.push(0.0);
+    }
+    Ok(Motion {
+        part_times,
+        min: out.min,
+        stats,
+    })
+}
+
+/// The backward pass under W from the end of the motion, recorded ([`Store`]) and turned
+/// into B(s) in place (no second copy: the record is the largest array of the pass).
+fn backward(
+    geo: &Geometry,
+    grid: &Grid,
+    machine: &Machine,
+    tcy_s: f64,
+) -> Result<Profile, SimError> {
+    let len = geo.length();
     let xb: Vec<f64> = grid.s.iter().rev().map(|s| len - s).collect();
     let wb: Vec<f64> = grid.limit.iter().rev().copied().collect();
     let back = Pass {
-        geo: &geo,
+        geo,
         machine,
         ceiling: Ceiling::new(&xb, &wb, None),
         limit: None,
@@ -379,69 +479,24 @@ pub fn simulate(
         let (v, a) = (*store.v.last().expect("non-empty"), 0.0);
         store.push(len, v, a);
     }
-    let bx: Vec<f64> = store.x.iter().rev().map(|x| len - x).collect();
-    let bv: Vec<f64> = store.v.iter().rev().copied().collect();
-    let ba: Vec<f64> = store.a.iter().rev().map(|a| -a).collect();
+    let Store {
+        mut x,
+        mut v,
+        mut a,
+        ..
+    } = store;
     // What only the backward pass used, freed before the forward pass (peak memory).
-    drop(store);
     drop(back);
     drop((xb, wb));
-
-    // Forward pass under B: the trajectory.
-    let fwd = Pass {
-        geo: &geo,
-        machine,
-        ceiling: Ceiling::new(&bx, &bv, Some(&ba)),
-        limit: Some(Ceiling::new(&grid.s, &grid.limit, None)),
-        forward: true,
-        dt: tcy_s,
-        use_caps: [1.0, 1.0],
-        // The same steps whether or not every cycle is handed out (the sink cuts the
-        // jumped cruises into cycles): one answer.
-        every_cycle: false,
-        rewind: opts.rewind,
-    };
-    let mut out = Forward {
-        geo: &geo,
-        user: sink,
-        part: 0,
-        part_start_t: 0.0,
-        part_times: Vec::with_capacity(parts.len()),
-        next_knot: 1,
-        min: vec![None; parts.len()],
-        started: false,
-        every_cycle: opts.every_cycle,
-        dt: tcy_s,
-    };
-    let stats_f = fwd
-        .run(&mut out)
-        .map_err(|s| SimError::Stalled { s_mm: s })?;
-    let mut part_times = out.part_times;
-    let min = out.min;
-    while part_times.len() < parts.len() {
-        part_times.push(0.0);
+    // Read forward: s = L − x, the acceleration's sign turned (the same values as the
+    // reversed copies this replaces).
+    x.reverse();
+    x.iter_mut().for_each(|e| *e = len - *e);
+    v.reverse();
+    a.reverse();
+    a.iter_mut().for_each(|e| *e = -*e);
+    for r in [&mut x, &mut v, &mut a] {
+        r.shrink_to_fit();
     }
-    let aopts = AnalysisOptions {
-        tcy_s: Some(tcy_s),
-        ..AnalysisOptions::default()
-    };
-    let mut out_parts = Vec::with_capacity(parts.len());
-    for (k, p) in parts.iter().enumerate() {
-        let a = analyze_path(p, machine, &aopts)
-            .map_err(|source| SimError::Path { part: k, source })?;
-        out_parts.push(PartSim {
-            time_s: part_times[k],
-            eq6_time_s: a.time_s,
-            ideal_time_s: a.ideal_time_s,
-            length_mm: a.length_mm,
-            feed_mm_min: p.feed_mm_min,
-            min_feed: min[k],
-        });
-    }
-    Ok(Simulation {
-        parts: out_parts,
-        time_s: stats_f.time_s,
-        clips: stats_f.clips,
-        steps: stats_f.steps,
-    })
+    Ok(Profile { x, v, a })
 }
