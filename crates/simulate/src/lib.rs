@@ -66,7 +66,7 @@ pub mod tolerances;
 pub use error::SimError;
 pub use grid::{Geometry, Grid};
 
-use pass::{Ceiling, Pass, Sink, State};
+use pass::{Ceiling, Limit, Pass, Sink, State};
 use polepatch_kinematics::Machine;
 use polepatch_patcher::{AnalysisOptions, Path, analyze_path};
 
@@ -405,7 +405,10 @@ fn passes(
         geo: &geo,
         machine,
         ceiling: Ceiling::new(&b.x, &b.v, Some(&b.a)),
-        limit: Some(Ceiling::new(&grid.s, &grid.limit, None)),
+        limit: Some(Limit {
+            x: &grid.s,
+            v: &grid.limit,
+        }),
         forward: true,
         dt: tcy_s,
         use_caps: [1.0, 1.0],
