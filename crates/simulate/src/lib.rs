@@ -468,13 +468,19 @@ fn backward(
         every_cycle: false,
         rewind: false,
     };
+    let room = xb.len() + xb.len() / tolerances::PROFILE_SWITCH_ROOM_INV;
+    let first = |value: f64| {
+        let mut r = Vec::with_capacity(room);
+        r.push(value);
+        r
+    };
     let mut store = Store {
         grid: &xb,
         next: 1,
         prev_j: 0.0,
-        x: vec![0.0],
-        v: vec![0.0],
-        a: vec![0.0],
+        x: first(0.0),
+        v: first(0.0),
+        a: first(0.0),
     };
     back.run(&mut store)
         .map_err(|s| SimError::Stalled { s_mm: s })?;
