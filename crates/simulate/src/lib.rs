@@ -167,22 +167,45 @@ pub struct Simulation {
 /// Backward pass: the speed and (forward) acceleration at each grid point, and at every
 /// state where the jerk switches (so that no cell of the recorded profile holds a switch,
 /// which an interpolant between grid points would round off).
+///
+/// Recorded (x, v, a) in blocks of [`tolerances::RECORD_BLOCK_STATES`]: the record is the
+/// largest array of the pass, and its length (grid points and switches) is known only at
+/// the end; a vector that doubles holds up to twice it, and for a moment both blocks when
+/// it moves. [`Profile::from_record`] turns it forward into arrays of its exact length,
+/// freeing each block as it is read.
 struct Store<'a> {
     /// Pass positions of the grid points (backward order).
     grid: &'a [f64],
     next: usize,
     prev_j: f64,
-    x: Vec<f64>,
-    v: Vec<f64>,
-    a: Vec<f64>,
+    blocks: Vec<Vec<[f64; 3]>>,
 }
 
 impl Store<'_> {
+    /// The last state recorded.
+    fn last(&self) -> Option<[f64; 3]> {
+        self.blocks.last().and_then(|b| b.last()).copied()
+    }
+
     fn push(&mut self, x: f64, v: f64, a: f64) {
-        if self.x.last().is_none_or(|&l| x > l) {
-            self.x.push(x);
-            self.v.push(v);
-            self.a.push(a);
+        if self.last().is_none_or(|l| x > l[0]) {
+            let full = self
+                .blocks
+                .last()
+                .is_none_or(|b| b.len() == tolerances::RECORD_BLOCK_STATES);
+            if full {
+                // The first block grows as a vector does (a short motion holds little),
+                // up to the size of a block; the others are allocated whole.
+                let room = if self.blocks.is_empty() {
+                    0
+                } else {
+                    tolerances::RECORD_BLOCK_STATES
+                };
+                self.blocks.push(Vec::with_capacity(room));
+            }
+            if let Some(b) = self.blocks.last_mut() {
+                b.push([x, v, a]);
+            }
         }
     }
 }
@@ -387,6 +410,27 @@ struct Profile {
     a: Vec<f64>,
 }
 
+impl Profile {
+    /// The backward pass's record ([`Store::blocks`]) read backward: s = L − x and the
+    /// acceleration's sign turned (`len`: L, mm); each block freed once read.
+    fn from_record(mut blocks: Vec<Vec<[f64; 3]>>, len: f64) -> Profile {
+        let n = blocks.iter().map(Vec::len).sum();
+        let mut b = Profile {
+            x: Vec::with_capacity(n),
+            v: Vec::with_capacity(n),
+            a: Vec::with_capacity(n),
+        };
+        while let Some(block) = blocks.pop() {
+            for &[x, v, a] in block.iter().rev() {
+                b.x.push(len - x);
+                b.v.push(v);
+                b.a.push(-a);
+            }
+        }
+        b
+    }
+}
+
 /// The spline of the motion, the grid of W, the backward pass and the forward pass that
 /// hands the states to `sink`; everything but the results dropped on return.
 fn passes(
@@ -444,7 +488,7 @@ fn passes(
 }
 
 /// The backward pass under W from the end of the motion, recorded ([`Store`]) and turned
-/// into B(s) in place (no second copy: the record is the largest array of the pass).
+/// into B(s).
 fn backward(
     geo: &Geometry,
     grid: &Grid,
@@ -468,44 +512,23 @@ fn backward(
         every_cycle: false,
         rewind: false,
     };
-    let room = xb.len() + xb.len() / tolerances::PROFILE_SWITCH_ROOM_INV;
-    let first = |value: f64| {
-        let mut r = Vec::with_capacity(room);
-        r.push(value);
-        r
-    };
     let mut store = Store {
         grid: &xb,
         next: 1,
         prev_j: 0.0,
-        x: first(0.0),
-        v: first(0.0),
-        a: first(0.0),
+        blocks: Vec::new(),
     };
+    store.push(0.0, 0.0, 0.0);
     back.run(&mut store)
         .map_err(|s| SimError::Stalled { s_mm: s })?;
-    if store.x.last().is_some_and(|&x| x < len) {
-        let (v, a) = (*store.v.last().expect("non-empty"), 0.0);
-        store.push(len, v, a);
+    if let Some([x, v, _]) = store.last()
+        && x < len
+    {
+        store.push(len, v, 0.0);
     }
-    let Store {
-        mut x,
-        mut v,
-        mut a,
-        ..
-    } = store;
+    let record = store.blocks;
     // What only the backward pass used, freed before the forward pass (peak memory).
     drop(back);
     drop((xb, wb));
-    // Read forward: s = L − x, the acceleration's sign turned (the same values as the
-    // reversed copies this replaces).
-    x.reverse();
-    x.iter_mut().for_each(|e| *e = len - *e);
-    v.reverse();
-    a.reverse();
-    a.iter_mut().for_each(|e| *e = -*e);
-    for r in [&mut x, &mut v, &mut a] {
-        r.shrink_to_fit();
-    }
-    Ok(Profile { x, v, a })
+    Ok(Profile::from_record(record, len))
 }

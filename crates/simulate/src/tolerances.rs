@@ -32,12 +32,10 @@ pub const BACKWARD_USE: [f64; 2] = [0.99, 0.98];
 /// of its size from one cycle to the next (a switch of the bang-bang profile).
 pub const JERK_SWITCH: f64 = 0.25;
 
-/// The backward pass's record (every grid point and every jerk switch) is reserved at the
-/// grid's size and 1/this more for the switches, so that on a long motion, where it is
-/// the largest array of the pass and the switches are few against the grid points, it is
-/// not doubled for a handful of switches (2× the grid held, and both blocks while one is
-/// moved to the other). A short motion with more switches grows as before.
-pub const PROFILE_SWITCH_ROOM_INV: usize = 8;
+/// States of the backward pass's record held in one block (`Store` in lib.rs): 1.5 MB
+/// of (x, v, a). The record grows a block at a time (the first as a vector grows, up to
+/// this), never held twice.
+pub const RECORD_BLOCK_STATES: usize = 1 << 16;
 
 /// A state within this fraction of a flat ceiling (or [`CRUISE_ABS_MM_S`], the larger),
 /// whose acceleration changes its speed by less than that in a cycle, cruises: when no

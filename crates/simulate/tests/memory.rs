@@ -5,14 +5,14 @@
 //! What it holds is the motion's spline, the grid of its velocity limit, the passes'
 //! ceilings and the backward profile — then, once those are freed, Equation 6's analysis
 //! of each part (its own spline and solver). Until 2026-11-29 the analysis ran while the
-//! passes' arrays were still held, and the reversed backward profile was a second copy
-//! of the record: 806 bytes a point at the peak on this path, 547 after; 510 once the
-//! velocity limit the forward pass consults beside its profile was computed where it is
-//! asked for (`pass::Limit`); 459 since the backward record is reserved at the grid's
-//! size (not doubled for a few jerk switches). The bound below sits between, so that
-//! holding the analysis on top of the passes again fails. It is a bound per point, not a bound by a window of
-//! the path: every array of the motion is still whole (docs/journal/simulate-memory.md
-//! says what is left).
+//! passes' arrays were still held, and the backward profile was a reversed copy of the
+//! backward pass's record: 806 bytes a point at the peak on this path. Since, with the
+//! analysis after the passes, the limit curve the forward pass consults beside its
+//! profile computed where it is asked for (`pass::Limit`) and the record kept in blocks:
+//! 480 (docs/journal/simulate-memory.md). The bound below sits between, so that holding
+//! the analysis on top of the passes again fails. It is a bound per point, not a bound by
+//! a window of the path: every array of the motion is still whole (the journal says what
+//! is left).
 
 #![cfg(target_os = "linux")]
 
@@ -36,7 +36,7 @@ fn status_kib(field: &str) -> usize {
 /// Points of the motion.
 const POINTS: usize = 100_000;
 /// Largest resident memory the simulation may add at its peak, bytes per point of the
-/// motion (module docs: 806 before, 459 now).
+/// motion (module docs: 806 before, 480 now).
 const PEAK_BYTES_PER_POINT: usize = 560;
 
 /// One G1 run as `examples/long_run.rs` writes it (a slow helix, radius 20 mm, points
