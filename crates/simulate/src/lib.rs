@@ -48,8 +48,11 @@
 //! work is bounded by the points and the speed changes, not by the run time, and the
 //! memory by the points whatever the mode. The simulator's memory is the spline, the
 //! passes' ceilings, the backward profile and the grid of one motion: it grows with the
-//! motion's points, not its duration (with the reading and the analysis around it, about
-//! 0.9 KB a point: docs/simulation.md, "Speed and memory").
+//! motion's points, not its duration. Equation 6's analysis of the parts runs once the
+//! passes' arrays are freed, the backward pass's record is kept in blocks and turned
+//! forward into the profile of its exact length, and the velocity limit the forward pass
+//! consults beside its profile is computed where it is asked for: with the reading around
+//! it, about 0.6 KB a point (docs/simulation.md, "Speed and memory"; `tests/memory.rs`).
 //!
 //! On a straight line this is the time-optimal jerk-limited rest-to-rest profile (the
 //! 7-segment S-curve) to a cycle; on a curved path it is a jerk-limited motion under the
