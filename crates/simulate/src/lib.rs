@@ -48,8 +48,11 @@
 //! work is bounded by the points and the speed changes, not by the run time, and the
 //! memory by the points whatever the mode. The simulator's memory is the spline, the
 //! passes' ceilings, the backward profile and the grid of one motion: it grows with the
-//! motion's points, not its duration (with the reading and the analysis around it, about
-//! 0.9 KB a point: docs/simulation.md, "Speed and memory").
+//! motion's points, not its duration. Equation 6's analysis of the parts runs once the
+//! passes' arrays are freed, the backward pass's record is kept in blocks and turned
+//! forward into the profile of its exact length, and the velocity limit the forward pass
+//! consults beside its profile is computed where it is asked for: with the reading around
+//! it, about 0.6 KB a point (docs/simulation.md, "Speed and memory"; `tests/memory.rs`).
 //!
 //! On a straight line this is the time-optimal jerk-limited rest-to-rest profile (the
 //! 7-segment S-curve) to a cycle; on a curved path it is a jerk-limited motion under the
@@ -66,7 +69,7 @@ pub mod tolerances;
 pub use error::SimError;
 pub use grid::{Geometry, Grid};
 
-use pass::{Ceiling, Pass, Sink, State};
+use pass::{Ceiling, Limit, Pass, Sink, State};
 use polepatch_kinematics::Machine;
 use polepatch_patcher::{AnalysisOptions, Path, analyze_path};
 
@@ -167,22 +170,45 @@ pub struct Simulation {
 /// Backward pass: the speed and (forward) acceleration at each grid point, and at every
 /// state where the jerk switches (so that no cell of the recorded profile holds a switch,
 /// which an interpolant between grid points would round off).
+///
+/// Recorded (x, v, a) in blocks of [`tolerances::RECORD_BLOCK_STATES`]: the record is the
+/// largest array of the pass, and its length (grid points and switches) is known only at
+/// the end; a vector that doubles holds up to twice it, and for a moment both blocks when
+/// it moves. [`Profile::from_record`] turns it forward into arrays of its exact length,
+/// freeing each block as it is read.
 struct Store<'a> {
     /// Pass positions of the grid points (backward order).
     grid: &'a [f64],
     next: usize,
     prev_j: f64,
-    x: Vec<f64>,
-    v: Vec<f64>,
-    a: Vec<f64>,
+    blocks: Vec<Vec<[f64; 3]>>,
 }
 
 impl Store<'_> {
+    /// The last state recorded.
+    fn last(&self) -> Option<[f64; 3]> {
+        self.blocks.last().and_then(|b| b.last()).copied()
+    }
+
     fn push(&mut self, x: f64, v: f64, a: f64) {
-        if self.x.last().is_none_or(|&l| x > l) {
-            self.x.push(x);
-            self.v.push(v);
-            self.a.push(a);
+        if self.last().is_none_or(|l| x > l[0]) {
+            let full = self
+                .blocks
+                .last()
+                .is_none_or(|b| b.len() == tolerances::RECORD_BLOCK_STATES);
+            if full {
+                // The first block grows as a vector does (a short motion holds little),
+                // up to the size of a block; the others are allocated whole.
+                let room = if self.blocks.is_empty() {
+                    0
+                } else {
+                    tolerances::RECORD_BLOCK_STATES
+                };
+                self.blocks.push(Vec::with_capacity(room));
+            }
+            if let Some(b) = self.blocks.last_mut() {
+                b.push([x, v, a]);
+            }
         }
     }
 }
@@ -344,55 +370,92 @@ pub fn simulate(
     if !(tcy_s.is_finite() && tcy_s > 0.0) {
         return Err(SimError::BadCycleTime(tcy_s));
     }
+    // The passes first, all they held (spline, grid, ceilings, profile) freed on return;
+    // then Equation 6 on each part, whose own spline and solver are then the only
+    // whole-motion arrays alive: the peak is one of the two, not their sum.
+    let motion = passes(parts, machine, opts, tcy_s, sink)?;
+    let aopts = AnalysisOptions {
+        tcy_s: Some(tcy_s),
+        ..AnalysisOptions::default()
+    };
+    let mut out_parts = Vec::with_capacity(parts.len());
+    for (k, p) in parts.iter().enumerate() {
+        let a = analyze_path(p, machine, &aopts)
+            .map_err(|source| SimError::Path { part: k, source })?;
+        out_parts.push(PartSim {
+            time_s: motion.part_times[k],
+            eq6_time_s: a.time_s,
+            ideal_time_s: a.ideal_time_s,
+            length_mm: a.length_mm,
+            feed_mm_min: p.feed_mm_min,
+            min_feed: motion.min[k],
+        });
+    }
+    Ok(Simulation {
+        parts: out_parts,
+        time_s: motion.stats.time_s,
+        clips: motion.stats.clips,
+        steps: motion.stats.steps,
+    })
+}
+
+/// What the forward pass found: each part's time and lowest feed, and the pass's counts.
+struct Motion {
+    part_times: Vec<f64>,
+    min: Vec<Option<MinFeed>>,
+    stats: pass::PassStats,
+}
+
+/// The backward profile B(s): speed and acceleration at increasing s.
+struct Profile {
+    x: Vec<f64>,
+    v: Vec<f64>,
+    a: Vec<f64>,
+}
+
+impl Profile {
+    /// The backward pass's record ([`Store::blocks`]) read backward: s = L − x and the
+    /// acceleration's sign turned (`len`: L, mm); each block freed once read.
+    fn from_record(mut blocks: Vec<Vec<[f64; 3]>>, len: f64) -> Profile {
+        let n = blocks.iter().map(Vec::len).sum();
+        let mut b = Profile {
+            x: Vec::with_capacity(n),
+            v: Vec::with_capacity(n),
+            a: Vec::with_capacity(n),
+        };
+        while let Some(block) = blocks.pop() {
+            for &[x, v, a] in block.iter().rev() {
+                b.x.push(len - x);
+                b.v.push(v);
+                b.a.push(-a);
+            }
+        }
+        b
+    }
+}
+
+/// The spline of the motion, the grid of W, the backward pass and the forward pass that
+/// hands the states to `sink`; everything but the results dropped on return.
+fn passes(
+    parts: &[Path],
+    machine: &Machine,
+    opts: &SimOptions,
+    tcy_s: f64,
+    sink: &mut dyn FnMut(&Step, &Geometry),
+) -> Result<Motion, SimError> {
     let geo = Geometry::new(parts)?;
     let grid = Grid::new(&geo, machine, tcy_s, opts.max_cells_per_span);
-    let len = geo.length();
-
-    // Backward pass under W.
-    let xb: Vec<f64> = grid.s.iter().rev().map(|s| len - s).collect();
-    let wb: Vec<f64> = grid.limit.iter().rev().copied().collect();
-    let back = Pass {
-        geo: &geo,
-        machine,
-        ceiling: Ceiling::new(&xb, &wb, None),
-        limit: None,
-        forward: false,
-        dt: tcy_s,
-        use_caps: tolerances::BACKWARD_USE,
-        // The backward profile is a ceiling, not the trajectory: it jumps cruises in both
-        // modes (the same profile for the report and the trajectory, and a long cruise
-        // records nothing per cycle: memory bounded by the points).
-        every_cycle: false,
-        rewind: false,
-    };
-    let mut store = Store {
-        grid: &xb,
-        next: 1,
-        prev_j: 0.0,
-        x: vec![0.0],
-        v: vec![0.0],
-        a: vec![0.0],
-    };
-    back.run(&mut store)
-        .map_err(|s| SimError::Stalled { s_mm: s })?;
-    if store.x.last().is_some_and(|&x| x < len) {
-        let (v, a) = (*store.v.last().expect("non-empty"), 0.0);
-        store.push(len, v, a);
-    }
-    let bx: Vec<f64> = store.x.iter().rev().map(|x| len - x).collect();
-    let bv: Vec<f64> = store.v.iter().rev().copied().collect();
-    let ba: Vec<f64> = store.a.iter().rev().map(|a| -a).collect();
-    // What only the backward pass used, freed before the forward pass (peak memory).
-    drop(store);
-    drop(back);
-    drop((xb, wb));
+    let b = backward(&geo, &grid, machine, tcy_s)?;
 
     // Forward pass under B: the trajectory.
     let fwd = Pass {
         geo: &geo,
         machine,
-        ceiling: Ceiling::new(&bx, &bv, Some(&ba)),
-        limit: Some(Ceiling::new(&grid.s, &grid.limit, None)),
+        ceiling: Ceiling::new(&b.x, &b.v, Some(&b.a)),
+        limit: Some(Limit {
+            x: &grid.s,
+            v: &grid.limit,
+        }),
         forward: true,
         dt: tcy_s,
         use_caps: [1.0, 1.0],
@@ -413,35 +476,62 @@ pub fn simulate(
         every_cycle: opts.every_cycle,
         dt: tcy_s,
     };
-    let stats_f = fwd
+    let stats = fwd
         .run(&mut out)
         .map_err(|s| SimError::Stalled { s_mm: s })?;
     let mut part_times = out.part_times;
-    let min = out.min;
     while part_times.len() < parts.len() {
         part_times.push(0.0);
     }
-    let aopts = AnalysisOptions {
-        tcy_s: Some(tcy_s),
-        ..AnalysisOptions::default()
-    };
-    let mut out_parts = Vec::with_capacity(parts.len());
-    for (k, p) in parts.iter().enumerate() {
-        let a = analyze_path(p, machine, &aopts)
-            .map_err(|source| SimError::Path { part: k, source })?;
-        out_parts.push(PartSim {
-            time_s: part_times[k],
-            eq6_time_s: a.time_s,
-            ideal_time_s: a.ideal_time_s,
-            length_mm: a.length_mm,
-            feed_mm_min: p.feed_mm_min,
-            min_feed: min[k],
-        });
-    }
-    Ok(Simulation {
-        parts: out_parts,
-        time_s: stats_f.time_s,
-        clips: stats_f.clips,
-        steps: stats_f.steps,
+    Ok(Motion {
+        part_times,
+        min: out.min,
+        stats,
     })
+}
+
+/// The backward pass under W from the end of the motion, recorded ([`Store`]) and turned
+/// into B(s).
+fn backward(
+    geo: &Geometry,
+    grid: &Grid,
+    machine: &Machine,
+    tcy_s: f64,
+) -> Result<Profile, SimError> {
+    let len = geo.length();
+    let xb: Vec<f64> = grid.s.iter().rev().map(|s| len - s).collect();
+    let wb: Vec<f64> = grid.limit.iter().rev().copied().collect();
+    let back = Pass {
+        geo,
+        machine,
+        ceiling: Ceiling::new(&xb, &wb, None),
+        limit: None,
+        forward: false,
+        dt: tcy_s,
+        use_caps: tolerances::BACKWARD_USE,
+        // The backward profile is a ceiling, not the trajectory: it jumps cruises in both
+        // modes (the same profile for the report and the trajectory, and a long cruise
+        // records nothing per cycle: memory bounded by the points).
+        every_cycle: false,
+        rewind: false,
+    };
+    let mut store = Store {
+        grid: &xb,
+        next: 1,
+        prev_j: 0.0,
+        blocks: Vec::new(),
+    };
+    store.push(0.0, 0.0, 0.0);
+    back.run(&mut store)
+        .map_err(|s| SimError::Stalled { s_mm: s })?;
+    if let Some([x, v, _]) = store.last()
+        && x < len
+    {
+        store.push(len, v, 0.0);
+    }
+    let record = store.blocks;
+    // What only the backward pass used, freed before the forward pass (peak memory).
+    drop(back);
+    drop((xb, wb));
+    Ok(Profile::from_record(record, len))
 }

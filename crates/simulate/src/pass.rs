@@ -94,7 +94,7 @@ impl<'a> Ceiling<'a> {
             x,
             v,
             cells: Vec::new(),
-            p: v.iter().map(|w| w * w.sqrt()).collect(),
+            p: v.iter().map(|&w| p_of(w)).collect(),
             m: a.map(|a| {
                 v.iter()
                     .zip(a)
@@ -136,23 +136,14 @@ impl<'a> Ceiling<'a> {
                 let m1 = pick(m[i + 1], m[i]) * h;
                 [inv_h, m0, m1]
             }
-            None => [inv_h, p1 - p0, (p1 - p0) * inv_h],
+            None => linear_cell(inv_h, p0, p1),
         }
     }
 
-    /// Cell index of `x`: `i` with `x[i] ≤ x < x[i+1]`, clamped to the cells; `hint` first.
+    /// Cell index of `x` ([`cell_of`]).
     #[inline]
     fn cell(&self, x: f64, hint: usize) -> usize {
-        let n = self.x.len();
-        let last = n.saturating_sub(2);
-        let h = hint.min(last);
-        if self.x[h] <= x && (h + 1 >= n || x < self.x[h + 1]) {
-            return h;
-        }
-        if h + 2 < n && self.x[h + 1] <= x && x < self.x[h + 2] {
-            return h + 1;
-        }
-        count_at_most(self.x, x, h).saturating_sub(1).min(last)
+        cell_of(self.x, x, hint)
     }
 
     /// (W, a_W) at `x`, and the cell.
@@ -193,11 +184,76 @@ impl<'a> Ceiling<'a> {
                 * inv_h;
             (p.max(0.0), dp)
         } else {
-            // P linear: exact for the jerk phase from rest, between the two values
-            // elsewhere (m0, m1: P₁ − P₀ and its slope).
-            (p0 + u * m0, m1)
+            linear_at(u, p0, m0, m1)
         };
         (p, dp, i)
+    }
+}
+
+/// Cell index of `x` among the increasing `xs`: `i` with `xs[i] ≤ x < xs[i+1]`, clamped
+/// to the cells; the cell `hint` and the one after it first.
+#[inline]
+fn cell_of(xs: &[f64], x: f64, hint: usize) -> usize {
+    let n = xs.len();
+    let last = n.saturating_sub(2);
+    let h = hint.min(last);
+    if xs[h] <= x && (h + 1 >= n || x < xs[h + 1]) {
+        return h;
+    }
+    if h + 2 < n && xs[h + 1] <= x && x < xs[h + 2] {
+        return h + 1;
+    }
+    count_at_most(xs, x, h).saturating_sub(1).min(last)
+}
+
+/// What a cell of a ceiling with P linear needs whatever the position in it: 1/h, P₁ − P₀
+/// and its slope (the entry of [`Ceiling::cells`]).
+#[inline]
+fn linear_cell(inv_h: f64, p0: f64, p1: f64) -> [f64; 3] {
+    [inv_h, p1 - p0, (p1 - p0) * inv_h]
+}
+
+/// (P, dP/dx) at `u` (0 to 1) of a cell with P linear: exact for the jerk phase from rest,
+/// between the two values elsewhere (m0, m1: P₁ − P₀ and its slope, [`linear_cell`]).
+#[inline(always)]
+fn linear_at(u: f64, p0: f64, m0: f64, m1: f64) -> (f64, f64) {
+    (p0 + u * m0, m1)
+}
+
+/// W^(3/2), the ceilings' P.
+#[inline]
+fn p_of(w: f64) -> f64 {
+    w * w.sqrt()
+}
+
+/// The velocity limit curve as the forward pass consults it beside its ceiling (where it
+/// crawls, or lets a state stand over the profile: a few cycles, not the pass's hot path).
+/// The values of [`Ceiling::new`] without an acceleration, computed where they are asked
+/// for instead of for every cell up front: 32 bytes a grid point fewer held through the
+/// forward pass.
+pub(crate) struct Limit<'a> {
+    /// Grid points, mm.
+    pub x: &'a [f64],
+    /// W at the grid points, mm/s.
+    pub v: &'a [f64],
+}
+
+impl Limit<'_> {
+    /// W at `x` (what `Ceiling::new(x, v, None).at(x, 0).0` is, to the bit).
+    pub fn w_at(&self, x: f64) -> f64 {
+        let i = cell_of(self.x, x, 0);
+        let p = if self.x.len() < 2 {
+            p_of(self.v[0])
+        } else {
+            let (x0, x1) = (self.x[i], self.x[i + 1]);
+            let inv_h = 1.0 / (x1 - x0);
+            let (p0, p1) = (p_of(self.v[i]), p_of(self.v[i + 1]));
+            let [inv_h, m0, m1] = linear_cell(inv_h, p0, p1);
+            let u = ((x - x0) * inv_h).clamp(0.0, 1.0);
+            linear_at(u, p0, m0, m1).0
+        };
+        let c = cbrt(p);
+        c * c
     }
 }
 
@@ -293,7 +349,7 @@ pub(crate) struct Pass<'a> {
     pub ceiling: Ceiling<'a>,
     /// The velocity limit curve, when the ceiling is another profile: a crawl (below)
     /// may use it where the profile stopped.
-    pub limit: Option<Ceiling<'a>>,
+    pub limit: Option<Limit<'a>>,
     /// Forward (x = s) or backward (x = L − s).
     pub forward: bool,
     /// Cycle time, s.
@@ -892,7 +948,7 @@ impl<'p, 's> Stepper<'p, 's> {
         if crawl {
             let xc = next.x.max(st.x);
             let w0 = match &pass.limit {
-                Some(l) => l.at(xc, 0).0,
+                Some(l) => l.w_at(xc),
                 _ => pass.ceiling.at(xc, self.hint).0,
             };
             let jm = here.jc.max(0.0);
@@ -960,7 +1016,7 @@ impl<'p, 's> Stepper<'p, 's> {
             && pass
                 .limit
                 .as_ref()
-                .is_some_and(|l| next.v <= l.at(next.x, 0).0.min(here.vmax) * (1.0 + CEILING_REL))
+                .is_some_and(|l| next.v <= l.w_at(next.x).min(here.vmax) * (1.0 + CEILING_REL))
     }
 
     /// Above the ceiling `w1` (mm/s) when rewinding, within the budget of undone steps:

@@ -32,6 +32,11 @@ pub const BACKWARD_USE: [f64; 2] = [0.99, 0.98];
 /// of its size from one cycle to the next (a switch of the bang-bang profile).
 pub const JERK_SWITCH: f64 = 0.25;
 
+/// States of the backward pass's record held in one block (`Store` in lib.rs): 1.5 MB
+/// of (x, v, a). The record grows a block at a time (the first as a vector grows, up to
+/// this), never held twice.
+pub const RECORD_BLOCK_STATES: usize = 1 << 16;
+
 /// A state within this fraction of a flat ceiling (or [`CRUISE_ABS_MM_S`], the larger),
 /// whose acceleration changes its speed by less than that in a cycle, cruises: when no
 /// trajectory is asked for it jumps to the next grid point in one step with a = 0. The
