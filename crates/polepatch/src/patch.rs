@@ -97,9 +97,15 @@ pub fn patch_program<'p>(
     let styles = file_styles(lp, opts);
     // Step 2: each run's choices, the plan over them, each run finished with its choice.
     let linked = linked_starts(lp, &styles.opts);
-    let prepared: Vec<Prepared> = (0..lp.runs.len())
-        .map(|r| prepare_run(lp, r, machine, &styles, linked[r]))
-        .collect();
+    // The runs' choices are independent of each other: on all cores (a stretch of linked
+    // runs is one part of the stream's batches).
+    let prepared: Vec<Prepared> = {
+        use rayon::prelude::*;
+        (0..lp.runs.len())
+            .into_par_iter()
+            .map(|r| prepare_run(lp, r, machine, &styles, linked[r]))
+            .collect()
+    };
     let chosen = plan_runs(lp, machine, &prepared, &linked);
     let mut outcomes: Vec<RunOutcome> = prepared
         .into_iter()
