@@ -506,16 +506,19 @@ fn run_time(run: &RunPatch, path: &Path) -> Option<(f64, f64)> {
     if run.part_path.is_some() {
         return None;
     }
-    let o = &run.opts;
-    let aopts = polepatch_patcher::AnalysisOptions {
+    polepatch_patcher::analyze_path(path, run.machine, &analysis_options(&run.opts))
+        .ok()
+        .map(|a| (a.time_s, a.time_error_s))
+}
+
+/// The analysis options of the patch options `o` (no samples kept).
+fn analysis_options(o: &PatchOptions) -> polepatch_patcher::AnalysisOptions {
+    polepatch_patcher::AnalysisOptions {
         cone_deg: o.cone_deg,
         pole_reach_deg: o.pole_reach_deg,
         tcy_s: o.tcy_s,
         keep_samples: false,
-    };
-    polepatch_patcher::analyze_path(path, run.machine, &aopts)
-        .ok()
-        .map(|a| (a.time_s, a.time_error_s))
+    }
 }
 
 /// Whether `res` writes a block that turns C by half a revolution or more where the
@@ -838,6 +841,7 @@ fn run_options<'a>(
 }
 
 /// One run being patched: what steps 2.4 to 2.7 share.
+#[derive(Clone)]
 struct RunPatch<'a> {
     lp: &'a LoadedProgram,
     r: usize,
@@ -991,7 +995,7 @@ impl RunPatch<'_> {
                 start_free,
                 flipped,
                 opts: pinned.clone(),
-                ..self.clone_shallow()
+                ..self.clone()
             };
             out.push(RunChoice {
                 keep_last_point: true,
@@ -1020,25 +1024,6 @@ impl RunPatch<'_> {
                     .is_ok_and(|r| !r.p_changed[0] && !r.c_changed[0])
         });
         out
-    }
-
-    /// The same run with the same options (for another choice).
-    fn clone_shallow(&self) -> RunPatch<'_> {
-        RunPatch {
-            lp: self.lp,
-            r: self.r,
-            machine: self.machine,
-            path: self.path,
-            part_path: None,
-            end: self.end.clone(),
-            tool: self.tool.clone(),
-            tool_capped: self.tool_capped,
-            opts: self.opts.clone(),
-            start_free: self.start_free,
-            flipped: self.flipped,
-            shift_deg: self.shift_deg,
-            next_target: self.next_target,
-        }
     }
 
     /// Step 2.5: the report rows of `result`'s zones; `centre_capped`: the orientation
@@ -1441,12 +1426,7 @@ fn through_chain(
             }
         }
     }
-    let aopts = polepatch_patcher::AnalysisOptions {
-        cone_deg: opts.cone_deg,
-        pole_reach_deg: opts.pole_reach_deg,
-        tcy_s: opts.tcy_s,
-        keep_samples: false,
-    };
+    let aopts = analysis_options(opts);
     let frame = |values: &[[f64; 5]]| {
         machine_frame::machine_frame_path(
             chain,
