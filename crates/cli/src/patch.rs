@@ -320,6 +320,45 @@ fn csv_rows(reports: &[&FileReport]) -> Result<Vec<u8>> {
     Ok(w.into_inner()?)
 }
 
+/// The summary's lines on the plan over the passes of one file's report: the positioning
+/// moves after the runs (they start from the patched end; a re-selected end may turn C
+/// further, or less) and the runs started on the other branch.
+fn print_plan(rep: &FileReport, out: &mut dyn std::io::Write) -> std::io::Result<()> {
+    // The positioning moves after runs whose end is free: they start from the patched
+    // end (a re-selected end may turn C further, or less).
+    let rapids: Vec<(f64, f64)> = rep
+        .zones
+        .iter()
+        .filter_map(|z| z.rapid_time_before_s.zip(z.rapid_time_after_s))
+        .collect();
+    if !rapids.is_empty() {
+        let (b, a) = rapids
+            .iter()
+            .fold((0.0, 0.0), |(b, a), &(x, y)| (b + x, a + y));
+        writeln!(
+            out,
+            "  positioning moves after the runs ({}): {b:.3} → {a:.3} s",
+            rapids.len()
+        )?;
+    }
+    // The plan (crate::plan): runs that start on the other branch (the positioning
+    // move before them rewritten to go there).
+    let carried: std::collections::BTreeSet<usize> = rep
+        .zones
+        .iter()
+        .filter(|z| z.start_branch == Some(polepatch::Branch::Other))
+        .map(|z| z.run)
+        .collect();
+    if !carried.is_empty() {
+        writeln!(
+            out,
+            "  runs started on the other branch (the move before each rewritten): {}",
+            carried.len()
+        )?;
+    }
+    Ok(())
+}
+
 /// One line per input file, in input order; a file that failed says so (its error is
 /// printed on standard error).
 fn print_summary(
@@ -429,38 +468,7 @@ fn print_summary(
             })
             .collect();
         writeln!(out, "  reasons: {}", counts.join(", "))?;
-        // The positioning moves after runs whose end is free: they start from the patched
-        // end (a re-selected end may turn C further, or less).
-        let rapids: Vec<(f64, f64)> = rep
-            .zones
-            .iter()
-            .filter_map(|z| z.rapid_time_before_s.zip(z.rapid_time_after_s))
-            .collect();
-        if !rapids.is_empty() {
-            let (b, a) = rapids
-                .iter()
-                .fold((0.0, 0.0), |(b, a), &(x, y)| (b + x, a + y));
-            writeln!(
-                out,
-                "  positioning moves after the runs ({}): {b:.3} → {a:.3} s",
-                rapids.len()
-            )?;
-        }
-        // The plan (crate::plan): runs that start on the other branch (the positioning
-        // move before them rewritten to go there).
-        let carried: std::collections::BTreeSet<usize> = rep
-            .zones
-            .iter()
-            .filter(|z| z.start_branch == Some(polepatch::Branch::Other))
-            .map(|z| z.run)
-            .collect();
-        if !carried.is_empty() {
-            writeln!(
-                out,
-                "  runs started on the other branch (the move before each rewritten): {}",
-                carried.len()
-            )?;
-        }
+        print_plan(rep, out)?;
         for (letter, written, file) in [
             ("C", rep.written_c_decimals, rep.file_c_decimals),
             (
