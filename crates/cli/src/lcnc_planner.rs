@@ -12,8 +12,14 @@ use std::process::ExitCode;
 /// Which planner `simulate` models.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub(crate) enum Planner {
-    /// A jerk-limited controller (V, A and J of every axis): the default.
+    /// A jerk-limited controller (V, A and J of every axis), planned in segments of
+    /// constant limits: within every axis' limits at every cycle. The default.
     Jerk,
+    /// The same controller simulated cycle by cycle under a velocity limit curve (the
+    /// model before 2026-11-29): closer to the fastest motion on curved paths, but it
+    /// puts the motion on its limit curve where it cannot brake in time, over the axes'
+    /// jerk there (docs/simulation.md).
+    Cycles,
     /// LinuxCNC 2.9 (V and A of the world axes, G64, the segment-stop rule).
     Linuxcnc,
 }

@@ -40,15 +40,17 @@ pub(crate) struct SimulateArgs {
     /// Interpolation cycle time override, ms (default: the machine's).
     #[arg(long)]
     tcy_ms: Option<f64>,
-    /// The planner: `jerk` (a jerk-limited controller, the default) or `linuxcnc` (a
-    /// model of LinuxCNC 2.9's planner: V and A only, each line stopping within itself at
-    /// half the acceleration; docs/linuxcnc.md, docs/validation.md).
+    /// The planner: `jerk` (a jerk-limited controller within every axis' V, A and J, the
+    /// default), `cycles` (the same limits simulated cycle by cycle, over them where it
+    /// cannot brake in time; docs/simulation.md) or `linuxcnc` (a model of LinuxCNC 2.9's
+    /// planner: V and A only, each line stopping within itself at half the acceleration;
+    /// docs/linuxcnc.md, docs/validation.md).
     #[arg(long, value_enum, default_value_t = crate::lcnc_planner::Planner::Jerk)]
     planner: crate::lcnc_planner::Planner,
-    /// Experimental: where the motion would be put on its velocity limit within one
-    /// cycle (the note's "cycles put on the velocity limit"), go back and brake in time
-    /// instead — a trajectory within the axes' jerk on more programs, somewhat slower,
-    /// at up to 2.4× the computing (docs/simulation.md, "Jerk at every cycle").
+    /// With `--planner cycles` (experimental): where the motion would be put on its
+    /// velocity limit within one cycle, go back and brake in time instead — within the
+    /// axes' jerk on more programs, somewhat slower, at up to 2.4× the computing
+    /// (docs/simulation.md, "Jerk at every cycle").
     #[arg(long)]
     rewind: bool,
 }
@@ -126,7 +128,7 @@ pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
         }
         if args.rewind {
             return Err(crate::usage(
-                "--rewind is for the jerk-limited planner, not --planner linuxcnc",
+                "--rewind is for --planner cycles, not --planner linuxcnc",
             ));
         }
         let tcy_s = args.tcy_ms.map(|ms| ms / 1000.0);
@@ -137,6 +139,12 @@ pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
             tcy_s,
             args.json,
         );
+    }
+    if args.rewind && args.planner != crate::lcnc_planner::Planner::Cycles {
+        return Err(crate::usage(
+            "--rewind is for --planner cycles (the default planner needs no rewinds: it is \
+             within every axis' limits)",
+        ));
     }
     if args.trajectory.is_some() && args.programs.len() > 1 {
         bail!("--trajectory writes one program's trajectory: give one program");
@@ -175,6 +183,7 @@ pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
         opts.sim.tcy_s = args.tcy_ms.map(|ms| ms / 1000.0);
         opts.sim.every_cycle = args.trajectory.is_some();
         opts.sim.rewind = args.rewind;
+        opts.sim.per_cycle = args.planner == crate::lcnc_planner::Planner::Cycles;
         let mut binned = Binned::new();
         let want_plot = args.plot.is_some();
         let report = if let Some(target) = trajectory_target {

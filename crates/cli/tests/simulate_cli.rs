@@ -115,9 +115,10 @@ fn two_programs_are_compared_and_outputs_never_overwrite_inputs() {
     assert!(err.contains("give one program"), "{err}");
 }
 
-/// `--rewind`: the same program simulates with fewer cycles put on the velocity limit
-/// (the `clips` of the JSON) and no faster than by default; refused (usage, 64) with the
-/// LinuxCNC planner, which has no such cycles.
+/// `--planner cycles --rewind`: the same program simulates with fewer cycles put on the
+/// velocity limit (the `clips` of the JSON) than `--planner cycles` alone and no faster;
+/// the default planner puts none there. `--rewind` is refused (usage, 64) without
+/// `--planner cycles`.
 #[test]
 fn rewind_puts_fewer_cycles_on_the_limit() {
     let run = |extra: &[&str]| {
@@ -138,27 +139,31 @@ fn rewind_puts_fewer_cycles_on_the_limit() {
             total["clips"].as_u64().unwrap(),
         )
     };
-    let (t_default, clips_default) = run(&[]);
-    let (t_rewind, clips_rewind) = run(&["--rewind"]);
+    let (_, clips_default) = run(&[]);
+    assert_eq!(clips_default, 0);
+    let (t_cycles, clips_cycles) = run(&["--planner", "cycles"]);
+    let (t_rewind, clips_rewind) = run(&["--planner", "cycles", "--rewind"]);
     assert!(
-        clips_rewind < clips_default,
-        "{clips_rewind} cycles on the limit with --rewind, {clips_default} without"
+        clips_rewind < clips_cycles,
+        "{clips_rewind} cycles on the limit with --rewind, {clips_cycles} without"
     );
     assert!(
-        t_rewind >= t_default * (1.0 - 1e-3),
-        "{t_rewind} s against {t_default} s"
+        t_rewind >= t_cycles * (1.0 - 1e-3),
+        "{t_rewind} s against {t_cycles} s"
     );
-    let (code, _, err) = polepatch(&[
-        "simulate",
-        "fixtures/c17/SING.I",
-        "-m",
-        "mikron-ucp710",
-        "--planner",
-        "linuxcnc",
-        "--rewind",
-    ]);
-    assert_eq!(code, 64, "{err}");
-    assert!(err.contains("--rewind"), "{err}");
+    for planner in ["linuxcnc", "jerk"] {
+        let (code, _, err) = polepatch(&[
+            "simulate",
+            "fixtures/c17/SING.I",
+            "-m",
+            "mikron-ucp710",
+            "--planner",
+            planner,
+            "--rewind",
+        ]);
+        assert_eq!(code, 64, "{err}");
+        assert!(err.contains("--rewind"), "{err}");
+    }
 }
 
 /// Issue 43, "one answer": a program with nothing to simulate says so, whatever output

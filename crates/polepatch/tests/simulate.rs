@@ -1,8 +1,8 @@
 //! `simulate` on C17's %SING, its patched version and generated flips and swings: the feed
 //! never exceeds F, every programmed point is passed, the patched program is faster, and
 //! the simulated time is at least Equation 6's estimate, itself at least L/F. The
-//! trajectory's finite differences within every axis' V, A and J: the ignored
-//! `every_fixture_is_within_the_limits_by_finite_differences` (issue 43 item 1, open).
+//! trajectory's finite differences within every axis' V, A and J on every fixture:
+//! `every_fixture_is_within_the_limits_by_finite_differences` (issue 43 item 1).
 
 mod common;
 use polepatch::ReadOptions;
@@ -70,8 +70,7 @@ fn check(bytes: &[u8], m: &Machine, what: &str) -> SimulateReport {
             run.length_mm
         );
         // Finite differences: printed here, held to the limits by
-        // `every_fixture_is_within_the_limits_by_finite_differences` (ignored while it
-        // fails). Until 2026-11-28 this function asserted them within 2 % over windows
+        // `every_fixture_is_within_the_limits_by_finite_differences`. Until 2026-11-28 this function asserted them within 2 % over windows
         // of states flagged as whole cycles; the flag compared t₁ − t₀ == Tcy exactly,
         // which rounding made false at random, so most windows were never checked
         // (%SING on the UCP710: X at 4.76× J at s = 145.44 mm once they are).
@@ -255,17 +254,14 @@ fn c17_on_the_ucp710_with_rewinds_is_within_the_limits_by_finite_differences() {
 
 /// Issue 32's check, as a user's scope would make it: on every program in `fixtures/` on
 /// both built-in machines, the finite differences of the trajectory within 1.05× V,
-/// 1.10× A and 1.25× J of each axis' limits, by default (the assertion) and with
-/// rewinds (printed).
+/// 1.10× A and 1.25× J of each axis' limits, by default.
 ///
-/// It fails today: by default on 130 of 132 runs (largest J 142×), with rewinds on 52
-/// (largest J 7.8×): where the backward profile cannot be followed and no kept state
-/// brakes in time the forward pass still clips, and the acceleration cap can fall along
-/// the path faster than a jerk can follow (C at 1.26× A on the A-C flips 0.5° from the
-/// pole). `docs/simulation.md` ("Jerk at every cycle") has the figures. Run:
-/// `cargo test --release -p polepatch --test simulate -- --ignored --nocapture`.
+/// It failed until 2026-11-29 (the per-cycle passes, then the default: 130 of 132 runs
+/// over, largest J 142×; with rewinds 52); the segments of constant limits keep every
+/// run within the limits by construction (`polepatch-simulate`'s `segments.rs`).
+/// `docs/simulation.md` ("Jerk at every cycle") has the figures; `-- --nocapture` prints
+/// each run's.
 #[test]
-#[ignore = "issue 43 item 1 is not done: 130 of 132 runs over, 52 with rewinds (docs/simulation.md)"]
 fn every_fixture_is_within_the_limits_by_finite_differences() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures");
     let mut files = Vec::new();
@@ -285,38 +281,31 @@ fn every_fixture_is_within_the_limits_by_finite_differences() {
         }
     }
     files.sort();
-    let (mut failures, mut runs, mut over_with_rewinds) = (Vec::new(), 0, 0);
-    for rewind in [true, false] {
-        for f in &files {
-            let bytes = std::fs::read(f).unwrap();
-            for name in Machine::builtin_names() {
-                let m = Machine::builtin(name).unwrap();
-                let Some(states) = every_cycle(&bytes, &m, rewind) else {
-                    continue;
-                };
-                let worst = worst_over_limits(&states, &m);
-                let within = within_issue_32(worst);
-                let rel = f.strip_prefix(&root).unwrap_or(f).display();
-                println!(
-                    "{}{rel} {name}: V {:.3} A {:.3} J {:.3}{}",
-                    if rewind { "with rewinds: " } else { "" },
-                    worst[0],
-                    worst[1],
-                    worst[2],
-                    if within { "" } else { "  OVER" }
-                );
-                if rewind {
-                    over_with_rewinds += usize::from(!within);
-                } else {
-                    runs += 1;
-                    if !within {
-                        failures.push(format!("{rel} on {name}: {worst:?}"));
-                    }
-                }
+    let (mut failures, mut runs) = (Vec::new(), 0);
+    for f in &files {
+        let bytes = std::fs::read(f).unwrap();
+        for name in Machine::builtin_names() {
+            let m = Machine::builtin(name).unwrap();
+            let Some(states) = every_cycle(&bytes, &m, false) else {
+                continue;
+            };
+            let worst = worst_over_limits(&states, &m);
+            let within = within_issue_32(worst);
+            let rel = f.strip_prefix(&root).unwrap_or(f).display();
+            println!(
+                "{rel} {name}: V {:.3} A {:.3} J {:.3}{}",
+                worst[0],
+                worst[1],
+                worst[2],
+                if within { "" } else { "  OVER" }
+            );
+            runs += 1;
+            if !within {
+                failures.push(format!("{rel} on {name}: {worst:?}"));
             }
         }
     }
-    println!("with rewinds: {over_with_rewinds} of {runs} runs over");
+    assert!(runs >= 100, "{runs} runs simulated");
     assert!(
         failures.is_empty(),
         "{} of {runs} runs over: {failures:#?}",

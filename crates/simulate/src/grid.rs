@@ -193,7 +193,6 @@ impl Grid {
     /// span), capped by F. The limit at a grid point is the lower of its two cells', and the
     /// limit curve is linear between grid points: below Equation 6 everywhere on the cell.
     pub fn new(geo: &Geometry, machine: &Machine, tcy_s: f64, max_cells: usize) -> Grid {
-        let n = geo.knots.len();
         // Equation 6 with the limits the passes plan with.
         let mut planned = machine.clone();
         for l in &mut planned.limits {
@@ -202,62 +201,13 @@ impl Grid {
             l.j *= LIMIT_USE;
         }
         let machine = &planned;
-        let mut s = Vec::with_capacity(n);
-        for k in 0..n - 1 {
-            let f = geo.feed_mm_s[geo.part_of_span(k)];
-            let (a, b) = (geo.knots[k], geo.knots[k + 1]);
-            let cells = ((b - a) / (f * tcy_s))
-                .ceil()
-                .clamp(1.0, max_cells.max(1) as f64) as usize;
-            for i in 0..cells {
-                s.push(a + (b - a) * i as f64 / cells as f64);
-            }
-        }
-        s.push(geo.knots[n - 1]);
-        let mut cell = Vec::with_capacity(s.len() - 1);
-        let mut derivs: Vec<[[f64; 4]; 5]> = Vec::with_capacity(GRID_BATCH_POINTS + 1);
-        let mut buf = vec![[0.0; 4]; GRID_BATCH_POINTS + 1];
-        let mut span = 0usize;
-        let mut start = 0usize;
-        while start + 1 < s.len() {
-            let end = (start + GRID_BATCH_POINTS).min(s.len() - 1);
-            let ts = &s[start..=end];
-            derivs.clear();
-            derivs.resize(ts.len(), [[0.0; 4]; 5]);
-            for a in 0..5 {
-                geo.splines[a].eval_derivs_sorted(ts, &mut buf[..ts.len()]);
-                for (d, e) in derivs.iter_mut().zip(&buf) {
-                    d[a] = *e;
-                }
-            }
-            for i in 0..ts.len() - 1 {
-                let t0 = ts[i];
-                while geo.knots[span + 1] <= t0 {
-                    span += 1;
-                }
-                let f = geo.feed_mm_s[geo.part_of_span(span)];
-                let h = ts[i + 1] - t0;
-                let mut d = [[0.0; 3]; 5];
-                for a in 0..5 {
-                    let [_, q1, q2, q3] = derivs[i][a];
-                    let e = derivs[i + 1][a];
-                    // End of the cell from the left piece (the right end may be a knot,
-                    // where the next piece starts with another q_sss).
-                    let q1e = q1 + q2 * h + 0.5 * q3 * h * h;
-                    let q2e = q2 + q3 * h;
-                    let mut m1 = q1.abs().max(q1e.abs()).max(e[1].abs());
-                    if q3 != 0.0 {
-                        let u = -q2 / q3;
-                        if u > 0.0 && u < h {
-                            m1 = m1.max((q1 + q2 * u + 0.5 * q3 * u * u).abs());
-                        }
-                    }
-                    d[a] = [m1, q2.abs().max(q2e.abs()).max(e[2].abs()), q3.abs()];
-                }
-                cell.push(feed_bound(machine, &d, f).feed_mm_s);
-            }
-            start = end;
-        }
+        let mut s = Vec::with_capacity(geo.knots.len());
+        let mut cell = Vec::with_capacity(geo.knots.len());
+        for_each_cell(geo, tcy_s, max_cells, &mut |c: &Cell| {
+            s.push(c.s0_mm);
+            cell.push(feed_bound(machine, &c.peaks, c.feed_mm_s).feed_mm_s);
+        });
+        s.push(geo.knots[geo.knots.len() - 1]);
         let m = cell.len();
         let limit = (0..s.len())
             .map(|i| {
@@ -267,6 +217,92 @@ impl Grid {
             })
             .collect();
         Grid { s, limit }
+    }
+}
+
+/// One cell of the grid: where it is, the largest |q_s|, |q_ss|, |q_sss| of each axis
+/// over it, and the programmed feed there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cell {
+    /// Start of the cell, mm.
+    pub s0_mm: f64,
+    /// End of the cell, mm.
+    pub s1_mm: f64,
+    /// Per axis `[max |q_s|, max |q_ss|, |q_sss|]` over the cell.
+    pub peaks: [[f64; 3]; 5],
+    /// Programmed feed on the cell, mm/s.
+    pub feed_mm_s: f64,
+}
+
+/// Every cell of the path in order: each span cut into `⌈h/(F·Tcy)⌉` cells (at most
+/// `max_cells`), with the largest |q_s|, |q_ss|, |q_sss| of each axis over the cell (exact
+/// for the cubic pieces: q_s is quadratic, q_ss linear, q_sss constant on a span).
+pub fn for_each_cell(geo: &Geometry, tcy_s: f64, max_cells: usize, f: &mut dyn FnMut(&Cell)) {
+    let n = geo.knots.len();
+    let mut s = Vec::with_capacity(GRID_BATCH_POINTS + 1);
+    let mut derivs: Vec<[[f64; 4]; 5]> = Vec::with_capacity(GRID_BATCH_POINTS + 1);
+    let mut buf = vec![[0.0; 4]; GRID_BATCH_POINTS + 1];
+    // The spans' cell boundaries are generated in batches of about GRID_BATCH_POINTS:
+    // a batch ends at a span's end (the last point is the next batch's first).
+    let mut k = 0usize;
+    while k + 1 < n {
+        s.clear();
+        let batch_first_span = k;
+        while k + 1 < n && s.len() < GRID_BATCH_POINTS {
+            let f = geo.feed_mm_s[geo.part_of_span(k)];
+            let (a, b) = (geo.knots[k], geo.knots[k + 1]);
+            let cells = ((b - a) / (f * tcy_s))
+                .ceil()
+                .clamp(1.0, max_cells.max(1) as f64) as usize;
+            for i in 0..cells {
+                s.push(a + (b - a) * i as f64 / cells as f64);
+            }
+            k += 1;
+        }
+        s.push(geo.knots[k]);
+        derivs.clear();
+        derivs.resize(s.len(), [[0.0; 4]; 5]);
+        if buf.len() < s.len() {
+            buf.resize(s.len(), [0.0; 4]);
+        }
+        for a in 0..5 {
+            geo.splines[a].eval_derivs_sorted(&s, &mut buf[..s.len()]);
+            for (d, e) in derivs.iter_mut().zip(&buf) {
+                d[a] = *e;
+            }
+        }
+        let mut span = batch_first_span;
+        for i in 0..s.len() - 1 {
+            let t0 = s[i];
+            while geo.knots[span + 1] <= t0 {
+                span += 1;
+            }
+            let feed_mm_s = geo.feed_mm_s[geo.part_of_span(span)];
+            let h = s[i + 1] - t0;
+            let mut peaks = [[0.0; 3]; 5];
+            for a in 0..5 {
+                let [_, q1, q2, q3] = derivs[i][a];
+                let e = derivs[i + 1][a];
+                // End of the cell from the left piece (the right end may be a knot,
+                // where the next piece starts with another q_sss).
+                let q1e = q1 + q2 * h + 0.5 * q3 * h * h;
+                let q2e = q2 + q3 * h;
+                let mut m1 = q1.abs().max(q1e.abs()).max(e[1].abs());
+                if q3 != 0.0 {
+                    let u = -q2 / q3;
+                    if u > 0.0 && u < h {
+                        m1 = m1.max((q1 + q2 * u + 0.5 * q3 * u * u).abs());
+                    }
+                }
+                peaks[a] = [m1, q2.abs().max(q2e.abs()).max(e[2].abs()), q3.abs()];
+            }
+            f(&Cell {
+                s0_mm: t0,
+                s1_mm: s[i + 1],
+                peaks,
+                feed_mm_s,
+            });
+        }
     }
 }
 

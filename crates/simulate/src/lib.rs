@@ -24,6 +24,21 @@
 //!
 //! (a sufficient condition by the triangle inequality; exact on a straight line).
 //!
+//! **The default** (`segments.rs`, since 2026-11-29): the path is cut into segments of
+//! constant limits V, A, J (each the worst of its grid cells', so that any motion within
+//! them meets every axis' limits there), passed with a = 0 between segments, and each
+//! segment is the time-optimal S-curve between its two junction speeds, found by a
+//! backward and a forward pass over the junctions. It is within every axis' V, A and J at
+//! every instant by construction, in closed form (the work grows with the segments, not
+//! the cycles), and on a straight line it is the time-optimal rest-to-rest profile. On a
+//! curved path it is slower than the fastest motion the limits allow (constant limits
+//! within a segment, a = 0 at its ends): `docs/simulation.md` measures by how much.
+//!
+//! **The per-cycle passes** ([`SimOptions::per_cycle`], `simulate --planner cycles`;
+//! the default until 2026-11-29), below: closer to the fastest motion on curved paths,
+//! but where a pass cannot brake in time it is put on its ceiling (a *clip*), over the
+//! axes' acceleration and jerk there.
+//!
 //! 1. **Velocity limit curve W(s)** ([`grid::Grid`]): each span between two points is cut
 //!    into cells (Equation 6's step F·Tcy, at most [`tolerances::MAX_CELLS_PER_SPAN`]); on
 //!    each cell `kinematics::feed_bound` (Equation 6) with the largest |q_s|, |q_ss|,
@@ -64,6 +79,7 @@ pub mod error;
 pub mod grid;
 pub mod linuxcnc;
 mod pass;
+mod segments;
 pub mod tolerances;
 
 pub use error::SimError;
@@ -90,8 +106,14 @@ pub struct SimOptions {
     /// fixtures it takes the runs within every axis' V, A and J by finite differences
     /// from 2 to 80 of 132 at a median +0.9 % of time, but costs up to 2.4× the work
     /// and lands up to 0.1 mm short of a run's end before creeping to it
-    /// (docs/simulation.md, "Jerk at every cycle").
+    /// (docs/simulation.md, "Jerk at every cycle"). Implies [`SimOptions::per_cycle`].
     pub rewind: bool,
+    /// Simulate with the per-cycle passes (`pass.rs`: a jerk bisected at every cycle under
+    /// a velocity limit curve) instead of the segments of constant limits (`segments.rs`,
+    /// the default); default `false`. Kept as a second model to compare with: it is
+    /// faster on curved paths but puts the motion on its ceiling where it cannot brake in
+    /// time (a *clip*: over the limits by finite differences).
+    pub per_cycle: bool,
 }
 
 impl Default for SimOptions {
@@ -101,6 +123,7 @@ impl Default for SimOptions {
             max_cells_per_span: tolerances::MAX_CELLS_PER_SPAN,
             every_cycle: false,
             rewind: false,
+            per_cycle: false,
         }
     }
 }
@@ -373,7 +396,28 @@ pub fn simulate(
     // The passes first, all they held (spline, grid, ceilings, profile) freed on return;
     // then Equation 6 on each part, whose own spline and solver are then the only
     // whole-motion arrays alive: the peak is one of the two, not their sum.
-    let motion = passes(parts, machine, opts, tcy_s, sink)?;
+    let motion = if opts.per_cycle || opts.rewind {
+        passes(parts, machine, opts, tcy_s, sink)?
+    } else {
+        let geo = Geometry::new(parts)?;
+        let p = segments::plan(
+            &geo,
+            machine,
+            tcy_s,
+            opts.max_cells_per_span,
+            opts.every_cycle,
+            sink,
+        );
+        Motion {
+            part_times: p.part_times,
+            min: p.min,
+            stats: pass::PassStats {
+                time_s: p.time_s,
+                clips: 0,
+                steps: p.steps,
+            },
+        }
+    };
     let aopts = AnalysisOptions {
         tcy_s: Some(tcy_s),
         ..AnalysisOptions::default()

@@ -167,3 +167,17 @@ pub const LCNC_TIME_EPSILON: f64 = 1e-12;
 /// does not finish within this many cycles means the model is stuck (never seen; a
 /// guard, not a limit).
 pub const LCNC_MAX_CYCLES_PER_SEGMENT: usize = 10_000_000;
+
+/// Share of each axis' A and J that a segment's speed may take with its curvature terms
+/// (|q_ss|·V² ≤ σ·A, |q_sss|·V³ ≤ σ·J), leaving the rest for the path's acceleration and
+/// jerk (`segments.rs`).
+pub const SPEED_SHARE: f64 = 0.8;
+/// A grid cell joins the segment before it while the merged segment's V, A and J each
+/// stay at or above this share of the largest of its cells' own (`segments.rs`). The
+/// motion is planned once per share (few long segments with low limits, or many short
+/// ones with a = 0 between them) and the fastest plan is the motion.
+pub const MERGE_RATIOS: [f64; 4] = [0.8, 0.6, 0.4, 0.2];
+/// Largest path acceleration of a segment where no axis bounds it (no axis moves), mm/s².
+pub const SEGMENT_A_MAX_MM_S2: f64 = 1e9;
+/// Largest path jerk of a segment where no axis bounds it, mm/s³.
+pub const SEGMENT_J_MAX_MM_S3: f64 = 1e12;

@@ -86,8 +86,7 @@ fn a_feed_change_is_not_a_stop() {
         q[0] += 50.0;
     }
     let tr = trajectory(&[a.clone(), b.clone()], &m);
-    // (Its finite differences: `a_feed_change_is_within_the_limits_by_finite_differences`,
-    // ignored while it fails.)
+    // (Its finite differences: `a_feed_change_is_within_the_limits_by_finite_differences`.)
     let at_join =
         tr.s.iter()
             .zip(&tr.feed)
@@ -108,12 +107,9 @@ fn a_feed_change_is_not_a_stop() {
 }
 
 /// [`a_feed_change_is_not_a_stop`]'s trajectory within every axis' limits by finite
-/// differences. It fails (2026-11-28): X at 1.066× J where the motion brakes from F3000
-/// towards the feed change (the jerk of consecutive cycles alternates: the bisection's
-/// safety is not monotone in the jerk, docs/simulation.md) — hidden until 2026-11-28 by
-/// the whole-cycle flag the check stops at (see `tests/line.rs`).
+/// differences. (Failed until 2026-11-29 with the per-cycle passes, then the default:
+/// X at 1.066× J where the motion braked from F3000 towards the feed change.)
 #[test]
-#[ignore = "issue 43 item 1: X at 1.066x J while braking for the feed change"]
 fn a_feed_change_is_within_the_limits_by_finite_differences() {
     let m = ucp();
     let a = line(0, 50.0, 1.0, 3000.0);

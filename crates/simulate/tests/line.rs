@@ -100,8 +100,7 @@ fn a_line_takes_the_s_curve_time() {
                     (got - want).abs() <= want * 0.01 + slack,
                     "{what}: simulated {got} s, closed form {want} s"
                 );
-                // (Finite differences: `every_line_is_within_the_limits_by_finite_differences`,
-                // ignored while it fails.)
+                // (Finite differences: `every_line_is_within_the_limits_by_finite_differences`.)
                 // The figures of docs/simulation.md (`-- --nocapture`).
                 println!(
                     "| {name} | {} | {len} | {feed} | {kind} | {want:.4} | {got:.4} | {:+.2} % |",
@@ -141,15 +140,11 @@ fn a_line_takes_the_s_curve_time() {
 /// The trajectory of every line above within every axis' V, A and J by finite differences
 /// (1 % slack), every window of the trajectory.
 ///
-/// It fails (measured 2026-11-28): up to 25.5× J (`mikron-ucp710` X 60 mm at F200000),
-/// at each move's end, where the forward pass comes to rest a few nanometres short and is
-/// put at the end (`pass.rs`, `END_MM`). Until 2026-11-28 the check skipped those cycles
-/// without saying so: it stopped at the last state flagged as a whole cycle, and the flag
-/// compared `t₁ − t₀ == Tcy` exactly, which rounding made false at random — this test's
-/// claim in docs/simulation.md ("within every axis' V, A and J") was never checked at
-/// the moves' ends. Issue 43 item 1; run with `-- --ignored --nocapture` for the figures.
+/// It failed until 2026-11-29 with the per-cycle passes, then the default (up to 25.5× J
+/// at each move's end, `mikron-ucp710` X 60 mm at F200000, where the forward pass came to
+/// rest a few nanometres short and was put at the end); the segments of constant limits
+/// (`segments.rs`) end exactly at rest. Run with `-- --nocapture` for the figures.
 #[test]
-#[ignore = "issue 43 item 1: the moves' ends exceed J, up to 25.5x (docs/journal/simulation.md)"]
 fn every_line_is_within_the_limits_by_finite_differences() {
     let mut worst_all = 0.0f64;
     for name in ["mikron-ucp710", "mikron-hsm600"] {

@@ -15,13 +15,11 @@ fn a_line_takes_ruckigs_time() {
     lines_against_ruckig(0.05);
 }
 
-/// The same lines with points every L/50 down to 0.01 mm apart. It fails (2026-11-28):
-/// `mikron-ucp710` Z over 1 mm at F3000 with points 0.02 mm apart takes 0.0897 s against
-/// Ruckig's 0.0862 s (+4.1 %, 3.5 ms: more than 1 % plus two cycles) — where the forward
-/// pass comes to rest at the end depends on the points (docs/simulation.md, the end
-/// sensitivity). Issue 43 item 1.
+/// The same lines with points every L/50 down to 0.01 mm apart. (Failed until 2026-11-29
+/// with the per-cycle passes, then the default: `mikron-ucp710` Z over 1 mm at F3000 with
+/// points 0.02 mm apart took 0.0897 s against Ruckig's 0.0862 s, where the forward pass
+/// came to rest at the end depending on the points.)
 #[test]
-#[ignore = "issue 43: a 1 mm Z line with points 0.02 mm apart is 4.1 % slower than Ruckig"]
 fn a_line_with_close_points_takes_ruckigs_time() {
     lines_against_ruckig(0.01);
 }
