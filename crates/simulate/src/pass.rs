@@ -288,7 +288,7 @@ fn bisect(mut good: f64, mut bad: f64, pred: impl Fn(f64) -> bool) -> f64 {
 /// Cube root of a non-negative `p` (the library's is a slow software routine on this
 /// target): exponent-halving first guess, then three Halley steps (cubic convergence: far
 /// below rounding after the third).
-fn cbrt(p: f64) -> f64 {
+pub(crate) fn cbrt(p: f64) -> f64 {
     if p <= 0.0 || !p.is_finite() {
         return p.max(0.0);
     }

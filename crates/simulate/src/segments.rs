@@ -13,47 +13,62 @@
 //!    largest of its cells' (per axis and order); from them ([`Peaks::limits`]):
 //!
 //!    ```text
-//!    V = min( F, V_i/|q_s|, √(σ·A_i/|q_ss|), ∛(σ·J_i/|q_sss|) )          (σ: SPEED_SHARE)
-//!    A = min_i (A_i − |q_ss|·V²)/|q_s|,   and 3·|q_ss|·V·A ≤ (J_i − |q_sss|·V³)/2
-//!    J = min_i (J_i − |q_sss|·V³ − 3·|q_ss|·V·A)/|q_s|
+//!    V = min( F, V_i/|q_s|, √(σ·A_i/|q_ss|), ∛(σ·J_i/|q_sss|) )        (σ: SPEED_SHARES)
+//!    A(v) = min_i (A_i − |q_ss|·v²)/|q_s|,   and 3·|q_ss|·v·A ≤ (J_i − |q_sss|·v³)/2
+//!    J(v) = min_i (J_i − |q_sss|·v³ − 3·|q_ss|·v·A(v))/|q_s|
 //!    ```
 //!
-//!    Every state with v ≤ V, |a| ≤ A, |j| ≤ J on the segment then meets every axis'
-//!    limits there (each term of the sufficient condition is increasing in |q_s|,
-//!    |q_ss|, |q_sss|, v and |a|). σ < 1 keeps room for A and J where Equation 6 binds. A
-//!    cell joins the segment before it while the merged limits stay within a share (one
-//!    of [`MERGE_RATIOS`]) of the largest of the segment's cells' and of the cell's own;
+//!    Every state on the segment with speed at most v, |a| ≤ A(v) and |j| ≤ J(v) meets
+//!    every axis' limits there (each term of the sufficient condition is increasing in
+//!    |q_s|, |q_ss|, |q_sss|, the speed and |a|), for any v ≤ V ([`Peaks::caps_at`]).
+//!    σ < 1 keeps room for A and J where Equation 6 binds. A cell joins the segment
+//!    before it while the merged limits at V stay within a share (one of
+//!    [`MERGE_RATIOS`]) of the largest of the segment's cells' and of the cell's own;
 //!    otherwise it starts a new segment. Few long segments have low limits, many short
-//!    ones a = 0 between them: the motion is planned for each share and the fastest plan
-//!    is the motion (each is within the limits).
+//!    ones a = 0 between them, a high σ cruises faster and a low one changes speed
+//!    faster: the motion is planned for each pair (with the caps at V, closed forms) and
+//!    the fastest plan is the motion (each is within the limits).
 //! 2. **The junctions** between segments are passed with a = 0 (and v under both
-//!    segments' V). With a = 0 at both ends, the distance to change speed from v₀ to v₁ is
-//!    (v₀ + v₁)/2 · T with T = Δv/A + A/J (or 2·√(Δv/J) when A is not reached): closed
-//!    forms ([`change`], [`reach`]). A backward pass over the junctions from rest at the
-//!    end (the fastest speed from which each later junction can still be met) and a
-//!    forward pass from rest at the start give the junction speeds — the classic
-//!    look-ahead of a CNC planner, over the whole motion.
-//! 3. **Each segment** is then the time-optimal motion between its two junction speeds
-//!    under its constant limits: a jerk-limited speed change up to a peak v_p ≤ V, a
-//!    cruise, and a speed change down (the 7-phase S-curve), v_p found by bisection so that
-//!    the segment's length is covered exactly.
+//!    segments' V). With a = 0 at both ends and constant caps, the distance to change
+//!    speed from v₀ to v₁ is (v₀ + v₁)/2 · T with T = Δv/A + A/J (or 2·√(Δv/J) when A is
+//!    not reached): closed forms ([`change`], [`reach`]). A backward pass over the
+//!    junctions from rest at the end (the fastest speed from which each later junction
+//!    can still be met) and a forward pass from rest at the start give the junction
+//!    speeds — the classic look-ahead of a CNC planner, over the whole motion.
+//! 3. **Caps in bands of speed.** The chosen plan is built again with each segment's caps
+//!    at [`BAND_SHARES`] of its V (A(v) and J(v) grow as the speed falls: near the pole
+//!    several times). A change of speed then follows a(v) = min(rise, A, fall): the
+//!    rise at each band's jerk from the lower speed (a²/2 = ∫J dv), the plateau at A of
+//!    the band of the higher speed, the fall to a = 0 at the higher speed — a piecewise
+//!    linear a² in v whose stretches are pieces of constant jerk ([`rise`]); a fall of
+//!    speed is a rise run backwards. Lengths are no longer closed forms: the junction
+//!    speeds are searched ([`reach_banded`], false position). The caps need not be
+//!    monotone across bands (a lower band's larger A leaves less of J).
+//! 4. **Each segment** is then the time-optimal motion between its two junction speeds
+//!    under its caps: a speed change up to a peak v_p ≤ V, a cruise, and a speed change
+//!    down, v_p searched so that the segment's length is covered exactly.
 //!
 //! The motion is a sequence of pieces of constant jerk, evaluated exactly wherever it is
 //! asked (every cycle for a trajectory): its finite differences are within the limits by
-//! construction. On a straight line there is one segment with the axis' own limits, and
-//! the motion is the time-optimal rest-to-rest S-curve. On a curved path the price of the
-//! proof is the constant limits within a segment and a = 0 at its ends; the time is an
-//! upper bound of what the limits allow (docs/simulation.md measures it against TOPP-RA's
-//! lower bound and the per-cycle passes).
+//! construction. On a straight line there is one segment with the axis' own limits (its
+//! bands are one), and the motion is the time-optimal rest-to-rest S-curve. On a curved
+//! path the price of the proof is the caps held constant over a segment (per band) and
+//! a = 0 at its ends; the time is an upper bound of what the limits allow
+//! (docs/simulation.md measures it against TOPP-RA's lower bound and the per-cycle
+//! passes).
 //!
-//! The work grows with the cells (the grid, once) and the segments (a few closed forms
-//! each), not the cycles; the memory with the segments (five numbers each).
+//! The work grows with the cells (one walk for every plan, one more for the chosen
+//! plan's bands) and the segments (a few closed forms each, a short search per junction
+//! with bands), not the cycles; the memory with the segments (five numbers each per plan,
+//! sixteen for the chosen plan).
 
 use polepatch_kinematics::Machine;
 
 use crate::grid::{Cell, Geometry, for_each_cell};
+use crate::pass::cbrt;
 use crate::tolerances::{
-    LIMIT_USE, MERGE_RATIOS, SEGMENT_A_MAX_MM_S2, SEGMENT_J_MAX_MM_S3, SPEED_SHARE, TIME_BISECTIONS,
+    BAND_SHARES, LIMIT_USE, MERGE_RATIOS, REACH_NEWTON_STEPS, REACH_REL, SEGMENT_A_MAX_MM_S2,
+    SEGMENT_J_MAX_MM_S3, SPEED_SHARES, TIME_BISECTIONS,
 };
 use crate::{MinFeed, Step};
 
@@ -90,28 +105,49 @@ impl Peaks {
 
     /// The segment's constant limits (module docs, step 1) with the machine's limits
     /// used at [`LIMIT_USE`].
-    fn limits(&self, machine: &Machine) -> Limits {
-        let lim = |i: usize| {
-            let l = machine.limits[i];
-            (LIMIT_USE * l.v, LIMIT_USE * l.a, LIMIT_USE * l.j)
-        };
-        let mut v = self.feed_mm_s;
+    fn limits(&self, machine: &Machine, share: f64) -> Limits {
+        let v = self.speed(machine, share);
+        let (a, j) = self.caps_at(machine, v);
+        Limits { v, a, j }
+    }
+
+    /// The segment's speed V: the feed, each axis' V, and its curvature terms within
+    /// `share` of A and J.
+    fn speed(&self, machine: &Machine, share: f64) -> f64 {
+        // The least of the square and cube roots is the root of the least radicand: one
+        // root each.
+        let (mut v, mut v2, mut v3) = (self.feed_mm_s, f64::INFINITY, f64::INFINITY);
         for i in 0..5 {
-            let (vl, al, jl) = lim(i);
+            let l = machine.limits[i];
+            let (vl, al, jl) = (LIMIT_USE * l.v, LIMIT_USE * l.a, LIMIT_USE * l.j);
             let [m1, m2, m3] = self.m[i];
             if m1 > 0.0 {
                 v = v.min(vl / m1);
             }
             if m2 > 0.0 {
-                v = v.min((SPEED_SHARE * al / m2).sqrt());
+                v2 = v2.min(share * al / m2);
             }
             if m3 > 0.0 {
-                v = v.min((SPEED_SHARE * jl / m3).cbrt());
+                v3 = v3.min(share * jl / m3);
             }
         }
+        if v2.is_finite() {
+            v = v.min(v2.sqrt());
+        }
+        if v3.is_finite() {
+            v = v.min(cbrt(v3));
+        }
+        v
+    }
+
+    /// The path's |acceleration| and |jerk| caps for every speed up to `v` (below the
+    /// segment's V): the rest of each axis' A after its curvature term at `v`, at most so
+    /// much that the v·|a| term takes half of J's rest; then the rest of J.
+    fn caps_at(&self, machine: &Machine, v: f64) -> (f64, f64) {
         let mut a = SEGMENT_A_MAX_MM_S2;
         for i in 0..5 {
-            let (_, al, jl) = lim(i);
+            let l = machine.limits[i];
+            let (al, jl) = (LIMIT_USE * l.a, LIMIT_USE * l.j);
             let [m1, m2, m3] = self.m[i];
             if m1 > 0.0 {
                 a = a.min((al - m2 * v * v) / m1);
@@ -122,13 +158,13 @@ impl Peaks {
         }
         let mut j = SEGMENT_J_MAX_MM_S3;
         for i in 0..5 {
-            let (_, _, jl) = lim(i);
+            let jl = LIMIT_USE * machine.limits[i].j;
             let [m1, m2, m3] = self.m[i];
             if m1 > 0.0 {
                 j = j.min((jl - m3 * v * v * v - 3.0 * m2 * v * a) / m1);
             }
         }
-        Limits { v, a, j }
+        (a, j)
     }
 }
 
@@ -169,25 +205,54 @@ impl Open {
             lim: self.lim,
         }
     }
+
+    /// The segment with its caps at [`BAND_SHARES`] of its speed (the last share is 1:
+    /// its V and caps).
+    fn banded(&self, machine: &Machine) -> Banded {
+        let v = self.lim.v;
+        Banded {
+            s0_mm: self.s0_mm,
+            len_mm: self.s1_mm - self.s0_mm,
+            bands: std::array::from_fn(|b| {
+                if BAND_SHARES[b] >= 1.0 {
+                    return self.lim;
+                }
+                let vb = v * BAND_SHARES[b];
+                let (a, j) = self.peaks.caps_at(machine, vb);
+                Limits { v: vb, a, j }
+            }),
+        }
+    }
 }
 
-/// The segments of the path (module docs, step 1), once per merge ratio of
-/// [`MERGE_RATIOS`], in one walk over the cells.
-fn segmentations(
+/// The merge plans: every speed share of [`SPEED_SHARES`] (by index) with every merge
+/// share of [`MERGE_RATIOS`].
+fn all_plans() -> Vec<(usize, f64)> {
+    (0..SPEED_SHARES.len())
+        .flat_map(|k| MERGE_RATIOS.iter().map(move |&r| (k, r)))
+        .collect()
+}
+
+/// The segments of the path (module docs, step 1), once per plan `(speed share index,
+/// merge share)`, in one walk over the cells; each closed by `close`.
+fn segmentations<T>(
     geo: &Geometry,
     machine: &Machine,
     tcy_s: f64,
     max_cells: usize,
-) -> Vec<Vec<Segment>> {
-    let mut out: Vec<Vec<Segment>> = vec![Vec::new(); MERGE_RATIOS.len()];
-    let mut open: Vec<Option<Open>> = vec![None; MERGE_RATIOS.len()];
+    plans: &[(usize, f64)],
+    close: &dyn Fn(&Open, f64) -> T,
+) -> Vec<Vec<T>> {
+    let mut out: Vec<Vec<T>> = plans.iter().map(|_| Vec::new()).collect();
+    let mut open: Vec<Option<Open>> = vec![None; plans.len()];
     for_each_cell(geo, tcy_s, max_cells, &mut |c: &Cell| {
         let p = Peaks::of(c);
-        let own = p.limits(machine);
-        for (k, &ratio) in MERGE_RATIOS.iter().enumerate() {
+        let mut own: [Option<Limits>; SPEED_SHARES.len()] = [None; SPEED_SHARES.len()];
+        for (k, &(share, ratio)) in plans.iter().enumerate() {
+            let own = *own[share].get_or_insert_with(|| p.limits(machine, SPEED_SHARES[share]));
             if let Some(o) = &mut open[k] {
                 let merged = o.peaks.merge(&p);
-                let lm = merged.limits(machine);
+                let lm = merged.limits(machine, SPEED_SHARES[share]);
                 let ok = |m: f64, a: f64, b: f64| m >= ratio * a.max(b);
                 if ok(lm.v, o.best.v, own.v)
                     && ok(lm.a, o.best.a, own.a)
@@ -203,14 +268,14 @@ fn segmentations(
                     o.s1_mm = c.s1_mm;
                     continue;
                 }
-                out[k].push(o.close());
+                out[k].push(close(o, SPEED_SHARES[share]));
             }
             open[k] = Some(Open::of(c, p, own));
         }
     });
     for (k, o) in open.iter().enumerate() {
         if let Some(o) = o {
-            out[k].push(o.close());
+            out[k].push(close(o, SPEED_SHARES[plans[k].0]));
         }
     }
     out
@@ -228,27 +293,91 @@ fn change(v0: f64, v1: f64, a: f64, j: f64) -> (f64, f64) {
     (t, 0.5 * (v0 + v1) * t)
 }
 
-/// The largest speed v ≥ `v0` to which a change from `v0` ([`change`]) fits in `len`.
+/// The largest x in [`lo`, `hi`] with `f(x) ≤ 0`, for `f` increasing with `f(lo) ≤ 0 <
+/// f(hi)`: false position with the Illinois rule, the bracket kept, to [`REACH_REL`] of
+/// `hi` (a smooth f: a few steps where halving takes thirty).
+fn largest_within(mut lo: f64, mut hi: f64, f: impl Fn(f64) -> f64) -> f64 {
+    let (mut flo, mut fhi) = (f(lo), f(hi));
+    let mut side = 0i8;
+    for _ in 0..TIME_BISECTIONS {
+        if hi - lo <= REACH_REL * hi.abs() {
+            break;
+        }
+        let mut x = if fhi > flo {
+            lo + (hi - lo) * (-flo / (fhi - flo))
+        } else {
+            0.5 * (lo + hi)
+        };
+        if !(x > lo && x < hi) {
+            x = 0.5 * (lo + hi);
+            if !(x > lo && x < hi) {
+                break;
+            }
+        }
+        let fx = f(x);
+        if fx <= 0.0 {
+            lo = x;
+            flo = fx;
+            if side == -1 {
+                fhi *= 0.5;
+            }
+            side = -1;
+        } else {
+            hi = x;
+            fhi = fx;
+            if side == 1 {
+                flo *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    lo
+}
+
+/// Top speed of a segment (its V).
+fn top_speed(seg: &impl Seg) -> f64 {
+    let b = seg.bands();
+    b[b.len() - 1].v
+}
+
+/// The largest speed v ≥ `v0` to which a change from `v0` ([`change`]) fits in `len`:
+/// the root of the change's length, then lowered by the last digits that v0 + Δv rounds
+/// up, so that the change never needs more than `len`.
 fn reach(v0: f64, len: f64, a: f64, j: f64) -> f64 {
+    let mut v1 = reach_root(v0, len, a, j);
+    for _ in 0..REACH_NEWTON_STEPS {
+        if v1 <= v0 || change(v0, v1, a, j).1 <= len {
+            break;
+        }
+        // The next float below (v1 > v0 ≥ 0: positive and finite).
+        v1 = f64::from_bits(v1.to_bits() - 1);
+    }
+    if change(v0, v1, a, j).1 > len { v0 } else { v1 }
+}
+
+/// The root of [`change`]'s length `len` from `v0` (both regimes, closed forms).
+fn reach_root(v0: f64, len: f64, a: f64, j: f64) -> f64 {
     if len <= 0.0 {
         return v0;
     }
-    // While A is not reached: x = √Δv solves x³ + 2·v0·x = len·√j (increasing, convex for
-    // x > 0: Newton from an upper bound falls monotonically onto the root).
+    // While A is not reached: x = √Δv solves x³ + p·x = q with p = 2·v0, q = len·√j: one
+    // real root, x = w − p/(3·w) with w = ∛(q/2 + √(q²/4 + p³/27)) (Cardano without the
+    // cancelling difference of two cube roots), polished by Newton where x ≪ w.
     let q = len * j.sqrt();
-    let mut x = q.cbrt();
-    if v0 > 0.0 {
-        x = x.min(q / (2.0 * v0));
+    let p = 2.0 * v0;
+    let w = cbrt(0.5 * q + (0.25 * q * q + p * p * p / 27.0).sqrt());
+    let mut x = if w > 0.0 { w - p / (3.0 * w) } else { 0.0 };
+    if x.is_nan() || x <= 0.0 || x * x < 1e-6 * w * w {
+        x = (q / p.max(f64::MIN_POSITIVE)).min(cbrt(q));
     }
-    for _ in 0..100 {
-        let f = x * x * x + 2.0 * v0 * x - q;
-        let nx = x - f / (3.0 * x * x + 2.0 * v0);
-        // Stop where Newton no longer falls (the root, to rounding) or on NaN.
-        if nx.partial_cmp(&x) != Some(std::cmp::Ordering::Less) || nx <= 0.0 {
+    for _ in 0..REACH_NEWTON_STEPS {
+        let d = 3.0 * x * x + p;
+        if d.is_nan() || d <= 0.0 {
             break;
         }
-        x = nx;
+        x -= (x * x * x + p * x - q) / d;
     }
+    let x = x.max(0.0);
     let dv = x * x;
     if dv * j < a * a {
         return v0 + dv;
@@ -273,61 +402,259 @@ struct Piece {
     j: f64,
 }
 
-/// The pieces of a change of speed from `v0` to `v1` ([`change`]).
-fn change_pieces(v0: f64, v1: f64, a: f64, j: f64, out: &mut Vec<Piece>) {
-    let dv = (v1 - v0).abs();
-    if dv == 0.0 {
-        return;
+/// The pieces of one change of speed (at most [`MAX_CHANGE_PIECES`]).
+#[derive(Debug, Clone, Copy)]
+struct Pieces {
+    p: [Piece; MAX_CHANGE_PIECES],
+    n: usize,
+}
+
+/// Pieces of a change of speed under banded caps: intervals (≤ 3 bands) × sub-intervals
+/// (≤ 4: where the rise, the plateau and the fall take over).
+const MAX_CHANGE_PIECES: usize = 4 * BAND_SHARES.len();
+
+impl Pieces {
+    fn new() -> Pieces {
+        Pieces {
+            p: [Piece { t: 0.0, j: 0.0 }; MAX_CHANGE_PIECES],
+            n: 0,
+        }
     }
-    let sign = if v1 > v0 { 1.0 } else { -1.0 };
-    if dv * j >= a * a {
-        out.push(Piece {
-            t: a / j,
-            j: sign * j,
-        });
-        out.push(Piece {
-            t: dv / a - a / j,
-            j: 0.0,
-        });
-        out.push(Piece {
-            t: a / j,
-            j: -sign * j,
-        });
+
+    fn push(&mut self, t: f64, j: f64) {
+        if t > 0.0 && self.n < MAX_CHANGE_PIECES {
+            self.p[self.n] = Piece { t, j };
+            self.n += 1;
+        }
+    }
+
+    fn as_slice(&self) -> &[Piece] {
+        &self.p[..self.n]
+    }
+
+    /// Time and distance from speed `v0` (a = 0).
+    fn time_distance(&self, v0: f64) -> (f64, f64) {
+        let (mut t, mut s, mut v, mut a) = (0.0, 0.0, v0, 0.0);
+        for p in self.as_slice() {
+            (s, v, a) = advance(s, v, a, p.j, p.t);
+            t += p.t;
+        }
+        (t, s)
+    }
+}
+
+/// Banded caps (`bands`, ascending in speed; each band's caps hold at every speed up to
+/// its `v`): the pieces of the time-optimal rise from `v_lo` to `v_hi` (≤ the last band's
+/// speed) with a = 0 at both ends. With the acceleration as a function of speed, a rise at
+/// jerk J gives a²/2 = ∫J dv from `v_lo`, a fall to 0 at `v_hi` a²/2 = ∫J dv to `v_hi`,
+/// and a ≤ A of the band of `v_hi` throughout (the plateau): a(v) is the least of the
+/// three, its square piecewise linear in v. Each stretch where one of them is the least,
+/// within one band, is one piece of constant jerk (+J, 0 or −J).
+fn rise(v_lo: f64, v_hi: f64, bands: &[Limits]) -> Pieces {
+    let mut out = Pieces::new();
+    if v_hi <= v_lo {
+        return out;
+    }
+    let band_of = |v: f64| {
+        bands
+            .iter()
+            .position(|b| v <= b.v)
+            .unwrap_or(bands.len() - 1)
+    };
+    let ap = bands[band_of(v_hi)].a;
+    let ap2 = ap * ap;
+    // Breakpoints: v_lo, the bands' tops strictly between, v_hi.
+    const NB: usize = BAND_SHARES.len();
+    let mut x = [0.0; NB + 1];
+    let mut nx = 0;
+    x[nx] = v_lo;
+    nx += 1;
+    for b in bands {
+        if b.v > v_lo && b.v < v_hi && nx < NB {
+            x[nx] = b.v;
+            nx += 1;
+        }
+    }
+    x[nx] = v_hi;
+    nx += 1;
+    let jerk: [f64; NB] = std::array::from_fn(|i| {
+        if i + 1 < nx {
+            bands[band_of(x[i + 1])].j
+        } else {
+            0.0
+        }
+    });
+    // a² of the rise and of the fall at the breakpoints.
+    let mut r = [0.0; NB + 1];
+    let mut f = [0.0; NB + 1];
+    for i in 0..nx - 1 {
+        r[i + 1] = r[i] + 2.0 * jerk[i] * (x[i + 1] - x[i]);
+    }
+    for i in (0..nx - 1).rev() {
+        f[i] = f[i + 1] + 2.0 * jerk[i] * (x[i + 1] - x[i]);
+    }
+    for i in 0..nx - 1 {
+        let (x0, x1, jj) = (x[i], x[i + 1], jerk[i]);
+        let rr = |y: f64| r[i] + 2.0 * jj * (y - x0);
+        let ff = |y: f64| f[i] - 2.0 * jj * (y - x0);
+        let e = |y: f64| rr(y).min(ff(y)).min(ap2).max(0.0);
+        // Where the least of the three changes within [x0, x1].
+        let mut y = [x0, x1, x1, x1, x1];
+        let mut ny = 1;
+        for c in [
+            x0 + (ap2 - r[i]) / (2.0 * jj),
+            x0 + (f[i] - ap2) / (2.0 * jj),
+            x0 + (f[i] - r[i]) / (4.0 * jj),
+        ] {
+            if c > x0 && c < x1 {
+                y[ny] = c;
+                ny += 1;
+            }
+        }
+        y[ny] = x1;
+        ny += 1;
+        y[..ny].sort_by(f64::total_cmp);
+        for k in 0..ny - 1 {
+            let (y0, y1) = (y[k], y[k + 1]);
+            if y1 <= y0 {
+                continue;
+            }
+            let mid = 0.5 * (y0 + y1);
+            let (rm, fm) = (rr(mid), ff(mid));
+            let (a0, a1) = (e(y0).sqrt(), e(y1).sqrt());
+            if ap2 <= rm && ap2 <= fm {
+                out.push((y1 - y0) / ap, 0.0);
+            } else if rm <= fm {
+                out.push((a1 - a0) / jj, jj);
+            } else {
+                out.push((a0 - a1) / jj, -jj);
+            }
+        }
+    }
+    out
+}
+
+/// The pieces of a change of speed from `v0` to `v1` (a = 0 at both ends) under banded
+/// caps: a rise, or a rise turned in time (a fall is a rise run backwards: same jerks,
+/// pieces in reverse order).
+fn change_pieces(v0: f64, v1: f64, bands: &[Limits]) -> Pieces {
+    if one_band(bands) {
+        let Limits { a, j, .. } = bands[bands.len() - 1];
+        let mut out = Pieces::new();
+        let dv = (v1 - v0).abs();
+        let sign = if v1 > v0 { 1.0 } else { -1.0 };
+        if dv * j >= a * a {
+            out.push(a / j, sign * j);
+            out.push(dv / a - a / j, 0.0);
+            out.push(a / j, -sign * j);
+        } else if dv > 0.0 {
+            let tj = (dv / j).sqrt();
+            out.push(tj, sign * j);
+            out.push(tj, -sign * j);
+        }
+        return out;
+    }
+    if v1 >= v0 {
+        rise(v0, v1, bands)
     } else {
-        let tj = (dv / j).sqrt();
-        out.push(Piece { t: tj, j: sign * j });
-        out.push(Piece {
-            t: tj,
-            j: -sign * j,
-        });
+        let mut up = rise(v1, v0, bands);
+        up.p[..up.n].reverse();
+        up
+    }
+}
+
+/// Whether the bands' caps are all the top band's (a line: the caps do not depend on the
+/// speed), so that the closed forms hold. (The caps need not be monotone across bands: a
+/// lower band's larger A leaves less of J for its jerk.)
+fn one_band(bands: &[Limits]) -> bool {
+    let top = bands[bands.len() - 1];
+    bands.iter().all(|b| b.a == top.a && b.j == top.j)
+}
+
+/// Time and distance of a change of speed under banded caps.
+fn change_banded(v0: f64, v1: f64, bands: &[Limits]) -> (f64, f64) {
+    if one_band(bands) {
+        let top = bands[bands.len() - 1];
+        return change(v0, v1, top.a, top.j);
+    }
+    change_pieces(v0, v1, bands).time_distance(v0)
+}
+
+/// The largest speed v ≥ `v0`, at most the last band's, to which a change from `v0`
+/// fits in `len` under banded caps: the closed form under the top band's caps where the
+/// bands are one, else a search from `v0` (or from that closed form's speed where it
+/// fits: a guess, since a lower band's jerk may be below the top's).
+fn reach_banded(v0: f64, len: f64, bands: &[Limits]) -> f64 {
+    let top = bands[bands.len() - 1];
+    let guess = reach(v0, len, top.a, top.j);
+    if one_band(bands) {
+        return guess;
+    }
+    if change_banded(v0, top.v, bands).1 <= len {
+        return top.v;
+    }
+    let lo = if guess > v0 && guess < top.v && change_banded(v0, guess, bands).1 <= len {
+        guess
+    } else {
+        v0
+    };
+    largest_within(lo, top.v, |v| change_banded(v0, v, bands).1 - len)
+}
+
+/// A segment's place and its caps, banded or not.
+trait Seg {
+    fn s0_mm(&self) -> f64;
+    fn len_mm(&self) -> f64;
+    /// Caps in bands of speed, ascending; the last is the segment's V and its caps.
+    fn bands(&self) -> &[Limits];
+}
+
+impl Seg for Segment {
+    fn s0_mm(&self) -> f64 {
+        self.s0_mm
+    }
+    fn len_mm(&self) -> f64 {
+        self.len_mm
+    }
+    fn bands(&self) -> &[Limits] {
+        std::slice::from_ref(&self.lim)
+    }
+}
+
+/// A segment with its caps at [`BAND_SHARES`] of its speed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Banded {
+    s0_mm: f64,
+    len_mm: f64,
+    bands: [Limits; BAND_SHARES.len()],
+}
+
+impl Seg for Banded {
+    fn s0_mm(&self) -> f64 {
+        self.s0_mm
+    }
+    fn len_mm(&self) -> f64 {
+        self.len_mm
+    }
+    fn bands(&self) -> &[Limits] {
+        &self.bands
     }
 }
 
 /// The pieces of segment `seg` from junction speed `u0` to `u1` (module docs, step 3).
-fn segment_pieces(seg: &Segment, u0: f64, u1: f64, out: &mut Vec<Piece>) {
+fn segment_pieces(seg: &impl Seg, u0: f64, u1: f64, out: &mut Vec<Piece>) {
     out.clear();
-    let Limits { v, a, j } = seg.lim;
-    let len = seg.len_mm;
-    let used = |vp: f64| change(u0, vp, a, j).1 + change(vp, u1, a, j).1;
+    let bands = seg.bands();
+    let v = bands[bands.len() - 1].v;
+    let len = seg.len_mm();
+    let used = |vp: f64| change_banded(u0, vp, bands).1 + change_banded(vp, u1, bands).1;
     let lo0 = u0.max(u1);
     let vp = if used(v) <= len {
         v
     } else {
-        let (mut lo, mut hi) = (lo0, v.max(lo0));
-        for _ in 0..TIME_BISECTIONS {
-            let mid = 0.5 * (lo + hi);
-            if !(mid > lo && mid < hi) {
-                break;
-            }
-            if used(mid) <= len {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        lo
+        largest_within(lo0, v.max(lo0), |vp| used(vp) - len)
     };
-    change_pieces(u0, vp, a, j, out);
+    out.extend_from_slice(change_pieces(u0, vp, bands).as_slice());
     let cruise = len - used(vp);
     if cruise > 0.0 && vp > 0.0 {
         out.push(Piece {
@@ -335,7 +662,7 @@ fn segment_pieces(seg: &Segment, u0: f64, u1: f64, out: &mut Vec<Piece>) {
             j: 0.0,
         });
     }
-    change_pieces(vp, u1, a, j, out);
+    out.extend_from_slice(change_pieces(vp, u1, bands).as_slice());
 }
 
 /// The state after time `t` of constant jerk `j` from (s, v, a).
@@ -367,22 +694,33 @@ pub(crate) fn plan(
     every_cycle: bool,
     sink: &mut dyn FnMut(&Step, &Geometry),
 ) -> Planned {
-    // Each segmentation planned (its junctions and time); the fastest handed out.
-    let mut best: Option<(f64, Vec<Segment>, Vec<f64>)> = None;
-    for segs in segmentations(geo, machine, tcy_s, max_cells) {
-        let u = junctions(&segs);
-        let t = time_of(&segs, &u);
-        if best.as_ref().is_none_or(|b| t < b.0) {
-            best = Some((t, segs, u));
+    // Each segmentation planned with its caps at its top speed (closed forms, all of
+    // them at once); the fastest plan is built again with its caps in bands of speed and
+    // handed out (no slower: a change under the bands is no longer than under the top's).
+    let plans = all_plans();
+    let mut best: Option<(f64, usize)> = None;
+    let close = |o: &Open, _share: f64| o.close();
+    for (k, segs) in segmentations(geo, machine, tcy_s, max_cells, &plans, &close)
+        .iter()
+        .enumerate()
+    {
+        let t = time_of(segs, &junctions(segs));
+        if best.is_none_or(|b| t < b.0) {
+            best = Some((t, k));
         }
     }
-    let (_, segs, u) = best.unwrap_or_default();
+    let chosen = [plans[best.map_or(0, |b| b.1)]];
+    let close = |o: &Open, _share: f64| o.banded(machine);
+    let segs = segmentations(geo, machine, tcy_s, max_cells, &chosen, &close)
+        .pop()
+        .unwrap_or_default();
+    let u = junctions(&segs);
     // Forward, segment by segment, handing out the states as they are computed.
     let mut out = Emit::new(geo, every_cycle, tcy_s, sink);
-    let mut pieces = Vec::with_capacity(7);
+    let mut pieces = Vec::with_capacity(2 * MAX_CHANGE_PIECES + 1);
     let mut u0 = 0.0;
     for (k, seg) in segs.iter().enumerate() {
-        let u1 = u[k + 1].min(reach(u0, seg.len_mm, seg.lim.a, seg.lim.j));
+        let u1 = u[k + 1].min(reach_banded(u0, seg.len_mm(), seg.bands()));
         segment_pieces(seg, u0, u1, &mut pieces);
         out.segment(seg, u0, &pieces);
         u0 = u1;
@@ -393,28 +731,28 @@ pub(crate) fn plan(
 /// The backward pass over the junctions (module docs, step 2): the fastest speed at each
 /// junction from which the rest of the motion can still be met, from rest at the end; at
 /// rest at the start.
-fn junctions(segs: &[Segment]) -> Vec<f64> {
+fn junctions<S: Seg>(segs: &[S]) -> Vec<f64> {
     let n = segs.len();
     let mut u = vec![0.0; n + 1];
     for k in (0..n).rev() {
         let cap = if k == 0 {
             0.0
         } else {
-            segs[k - 1].lim.v.min(segs[k].lim.v)
+            top_speed(&segs[k - 1]).min(top_speed(&segs[k]))
         };
         let s = &segs[k];
-        u[k] = cap.min(reach(u[k + 1], s.len_mm, s.lim.a, s.lim.j));
+        u[k] = cap.min(reach_banded(u[k + 1], s.len_mm(), s.bands()));
     }
     u
 }
 
 /// The time of the motion on `segs` with the backward junction speeds `u` (the forward
 /// pass of [`plan`] without its states).
-fn time_of(segs: &[Segment], u: &[f64]) -> f64 {
+fn time_of<S: Seg>(segs: &[S], u: &[f64]) -> f64 {
     let mut pieces = Vec::with_capacity(7);
     let (mut u0, mut t) = (0.0, 0.0);
     for (k, seg) in segs.iter().enumerate() {
-        let u1 = u[k + 1].min(reach(u0, seg.len_mm, seg.lim.a, seg.lim.j));
+        let u1 = u[k + 1].min(reach_banded(u0, seg.len_mm(), seg.bands()));
         segment_pieces(seg, u0, u1, &mut pieces);
         t += pieces.iter().map(|p| p.t).sum::<f64>();
         u0 = u1;
@@ -487,9 +825,9 @@ impl<'a, 'b> Emit<'a, 'b> {
     }
 
     /// The pieces of one segment from its start (speed `u0`, a = 0).
-    fn segment(&mut self, seg: &Segment, u0: f64, pieces: &[Piece]) {
-        let end = seg.s0_mm + seg.len_mm;
-        let (mut s, mut v, mut a) = (seg.s0_mm, u0, 0.0);
+    fn segment(&mut self, seg: &impl Seg, u0: f64, pieces: &[Piece]) {
+        let end = seg.s0_mm() + seg.len_mm();
+        let (mut s, mut v, mut a) = (seg.s0_mm(), u0, 0.0);
         let mut t0 = self.t;
         for (i, p) in pieces.iter().enumerate() {
             let last_piece = i + 1 == pieces.len();
@@ -651,6 +989,130 @@ mod tests {
                 "{u0} {u1} {len}: {s}"
             );
             assert!((v - u1).abs() <= 1e-9 * 40.0 && a.abs() <= 1e-9 * 500.0);
+        }
+    }
+}
+
+#[cfg(test)]
+mod banded_tests {
+    use super::*;
+
+    /// `reach` inverts `change` over a wide range of speeds, lengths and caps: never past
+    /// the length, and short of it by at most 10⁻⁶ of it.
+    #[test]
+    fn reach_inverts_the_change_over_a_wide_range() {
+        for &v0 in &[0.0, 1e-3, 0.1, 3.0, 30.0, 500.0] {
+            for &len in &[1e-6, 1e-3, 0.05, 1.0, 20.0, 3000.0] {
+                for &(a, j) in &[
+                    (1.0, 10.0),
+                    (100.0, 300.0),
+                    (1000.0, 5000.0),
+                    (5.0, 1e5),
+                    (5000.0, 50.0),
+                ] {
+                    let v1 = reach(v0, len, a, j);
+                    let d = change(v0, v1, a, j).1;
+                    let rel = (d - len) / len;
+                    // A change too small for v0 + Δv to hold it exactly (Δv within 10⁻⁶ of
+                    // v0: its last digits) is held to the rounding of v0 + Δv.
+                    let (low, high) = if v1 - v0 > 1e-6 * v0 {
+                        (-1e-6, 0.0)
+                    } else {
+                        (-1.0, 0.0)
+                    };
+                    assert!(
+                        (low..=high).contains(&rel),
+                        "v0 {v0} len {len} a {a} j {j}: v1 {v1} d {d}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// Bands whose caps are not monotone in speed (a lower band's larger A leaves it less
+    /// jerk), as `Peaks::caps_at` gives near the pole.
+    fn bands() -> [Limits; 3] {
+        [
+            Limits {
+                v: 2.0,
+                a: 60.0,
+                j: 800.0,
+            },
+            Limits {
+                v: 5.0,
+                a: 30.0,
+                j: 2000.0,
+            },
+            Limits {
+                v: 8.0,
+                a: 10.0,
+                j: 1500.0,
+            },
+        ]
+    }
+
+    /// A change under banded caps ends at its speed with a = 0, and every piece keeps
+    /// the jerk of the band it runs in and the acceleration of the band of the change's
+    /// top speed; a fall is the rise run backwards (same time and length).
+    #[test]
+    fn a_banded_change_keeps_each_bands_caps() {
+        let b = bands();
+        for &(v0, v1) in &[
+            (0.0, 8.0),
+            (0.5, 4.0),
+            (1.0, 1.5),
+            (3.0, 7.9),
+            (8.0, 0.0),
+            (6.0, 2.0),
+        ] {
+            let ps = change_pieces(v0, v1, &b);
+            let hi = f64::max(v0, v1);
+            let ap = b.iter().find(|x| hi <= x.v).map_or(0.0, |x| x.a);
+            let (mut s, mut v, mut a) = (0.0, v0, 0.0);
+            for p in ps.as_slice() {
+                let (s1, v_end, a_end) = advance(s, v, a, p.j, p.t);
+                // The band of the piece: the highest speed it reaches.
+                let top = v.max(v_end);
+                let band = b.iter().find(|x| top <= x.v * (1.0 + 1e-9)).unwrap();
+                assert!(
+                    p.j.abs() <= band.j * (1.0 + 1e-12),
+                    "{v0}→{v1}: {p:?} in {band:?}"
+                );
+                assert!(a_end.abs() <= ap * (1.0 + 1e-9) && top <= hi * (1.0 + 1e-9));
+                (s, v, a) = (s1, v_end, a_end);
+            }
+            assert!(
+                (v - v1).abs() <= 1e-9 && a.abs() <= 1e-6,
+                "{v0}→{v1}: v {v} a {a}"
+            );
+            let (t_up, d_up) = change_banded(v0, v1, &b);
+            let (t_down, d_down) = change_banded(v1, v0, &b);
+            assert!((t_up - t_down).abs() <= 1e-12 && (d_up - d_down).abs() <= 1e-9);
+            assert!((d_up - s).abs() <= 1e-9);
+        }
+    }
+
+    /// `reach_banded` finds the largest speed whose change fits, with bands that are not
+    /// monotone: the change to it fits, a little more does not.
+    #[test]
+    fn the_banded_reach_fits_and_is_the_largest() {
+        let b = bands();
+        for &(v0, len) in &[
+            (0.0, 0.01),
+            (0.0, 0.5),
+            (1.0, 0.2),
+            (4.0, 1.0),
+            (0.0, 100.0),
+        ] {
+            let v1 = reach_banded(v0, len, &b);
+            assert!(
+                change_banded(v0, v1, &b).1 <= len * (1.0 + 1e-12),
+                "{v0} {len}: {v1}"
+            );
+            if v1 < 8.0 {
+                let more = v1 + 1e-6 * (v1 - v0).max(1e-3);
+                assert!(change_banded(v0, more, &b).1 > len, "{v0} {len}: {v1}");
+            }
         }
     }
 }

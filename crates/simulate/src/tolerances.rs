@@ -168,10 +168,11 @@ pub const LCNC_TIME_EPSILON: f64 = 1e-12;
 /// guard, not a limit).
 pub const LCNC_MAX_CYCLES_PER_SEGMENT: usize = 10_000_000;
 
-/// Share of each axis' A and J that a segment's speed may take with its curvature terms
+/// Shares of each axis' A and J that a segment's speed may take with its curvature terms
 /// (|q_ss|·V² ≤ σ·A, |q_sss|·V³ ≤ σ·J), leaving the rest for the path's acceleration and
-/// jerk (`segments.rs`).
-pub const SPEED_SHARE: f64 = 0.8;
+/// jerk (`segments.rs`): a high share cruises faster, a low one changes speed faster; the
+/// motion is planned with each and the fastest plan kept.
+pub const SPEED_SHARES: [f64; 2] = [0.8, 0.5];
 /// A grid cell joins the segment before it while the merged segment's V, A and J each
 /// stay at or above this share of the largest of its cells' own (`segments.rs`). The
 /// motion is planned once per share (few long segments with low limits, or many short
@@ -181,3 +182,13 @@ pub const MERGE_RATIOS: [f64; 4] = [0.8, 0.6, 0.4, 0.2];
 pub const SEGMENT_A_MAX_MM_S2: f64 = 1e9;
 /// Largest path jerk of a segment where no axis bounds it, mm/s³.
 pub const SEGMENT_J_MAX_MM_S3: f64 = 1e12;
+/// Speeds, as shares of a segment's V, at which its caps are taken again for the speed
+/// changes below them (ascending, the last 1: the caps fall with the speed, so a change
+/// at low speed may accelerate and jerk harder; `segments.rs`).
+pub const BAND_SHARES: [f64; 5] = [0.25, 0.5, 0.7, 0.85, 1.0];
+/// The search for the largest speed a change reaches within a length stops when its
+/// bracket is within this share of the speed.
+pub const REACH_REL: f64 = 1e-9;
+/// Newton steps that polish the closed-form root of a speed change's length
+/// (`segments.rs::reach`).
+pub const REACH_NEWTON_STEPS: usize = 3;
