@@ -245,6 +245,28 @@ pub fn simulate_nc_with(
     opts: &SimulateOptions,
     on_state: Option<&mut dyn FnMut(&SimState)>,
 ) -> Result<SimulateReport, Error> {
+    simulate_bytes(std::borrow::Cow::Borrowed(bytes), machine, opts, on_state)
+}
+
+/// [`simulate_nc_with`] taking the program's bytes: they are freed once read, before the
+/// last motion is simulated (a program of one long run is simulated without its file in
+/// memory).
+pub fn simulate_nc_owned(
+    bytes: Vec<u8>,
+    machine: &Machine,
+    opts: &SimulateOptions,
+    on_state: Option<&mut dyn FnMut(&SimState)>,
+) -> Result<SimulateReport, Error> {
+    simulate_bytes(std::borrow::Cow::Owned(bytes), machine, opts, on_state)
+}
+
+/// [`simulate_nc_with`] and [`simulate_nc_owned`]: owned bytes dropped once read.
+fn simulate_bytes(
+    bytes: std::borrow::Cow<'_, [u8]>,
+    machine: &Machine,
+    opts: &SimulateOptions,
+    on_state: Option<&mut dyn FnMut(&SimState)>,
+) -> Result<SimulateReport, Error> {
     let tcy_s = opts.sim.tcy_s.unwrap_or(machine.tcy_s);
     let mut sim = Simulating {
         machine,
@@ -269,7 +291,7 @@ pub fn simulate_nc_with(
         ..crate::options::AnalyzeOptions::default()
     };
     let read = crate::stream::each_run(
-        bytes,
+        &bytes,
         machine,
         &reading,
         |rr| run_input(rr, machine),
@@ -291,7 +313,35 @@ pub fn simulate_nc_with(
         }
         Err(e) => return Err(e),
     };
+    // Read: the last motion is simulated without the file (peak memory).
+    drop(bytes);
     sim.flush();
     sim.report.primary = primary.to_string();
     Ok(sim.report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The program's bytes handed over (freed once read) or lent give the same report and
+    /// the same states: on a program of several motions, and on one whose last motion is
+    /// simulated after the file is dropped.
+    #[test]
+    fn owned_bytes_simulate_as_borrowed_ones() {
+        let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let machine = Machine::builtin("mikron-ucp710").expect("built-in machine");
+        for file in ["fixtures/c17/SING.I", "fixtures/c17/NON_SING.I"] {
+            let bytes = std::fs::read(root.join(file)).expect("fixture");
+            let mut opts = SimulateOptions::default();
+            opts.sim.every_cycle = true;
+            let (mut lent, mut owned) = (Vec::new(), Vec::new());
+            let a = simulate_nc_with(&bytes, &machine, &opts, Some(&mut |s| lent.push(*s)));
+            let b = simulate_nc_owned(bytes, &machine, &opts, Some(&mut |s| owned.push(*s)));
+            let (a, b) = (a.expect("simulates"), b.expect("simulates"));
+            assert!(!a.runs.is_empty(), "{file}");
+            assert_eq!(a, b, "{file}");
+            assert!(!lent.is_empty() && lent == owned, "{file}");
+        }
+    }
 }
