@@ -4,7 +4,9 @@
 //! axis values over the tool-tip path length s (knots at the CL points). Everything in the
 //! patcher that evaluates it goes through here:
 //! - [`SplineSystem`] factors the not-a-knot system once per knot vector (a run, or a
-//!   window of it) and fits any number of axes on it ([`SplineSystem::fit`]);
+//!   window of it) and fits any number of axes on it ([`SplineSystem::fit`]; the splines
+//!   share one copy of their breaks), or several at once with its factors freed before
+//!   their pieces are made ([`SplineSystem::fit_axes`]: the least memory on a long run);
 //! - [`AnalysisSpline`] evaluates a fitted axis (piecewise-polynomial form), and hands out
 //!   one span at a time as a [`SpanCubic`];
 //! - [`SpanCubic::peaks`] is the exact largest `|q'|`, `|q''|`, `|q'''|` over a span, which
