@@ -5,13 +5,15 @@
 //! arithmetic at all. Converting a [`BSpline`] costs one `eval_derivs` per span.
 
 use crate::spline::{BSpline, horner};
+use std::sync::Arc;
 
 /// A spline of degree ≤ 3 as polynomial pieces: `coefs[j] = [a0, a1, a2, a3]` on
 /// `[breaks[j], breaks[j + 1])`, in powers of `t − breaks[j]`. Outside
-/// `[breaks[0], breaks[last]]` the end pieces are extended (as [`BSpline`] does).
+/// `[breaks[0], breaks[last]]` the end pieces are extended (as [`BSpline`] does). Splines
+/// on the same breaks may hold one copy of them ([`PpCubic::share_breaks`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PpCubic {
-    breaks: Vec<f64>,
+    breaks: Arc<[f64]>,
     coefs: Vec<[f64; 4]>,
 }
 
@@ -31,7 +33,10 @@ impl BSpline {
             }
         }
         breaks.push(k[n]);
-        PpCubic { breaks, coefs }
+        PpCubic {
+            breaks: breaks.into(),
+            coefs,
+        }
     }
 }
 
@@ -39,6 +44,23 @@ impl PpCubic {
     /// Break points (strictly increasing, `pieces + 1` of them).
     pub fn breaks(&self) -> &[f64] {
         &self.breaks
+    }
+
+    /// The break points, to share with splines on the same ones
+    /// ([`PpCubic::share_breaks`]).
+    pub fn shared_breaks(&self) -> Arc<[f64]> {
+        Arc::clone(&self.breaks)
+    }
+
+    /// Hold `breaks` instead of this spline's own copy when they are the same values (the
+    /// spline unchanged: the same numbers, one allocation for the splines of one knot
+    /// vector); whether they were.
+    pub fn share_breaks(&mut self, breaks: &Arc<[f64]>) -> bool {
+        let same = *self.breaks == **breaks;
+        if same {
+            self.breaks = Arc::clone(breaks);
+        }
+        same
     }
 
     /// Taylor coefficients of each piece about its left break.

@@ -8,7 +8,7 @@ use plotters::prelude::*;
 use polepatch::kinematics::{Axis, Machine};
 use polepatch::report::SimulateReport;
 use polepatch::report::axis_letter;
-use polepatch::simulate::{SimState, SimulateOptions, simulate_nc_with};
+use polepatch::simulate::{SimState, SimulateOptions, simulate_nc_owned};
 use polepatch_cli::files::read;
 use polepatch_cli::outputs::{Input, Output, plan};
 use std::io::Write;
@@ -225,7 +225,7 @@ pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
                         failure = Some(e);
                     }
                 };
-                let r = simulate_nc_with(&bytes, &machine, &opts, Some(&mut on))
+                let r = simulate_nc_owned(bytes, &machine, &opts, Some(&mut on))
                     .map_err(std::io::Error::other)?;
                 if let Some(e) = failure {
                     return Err(e);
@@ -251,9 +251,9 @@ pub(crate) fn run(args: SimulateArgs) -> Result<ExitCode> {
             report
         } else if want_plot {
             let mut on = |s: &SimState| binned.add(s);
-            simulate_nc_with(&bytes, &machine, &opts, Some(&mut on))?
+            simulate_nc_owned(bytes, &machine, &opts, Some(&mut on))?
         } else {
-            simulate_nc_with(&bytes, &machine, &opts, None)?
+            simulate_nc_owned(bytes, &machine, &opts, None)?
         };
         reports.push(report);
         plots.push(binned);

@@ -10,6 +10,7 @@
 
 use crate::builder::ProgramBuilder;
 use crate::error::ParseError;
+use crate::modal::Modal;
 use crate::reader::{Resume, Scanned, scan_resumed};
 use crate::run::{Run, RunBuilder};
 use crate::tcpm::ReadOptions;
@@ -66,6 +67,66 @@ pub fn read_stretch(
     spec: &StretchSpec,
     wanted: impl Fn(usize) -> bool,
 ) -> Result<Stretch, ParseError> {
+    let mut program: Option<ProgramBuilder> = None;
+    let walked = walk(bytes, opts, spec, wanted, |s, prev| {
+        let base = if spec.whole { 0 } else { s.block.span().start };
+        program
+            .get_or_insert_with(|| ProgramBuilder::new(base, prev))
+            .push(s);
+    })?;
+    Ok(Stretch {
+        program: program.unwrap_or_else(|| ProgramBuilder::new(0, &walked.after)),
+        runs: walked.runs,
+        end_byte: walked.end_byte,
+    })
+}
+
+/// A stretch's runs as read ([`read_stretch_runs`]): without its program.
+#[derive(Debug)]
+pub struct StretchRuns {
+    /// The file line (1-based) of each block of the stretch, from its first block.
+    pub lines: Vec<usize>,
+    /// The runs, as [`Stretch::runs`].
+    pub runs: Vec<Run>,
+    /// The byte just past the stretch's last line, as [`Stretch::end_byte`].
+    pub end_byte: usize,
+}
+
+/// [`read_stretch`] for a reader that needs the runs and where their blocks are, not the
+/// blocks: the runs and the line of each block, no words, blocks or modal states kept
+/// (`polepatch simulate`: a run of n points costs its run, not its program).
+pub fn read_stretch_runs(
+    bytes: &[u8],
+    opts: &ReadOptions,
+    spec: &StretchSpec,
+    wanted: impl Fn(usize) -> bool,
+) -> Result<StretchRuns, ParseError> {
+    let mut lines = Vec::new();
+    let walked = walk(bytes, opts, spec, wanted, |s, _| lines.push(s.block.line))?;
+    Ok(StretchRuns {
+        lines,
+        runs: walked.runs,
+        end_byte: walked.end_byte,
+    })
+}
+
+/// What [`walk`] found besides the blocks it handed out.
+struct Walked {
+    runs: Vec<Run>,
+    end_byte: usize,
+    /// The modal state after the last block read.
+    after: Modal,
+}
+
+/// The walk of [`read_stretch`]: each block of the stretch to `keep` with the modal state
+/// before it, the wanted runs collected.
+fn walk(
+    bytes: &[u8],
+    opts: &ReadOptions,
+    spec: &StretchSpec,
+    wanted: impl Fn(usize) -> bool,
+    mut keep: impl FnMut(&Scanned<'_>, &Modal),
+) -> Result<Walked, ParseError> {
     let (from, mut i) = match &spec.from {
         ReadFrom::RunStart(at) => (Resume::clone(at), spec.first_block),
         ReadFrom::FileStart => (Resume::file_start(opts), 0),
@@ -75,16 +136,12 @@ pub fn read_stretch(
         ReadFrom::RunStart(_) => None,
         ReadFrom::FileStart => Some(RunBuilder::of_kind(spec.passes)),
     };
-    let mut program: Option<ProgramBuilder> = None;
     let mut runs = Vec::new();
     let mut end_byte = bytes.len();
     let mut prev = *from.state();
     scan_resumed(bytes, opts, &from, |s: Scanned<'_>| {
         if i >= spec.first_block {
-            let base = if spec.whole { 0 } else { s.block.span().start };
-            program
-                .get_or_insert_with(|| ProgramBuilder::new(base, &prev))
-                .push(&s);
+            keep(&s, &prev);
         }
         match &mut builder {
             Some(b) => b.push(i, s.block, s.state, &mut |run| {
@@ -111,10 +168,10 @@ pub fn read_stretch(
             }
         });
     }
-    Ok(Stretch {
-        program: program.unwrap_or_else(|| ProgramBuilder::new(0, &prev)),
+    Ok(Walked {
         runs,
         end_byte,
+        after: prev,
     })
 }
 
@@ -151,12 +208,14 @@ mod tests {
     }
 
     #[test]
-    fn a_run_read_again_from_its_place_is_the_run_the_whole_walk_found() {
+    fn a_run_read_again_from_its_place_is_the_run_the_whole_walk_found_with_or_without_its_program()
+    {
         // Runs that share a block (a change of F ends a run of the default walk), a run
         // that starts at a rapid, one after a zero-length move, one whose first rotary word
         // comes with its first move, and the file's last run.
         let text = "G90 G94\nG0 X0 Y0 Z5 A0 C0\nG1 Z0 F500\nX1 A1 C2\nX2 A2 C4 F800\nX3 A3 C6\n\
                     G0 Z20\nX10 Y10\nG1 Z0 F300\nZ0\nX11 B5\nX12 B6\nM5\nG1 X13 F400\nX14 A4\n";
+        let whole = crate::parse(text.as_bytes().to_vec(), Dialect::Fanuc).unwrap();
         for passes in [false, true] {
             let (runs, places) = walked(text, passes);
             assert!(runs.len() >= 3, "{runs:?}");
@@ -182,6 +241,15 @@ mod tests {
                 again.ended_by = run.ended_by;
                 assert_eq!(&again, run, "passes {passes}, run at block {first}");
                 assert_eq!(got.program.len(), last - first + 1);
+                let light =
+                    read_stretch_runs(text.as_bytes(), &opts, &spec, |f| f == first).unwrap();
+                assert_eq!(
+                    light.runs, got.runs,
+                    "passes {passes}, run at block {first}"
+                );
+                assert_eq!(light.end_byte, got.end_byte);
+                let lines: Vec<usize> = whole.blocks[first..=last].iter().map(|b| b.line).collect();
+                assert_eq!(light.lines, lines);
             }
         }
     }

@@ -230,13 +230,7 @@ pub fn validate(path: &Path) -> Result<(), PathError> {
 
 /// The analysis splines of the five axes ([`crate::spline`]), on one factored system.
 pub fn axis_splines(path: &Path) -> Result<Vec<AnalysisSpline>, PathError> {
-    let sys = SplineSystem::new(&path.s_mm)?;
-    (0..5)
-        .map(|k| {
-            let y: Vec<f64> = path.axes.iter().map(|q| q[k]).collect();
-            sys.fit(&y)
-        })
-        .collect()
+    SplineSystem::new(&path.s_mm)?.fit_axes(5, |k| path.axes.iter().map(|q| q[k]).collect())
 }
 
 /// Analyse a run (module docs): the not-a-knot spline of each axis over s, Equation 6

@@ -4,7 +4,9 @@
 //! axis values over the tool-tip path length s (knots at the CL points). Everything in the
 //! patcher that evaluates it goes through here:
 //! - [`SplineSystem`] factors the not-a-knot system once per knot vector (a run, or a
-//!   window of it) and fits any number of axes on it ([`SplineSystem::fit`]);
+//!   window of it) and fits any number of axes on it ([`SplineSystem::fit`]; the splines
+//!   share one copy of their breaks), or several at once with its factors freed before
+//!   their pieces are made ([`SplineSystem::fit_axes`]: the least memory on a long run);
 //! - [`AnalysisSpline`] evaluates a fitted axis (piecewise-polynomial form), and hands out
 //!   one span at a time as a [`SpanCubic`];
 //! - [`SpanCubic::peaks`] is the exact largest `|q'|`, `|q''|`, `|q'''|` over a span, which
@@ -139,17 +141,23 @@ impl SpanCubic {
     }
 }
 
-/// The not-a-knot system of one knot vector, factored once.
+/// The not-a-knot system of one knot vector, factored once. The splines it fits hold one
+/// copy of their break points between them (the first fit's): five axes of a long run
+/// hold 8 bytes a point of breaks, not 40.
 #[derive(Debug, Clone)]
 pub struct SplineSystem {
     sys: NotAKnotSystem,
+    breaks: std::sync::OnceLock<std::sync::Arc<[f64]>>,
 }
 
 impl SplineSystem {
     /// Factor the system of the knots `s_mm` (≥ 2, finite, strictly increasing).
     pub fn new(s_mm: &[f64]) -> Result<SplineSystem, PathError> {
         NotAKnotSystem::new(s_mm)
-            .map(|sys| SplineSystem { sys })
+            .map(|sys| SplineSystem {
+                sys,
+                breaks: std::sync::OnceLock::new(),
+            })
             .map_err(|e| PathError::Spline(e.to_string()))
     }
 
@@ -169,10 +177,40 @@ impl SplineSystem {
 
     /// The analysis spline of the values `y` (one per knot, finite).
     pub fn fit(&self, y: &[f64]) -> Result<AnalysisSpline, PathError> {
-        self.sys
+        let mut pp = self
+            .sys
             .solve(y)
-            .map(|b| AnalysisSpline { pp: b.to_pp() })
-            .map_err(|e| PathError::Spline(e.to_string()))
+            .map_err(|e| PathError::Spline(e.to_string()))?
+            .to_pp();
+        pp.share_breaks(self.breaks.get_or_init(|| pp.shared_breaks()));
+        Ok(AnalysisSpline { pp })
+    }
+
+    /// The analysis splines of `count` axes, `values(a)` the values of axis `a` (one per
+    /// knot, finite), the system consumed: every axis solved first, the system's factors
+    /// then freed, and only then each solution put in piecewise-polynomial form — the
+    /// same splines as [`SplineSystem::fit`] on each, with at most one of the factors and
+    /// the five splines' pieces held at a time (peak memory of a long run).
+    pub fn fit_axes(
+        self,
+        count: usize,
+        mut values: impl FnMut(usize) -> Vec<f64>,
+    ) -> Result<Vec<AnalysisSpline>, PathError> {
+        let solved = (0..count)
+            .map(|a| self.sys.solve(&values(a)))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| PathError::Spline(e.to_string()))?;
+        drop(self.sys);
+        let mut breaks = self.breaks.into_inner();
+        Ok(solved
+            .into_iter()
+            .map(|b| {
+                let mut pp = b.to_pp();
+                drop(b);
+                pp.share_breaks(breaks.get_or_insert_with(|| pp.shared_breaks()));
+                AnalysisSpline { pp }
+            })
+            .collect())
     }
 }
 
@@ -417,6 +455,53 @@ mod tests {
         assert!(q3 <= g[2] + 1e-9);
         // Uniform spacing h: the third-derivative gain scales as 1/h³.
         assert!(g[2] > 10.0 / 0.125 && g[2] < 100.0 / 0.125, "{g:?}");
+    }
+
+    /// The splines one system fits hold one copy of the break points between them, and
+    /// evaluate as splines with their own copy do, bit for bit.
+    #[test]
+    fn splines_of_one_system_share_one_copy_of_their_breaks() {
+        let s: Vec<f64> = (0..40)
+            .map(|i| i as f64 * 0.3 + (i % 3) as f64 * 0.05)
+            .collect();
+        let sys = SplineSystem::new(&s).unwrap();
+        let ys: Vec<Vec<f64>> = (0..5)
+            .map(|a| s.iter().map(|t| (t * (a + 1) as f64).sin()).collect())
+            .collect();
+        let fitted: Vec<AnalysisSpline> = ys.iter().map(|y| sys.fit(y).unwrap()).collect();
+        let first = fitted[0].pp.shared_breaks();
+        for (a, y) in fitted.iter().zip(&ys) {
+            assert!(std::sync::Arc::ptr_eq(&a.pp.shared_breaks(), &first));
+            let alone = AnalysisSpline::new(&s, y).unwrap();
+            assert_eq!(a.pp, alone.pp);
+            for k in 0..400 {
+                let t = k as f64 * 0.03 - 0.1;
+                assert_eq!(a.eval_derivs(t), alone.eval_derivs(t));
+            }
+        }
+    }
+
+    /// The axes fitted together by a consumed system are the splines of each fitted
+    /// alone, sharing one copy of their breaks.
+    #[test]
+    fn axes_fitted_together_are_the_axes_fitted_one_by_one() {
+        let s: Vec<f64> = (0..50)
+            .map(|i| i as f64 * 0.2 + (i % 4) as f64 * 0.03)
+            .collect();
+        let y = |a: usize| -> Vec<f64> { s.iter().map(|t| (t * (a + 2) as f64).cos()).collect() };
+        let one = SplineSystem::new(&s).unwrap();
+        let alone: Vec<AnalysisSpline> = (0..5).map(|a| one.fit(&y(a)).unwrap()).collect();
+        let together = SplineSystem::new(&s).unwrap().fit_axes(5, y).unwrap();
+        assert_eq!(together.len(), 5);
+        for (a, b) in together.iter().zip(&alone) {
+            assert_eq!(a.pp, b.pp);
+            assert!(std::sync::Arc::ptr_eq(
+                &a.pp.shared_breaks(),
+                &together[0].pp.shared_breaks()
+            ));
+        }
+        let bad = SplineSystem::new(&s).unwrap().fit_axes(2, |_| vec![1.0; 3]);
+        assert!(matches!(bad, Err(PathError::Spline(_))));
     }
 
     /// Fitting several axes on one factored system equals fitting each alone.

@@ -69,5 +69,5 @@ pub use report::{
     AnalyzeReport, Branch, EndFreedom, FileReport, Outcome, SimulateReport, UntouchedReason,
     UntouchedRun, ZoneReason, ZoneRow, ZoneTool,
 };
-pub use simulate::{simulate_nc, simulate_nc_with};
+pub use simulate::{simulate_nc, simulate_nc_owned, simulate_nc_with};
 pub use stream::{Piece, analyze_nc_each, load_nc, load_nc_with};

@@ -13,7 +13,6 @@
 
 use crate::error::Error;
 pub use crate::options::SimulateOptions;
-use crate::program::LoadedProgram;
 use crate::report::{SimFrame, SimRun, SimTotals, SimulateReport};
 use polepatch_kinematics::Machine;
 use polepatch_nc::RunBreak;
@@ -54,59 +53,69 @@ struct RunIn {
     feed_change_after: bool,
 }
 
-fn run_inputs(lp: &LoadedProgram, machine: &Machine) -> Vec<RunIn> {
-    lp.runs
-        .iter()
-        .enumerate()
-        .map(|(r, rp)| {
-            let n = rp.run.len();
-            let mut row = SimRun {
-                run: lp.run_number(r),
-                lines: lp.lines_of_run(r),
-                points: n,
-                length_mm: rp.run.length_mm(),
-                feed_mm_min: lp.run_feed_mm_min(r),
-                error: None,
-                time_s: 0.0,
-                eq6_time_s: 0.0,
-                ideal_time_s: 0.0,
-                min_feed_mm_min: None,
-                min_feed_line: None,
-                joined: false,
-                frame: SimFrame::Program,
-            };
-            let path = match &rp.path {
-                Err(problem) => {
-                    row.error = Some(problem.to_string());
-                    None
-                }
-                Ok(path) => {
-                    let frame = machine.chain.as_ref().and_then(|chain| {
-                        let datum = lp.datum_mm(r)?;
-                        Some(crate::machine_frame::machine_frame_path(
-                            chain,
-                            machine,
-                            datum,
-                            rp.run.tcpm.is_on(),
-                            &path.axes,
-                            &path.s_mm,
-                            path.feed_mm_min,
-                        ))
-                    });
-                    if frame.is_some() {
-                        row.frame = SimFrame::Machine;
-                    }
-                    Some(frame.unwrap_or_else(|| path.clone()))
-                }
-            };
-            RunIn {
-                row,
-                point_lines: (0..n).map(|k| lp.line_of(r, k)).collect(),
-                path,
-                feed_change_after: rp.run.ended_by == RunBreak::FeedChange,
+/// What the simulation keeps of a run read ([`crate::stream::each_run`]): the run itself
+/// is dropped before its path is turned into the machine's frame (peak memory).
+fn run_input(rr: crate::stream::RunRead, machine: &Machine) -> RunIn {
+    let crate::stream::RunRead {
+        number,
+        run,
+        path,
+        point_lines,
+        datum_mm,
+    } = rr;
+    let n = run.len();
+    let mut row = SimRun {
+        run: number,
+        lines: [point_lines[0], point_lines[n - 1]],
+        points: n,
+        length_mm: run.length_mm(),
+        feed_mm_min: path
+            .as_ref()
+            .ok()
+            .map(|p| p.feed_mm_min)
+            .or(run.feed_mm_min),
+        error: None,
+        time_s: 0.0,
+        eq6_time_s: 0.0,
+        ideal_time_s: 0.0,
+        min_feed_mm_min: None,
+        min_feed_line: None,
+        joined: false,
+        frame: SimFrame::Program,
+    };
+    let tcpm_on = run.tcpm.is_on();
+    let feed_change_after = run.ended_by == RunBreak::FeedChange;
+    drop(run);
+    let path = match path {
+        Err(problem) => {
+            row.error = Some(problem.to_string());
+            None
+        }
+        Ok(path) => {
+            let frame = machine.chain.as_ref().and_then(|chain| {
+                let datum = datum_mm?;
+                Some(crate::machine_frame::machine_frame_path(
+                    chain,
+                    machine,
+                    datum,
+                    tcpm_on,
+                    &path.axes,
+                    &path.s_mm,
+                    path.feed_mm_min,
+                ))
+            });
+            if frame.is_some() {
+                row.frame = SimFrame::Machine;
             }
-        })
-        .collect()
+            Some(frame.unwrap_or(path))
+        }
+    };
+    RunIn {
+        row,
+        point_lines,
+        path,
+        feed_change_after,
+    }
 }
 
 /// The simulation in progress: the motion being gathered and the report.
@@ -236,6 +245,28 @@ pub fn simulate_nc_with(
     opts: &SimulateOptions,
     on_state: Option<&mut dyn FnMut(&SimState)>,
 ) -> Result<SimulateReport, Error> {
+    simulate_bytes(std::borrow::Cow::Borrowed(bytes), machine, opts, on_state)
+}
+
+/// [`simulate_nc_with`] taking the program's bytes: they are freed once read, before the
+/// last motion is simulated (a program of one long run is simulated without its file in
+/// memory).
+pub fn simulate_nc_owned(
+    bytes: Vec<u8>,
+    machine: &Machine,
+    opts: &SimulateOptions,
+    on_state: Option<&mut dyn FnMut(&SimState)>,
+) -> Result<SimulateReport, Error> {
+    simulate_bytes(std::borrow::Cow::Owned(bytes), machine, opts, on_state)
+}
+
+/// [`simulate_nc_with`] and [`simulate_nc_owned`]: owned bytes dropped once read.
+fn simulate_bytes(
+    bytes: std::borrow::Cow<'_, [u8]>,
+    machine: &Machine,
+    opts: &SimulateOptions,
+    on_state: Option<&mut dyn FnMut(&SimState)>,
+) -> Result<SimulateReport, Error> {
     let tcy_s = opts.sim.tcy_s.unwrap_or(machine.tcy_s);
     let mut sim = Simulating {
         machine,
@@ -260,10 +291,10 @@ pub fn simulate_nc_with(
         ..crate::options::AnalyzeOptions::default()
     };
     let read = crate::stream::each_run(
-        bytes,
+        &bytes,
         machine,
         &reading,
-        |lp| run_inputs(lp, machine),
+        |rr| run_input(rr, machine),
         |runs| {
             for r in runs {
                 sim.take(r);
@@ -282,7 +313,35 @@ pub fn simulate_nc_with(
         }
         Err(e) => return Err(e),
     };
+    // Read: the last motion is simulated without the file (peak memory).
+    drop(bytes);
     sim.flush();
     sim.report.primary = primary.to_string();
     Ok(sim.report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The program's bytes handed over (freed once read) or lent give the same report and
+    /// the same states: on a program of several motions, and on one whose last motion is
+    /// simulated after the file is dropped.
+    #[test]
+    fn owned_bytes_simulate_as_borrowed_ones() {
+        let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let machine = Machine::builtin("mikron-ucp710").expect("built-in machine");
+        for file in ["fixtures/c17/SING.I", "fixtures/c17/NON_SING.I"] {
+            let bytes = std::fs::read(root.join(file)).expect("fixture");
+            let mut opts = SimulateOptions::default();
+            opts.sim.every_cycle = true;
+            let (mut lent, mut owned) = (Vec::new(), Vec::new());
+            let a = simulate_nc_with(&bytes, &machine, &opts, Some(&mut |s| lent.push(*s)));
+            let b = simulate_nc_owned(bytes, &machine, &opts, Some(&mut |s| owned.push(*s)));
+            let (a, b) = (a.expect("simulates"), b.expect("simulates"));
+            assert!(!a.runs.is_empty(), "{file}");
+            assert_eq!(a, b, "{file}");
+            assert!(!lent.is_empty() && lent == owned, "{file}");
+        }
+    }
 }

@@ -51,11 +51,15 @@
 //!
 //! [`analyze_nc_each`] reads the same way with every run a stretch, and hands each run's
 //! report out as it is made (a program of many runs has a report larger than itself).
+//! [`each_run`] (`crate::simulate`) reads the same stretches for their runs alone
+//! ([`polepatch_nc::stretch::read_stretch_runs`]: the runs and the line of each block, no
+//! program), and hands each run out with its path and the lines of its points.
 //!
 //! Memory: the input, the output writer's buffer, one record per run (first and last
 //! block, flags: ~64 B), and the batch of stretches in hand. A single run is parsed whole,
-//! so one giant run costs ~10× its own bytes; runs that share a block are not joined, so a
-//! program of many runs is bounded by its longest run.
+//! so one giant run costs ~10× its own bytes (its run alone, ~112 B a point, for
+//! [`each_run`]); runs that share a block are not joined, so a program of many runs is
+//! bounded by its longest run.
 
 use crate::end_pose::{After, EndPose, Scan, Step};
 use crate::error::Error;
@@ -1362,15 +1366,31 @@ fn analyze_each(
     )
 }
 
-/// Every run of the program as a loaded program of its own (every run a stretch, as
-/// [`analyze_nc_each`] reads), in file order: `work` on all cores, `sink` in file order.
-/// Returns the tilting letter in use. For readers of every run (`crate::simulate`).
+/// A run as [`each_run`] hands it out: the run, its path and the lines of its points,
+/// without the program around it.
+pub(crate) struct RunRead {
+    /// Number of the run in the file, from 1 (as reports give it).
+    pub number: usize,
+    /// The run as the NC crate found it, ended as in the file.
+    pub run: Run,
+    /// The path (axes X Y Z P C), or why there is none.
+    pub path: Result<polepatch_patcher::Path, crate::program::RunProblem>,
+    /// The file line (1-based) of each point.
+    pub point_lines: Vec<usize>,
+    /// The work offset for the run ([`LoadedProgram::datum_mm`]).
+    pub datum_mm: Option<[f64; 3]>,
+}
+
+/// Every run of the program, as the analysis reads it (every run a stretch), handed to
+/// `work` (on all cores) and the results of each stretch to `sink` in file order; the
+/// tilting letter in use. A stretch is read for its runs only
+/// ([`polepatch_nc::stretch::read_stretch_runs`]): a run costs its points, not its program.
 pub(crate) fn each_run<T: Send>(
     bytes: &[u8],
     machine: &Machine,
     opts: &crate::options::AnalyzeOptions,
-    work: impl Fn(&LoadedProgram) -> T + Sync,
-    mut sink: impl FnMut(T) -> std::io::Result<()>,
+    work: impl Fn(RunRead) -> T + Sync,
+    mut sink: impl FnMut(Vec<T>) -> std::io::Result<()>,
 ) -> Result<char, Error> {
     // The simulator takes a motion apart at every feed change and joins the runs itself.
     let rd = Reading {
@@ -1382,8 +1402,51 @@ pub(crate) fn each_run<T: Send>(
         Begun::Stretches { sv, l, .. } => (sv, l),
     };
     let todo = stretches(&sv.runs, l, |_| true);
-    each_stretch(bytes, &sv, &todo, l, &rd, |lp| work(&lp), |t, _| sink(t))?;
-    Ok(readings(rd.letters)[l].tilt as char)
+    let letters = readings(rd.letters)[l];
+    in_batches(
+        bytes,
+        &sv,
+        &todo,
+        |st| {
+            let recs = &sv.runs[st.runs.clone()];
+            let read = polepatch_nc::stretch::read_stretch_runs(
+                bytes,
+                &sv.read,
+                &stretch_spec(resume_place(recs, st), st, rd.passes),
+                |first| recs.iter().any(|r| r.first_block == first),
+            )
+            .map_err(|e| Error::Parse(e.with_path(rd.name)))?;
+            check_runs(&read.runs, recs, st);
+            let line = |b: usize| read.lines[b - st.first_block];
+            let out = read
+                .runs
+                .into_iter()
+                .zip(recs)
+                .enumerate()
+                .map(|(k, (mut run, rec))| {
+                    run.ended_by = rec.ended_by;
+                    let point_lines: Vec<usize> = run.blocks.iter().map(|&b| line(b)).collect();
+                    let mut rp = run_path(run, letters, rd.fallback, point_lines[0]);
+                    // A G93 block too slow to analyse is named at its own line.
+                    if let Err(crate::program::RunProblem::FeedTooLow { line, point, .. }) =
+                        &mut rp.path
+                    {
+                        *line = point_lines[*point];
+                    }
+                    work(RunRead {
+                        number: st.runs.start + k + 1,
+                        run: rp.run,
+                        path: rp.path,
+                        point_lines,
+                        datum_mm: rec.datum_mm,
+                    })
+                })
+                .collect();
+            Ok((out, 0..0))
+        },
+        |t, _| sink(t),
+    )?;
+    Ok(letters.tilt as char)
 }
 
 /// Read `bytes` (named `name` in messages) as one stretch of the one reader
@@ -1472,6 +1535,29 @@ fn each_stretch<T: Send>(
     l: usize,
     rd: &Reading<'_>,
     work: impl Fn(LoadedProgram) -> T + Sync,
+    sink: impl FnMut(T, std::ops::Range<usize>) -> std::io::Result<()>,
+) -> Result<(), Error> {
+    in_batches(
+        bytes,
+        sv,
+        todo,
+        |st| {
+            let hand = read_stretch(bytes, sv, st, rd)?;
+            let replaced = hand.program.base()..hand.end_byte.unwrap_or(bytes.len());
+            Ok((work(loaded(bytes, hand, sv, l, rd)), replaced))
+        },
+        sink,
+    )
+}
+
+/// The stretches of `todo` made into results by `make` (each with the bytes of the file it
+/// covers), in batches of about [`BATCH_FRACTION`] of the file on all cores, and handed to
+/// `sink` in file order.
+fn in_batches<T: Send>(
+    bytes: &[u8],
+    sv: &Survey,
+    todo: &[Stretch],
+    make: impl Fn(&Stretch) -> Result<(T, std::ops::Range<usize>), Error> + Sync,
     mut sink: impl FnMut(T, std::ops::Range<usize>) -> std::io::Result<()>,
 ) -> Result<(), Error> {
     use rayon::prelude::*;
@@ -1494,14 +1580,8 @@ fn each_stretch<T: Send>(
             size += next.saturating_sub(near_byte[e]);
             e += 1;
         }
-        let parts: Vec<Result<(T, std::ops::Range<usize>), Error>> = todo[k..e]
-            .par_iter()
-            .map(|st| {
-                let hand = read_stretch(bytes, sv, st, rd)?;
-                let replaced = hand.program.base()..hand.end_byte.unwrap_or(bytes.len());
-                Ok((work(loaded(bytes, hand, sv, l, rd)), replaced))
-            })
-            .collect();
+        let parts: Vec<Result<(T, std::ops::Range<usize>), Error>> =
+            todo[k..e].par_iter().map(&make).collect();
         for part in parts {
             let (t, replaced) = part?;
             sink(t, replaced).map_err(Error::Output)?;
@@ -1521,33 +1601,14 @@ fn read_stretch(
     st: &Stretch,
     rd: &Reading<'_>,
 ) -> Result<InHand, Error> {
-    use polepatch_nc::stretch::{ReadFrom, StretchSpec, read_stretch};
     let recs = &sv.runs[st.runs.clone()];
-    let resumed = (!st.whole)
-        .then(|| recs.first()?.kept.as_ref()?.start.clone())
-        .flatten();
-    let spec = StretchSpec {
-        from: resumed.map_or(ReadFrom::FileStart, |at| ReadFrom::RunStart(Box::new(at))),
-        first_block: st.first_block,
-        last_block: st.last_block,
-        whole: st.whole,
-        passes: rd.passes,
-    };
-    let read = read_stretch(bytes, &sv.read, &spec, |first| {
+    let spec = stretch_spec(resume_place(recs, st), st, rd.passes);
+    let read = polepatch_nc::stretch::read_stretch(bytes, &sv.read, &spec, |first| {
         recs.iter().any(|r| r.first_block == first)
     })
     .map_err(|e| Error::Parse(e.with_path(rd.name)))?;
-    // The runs as the survey found them: the same blocks (a stretch's end is its run's end
-    // or later), what ended each in the file, the tool the survey tracked.
-    assert!(
-        read.runs.len() == recs.len()
-            && read.runs.iter().zip(recs).all(|(run, rec)| {
-                run.blocks.first() == Some(&rec.first_block)
-                    && run.blocks.last() == Some(&rec.last_block)
-            }),
-        "the second read found other runs than the survey in the stretch at block {}",
-        st.first_block
-    );
+    check_runs(&read.runs, recs, st);
+    // What ended each run in the file, the tool the survey tracked.
     let runs = read
         .runs
         .into_iter()
@@ -1568,6 +1629,47 @@ fn read_stretch(
         end_byte: Some(read.end_byte),
         runs,
     })
+}
+
+/// Where the second read of stretch `st` (of runs `recs`) resumes: the place the survey
+/// kept before its first run, or none (the whole file, or none kept: from the start).
+fn resume_place(recs: &[RunRec], st: &Stretch) -> Option<Resume> {
+    (!st.whole)
+        .then(|| recs.first()?.kept.as_ref()?.start.clone())
+        .flatten()
+}
+
+/// The second read of stretch `st`, from `resumed` ([`resume_place`]).
+fn stretch_spec(
+    resumed: Option<Resume>,
+    st: &Stretch,
+    passes: bool,
+) -> polepatch_nc::stretch::StretchSpec {
+    use polepatch_nc::stretch::{ReadFrom, StretchSpec};
+    StretchSpec {
+        from: resumed.map_or(ReadFrom::FileStart, |at| ReadFrom::RunStart(Box::new(at))),
+        first_block: st.first_block,
+        last_block: st.last_block,
+        whole: st.whole,
+        passes,
+    }
+}
+
+/// The runs of the second read are those the survey found: the same blocks (a stretch's
+/// end is its run's end or later).
+///
+/// # Panics
+/// If they are not (a defect of the reader, not of the program).
+fn check_runs(runs: &[Run], recs: &[RunRec], st: &Stretch) {
+    assert!(
+        runs.len() == recs.len()
+            && runs.iter().zip(recs).all(|(run, rec)| {
+                run.blocks.first() == Some(&rec.first_block)
+                    && run.blocks.last() == Some(&rec.last_block)
+            }),
+        "the second read found other runs than the survey in the stretch at block {}",
+        st.first_block
+    );
 }
 
 /// A stretch as a loaded program: its blocks, its runs (block indices re-based) with their

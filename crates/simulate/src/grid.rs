@@ -30,7 +30,6 @@ impl Geometry {
             return Err(SimError::Empty);
         }
         let mut knots = Vec::new();
-        let mut values: Vec<[f64; 5]> = Vec::new();
         let mut part_end = Vec::new();
         let mut feed_mm_s = Vec::new();
         for (k, p) in parts.iter().enumerate() {
@@ -38,7 +37,7 @@ impl Geometry {
             let skip = if k == 0 {
                 0
             } else {
-                let end = *values.last().expect("a part has points");
+                let end = *parts[k - 1].axes.last().expect("a part has points");
                 if p.axes[0] != end {
                     return Err(SimError::NotJoined {
                         part: k,
@@ -51,7 +50,6 @@ impl Geometry {
             };
             let base = knots.last().copied().unwrap_or(0.0) - p.s_mm[0];
             knots.extend(p.s_mm[skip..].iter().map(|s| s + base));
-            values.extend_from_slice(&p.axes[skip..]);
             part_end.push(knots.len() - 1);
             feed_mm_s.push(p.feed_mm_min / 60.0);
         }
@@ -66,13 +64,18 @@ impl Geometry {
                 },
             });
         }
-        let sys = SplineSystem::new(&knots).map_err(|source| SimError::Path { part: 0, source })?;
-        let splines = (0..5)
-            .map(|a| {
-                let y: Vec<f64> = values.iter().map(|q| q[a]).collect();
-                sys.fit(&y)
+        // Each axis' values gathered from the parts as it is solved (no copy of every
+        // point's five values held through the fits: peak memory).
+        let splines = SplineSystem::new(&knots)
+            .and_then(|sys| {
+                sys.fit_axes(5, |a| {
+                    let mut y = Vec::with_capacity(knots.len());
+                    for (k, p) in parts.iter().enumerate() {
+                        y.extend(p.axes[usize::from(k > 0)..].iter().map(|q| q[a]));
+                    }
+                    y
+                })
             })
-            .collect::<Result<Vec<_>, _>>()
             .map_err(|source| SimError::Path { part: 0, source })?;
         Ok(Geometry {
             knots,

@@ -2,17 +2,18 @@
 //! peak, per point of the motion, as the process's most resident memory (`VmHWM`, Linux)
 //! above what was resident before (the path).
 //!
-//! What it holds is the motion's spline, the grid of its velocity limit, the passes'
-//! ceilings and the backward profile — then, once those are freed, Equation 6's analysis
-//! of each part (its own spline and solver). Until 2026-11-29 the analysis ran while the
-//! passes' arrays were still held, and the backward profile was a reversed copy of the
-//! backward pass's record: 806 bytes a point at the peak on this path. Since, with the
-//! analysis after the passes, the limit curve the forward pass consults beside its
-//! profile computed where it is asked for (`pass::Limit`) and the record kept in blocks:
-//! 480 (docs/journal/simulate-memory.md). The bound below sits between, so that holding
-//! the analysis on top of the passes again fails. It is a bound per point, not a bound by
-//! a window of the path: every array of the motion is still whole (the journal says what
-//! is left).
+//! What it holds is the motion's spline and the plan over it, then, once those are freed,
+//! Equation 6's analysis of each part (its own spline and solver). Until 2026-11-29 the
+//! analysis ran while the passes' arrays were still held: 806 bytes a point at the peak
+//! on this path; 480 with the analysis after the passes, the limit curve computed where
+//! asked (`pass::Limit`) and the record kept in blocks; 327 with the segments of constant
+//! limits as the default (`e2ed2b8`). Since, the five axes' splines hold one copy of their
+//! breaks, and are solved before any is put in piecewise-polynomial form, the system's
+//! factors freed between (`SplineSystem::fit_axes`), the axes' values gathered one axis
+//! at a time: 223 (docs/journal/simulate-memory.md). The bound below sits above, so that
+//! a copy of every point's values or the factors held with the five splines again
+//! fails. It is a bound per point, not a bound by a window of the path: every array of
+//! the motion is still whole (the journal says what is left).
 
 #![cfg(target_os = "linux")]
 
@@ -36,8 +37,8 @@ fn status_kib(field: &str) -> usize {
 /// Points of the motion.
 const POINTS: usize = 100_000;
 /// Largest resident memory the simulation may add at its peak, bytes per point of the
-/// motion (module docs: 806 before, 480 now).
-const PEAK_BYTES_PER_POINT: usize = 560;
+/// motion (module docs: 327 at `e2ed2b8`, 223 now).
+const PEAK_BYTES_PER_POINT: usize = 250;
 
 /// One G1 run as `examples/long_run.rs` writes it (a slow helix, radius 20 mm, points
 /// 0.1 mm apart, A 20° ± 5°, C 0.01° a point, F3000), as the path the reader makes of
