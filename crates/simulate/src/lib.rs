@@ -259,26 +259,73 @@ impl Sink for Store<'_> {
     }
 }
 
+/// Where a motion is among its parts, and what it found at the points it passed: each
+/// part's time and its lowest feed at one of its points (both models hand their points to
+/// it).
+pub(crate) struct Parts {
+    /// The part the motion is in (at a shared point: the earlier).
+    pub part: usize,
+    start_t: f64,
+    /// Each part's time, s, in order, for the parts ended so far.
+    pub times: Vec<f64>,
+    /// Each part's lowest feed at one of its points (its first and last excluded).
+    pub min: Vec<Option<MinFeed>>,
+}
+
+impl Parts {
+    pub(crate) fn new(n: usize) -> Parts {
+        Parts {
+            part: 0,
+            start_t: 0.0,
+            times: Vec::with_capacity(n),
+            min: vec![None; n],
+        }
+    }
+
+    /// Point `k` of `geo` passed at speed `v` (mm/s) at time `t` (s).
+    pub(crate) fn passed(&mut self, geo: &Geometry, k: usize, v: f64, t: f64) {
+        let p = self.part;
+        let first = if p == 0 { 0 } else { geo.part_end[p - 1] };
+        if k > first && k < geo.part_end[p] {
+            let better = self.min[p].is_none_or(|m| v < m.feed_mm_s);
+            if better {
+                self.min[p] = Some(MinFeed {
+                    feed_mm_s: v,
+                    point: k - first,
+                    s_mm: geo.knots[k] - geo.knots[first],
+                });
+            }
+        }
+        if k == geo.part_end[p] {
+            self.times.push(t - self.start_t);
+            self.start_t = t;
+            if p + 1 < geo.part_end.len() {
+                self.part += 1;
+            }
+        }
+    }
+
+    /// The parts not ended by the last point (a motion cut short), each its time from
+    /// the last end to `t`.
+    pub(crate) fn finish(&mut self, n: usize, t: f64) {
+        while self.times.len() < n {
+            self.times.push(t - self.start_t);
+            self.start_t = t;
+        }
+    }
+}
+
 /// Forward pass: the results and the caller's sink.
 struct Forward<'a> {
     geo: &'a Geometry,
     user: &'a mut dyn FnMut(&Step, &Geometry),
-    part: usize,
-    part_start_t: f64,
-    part_times: Vec<f64>,
+    parts: Parts,
     next_knot: usize,
-    min: Vec<Option<MinFeed>>,
     started: bool,
     /// Hand out every cycle: cut jumped cruises into their cycles.
     every_cycle: bool,
     /// Cycle time, s.
     dt: f64,
-}
-
-impl Forward<'_> {
-    fn part_start_knot(&self, p: usize) -> usize {
-        if p == 0 { 0 } else { self.geo.part_end[p - 1] }
-    }
 }
 
 impl Sink for Forward<'_> {
@@ -343,25 +390,7 @@ impl Forward<'_> {
             };
             let v = from.v + u * (to.v - from.v);
             let t = from.t + u * (to.t - from.t);
-            let p = self.part;
-            let first = self.part_start_knot(p);
-            if k > first && k < self.geo.part_end[p] {
-                let better = self.min[p].is_none_or(|m| v < m.feed_mm_s);
-                if better {
-                    self.min[p] = Some(MinFeed {
-                        feed_mm_s: v,
-                        point: k - first,
-                        s_mm: knots[k] - knots[first],
-                    });
-                }
-            }
-            if k == self.geo.part_end[p] {
-                self.part_times.push(t - self.part_start_t);
-                self.part_start_t = t;
-                if p + 1 < self.geo.part_end.len() {
-                    self.part += 1;
-                }
-            }
+            self.parts.passed(self.geo, k, v, t);
             self.next_knot += 1;
         }
         (self.user)(
@@ -371,7 +400,7 @@ impl Forward<'_> {
                 feed_mm_s: to.v,
                 accel_mm_s2: to.a,
                 jerk_mm_s3: j,
-                part: self.part,
+                part: self.parts.part,
                 cycle: cycle && (to.t - from.t) > 0.0,
             },
             self.geo,
@@ -511,11 +540,8 @@ fn passes(
     let mut out = Forward {
         geo: &geo,
         user: sink,
-        part: 0,
-        part_start_t: 0.0,
-        part_times: Vec::with_capacity(parts.len()),
+        parts: Parts::new(parts.len()),
         next_knot: 1,
-        min: vec![None; parts.len()],
         started: false,
         every_cycle: opts.every_cycle,
         dt: tcy_s,
@@ -523,13 +549,13 @@ fn passes(
     let stats = fwd
         .run(&mut out)
         .map_err(|s| SimError::Stalled { s_mm: s })?;
-    let mut part_times = out.part_times;
+    let mut part_times = out.parts.times;
     while part_times.len() < parts.len() {
         part_times.push(0.0);
     }
     Ok(Motion {
         part_times,
-        min: out.min,
+        min: out.parts.min,
         stats,
     })
 }

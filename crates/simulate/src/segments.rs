@@ -70,7 +70,7 @@ use crate::tolerances::{
     BAND_SHARES, LIMIT_USE, MERGE_RATIOS, REACH_NEWTON_STEPS, REACH_REL, SEGMENT_A_MAX_MM_S2,
     SEGMENT_J_MAX_MM_S3, SPEED_SHARES, TIME_BISECTIONS,
 };
-use crate::{MinFeed, Step};
+use crate::{MinFeed, Parts, Step};
 
 /// The largest |q_s|, |q_ss|, |q_sss| of each axis over a set of cells and its lowest
 /// programmed feed.
@@ -241,7 +241,7 @@ fn segmentations<T>(
     tcy_s: f64,
     max_cells: usize,
     plans: &[(usize, f64)],
-    close: &dyn Fn(&Open, f64) -> T,
+    close: &dyn Fn(&Open) -> T,
 ) -> Vec<Vec<T>> {
     let mut out: Vec<Vec<T>> = plans.iter().map(|_| Vec::new()).collect();
     let mut open: Vec<Option<Open>> = vec![None; plans.len()];
@@ -268,14 +268,14 @@ fn segmentations<T>(
                     o.s1_mm = c.s1_mm;
                     continue;
                 }
-                out[k].push(close(o, SPEED_SHARES[share]));
+                out[k].push(close(o));
             }
             open[k] = Some(Open::of(c, p, own));
         }
     });
     for (k, o) in open.iter().enumerate() {
         if let Some(o) = o {
-            out[k].push(close(o, SPEED_SHARES[plans[k].0]));
+            out[k].push(close(o));
         }
     }
     out
@@ -699,7 +699,7 @@ pub(crate) fn plan(
     // handed out (no slower: a change under the bands is no longer than under the top's).
     let plans = all_plans();
     let mut best: Option<(f64, usize)> = None;
-    let close = |o: &Open, _share: f64| o.close();
+    let close = |o: &Open| o.close();
     for (k, segs) in segmentations(geo, machine, tcy_s, max_cells, &plans, &close)
         .iter()
         .enumerate()
@@ -710,7 +710,7 @@ pub(crate) fn plan(
         }
     }
     let chosen = [plans[best.map_or(0, |b| b.1)]];
-    let close = |o: &Open, _share: f64| o.banded(machine);
+    let close = |o: &Open| o.banded(machine);
     let segs = segmentations(geo, machine, tcy_s, max_cells, &chosen, &close)
         .pop()
         .unwrap_or_default();
@@ -772,11 +772,8 @@ struct Emit<'a, 'b> {
     next_cycle: u64,
     /// The last state handed out: t, s, v, a.
     last: (f64, f64, f64, f64),
-    part: usize,
-    part_start_t: f64,
-    part_times: Vec<f64>,
+    parts: Parts,
     next_knot: usize,
-    min: Vec<Option<MinFeed>>,
     steps: u64,
 }
 
@@ -796,11 +793,8 @@ impl<'a, 'b> Emit<'a, 'b> {
             t: 0.0,
             next_cycle: 1,
             last: (0.0, 0.0, 0.0, 0.0),
-            part: 0,
-            part_start_t: 0.0,
-            part_times: Vec::with_capacity(parts),
+            parts: Parts::new(parts),
             next_knot: 1,
-            min: vec![None; parts],
             steps: 0,
         };
         e.hand_out(0.0, 0.0, 0.0, 0.0, 0.0, false);
@@ -817,7 +811,7 @@ impl<'a, 'b> Emit<'a, 'b> {
                 feed_mm_s: v,
                 accel_mm_s2: a,
                 jerk_mm_s3: j,
-                part: self.part,
+                part: self.parts.part,
                 cycle,
             },
             self.geo,
@@ -880,30 +874,8 @@ impl<'a, 'b> Emit<'a, 'b> {
             let tau = if target >= s1 { p.t } else { hi };
             let (_, vk, _) = advance(s, v, a, p.j, tau);
             let tk = t0 + tau;
-            self.passed(k, vk.max(0.0), tk);
+            self.parts.passed(self.geo, k, vk.max(0.0), tk);
             self.next_knot += 1;
-        }
-    }
-
-    fn passed(&mut self, k: usize, v: f64, t: f64) {
-        let p = self.part;
-        let first = if p == 0 { 0 } else { self.geo.part_end[p - 1] };
-        if k > first && k < self.geo.part_end[p] {
-            let better = self.min[p].is_none_or(|m| v < m.feed_mm_s);
-            if better {
-                self.min[p] = Some(MinFeed {
-                    feed_mm_s: v,
-                    point: k - first,
-                    s_mm: self.geo.knots[k] - self.geo.knots[first],
-                });
-            }
-        }
-        if k == self.geo.part_end[p] {
-            self.part_times.push(t - self.part_start_t);
-            self.part_start_t = t;
-            if p + 1 < self.geo.part_end.len() {
-                self.part += 1;
-            }
         }
     }
 
@@ -914,14 +886,10 @@ impl<'a, 'b> Emit<'a, 'b> {
             let whole = self.every_cycle && ((self.t - self.last.0) / self.dt - 1.0).abs() < 1e-9;
             self.hand_out(self.t, end, 0.0, 0.0, 0.0, whole);
         }
-        while self.part_times.len() < self.geo.part_end.len() {
-            let t = self.t - self.part_start_t;
-            self.part_times.push(t);
-            self.part_start_t = self.t;
-        }
+        self.parts.finish(self.geo.part_end.len(), self.t);
         Planned {
-            part_times: self.part_times,
-            min: self.min,
+            part_times: self.parts.times,
+            min: self.parts.min,
             steps: self.steps,
             time_s: self.t,
         }
