@@ -88,6 +88,7 @@ pub use grid::{Geometry, Grid};
 use pass::{Ceiling, Limit, Pass, Sink, State};
 use polepatch_kinematics::Machine;
 use polepatch_patcher::{AnalysisOptions, Path, analyze_path};
+use rayon::prelude::*;
 
 /// Options of [`simulate`]. Plain struct; see each field for its default.
 #[derive(Debug, Clone, PartialEq)]
@@ -451,15 +452,25 @@ pub fn simulate(
         tcy_s: Some(tcy_s),
         ..AnalysisOptions::default()
     };
+    // Each part's analysis on its own (on all cores where there are several), only its
+    // three figures kept; the first failure in order is the motion's.
+    let estimate = |p: &Path| {
+        analyze_path(p, machine, &aopts).map(|a| (a.time_s, a.ideal_time_s, a.length_mm))
+    };
+    let estimates: Vec<_> = if parts.len() > 1 {
+        parts.par_iter().map(estimate).collect()
+    } else {
+        parts.iter().map(estimate).collect()
+    };
     let mut out_parts = Vec::with_capacity(parts.len());
-    for (k, p) in parts.iter().enumerate() {
-        let a = analyze_path(p, machine, &aopts)
-            .map_err(|source| SimError::Path { part: k, source })?;
+    for (k, (p, e)) in parts.iter().zip(estimates).enumerate() {
+        let (eq6_time_s, ideal_time_s, length_mm) =
+            e.map_err(|source| SimError::Path { part: k, source })?;
         out_parts.push(PartSim {
             time_s: motion.part_times[k],
-            eq6_time_s: a.time_s,
-            ideal_time_s: a.ideal_time_s,
-            length_mm: a.length_mm,
+            eq6_time_s,
+            ideal_time_s,
+            length_mm,
             feed_mm_min: p.feed_mm_min,
             min_feed: motion.min[k],
         });

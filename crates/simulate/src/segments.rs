@@ -63,12 +63,13 @@
 //! sixteen for the chosen plan).
 
 use polepatch_kinematics::Machine;
+use rayon::prelude::*;
 
 use crate::grid::{Cell, Geometry, for_each_cell};
 use crate::pass::cbrt;
 use crate::tolerances::{
-    BAND_SHARES, LIMIT_USE, MERGE_RATIOS, REACH_NEWTON_STEPS, REACH_REL, SEGMENT_A_MAX_MM_S2,
-    SEGMENT_J_MAX_MM_S3, SPEED_SHARES, TIME_BISECTIONS,
+    BAND_SHARES, LIMIT_USE, MERGE_RATIOS, PARALLEL_MIN_SEGMENTS, REACH_NEWTON_STEPS, REACH_REL,
+    SEGMENT_A_MAX_MM_S2, SEGMENT_J_MAX_MM_S3, SPEED_SHARES, TIME_BISECTIONS,
 };
 use crate::{MinFeed, Parts, Step};
 
@@ -641,6 +642,12 @@ impl Seg for Banded {
     }
 }
 
+/// The most pieces of one segment: a change up, a cruise, a change down.
+const MAX_SEGMENT_PIECES: usize = 2 * MAX_CHANGE_PIECES + 1;
+
+/// Segments whose pieces are made at once before they are handed out ([`plan`]).
+const PIECES_CHUNK: usize = 4096;
+
 /// The pieces of segment `seg` from junction speed `u0` to `u1` (module docs, step 3).
 fn segment_pieces(seg: &impl Seg, u0: f64, u1: f64, out: &mut Vec<Piece>) {
     out.clear();
@@ -698,13 +705,17 @@ pub(crate) fn plan(
     // them at once); the fastest plan is built again with its caps in bands of speed and
     // handed out (no slower: a change under the bands is no longer than under the top's).
     let plans = all_plans();
-    let mut best: Option<(f64, usize)> = None;
     let close = |o: &Open| o.close();
-    for (k, segs) in segmentations(geo, machine, tcy_s, max_cells, &plans, &close)
-        .iter()
-        .enumerate()
-    {
-        let t = time_of(segs, &junctions(segs));
+    let all = segmentations(geo, machine, tcy_s, max_cells, &plans, &close);
+    let time = |segs: &Vec<Segment>| time_of(segs, &junctions(segs));
+    let times: Vec<f64> = if all.iter().map(Vec::len).sum::<usize>() >= PARALLEL_MIN_SEGMENTS {
+        all.par_iter().map(time).collect()
+    } else {
+        all.iter().map(time).collect()
+    };
+    drop(all);
+    let mut best: Option<(f64, usize)> = None;
+    for (k, &t) in times.iter().enumerate() {
         if best.is_none_or(|b| t < b.0) {
             best = Some((t, k));
         }
@@ -714,16 +725,41 @@ pub(crate) fn plan(
     let segs = segmentations(geo, machine, tcy_s, max_cells, &chosen, &close)
         .pop()
         .unwrap_or_default();
-    let u = junctions(&segs);
-    // Forward, segment by segment, handing out the states as they are computed.
-    let mut out = Emit::new(geo, every_cycle, tcy_s, sink);
-    let mut pieces = Vec::with_capacity(2 * MAX_CHANGE_PIECES + 1);
-    let mut u0 = 0.0;
+    // The junction speeds: backward, then forward in place (the speed each segment
+    // ends at).
+    let mut u = junctions(&segs);
     for (k, seg) in segs.iter().enumerate() {
-        let u1 = u[k + 1].min(reach_banded(u0, seg.len_mm(), seg.bands()));
-        segment_pieces(seg, u0, u1, &mut pieces);
-        out.segment(seg, u0, &pieces);
-        u0 = u1;
+        u[k + 1] = u[k + 1].min(reach_banded(u[k], seg.len_mm(), seg.bands()));
+    }
+    // Each segment's pieces depend on its two junction speeds only: made in chunks (on
+    // all cores where the motion is long), then handed out in order, state by state.
+    let parallel = segs.len() >= PARALLEL_MIN_SEGMENTS;
+    let mut out = Emit::new(geo, every_cycle, tcy_s, sink);
+    let mut pieces: Vec<Vec<Piece>> = (0..segs.len().min(PIECES_CHUNK))
+        .map(|_| Vec::with_capacity(MAX_SEGMENT_PIECES))
+        .collect();
+    for (c, chunk) in segs.chunks(PIECES_CHUNK).enumerate() {
+        let first = c * PIECES_CHUNK;
+        let make = |(i, (seg, out)): (usize, (&Banded, &mut Vec<Piece>))| {
+            segment_pieces(seg, u[first + i], u[first + i + 1], out);
+        };
+        let slots = &mut pieces[..chunk.len()];
+        if parallel {
+            chunk
+                .par_iter()
+                .zip(slots.par_iter_mut())
+                .enumerate()
+                .for_each(make);
+        } else {
+            chunk
+                .iter()
+                .zip(slots.iter_mut())
+                .enumerate()
+                .for_each(make);
+        }
+        for (i, seg) in chunk.iter().enumerate() {
+            out.segment(seg, u[first + i], &pieces[i]);
+        }
     }
     out.finish()
 }

@@ -192,3 +192,9 @@ pub const REACH_REL: f64 = 1e-9;
 /// Newton steps that polish the closed-form root of a speed change's length
 /// (`segments.rs::reach`).
 pub const REACH_NEWTON_STEPS: usize = 3;
+
+/// A motion planned in at least this many segments (summed over the plans compared) has
+/// its plans' times, and its pieces, made on all cores (`segments.rs::plan`): the same
+/// numbers, in less time; a shorter one on one thread, where handing work to others
+/// costs more than it saves.
+pub const PARALLEL_MIN_SEGMENTS: usize = 512;
