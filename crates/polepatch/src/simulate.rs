@@ -123,14 +123,66 @@ struct Simulating<'a, 'f> {
     machine: &'a Machine,
     opts: &'a SimulateOptions,
     chain: Vec<RunIn>,
+    /// Complete motions (and rows) waiting to be simulated together ([`Self::take_all`]).
+    ready: Vec<Item>,
     report: SimulateReport,
     on_state: Option<&'f mut dyn FnMut(&SimState)>,
     t0_s: f64,
     s0_mm: f64,
 }
 
+/// A piece of the report in file order: a motion to simulate (runs that follow one
+/// another without a stop), or the row of a run with nothing to simulate.
+enum Item {
+    Motion(Vec<RunIn>),
+    Row(SimRun),
+}
+
+impl Item {
+    /// The path points it holds.
+    fn points(&self) -> usize {
+        match self {
+            Item::Motion(m) => m.iter().map(|r| r.row.points).sum(),
+            Item::Row(_) => 0,
+        }
+    }
+}
+
+/// Without a state callback, complete motions wait until they hold this many path points
+/// together (or the program ends) and are then simulated on all cores: few enough to
+/// bound what waits, enough to share out (a longer motion is simulated alone, its plan
+/// on all cores).
+const MOTIONS_AT_ONCE_POINTS: usize = 20_000;
+
+/// A motion simulated: its runs' rows with their figures (or the error), and what the
+/// totals take from it.
+struct Simulated {
+    rows: Vec<SimRun>,
+    /// `(time, length)` of the motion, s and mm, when it simulated.
+    ok: Option<(f64, f64)>,
+    clips: usize,
+}
+
 impl Simulating<'_, '_> {
-    fn take(&mut self, run: RunIn) {
+    /// The runs of one batch of the reading, in file order. Without a state callback the
+    /// motions the batch completes are simulated on all cores and taken in order (each
+    /// motion's figures do not depend on the others', and the totals are summed in file
+    /// order: the same report as one by one); with one, one by one as they complete.
+    fn take_all(&mut self, runs: Vec<RunIn>) {
+        for run in runs {
+            let mut items = std::mem::take(&mut self.ready);
+            self.gather(run, &mut items);
+            self.ready = items;
+            let points: usize = self.ready.iter().map(Item::points).sum();
+            if self.on_state.is_some() || points >= MOTIONS_AT_ONCE_POINTS {
+                let items = std::mem::take(&mut self.ready);
+                self.settle(items);
+            }
+        }
+    }
+
+    /// Add a run to the motion being gathered; what it completes goes to `items`.
+    fn gather(&mut self, run: RunIn, items: &mut Vec<Item>) {
         let joins = self.chain.last().is_some_and(|prev| {
             prev.feed_change_after
                 && prev.path.is_some()
@@ -140,11 +192,11 @@ impl Simulating<'_, '_> {
                 && prev.path.as_ref().and_then(|p| p.axes.last())
                     == run.path.as_ref().map(|p| &p.axes[0])
         });
-        if !joins {
-            self.flush();
+        if !joins && !self.chain.is_empty() {
+            items.push(Item::Motion(std::mem::take(&mut self.chain)));
         }
         if run.path.is_none() {
-            self.report.runs.push(run.row);
+            items.push(Item::Row(run.row));
             return;
         }
         self.chain.push(run);
@@ -153,77 +205,147 @@ impl Simulating<'_, '_> {
         }
     }
 
+    /// Simulate what is left: the motions waiting and the one being gathered (the end of
+    /// the program).
     fn flush(&mut self) {
-        if self.chain.is_empty() {
+        let mut items = std::mem::take(&mut self.ready);
+        if !self.chain.is_empty() {
+            items.push(Item::Motion(std::mem::take(&mut self.chain)));
+        }
+        self.settle(items);
+    }
+
+    /// Simulate `items`' motions and put them in the report, in order.
+    fn settle(&mut self, items: Vec<Item>) {
+        let (machine, opts) = (self.machine, self.opts);
+        let motions = items
+            .iter()
+            .filter(|i| matches!(i, Item::Motion(_)))
+            .count();
+        if self.on_state.is_none() && motions > 1 {
+            use rayon::prelude::*;
+            let done: Vec<Simulated> = items
+                .into_par_iter()
+                .map(|i| match i {
+                    Item::Motion(m) => simulate_motion(m, machine, opts, None, 0.0, 0.0),
+                    // A row alone: taken as it is, into no total.
+                    Item::Row(r) => Simulated {
+                        rows: vec![r],
+                        ok: None,
+                        clips: 0,
+                    },
+                })
+                .collect();
+            for d in done {
+                self.record(d);
+            }
             return;
         }
-        let mut chain = std::mem::take(&mut self.chain);
-        let parts: Vec<Path> = chain.iter_mut().filter_map(|r| r.path.take()).collect();
-        let runs: Vec<usize> = chain.iter().map(|r| r.row.run).collect();
-        let (t0, s0) = (self.t0_s, self.s0_mm);
-        let machine = self.machine;
-        let mut sim_opts = self.opts.sim.clone();
-        let mut user = self.on_state.take();
-        sim_opts.every_cycle &= user.is_some();
-        let mut part_start_s = vec![0.0; parts.len()];
-        let mut acc = 0.0;
-        for (k, p) in parts.iter().enumerate() {
-            part_start_s[k] = acc;
-            acc += p.s_mm[p.s_mm.len() - 1] - p.s_mm[0];
-        }
-        let result = {
-            let mut sink = |st: &Step, geo: &Geometry| {
-                if let Some(f) = user.as_mut() {
-                    let d = geo.derivs(st.s_mm);
-                    let shares = polepatch_simulate::caps::shares(
-                        machine,
-                        &d,
-                        st.feed_mm_s,
-                        st.accel_mm_s2,
-                        st.jerk_mm_s3,
-                    );
-                    f(&SimState {
-                        run: runs[st.part],
-                        t_s: t0 + st.t_s,
-                        s_mm: st.s_mm - part_start_s[st.part],
-                        s_total_mm: s0 + st.s_mm,
-                        axes: d.map(|e| e[0]),
-                        feed_mm_min: st.feed_mm_s * 60.0,
-                        shares,
-                        cycle: st.cycle,
-                    });
+        for i in items {
+            match i {
+                Item::Motion(m) => {
+                    let mut user = self.on_state.take();
+                    let (t0, s0) = (self.t0_s, self.s0_mm);
+                    let sim = simulate_motion(m, machine, opts, user.as_deref_mut(), t0, s0);
+                    self.on_state = user;
+                    self.record(sim);
                 }
-            };
-            simulate(&parts, machine, &sim_opts, &mut sink)
+                Item::Row(r) => self.report.runs.push(r),
+            }
+        }
+    }
+
+    /// A simulated motion's rows and totals.
+    fn record(&mut self, sim: Simulated) {
+        if let Some((time_s, length_mm)) = sim.ok {
+            for row in &sim.rows {
+                let t = &mut self.report.total;
+                t.time_s += row.time_s;
+                t.eq6_time_s += row.eq6_time_s;
+                t.ideal_time_s += row.ideal_time_s;
+                t.runs += 1;
+            }
+            self.report.total.clips += sim.clips;
+            self.t0_s += time_s;
+            self.s0_mm += length_mm;
+        }
+        self.report.runs.extend(sim.rows);
+    }
+}
+
+/// Simulate one motion (`chain`, its runs), handing its states to `user` (times from
+/// `t0`, s from `s0`).
+fn simulate_motion<'f>(
+    mut chain: Vec<RunIn>,
+    machine: &Machine,
+    opts: &SimulateOptions,
+    mut user: Option<&mut (dyn FnMut(&SimState) + 'f)>,
+    t0: f64,
+    s0: f64,
+) -> Simulated {
+    let parts: Vec<Path> = chain.iter_mut().filter_map(|r| r.path.take()).collect();
+    let runs: Vec<usize> = chain.iter().map(|r| r.row.run).collect();
+    let mut sim_opts = opts.sim.clone();
+    sim_opts.every_cycle &= user.is_some();
+    let mut part_start_s = vec![0.0; parts.len()];
+    let mut acc = 0.0;
+    for (k, p) in parts.iter().enumerate() {
+        part_start_s[k] = acc;
+        acc += p.s_mm[p.s_mm.len() - 1] - p.s_mm[0];
+    }
+    let result = {
+        let mut sink = |st: &Step, geo: &Geometry| {
+            if let Some(f) = user.as_mut() {
+                let d = geo.derivs(st.s_mm);
+                let shares = polepatch_simulate::caps::shares(
+                    machine,
+                    &d,
+                    st.feed_mm_s,
+                    st.accel_mm_s2,
+                    st.jerk_mm_s3,
+                );
+                f(&SimState {
+                    run: runs[st.part],
+                    t_s: t0 + st.t_s,
+                    s_mm: st.s_mm - part_start_s[st.part],
+                    s_total_mm: s0 + st.s_mm,
+                    axes: d.map(|e| e[0]),
+                    feed_mm_min: st.feed_mm_s * 60.0,
+                    shares,
+                    cycle: st.cycle,
+                });
+            }
         };
-        self.on_state = user;
-        match result {
-            Ok(sim) => {
-                for (r, ps) in chain.iter_mut().zip(&sim.parts) {
-                    r.row.time_s = ps.time_s;
-                    r.row.eq6_time_s = ps.eq6_time_s;
-                    r.row.ideal_time_s = ps.ideal_time_s;
-                    if let Some(m) = ps.min_feed {
-                        r.row.min_feed_mm_min = Some(m.feed_mm_s * 60.0);
-                        r.row.min_feed_line = r.point_lines.get(m.point).copied();
-                    }
-                    let t = &mut self.report.total;
-                    t.time_s += ps.time_s;
-                    t.eq6_time_s += ps.eq6_time_s;
-                    t.ideal_time_s += ps.ideal_time_s;
-                    t.runs += 1;
+        simulate(&parts, machine, &sim_opts, &mut sink)
+    };
+    drop(parts);
+    match result {
+        Ok(sim) => {
+            for (r, ps) in chain.iter_mut().zip(&sim.parts) {
+                r.row.time_s = ps.time_s;
+                r.row.eq6_time_s = ps.eq6_time_s;
+                r.row.ideal_time_s = ps.ideal_time_s;
+                if let Some(m) = ps.min_feed {
+                    r.row.min_feed_mm_min = Some(m.feed_mm_s * 60.0);
+                    r.row.min_feed_line = r.point_lines.get(m.point).copied();
                 }
-                self.report.total.clips += sim.clips;
-                self.t0_s += sim.time_s;
-                self.s0_mm += acc;
             }
-            Err(e) => {
-                for r in &mut chain {
-                    r.row.error = Some(e.to_string());
-                }
+            Simulated {
+                rows: chain.into_iter().map(|r| r.row).collect(),
+                ok: Some((sim.time_s, acc)),
+                clips: sim.clips,
             }
         }
-        self.report.runs.extend(chain.into_iter().map(|r| r.row));
+        Err(e) => {
+            for r in &mut chain {
+                r.row.error = Some(e.to_string());
+            }
+            Simulated {
+                rows: chain.into_iter().map(|r| r.row).collect(),
+                ok: None,
+                clips: 0,
+            }
+        }
     }
 }
 
@@ -272,6 +394,7 @@ fn simulate_bytes(
         machine,
         opts,
         chain: Vec::new(),
+        ready: Vec::new(),
         report: SimulateReport {
             file: opts.read.name.clone(),
             machine: machine.name.clone(),
@@ -296,9 +419,7 @@ fn simulate_bytes(
         &reading,
         |rr| run_input(rr, machine),
         |runs| {
-            for r in runs {
-                sim.take(r);
-            }
+            sim.take_all(runs);
             Ok(())
         },
     );
@@ -343,5 +464,45 @@ mod tests {
             assert_eq!(a, b, "{file}");
             assert!(!lent.is_empty() && lent == owned, "{file}");
         }
+    }
+
+    /// Motions simulated side by side (no state callback) report what they report one by
+    /// one in order (a callback): a program of 30 motions, 30 000 points in all (more
+    /// than wait together, so motions are settled both along the way and at the end), with
+    /// a run that has nothing to simulate (a feed too low) among them, its row in place.
+    #[test]
+    fn motions_side_by_side_report_as_one_by_one() {
+        use std::fmt::Write as _;
+        let mut p = String::from("%\nO1000\nG90 G21 G94\nT1 M6\nS1000 M3\nG43.4 H1\n");
+        for m in 0..30 {
+            let y = 5.0 * f64::from(m);
+            let f = if m == 12 { "F0.00001" } else { "F1000" };
+            writeln!(p, "G0 X0 Y{y} Z5 A10 C{}", 2 * m).unwrap();
+            writeln!(p, "G1 Z0 {f}").unwrap();
+            for i in 1..=1000 {
+                writeln!(
+                    p,
+                    "X{:.1} Y{:.3}",
+                    0.1 * f64::from(i),
+                    y + 0.2 * (0.01 * f64::from(i)).sin()
+                )
+                .unwrap();
+            }
+            writeln!(p, "G0 Z5").unwrap();
+        }
+        p.push_str("M30\n%\n");
+        const { assert!(30 * 1000 > MOTIONS_AT_ONCE_POINTS) };
+        let machine = Machine::builtin("mikron-ucp710").expect("built-in machine");
+        let opts = SimulateOptions::default();
+        let side = simulate_nc(p.as_bytes(), &machine, &opts).expect("simulates");
+        let mut states = 0usize;
+        let one = simulate_nc_with(p.as_bytes(), &machine, &opts, Some(&mut |_| states += 1))
+            .expect("simulates");
+        assert!(states > 0);
+        assert_eq!(side, one);
+        assert!(side.total.runs >= 29, "{:?}", side.total);
+        let rows: Vec<_> = side.runs.iter().map(|r| r.error.is_some()).collect();
+        assert_eq!(rows.iter().filter(|&&e| e).count(), 1, "{rows:?}");
+        assert!(side.runs.windows(2).all(|w| w[0].run < w[1].run));
     }
 }
