@@ -253,11 +253,14 @@ fn segmentations<T>(
             let own = *own[share].get_or_insert_with(|| p.limits(machine, SPEED_SHARES[share]));
             if let Some(o) = &mut open[k] {
                 let merged = o.peaks.merge(&p);
-                let lm = merged.limits(machine, SPEED_SHARES[share]);
                 let ok = |m: f64, a: f64, b: f64| m >= ratio * a.max(b);
-                if ok(lm.v, o.best.v, own.v)
-                    && ok(lm.a, o.best.a, own.a)
-                    && ok(lm.j, o.best.j, own.j)
+                // The merged limits as `Peaks::limits` makes them, the caps only for a
+                // speed that passes.
+                let v = merged.speed(machine, SPEED_SHARES[share]);
+                let caps = ok(v, o.best.v, own.v).then(|| merged.caps_at(machine, v));
+                if let Some((a, j)) = caps
+                    && ok(a, o.best.a, own.a)
+                    && ok(j, o.best.j, own.j)
                 {
                     o.best = Limits {
                         v: o.best.v.max(own.v),
@@ -265,7 +268,7 @@ fn segmentations<T>(
                         j: o.best.j.max(own.j),
                     };
                     o.peaks = merged;
-                    o.lim = lm;
+                    o.lim = Limits { v, a, j };
                     o.s1_mm = c.s1_mm;
                     continue;
                 }
