@@ -125,6 +125,8 @@ struct Simulating<'a, 'f> {
     chain: Vec<RunIn>,
     /// Complete motions (and rows) waiting to be simulated together ([`Self::take_all`]).
     ready: Vec<Item>,
+    /// The path points of `ready`.
+    ready_points: usize,
     report: SimulateReport,
     on_state: Option<&'f mut dyn FnMut(&SimState)>,
     t0_s: f64,
@@ -171,11 +173,13 @@ impl Simulating<'_, '_> {
     fn take_all(&mut self, runs: Vec<RunIn>) {
         for run in runs {
             let mut items = std::mem::take(&mut self.ready);
+            let before = items.len();
             self.gather(run, &mut items);
+            self.ready_points += items[before..].iter().map(Item::points).sum::<usize>();
             self.ready = items;
-            let points: usize = self.ready.iter().map(Item::points).sum();
-            if self.on_state.is_some() || points >= MOTIONS_AT_ONCE_POINTS {
+            if self.on_state.is_some() || self.ready_points >= MOTIONS_AT_ONCE_POINTS {
                 let items = std::mem::take(&mut self.ready);
+                self.ready_points = 0;
                 self.settle(items);
             }
         }
@@ -209,6 +213,7 @@ impl Simulating<'_, '_> {
     /// the program).
     fn flush(&mut self) {
         let mut items = std::mem::take(&mut self.ready);
+        self.ready_points = 0;
         if !self.chain.is_empty() {
             items.push(Item::Motion(std::mem::take(&mut self.chain)));
         }
@@ -395,6 +400,7 @@ fn simulate_bytes(
         opts,
         chain: Vec::new(),
         ready: Vec::new(),
+        ready_points: 0,
         report: SimulateReport {
             file: opts.read.name.clone(),
             machine: machine.name.clone(),
