@@ -47,15 +47,16 @@
 //! 4. **Each segment** is then the time-optimal motion between its two junction speeds
 //!    under its caps: a speed change up to a peak v_p ≤ V, a cruise, and a speed change
 //!    down, v_p searched so that the segment's length is covered exactly.
-//! 5. **The fastest plan.** Every plan is first timed in closed form twice: with each
-//!    segment's caps at its V (one band: the estimate) and with the largest of its bands'
-//!    caps (a lower bound of its banded time: the banded motion keeps those caps). The
-//!    plan of the least estimate is built with its bands; every other plan whose lower
-//!    bound is below that plan's banded time is built too, and the fastest is the
-//!    motion — the fastest of the eight under their banded caps (to the searches'
-//!    tolerance), without building the plans that cannot be. (The estimate alone chose
-//!    a plan up to 10 % slower on the fixtures' motions: the bands help plans unequally,
-//!    and a lower band's J may be below the top's.)
+//! 5. **The plan.** Every plan is first timed in closed form twice: with each segment's
+//!    caps at its V (one band: the estimate) and with the largest of its bands' caps (a
+//!    lower bound of its banded time: the banded motion keeps those caps). The plan of
+//!    the least estimate is built with its bands, and the plan of the least lower bound
+//!    too where that bound is below the first's banded time; the faster is the motion.
+//!    (The estimate alone chose a plan up to 10 % slower on the fixtures' motions: the
+//!    bands help plans unequally, and a lower band's J may be below the top's. Building
+//!    every plan whose bound is below the best time found — the fastest of the eight,
+//!    exactly — gained no more on the fixtures and cost twice the time on near-pole
+//!    programs.)
 //!
 //! The motion is a sequence of pieces of constant jerk, evaluated exactly wherever it is
 //! asked (every cycle for a trajectory): its finite differences are within the limits by
@@ -821,12 +822,11 @@ pub(crate) fn plan(
     every_cycle: bool,
     sink: &mut dyn FnMut(&Step, &Geometry),
 ) -> Planned {
-    // Each segmentation timed with its caps at its top speed (the estimate to start
-    // from) and with its largest banded caps (a lower bound of its banded time), closed
-    // forms, all of them at once. The one with the least estimate is built with its
-    // banded caps; every other whose lower bound is below that plan's banded time is
-    // built too, and the fastest is the motion: the fastest of the eight under their
-    // banded caps, without building those that cannot be.
+    // Each segmentation timed with its caps at its top speed (the estimate) and with its
+    // largest banded caps (a lower bound of its banded time), closed forms, all of them
+    // at once. The one with the least estimate is built with its banded caps, and the one
+    // with the least lower bound where that bound is below the first's banded time; the
+    // faster is the motion.
     let plans = all_plans();
     let close = |o: &Open| o.close(machine);
     let all = segmentations(geo, machine, tcy_s, max_cells, &plans, &close);
@@ -854,16 +854,31 @@ pub(crate) fn plan(
         let close = |o: &Open| o.banded(machine);
         segmentations(geo, machine, tcy_s, max_cells, these, &close)
     };
-    let mut best = BandedPlan::new(banded(&[plans[first]]).pop().unwrap_or_default());
-    let others: Vec<(usize, f64)> = (0..plans.len())
-        .filter(|&k| k != first && bounds[k].1 < best.time_s)
-        .map(|k| plans[k])
-        .collect();
-    if !others.is_empty() {
-        for p in banded(&others).into_iter().map(BandedPlan::new) {
-            if p.time_s < best.time_s {
-                best = p;
-            }
+    // The plan of the least lower bound is the one likeliest to beat the first: built
+    // too while its bound is below the first's banded time (one walk for both where its
+    // bound is below the first's estimate, where it will likely pass).
+    let mut second = first;
+    for (k, b) in bounds.iter().enumerate() {
+        if k != first && (second == first || b.1 < bounds[second].1) {
+            second = k;
+        }
+    }
+    let together = second != first && bounds[second].1 < bounds[first].0;
+    let these: Vec<(usize, f64)> = if together {
+        vec![plans[first], plans[second]]
+    } else {
+        vec![plans[first]]
+    };
+    let mut sets = banded(&these).into_iter();
+    let mut best = BandedPlan::new(sets.next().unwrap_or_default());
+    if second != first && bounds[second].1 < best.time_s {
+        let segs = match sets.next() {
+            Some(segs) => segs,
+            None => banded(&[plans[second]]).pop().unwrap_or_default(),
+        };
+        let p = BandedPlan::new(segs);
+        if p.time_s < best.time_s {
+            best = p;
         }
     }
     let BandedPlan { segs, u, vp, .. } = best;
