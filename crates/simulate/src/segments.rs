@@ -34,7 +34,11 @@
 //!    not reached): closed forms ([`change`], [`reach`]). A backward pass over the
 //!    junctions from rest at the end (the fastest speed from which each later junction
 //!    can still be met) and a forward pass from rest at the start give the junction
-//!    speeds — the classic look-ahead of a CNC planner, over the whole motion.
+//!    speeds — the classic look-ahead of a CNC planner, over the whole motion, run as
+//!    the segments come ([`Lookahead`]): the backward pass reaches a junction's cap
+//!    whatever follows where a bound of it that grows with the speed after does
+//!    ([`surely_reached`]), and the segments before that junction are passed then, with
+//!    the speeds of the passes over the whole motion to the last bit.
 //! 3. **Caps in bands of speed.** A plan is built with each segment's caps
 //!    at [`BAND_SHARES`] of its V (A(v) and J(v) grow as the speed falls: near the pole
 //!    several times). A change of speed then follows a(v) = min(rise, A, fall): the
@@ -68,9 +72,12 @@
 //! passes).
 //!
 //! The work grows with the cells (one walk for every plan, one more for the plans built
-//! with bands) and the segments (a few closed forms each, a short search per junction
-//! with bands), not the cycles; the memory with the segments (eight numbers each per
-//! plan, nineteen for each plan built with bands).
+//! with bands, and for a plan of more than [`KEPT_SEGMENTS`] one more to hand its
+//! segments out, beside the states) and the segments (a few closed forms each, a short
+//! search per junction with bands), not the cycles. The memory grows with each plan's
+//! look-ahead (the segments after the last junction whose speed is known: a braking
+//! distance's worth where the caps allow), and three speeds a segment for the plans built
+//! with bands where they are long, not with whole plans.
 
 use polepatch_kinematics::Machine;
 use rayon::prelude::*;
@@ -78,8 +85,9 @@ use rayon::prelude::*;
 use crate::grid::{Cell, Geometry, for_each_cell};
 use crate::pass::cbrt;
 use crate::tolerances::{
-    BAND_SHARES, LIMIT_USE, MERGE_RATIOS, PARALLEL_MIN_SEGMENTS, REACH_NEWTON_STEPS, REACH_REL,
-    SEGMENT_A_MAX_MM_S2, SEGMENT_J_MAX_MM_S3, SPEED_SHARES, TIME_BISECTIONS,
+    BAND_SHARES, JUNCTION_CAP_ROOM, LIMIT_USE, MERGE_RATIOS, PARALLEL_MIN_SEGMENTS,
+    REACH_NEWTON_STEPS, REACH_REL, SEGMENT_A_MAX_MM_S2, SEGMENT_J_MAX_MM_S3, SPEED_SHARES,
+    TIME_BISECTIONS,
 };
 use crate::{MinFeed, Parts, Step};
 
@@ -190,12 +198,6 @@ struct Segment {
     low: Limits,
 }
 
-/// A segment under its largest caps over its bands: no motion under its banded caps is
-/// faster (each band's caps are at most these), so the plan's time under these is a
-/// lower bound of its banded time.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct AtLow<'a>(&'a Segment);
-
 /// A segment being merged: its peaks and limits, the largest of its cells' own limits,
 /// and where it starts and ends.
 #[derive(Debug, Clone, Copy)]
@@ -264,16 +266,17 @@ fn all_plans() -> Vec<(usize, f64)> {
 }
 
 /// The segments of the path (module docs, step 1), once per plan `(speed share index,
-/// merge share)`, in one walk over the cells; each closed by `close`.
-fn segmentations<T>(
+/// merge share)`, in one walk over the cells; each closed by `close` and handed to `sink`
+/// with its plan's index as it is closed (in order within a plan).
+fn walk_segments<T>(
     geo: &Geometry,
     machine: &Machine,
     tcy_s: f64,
     max_cells: usize,
     plans: &[(usize, f64)],
     close: &dyn Fn(&Open) -> T,
-) -> Vec<Vec<T>> {
-    let mut out: Vec<Vec<T>> = plans.iter().map(|_| Vec::new()).collect();
+    sink: &mut dyn FnMut(usize, T),
+) {
     let mut open: Vec<Option<Open>> = vec![None; plans.len()];
     for_each_cell(geo, tcy_s, max_cells, &mut |c: &Cell| {
         let p = Peaks::of(c);
@@ -301,17 +304,16 @@ fn segmentations<T>(
                     o.s1_mm = c.s1_mm;
                     continue;
                 }
-                out[k].push(close(o));
+                sink(k, close(o));
             }
             open[k] = Some(Open::of(c, p, own));
         }
     });
     for (k, o) in open.iter().enumerate() {
         if let Some(o) = o {
-            out[k].push(close(o));
+            sink(k, close(o));
         }
     }
-    out
 }
 
 /// Time and distance of a jerk-limited change of speed from `v0` to `v1` with a = 0 at
@@ -666,18 +668,6 @@ impl<T: Seg> Seg for &T {
     }
 }
 
-impl Seg for AtLow<'_> {
-    fn s0_mm(&self) -> f64 {
-        self.0.s0_mm
-    }
-    fn len_mm(&self) -> f64 {
-        self.0.len_mm
-    }
-    fn bands(&self) -> &[Limits] {
-        std::slice::from_ref(&self.0.low)
-    }
-}
-
 /// A segment with its caps at [`BAND_SHARES`] of its speed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Banded {
@@ -703,6 +693,23 @@ const MAX_SEGMENT_PIECES: usize = 2 * MAX_CHANGE_PIECES + 1;
 
 /// Segments whose pieces are made at once before they are handed out ([`plan`]).
 const PIECES_CHUNK: usize = 4096;
+
+/// Chunks of [`PIECES_CHUNK`] segments the walk that hands out a long plan's segments
+/// may have ready before they are handed out ([`plan`]).
+const WALKED_CHUNKS_AHEAD: usize = 2;
+
+/// Segments a [`Lookahead`] holds before its first backward pass, and at least between
+/// two (each pass runs over all it holds: doubling the wait keeps the work linear where
+/// the speeds stay unknown long).
+const LOOKAHEAD_MIN_SEGMENTS: usize = 1024;
+
+/// Segments (over all plans) the walk gathers before handing them to the plans' timers
+/// at once ([`plan_times`]).
+const TIMER_BATCH_SEGMENTS: usize = 8 * PIECES_CHUNK;
+
+/// A plan built with its bands keeps its segments for the motion's states up to this many
+/// (about 3 MB); a longer one keeps only their speeds, and is walked again for them.
+const KEPT_SEGMENTS: usize = 4 * PIECES_CHUNK;
 
 /// The pieces of segment `seg` from junction speed `u0` to `u1` (module docs, step 3).
 fn segment_pieces(seg: &impl Seg, u0: f64, u1: f64, out: &mut Vec<Piece>) {
@@ -747,52 +754,6 @@ fn pieces_at(seg: &impl Seg, u0: f64, vp: f64, u1: f64, out: &mut Vec<Piece>) {
     out.extend_from_slice(change_pieces(vp, u1, bands).as_slice());
 }
 
-/// A plan built with its banded caps: its segments, the junction speeds (backward then
-/// forward), each segment's top speed, and its time.
-struct BandedPlan {
-    segs: Vec<Banded>,
-    u: Vec<f64>,
-    vp: Vec<f64>,
-    time_s: f64,
-}
-
-impl BandedPlan {
-    /// The motion on `segs` (module docs, steps 2–4); each segment's top speed and time
-    /// on all cores where the plan is long.
-    fn new(segs: Vec<Banded>) -> BandedPlan {
-        let mut u = junctions(&segs);
-        for (k, seg) in segs.iter().enumerate() {
-            u[k + 1] = u[k + 1].min(reach_banded(u[k], seg.len_mm(), seg.bands()));
-        }
-        let top = |(k, seg): (usize, &Banded)| {
-            let vp = peak_speed(seg, u[k], u[k + 1]);
-            let (used, t) = changes(seg, u[k], vp, u[k + 1]);
-            let cruise = seg.len_mm() - used;
-            (
-                vp,
-                if cruise > 0.0 && vp > 0.0 {
-                    t + cruise / vp
-                } else {
-                    t
-                },
-            )
-        };
-        let timed: Vec<(f64, f64)> = if segs.len() >= PARALLEL_MIN_SEGMENTS {
-            segs.par_iter().enumerate().map(top).collect()
-        } else {
-            segs.iter().enumerate().map(top).collect()
-        };
-        let time_s = timed.iter().map(|x| x.1).sum();
-        let vp = timed.into_iter().map(|x| x.0).collect();
-        BandedPlan {
-            segs,
-            u,
-            vp,
-            time_s,
-        }
-    }
-}
-
 /// The state after time `t` of constant jerk `j` from (s, v, a).
 #[inline]
 fn advance(s: f64, v: f64, a: f64, j: f64, t: f64) -> (f64, f64, f64) {
@@ -829,34 +790,17 @@ pub(crate) fn plan(
     // faster is the motion.
     let plans = all_plans();
     let close = |o: &Open| o.close(machine);
-    let all = segmentations(geo, machine, tcy_s, max_cells, &plans, &close);
-    let bounds = |segs: &Vec<Segment>| {
-        let (n, low) = (segs.len(), |k: usize| AtLow(&segs[k]));
-        (
-            time_by(n, |k| &segs[k], &junctions(segs)),
-            time_by(n, low, &junctions_by(n, low)),
-        )
-    };
-    let bounds: Vec<(f64, f64)> =
-        if all.iter().map(Vec::len).sum::<usize>() >= PARALLEL_MIN_SEGMENTS {
-            all.par_iter().map(bounds).collect()
-        } else {
-            all.iter().map(bounds).collect()
-        };
-    drop(all);
+    let bounds = plan_times(geo, machine, tcy_s, max_cells, &plans, &close);
     let mut first = 0;
     for (k, b) in bounds.iter().enumerate() {
         if b.0 < bounds[first].0 {
             first = k;
         }
     }
-    let banded = |these: &[(usize, f64)]| {
-        let close = |o: &Open| o.banded(machine);
-        segmentations(geo, machine, tcy_s, max_cells, these, &close)
-    };
+    let banded = |this, also| banded_time(geo, machine, tcy_s, max_cells, this, also);
     // The plan of the least lower bound is the one likeliest to beat the first: built
-    // too while its bound is below the first's banded time (one walk for both where its
-    // bound is below the first's estimate, where it will likely pass).
+    // too while its bound is below the first's banded time (its segments gathered in the
+    // same walk where its bound is below the first's estimate, where it will likely pass).
     let mut second = first;
     for (k, b) in bounds.iter().enumerate() {
         if k != first && (second == first || b.1 < bounds[second].1) {
@@ -864,94 +808,523 @@ pub(crate) fn plan(
         }
     }
     let together = second != first && bounds[second].1 < bounds[first].0;
-    let these: Vec<(usize, f64)> = if together {
-        vec![plans[first], plans[second]]
-    } else {
-        vec![plans[first]]
-    };
-    let mut sets = banded(&these).into_iter();
-    let mut best = BandedPlan::new(sets.next().unwrap_or_default());
+    let (mut best, gathered) = banded(plans[first], together.then_some(plans[second]));
+    let mut best_plan = plans[first];
     if second != first && bounds[second].1 < best.time_s {
-        let segs = match sets.next() {
-            Some(segs) => segs,
-            None => banded(&[plans[second]]).pop().unwrap_or_default(),
+        let p = match gathered {
+            Some(segs) => {
+                let mut timer = BandedTimer::new();
+                segs.into_iter().for_each(|seg| timer.push(seg));
+                timer.finish()
+            }
+            None => banded(plans[second], None).0,
         };
-        let p = BandedPlan::new(segs);
         if p.time_s < best.time_s {
-            best = p;
+            (best, best_plan) = (p, plans[second]);
         }
     }
-    let BandedPlan { segs, u, vp, .. } = best;
-    // Each segment's pieces depend on its junction speeds and top speed only: made in
-    // chunks (on all cores where the motion is long), then handed out in order, state by
-    // state.
-    let parallel = segs.len() >= PARALLEL_MIN_SEGMENTS;
+    // The motion's states: its segments' pieces (each depends on its junction speeds and
+    // top speed only) made in chunks, on all cores where a chunk is long, then handed out
+    // in order, state by state. From the segments kept, or from the plan walked again
+    // where it was too long to keep.
     let mut out = Emit::new(geo, every_cycle, tcy_s, sink);
-    let mut pieces: Vec<Vec<Piece>> = (0..segs.len().min(PIECES_CHUNK))
-        .map(|_| Vec::with_capacity(MAX_SEGMENT_PIECES))
-        .collect();
-    for (c, chunk) in segs.chunks(PIECES_CHUNK).enumerate() {
-        let start = c * PIECES_CHUNK;
-        let make = |(i, (seg, out)): (usize, (&Banded, &mut Vec<Piece>))| {
-            let k = start + i;
-            pieces_at(seg, u[k], vp[k], u[k + 1], out);
-        };
-        let slots = &mut pieces[..chunk.len()];
-        if parallel {
-            chunk
-                .par_iter()
-                .zip(slots.par_iter_mut())
-                .enumerate()
-                .for_each(make);
-        } else {
-            chunk
-                .iter()
-                .zip(slots.iter_mut())
-                .enumerate()
-                .for_each(make);
+    let mut pieces: Vec<Vec<Piece>> = Vec::new();
+    let mut emit = |chunk: &[Passed]| {
+        if pieces.len() < chunk.len() {
+            pieces.resize_with(chunk.len(), || Vec::with_capacity(MAX_SEGMENT_PIECES));
         }
-        for (i, seg) in chunk.iter().enumerate() {
-            out.segment(seg, u[start + i], &pieces[i]);
+        let make = |(p, out): (&Passed, &mut Vec<Piece>)| pieces_at(&p.seg, p.u0, p.vp, p.u1, out);
+        let slots = &mut pieces[..chunk.len()];
+        if chunk.len() >= PARALLEL_MIN_SEGMENTS {
+            chunk.par_iter().zip(slots.par_iter_mut()).for_each(make);
+        } else {
+            chunk.iter().zip(slots.iter_mut()).for_each(make);
+        }
+        for (p, pieces) in chunk.iter().zip(pieces.iter()) {
+            out.segment(&p.seg, p.u0, pieces);
+        }
+    };
+    match best.built {
+        Built::Kept(kept) => kept.chunks(PIECES_CHUNK).for_each(&mut emit),
+        Built::Speeds(speeds) => {
+            // The same walk as the one that timed it (the same segments, in order), on a
+            // thread of its own, its chunks handed out here as they come.
+            std::thread::scope(|scope| {
+                let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<Passed>>(WALKED_CHUNKS_AHEAD);
+                scope.spawn(move || {
+                    let mut chunk = Vec::with_capacity(PIECES_CHUNK);
+                    let mut next = speeds.iter();
+                    walk_segments(
+                        geo,
+                        machine,
+                        tcy_s,
+                        max_cells,
+                        &[best_plan],
+                        &|o: &Open| o.banded(machine),
+                        &mut |_, seg| {
+                            let [u0, u1, vp] = *next.next().expect("the same segments as timed");
+                            chunk.push(Passed {
+                                seg,
+                                u0,
+                                u1,
+                                vp,
+                                t_s: 0.0,
+                            });
+                            if chunk.len() == PIECES_CHUNK {
+                                let full =
+                                    std::mem::replace(&mut chunk, Vec::with_capacity(PIECES_CHUNK));
+                                // Only fails where the receiver panicked: that panic is
+                                // the one the scope passes on.
+                                let _ = tx.send(full);
+                            }
+                        },
+                    );
+                    let _ = tx.send(chunk);
+                });
+                for chunk in rx {
+                    emit(&chunk);
+                }
+            });
         }
     }
     out.finish()
 }
 
-/// The backward pass over the junctions (module docs, step 2): the fastest speed at each
-/// junction from which the rest of the motion can still be met, from rest at the end; at
-/// rest at the start.
-fn junctions<S: Seg>(segs: &[S]) -> Vec<f64> {
-    junctions_by(segs.len(), |k| &segs[k])
+/// Each plan's time with its caps at V and with its low caps (module docs, step 5), in
+/// one walk of the cells; the segments handed to the plans' [`Timer`]s in batches, the
+/// timers on all cores where a batch is long.
+fn plan_times(
+    geo: &Geometry,
+    machine: &Machine,
+    tcy_s: f64,
+    max_cells: usize,
+    plans: &[(usize, f64)],
+    close: &dyn Fn(&Open) -> Segment,
+) -> Vec<(f64, f64)> {
+    let mut timers: Vec<(Timer, Timer)> = plans
+        .iter()
+        .map(|_| (Timer::default(), Timer::default()))
+        .collect();
+    let mut batch: Vec<Vec<Segment>> = plans.iter().map(|_| Vec::new()).collect();
+    let mut held = 0;
+    walk_segments(
+        geo,
+        machine,
+        tcy_s,
+        max_cells,
+        plans,
+        close,
+        &mut |k, seg| {
+            batch[k].push(seg);
+            held += 1;
+            if held >= TIMER_BATCH_SEGMENTS {
+                hand(&mut timers, &mut batch, true);
+                held = 0;
+            }
+        },
+    );
+    hand(&mut timers, &mut batch, held >= PARALLEL_MIN_SEGMENTS);
+    let finish = |(e, l): (Timer, Timer)| (e.finish(), l.finish());
+    if timers.iter().map(|t| t.0.held()).sum::<usize>() >= PARALLEL_MIN_SEGMENTS {
+        timers.into_par_iter().map(finish).collect()
+    } else {
+        timers.into_iter().map(finish).collect()
+    }
 }
 
-/// [`junctions`] over `n` segments given by `seg`.
-fn junctions_by<S: Seg>(n: usize, seg: impl Fn(usize) -> S) -> Vec<f64> {
-    let mut u = vec![0.0; n + 1];
-    for k in (0..n).rev() {
-        let s = seg(k);
-        let cap = if k == 0 {
-            0.0
+/// Each plan's batch of segments to its two timers: with its caps at V and with its low
+/// caps (on all cores when `parallel`).
+fn hand(timers: &mut [(Timer, Timer)], batch: &mut [Vec<Segment>], parallel: bool) {
+    let take = |(t, b): (&mut (Timer, Timer), &mut Vec<Segment>)| {
+        for seg in b.drain(..) {
+            t.0.push(seg);
+            t.1.push(Segment {
+                lim: seg.low,
+                ..seg
+            });
+        }
+    };
+    if parallel {
+        timers
+            .par_iter_mut()
+            .zip(batch.par_iter_mut())
+            .for_each(take);
+    } else {
+        timers.iter_mut().zip(batch.iter_mut()).for_each(take);
+    }
+}
+
+/// The junction speeds of a plan over segments handed to it in order (module docs, step
+/// 2: the backward pass from rest at the end, then the forward pass from rest at the
+/// start), holding only the segments whose speeds are not yet known: the memory of a
+/// plan bounded by its look-ahead, not by the motion.
+///
+/// From rest after the last segment held, a speed each junction surely reaches whatever
+/// follows ([`surely_reached`], a bound that grows with the speed after the junction).
+/// Where that reaches a junction's cap, the backward pass's speed there is its cap,
+/// whatever follows, and from that junction back the pass is the same operations on the
+/// same numbers as over the whole motion: the forward pass runs to it and hands each
+/// segment on with its speeds, those of the passes over the whole motion.
+/// [`Lookahead::finish`] ends the motion at rest. (The backward pass's own speeds from
+/// rest would not do as the bound: a change's reach, with a = 0 at both ends, falls as
+/// the speed it starts from rises while it more than triples it.)
+struct Lookahead<S> {
+    /// Segments from the first junction the forward pass has not passed.
+    segs: std::collections::VecDeque<S>,
+    /// Forward speed at the first junction held, mm/s.
+    u0: f64,
+    /// Segments held at which the next backward pass runs.
+    check_at: usize,
+    /// The backward pass's junction speeds (reused).
+    u: Vec<f64>,
+}
+
+impl<S> Default for Lookahead<S> {
+    fn default() -> Self {
+        Lookahead {
+            segs: std::collections::VecDeque::new(),
+            u0: 0.0,
+            check_at: LOOKAHEAD_MIN_SEGMENTS,
+            u: Vec::new(),
+        }
+    }
+}
+
+impl<S: Seg + Copy> Lookahead<S> {
+    /// Take the next segment; `known` gets, in order, each segment whose junction speeds
+    /// (`u0` before it, `u1` after) are known.
+    fn push(&mut self, seg: S, known: &mut dyn FnMut(&S, f64, f64)) {
+        self.segs.push_back(seg);
+        if self.segs.len() >= self.check_at {
+            self.advance(false, known);
+            self.check_at = (2 * self.segs.len()).max(LOOKAHEAD_MIN_SEGMENTS);
+        }
+    }
+
+    /// The motion ends at rest after the last segment pushed: the rest to `known`.
+    fn finish(mut self, known: &mut dyn FnMut(&S, f64, f64)) {
+        self.advance(true, known);
+    }
+
+    /// The backward pass over the segments held, from the last junction whose speed is
+    /// known (`end`: the end, at rest), and the forward pass up to it.
+    fn advance(&mut self, end: bool, known: &mut dyn FnMut(&S, f64, f64)) {
+        let n = self.segs.len();
+        let cap = |k: usize| top_speed(&self.segs[k - 1]).min(top_speed(&self.segs[k]));
+        // u[k]: the speed between held segments k − 1 and k (u[0] is the forward pass's).
+        let (upto, last) = if end {
+            (n, 0.0)
         } else {
-            top_speed(&seg(k - 1)).min(top_speed(&s))
+            // From the last junction held back: a speed each junction surely reaches
+            // whatever follows (from rest after the last), until one surely reaches its
+            // cap.
+            let mut lo = 0.0;
+            let mut found = None;
+            for k in (1..n).rev() {
+                let (c, s) = (cap(k), &self.segs[k]);
+                let r = surely_reached(s, lo);
+                if r >= c * (1.0 + JUNCTION_CAP_ROOM) {
+                    found = Some((k, c));
+                    break;
+                }
+                lo = c.min(r);
+            }
+            match found {
+                Some(f) => f,
+                None => return,
+            }
         };
-        u[k] = cap.min(reach_banded(u[k + 1], s.len_mm(), s.bands()));
+        let mut u = std::mem::take(&mut self.u);
+        u.clear();
+        u.resize(upto + 1, 0.0);
+        u[upto] = last;
+        for k in (1..upto).rev() {
+            let s = &self.segs[k];
+            u[k] = cap(k).min(reach_banded(u[k + 1], s.len_mm(), s.bands()));
+        }
+        for (k, seg) in self.segs.iter().take(upto).enumerate() {
+            let u1 = u[k + 1].min(reach_banded(self.u0, seg.len_mm(), seg.bands()));
+            known(seg, self.u0, u1);
+            self.u0 = u1;
+        }
+        self.segs.drain(..upto);
+        self.u = u;
     }
-    u
 }
 
-/// The time of the motion on `n` segments given by `seg` with the backward junction
-/// speeds `u` (the forward pass of [`plan`] without its states).
-fn time_by<S: Seg>(n: usize, seg: impl Fn(usize) -> S, u: &[f64]) -> f64 {
-    let mut pieces = Vec::with_capacity(7);
-    let (mut u0, mut t) = (0.0, 0.0);
-    for k in 0..n {
-        let seg = seg(k);
-        let u1 = u[k + 1].min(reach_banded(u0, seg.len_mm(), seg.bands()));
-        segment_pieces(&seg, u0, u1, &mut pieces);
-        t += pieces.iter().map(|p| p.t).sum::<f64>();
-        u0 = u1;
+/// A speed that the backward pass reaches over `seg` from every speed at least `lo` at
+/// its end (a lower bound of the pass's [`reach_banded`], which falls as the speed it
+/// starts from rises while it more than triples it, and so bounds nothing by itself).
+///
+/// A change from x ≥ `lo` to v ≥ x takes its mean speed times its time, at most
+/// v·T(v − `lo`) with T the time of that change under the least of the segment's bands'
+/// caps (a time that grows with the change, and is longest under the least caps). A v with
+/// v·T(v − `lo`) within the length less [`JUNCTION_CAP_ROOM`] is reached from every such x
+/// (from an x above it, by not braking): the root of v·T(v − `lo`) = length, in closed form
+/// (a quadratic where A is reached, Newton on the cubic from above where it is not),
+/// checked, and halved towards `lo` where the check fails.
+fn surely_reached(seg: &impl Seg, lo: f64) -> f64 {
+    let (a, j) = seg
+        .bands()
+        .iter()
+        .fold((f64::INFINITY, f64::INFINITY), |(a, j), b| {
+            (a.min(b.a), j.min(b.j))
+        });
+    let len = seg.len_mm();
+    let fits = |v: f64| v * change(lo, v, a, j).0 <= len * (1.0 - JUNCTION_CAP_ROOM);
+    let target = len * (1.0 - 2.0 * JUNCTION_CAP_ROOM);
+    // A reached: v·((v − lo)/a + a/j) = target, a quadratic in v.
+    let b = a / j - lo / a;
+    let mut v = 0.5 * a * (-b + (b * b + 4.0 * target / a).sqrt());
+    let a_reached = v - lo >= a * a / j;
+    if !a_reached {
+        // A not reached: 2·v·√((v − lo)/j) = target, the cubic v²·(v − lo) = q, whose root
+        // Newton approaches from above (from lo + ∛q, above it) where it is convex.
+        let q = 0.25 * j * target * target;
+        v = lo + cbrt(q);
+        for _ in 0..REACH_NEWTON_STEPS + 3 {
+            let d = v * (3.0 * v - 2.0 * lo);
+            if d.is_nan() || d <= 0.0 {
+                break;
+            }
+            v -= (v * v * (v - lo) - q) / d;
+        }
     }
-    t
+    for _ in 0..4 {
+        if v > lo && fits(v) {
+            return v;
+        }
+        v = lo + 0.5 * (v - lo);
+    }
+    lo
+}
+
+/// A plan's time with each segment's caps at its V (the estimate) or with its low caps
+/// (a lower bound of its banded time): the forward pass of [`Lookahead`], each segment's
+/// pieces timed.
+struct Timer {
+    ahead: Lookahead<Segment>,
+    pieces: Vec<Piece>,
+    time_s: f64,
+}
+
+impl Default for Timer {
+    fn default() -> Self {
+        Timer {
+            ahead: Lookahead::default(),
+            pieces: Vec::with_capacity(MAX_SEGMENT_PIECES),
+            time_s: 0.0,
+        }
+    }
+}
+
+impl Timer {
+    fn push(&mut self, seg: Segment) {
+        let Timer {
+            ahead,
+            pieces,
+            time_s,
+        } = self;
+        ahead.push(seg, &mut |seg, u0, u1| {
+            segment_pieces(seg, u0, u1, pieces);
+            *time_s += pieces.iter().map(|p| p.t).sum::<f64>();
+        });
+    }
+
+    /// Segments held.
+    fn held(&self) -> usize {
+        self.ahead.segs.len()
+    }
+
+    fn finish(self) -> f64 {
+        let Timer {
+            ahead,
+            mut pieces,
+            mut time_s,
+        } = self;
+        ahead.finish(&mut |seg, u0, u1| {
+            segment_pieces(seg, u0, u1, &mut pieces);
+            time_s += pieces.iter().map(|p| p.t).sum::<f64>();
+        });
+        time_s
+    }
+}
+
+/// A segment of a plan built with its bands, with its junction speeds, its top speed and
+/// its time.
+#[derive(Debug, Clone, Copy)]
+struct Passed {
+    seg: Banded,
+    u0: f64,
+    u1: f64,
+    vp: f64,
+    t_s: f64,
+}
+
+/// A plan built with its banded caps (module docs, steps 2–4) as its segments come: the
+/// [`Lookahead`]'s speeds, then each segment's top speed and time, in chunks of
+/// [`PIECES_CHUNK`] (on all cores where a chunk is long), handed on in order.
+struct BandedRun {
+    ahead: Lookahead<Banded>,
+    ready: Vec<(Banded, f64, f64)>,
+}
+
+impl BandedRun {
+    fn new() -> BandedRun {
+        BandedRun {
+            ahead: Lookahead::default(),
+            ready: Vec::new(),
+        }
+    }
+
+    fn push(&mut self, seg: Banded, out: &mut dyn FnMut(&[Passed])) {
+        let ready = &mut self.ready;
+        self.ahead
+            .push(seg, &mut |s, u0, u1| ready.push((*s, u0, u1)));
+        if self.ready.len() >= PIECES_CHUNK {
+            Self::pass(&mut self.ready, out);
+        }
+    }
+
+    fn finish(mut self, out: &mut dyn FnMut(&[Passed])) {
+        let ready = &mut self.ready;
+        self.ahead.finish(&mut |s, u0, u1| ready.push((*s, u0, u1)));
+        Self::pass(&mut self.ready, out);
+    }
+
+    /// Each ready segment's top speed and time, handed on.
+    fn pass(ready: &mut Vec<(Banded, f64, f64)>, out: &mut dyn FnMut(&[Passed])) {
+        let top = |&(seg, u0, u1): &(Banded, f64, f64)| {
+            let vp = peak_speed(&seg, u0, u1);
+            let (used, t) = changes(&seg, u0, vp, u1);
+            let cruise = seg.len_mm() - used;
+            let t_s = if cruise > 0.0 && vp > 0.0 {
+                t + cruise / vp
+            } else {
+                t
+            };
+            Passed {
+                seg,
+                u0,
+                u1,
+                vp,
+                t_s,
+            }
+        };
+        let passed: Vec<Passed> = if ready.len() >= PARALLEL_MIN_SEGMENTS {
+            ready.par_iter().map(top).collect()
+        } else {
+            ready.iter().map(top).collect()
+        };
+        ready.clear();
+        if !passed.is_empty() {
+            out(&passed);
+        }
+    }
+}
+
+/// A plan built with its bands: its time, and its segments with their speeds.
+#[derive(Debug, Default)]
+struct BandedTime {
+    time_s: f64,
+    built: Built,
+}
+
+/// What a plan built with its bands keeps for the motion's states.
+#[derive(Debug)]
+enum Built {
+    /// Its segments with their speeds, up to [`KEPT_SEGMENTS`] of them.
+    Kept(Vec<Passed>),
+    /// Each segment's junction speeds and top speed (`u0`, `u1`, `vp`), the segments to be
+    /// walked again.
+    Speeds(Vec<[f64; 3]>),
+}
+
+impl Default for Built {
+    fn default() -> Self {
+        Built::Kept(Vec::new())
+    }
+}
+
+/// A plan built with its banded caps as its segments come: its time and what it keeps.
+struct BandedTimer {
+    run: BandedRun,
+    out: BandedTime,
+}
+
+impl BandedTimer {
+    fn new() -> BandedTimer {
+        BandedTimer {
+            run: BandedRun::new(),
+            out: BandedTime::default(),
+        }
+    }
+
+    fn push(&mut self, seg: Banded) {
+        let out = &mut self.out;
+        self.run.push(seg, &mut |p| out.take(p));
+    }
+
+    fn finish(self) -> BandedTime {
+        let BandedTimer { run, mut out } = self;
+        run.finish(&mut |p| out.take(p));
+        out
+    }
+}
+
+impl BandedTime {
+    /// The next segments of the plan, passed.
+    fn take(&mut self, passed: &[Passed]) {
+        for p in passed {
+            self.time_s += p.t_s;
+        }
+        let speeds = |p: &Passed| [p.u0, p.u1, p.vp];
+        if let Built::Kept(k) = &self.built
+            && k.len() + passed.len() > KEPT_SEGMENTS
+        {
+            self.built = Built::Speeds(k.iter().map(speeds).collect());
+        }
+        match &mut self.built {
+            Built::Kept(k) => k.extend_from_slice(passed),
+            Built::Speeds(v) => v.extend(passed.iter().map(speeds)),
+        }
+    }
+}
+
+/// Plan `this` built with its banded caps in one walk of the cells; with `also`, the
+/// segments of that plan gathered in the same walk (`None` where they are more than
+/// [`KEPT_SEGMENTS`]: to be walked again if needed).
+fn banded_time(
+    geo: &Geometry,
+    machine: &Machine,
+    tcy_s: f64,
+    max_cells: usize,
+    this: (usize, f64),
+    also: Option<(usize, f64)>,
+) -> (BandedTime, Option<Vec<Banded>>) {
+    let mut timer = BandedTimer::new();
+    let mut gathered = also.map(|_| Vec::new());
+    let plans: Vec<(usize, f64)> = std::iter::once(this).chain(also).collect();
+    walk_segments(
+        geo,
+        machine,
+        tcy_s,
+        max_cells,
+        &plans,
+        &|o: &Open| o.banded(machine),
+        &mut |k, seg| {
+            if k == 0 {
+                timer.push(seg);
+            } else if let Some(g) = &mut gathered {
+                if g.len() < KEPT_SEGMENTS {
+                    g.push(seg);
+                } else {
+                    gathered = None;
+                }
+            }
+        },
+    );
+    (timer.finish(), gathered)
 }
 
 /// Hands out the states of the motion, and finds where it passes the path's points.
@@ -1333,10 +1706,17 @@ mod banded_tests {
                         }
                     })
                     .collect();
-                let n = segs.len();
-                let low = |k: usize| AtLow(&segs[k]);
-                let lower = time_by(n, low, &junctions_by(n, low));
-                let t = BandedPlan::new(banded).time_s;
+                let mut lower = Timer::default();
+                for seg in &segs {
+                    lower.push(Segment {
+                        lim: seg.low,
+                        ..*seg
+                    });
+                }
+                let lower = lower.finish();
+                let mut t = BandedTimer::new();
+                banded.into_iter().for_each(|seg| t.push(seg));
+                let t = t.finish().time_s;
                 assert!(lower <= t * (1.0 + 1e-9), "{lower} {t}");
                 strict += usize::from(lower < t * (1.0 - 1e-3));
                 cases += 1;
@@ -1344,5 +1724,146 @@ mod banded_tests {
         }
         // Not a bound that holds by being equal: below by more than 0.1 % in most cases.
         assert!(2 * strict > cases, "{strict} of {cases}");
+    }
+
+    /// The passes over the whole motion at once (module docs, step 2): the reference
+    /// [`Lookahead`] must equal. Each segment's junction speeds (before, after).
+    fn whole_motion<S: Seg>(segs: &[S]) -> Vec<(f64, f64)> {
+        let n = segs.len();
+        let mut u = vec![0.0; n + 1];
+        for k in (0..n).rev() {
+            let s = &segs[k];
+            let cap = if k == 0 {
+                0.0
+            } else {
+                top_speed(&segs[k - 1]).min(top_speed(s))
+            };
+            u[k] = cap.min(reach_banded(u[k + 1], s.len_mm(), s.bands()));
+        }
+        let mut u0 = 0.0;
+        let mut out = Vec::with_capacity(n);
+        for (k, s) in segs.iter().enumerate() {
+            let u1 = u[k + 1].min(reach_banded(u0, s.len_mm(), s.bands()));
+            out.push((u0, u1));
+            u0 = u1;
+        }
+        out
+    }
+
+    /// Segments of a plan, pseudo-random but repeatable: lengths, speeds and caps over
+    /// several orders of magnitude, with a long stretch of tiny caps under a high speed
+    /// (where no junction's speed is known before the stretch ends) in the middle.
+    fn plan_like(n: usize) -> Vec<Banded> {
+        let mut x: u64 = 0x2545_f491_4f6c_dd1d;
+        let mut r = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        (0..n)
+            .map(|k| {
+                let slow = k > n / 3 && k < n / 3 + n / 5;
+                let len = 10f64.powf(-2.0 + 3.0 * r());
+                let v = if slow { 500.0 } else { 10f64.powf(3.0 * r()) };
+                let (a, j) = if slow {
+                    (1e-3 * (1.0 + r()), 1e-2 * (1.0 + r()))
+                } else {
+                    (10f64.powf(1.0 + 3.0 * r()), 10f64.powf(2.0 + 4.0 * r()))
+                };
+                // Caps that grow as the speed falls, as near the pole.
+                let bands = std::array::from_fn(|b| {
+                    let f = 1.0 + (1.0 - BAND_SHARES[b]) * 2.0 * r();
+                    Limits {
+                        v: v * BAND_SHARES[b],
+                        a: a * f,
+                        j: j * f,
+                    }
+                });
+                Banded {
+                    s0_mm: 0.0,
+                    len_mm: len,
+                    bands,
+                }
+            })
+            .collect()
+    }
+
+    /// The look-ahead hands on exactly the junction speeds of the passes over the whole
+    /// motion (to the last bit), holding a few checks' worth of segments where the speeds
+    /// allow, for banded segments and for segments of one band. (A look-ahead that trusted
+    /// the backward pass from rest as a lower bound failed here.)
+    #[test]
+    fn the_lookahead_equals_the_whole_motion_passes() {
+        let banded = plan_like(40_000);
+        let single: Vec<Segment> = banded
+            .iter()
+            .map(|b| Segment {
+                s0_mm: 0.0,
+                len_mm: b.len_mm,
+                lim: b.bands[BAND_SHARES.len() - 1],
+                low: b.bands[BAND_SHARES.len() - 1],
+            })
+            .collect();
+        fn check<S: Seg + Copy>(segs: &[S]) {
+            let reference = whole_motion(segs);
+            let mut got = Vec::with_capacity(segs.len());
+            let mut ahead = Lookahead::default();
+            let (mut most, mut most_before_slow) = (0, 0);
+            for (k, &seg) in segs.iter().enumerate() {
+                ahead.push(seg, &mut |_, u0, u1| got.push((u0, u1)));
+                most = most.max(ahead.segs.len());
+                if k < segs.len() / 3 {
+                    most_before_slow = most;
+                }
+            }
+            // Before the stretch of tiny caps, a window of a few checks' length; in it,
+            // the whole stretch held (no junction there is known before its end).
+            assert!(
+                most_before_slow <= 2 * LOOKAHEAD_MIN_SEGMENTS,
+                "{most_before_slow}"
+            );
+            assert!(most >= segs.len() / 5, "{most}");
+            ahead.finish(&mut |_, u0, u1| got.push((u0, u1)));
+            assert_eq!(got.len(), reference.len());
+            for (k, (g, r)) in got.iter().zip(&reference).enumerate() {
+                assert!(
+                    g.0.to_bits() == r.0.to_bits() && g.1.to_bits() == r.1.to_bits(),
+                    "segment {k}: {g:?} against {r:?}"
+                );
+            }
+            // Not a reference that agrees by being trivial: most junctions move.
+            let moving = reference.iter().filter(|r| r.1 > 0.0).count();
+            assert!(moving > segs.len() * 9 / 10, "{moving}");
+        }
+        check(&banded);
+        check(&single);
+    }
+
+    /// The look-ahead's bound: from every speed at least `lo` the backward pass's reach
+    /// over the segment is at least [`surely_reached`], in both regimes, for banded
+    /// segments whose caps grow as the speed falls; and it is no trivial bound.
+    #[test]
+    fn the_surely_reached_speed_is_reached_from_every_speed_above_lo() {
+        let segs = plan_like(3000);
+        let mut above = 0;
+        for (k, seg) in segs.iter().enumerate() {
+            let top = top_speed(seg);
+            let lo = top * [0.0, 0.01, 0.1, 0.3, 0.6][k % 5];
+            let r = surely_reached(seg, lo);
+            assert!(r >= lo, "{r} {lo}");
+            above += usize::from(r > lo * (1.0 + 1e-6) + f64::MIN_POSITIVE);
+            for i in 0..=100 {
+                let x = lo + (r - lo) * i as f64 / 100.0;
+                // The pass reaches at most the segment's top speed.
+                let got = reach_banded(x, seg.len_mm, &seg.bands);
+                assert!(
+                    got >= r.min(top) * (1.0 - 1e-9),
+                    "segment {k}: from {x} reached {got} < {r} (lo {lo})"
+                );
+            }
+        }
+        // All but the stretch of tiny caps (a fifth), where the bound stays near lo.
+        assert!(above > segs.len() * 3 / 4, "{above}");
     }
 }

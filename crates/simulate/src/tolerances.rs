@@ -189,6 +189,11 @@ pub const BAND_SHARES: [f64; 5] = [0.25, 0.5, 0.7, 0.85, 1.0];
 /// The search for the largest speed a change reaches within a length stops when its
 /// bracket is within this share of the speed.
 pub const REACH_REL: f64 = 1e-9;
+/// A junction's speed is known before the motion after it is (`segments.rs::Lookahead`)
+/// where the segment after it changes between the junction's cap and any lower speed in
+/// its length less this share: room for the searches that give the speeds (exact to
+/// [`REACH_REL`], far below this).
+pub const JUNCTION_CAP_ROOM: f64 = 1e-6;
 /// Newton steps that polish the closed-form root of a speed change's length
 /// (`segments.rs::reach`).
 pub const REACH_NEWTON_STEPS: usize = 3;
