@@ -14,28 +14,17 @@
 //! a copy of every point's values or the factors held with the five splines again
 //! fails. It is a bound per point, not a bound by a window of the path: every array of
 //! the motion is still whole (the journal says what is left). The helix is planned in a
-//! few long segments; the second case, a run of many short ones, holds each plan's
-//! look-ahead rather than its segments (`segments.rs::Lookahead`): 343–345 bytes a point
-//! with every plan's segments held, 256–302 with the look-ahead.
+//! few long segments; `tests/memory_segments.rs` holds a run of many short ones. The
+//! simulation runs on one worker thread (`common::memory::peak_added`).
 
 #![cfg(target_os = "linux")]
 
 use std::f64::consts::TAU;
 
-use polepatch_kinematics::Machine;
-use polepatch_patcher::Path;
-use polepatch_simulate::{SimOptions, simulate};
+mod common;
 
-/// A field of `/proc/self/status` in KiB (`VmRSS`: resident now, `VmHWM`: the most
-/// resident so far).
-fn status_kib(field: &str) -> usize {
-    let status = std::fs::read_to_string("/proc/self/status").expect("/proc/self/status");
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix(field)?.strip_prefix(':'))
-        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
-        .expect(field)
-}
+use common::memory::{at_f3000, peak_added};
+use polepatch_patcher::Path;
 
 /// Points of the motion.
 const POINTS: usize = 100_000;
@@ -61,92 +50,15 @@ fn helix(n: usize) -> Path {
             ]
         })
         .collect();
-    let mut s_mm = vec![0.0];
-    for k in 1..n {
-        let d: f64 = (0..3)
-            .map(|i| (axes[k][i] - axes[k - 1][i]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        s_mm.push(s_mm[k - 1] + d);
-    }
-    Path {
-        s_mm,
-        axes,
-        feed_mm_min: 3000.0,
-    }
+    at_f3000(axes)
 }
 
 #[test]
 fn the_simulation_holds_the_passes_or_the_analysis_never_both() {
-    let m = Machine::builtin("mikron-ucp710").expect("built-in machine");
-    let parts = [helix(POINTS)];
-    let opts = SimOptions::default();
-    // This test is alone in its process: the most resident so far is the path's.
-    let before_kib = status_kib("VmHWM").max(status_kib("VmRSS"));
-    let sim = simulate(&parts, &m, &opts, &mut |_, _| {}).expect("simulates");
-    let peak_kib = status_kib("VmHWM").saturating_sub(before_kib);
-    let per_point = peak_kib * 1024 / POINTS;
-    assert!(sim.time_s >= sim.parts[0].eq6_time_s, "{sim:?}");
+    let (peak_kib, per_point) = peak_added(helix(POINTS));
     assert!(
         per_point <= PEAK_BYTES_PER_POINT,
         "the simulation's peak resident memory was {peak_kib} KiB above what was resident \
          before, {per_point} bytes a point (bound {PEAK_BYTES_PER_POINT})"
-    );
-}
-
-/// One G1 run as an NC program writes it, its values rounded to the written 0.001: a
-/// line in X and Y while C turns 0.0713° a point at A 35° (as `big_program`'s body). The
-/// rounding makes the path's derivatives vary from span to span: a plan of many short
-/// segments (about one for every three points).
-fn rounded_line(n: usize) -> Path {
-    let round = |v: f64| (v * 1000.0).round() / 1000.0;
-    let axes: Vec<[f64; 5]> = (0..n)
-        .map(|k| {
-            let kf = k as f64;
-            [
-                round(0.0137 * kf),
-                round(0.0213 * kf),
-                -8.0,
-                35.0,
-                round(-360.0 + 0.0713 * kf),
-            ]
-        })
-        .collect();
-    let mut s_mm = vec![0.0];
-    for k in 1..n {
-        let d: f64 = (0..3)
-            .map(|i| (axes[k][i] - axes[k - 1][i]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        s_mm.push(s_mm[k - 1] + d);
-    }
-    Path {
-        s_mm,
-        axes,
-        feed_mm_min: 3000.0,
-    }
-}
-
-/// Largest resident memory the simulation of [`rounded_line`] may add at its peak, bytes
-/// per point: 343–345 in 10 runs when every plan held all its segments (until
-/// 2026-11-29), 256–302 in 20 runs with each plan's look-ahead (`segments.rs::Lookahead`;
-/// where the allocator puts the threads' blocks moves it); the spline and the path are
-/// the rest.
-const MANY_SEGMENTS_PEAK_BYTES_PER_POINT: usize = 330;
-
-#[test]
-fn a_plan_of_many_segments_holds_its_look_ahead_not_its_segments() {
-    let m = Machine::builtin("mikron-ucp710").expect("built-in machine");
-    let parts = [rounded_line(POINTS)];
-    let opts = SimOptions::default();
-    let before_kib = status_kib("VmHWM").max(status_kib("VmRSS"));
-    let sim = simulate(&parts, &m, &opts, &mut |_, _| {}).expect("simulates");
-    let peak_kib = status_kib("VmHWM").saturating_sub(before_kib);
-    let per_point = peak_kib * 1024 / POINTS;
-    assert!(sim.time_s >= sim.parts[0].eq6_time_s, "{sim:?}");
-    assert!(
-        per_point <= MANY_SEGMENTS_PEAK_BYTES_PER_POINT,
-        "the simulation's peak resident memory was {peak_kib} KiB above what was resident \
-         before, {per_point} bytes a point (bound {MANY_SEGMENTS_PEAK_BYTES_PER_POINT})"
     );
 }

@@ -116,4 +116,5 @@ pub fn line(axis: usize, len: f64, spacing: f64, feed_mm_min: f64) -> Path {
         feed_mm_min,
     }
 }
+pub mod memory;
 pub mod reference;
