@@ -713,21 +713,37 @@ const KEPT_SEGMENTS: usize = 4 * PIECES_CHUNK;
 
 /// The pieces of segment `seg` from junction speed `u0` to `u1` (module docs, step 3).
 fn segment_pieces(seg: &impl Seg, u0: f64, u1: f64, out: &mut Vec<Piece>) {
-    pieces_at(seg, u0, peak_speed(seg, u0, u1), u1, out);
+    pieces_at(seg, u0, peak(seg, u0, u1), u1, out);
 }
 
-/// The top speed of segment `seg` between junction speeds `u0` and `u1`: its V where the
-/// changes up to it and down from it fit its length, else the largest that fits.
-fn peak_speed(seg: &impl Seg, u0: f64, u1: f64) -> f64 {
+/// A segment's top speed between its junction speeds, and the length and time of its
+/// changes up to it and down from it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Top {
+    vp: f64,
+    used_mm: f64,
+    t_s: f64,
+}
+
+/// The top speed of segment `seg` between junction speeds `u0` and `u1` (its V where the
+/// changes up to it and down from it fit its length, else the largest that fits), with
+/// what its changes take there.
+fn peak(seg: &impl Seg, u0: f64, u1: f64) -> Top {
     let bands = seg.bands();
     let v = bands[bands.len() - 1].v;
     let len = seg.len_mm();
-    let used = |vp: f64| change_banded(u0, vp, bands).1 + change_banded(vp, u1, bands).1;
+    let at = |vp: f64| {
+        let (used_mm, t_s) = changes(seg, u0, vp, u1);
+        Top { vp, used_mm, t_s }
+    };
     let lo0 = u0.max(u1);
-    if used(v) <= len {
-        v
+    let top = at(v);
+    if top.used_mm <= len {
+        top
     } else {
-        largest_within(lo0, v.max(lo0), |vp| used(vp) - len)
+        at(largest_within(lo0, v.max(lo0), |vp| {
+            changes(seg, u0, vp, u1).0 - len
+        }))
     }
 }
 
@@ -739,12 +755,13 @@ fn changes(seg: &impl Seg, u0: f64, vp: f64, u1: f64) -> (f64, f64) {
     (up.1 + down.1, up.0 + down.0)
 }
 
-/// The pieces of segment `seg` from `u0` up to `vp`, a cruise, and down to `u1`.
-fn pieces_at(seg: &impl Seg, u0: f64, vp: f64, u1: f64, out: &mut Vec<Piece>) {
+/// The pieces of segment `seg` from `u0` up to its top speed, a cruise, and down to `u1`.
+fn pieces_at(seg: &impl Seg, u0: f64, top: Top, u1: f64, out: &mut Vec<Piece>) {
     out.clear();
     let bands = seg.bands();
+    let vp = top.vp;
     out.extend_from_slice(change_pieces(u0, vp, bands).as_slice());
-    let cruise = seg.len_mm() - changes(seg, u0, vp, u1).0;
+    let cruise = seg.len_mm() - top.used_mm;
     if cruise > 0.0 && vp > 0.0 {
         out.push(Piece {
             t: cruise / vp,
@@ -833,7 +850,7 @@ pub(crate) fn plan(
         if pieces.len() < chunk.len() {
             pieces.resize_with(chunk.len(), || Vec::with_capacity(MAX_SEGMENT_PIECES));
         }
-        let make = |(p, out): (&Passed, &mut Vec<Piece>)| pieces_at(&p.seg, p.u0, p.vp, p.u1, out);
+        let make = |(p, out): (&Passed, &mut Vec<Piece>)| pieces_at(&p.seg, p.u0, p.top, p.u1, out);
         let slots = &mut pieces[..chunk.len()];
         if chunk.len() >= PARALLEL_MIN_SEGMENTS {
             chunk.par_iter().zip(slots.par_iter_mut()).for_each(make);
@@ -862,12 +879,19 @@ pub(crate) fn plan(
                         &[best_plan],
                         &|o: &Open| o.banded(machine),
                         &mut |_, seg| {
-                            let [u0, u1, vp] = *next.next().expect("the same segments as timed");
+                            let [u0, u1, vp, used_mm] =
+                                *next.next().expect("the same segments as timed");
+                            // The times are not needed to hand the segments out.
+                            let top = Top {
+                                vp,
+                                used_mm,
+                                t_s: 0.0,
+                            };
                             chunk.push(Passed {
                                 seg,
                                 u0,
                                 u1,
-                                vp,
+                                top,
                                 t_s: 0.0,
                             });
                             if chunk.len() == PIECES_CHUNK {
@@ -1157,7 +1181,7 @@ struct Passed {
     seg: Banded,
     u0: f64,
     u1: f64,
-    vp: f64,
+    top: Top,
     t_s: f64,
 }
 
@@ -1195,8 +1219,8 @@ impl BandedRun {
     /// Each ready segment's top speed and time, handed on.
     fn pass(ready: &mut Vec<(Banded, f64, f64)>, out: &mut dyn FnMut(&[Passed])) {
         let top = |&(seg, u0, u1): &(Banded, f64, f64)| {
-            let vp = peak_speed(&seg, u0, u1);
-            let (used, t) = changes(&seg, u0, vp, u1);
+            let top = peak(&seg, u0, u1);
+            let (vp, used, t) = (top.vp, top.used_mm, top.t_s);
             let cruise = seg.len_mm() - used;
             let t_s = if cruise > 0.0 && vp > 0.0 {
                 t + cruise / vp
@@ -1207,7 +1231,7 @@ impl BandedRun {
                 seg,
                 u0,
                 u1,
-                vp,
+                top,
                 t_s,
             }
         };
@@ -1235,9 +1259,10 @@ struct BandedTime {
 enum Built {
     /// Its segments with their speeds, up to [`KEPT_SEGMENTS`] of them.
     Kept(Vec<Passed>),
-    /// Each segment's junction speeds and top speed (`u0`, `u1`, `vp`), the segments to be
+    /// Each segment's junction speeds, top speed and its changes' length (`u0`, `u1`, `vp`,
+    /// `used_mm`), the segments to be
     /// walked again.
-    Speeds(Vec<[f64; 3]>),
+    Speeds(Vec<[f64; 4]>),
 }
 
 impl Default for Built {
@@ -1278,7 +1303,7 @@ impl BandedTime {
         for p in passed {
             self.time_s += p.t_s;
         }
-        let speeds = |p: &Passed| [p.u0, p.u1, p.vp];
+        let speeds = |p: &Passed| [p.u0, p.u1, p.top.vp, p.top.used_mm];
         if let Built::Kept(k) = &self.built
             && k.len() + passed.len() > KEPT_SEGMENTS
         {
