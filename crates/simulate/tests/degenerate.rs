@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{assert_within_limits, line, trajectory};
+use common::{assert_within_limits, chord_path, line, trajectory};
 use polepatch_kinematics::Machine;
 use polepatch_patcher::Path;
 use polepatch_simulate::{SimError, SimOptions, simulate};
@@ -177,19 +177,7 @@ fn issue_43_rot_path() -> Path {
             ]
         })
         .collect();
-    let mut s_mm = vec![0.0];
-    for k in 1..axes.len() {
-        let d: f64 = (0..3)
-            .map(|i| (axes[k][i] - axes[k - 1][i]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        s_mm.push(s_mm[k - 1] + d);
-    }
-    Path {
-        s_mm,
-        axes,
-        feed_mm_min: 3264.0,
-    }
+    chord_path(axes, 3264.0)
 }
 
 /// Issue 43, "one answer": a motion the limits allow is simulated, and the answer does

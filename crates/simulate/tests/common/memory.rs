@@ -18,19 +18,7 @@ pub fn status_kib(field: &str) -> usize {
 
 /// The path through `axes` at F3000, s the tool tip's chord lengths.
 pub fn at_f3000(axes: Vec<[f64; 5]>) -> Path {
-    let mut s_mm = vec![0.0];
-    for k in 1..axes.len() {
-        let d: f64 = (0..3)
-            .map(|i| (axes[k][i] - axes[k - 1][i]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        s_mm.push(s_mm[k - 1] + d);
-    }
-    Path {
-        s_mm,
-        axes,
-        feed_mm_min: 3000.0,
-    }
+    super::chord_path(axes, 3000.0)
 }
 
 /// The most resident memory the simulation of `path` on the UCP710 adds, KiB, and its

@@ -116,5 +116,23 @@ pub fn line(axis: usize, len: f64, spacing: f64, feed_mm_min: f64) -> Path {
         feed_mm_min,
     }
 }
+
+/// The path through `axes` at `feed_mm_min`, s the tool tip's chord lengths (X Y Z).
+pub fn chord_path(axes: Vec<[f64; 5]>, feed_mm_min: f64) -> Path {
+    let mut s_mm = vec![0.0];
+    for k in 1..axes.len() {
+        let d: f64 = (0..3)
+            .map(|i| (axes[k][i] - axes[k - 1][i]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        s_mm.push(s_mm[k - 1] + d);
+    }
+    Path {
+        s_mm,
+        axes,
+        feed_mm_min,
+    }
+}
+
 pub mod memory;
 pub mod reference;
