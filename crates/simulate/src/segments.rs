@@ -76,7 +76,7 @@
 //! segments out, beside the states) and the segments (a few closed forms each, a short
 //! search per junction with bands), not the cycles. The memory grows with each plan's
 //! look-ahead (the segments after the last junction whose speed is known: a braking
-//! distance's worth where the caps allow), and three speeds a segment for the plans built
+//! distance's worth where the caps allow), and four numbers a segment for the plans built
 //! with bands where they are long, not with whole plans.
 
 use polepatch_kinematics::Machine;
@@ -708,7 +708,8 @@ const LOOKAHEAD_MIN_SEGMENTS: usize = 1024;
 const TIMER_BATCH_SEGMENTS: usize = 8 * PIECES_CHUNK;
 
 /// A plan built with its bands keeps its segments for the motion's states up to this many
-/// (about 3 MB); a longer one keeps only their speeds, and is walked again for them.
+/// (about 3 MB); a longer one keeps only their speeds and their changes' length, and is
+/// walked again.
 const KEPT_SEGMENTS: usize = 4 * PIECES_CHUNK;
 
 /// The pieces of segment `seg` from junction speed `u0` to `u1` (module docs, step 3).
