@@ -1027,8 +1027,16 @@ impl<S: Seg + Copy> Lookahead<S> {
     }
 
     /// The motion ends at rest after the last segment pushed: the rest to `known`.
-    fn finish(mut self, known: &mut dyn FnMut(&S, f64, f64)) {
+    fn finish(&mut self, known: &mut dyn FnMut(&S, f64, f64)) {
         self.advance(true, known);
+    }
+
+    /// [`Lookahead::push`] the next segment, or with `None` [`Lookahead::finish`].
+    fn take(&mut self, seg: Option<S>, known: &mut dyn FnMut(&S, f64, f64)) {
+        match seg {
+            Some(seg) => self.push(seg, known),
+            None => self.finish(known),
+        }
     }
 
     /// The backward pass over the segments held, from the last junction whose speed is
@@ -1145,12 +1153,18 @@ impl Default for Timer {
 
 impl Timer {
     fn push(&mut self, seg: Segment) {
+        self.take(Some(seg));
+    }
+
+    /// The next segment (`None`: the end of the motion), and the time of each segment
+    /// whose speeds are then known.
+    fn take(&mut self, seg: Option<Segment>) {
         let Timer {
             ahead,
             pieces,
             time_s,
         } = self;
-        ahead.push(seg, &mut |seg, u0, u1| {
+        ahead.take(seg, &mut |seg, u0, u1| {
             segment_pieces(seg, u0, u1, pieces);
             *time_s += pieces.iter().map(|p| p.t).sum::<f64>();
         });
@@ -1161,17 +1175,9 @@ impl Timer {
         self.ahead.segs.len()
     }
 
-    fn finish(self) -> f64 {
-        let Timer {
-            ahead,
-            mut pieces,
-            mut time_s,
-        } = self;
-        ahead.finish(&mut |seg, u0, u1| {
-            segment_pieces(seg, u0, u1, &mut pieces);
-            time_s += pieces.iter().map(|p| p.t).sum::<f64>();
-        });
-        time_s
+    fn finish(mut self) -> f64 {
+        self.take(None);
+        self.time_s
     }
 }
 
@@ -1203,18 +1209,23 @@ impl BandedRun {
     }
 
     fn push(&mut self, seg: Banded, out: &mut dyn FnMut(&[Passed])) {
-        let ready = &mut self.ready;
-        self.ahead
-            .push(seg, &mut |s, u0, u1| ready.push((*s, u0, u1)));
-        if self.ready.len() >= PIECES_CHUNK {
-            Self::pass(&mut self.ready, out);
-        }
+        self.take(Some(seg), out);
     }
 
     fn finish(mut self, out: &mut dyn FnMut(&[Passed])) {
+        self.take(None, out);
+    }
+
+    /// The next segment (`None`: the end of the motion); the segments whose speeds are
+    /// then known passed on in chunks (all that are left at the end).
+    fn take(&mut self, seg: Option<Banded>, out: &mut dyn FnMut(&[Passed])) {
+        let end = seg.is_none();
         let ready = &mut self.ready;
-        self.ahead.finish(&mut |s, u0, u1| ready.push((*s, u0, u1)));
-        Self::pass(&mut self.ready, out);
+        self.ahead
+            .take(seg, &mut |s, u0, u1| ready.push((*s, u0, u1)));
+        if end || self.ready.len() >= PIECES_CHUNK {
+            Self::pass(&mut self.ready, out);
+        }
     }
 
     /// Each ready segment's top speed and time, handed on.
